@@ -1,0 +1,151 @@
+#pragma once
+/// @file
+/// Principal contacts, contact formations and the CF graph of SPEC sections 4-5.
+/// The graph is immutable once built or loaded; Boost.Graph and nlohmann live behind it.
+
+#include <cf/polyhedron.hpp>
+#include <cf/types.hpp>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cf {
+
+/// Non-degenerate PC types, named A-element then B-element (paper Fig. 1). The enumerator
+/// order is the canonical order used to sort PCs.
+enum class PcType : std::uint8_t { kFF = 0, kEF, kFE, kVF, kFV, kEE };
+
+/// "f-f", "e-f", ... as in the graph file.
+const char* to_string(PcType type);
+/// Parses "f-f", "e-f", ...; std::nullopt for anything else.
+std::optional<PcType> pc_type_from_string(std::string_view name);
+/// Kind of the A element (first letter) and of the B element (last letter).
+ElementKind a_kind(PcType type);
+ElementKind b_kind(PcType type);
+
+/// A principal contact: a pair of elements, by index into A's and B's arrays of the kinds
+/// that `type` names.
+struct Pc {
+  PcType type = PcType::kFF;
+  std::int32_t a = -1;  ///< index of A's element (vertex, edge or face per type)
+  std::int32_t b = -1;  ///< index of B's element
+  friend bool operator==(const Pc& x, const Pc& y) {
+    return x.type == y.type && x.a == y.a && x.b == y.b;
+  }
+  friend bool operator!=(const Pc& x, const Pc& y) { return !(x == y); }
+  friend bool operator<(const Pc& x, const Pc& y) {
+    if (x.type != y.type) return x.type < y.type;
+    if (x.a != y.a) return x.a < y.a;
+    return x.b < y.b;
+  }
+};
+
+/// "type:a:b", as in the `pcs` column of cfreplay's output.
+std::string to_string(const Pc& pc);
+
+/// Up to three PCs in canonical (sorted) order: the key of a CF. Fixed capacity, no heap.
+class PcSet {
+ public:
+  static constexpr int kMaxPcs = 3;
+  PcSet() = default;
+  /// Builds the canonical set. @pre 1 <= pcs.size() <= 3 and no PC repeated.
+  explicit PcSet(const std::vector<Pc>& pcs);
+  /// Inserts keeping the order; returns false when full or already present.
+  bool insert(const Pc& pc);
+  int size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  const Pc& operator[](int i) const { return pcs_[static_cast<std::size_t>(i)]; }
+  const Pc* begin() const { return pcs_.data(); }
+  const Pc* end() const { return pcs_.data() + size_; }
+  bool contains(const Pc& pc) const;
+  std::size_t hash() const;
+  friend bool operator==(const PcSet& x, const PcSet& y);
+  friend bool operator!=(const PcSet& x, const PcSet& y) { return !(x == y); }
+
+ private:
+  std::array<Pc, kMaxPcs> pcs_{};
+  int size_ = 0;
+};
+
+using CfId = Id<struct CfTag>;
+
+/// Prior-motion kinds a transition allows (SPEC section 4).
+enum class TransitionKind : std::uint8_t { kGain, kLose, kChange };
+const char* to_string(TransitionKind kind);
+
+/// One contact formation of the graph, with what the run time needs that is cheap to store.
+struct CfRecord {
+  PcSet pcs;
+  Pose witness;  ///< a pose of A realising exactly these PCs with the interiors disjoint
+  /// Instantaneous freedoms at the witness: dimension of the space of twists of A that keep
+  /// every PC (0..6), of pure translations, and whether some pure rotation keeps the CF.
+  int dof = -1;              ///< -1 when not stored in the file
+  int translation_dof = -1;  ///< -1 when not stored
+  bool pure_rotation = false;
+};
+
+/// A directed graph edge between two CFs.
+struct Transition {
+  CfId from;
+  CfId to;
+  TransitionKind kind = TransitionKind::kGain;
+};
+
+/// The CF graph of a model pair (SPEC section 5). Immutable; share one `const CfGraph`
+/// between threads.
+class CfGraph {
+ public:
+  /// Builds and checks a graph from its parts (what cfgen produces).
+  /// @param metadata_json  a JSON object text with extra top-level members to write
+  ///   (statistics, parameters); "{}" for none.
+  /// @throws cf::Error when an index is out of range, a PC type does not match the element
+  ///   kinds, a PC set repeats, or a transition names a missing CF.
+  static CfGraph from_parts(Polyhedron a, Polyhedron b, std::vector<CfRecord> cfs,
+                            std::vector<Transition> transitions,
+                            const std::string& metadata_json = "{}");
+
+  /// Loads a graph file (JSON, or CBOR when the name ends in .cbor), checks it against the
+  /// schema and for internal consistency.
+  /// @throws cf::Error naming the file, the JSON pointer and the problem.
+  static CfGraph load(const std::string& path);
+
+  /// Writes the graph (JSON, or CBOR when the name ends in .cbor) to a temporary file and
+  /// renames it into place, so that the file is whole or absent.
+  /// @throws cf::Error when the file cannot be written.
+  void save(const std::string& path) const;
+  /// The JSON text of the graph file; deterministic for the same graph.
+  std::string to_json(int indent = -1) const;
+
+  CfGraph();
+  ~CfGraph();
+  CfGraph(CfGraph&&) noexcept;
+  CfGraph& operator=(CfGraph&&) noexcept;
+
+  const Polyhedron& model_a() const;
+  const Polyhedron& model_b() const;
+  std::size_t num_cfs() const;
+  const CfRecord& cf(CfId id) const;
+  std::size_t num_transitions() const;
+  const Transition& transition(std::size_t i) const;
+
+  /// The CF with exactly this PC set, in constant time.
+  std::optional<CfId> find(const PcSet& pcs) const;
+  /// Transitions leaving `id` (to, kind), sorted by target id.
+  const std::vector<Transition>& out_transitions(CfId id) const;
+  /// True when the graph has a transition from `from` to `to`.
+  bool adjacent(CfId from, CfId to) const;
+  /// The extra top-level members of the file (statistics, parameters) as JSON text.
+  const std::string& metadata_json() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<const Impl> impl_;
+};
+
+}  // namespace cf
