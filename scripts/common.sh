@@ -1,3 +1,4 @@
+# shellcheck shell=bash
 # Shared by scripts/setup.sh and scripts/test.sh; source it, do not run it.
 # Environment knobs (all optional):
 #   CF_BUILD_DIR    build directory, relative to the repo root or absolute (default: build)
@@ -8,7 +9,7 @@
 #   CF_SKIP_DEPS=1  do not run scripts/install-deps.sh
 
 CF_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-cd "$CF_ROOT"
+cd "$CF_ROOT" || exit 1
 CF_BUILD_DIR="${CF_BUILD_DIR:-build}"
 CF_BUILD_TYPE="${CF_BUILD_TYPE:-Release}"
 CF_JOBS="${CF_JOBS:-$(nproc 2>/dev/null || echo 2)}"

@@ -13,6 +13,7 @@ DEFAULT_MODELS=(
   data/models/block_with_hole.off
 )
 
+# shellcheck source=scripts/common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 # ---------------------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 # Installs missing dependencies, configures and builds everything in build/, then runs the
 # whole test suite. The exit status is ctest's. Knobs: see scripts/common.sh.
 set -euo pipefail
+# shellcheck source=scripts/common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 cf_install_deps
