@@ -1,0 +1,160 @@
+#include "analysis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace cf::gen {
+
+Mat3 align(const Vec3& x, const Vec3& y) {
+  return Eigen::Quaterniond::FromTwoVectors(x, y).toRotationMatrix();
+}
+
+Mat3 axis_angle(const Vec3& axis, double angle) {
+  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+}
+
+namespace {
+
+// Unit m maximising min_i m . r_i, by a small LP over m in the box [-1, 1]^3.
+std::pair<Vec3, double> cone_center(const std::vector<Vec3>& rays) {
+  LinearProgram lp(4);  // m (3), s
+  for (int j = 0; j < 3; ++j) {
+    lp.lower[j] = {true, -1.0};
+    lp.upper[j] = {true, 1.0};
+  }
+  lp.upper[3] = {true, 2.0};
+  lp.c[3] = -1.0;
+  for (const Vec3& r : rays)
+    lp.add({{0, r.x()}, {1, r.y()}, {2, r.z()}, {3, -1.0}}, LinearProgram::Rel::kGreaterEq, 0.0);
+  const LpResult res = solve(lp);
+  if (res.status != LpResult::Status::kOptimal || res.x.head<3>().norm() == 0)
+    return {Vec3::Zero(), -1.0};
+  const Vec3 m = res.x.head<3>().normalized();
+  double margin = 2.0;
+  for (const Vec3& r : rays) margin = std::min(margin, m.dot(r));
+  return {m, margin};
+}
+
+double piece_area(const ConvexPiece& p) {
+  double a = 0;
+  for (std::size_t i = 0; i < p.points.size(); ++i) {
+    const auto& u = p.points[i];
+    const auto& v = p.points[(i + 1) % p.points.size()];
+    a += u.x() * v.y() - v.x() * u.y();
+  }
+  return 0.5 * a;
+}
+
+}  // namespace
+
+bool point_inside(const Polyhedron& m, const Vec3& p, double boundary_tol) {
+  // Fixed, irrational-looking directions keep the result deterministic.
+  static const Vec3 kDirs[] = {Vec3(0.5773, 0.5812, 0.5735), Vec3(-0.3217, 0.8823, 0.3437),
+                               Vec3(0.7071, -0.1237, 0.6962), Vec3(-0.2643, -0.5127, 0.8171),
+                               Vec3(0.9123, 0.2957, -0.2831)};
+  for (const Vec3& d0 : kDirs) {
+    const Vec3 d = d0.normalized();
+    int crossings = 0;
+    bool ambiguous = false;
+    for (std::size_t f = 0; f < m.num_faces() && !ambiguous; ++f) {
+      const Face& F = m.faces()[f];
+      const double dist = F.normal.dot(p) - F.offset;
+      const double dn = F.normal.dot(d);
+      if (std::abs(dist) <= boundary_tol) {
+        // p on this face's plane: on the boundary if inside the face.
+        if (m.face_inset(FaceId(static_cast<int>(f)), p) > -boundary_tol) return false;
+        if (std::abs(dn) < 1e-9) continue;
+        continue;  // leaving the plane immediately; no crossing
+      }
+      if (std::abs(dn) < 1e-12) continue;
+      const double s = -dist / dn;
+      if (s <= 0) continue;
+      const double inset = m.face_inset(FaceId(static_cast<int>(f)), p + s * d);
+      if (std::abs(inset) <= boundary_tol) ambiguous = true;
+      else if (inset > 0) ++crossings;
+    }
+    if (!ambiguous) return crossings % 2 == 1;
+  }
+  return false;  // every direction grazed the boundary: p is on it for all practical purposes
+}
+
+ModelInfo analyse_model(const Polyhedron& m) {
+  ModelInfo info;
+  info.model = &m;
+  const double tol = 1e-9 * m.size();
+  info.cones.resize(m.num_vertices());
+  for (std::size_t v = 0; v < m.num_vertices(); ++v) {
+    VertexCone& c = info.cones[v];
+    const Vertex& V = m.vertices()[v];
+    for (EdgeId e : V.edges) {
+      const Edge& E = m.edge(e);
+      c.rays.push_back(E.v0.index() == v ? E.dir : Vec3(-E.dir));
+    }
+    auto [center, margin] = cone_center(c.rays);
+    c.center = center;
+    c.center_margin = margin;
+    bool pointed = margin > 1e-9;
+    // A face with a reflex corner here puts opposite directions into the cone.
+    for (FaceId f : V.faces) {
+      const Face& F = m.face(f);
+      for (std::size_t l = 0; l < F.loops.size() && pointed; ++l) {
+        const auto& loop = F.loops[l];
+        for (std::size_t k = 0; k < loop.size(); ++k) {
+          if (loop[k].index() != v) continue;
+          const auto& a = F.loops_2d[l][(k + loop.size() - 1) % loop.size()];
+          const auto& b = F.loops_2d[l][k];
+          const auto& c2 = F.loops_2d[l][(k + 1) % loop.size()];
+          const double cr = (b - a).x() * (c2 - b).y() - (b - a).y() * (c2 - b).x();
+          if (cr <= 0) pointed = false;
+        }
+      }
+    }
+    if (pointed) {
+      // The rays fit in a half-space, but the solid may be the complement (an inner corner).
+      double h = m.size();
+      for (EdgeId e : V.edges) h = std::min(h, m.edge(e).length);
+      pointed = !point_inside(m, V.p - 1e-3 * h * center, tol);
+    }
+    c.pointed = pointed;
+  }
+  info.wedges.resize(m.num_edges());
+  for (std::size_t e = 0; e < m.num_edges(); ++e) {
+    const Edge& E = m.edges()[e];
+    const Vec3& nl = m.face(E.left).normal;
+    const Vec3& nr = m.face(E.right).normal;
+    EdgeWedge& w = info.wedges[e];
+    w.into_left = nl.cross(E.dir).normalized();
+    w.into_right = E.dir.cross(nr).normalized();
+    const Vec3 bis = nl + nr;
+    w.bisector = bis.norm() > 1e-12 ? bis.normalized() : Vec3::Zero();
+  }
+  info.pieces.resize(m.num_faces());
+  for (std::size_t f = 0; f < m.num_faces(); ++f) {
+    auto pieces = convex_partition(m.faces()[f].loops_2d);
+    if (pieces.empty())
+      throw Error("model '" + m.name() + "': face " + std::to_string(f) +
+                  " could not be partitioned into convex pieces");
+    std::stable_sort(pieces.begin(), pieces.end(), [](const ConvexPiece& a, const ConvexPiece& b) {
+      return piece_area(a) > piece_area(b);
+    });
+    info.pieces[f] = std::move(pieces);
+  }
+  info.face_plane.assign(m.num_faces(), -1);
+  int next = 0;
+  const double ptol = 1e-7 * m.size();
+  for (std::size_t f = 0; f < m.num_faces(); ++f) {
+    if (info.face_plane[f] >= 0) continue;
+    info.face_plane[f] = next;
+    for (std::size_t g = f + 1; g < m.num_faces(); ++g) {
+      const Face& F = m.faces()[f];
+      const Face& G = m.faces()[g];
+      if (F.normal.dot(G.normal) > 1 - 1e-12 && std::abs(F.offset - G.offset) < ptol)
+        info.face_plane[g] = next;
+    }
+    ++next;
+  }
+  return info;
+}
+
+}  // namespace cf::gen

@@ -1,0 +1,45 @@
+#pragma once
+// Per-model facts the generator needs again and again: vertex tangent cones, edge wedges,
+// convex partitions of faces, coplanar face groups, and a point-in-solid test.
+
+#include "cgal_support.hpp"
+
+#include <cf/polyhedron.hpp>
+
+#include <vector>
+
+namespace cf::gen {
+
+struct VertexCone {
+  std::vector<Vec3> rays;   // unit, model frame, along each incident edge away from the vertex
+  bool pointed = false;     // the solid's tangent cone lies in an open half-space (v-f / f-v able)
+  Vec3 center = Vec3::Zero();  // unit m maximising min_i m . ray_i: points into the solid
+  double center_margin = 0;    // that minimum (cosine)
+};
+
+struct EdgeWedge {
+  Vec3 into_left, into_right;  // unit, perpendicular to the edge, in each face, pointing into it
+  Vec3 bisector = Vec3::Zero();  // unit bisector of the two outward normals (convex edges)
+};
+
+struct ModelInfo {
+  const Polyhedron* model = nullptr;
+  std::vector<VertexCone> cones;
+  std::vector<EdgeWedge> wedges;
+  std::vector<std::vector<ConvexPiece>> pieces;  // per face, largest piece first
+  std::vector<int> face_plane;  // faces lying in one plane (same orientation) share an id
+};
+
+/// @throws cf::Error when the model has a face that cannot be partitioned.
+ModelInfo analyse_model(const Polyhedron& m);
+
+/// True when p lies strictly inside the solid (ray casting; directions that graze an edge or
+/// vertex are retried). Points within `boundary_tol` of the boundary count as outside.
+bool point_inside(const Polyhedron& m, const Vec3& p, double boundary_tol);
+
+/// Minimal rotation taking unit vector x to unit vector y.
+Mat3 align(const Vec3& x, const Vec3& y);
+/// Rotation by angle (rad) about a unit axis.
+Mat3 axis_angle(const Vec3& axis, double angle);
+
+}  // namespace cf::gen

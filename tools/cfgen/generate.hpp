@@ -1,0 +1,24 @@
+#pragma once
+/// @file
+/// cfgen's graph generation mode (SPEC section 5b): `cfgen A_MODEL B_MODEL -o GRAPH.json`.
+/// main.cpp parses the command line; run_generate does the work (generate.cpp, built when
+/// present, which defines CF_HAVE_GENERATOR).
+
+#include <string>
+
+namespace cf::tools {
+
+/// Parsed arguments of `cfgen A_MODEL B_MODEL -o GRAPH.json [options]`.
+struct GenerateArgs {
+  std::string a_path;    ///< model of A, the moving object
+  std::string b_path;    ///< model of B, the fixed object (world frame)
+  std::string out_path;  ///< graph file to write, whole or not at all
+  int threads = 0;       ///< worker threads; 0 = hardware concurrency
+  bool quiet = false;    ///< no progress on stderr
+};
+
+/// Generates the CF graph of A against B and writes it to args.out_path.
+/// @returns the process exit status (0 on success); errors are one line on stderr.
+int run_generate(const GenerateArgs& args);
+
+}  // namespace cf::tools

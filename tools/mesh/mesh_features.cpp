@@ -1,0 +1,469 @@
+// CGAL-free validation of a polygon soup and extraction of the features of SPEC section 3.
+// The rules implemented here are documented in docs/features.md; keep the two in step.
+
+#include "mesh_detail.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <numeric>
+#include <sstream>
+#include <unordered_map>
+
+namespace cf::tools::detail {
+namespace {
+
+// A facet is degenerate when its smallest height (twice its area over its longest side) is
+// below this fraction of the bounding-box diagonal: zero up to the rounding of coordinates
+// that came through single precision (STL), which is about 6e-8 of the largest coordinate.
+constexpr double kDegenerateRelTol = 1e-7;
+// Feature vertices further than this (relative to the diagonal) from the fitted plane of one
+// of their faces are moved onto the planes' intersection; exact input is left untouched.
+constexpr double kSnapRelTol = 1e-9;
+
+std::string num(double x) {
+  std::ostringstream os;
+  os.precision(6);
+  os << x;
+  return os.str();
+}
+
+std::uint64_t key(int a, int b) {
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
+         static_cast<std::uint32_t>(b);
+}
+
+// Newell vector: twice the polygon's area vector (right-handed with the vertex order).
+Vec3 newell(const std::vector<Vec3>& P, const std::vector<int>& poly) {
+  Vec3 n = Vec3::Zero();
+  for (std::size_t k = 0; k < poly.size(); ++k)
+    n += P[poly[k]].cross(P[poly[(k + 1) % poly.size()]]);
+  return n;
+}
+
+Vec3 mean_point(const std::vector<Vec3>& P, const std::vector<int>& poly) {
+  Vec3 c = Vec3::Zero();
+  for (int i : poly) c += P[i];
+  return c / static_cast<double>(poly.size());
+}
+
+double diagonal(const PolygonSoup& s) {
+  Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
+  for (const auto& poly : s.polygons)
+    for (int i : poly) {
+      lo = lo.cwiseMin(s.points[i]);
+      hi = hi.cwiseMax(s.points[i]);
+    }
+  return (hi - lo).norm();
+}
+
+struct UnionFind {
+  std::vector<int> parent;
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(int a, int b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+// Directed half-edges of a validated soup: key(a, b) -> (facet, corner index of a).
+using HalfEdges = std::unordered_map<std::uint64_t, std::pair<int, int>>;
+
+HalfEdges half_edges(const PolygonSoup& s) {
+  HalfEdges he;
+  he.reserve(s.polygons.size() * 4);
+  for (int f = 0; f < static_cast<int>(s.polygons.size()); ++f) {
+    const auto& poly = s.polygons[f];
+    for (int k = 0; k < static_cast<int>(poly.size()); ++k)
+      he.emplace(key(poly[k], poly[(k + 1) % poly.size()]), std::make_pair(f, k));
+  }
+  return he;
+}
+
+double point_segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+}  // namespace
+
+void fail(const std::string& source, const std::string& what) {
+  throw Error("loading '" + source + "': " + what);
+}
+
+void check_soup(const PolygonSoup& s, const std::string& src, const LoadOptions& opt) {
+  const auto& P = s.points;
+  const auto& F = s.polygons;
+  const int np = static_cast<int>(P.size());
+  if (F.empty()) fail(src, "the file contains no facets");
+  for (std::size_t f = 0; f < F.size(); ++f) {
+    const std::string fs = "facet " + std::to_string(f);
+    if (F[f].size() < 3)
+      fail(src, "degenerate facet: " + fs + " has only " + std::to_string(F[f].size()) +
+                    " vertices");
+    for (int i : F[f])
+      if (i < 0 || i >= np)
+        fail(src, "parse error: " + fs + " refers to vertex " + std::to_string(i) +
+                      " but the file has " + std::to_string(np) + " vertices");
+    std::vector<int> sorted = F[f];
+    std::sort(sorted.begin(), sorted.end());
+    const auto dup = std::adjacent_find(sorted.begin(), sorted.end());
+    if (dup != sorted.end())
+      fail(src, "degenerate facet: " + fs + " uses vertex " + std::to_string(*dup) +
+                    " more than once");
+    for (int i : F[f])
+      if (!P[i].allFinite()) fail(src, "vertex " + std::to_string(i) + " is not finite");
+  }
+
+  // Edge manifoldness, open boundary and orientation, reported in that order of severity.
+  std::map<std::pair<int, int>, std::vector<std::pair<int, bool>>> uses;  // forward: a < b
+  for (int f = 0; f < static_cast<int>(F.size()); ++f)
+    for (std::size_t k = 0; k < F[f].size(); ++k) {
+      const int a = F[f][k], b = F[f][(k + 1) % F[f].size()];
+      uses[{std::min(a, b), std::max(a, b)}].emplace_back(f, a < b);
+    }
+  auto edge_name = [](const std::pair<int, int>& e) {
+    return "edge " + std::to_string(e.first) + "-" + std::to_string(e.second);
+  };
+  for (const auto& [e, u] : uses)
+    if (u.size() > 2) {
+      std::string fl;
+      for (const auto& x : u) fl += (fl.empty() ? "" : ", ") + std::to_string(x.first);
+      fail(src, "non-manifold edge: " + edge_name(e) + " is shared by " + std::to_string(u.size()) +
+                    " facets (" + fl + ")");
+    }
+  for (const auto& [e, u] : uses)
+    if (u.size() == 1)
+      fail(src, "open boundary: " + edge_name(e) + " belongs to facet " +
+                    std::to_string(u[0].first) + " only");
+  for (const auto& [e, u] : uses)
+    if (u[0].second == u[1].second) {
+      const int a = u[0].second ? e.first : e.second;
+      const int b = u[0].second ? e.second : e.first;
+      fail(src, "inconsistent orientation: facets " + std::to_string(u[0].first) + " and " +
+                    std::to_string(u[1].first) + " both run edge " + std::to_string(a) + "-" +
+                    std::to_string(b) + " from " + std::to_string(a) + " to " + std::to_string(b));
+    }
+
+  // Vertex manifoldness: the facets around a vertex must form a single fan. Walk the fan
+  // from one corner and compare with the number of corners at the vertex.
+  const HalfEdges he = half_edges(s);
+  std::vector<std::vector<std::pair<int, int>>> corners(np);
+  for (int f = 0; f < static_cast<int>(F.size()); ++f)
+    for (int k = 0; k < static_cast<int>(F[f].size()); ++k) corners[F[f][k]].emplace_back(f, k);
+  for (int v = 0; v < np; ++v) {
+    if (corners[v].empty()) continue;
+    std::size_t walked = 0;
+    auto [f, k] = corners[v][0];
+    do {
+      ++walked;
+      const int next = F[f][(k + 1) % F[f].size()];  // facet f runs v -> next
+      const auto [g, j] = he.at(key(next, v));        // its twin runs next -> v, v at j + 1
+      f = g;
+      k = static_cast<int>((j + 1) % F[g].size());
+    } while (!(f == corners[v][0].first && k == corners[v][0].second) &&
+             walked <= corners[v].size());
+    if (walked != corners[v].size())
+      fail(src, "non-manifold vertex: vertex " + std::to_string(v) +
+                    " joins separate fans of facets (" + std::to_string(walked) + " of its " +
+                    std::to_string(corners[v].size()) + " facets form one fan)");
+  }
+
+  const double diag = diagonal(s);
+  if (!(diag > 0)) fail(src, "degenerate model: all vertices coincide");
+  const double tol = opt.coplanar_rel_tol * diag;
+  for (std::size_t f = 0; f < F.size(); ++f) {
+    const Vec3 n2 = newell(P, F[f]);
+    double longest = 0;
+    for (std::size_t k = 0; k < F[f].size(); ++k)
+      longest = std::max(longest, (P[F[f][k]] - P[F[f][(k + 1) % F[f].size()]]).norm());
+    const double height = n2.norm() / longest;  // 2 area / longest side
+    if (!(height > kDegenerateRelTol * diag))
+      fail(src, "degenerate facet: facet " + std::to_string(f) + " has zero area (area " +
+                    num(0.5 * n2.norm()) + " mm^2)");
+    if (F[f].size() > 3) {
+      const Vec3 n = n2.normalized();
+      const Vec3 c = mean_point(P, F[f]);
+      for (int i : F[f]) {
+        const double d = std::abs(n.dot(P[i] - c));
+        if (d > tol)
+          fail(src, "non-planar facet: vertex " + std::to_string(i) + " of facet " +
+                        std::to_string(f) + " lies " + num(d) + " mm off the facet's plane (tolerance " +
+                        num(tol) + " mm)");
+      }
+    }
+  }
+
+  UnionFind uf(F.size());
+  for (const auto& [e, u] : uses) uf.unite(u[0].first, u[1].first);
+  int solids = 0;
+  for (std::size_t f = 0; f < F.size(); ++f) solids += uf.find(static_cast<int>(f)) == static_cast<int>(f);
+  if (solids > 1)
+    fail(src, "the file holds " + std::to_string(solids) +
+                  " separate solids (facet groups not connected by edges); one solid is expected");
+
+  double vol6 = 0;
+  for (const auto& poly : F)
+    for (std::size_t k = 1; k + 1 < poly.size(); ++k)
+      vol6 += P[poly[0]].dot(P[poly[k]].cross(P[poly[k + 1]]));
+  if (!(vol6 > 0))
+    fail(src, "inward orientation: the enclosed volume is " + num(vol6 / 6) +
+                  " mm^3; facet normals must point out of the solid (counter-clockwise seen "
+                  "from outside)");
+}
+
+cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
+                                const std::string& name, const LoadOptions& opt) {
+  const auto& P = s.points;
+  const auto& F = s.polygons;
+  const int nf = static_cast<int>(F.size());
+  const int np = static_cast<int>(P.size());
+  const double diag = diagonal(s);
+  const double tol = opt.coplanar_rel_tol * diag;
+  const HalfEdges he = half_edges(s);
+  auto twin = [&](int f, int k) {
+    const auto& poly = F[f];
+    return he.at(key(poly[(k + 1) % poly.size()], poly[k]));
+  };
+
+  std::vector<Vec3> area2(nf), centre(nf);
+  for (int f = 0; f < nf; ++f) {
+    area2[f] = newell(P, F[f]);
+    centre[f] = mean_point(P, F[f]);
+  }
+
+  // Faces: region growing from the lowest unassigned facet, breadth first over shared edges.
+  // A neighbour joins when it faces the same way and all its vertices lie within tol of the
+  // region's current plane (area-weighted normal and centroid of the facets so far).
+  std::vector<int> region(nf, -1);
+  std::vector<int> seed;
+  for (int s0 = 0; s0 < nf; ++s0) {
+    if (region[s0] >= 0) continue;
+    const int r = static_cast<int>(seed.size());
+    seed.push_back(s0);
+    region[s0] = r;
+    Vec3 N = area2[s0];
+    Vec3 C = area2[s0].norm() * centre[s0];
+    double W = area2[s0].norm();
+    std::vector<int> queue{s0};
+    for (std::size_t qi = 0; qi < queue.size(); ++qi) {
+      const int f = queue[qi];
+      for (int k = 0; k < static_cast<int>(F[f].size()); ++k) {
+        const int g = twin(f, k).first;
+        if (region[g] >= 0) continue;
+        const Vec3 n = N.normalized();
+        const Vec3 c = C / W;
+        if (!(n.dot(area2[g]) > 0)) continue;
+        bool flat = true;
+        for (int i : F[g]) flat = flat && std::abs(n.dot(P[i] - c)) <= tol;
+        if (!flat) continue;
+        region[g] = r;
+        N += area2[g];
+        C += area2[g].norm() * centre[g];
+        W += area2[g].norm();
+        queue.push_back(g);
+      }
+    }
+  }
+  const int nr = static_cast<int>(seed.size());
+
+  // Plane of each face: least squares through all its mesh vertices, oriented like the facets.
+  std::vector<std::vector<int>> region_vertices(nr);
+  std::vector<Vec3> region_area(nr, Vec3::Zero());
+  for (int f = 0; f < nf; ++f) {
+    region_area[region[f]] += area2[f];
+    for (int i : F[f]) region_vertices[region[f]].push_back(i);
+  }
+  std::vector<Vec3> plane_n(nr);
+  std::vector<double> plane_d(nr);
+  for (int r = 0; r < nr; ++r) {
+    auto& vs = region_vertices[r];
+    std::sort(vs.begin(), vs.end());
+    vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
+    Vec3 c = Vec3::Zero();
+    for (int i : vs) c += P[i];
+    c /= static_cast<double>(vs.size());
+    Mat3 cov = Mat3::Zero();
+    for (int i : vs) cov += (P[i] - c) * (P[i] - c).transpose();
+    Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
+    Vec3 n = es.eigenvectors().col(0);  // smallest eigenvalue first
+    if (n.dot(region_area[r]) < 0) n = -n;
+    plane_n[r] = n;
+    plane_d[r] = n.dot(c);
+  }
+
+  // Boundary rays: mesh edges between facets of different faces.
+  auto on_boundary = [&](int f, int k) { return region[twin(f, k).first] != region[f]; };
+  std::vector<std::vector<int>> rays(np);
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < static_cast<int>(F[f].size()); ++k)
+      if (on_boundary(f, k)) {
+        const int a = F[f][k], b = F[f][(k + 1) % F[f].size()];
+        rays[a].push_back(b);  // each boundary edge is seen once from each side
+      }
+  // A boundary edge a-b is run a -> b by one face and b -> a by the other, so the heads of
+  // the outgoing boundary half-edges are all the rays of a vertex.
+  std::vector<char> is_feature(np, 0);
+  for (int v = 0; v < np; ++v) {
+    auto& r = rays[v];
+    std::sort(r.begin(), r.end());
+    r.erase(std::unique(r.begin(), r.end()), r.end());
+    if (r.size() >= 3) {
+      is_feature[v] = 1;
+    } else if (r.size() == 2) {
+      const Vec3& p = P[v];
+      const bool opposite = (P[r[0]] - p).dot(P[r[1]] - p) < 0;
+      is_feature[v] = !(opposite && point_segment_distance(p, P[r[0]], P[r[1]]) <= tol);
+    }
+  }
+
+  // Loops: follow boundary half-edges; from the end of one, turn around its end vertex
+  // through facets of the same face until the next boundary half-edge.
+  std::unordered_map<std::uint64_t, char> visited;
+  auto next_boundary = [&](int f, int k) {
+    int g = f;
+    int j = static_cast<int>((k + 1) % F[f].size());
+    for (int guard = 0; !on_boundary(g, j); ++guard) {
+      if (guard > nf) fail(src, "internal error: cannot close a face boundary loop");
+      const auto [g2, j2] = twin(g, j);
+      g = g2;
+      j = static_cast<int>((j2 + 1) % F[g2].size());
+    }
+    return std::make_pair(g, j);
+  };
+  std::vector<std::vector<std::vector<int>>> loops(nr);  // feature mesh vertices per loop
+  std::vector<std::vector<double>> loop_area(nr);
+  auto face_desc = [&](int r) { return "the face containing facet " + std::to_string(seed[r]); };
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < static_cast<int>(F[f].size()); ++k) {
+      if (!on_boundary(f, k) || visited.count(key(f, k))) continue;
+      const int r = region[f];
+      std::vector<int> mesh_loop;
+      int g = f, j = k;
+      do {
+        visited[key(g, j)] = 1;
+        mesh_loop.push_back(F[g][j]);
+        std::tie(g, j) = next_boundary(g, j);
+        if (mesh_loop.size() > static_cast<std::size_t>(np) * 2)
+          fail(src, "internal error: a boundary loop of " + face_desc(r) + " does not close");
+      } while (!(g == f && j == k));
+      std::vector<int> corners;
+      std::vector<std::size_t> at;
+      for (std::size_t q = 0; q < mesh_loop.size(); ++q)
+        if (is_feature[mesh_loop[q]]) {
+          corners.push_back(mesh_loop[q]);
+          at.push_back(q);
+        }
+      if (corners.size() < 3)
+        fail(src, "a boundary loop of " + face_desc(r) + " has " + std::to_string(corners.size()) +
+                      " corners; a curved boundary tessellated finer than the collinearity "
+                      "tolerance (" + num(tol) + " mm) is not a polyhedron");
+      // Every run of non-feature vertices between two corners must be one straight edge.
+      const std::size_t m = mesh_loop.size();
+      for (std::size_t c = 0; c < corners.size(); ++c) {
+        const Vec3& a = P[corners[c]];
+        const Vec3& b = P[corners[(c + 1) % corners.size()]];
+        for (std::size_t q = (at[c] + 1) % m; q != at[(c + 1) % corners.size()]; q = (q + 1) % m) {
+          const double d = point_segment_distance(P[mesh_loop[q]], a, b);
+          if (d > tol)
+            fail(src, "the boundary of " + face_desc(r) + " bends gradually near vertex " +
+                          std::to_string(mesh_loop[q]) + " (" + num(d) +
+                          " mm off a straight edge); not a polyhedral edge");
+        }
+      }
+      Vec3 n2 = Vec3::Zero();
+      for (std::size_t q = 0; q < m; ++q) n2 += P[mesh_loop[q]].cross(P[mesh_loop[(q + 1) % m]]);
+      loops[r].push_back(std::move(corners));
+      loop_area[r].push_back(0.5 * n2.dot(plane_n[r]));
+    }
+
+  // Feature vertex ids: by input vertex index.
+  std::vector<int> vid(np, -1);
+  std::vector<int> feature_points;
+  for (int v = 0; v < np; ++v)
+    if (is_feature[v]) {
+      vid[v] = static_cast<int>(feature_points.size());
+      feature_points.push_back(v);
+    }
+
+  std::vector<std::vector<std::vector<int>>> face_loops(nr);
+  std::vector<std::vector<int>> faces_of(feature_points.size());
+  std::vector<std::array<int, 2>> edges;
+  for (int r = 0; r < nr; ++r) {
+    int outer = -1, outers = 0;
+    for (std::size_t l = 0; l < loops[r].size(); ++l)
+      if (loop_area[r][l] > 0) {
+        ++outers;
+        outer = static_cast<int>(l);
+      }
+    if (outers != 1)
+      fail(src, face_desc(r) + " has " + std::to_string(outers) +
+                    " outer boundaries (counter-clockwise loops); expected 1");
+    std::vector<std::vector<int>> out;
+    auto convert = [&](const std::vector<int>& loop) {
+      std::vector<int> ids;
+      for (int v : loop) ids.push_back(vid[v]);
+      std::rotate(ids.begin(), std::min_element(ids.begin(), ids.end()), ids.end());
+      return ids;
+    };
+    out.push_back(convert(loops[r][outer]));
+    std::vector<std::vector<int>> holes;
+    for (std::size_t l = 0; l < loops[r].size(); ++l)
+      if (static_cast<int>(l) != outer) holes.push_back(convert(loops[r][l]));
+    std::sort(holes.begin(), holes.end());
+    for (auto& h : holes) out.push_back(std::move(h));
+    for (const auto& loop : out)
+      for (std::size_t q = 0; q < loop.size(); ++q) {
+        const int a = loop[q], b = loop[(q + 1) % loop.size()];
+        faces_of[a].push_back(r);
+        if (a < b) edges.push_back({a, b});  // each edge is run a -> b by exactly one face
+      }
+    face_loops[r] = std::move(out);
+  }
+  std::sort(edges.begin(), edges.end());
+
+  // Coordinates: the input points, moved onto the intersection of their faces' planes only
+  // when they are off by more than rounding (single-precision input).
+  std::vector<Vec3> coords;
+  coords.reserve(feature_points.size());
+  for (std::size_t i = 0; i < feature_points.size(); ++i) {
+    const Vec3 p = P[feature_points[i]];
+    auto& fs = faces_of[i];
+    std::sort(fs.begin(), fs.end());
+    fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
+    double dev = 0;
+    Eigen::MatrixXd A(fs.size(), 3);
+    Eigen::VectorXd res(fs.size());
+    for (std::size_t q = 0; q < fs.size(); ++q) {
+      A.row(q) = plane_n[fs[q]].transpose();
+      res[q] = plane_d[fs[q]] - plane_n[fs[q]].dot(p);
+      dev = std::max(dev, std::abs(res[q]));
+    }
+    if (dev <= kSnapRelTol * diag) {
+      coords.push_back(p);
+    } else {
+      Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      svd.setThreshold(1e-6);
+      coords.push_back(p + Vec3(svd.solve(res)));
+    }
+  }
+
+  try {
+    return Polyhedron::from_features(name, std::move(coords), edges, face_loops);
+  } catch (const Error& e) {
+    fail(src, std::string("the extracted features do not form a valid polyhedron: ") + e.what());
+  }
+}
+
+}  // namespace cf::tools::detail
