@@ -47,13 +47,16 @@ struct Pc {
 
 /// "type:a:b", as in the `pcs` column of cfreplay's output.
 std::string to_string(const Pc& pc);
+/// Parses "type:a:b" (e.g. "v-f:3:5"); std::nullopt when malformed. Ranges are not checked.
+std::optional<Pc> pc_from_string(std::string_view text);
 
 /// Up to three PCs in canonical (sorted) order: the key of a CF. Fixed capacity, no heap.
 class PcSet {
  public:
   static constexpr int kMaxPcs = 3;
   PcSet() = default;
-  /// Builds the canonical set. @pre 1 <= pcs.size() <= 3 and no PC repeated.
+  /// Builds the canonical set.
+  /// @throws cf::Error when pcs has more than 3 PCs or repeats one.
   explicit PcSet(const std::vector<Pc>& pcs);
   /// Inserts keeping the order; returns false when full or already present.
   bool insert(const Pc& pc);
@@ -72,11 +75,18 @@ class PcSet {
   int size_ = 0;
 };
 
+/// The PCs as "type:a:b" joined by ';' in canonical order (cfreplay's `pcs` column);
+/// "" for the empty set.
+std::string to_string(const PcSet& pcs);
+
 using CfId = Id<struct CfTag>;
 
 /// Prior-motion kinds a transition allows (SPEC section 4).
 enum class TransitionKind : std::uint8_t { kGain, kLose, kChange };
+/// "gain", "lose", "change" as in the graph file.
 const char* to_string(TransitionKind kind);
+/// Parses "gain", "lose", "change"; std::nullopt for anything else.
+std::optional<TransitionKind> transition_kind_from_string(std::string_view name);
 
 /// One contact formation of the graph, with what the run time needs that is cheap to store.
 struct CfRecord {
@@ -96,6 +106,14 @@ struct Transition {
   TransitionKind kind = TransitionKind::kGain;
 };
 
+/// Options of CfGraph::load.
+struct GraphLoadOptions {
+  /// Check the file against schemas/cf-graph.schema.json (embedded in the library). The
+  /// structural and consistency checks run either way; turning this off only saves time
+  /// on very large graphs that a trusted program has just written.
+  bool validate_schema = true;
+};
+
 /// The CF graph of a model pair (SPEC section 5). Immutable; share one `const CfGraph`
 /// between threads.
 class CfGraph {
@@ -113,6 +131,10 @@ class CfGraph {
   /// schema and for internal consistency.
   /// @throws cf::Error naming the file, the JSON pointer and the problem.
   static CfGraph load(const std::string& path);
+  static CfGraph load(const std::string& path, const GraphLoadOptions& options);
+  /// Same as load, from the file's bytes already in memory; `source` names them in errors.
+  static CfGraph from_bytes(const std::string& bytes, const std::string& source, bool cbor,
+                            const GraphLoadOptions& options = GraphLoadOptions());
 
   /// Writes the graph (JSON, or CBOR when the name ends in .cbor) to a temporary file and
   /// renames it into place, so that the file is whole or absent.
@@ -142,10 +164,18 @@ class CfGraph {
   /// The extra top-level members of the file (statistics, parameters) as JSON text.
   const std::string& metadata_json() const;
 
+  /// The representation; complete only inside libcf (and tools that include its private
+  /// headers). An empty graph when default-constructed or moved from.
   struct Impl;
+  const Impl& impl() const;
 
  private:
   std::unique_ptr<const Impl> impl_;
 };
 
 }  // namespace cf
+
+template <>
+struct std::hash<cf::PcSet> {
+  std::size_t operator()(const cf::PcSet& s) const noexcept { return s.hash(); }
+};

@@ -1,0 +1,395 @@
+// PCs, PC sets and the in-memory CF graph: construction, consistency checks and queries.
+// Reading and writing the file is in graph_json.cpp.
+
+#include "graph_impl.hpp"
+#include "json_util.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <charconv>
+#include <utility>
+
+namespace cf {
+
+namespace {
+
+constexpr const char* kPcTypeNames[] = {"f-f", "e-f", "f-e", "v-f", "f-v", "e-e"};
+constexpr const char* kTransitionKindNames[] = {"gain", "lose", "change"};
+
+ElementKind kind_of_letter(char c) {
+  switch (c) {
+    case 'v': return ElementKind::kVertex;
+    case 'e': return ElementKind::kEdge;
+    default: return ElementKind::kFace;
+  }
+}
+
+const char* kind_plural(ElementKind k) {
+  switch (k) {
+    case ElementKind::kVertex: return "vertices";
+    case ElementKind::kEdge: return "edges";
+    default: return "faces";
+  }
+}
+
+std::size_t count_of(const Polyhedron& m, ElementKind k) {
+  switch (k) {
+    case ElementKind::kVertex: return m.num_vertices();
+    case ElementKind::kEdge: return m.num_edges();
+    default: return m.num_faces();
+  }
+}
+
+std::uint64_t mix64(std::uint64_t x) {  // splitmix64 finaliser
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ULL;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebULL;
+  x ^= x >> 31;
+  return x;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// PC types and PCs
+
+const char* to_string(PcType type) { return kPcTypeNames[static_cast<int>(type)]; }
+
+std::optional<PcType> pc_type_from_string(std::string_view name) {
+  for (int i = 0; i < 6; ++i)
+    if (name == kPcTypeNames[i]) return static_cast<PcType>(i);
+  return std::nullopt;
+}
+
+ElementKind a_kind(PcType type) { return kind_of_letter(kPcTypeNames[static_cast<int>(type)][0]); }
+ElementKind b_kind(PcType type) { return kind_of_letter(kPcTypeNames[static_cast<int>(type)][2]); }
+
+std::string to_string(const Pc& pc) {
+  return std::string(to_string(pc.type)) + ":" + std::to_string(pc.a) + ":" + std::to_string(pc.b);
+}
+
+std::optional<Pc> pc_from_string(std::string_view text) {
+  const std::size_t c1 = text.find(':');
+  if (c1 == std::string_view::npos) return std::nullopt;
+  const std::size_t c2 = text.find(':', c1 + 1);
+  if (c2 == std::string_view::npos) return std::nullopt;
+  const auto type = pc_type_from_string(text.substr(0, c1));
+  if (!type) return std::nullopt;
+  auto parse_index = [](std::string_view s, std::int32_t& out) {
+    if (s.empty()) return false;
+    const auto r = std::from_chars(s.data(), s.data() + s.size(), out);
+    return r.ec == std::errc() && r.ptr == s.data() + s.size() && out >= 0;
+  };
+  Pc pc;
+  pc.type = *type;
+  if (!parse_index(text.substr(c1 + 1, c2 - c1 - 1), pc.a)) return std::nullopt;
+  if (!parse_index(text.substr(c2 + 1), pc.b)) return std::nullopt;
+  return pc;
+}
+
+// ---------------------------------------------------------------------------------------
+// PcSet
+
+PcSet::PcSet(const std::vector<Pc>& pcs) {
+  if (pcs.size() > static_cast<std::size_t>(kMaxPcs))
+    throw Error("PcSet: " + std::to_string(pcs.size()) + " PCs given, a CF has at most 3");
+  for (const Pc& pc : pcs)
+    if (!insert(pc)) throw Error("PcSet: PC " + to_string(pc) + " is repeated");
+}
+
+bool PcSet::insert(const Pc& pc) {
+  if (size_ == kMaxPcs || contains(pc)) return false;
+  int i = size_;
+  while (i > 0 && pc < pcs_[static_cast<std::size_t>(i - 1)]) {
+    pcs_[static_cast<std::size_t>(i)] = pcs_[static_cast<std::size_t>(i - 1)];
+    --i;
+  }
+  pcs_[static_cast<std::size_t>(i)] = pc;
+  ++size_;
+  return true;
+}
+
+bool PcSet::contains(const Pc& pc) const {
+  for (int i = 0; i < size_; ++i)
+    if (pcs_[static_cast<std::size_t>(i)] == pc) return true;
+  return false;
+}
+
+std::size_t PcSet::hash() const {
+  std::uint64_t h = static_cast<std::uint64_t>(size_);
+  for (int i = 0; i < size_; ++i) {
+    const Pc& pc = pcs_[static_cast<std::size_t>(i)];
+    const std::uint64_t key = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(pc.a)) << 32) |
+                              static_cast<std::uint32_t>(pc.b);
+    h = mix64(h ^ key ^ (static_cast<std::uint64_t>(pc.type) << 61));
+  }
+  return static_cast<std::size_t>(h);
+}
+
+bool operator==(const PcSet& x, const PcSet& y) {
+  if (x.size_ != y.size_) return false;
+  for (int i = 0; i < x.size_; ++i)
+    if (x.pcs_[static_cast<std::size_t>(i)] != y.pcs_[static_cast<std::size_t>(i)]) return false;
+  return true;
+}
+
+std::string to_string(const PcSet& pcs) {
+  std::string s;
+  for (const Pc& pc : pcs) {
+    if (!s.empty()) s += ';';
+    s += to_string(pc);
+  }
+  return s;
+}
+
+const char* to_string(TransitionKind kind) { return kTransitionKindNames[static_cast<int>(kind)]; }
+
+std::optional<TransitionKind> transition_kind_from_string(std::string_view name) {
+  for (int i = 0; i < 3; ++i)
+    if (name == kTransitionKindNames[i]) return static_cast<TransitionKind>(i);
+  return std::nullopt;
+}
+
+// ---------------------------------------------------------------------------------------
+// Checks and construction
+
+namespace detail {
+
+std::string check_pc(const Pc& pc, const Polyhedron& a, const Polyhedron& b, const char** field) {
+  const auto check = [&](std::int32_t index, const Polyhedron& m, ElementKind kind, const char* side,
+                         const char* name) -> std::string {
+    const std::size_t n = count_of(m, kind);
+    if (index < 0 || static_cast<std::size_t>(index) >= n) {
+      *field = name;
+      return std::string(to_string(pc.type)) + " PC: " + name + " = " + std::to_string(index) +
+             " is not an index into the " + kind_plural(kind) + " of model " + side + " '" + m.name() +
+             "' (" + std::to_string(n) + " " + kind_plural(kind) + ")";
+    }
+    return {};
+  };
+  std::string r = check(pc.a, a, a_kind(pc.type), "A", "a");
+  if (r.empty()) r = check(pc.b, b, b_kind(pc.type), "B", "b");
+  return r;
+}
+
+const BoostCfGraph& boost_graph(const CfGraph& graph) { return graph.impl().bgraph; }
+
+}  // namespace detail
+
+void CfGraph::Impl::build(const detail::FaultLocator& where) {
+  const std::size_t n = cfs.size();
+  index.clear();
+  index.reserve(n + n / 4);
+  for (std::size_t i = 0; i < n; ++i) {
+    const PcSet& pcs = cfs[i].pcs;
+    if (pcs.empty()) where.cf_fault(i, "a CF needs 1 to 3 PCs, this one has none");
+    // PCs of one CF have pairwise distinct contact planes (SPEC section 4): two PCs on the
+    // same face of B (types x-f) or of A (types f-x) share that face's plane.
+    for (int p = 0; p < pcs.size(); ++p)
+      for (int q = p + 1; q < pcs.size(); ++q) {
+        const Pc& x = pcs[p];
+        const Pc& y = pcs[q];
+        const bool same_b_face = b_kind(x.type) == ElementKind::kFace &&
+                                 b_kind(y.type) == ElementKind::kFace && x.b == y.b;
+        const bool same_a_face = a_kind(x.type) == ElementKind::kFace &&
+                                 a_kind(y.type) == ElementKind::kFace && x.a == y.a;
+        if (same_a_face || same_b_face)
+          where.cf_fault(i, "PCs " + to_string(x) + " and " + to_string(y) +
+                                " share the contact plane of " +
+                                (same_b_face ? "B's face " + std::to_string(x.b)
+                                             : "A's face " + std::to_string(x.a)) +
+                                "; the PCs of a CF have distinct contact planes");
+      }
+    const auto [it, inserted] = index.emplace(pcs, CfId(static_cast<std::int32_t>(i)));
+    if (!inserted)
+      where.cf_fault(i, "PC set {" + to_string(pcs) + "} repeats CF " + std::to_string(it->second.value()));
+  }
+
+  out.assign(n, {});
+  for (std::size_t t = 0; t < transitions.size(); ++t) {
+    const Transition& tr = transitions[t];
+    const auto in_range = [&](CfId id, const char* field) {
+      if (!id.valid() || id.index() >= n)
+        where.transition_fault(t, field, std::string(field) + " = " + std::to_string(id.value()) +
+                                             " is not a CF id (the graph has " + std::to_string(n) +
+                                             " CFs)");
+    };
+    in_range(tr.from, "from");
+    in_range(tr.to, "to");
+    if (tr.from == tr.to)
+      where.transition_fault(t, "to", "a transition from CF " + std::to_string(tr.from.value()) +
+                                          " to itself");
+    const PcSet& f = cfs[tr.from.index()].pcs;
+    const PcSet& g = cfs[tr.to.index()].pcs;
+    const auto superset = [](const PcSet& big, const PcSet& small) {
+      if (big.size() != small.size() + 1) return false;
+      for (const Pc& pc : small)
+        if (!big.contains(pc)) return false;
+      return true;
+    };
+    bool ok = false;
+    const char* rule = "";
+    switch (tr.kind) {
+      case TransitionKind::kGain:
+        ok = superset(g, f);
+        rule = "'gain' needs the target to be the source plus one PC";
+        break;
+      case TransitionKind::kLose:
+        ok = superset(f, g);
+        rule = "'lose' needs the target to be the source minus one PC";
+        break;
+      case TransitionKind::kChange:
+        ok = f.size() == g.size();
+        rule = "'change' needs the same number of PCs";
+        break;
+    }
+    if (!ok)
+      where.transition_fault(t, "kind", std::string("kind ") + rule + ": CF " +
+                                            std::to_string(tr.from.value()) + " {" + to_string(f) +
+                                            "} -> CF " + std::to_string(tr.to.value()) + " {" +
+                                            to_string(g) + "}");
+    out[tr.from.index()].push_back(tr);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    auto& list = out[i];
+    std::stable_sort(list.begin(), list.end(),
+                     [](const Transition& x, const Transition& y) { return x.to < y.to; });
+    for (std::size_t k = 1; k < list.size(); ++k)
+      if (list[k].to == list[k - 1].to) {
+        // Find the later of the two in file order, to point at it.
+        std::size_t seen = 0, t = 0;
+        for (; t < transitions.size(); ++t)
+          if (transitions[t].from == list[k].from && transitions[t].to == list[k].to && seen++ == 1) break;
+        where.transition_fault(t, "to", "transition CF " + std::to_string(list[k].from.value()) +
+                                            " -> CF " + std::to_string(list[k].to.value()) +
+                                            " is listed twice");
+      }
+  }
+
+  bgraph = detail::BoostCfGraph(n);
+  for (std::size_t t = 0; t < transitions.size(); ++t)
+    boost::add_edge(transitions[t].from.index(), transitions[t].to.index(),
+                    detail::GraphEdge{t, transitions[t].kind}, bgraph);
+}
+
+namespace {
+
+class PartsLocator final : public detail::FaultLocator {
+ public:
+  [[noreturn]] void cf_fault(std::size_t cf, const std::string& what) const override {
+    throw Error("CfGraph::from_parts: CF " + std::to_string(cf) + ": " + what);
+  }
+  [[noreturn]] void pc_fault(std::size_t cf, std::size_t pc, const char*,
+                             const std::string& what) const override {
+    throw Error("CfGraph::from_parts: CF " + std::to_string(cf) + ", PC " + std::to_string(pc) + ": " +
+                what);
+  }
+  [[noreturn]] void transition_fault(std::size_t t, const char*, const std::string& what) const override {
+    throw Error("CfGraph::from_parts: transition " + std::to_string(t) + ": " + what);
+  }
+  [[noreturn]] void metadata_fault(const std::string& what) const override {
+    throw Error("CfGraph::from_parts: metadata: " + what);
+  }
+};
+
+}  // namespace
+
+std::string detail::check_metadata(const json& meta) {
+  static const char* const kReserved[] = {"format", "version", "units", "models", "cfs", "transitions"};
+  if (!meta.is_object()) return "expected a JSON object, got " + json_short(meta);
+  for (const char* key : kReserved)
+    if (meta.contains(key))
+      return std::string("member \"") + key + "\" is part of the graph itself, not metadata";
+  return {};
+}
+
+CfGraph CfGraph::from_parts(Polyhedron a, Polyhedron b, std::vector<CfRecord> cfs,
+                            std::vector<Transition> transitions, const std::string& metadata_json) {
+  const PartsLocator where;
+  auto impl = std::make_unique<Impl>();
+  detail::json meta;
+  try {
+    meta = detail::json::parse(metadata_json.empty() ? std::string("{}") : metadata_json);
+  } catch (const detail::json::parse_error& e) {
+    where.metadata_fault(std::string("not valid JSON: ") + e.what());
+  }
+  if (std::string why = detail::check_metadata(meta); !why.empty()) where.metadata_fault(why);
+  impl->metadata = meta.dump();
+  for (std::size_t i = 0; i < cfs.size(); ++i) {
+    const CfRecord& r = cfs[i];
+    for (int p = 0; p < r.pcs.size(); ++p) {
+      const char* field = "";
+      if (std::string why = detail::check_pc(r.pcs[p], a, b, &field); !why.empty())
+        where.pc_fault(i, static_cast<std::size_t>(p), field, why);
+    }
+    if (r.dof < -1 || r.dof > 6) where.cf_fault(i, "dof = " + std::to_string(r.dof) + " is not in 0..6");
+    if (r.translation_dof < -1 || r.translation_dof > 3)
+      where.cf_fault(i, "translation_dof = " + std::to_string(r.translation_dof) + " is not in 0..3");
+  }
+  impl->a = std::move(a);
+  impl->b = std::move(b);
+  impl->cfs = std::move(cfs);
+  impl->transitions = std::move(transitions);
+  impl->build(where);
+  CfGraph g;
+  g.impl_ = std::move(impl);
+  return g;
+}
+
+// ---------------------------------------------------------------------------------------
+// Queries
+
+namespace {
+const CfGraph::Impl& empty_impl() {
+  static const CfGraph::Impl e;
+  return e;
+}
+}  // namespace
+
+const CfGraph::Impl& CfGraph::impl() const { return impl_ ? *impl_ : empty_impl(); }
+
+const Polyhedron& CfGraph::model_a() const { return impl().a; }
+const Polyhedron& CfGraph::model_b() const { return impl().b; }
+std::size_t CfGraph::num_cfs() const { return impl().cfs.size(); }
+const CfRecord& CfGraph::cf(CfId id) const {
+  assert(id.valid() && id.index() < num_cfs());
+  return impl().cfs[id.index()];
+}
+std::size_t CfGraph::num_transitions() const { return impl().transitions.size(); }
+const Transition& CfGraph::transition(std::size_t i) const {
+  assert(i < num_transitions());
+  return impl().transitions[i];
+}
+
+std::optional<CfId> CfGraph::find(const PcSet& pcs) const {
+  const auto& index = impl().index;
+  const auto it = index.find(pcs);
+  if (it == index.end()) return std::nullopt;
+  return it->second;
+}
+
+const std::vector<Transition>& CfGraph::out_transitions(CfId id) const {
+  assert(id.valid() && id.index() < num_cfs());
+  return impl().out[id.index()];
+}
+
+bool CfGraph::adjacent(CfId from, CfId to) const {
+  if (!from.valid() || from.index() >= num_cfs()) return false;
+  const auto& list = impl().out[from.index()];
+  const auto it = std::lower_bound(list.begin(), list.end(), to,
+                                   [](const Transition& t, CfId id) { return t.to < id; });
+  return it != list.end() && it->to == to;
+}
+
+const std::string& CfGraph::metadata_json() const {
+  static const std::string kEmpty = "{}";
+  return impl_ ? impl_->metadata : kEmpty;
+}
+
+CfGraph::CfGraph() = default;
+CfGraph::~CfGraph() = default;
+CfGraph::CfGraph(CfGraph&&) noexcept = default;
+CfGraph& CfGraph::operator=(CfGraph&&) noexcept = default;
+
+}  // namespace cf

@@ -1,0 +1,77 @@
+#pragma once
+// Private: the representation behind cf::CfGraph. Tools in this repository (cfinspect) may
+// include it to reach the Boost.Graph view; nothing public depends on it.
+
+#include <cf/graph.hpp>
+
+#include <boost/graph/adjacency_list.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cstddef>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace cf::detail {
+
+/// Bundled edge property of the Boost.Graph view: which transition this edge is.
+struct GraphEdge {
+  std::size_t transition = 0;  ///< index into CfGraph::transition()
+  TransitionKind kind = TransitionKind::kGain;
+};
+
+/// Vertex i is CF i; one directed edge per transition, in file order.
+using BoostCfGraph = boost::adjacency_list<boost::vecS, boost::vecS, boost::bidirectionalS,
+                                           boost::no_property, GraphEdge>;
+
+/// The Boost.Graph view of a graph (for algorithms: components, Graphviz export).
+const BoostCfGraph& boost_graph(const CfGraph& graph);
+
+/// Says where a fault is, in the caller's terms: "CF 3" for from_parts, "'g.json' at
+/// /cfs/3" for load. The checks below use it to build their messages.
+class FaultLocator {
+ public:
+  virtual ~FaultLocator() = default;
+  [[noreturn]] virtual void cf_fault(std::size_t cf, const std::string& what) const = 0;
+  /// `pc` indexes the PCs as the caller gave them (before sorting into a PcSet).
+  [[noreturn]] virtual void pc_fault(std::size_t cf, std::size_t pc, const char* field,
+                                     const std::string& what) const = 0;
+  [[noreturn]] virtual void transition_fault(std::size_t t, const char* field,
+                                             const std::string& what) const = 0;
+  [[noreturn]] virtual void metadata_fault(const std::string& what) const = 0;
+};
+
+/// Checks one PC against the models: the indices are in range for the kinds its type names.
+/// Returns an empty string when fine, else the reason; `field` is set to "a" or "b".
+std::string check_pc(const Pc& pc, const Polyhedron& a, const Polyhedron& b, const char** field);
+
+}  // namespace cf::detail
+
+namespace cf {
+
+struct CfGraph::Impl {
+  Polyhedron a, b;
+  std::vector<CfRecord> cfs;
+  std::vector<Transition> transitions;
+  std::unordered_map<PcSet, CfId> index;          ///< PC set -> CF, for constant-time find
+  std::vector<std::vector<Transition>> out;       ///< per CF, sorted by target id
+  detail::BoostCfGraph bgraph;
+  std::string metadata;                           ///< JSON object text, canonical dump
+
+  /// Checks everything that does not need the original PC order (repeated PC sets, PCs
+  /// sharing a contact plane, transitions) and builds the index, the out lists and the
+  /// Boost view. PC index ranges are the caller's job (check_pc), so that it can point at
+  /// the PC as given.
+  void build(const detail::FaultLocator& where);
+};
+
+}  // namespace cf
+
+namespace cf::detail {
+/// Empty when `meta` is a JSON object without the graph's own members, else the reason.
+std::string check_metadata(const nlohmann::json& meta);
+/// Writes `bytes` to a temporary file next to `path`, then renames it into place: the file
+/// is whole or untouched. `what` starts the error message ("writing graph").
+/// @throws cf::Error naming the file and the system's reason.
+void write_file_atomically(const std::string& path, const std::string& bytes, const char* what);
+}  // namespace cf::detail

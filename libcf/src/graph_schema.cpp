@@ -1,0 +1,78 @@
+// Schema validation of graph files with valijson (kept in its own translation unit: it is
+// heavy to compile).
+
+#define VALIJSON_USE_EXCEPTIONS 1
+
+#include "graph_schema.hpp"
+
+#include <cf/types.hpp>
+
+#include <valijson/adapters/nlohmann_json_adapter.hpp>
+#include <valijson/schema.hpp>
+#include <valijson/schema_parser.hpp>
+#include <valijson/validation_results.hpp>
+#include <valijson/validator.hpp>
+
+#include <memory>
+
+namespace cf::detail {
+
+namespace {
+
+const valijson::Schema& graph_schema() {
+  static const std::unique_ptr<valijson::Schema> schema = [] {
+    auto s = std::make_unique<valijson::Schema>();
+    const nlohmann::json doc = nlohmann::json::parse(graph_schema_text());
+    valijson::SchemaParser parser(valijson::SchemaParser::kDraft7);
+    valijson::adapters::NlohmannJsonAdapter adapter(doc);
+    parser.populateSchema(adapter, *s);
+    return s;
+  }();
+  return *schema;
+}
+
+/// valijson's context is {"<root>", "[cfs]", "[3]", ...}; a JSON pointer is /cfs/3/...
+std::string pointer_of(const std::vector<std::string>& context) {
+  std::string p;
+  for (const std::string& c : context) {
+    if (c == "<root>") continue;
+    std::string token = c;
+    if (token.size() >= 2 && token.front() == '[' && token.back() == ']')
+      token = token.substr(1, token.size() - 2);
+    if (token.size() >= 2 && token.front() == '"' && token.back() == '"')
+      token = token.substr(1, token.size() - 2);
+    std::string escaped;  // RFC 6901
+    for (char ch : token) {
+      if (ch == '~') escaped += "~0";
+      else if (ch == '/') escaped += "~1";
+      else escaped += ch;
+    }
+    p += "/" + escaped;
+  }
+  return p.empty() ? "/" : p;
+}
+
+}  // namespace
+
+void validate_graph_schema(const nlohmann::json& document, const std::string& source) {
+  valijson::Validator validator;
+  valijson::ValidationResults results;
+  valijson::adapters::NlohmannJsonAdapter target(document);
+  if (validator.validate(graph_schema(), target, &results)) return;
+  // valijson reports the failing sub-schemas from the outside in; the deepest complaint is
+  // the most specific one.
+  valijson::ValidationResults::Error error, best;
+  std::size_t best_depth = 0;
+  bool have = false;
+  while (results.popError(error)) {
+    if (!have || error.context.size() > best_depth) {
+      best = error;
+      best_depth = error.context.size();
+      have = true;
+    }
+  }
+  throw Error("reading '" + source + "' at " + pointer_of(best.context) +
+              ": does not match the cf-graph schema: " + best.description);
+}
+
+}  // namespace cf::detail

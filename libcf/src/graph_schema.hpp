@@ -1,0 +1,19 @@
+#pragma once
+// Private: the graph file's JSON Schema (schemas/cf-graph.schema.json, embedded at build
+// time) and validation against it with valijson.
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace cf::detail {
+
+/// The text of schemas/cf-graph.schema.json as it was when the library was built.
+const char* graph_schema_text();
+
+/// Validates a whole graph document against the schema.
+/// @throws cf::Error "reading '<source>' at <JSON pointer>: does not match the cf-graph
+///   schema: <complaint>" for the first (deepest) violation.
+void validate_graph_schema(const nlohmann::json& document, const std::string& source);
+
+}  // namespace cf::detail

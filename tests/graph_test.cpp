@@ -1,0 +1,496 @@
+// A small, geometrically real CF graph for tests: A is a 10 mm cube, B an L-shaped block
+// (a floor 40 x 10 and a wall 10 x 40 in the x-y profile, y up, extruded 20 in z).
+// Every witness below realises exactly its CF (checked by hand; see the comments).
+
+#include <cf/graph.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+
+namespace cf_test {
+
+// Axis-aligned box [0,sx] x [0,sy] x [0,sz]. Faces: 0 z=0, 1 z=sz, 2 y=0, 3 y=sy, 4 x=sx,
+// 5 x=0. Edges: 0 (0,1), 1 (1,2), 2 (2,3), 3 (0,3), 4 (4,5), 5 (5,6), 6 (6,7), 7 (4,7),
+// 8 (0,4), 9 (1,5), 10 (2,6), 11 (3,7).
+cf::Polyhedron box(double sx, double sy, double sz) {
+  std::vector<cf::Vec3> v = {{0, 0, 0},  {sx, 0, 0},  {sx, sy, 0},  {0, sy, 0},
+                             {0, 0, sz}, {sx, 0, sz}, {sx, sy, sz}, {0, sy, sz}};
+  std::vector<std::vector<std::vector<int>>> f = {
+      {{0, 3, 2, 1}}, {{4, 5, 6, 7}}, {{0, 1, 5, 4}}, {{2, 3, 7, 6}}, {{1, 2, 6, 5}}, {{0, 4, 7, 3}}};
+  std::vector<std::array<int, 2>> e = {{0, 1}, {1, 2}, {2, 3}, {0, 3}, {4, 5}, {5, 6},
+                                       {6, 7}, {4, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+  return cf::Polyhedron::from_features("cube", v, e, f);
+}
+
+// L profile (0,0) (40,0) (40,10) (10,10) (10,40) (0,40), vertices 0..5 at z=0 and 6..11 at
+// z=20. Faces: 0 z=0, 1 z=20, then side i+2 over profile edge i -> i+1: 2 y=0 (bottom),
+// 3 x=40, 4 y=10 (floor top), 5 x=10 (wall, facing +x), 6 y=40 (wall top), 7 x=0.
+// Edges 0..5 bottom ring, 6..11 top ring, 12..17 verticals; edge 15 (3,9) is the reflex
+// corner between floor and wall.
+cf::Polyhedron l_block() {
+  const double px[6] = {0, 40, 40, 10, 10, 0};
+  const double py[6] = {0, 0, 10, 10, 40, 40};
+  std::vector<cf::Vec3> v;
+  for (double z : {0.0, 20.0})
+    for (int i = 0; i < 6; ++i) v.emplace_back(px[i], py[i], z);
+  std::vector<std::vector<std::vector<int>>> f = {{{0, 5, 4, 3, 2, 1}}, {{6, 7, 8, 9, 10, 11}}};
+  for (int i = 0; i < 6; ++i) f.push_back({{i, (i + 1) % 6, (i + 1) % 6 + 6, i + 6}});
+  std::vector<std::array<int, 2>> e;
+  for (int ring : {0, 6})
+    for (int i = 0; i < 6; ++i) {
+      const int a = ring + i, b = ring + (i + 1) % 6;
+      e.push_back({std::min(a, b), std::max(a, b)});
+    }
+  for (int i = 0; i < 6; ++i) e.push_back({i, i + 6});
+  return cf::Polyhedron::from_features("L-block", v, e, f);
+}
+
+cf::Pose pose(const cf::Mat3& R, const cf::Vec3& t) {
+  cf::Pose p;
+  p.R_BA = R;
+  p.t_BA = t;
+  return p;
+}
+
+cf::Mat3 rot(double angle, const cf::Vec3& axis) {
+  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+}
+
+cf::Pc pc(cf::PcType type, int a, int b) { return cf::Pc{type, a, b}; }
+
+/// CFs:
+///  0 {f-f:2:4}            cube's y=0 face flat on the floor top, clear of the wall
+///  1 {f-f:5:5}            cube's x=0 face flat on the wall, above the floor
+///  2 {f-f:2:4; f-f:5:5}   in the corner (the collinear edge touch there is dominated)
+///  3 {e-f:0:4}            on the floor, tipped about its edge 0 (the x axis)
+///  4 {v-f:0:4}            on the floor, tipped onto its vertex 0
+/// Transitions: 0<->2 and 1<->2 gain/lose, 0<->3 and 3<->4 change.
+cf::CfGraph box_l_graph() {
+  using cf::PcType;
+  const cf::Mat3 I = cf::Mat3::Identity();
+  const cf::Vec3 x(1, 0, 0), z(0, 0, 1);
+  std::vector<cf::CfRecord> cfs(5);
+  cfs[0].pcs = cf::PcSet({pc(PcType::kFF, 2, 4)});
+  cfs[0].witness = pose(I, {20, 10, 5});
+  cfs[1].pcs = cf::PcSet({pc(PcType::kFF, 5, 5)});
+  cfs[1].witness = pose(I, {10, 20, 5});
+  cfs[2].pcs = cf::PcSet({pc(PcType::kFF, 5, 5), pc(PcType::kFF, 2, 4)});
+  cfs[2].witness = pose(I, {10, 10, 5});
+  // Rotating by -0.2 rad about x lifts every point off y = 0 except the x-axis edge.
+  cfs[3].pcs = cf::PcSet({pc(PcType::kEF, 0, 4)});
+  cfs[3].witness = pose(rot(-0.2, x), {20, 10, 5});
+  // Then 0.1 rad about z first lifts the x-axis edge too, except its vertex 0.
+  cfs[4].pcs = cf::PcSet({pc(PcType::kVF, 0, 4)});
+  cfs[4].witness = pose(rot(-0.2, x) * rot(0.1, z), {20, 10, 5});
+  // Freedoms where they are easy to state: a face on a plane keeps 3 (2 slides, 1 spin).
+  cfs[0].dof = 3;
+  cfs[0].translation_dof = 2;
+  cfs[0].pure_rotation = true;
+  cfs[2].dof = 1;
+  cfs[2].translation_dof = 1;
+  cfs[2].pure_rotation = false;
+  using K = cf::TransitionKind;
+  auto tr = [](int f, int t, K k) { return cf::Transition{cf::CfId(f), cf::CfId(t), k}; };
+  std::vector<cf::Transition> transitions = {
+      tr(0, 2, K::kGain),   tr(2, 0, K::kLose),   tr(1, 2, K::kGain),   tr(2, 1, K::kLose),
+      tr(0, 3, K::kChange), tr(3, 0, K::kChange), tr(3, 4, K::kChange), tr(4, 3, K::kChange)};
+  return cf::CfGraph::from_parts(box(10, 10, 10), l_block(), std::move(cfs), std::move(transitions),
+                                 R"({"stats":{"note":"hand-made test fixture"},"parameters":{"epsilon_mm":1.0}})");
+}
+
+}  // namespace cf_test
+
+namespace {
+
+using cf::CfGraph;
+using cf::CfId;
+using cf::Pc;
+using cf::PcSet;
+using cf::PcType;
+using cf::TransitionKind;
+using cf_test::pc;
+
+const std::string kGraphDir = std::string(CF_TEST_DATA_DIR) + "/graphs";
+const std::string kFixture = kGraphDir + "/box_l.json";
+
+std::string bad(const std::string& name) { return kGraphDir + "/bad/" + name; }
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// A fresh empty directory for files a test writes.
+std::filesystem::path scratch_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cf_graph_test_" + name + "_" +
+                                                             std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+/// Exact equality of everything the graph holds (witnesses are stored with round-trip
+/// precision, so exact comparison is the right test).
+void check_same(const CfGraph& x, const CfGraph& y) {
+  REQUIRE(x.num_cfs() == y.num_cfs());
+  REQUIRE(x.num_transitions() == y.num_transitions());
+  CHECK(x.model_a().name() == y.model_a().name());
+  CHECK(x.model_b().num_faces() == y.model_b().num_faces());
+  for (std::size_t i = 0; i < x.num_cfs(); ++i) {
+    const cf::CfRecord& a = x.cf(CfId(static_cast<int>(i)));
+    const cf::CfRecord& b = y.cf(CfId(static_cast<int>(i)));
+    CHECK(a.pcs == b.pcs);
+    CHECK(a.witness.R_BA == b.witness.R_BA);
+    CHECK(a.witness.t_BA == b.witness.t_BA);
+    CHECK(a.dof == b.dof);
+    CHECK(a.translation_dof == b.translation_dof);
+    CHECK(a.pure_rotation == b.pure_rotation);
+  }
+  for (std::size_t i = 0; i < x.num_transitions(); ++i) {
+    CHECK(x.transition(i).from == y.transition(i).from);
+    CHECK(x.transition(i).to == y.transition(i).to);
+    CHECK(x.transition(i).kind == y.transition(i).kind);
+  }
+  CHECK(x.metadata_json() == y.metadata_json());
+}
+
+}  // namespace
+
+TEST_CASE("PC types name their element kinds and parse back", "[graph]") {
+  CHECK(std::string(cf::to_string(PcType::kVF)) == "v-f");
+  CHECK(cf::a_kind(PcType::kVF) == cf::ElementKind::kVertex);
+  CHECK(cf::b_kind(PcType::kVF) == cf::ElementKind::kFace);
+  CHECK(cf::a_kind(PcType::kFE) == cf::ElementKind::kFace);
+  CHECK(cf::b_kind(PcType::kFE) == cf::ElementKind::kEdge);
+  CHECK(cf::a_kind(PcType::kEE) == cf::ElementKind::kEdge);
+  for (PcType t : {PcType::kFF, PcType::kEF, PcType::kFE, PcType::kVF, PcType::kFV, PcType::kEE})
+    CHECK(cf::pc_type_from_string(cf::to_string(t)) == t);
+  CHECK_FALSE(cf::pc_type_from_string("v-v"));
+  CHECK_FALSE(cf::pc_type_from_string("f-f "));
+  CHECK(cf::to_string(pc(PcType::kEE, 3, 11)) == "e-e:3:11");
+  CHECK(cf::pc_from_string("e-e:3:11") == pc(PcType::kEE, 3, 11));
+  CHECK_FALSE(cf::pc_from_string("e-e:3"));
+  CHECK_FALSE(cf::pc_from_string("e-e:3:-1"));
+  CHECK_FALSE(cf::pc_from_string("x-e:3:1"));
+  CHECK_FALSE(cf::pc_from_string("e-e:3:1x"));
+  CHECK(cf::transition_kind_from_string("change") == TransitionKind::kChange);
+  CHECK_FALSE(cf::transition_kind_from_string("gained"));
+}
+
+TEST_CASE("a PC set is canonical whatever the insertion order", "[graph]") {
+  const Pc p1 = pc(PcType::kFF, 2, 4), p2 = pc(PcType::kVF, 0, 5), p3 = pc(PcType::kEE, 1, 1);
+  const PcSet s({p2, p3, p1});
+  REQUIRE(s.size() == 3);
+  CHECK(s[0] == p1);  // enumerator order: f-f < v-f < e-e
+  CHECK(s[1] == p2);
+  CHECK(s[2] == p3);
+  const std::vector<std::vector<Pc>> orders = {{p1, p2, p3}, {p1, p3, p2}, {p2, p1, p3},
+                                               {p2, p3, p1}, {p3, p1, p2}, {p3, p2, p1}};
+  for (const auto& order : orders) {
+    PcSet t;
+    for (const Pc& p : order) CHECK(t.insert(p));
+    CHECK(t == s);
+    CHECK(t.hash() == s.hash());
+  }
+  PcSet full = s;
+  CHECK_FALSE(full.insert(pc(PcType::kFF, 0, 0)));  // full
+  PcSet one({p1});
+  CHECK_FALSE(one.insert(p1));  // already present
+  CHECK(one.contains(p1));
+  CHECK_FALSE(one.contains(p2));
+  CHECK(one != s);
+  CHECK(cf::to_string(s) == "f-f:2:4;v-f:0:5;e-e:1:1");
+  CHECK(cf::to_string(PcSet()) == "");
+  CHECK_THROWS_WITH(PcSet({p1, p1}), Catch::Contains("PC f-f:2:4 is repeated"));
+  CHECK_THROWS_WITH(PcSet({p1, p2, p3, pc(PcType::kFF, 0, 0)}), Catch::Contains("at most 3"));
+}
+
+TEST_CASE("find answers any permutation of a CF's PCs, and nothing else", "[graph]") {
+  const CfGraph g = cf_test::box_l_graph();
+  REQUIRE(g.num_cfs() == 5);
+  CHECK(g.find(PcSet({pc(PcType::kFF, 2, 4)})) == CfId(0));
+  CHECK(g.find(PcSet({pc(PcType::kFF, 2, 4), pc(PcType::kFF, 5, 5)})) == CfId(2));
+  CHECK(g.find(PcSet({pc(PcType::kFF, 5, 5), pc(PcType::kFF, 2, 4)})) == CfId(2));
+  CHECK(g.find(PcSet({pc(PcType::kVF, 0, 4)})) == CfId(4));
+  CHECK_FALSE(g.find(PcSet({pc(PcType::kVF, 1, 4)})));
+  CHECK_FALSE(g.find(PcSet({pc(PcType::kFF, 2, 4), pc(PcType::kVF, 0, 4)})));
+  CHECK_FALSE(g.find(PcSet()));
+  for (std::size_t i = 0; i < g.num_cfs(); ++i) CHECK(g.find(g.cf(CfId(static_cast<int>(i))).pcs) == CfId(static_cast<int>(i)));
+}
+
+TEST_CASE("transitions are listed per CF by target and answer adjacency", "[graph]") {
+  const CfGraph g = cf_test::box_l_graph();
+  CHECK(g.num_transitions() == 8);
+  const auto& out2 = g.out_transitions(CfId(2));
+  REQUIRE(out2.size() == 2);
+  CHECK(out2[0].to == CfId(0));
+  CHECK(out2[0].kind == TransitionKind::kLose);
+  CHECK(out2[1].to == CfId(1));
+  const auto& out0 = g.out_transitions(CfId(0));
+  REQUIRE(out0.size() == 2);
+  CHECK(out0[0].to == CfId(2));  // gain was listed first in the file, but 2 < 3 anyway
+  CHECK(out0[0].kind == TransitionKind::kGain);
+  CHECK(out0[1].to == CfId(3));
+  CHECK(out0[1].kind == TransitionKind::kChange);
+  CHECK(g.adjacent(CfId(3), CfId(4)));
+  CHECK(g.adjacent(CfId(4), CfId(3)));
+  CHECK_FALSE(g.adjacent(CfId(0), CfId(4)));
+  CHECK_FALSE(g.adjacent(CfId(0), CfId(1)));
+  CHECK_FALSE(g.adjacent(CfId(9), CfId(1)));
+  CHECK(g.transition(1).from == CfId(2));
+}
+
+TEST_CASE("an empty graph answers queries", "[graph]") {
+  const CfGraph g;
+  CHECK(g.num_cfs() == 0);
+  CHECK(g.num_transitions() == 0);
+  CHECK(g.metadata_json() == "{}");
+  CHECK_FALSE(g.find(PcSet({pc(PcType::kFF, 0, 0)})));
+  CHECK_FALSE(g.adjacent(CfId(0), CfId(1)));
+}
+
+TEST_CASE("to_json round-trips exactly and is deterministic", "[graph]") {
+  const CfGraph g = cf_test::box_l_graph();
+  const std::string compact = g.to_json();
+  const std::string pretty = g.to_json(2);
+  CHECK(compact == cf_test::box_l_graph().to_json());  // same graph, same bytes
+  CHECK(pretty == cf_test::box_l_graph().to_json(2));
+  CHECK(compact.find('\n') == std::string::npos);
+  // Top-level order: the contract's fixed members first, metadata, then the big arrays.
+  CHECK(compact.rfind(R"({"format":"cf-graph","version":1,"units":"mm","parameters":{"epsilon_mm":1.0},"stats":)", 0) == 0);
+  const CfGraph h = CfGraph::from_bytes(compact, "compact", false);
+  check_same(g, h);
+  CHECK(h.to_json() == compact);
+  const CfGraph p = CfGraph::from_bytes(pretty, "pretty", false);
+  check_same(g, p);
+  CHECK(p.to_json(2) == pretty);
+  CHECK(g.metadata_json() == R"({"parameters":{"epsilon_mm":1.0},"stats":{"note":"hand-made test fixture"}})");
+  // Optional freedoms are written only when known.
+  CHECK(compact.find(R"("id":0,"pcs":[{"type":"f-f","a":2,"b":4}],"witness":{"R":[[1.0,0.0,0.0],[0.0,1.0,0.0],[0.0,0.0,1.0]],"t":[20.0,10.0,5.0]},"dof":3,"translation_dof":2,"pure_rotation":true})") != std::string::npos);
+  CHECK(compact.find(R"({"id":1,"pcs":[{"type":"f-f","a":5,"b":5}],"witness":{"R":[[1.0,0.0,0.0],[0.0,1.0,0.0],[0.0,0.0,1.0]],"t":[10.0,20.0,5.0]}})") != std::string::npos);
+}
+
+TEST_CASE("the committed fixture is the graph the code builds", "[graph]") {
+  const CfGraph g = cf_test::box_l_graph();
+  if (std::getenv("CF_WRITE_GRAPH_FIXTURES")) g.save(kFixture);
+  const CfGraph f = CfGraph::load(kFixture);
+  check_same(g, f);
+  CHECK(slurp(kFixture) == g.to_json(1));
+}
+
+TEST_CASE("save writes JSON or CBOR whole and load reads it back", "[graph]") {
+  const CfGraph g = cf_test::box_l_graph();
+  const auto dir = scratch_dir("save");
+  const std::string json_path = (dir / "g.json").string();
+  const std::string cbor_path = (dir / "g.cbor").string();
+  g.save(json_path);
+  g.save(cbor_path);
+  g.save(json_path);  // overwriting an existing file goes through the same rename
+  check_same(g, CfGraph::load(json_path));
+  check_same(g, CfGraph::load(cbor_path));
+  // CBOR is smaller and holds the same document.
+  CHECK(std::filesystem::file_size(cbor_path) < std::filesystem::file_size(json_path));
+  // No temporary file is left behind.
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
+  CHECK(entries == 2);
+  CHECK_THROWS_WITH(g.save((dir / "no" / "such" / "dir.json").string()),
+                    Catch::Contains("writing graph '" + (dir / "no" / "such" / "dir.json").string() +
+                                    "': cannot create a temporary file in '" + (dir / "no" / "such").string()));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("schema validation can be skipped for trusted large files", "[graph]") {
+  cf::GraphLoadOptions fast;
+  fast.validate_schema = false;
+  check_same(CfGraph::load(kFixture), CfGraph::load(kFixture, fast));
+  // The extra member is only a schema complaint, so the fast path accepts the file...
+  CHECK_NOTHROW(CfGraph::load(bad("schema_violation.json"), fast));
+  // ... while every structural fault is still caught.
+  CHECK_THROWS_WITH(CfGraph::load(bad("index_out_of_range.json"), fast), Catch::Contains("/cfs/3/pcs/0/b"));
+}
+
+// ---- from_parts rejects inconsistent parts --------------------------------------------
+
+namespace {
+
+CfGraph build(std::vector<cf::CfRecord> cfs, std::vector<cf::Transition> tr = {},
+              const std::string& meta = "{}") {
+  return CfGraph::from_parts(cf_test::box(10, 10, 10), cf_test::l_block(), std::move(cfs), std::move(tr), meta);
+}
+
+cf::CfRecord rec(std::vector<Pc> pcs) {
+  cf::CfRecord r;
+  r.pcs = PcSet(pcs);
+  return r;
+}
+
+cf::Transition tr(int f, int t, TransitionKind k) { return {CfId(f), CfId(t), k}; }
+
+}  // namespace
+
+TEST_CASE("from_parts rejects indices out of range for the kinds the type names", "[graph]") {
+  // The cube has 8 vertices, 12 edges, 6 faces; the L-block 12, 18, 8.
+  CHECK_THROWS_WITH(build({rec({pc(PcType::kVF, 8, 0)})}),
+                    Catch::Contains("CF 0, PC 0: v-f PC: a = 8 is not an index into the vertices of model A 'cube' (8 vertices)"));
+  CHECK_THROWS_WITH(build({rec({pc(PcType::kFF, 0, 1)}), rec({pc(PcType::kFE, 0, 18)})}),
+                    Catch::Contains("CF 1, PC 0: f-e PC: b = 18 is not an index into the edges of model B 'L-block' (18 edges)"));
+  CHECK_NOTHROW(build({rec({pc(PcType::kEE, 11, 17)})}));
+}
+
+TEST_CASE("from_parts rejects empty, repeated and coplanar PC sets", "[graph]") {
+  CHECK_THROWS_WITH(build({cf::CfRecord()}), Catch::Contains("CF 0: a CF needs 1 to 3 PCs, this one has none"));
+  CHECK_THROWS_WITH(build({rec({pc(PcType::kVF, 0, 4)}), rec({pc(PcType::kVF, 0, 4)})}),
+                    Catch::Contains("CF 1: PC set {v-f:0:4} repeats CF 0"));
+  CHECK_THROWS_WITH(build({rec({pc(PcType::kVF, 0, 4), pc(PcType::kEF, 3, 4)})}),
+                    Catch::Contains("share the contact plane of B's face 4"));
+  CHECK_THROWS_WITH(build({rec({pc(PcType::kFF, 2, 4), pc(PcType::kFV, 2, 3)})}),
+                    Catch::Contains("share the contact plane of A's face 2"));
+  cf::CfRecord r = rec({pc(PcType::kVF, 0, 4)});
+  r.dof = 7;
+  CHECK_THROWS_WITH(build({r}), Catch::Contains("CF 0: dof = 7 is not in 0..6"));
+}
+
+TEST_CASE("from_parts rejects transitions that do not fit their CFs", "[graph]") {
+  const std::vector<cf::CfRecord> cfs = {rec({pc(PcType::kFF, 2, 4)}), rec({pc(PcType::kFF, 5, 5)}),
+                                         rec({pc(PcType::kFF, 2, 4), pc(PcType::kFF, 5, 5)})};
+  CHECK_NOTHROW(build(cfs, {tr(0, 2, TransitionKind::kGain), tr(2, 1, TransitionKind::kLose),
+                            tr(0, 1, TransitionKind::kChange)}));
+  CHECK_THROWS_WITH(build(cfs, {tr(0, 3, TransitionKind::kGain)}),
+                    Catch::Contains("transition 0: to = 3 is not a CF id (the graph has 3 CFs)"));
+  CHECK_THROWS_WITH(build(cfs, {tr(-1, 0, TransitionKind::kGain)}),
+                    Catch::Contains("transition 0: from = -1 is not a CF id"));
+  CHECK_THROWS_WITH(build(cfs, {tr(1, 1, TransitionKind::kChange)}), Catch::Contains("from CF 1 to itself"));
+  CHECK_THROWS_WITH(build(cfs, {tr(2, 0, TransitionKind::kGain)}),
+                    Catch::Contains("transition 0: kind 'gain' needs the target to be the source plus one PC: "
+                                    "CF 2 {f-f:2:4;f-f:5:5} -> CF 0 {f-f:2:4}"));
+  CHECK_THROWS_WITH(build(cfs, {tr(0, 1, TransitionKind::kLose)}), Catch::Contains("kind 'lose' needs"));
+  CHECK_THROWS_WITH(build(cfs, {tr(0, 2, TransitionKind::kChange)}),
+                    Catch::Contains("kind 'change' needs the same number of PCs"));
+  CHECK_THROWS_WITH(build(cfs, {tr(0, 2, TransitionKind::kGain), tr(0, 1, TransitionKind::kChange),
+                                tr(0, 2, TransitionKind::kGain)}),
+                    Catch::Contains("transition 2: transition CF 0 -> CF 2 is listed twice"));
+}
+
+TEST_CASE("from_parts rejects metadata that is not an object or that overrides the graph", "[graph]") {
+  const std::vector<cf::CfRecord> cfs = {rec({pc(PcType::kFF, 2, 4)})};
+  CHECK_THROWS_WITH(build(cfs, {}, "[1]"), Catch::Contains("metadata: expected a JSON object"));
+  CHECK_THROWS_WITH(build(cfs, {}, R"({"cfs":1})"), Catch::Contains("member \"cfs\" is part of the graph itself"));
+  CHECK_THROWS_WITH(build(cfs, {}, "{"), Catch::Contains("metadata: not valid JSON"));
+  CHECK(build(cfs, {}, "").metadata_json() == "{}");
+}
+
+// ---- load rejects bad files, naming the file and the JSON pointer ---------------------
+
+TEST_CASE("load: a missing file", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("no_such_file.json")),
+                    Catch::Contains("reading '" + bad("no_such_file.json") + "': cannot open: No such file or directory"));
+}
+
+TEST_CASE("load: truncated JSON gives the line and column", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("truncated.json")),
+                    Catch::Contains("reading '" + bad("truncated.json") + "': not valid JSON:") &&
+                        Catch::Contains("line 6, column"));
+}
+
+TEST_CASE("load: an empty file", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("empty.json")),
+                    Catch::Contains("reading '" + bad("empty.json") + "': not valid JSON:"));
+}
+
+TEST_CASE("load: corrupt CBOR", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("corrupt.cbor")),
+                    Catch::Contains("reading '" + bad("corrupt.cbor") + "': not valid CBOR:"));
+}
+
+TEST_CASE("load: a JSON document that is not an object", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("not_object.json")),
+                    Catch::Contains("reading '" + bad("not_object.json") + "' at /: expected a cf-graph object"));
+}
+
+TEST_CASE("load: wrong format and version", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("wrong_format.json")),
+                    Catch::Contains("'" + bad("wrong_format.json") + "' at /format: format is \"cf-table\", expected \"cf-graph\""));
+  CHECK_THROWS_WITH(CfGraph::load(bad("wrong_version.json")),
+                    Catch::Contains("'" + bad("wrong_version.json") + "' at /version: version 2 is not supported"));
+}
+
+TEST_CASE("load: a value of the wrong type", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("wrong_type.json")),
+                    Catch::Contains("'" + bad("wrong_type.json") + "' at /cfs/1/pcs/0/a: expected a non-negative integer index, got \"5\""));
+}
+
+TEST_CASE("load: a missing member", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("missing_witness.json")),
+                    Catch::Contains("'" + bad("missing_witness.json") + "' at /cfs/0: missing member \"witness\""));
+}
+
+TEST_CASE("load: an element index out of range", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("index_out_of_range.json")),
+                    Catch::Contains("'" + bad("index_out_of_range.json") +
+                                    "' at /cfs/3/pcs/0/b: e-f PC: b = 99 is not an index into the faces of model B 'L-block' (8 faces)"));
+}
+
+TEST_CASE("load: an unknown PC type", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("unknown_pc_type.json")),
+                    Catch::Contains("'" + bad("unknown_pc_type.json") + "' at /cfs/0/pcs/0/type: unknown PC type \"v-v\""));
+}
+
+TEST_CASE("load: a PC type that does not match the element kinds", "[graph][bad]") {
+  // a = 11 is a valid edge of the cube but not a vertex: the type says vertex.
+  CHECK_THROWS_WITH(CfGraph::load(bad("kind_mismatch.json")),
+                    Catch::Contains("'" + bad("kind_mismatch.json") +
+                                    "' at /cfs/4/pcs/0/a: v-f PC: a = 11 is not an index into the vertices of model A 'cube' (8 vertices)"));
+}
+
+TEST_CASE("load: a transition to a missing CF", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("missing_cf_transition.json")),
+                    Catch::Contains("'" + bad("missing_cf_transition.json") +
+                                    "' at /transitions/2/to: to = 17 is not a CF id (the graph has 5 CFs)"));
+}
+
+TEST_CASE("load: a transition whose kind does not fit its CFs", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("bad_transition_kind.json")),
+                    Catch::Contains("'" + bad("bad_transition_kind.json") +
+                                    "' at /transitions/0/kind: kind 'change' needs the same number of PCs"));
+}
+
+TEST_CASE("load: a repeated PC set and a repeated PC", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("repeated_cf.json")),
+                    Catch::Contains("'" + bad("repeated_cf.json") + "' at /cfs/4: PC set {e-f:0:4} repeats CF 3"));
+  CHECK_THROWS_WITH(CfGraph::load(bad("repeated_pc.json")),
+                    Catch::Contains("'" + bad("repeated_pc.json") + "' at /cfs/2/pcs/1: PC f-f:2:4 is repeated in this CF"));
+}
+
+TEST_CASE("load: a CF id that is not its position", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("id_mismatch.json")),
+                    Catch::Contains("'" + bad("id_mismatch.json") + "' at /cfs/1/id: id 7 should be 1"));
+}
+
+TEST_CASE("load: a witness that is not a rotation", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("not_rotation.json")),
+                    Catch::Contains("'" + bad("not_rotation.json") + "' at /cfs/0/witness/R: not a rotation matrix"));
+}
+
+TEST_CASE("load: a broken model", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("bad_model.json")),
+                    Catch::Contains("'" + bad("bad_model.json") + "' at /models/B/faces/0/loops/0/1: expected a non-negative integer index"));
+}
+
+TEST_CASE("load: a schema violation the reader itself would let through", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("schema_violation.json")),
+                    Catch::Contains("'" + bad("schema_violation.json") +
+                                    "' at /cfs/2/witness: does not match the cf-graph schema:"));
+}
