@@ -1,0 +1,121 @@
+#pragma once
+/// @file
+/// Contact force and moment of paper sections 4.3-5 from the PCs at the current pose and the
+/// prior motion: normal force eq. (1), friction eqs. (2)-(6) with the per-MT rules of
+/// section 4.4, totals eqs. (7)-(9), gravity and smoothing (section 4.5). Independent of
+/// detection: the input is an array of ContactPc. See docs/force-model.md.
+
+#include <cf/contact.hpp>
+#include <cf/motion.hpp>
+#include <cf/params.hpp>
+#include <cf/polyhedron.hpp>
+
+#include <array>
+#include <cstdint>
+
+namespace cf {
+
+/// Which friction law a PC got this tick.
+enum class Regime : std::uint8_t {
+  kNone,          ///< not rendered
+  kImpactStatic,  ///< eq. (2): guarded impact inside the static friction cone
+  kStick,         ///< eq. (4): static friction -K_p s_pj, with eq. (3) holding
+  kMaxStatic,     ///< eq. (6): largest static friction mu F_cy
+  kKinetic,       ///< eq. (5): kinetic friction mu_D F_cy
+};
+/// "none", "impact_static", "stick", "max_static", "kinetic".
+const char* to_string(Regime regime);
+
+/// Per-PC diagnostics and force.
+struct PcForce {
+  Pc pc;
+  PcExtent extent = PcExtent::kPoint;
+  Mat3 R_WT = Mat3::Identity();   ///< task frame axes in the world (y: normal into A)
+  Vec3 origin_W = Vec3::Zero();   ///< task frame origin, mm
+  Vec3 p_W = Vec3::Zero();        ///< point of action p_j, mm
+  double distance = 0;            ///< d_j, mm
+  double F_cy = 0;                ///< N, eq. (1) (after the hold of section 4.5)
+  double s_mm = 0;                ///< s_pj as used in eq. (3)
+  double s_bound_mm = 0;          ///< mu F_cy / K_p, the eq. (3) bound
+  Vec3 u_T = Vec3::Zero();        ///< [a b c]: unit direction of p_j's motion this tick
+  Regime regime = Regime::kNone;
+  Vec3 F_T = Vec3::Zero();        ///< N, contact force in the task frame [F_cx F_cy F_cz]
+  Vec3 F_W = Vec3::Zero();        ///< N, the same in the world
+  bool gained = false;            ///< the PC MT4 gained
+};
+
+/// Result of one force evaluation. Fixed capacity: no heap.
+struct ForceResult {
+  static constexpr int kMaxPcs = 16;
+  std::array<PcForce, kMaxPcs> pcs{};
+  int num_pcs = 0;
+  bool truncated = false;  ///< more contacts than kMaxPcs were given; the rest are ignored
+  MotionType motion = MotionType::kNone;
+  /// Rendered with the conservative laws (normal force eq. (1) + kinetic friction eq. (5)
+  /// on the non-dominated contacts) because no CF or transition of the graph fits.
+  bool conservative = false;
+  Freedoms freedoms;  ///< of the current PCs (computed for MT2 and MT3)
+  MotionCheck check;  ///< pose change against the freedoms (MT2)
+  Vec3 reference_W = Vec3::Zero();  ///< moment reference point, mm
+  Vec3 centroid_W = Vec3::Zero();   ///< p_g, mm
+  Vec3 F_contact_W = Vec3::Zero();  ///< eq. (7) in the world (after interpolation)
+  Vec3 F_gravity_W = Vec3::Zero();  ///< m g along -y
+  Vec3 F_W = Vec3::Zero();          ///< haptic force F_h = F_c + F_g, world axes
+  Vec3 M_W = Vec3::Zero();          ///< N mm, haptic moment about reference_W, world axes
+  Vec3 F_A = Vec3::Zero();          ///< F_h in A's axes
+  Vec3 M_A = Vec3::Zero();          ///< eq. (9) in A's axes
+};
+
+/// The force model with its per-tick state (stick anchors, held F_cy, previous pose).
+/// Create once; step() allocates nothing.
+class ForceModel {
+ public:
+  /// The models must outlive the ForceModel (they are the graph's models at run time).
+  ForceModel(const Polyhedron& A, const Polyhedron& B, const Params& params = Params());
+
+  /// Forgets the previous tick (anchors, held forces, filter, previous pose).
+  void reset();
+
+  /// One servo tick.
+  /// @param pose          pose of A now.
+  /// @param t_s           time now, s (strictly increasing across calls).
+  /// @param pcs, n        the PCs to render: the identified CF's PCs, or all detected
+  ///                      contacts when `conservative`.
+  /// @param prior         prior motion from classify_prior_motion (the MT2 case is decided
+  ///                      here); ignored when conservative.
+  /// @param conservative  no CF or transition of the graph fits: normal force + kinetic
+  ///                      friction on the contacts that no other contact dominates.
+  const ForceResult& step(const Pose& pose, double t_s, const ContactPc* pcs, int n,
+                          const PriorMotion& prior, bool conservative = false);
+
+  const ForceResult& result() const { return result_; }
+  const Params& params() const { return params_; }
+
+ private:
+  struct Slot {
+    Pc pc;
+    bool used = false;
+    bool seen = false;
+    Vec3 anchor_A = Vec3::Zero();  ///< material point of A the anchor holds, A frame
+    Vec3 anchor_W = Vec3::Zero();  ///< where it is tied, world
+    double held_fcy = 0;
+  };
+  Slot* find_slot(const Pc& pc);
+  Slot* new_slot(const Pc& pc);
+  bool dominated(const ContactPc& x, const ContactPc& y) const;
+
+  const Polyhedron* A_;
+  const Polyhedron* B_;
+  Params params_;
+  Vec3 centroid_A_;
+  std::array<Slot, ForceResult::kMaxPcs> slots_{};
+  bool has_prev_ = false;
+  Pose prev_pose_;
+  double prev_t_ = 0;
+  Vec3 filt_F_ = Vec3::Zero();
+  Vec3 filt_M_ = Vec3::Zero();
+  bool filt_valid_ = false;
+  ForceResult result_;
+};
+
+}  // namespace cf
