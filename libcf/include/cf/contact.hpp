@@ -1,10 +1,13 @@
 #pragma once
 /// @file
 /// Contacts detected at a pose: the candidate principal contacts of SPEC section 6, each
-/// with its distance, point of action and task frame.
+/// with its distance, point of action and task frame, and a fixed-capacity set of them.
 
 #include <cf/graph.hpp>
 #include <cf/types.hpp>
+
+#include <array>
+#include <cstdint>
 
 namespace cf {
 
@@ -16,7 +19,8 @@ PcExtent extent(PcType type);
 struct ContactPc {
   Pc pc;
   /// mm, signed distance along the task frame's y axis: > 0 apart, < 0 interpenetrating.
-  /// Paper eq. (1) uses it as d_j.
+  /// Paper eq. (1) uses it as d_j. For line and plane PCs it is the smallest such distance
+  /// over the contact region (its deepest point).
   double distance = 0;
   /// mm, world frame: the contact point (point PC) or the centroid of the contact region
   /// (line and plane PCs), taken on A.
@@ -25,10 +29,60 @@ struct ContactPc {
   /// pointing into A; origin on the contact plane at the contact point or region centroid.
   Mat3 R_WT = Mat3::Identity();
   Vec3 origin_W = Vec3::Zero();  ///< mm, world frame
-  /// Non-negative residual of the type's geometric conditions (angle misfit in rad for
-  /// parallel types, plus distance / epsilon): smaller fits better. Used to rank
-  /// interpretations.
+  /// Non-negative residual of the type's geometric conditions: smaller fits better. Used to
+  /// rank interpretations. It is the sum of
+  ///   angle / angular tolerance (parallel types: f-f, e-f, f-e),
+  ///   |distance| / epsilon,
+  ///   in-plane gap / epsilon (how far the contact falls outside the face or edge ends),
+  ///   a dominance penalty when another detected contact dominates this one
+  /// (docs/runtime.md gives the tolerances).
   double misfit = 0;
+  /// True when another detected contact dominates this one (SPEC section 4: its elements
+  /// are those of the other or lie on their boundaries), e.g. a v-f beside the e-f of an
+  /// edge ending at that vertex. Dominated contacts remain candidates (paper Fig. 3).
+  bool dominated = false;
+  /// Index of the contact plane group at this pose (contacts whose planes coincide within
+  /// tolerance share it; a CF takes at most one contact per group); -1 before grouping.
+  std::int16_t plane = -1;
+};
+
+/// The contacts detected at one pose: fixed capacity, no heap, created once.
+class ContactSet {
+ public:
+  static constexpr int kCapacity = 256;
+  int size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  /// True when more contacts were found than fit; the extra ones were dropped.
+  bool overflow() const { return overflow_; }
+  /// Number of contact plane groups (ContactPc::plane is in [0, num_planes)).
+  int num_planes() const { return num_planes_; }
+  const ContactPc& operator[](int i) const { return items_[static_cast<std::size_t>(i)]; }
+  ContactPc& operator[](int i) { return items_[static_cast<std::size_t>(i)]; }
+  const ContactPc* begin() const { return items_.data(); }
+  const ContactPc* end() const { return items_.data() + size_; }
+  ContactPc* begin() { return items_.data(); }
+  ContactPc* end() { return items_.data() + size_; }
+  void clear() {
+    size_ = 0;
+    overflow_ = false;
+    num_planes_ = 0;
+  }
+  /// Appends; returns false (and sets overflow) when full.
+  bool push(const ContactPc& c) {
+    if (size_ == kCapacity) {
+      overflow_ = true;
+      return false;
+    }
+    items_[static_cast<std::size_t>(size_++)] = c;
+    return true;
+  }
+  void set_num_planes(int n) { num_planes_ = n; }
+
+ private:
+  std::array<ContactPc, kCapacity> items_{};
+  int size_ = 0;
+  bool overflow_ = false;
+  int num_planes_ = 0;
 };
 
 }  // namespace cf

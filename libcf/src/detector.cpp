@@ -1,0 +1,522 @@
+#include <cf/detector.hpp>
+
+#include "bvh.hpp"
+#include "detector_poly.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace cf {
+
+PcExtent extent(PcType type) {
+  switch (type) {
+    case PcType::kFF:
+      return PcExtent::kPlane;
+    case PcType::kEF:
+    case PcType::kFE:
+      return PcExtent::kLine;
+    default:
+      return PcExtent::kPoint;
+  }
+}
+
+namespace {
+
+using detail::Vec2;
+
+// Flattened 2D loops of every face of a model, in each face's own (u, v) frame.
+struct FlatFaces {
+  std::vector<Vec2> pts;
+  std::vector<int> loop_begin;  // per loop, plus a sentinel
+  std::vector<int> face_first;  // per face, its first loop index, plus a sentinel
+  int max_face_points = 0;
+
+  explicit FlatFaces(const Polyhedron& m) {
+    for (const Face& F : m.faces()) {
+      face_first.push_back(static_cast<int>(loop_begin.size()));
+      int n = 0;
+      for (const auto& loop : F.loops_2d) {
+        loop_begin.push_back(static_cast<int>(pts.size()));
+        pts.insert(pts.end(), loop.begin(), loop.end());
+        n += static_cast<int>(loop.size());
+      }
+      max_face_points = std::max(max_face_points, n);
+    }
+    face_first.push_back(static_cast<int>(loop_begin.size()));
+    loop_begin.push_back(static_cast<int>(pts.size()));
+  }
+  FlatFaces() = default;
+  detail::Poly2 poly(int f) const {
+    const int l0 = face_first[static_cast<std::size_t>(f)];
+    const int l1 = face_first[static_cast<std::size_t>(f) + 1];
+    return {pts.data(), loop_begin.data() + l0, l1 - l0};
+  }
+};
+
+// Per edge, the unit in-face directions perpendicular to it pointing into its left and
+// right faces (model frame): how the solid continues away from the edge.
+struct EdgeWings {
+  Vec3 left, right;
+};
+
+std::vector<EdgeWings> wings_of(const Polyhedron& m) {
+  std::vector<EdgeWings> w;
+  w.reserve(m.num_edges());
+  for (const Edge& e : m.edges()) {
+    const Vec3& nl = m.face(e.left).normal;
+    const Vec3& nr = m.face(e.right).normal;
+    w.push_back({nl.cross(e.dir).normalized(), e.dir.cross(nr).normalized()});
+  }
+  return w;
+}
+
+Mat3 task_frame(const Vec3& y, const Vec3& x_hint) {
+  Vec3 x = x_hint - x_hint.dot(y) * y;
+  if (!(x.squaredNorm() > 1e-20)) {
+    // Any tangent: the world axis least aligned with y.
+    int axis = 0;
+    y.cwiseAbs().minCoeff(&axis);
+    const Vec3 a = Vec3::Unit(axis);
+    x = a - a.dot(y) * y;
+  }
+  x.normalize();
+  Mat3 R;
+  R.col(0) = x;
+  R.col(1) = y;
+  R.col(2) = x.cross(y);
+  return R;
+}
+
+// Minimum distance between 2D segments that do not cross, and the parameter on the first.
+double segment_segment_2d(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d,
+                          double* t_on_first) {
+  auto point_seg = [](const Vec2& p, const Vec2& s0, const Vec2& s1, double* t) {
+    const Vec2 r = s1 - s0;
+    const double len2 = r.squaredNorm();
+    *t = len2 > 0 ? std::clamp((p - s0).dot(r) / len2, 0.0, 1.0) : 0.0;
+    return (s0 + *t * r - p).norm();
+  };
+  double t, best, tb;
+  best = point_seg(c, a, b, &tb);
+  double v = point_seg(d, a, b, &t);
+  if (v < best) best = v, tb = t;
+  v = point_seg(a, c, d, &t);
+  if (v < best) best = v, tb = 0;
+  v = point_seg(b, c, d, &t);
+  if (v < best) best = v, tb = 1;
+  *t_on_first = tb;
+  return best;
+}
+
+}  // namespace
+
+struct ContactDetector::Impl {
+  Polyhedron a, b;
+  DetectionParams prm;
+  double eps, depth, in_plane, geo_tol, area_tol;
+  detail::Bvh bvh_a, bvh_b;
+  FlatFaces flat_a, flat_b;
+  std::vector<EdgeWings> wings_a, wings_b;
+  std::vector<double> extent_a, extent_b;  // per face, sqrt(area): scale of its tilt
+  // Scratch (sized once).
+  std::vector<detail::NodePair> stack;
+  std::vector<Vec2> q_pts;
+  std::vector<int> q_lb;
+  std::vector<double> params;
+  std::vector<Vec3> aw;  // A's vertices in the world at the current pose
+  std::vector<std::uint32_t> aw_stamp;
+  std::uint32_t stamp = 0;
+  // Per call.
+  Pose pose;
+  ContactSet* out = nullptr;
+  std::size_t pairs = 0;
+  std::array<int, ContactSet::kCapacity> reps{};  // first member of each plane group
+
+  Impl(const Polyhedron& ma, const Polyhedron& mb, const DetectionParams& p)
+      : a(ma), b(mb), prm(p), flat_a(ma), flat_b(mb), wings_a(wings_of(ma)), wings_b(wings_of(mb)) {
+    auto check = [](double v, const char* name, bool positive) {
+      if (!std::isfinite(v) || v < 0 || (positive && v == 0))
+        throw Error(std::string("ContactDetector: parameter ") + name + " must be " +
+                    (positive ? "positive" : "non-negative") + ", got " + std::to_string(v));
+    };
+    check(p.epsilon, "epsilon", true);
+    check(p.max_penetration, "max_penetration", false);
+    check(p.min_angular_tolerance, "min_angular_tolerance", true);
+    check(p.max_angular_tolerance, "max_angular_tolerance", true);
+    check(p.dominance_penalty, "dominance_penalty", false);
+    if (!std::isfinite(p.in_plane_tolerance) || !std::isfinite(p.angular_tolerance))
+      throw Error("ContactDetector: in_plane_tolerance and angular_tolerance must be finite");
+    eps = p.epsilon;
+    depth = p.max_penetration;
+    in_plane = p.in_plane_tolerance > 0 ? p.in_plane_tolerance : eps;
+    const double scale = std::max(ma.size(), mb.size());
+    // Coincidence tolerance for boundaries in 2D: far below any feature, far above rounding.
+    geo_tol = 1e-9 * std::max(scale, 1.0);
+    area_tol = 1e-12 * std::max(scale * scale, 1.0);
+    bvh_a = detail::Bvh(ma, 0.0);
+    // B's boxes grow by the deepest band and the in-plane allowance, so that every pair the
+    // exact tests could accept has overlapping boxes.
+    bvh_b = detail::Bvh(mb, std::max(eps, depth) + in_plane + geo_tol);
+    stack.resize(detail::stack_capacity(bvh_a, bvh_b));
+    q_pts.resize(static_cast<std::size_t>(flat_a.max_face_points));
+    std::size_t max_loops = 1;
+    for (const Face& F : ma.faces()) max_loops = std::max(max_loops, F.loops.size());
+    q_lb.resize(max_loops + 1);
+    params.resize(static_cast<std::size_t>(
+        4 + 4 * std::max(flat_a.max_face_points, flat_b.max_face_points)));
+    aw.resize(ma.num_vertices());
+    aw_stamp.assign(ma.num_vertices(), 0);
+    for (const Face& F : ma.faces()) extent_a.push_back(std::sqrt(F.area));
+    for (const Face& F : mb.faces()) extent_b.push_back(std::sqrt(F.area));
+  }
+
+  double tol_for(double extent) const {
+    if (prm.angular_tolerance > 0) return prm.angular_tolerance;
+    const double t = std::atan(eps / std::max(extent, 1e-12));
+    return std::clamp(t, prm.min_angular_tolerance, prm.max_angular_tolerance);
+  }
+
+  const Vec3& world(VertexId v) {
+    const std::size_t i = v.index();
+    if (aw_stamp[i] != stamp) {
+      aw[i] = pose.apply(a.vertex(v).p);
+      aw_stamp[i] = stamp;
+    }
+    return aw[i];
+  }
+
+  void emit(PcType type, int ia, int ib, double d, const Vec3& p_W, const Vec3& origin,
+            const Mat3& R_WT, double misfit) {
+    ContactPc c;
+    c.pc = {type, ia, ib};
+    c.distance = d;
+    c.p_W = p_W;
+    c.origin_W = origin;
+    c.R_WT = R_WT;
+    c.misfit = misfit;
+    out->push(c);
+  }
+
+  bool in_band(double d) const { return d <= eps && d >= -depth; }
+
+  // ---- v-f: vertex of A on face of B ------------------------------------------------------
+  void vf(int v, int fb) {
+    const Face& F = b.faces()[static_cast<std::size_t>(fb)];
+    const Vec3& p = world(VertexId(v));
+    const double h = F.normal.dot(p) - F.offset;
+    if (!in_band(h)) return;
+    // A's edges at the vertex must not run into B (beyond the angular tolerance).
+    for (EdgeId e : a.vertex(VertexId(v)).edges) {
+      const Edge& E = a.edge(e);
+      const Vec3& q = world(E.v0 == VertexId(v) ? E.v1 : E.v0);
+      if (F.normal.dot(q - p) < -std::sin(tol_for(E.length)) * E.length) return;
+    }
+    const detail::Loc2 loc = detail::locate(flat_b.poly(fb), Vec2(F.u.dot(p), F.v.dot(p)));
+    const double gap = (loc.inside || loc.dist <= geo_tol) ? 0.0 : loc.dist;
+    if (gap > in_plane) return;
+    emit(PcType::kVF, v, fb, h, p, p - h * F.normal, task_frame(F.normal, F.u),
+         std::abs(h) / eps + gap / eps);
+  }
+
+  // ---- f-v: face of A on vertex of B -------------------------------------------------------
+  void fv(int fa, int v) {
+    const Face& F = a.faces()[static_cast<std::size_t>(fa)];
+    const Vec3& q = b.vertex(VertexId(v)).p;
+    const Vec3 qA = pose.inverse_apply(q);
+    const double h = F.normal.dot(qA) - F.offset;
+    if (!in_band(h)) return;
+    for (EdgeId e : b.vertex(VertexId(v)).edges) {
+      const Edge& E = b.edge(e);
+      const Vec3& o = b.vertex(E.v0 == VertexId(v) ? E.v1 : E.v0).p;
+      const Vec3 wA = pose.R_BA.transpose() * (o - q);
+      if (F.normal.dot(wA) < -std::sin(tol_for(E.length)) * E.length) return;
+    }
+    const detail::Loc2 loc = detail::locate(flat_a.poly(fa), Vec2(F.u.dot(qA), F.v.dot(qA)));
+    const double gap = (loc.inside || loc.dist <= geo_tol) ? 0.0 : loc.dist;
+    if (gap > in_plane) return;
+    const Vec3 nW = pose.R_BA * F.normal;
+    const Vec3 onA = q - h * nW;
+    emit(PcType::kFV, fa, v, h, onA, onA, task_frame(-nW, pose.R_BA * F.u),
+         std::abs(h) / eps + gap / eps);
+  }
+
+  // Line contact of segment s0->s1 (in the face's model frame) against face f of model m
+  // (flat f): shared by e-f (m = B, segment world) and f-e (m = A, segment in A's frame).
+  // Returns false when not a contact; else the region's centroid parameter, its deepest
+  // height and the in-plane gap.
+  bool line_on_face(const Polyhedron& m, const FlatFaces& flat, int f, const Vec3& s0,
+                    const Vec3& s1, double* t_c, double* d, double* gap) {
+    const Face& F = m.faces()[static_cast<std::size_t>(f)];
+    const double h0 = F.normal.dot(s0) - F.offset, h1 = F.normal.dot(s1) - F.offset;
+    if (std::min(h0, h1) > eps || std::max(h0, h1) < -depth) return false;
+    const Vec2 a2(F.u.dot(s0), F.v.dot(s0)), b2(F.u.dot(s1), F.v.dot(s1));
+    double len = 0, moment = 0, dmin = std::numeric_limits<double>::infinity();
+    detail::clip_segment(a2, b2, flat.poly(f), geo_tol, detail::OnBoundary::kInclude,
+                         params.data(), [&](double t0, double t1) {
+                           len += t1 - t0;
+                           moment += 0.5 * (t1 * t1 - t0 * t0);
+                           dmin = std::min({dmin, h0 + t0 * (h1 - h0), h0 + t1 * (h1 - h0)});
+                         });
+    if (len > 1e-12) {
+      *t_c = moment / len;
+      *d = dmin;
+      *gap = 0;
+    } else {
+      // Beside the face: the nearest in-plane approach to its boundary.
+      const detail::Poly2 P = flat.poly(f);
+      double best = std::numeric_limits<double>::infinity(), tb = 0;
+      for (int l = 0; l < P.num_loops; ++l)
+        for (int i = P.lb[l]; i < P.lb[l + 1]; ++i) {
+          double t;
+          const double g = segment_segment_2d(a2, b2, P.pts[i],
+                                              P.pts[i + 1 == P.lb[l + 1] ? P.lb[l] : i + 1], &t);
+          if (g < best) best = g, tb = t;
+        }
+      if (best > in_plane) return false;
+      *t_c = tb;
+      *d = h0 + tb * (h1 - h0);
+      *gap = best;
+    }
+    return in_band(*d);
+  }
+
+  // ---- e-f: edge of A on face of B ---------------------------------------------------------
+  void ef(int e, int fb) {
+    const Edge& E = a.edges()[static_cast<std::size_t>(e)];
+    if (!E.convex) return;
+    const Face& F = b.faces()[static_cast<std::size_t>(fb)];
+    const Vec3& p0 = world(E.v0);
+    const Vec3& p1 = world(E.v1);
+    const Vec3 dW = pose.R_BA * E.dir;
+    const double ang = std::asin(std::min(1.0, std::abs(dW.dot(F.normal))));
+    const double tol = tol_for(E.length);
+    if (ang > tol) return;
+    const EdgeWings& w = wings_a[static_cast<std::size_t>(e)];
+    if (F.normal.dot(pose.R_BA * w.left) < -std::sin(tol_for(extent_a[E.left.index()])) ||
+        F.normal.dot(pose.R_BA * w.right) < -std::sin(tol_for(extent_a[E.right.index()])))
+      return;
+    double tc, d, gap;
+    if (!line_on_face(b, flat_b, fb, p0, p1, &tc, &d, &gap)) return;
+    const Vec3 p = p0 + tc * (p1 - p0);
+    const double hc = F.normal.dot(p) - F.offset;
+    emit(PcType::kEF, e, fb, d, p, p - hc * F.normal, task_frame(F.normal, dW),
+         ang / tol + std::abs(d) / eps + gap / eps);
+  }
+
+  // ---- f-e: face of A on edge of B ---------------------------------------------------------
+  void fe(int fa, int e) {
+    const Edge& E = b.edges()[static_cast<std::size_t>(e)];
+    if (!E.convex) return;
+    const Face& F = a.faces()[static_cast<std::size_t>(fa)];
+    const Mat3 Rt = pose.R_BA.transpose();
+    const Vec3 dA = Rt * E.dir;
+    const double ang = std::asin(std::min(1.0, std::abs(dA.dot(F.normal))));
+    const double tol = tol_for(E.length);
+    if (ang > tol) return;
+    const EdgeWings& w = wings_b[static_cast<std::size_t>(e)];
+    if (F.normal.dot(Rt * w.left) < -std::sin(tol_for(extent_b[E.left.index()])) ||
+        F.normal.dot(Rt * w.right) < -std::sin(tol_for(extent_b[E.right.index()])))
+      return;
+    const Vec3& q0 = b.vertex(E.v0).p;
+    const Vec3& q1 = b.vertex(E.v1).p;
+    const Vec3 q0A = pose.inverse_apply(q0), q1A = pose.inverse_apply(q1);
+    double tc, d, gap;
+    if (!line_on_face(a, flat_a, fa, q0A, q1A, &tc, &d, &gap)) return;
+    const Vec3 qcA = q0A + tc * (q1A - q0A);
+    const Vec3 onA = pose.apply(qcA - (F.normal.dot(qcA) - F.offset) * F.normal);
+    emit(PcType::kFE, fa, e, d, onA, onA, task_frame(-(pose.R_BA * F.normal), E.dir),
+         ang / tol + std::abs(d) / eps + gap / eps);
+  }
+
+  // ---- f-f: face of A on face of B ---------------------------------------------------------
+  void ff(int fa, int fb) {
+    const Face& FA = a.faces()[static_cast<std::size_t>(fa)];
+    const Face& FB = b.faces()[static_cast<std::size_t>(fb)];
+    const Vec3 nA = pose.R_BA * FA.normal;
+    const double c = -nA.dot(FB.normal);
+    const double tol_cap = prm.angular_tolerance > 0 ? prm.angular_tolerance : prm.max_angular_tolerance;
+    if (c < std::cos(tol_cap)) return;
+    double hmin = std::numeric_limits<double>::infinity(), hmax = -hmin;
+    for (VertexId v : FA.vertices) {
+      const double h = FB.normal.dot(world(v)) - FB.offset;
+      hmin = std::min(hmin, h);
+      hmax = std::max(hmax, h);
+    }
+    if (hmin > eps || hmax < -depth) return;
+    // A's loops in B's face frame, reversed so that they run positively there.
+    int n = 0, nl = 0;
+    for (const auto& loop : FA.loops) {
+      q_lb[static_cast<std::size_t>(nl++)] = n;
+      for (std::size_t k = loop.size(); k-- > 0;) {
+        const Vec3& p = world(loop[k]);
+        q_pts[static_cast<std::size_t>(n++)] = Vec2(FB.u.dot(p), FB.v.dot(p));
+      }
+    }
+    q_lb[static_cast<std::size_t>(nl)] = n;
+    const detail::Poly2 Q{q_pts.data(), q_lb.data(), nl};
+    // Height of A's plane above B's plane at in-plane point (x, y): linear.
+    const double nn = nA.dot(FB.normal);
+    const double offA = nA.dot(pose.t_BA) + FA.offset;
+    const double ku = nA.dot(FB.u) / nn, kv = nA.dot(FB.v) / nn, k0 = offA / nn - FB.offset;
+    auto height = [&](const Vec2& q) { return k0 - ku * q.x() - kv * q.y(); };
+    double dmin = std::numeric_limits<double>::infinity();
+    const detail::Overlap2 ov = detail::overlap(flat_b.poly(fb), Q, geo_tol, params.data(),
+                                                [&](const Vec2& q) { dmin = std::min(dmin, height(q)); });
+    if (!(ov.area > area_tol)) return;
+    const double tol = tol_for((ov.hi - ov.lo).norm());
+    const double ang = std::acos(std::min(1.0, c));
+    if (ang > tol || !in_band(dmin)) return;
+    const Vec3 origin = ov.centroid.x() * FB.u + ov.centroid.y() * FB.v + FB.offset * FB.normal;
+    emit(PcType::kFF, fa, fb, dmin, origin + height(ov.centroid) * FB.normal, origin,
+         task_frame(FB.normal, FB.u), ang / tol + std::abs(dmin) / eps);
+  }
+
+  // ---- e-e: edge of A crossing edge of B ---------------------------------------------------
+  void ee(int ea, int eb) {
+    const Edge& EA = a.edges()[static_cast<std::size_t>(ea)];
+    const Edge& EB = b.edges()[static_cast<std::size_t>(eb)];
+    if (!EA.convex || !EB.convex) return;
+    const Vec3& p0 = world(EA.v0);
+    const Vec3 uA = pose.R_BA * EA.dir;
+    const Vec3& q0 = b.vertex(EB.v0).p;
+    const Vec3& uB = EB.dir;
+    Vec3 n = uA.cross(uB);
+    const double sn = n.norm();
+    const double tol = tol_for(std::min(EA.length, EB.length));
+    if (std::asin(std::min(1.0, sn)) <= tol) return;  // near-parallel: not e-e
+    n /= sn;
+    // Closest points of the two lines (unit directions): s along A, t along B.
+    const Vec3 r = p0 - q0;
+    const double bb = uA.dot(uB), c = uA.dot(r), f = uB.dot(r);
+    const double den = 1 - bb * bb;
+    const double s = (bb * f - c) / den;
+    const double t = (f - bb * c) / den;
+    const double over = std::max({0.0, -s, s - EA.length}) + std::max({0.0, -t, t - EB.length});
+    if (over > in_plane) return;
+    const Vec3 pA = p0 + std::clamp(s, 0.0, EA.length) * uA;
+    const Vec3 pB = q0 + std::clamp(t, 0.0, EB.length) * uB;
+    const Vec3 sumB = b.face(EB.left).normal + b.face(EB.right).normal;
+    const Vec3 sumA = pose.R_BA * (a.face(EA.left).normal + a.face(EA.right).normal);
+    if (n.dot(sumB - sumA) < 0) n = -n;
+    const double d = (pA - pB).dot(n);
+    if (!in_band(d)) return;
+    // The wedges of the two edges must lie on their own sides of the contact plane.
+    const EdgeWings& wa = wings_a[static_cast<std::size_t>(ea)];
+    const EdgeWings& wb = wings_b[static_cast<std::size_t>(eb)];
+    if (n.dot(pose.R_BA * wa.left) < -std::sin(tol_for(extent_a[EA.left.index()])) ||
+        n.dot(pose.R_BA * wa.right) < -std::sin(tol_for(extent_a[EA.right.index()])) ||
+        n.dot(wb.left) > std::sin(tol_for(extent_b[EB.left.index()])) ||
+        n.dot(wb.right) > std::sin(tol_for(extent_b[EB.right.index()])))
+      return;
+    emit(PcType::kEE, ea, eb, d, pA, pB, task_frame(n, uB), std::abs(d) / eps + over / eps);
+  }
+
+  void pair(const detail::BvhElement& x, const detail::BvhElement& y) {
+    using K = ElementKind;
+    ++pairs;
+    switch (x.kind) {
+      case K::kVertex:
+        if (y.kind == K::kFace) vf(x.index, y.index);
+        break;
+      case K::kEdge:
+        if (y.kind == K::kFace) ef(x.index, y.index);
+        else if (y.kind == K::kEdge) ee(x.index, y.index);
+        break;
+      case K::kFace:
+        if (y.kind == K::kFace) ff(x.index, y.index);
+        else if (y.kind == K::kEdge) fe(x.index, y.index);
+        else fv(x.index, y.index);
+        break;
+    }
+  }
+
+  // Is element (ki, i) the element (kj, j) or on its boundary, in model m?
+  static bool within(const Polyhedron& m, ElementKind ki, int i, ElementKind kj, int j) {
+    using K = ElementKind;
+    if (ki == kj) return i == j;
+    if (ki == K::kVertex && kj == K::kEdge) return m.vertex_ends_edge(VertexId(i), EdgeId(j));
+    if (ki == K::kVertex && kj == K::kFace) return m.vertex_on_face(VertexId(i), FaceId(j));
+    if (ki == K::kEdge && kj == K::kFace) return m.edge_bounds_face(EdgeId(i), FaceId(j));
+    return false;
+  }
+
+  void finish(ContactSet& cs) {
+    std::sort(cs.begin(), cs.end(), [](const ContactPc& x, const ContactPc& y) { return x.pc < y.pc; });
+    const int n = cs.size();
+    for (int i = 0; i < n; ++i) {
+      ContactPc& ci = cs[i];
+      const ElementKind ai = a_kind(ci.pc.type), bi = b_kind(ci.pc.type);
+      for (int j = 0; j < n && !ci.dominated; ++j) {
+        if (j == i) continue;
+        const ContactPc& cj = cs[j];
+        if (within(a, ai, ci.pc.a, a_kind(cj.pc.type), cj.pc.a) &&
+            within(b, bi, ci.pc.b, b_kind(cj.pc.type), cj.pc.b))
+          ci.dominated = true;
+      }
+      if (ci.dominated) ci.misfit += prm.dominance_penalty;
+    }
+    // Contact planes: greedy clustering in canonical order.
+    const double cos_tol = std::cos(prm.angular_tolerance > 0 ? prm.angular_tolerance
+                                                              : prm.max_angular_tolerance);
+    int groups = 0;
+    for (int i = 0; i < n; ++i) {
+      ContactPc& ci = cs[i];
+      const Vec3 ni = ci.R_WT.col(1);
+      // Compare with each group's first member.
+      for (int g = 0; g < groups; ++g) {
+        const ContactPc& cj = cs[reps[static_cast<std::size_t>(g)]];
+        const Vec3 nj = cj.R_WT.col(1);
+        if (ni.dot(nj) >= cos_tol && std::abs(nj.dot(ci.origin_W - cj.origin_W)) <= eps &&
+            std::abs(ni.dot(cj.origin_W - ci.origin_W)) <= eps) {
+          ci.plane = static_cast<std::int16_t>(g);
+          break;
+        }
+      }
+      if (ci.plane < 0) {
+        reps[static_cast<std::size_t>(groups)] = i;
+        ci.plane = static_cast<std::int16_t>(groups++);
+      }
+    }
+    cs.set_num_planes(groups);
+  }
+
+  void detect(const Pose& p, ContactSet& cs) {
+    pose = p;
+    out = &cs;
+    cs.clear();
+    pairs = 0;
+    if (++stamp == 0) {
+      std::fill(aw_stamp.begin(), aw_stamp.end(), 0);
+      stamp = 1;
+    }
+    if (!prm.use_bvh) {
+      for (const detail::BvhElement& x : bvh_a.elements())
+        for (const detail::BvhElement& y : bvh_b.elements()) pair(x, y);
+      finish(cs);
+      out = nullptr;
+      return;
+    }
+    // The stack is sized for the trees' depths, so descend cannot overflow it.
+    detail::descend(bvh_a, pose, bvh_b, stack.data(), stack.size(),
+                    [this](const detail::BvhElement& x, const detail::BvhElement& y) { pair(x, y); });
+    finish(cs);
+    out = nullptr;
+  }
+};
+
+ContactDetector::ContactDetector(const Polyhedron& a, const Polyhedron& b, const DetectionParams& params)
+    : impl_(std::make_unique<Impl>(a, b, params)) {}
+ContactDetector::~ContactDetector() = default;
+ContactDetector::ContactDetector(ContactDetector&&) noexcept = default;
+ContactDetector& ContactDetector::operator=(ContactDetector&&) noexcept = default;
+
+void ContactDetector::detect(const Pose& pose, ContactSet& out) { impl_->detect(pose, out); }
+const DetectionParams& ContactDetector::params() const { return impl_->prm; }
+const Polyhedron& ContactDetector::model_a() const { return impl_->a; }
+const Polyhedron& ContactDetector::model_b() const { return impl_->b; }
+std::size_t ContactDetector::last_pairs_tested() const { return impl_->pairs; }
+
+}  // namespace cf

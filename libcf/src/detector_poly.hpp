@@ -1,0 +1,184 @@
+#pragma once
+// Private: 2D polygons with holes as flat arrays, point location, clipping of a segment
+// against a polygon, and the area and centroid of the intersection of two polygons by
+// Green's theorem over the clipped boundaries. Allocation-free: the caller passes scratch.
+//
+// Why not Boost.Geometry here: its intersection allocates internally (turn lists, output
+// rings), and the servo step must not allocate (SPEC section 7). tests/detector_test.cpp
+// checks this code against boost::geometry::intersection.
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace cf::detail {
+
+using Vec2 = Eigen::Vector2d;
+
+/// Loops l in [0, num_loops): points pts[lb[l]] .. pts[lb[l + 1] - 1]; outer loop
+/// counter-clockwise, holes clockwise.
+struct Poly2 {
+  const Vec2* pts = nullptr;
+  const int* lb = nullptr;
+  int num_loops = 0;
+};
+
+struct Loc2 {
+  bool inside = false;   // even-odd over all loops
+  double dist = std::numeric_limits<double>::infinity();  // to the boundary
+  Vec2 closest = Vec2::Zero();
+  Vec2 seg_dir = Vec2::Zero();  // direction (not normalised) of the nearest boundary segment
+};
+
+inline Loc2 locate(const Poly2& P, const Vec2& q) {
+  Loc2 out;
+  double best2 = std::numeric_limits<double>::infinity();
+  bool inside = false;
+  for (int l = 0; l < P.num_loops; ++l) {
+    const int b = P.lb[l], e = P.lb[l + 1];
+    for (int i = b; i < e; ++i) {
+      const Vec2& p0 = P.pts[i];
+      const Vec2& p1 = P.pts[i + 1 == e ? b : i + 1];
+      const Vec2 d = p1 - p0;
+      const double len2 = d.squaredNorm();
+      const double s = len2 > 0 ? std::clamp((q - p0).dot(d) / len2, 0.0, 1.0) : 0.0;
+      const Vec2 c = p0 + s * d;
+      const double d2 = (c - q).squaredNorm();
+      if (d2 < best2) {
+        best2 = d2;
+        out.closest = c;
+        out.seg_dir = d;
+      }
+      if ((p0.y() > q.y()) != (p1.y() > q.y())) {
+        const double x = p0.x() + (q.y() - p0.y()) / (p1.y() - p0.y()) * (p1.x() - p0.x());
+        if (x > q.x()) inside = !inside;
+      }
+    }
+  }
+  out.dist = std::sqrt(best2);
+  out.inside = inside;
+  return out;
+}
+
+inline double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+/// How a piece of the segment lying on P's boundary (within tol) is classified.
+enum class OnBoundary { kInclude, kSameDirection, kExclude };
+
+/// Calls piece(t0, t1) for every maximal piece [t0, t1] of segment a->b (t in [0, 1]) inside
+/// P. `params` is scratch with room for 2 + 2 * (number of P's vertices) doubles.
+template <class Piece>
+void clip_segment(const Vec2& a, const Vec2& b, const Poly2& P, double tol, OnBoundary mode,
+                  double* params, Piece&& piece) {
+  const Vec2 r = b - a;
+  const double rlen = r.norm();
+  if (!(rlen > 0)) return;
+  int n = 0;
+  params[n++] = 0;
+  params[n++] = 1;
+  for (int l = 0; l < P.num_loops; ++l) {
+    const int lb = P.lb[l], le = P.lb[l + 1];
+    for (int i = lb; i < le; ++i) {
+      const Vec2& c = P.pts[i];
+      const Vec2& d = P.pts[i + 1 == le ? lb : i + 1];
+      const Vec2 s = d - c;
+      const Vec2 qa = c - a;
+      const double denom = cross2(r, s);
+      const double slen = s.norm();
+      if (std::abs(denom) > 1e-12 * rlen * slen) {
+        const double t = cross2(qa, s) / denom;
+        const double u = cross2(qa, r) / denom;
+        if (u >= -1e-12 && u <= 1 + 1e-12 && t > 0 && t < 1) params[n++] = t;
+      } else if (std::abs(cross2(qa, r)) / rlen <= tol) {
+        // Collinear within tol: the overlap's ends split the segment.
+        const double tc = qa.dot(r) / (rlen * rlen);
+        const double td = (d - a).dot(r) / (rlen * rlen);
+        if (tc > 0 && tc < 1) params[n++] = tc;
+        if (td > 0 && td < 1) params[n++] = td;
+      }
+    }
+  }
+  // Insertion sort: few parameters in practice.
+  for (int i = 1; i < n; ++i) {
+    const double v = params[i];
+    int j = i - 1;
+    while (j >= 0 && params[j] > v) {
+      params[j + 1] = params[j];
+      --j;
+    }
+    params[j + 1] = v;
+  }
+  const double tmin = 1e-12;
+  double run0 = -1, run1 = -1;  // current run of included pieces, merged
+  for (int i = 0; i + 1 < n; ++i) {
+    const double t0 = params[i], t1 = params[i + 1];
+    if (t1 - t0 <= tmin) continue;
+    const Vec2 m = a + (0.5 * (t0 + t1)) * r;
+    const Loc2 loc = locate(P, m);
+    bool in;
+    if (loc.dist <= tol) {
+      in = mode == OnBoundary::kInclude ||
+           (mode == OnBoundary::kSameDirection && loc.seg_dir.dot(r) > 0);
+    } else {
+      in = loc.inside;
+    }
+    if (in) {
+      if (run0 >= 0 && std::abs(run1 - t0) <= tmin) {
+        run1 = t1;
+      } else {
+        if (run0 >= 0) piece(run0, run1);
+        run0 = t0;
+        run1 = t1;
+      }
+    }
+  }
+  if (run0 >= 0) piece(run0, run1);
+}
+
+/// Area, centroid and the points' extent of the intersection of P and Q (both positively
+/// oriented), accumulated from the boundary pieces of each inside the other. `visit(p)`
+/// sees every vertex of the intersection's boundary (e.g. to take the deepest point).
+struct Overlap2 {
+  double area = 0;
+  Vec2 centroid = Vec2::Zero();
+  Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity());
+  Vec2 hi = Vec2::Constant(-std::numeric_limits<double>::infinity());
+};
+
+template <class Visit>
+Overlap2 overlap(const Poly2& P, const Poly2& Q, double tol, double* params, Visit&& visit) {
+  double a2 = 0, cx = 0, cy = 0;
+  Overlap2 out;
+  auto add = [&](const Vec2& p, const Vec2& q) {
+    const double c = cross2(p, q);
+    a2 += c;
+    cx += (p.x() + q.x()) * c;
+    cy += (p.y() + q.y()) * c;
+    out.lo = out.lo.cwiseMin(p).cwiseMin(q);
+    out.hi = out.hi.cwiseMax(p).cwiseMax(q);
+    visit(p);
+    visit(q);
+  };
+  auto edges_of = [&](const Poly2& S, const Poly2& T, OnBoundary mode) {
+    for (int l = 0; l < S.num_loops; ++l) {
+      const int lb = S.lb[l], le = S.lb[l + 1];
+      for (int i = lb; i < le; ++i) {
+        const Vec2& a = S.pts[i];
+        const Vec2& b = S.pts[i + 1 == le ? lb : i + 1];
+        const Vec2 r = b - a;
+        clip_segment(a, b, T, tol, mode, params,
+                     [&](double t0, double t1) { add(a + t0 * r, a + t1 * r); });
+      }
+    }
+  };
+  // Shared boundary running the same way is taken once (from P); opposite ways cancel.
+  edges_of(P, Q, OnBoundary::kSameDirection);
+  edges_of(Q, P, OnBoundary::kExclude);
+  out.area = 0.5 * a2;
+  if (a2 > 0) out.centroid = Vec2(cx, cy) / (3.0 * a2);
+  return out;
+}
+
+}  // namespace cf::detail

@@ -1,0 +1,312 @@
+#include <cf/detector.hpp>
+#include <cf/geometry.hpp>
+
+#include "../bench/runtime_models.hpp"
+#include "detector_poly.hpp"
+
+#include <boost/geometry.hpp>
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+namespace {
+
+using cf::PcType;
+using cf::Vec3;
+namespace tm = cf::testmodels;
+
+// Poses are built from round numbers; results follow through a few rotations: 1e-9 mm.
+constexpr double kTol = 1e-9;
+
+Eigen::Matrix3d rot(double angle, const Vec3& axis) {
+  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+}
+
+cf::Pose pose(const Eigen::Matrix3d& R, const Vec3& t) {
+  cf::Pose p;
+  p.R_BA = R;
+  p.t_BA = t;
+  return p;
+}
+
+int count(const cf::ContactSet& cs, PcType type) {
+  int n = 0;
+  for (const cf::ContactPc& c : cs) n += c.pc.type == type;
+  return n;
+}
+
+const cf::ContactPc* find(const cf::ContactSet& cs, PcType type, int a, int b) {
+  for (const cf::ContactPc& c : cs)
+    if (c.pc == cf::Pc{type, a, b}) return &c;
+  return nullptr;
+}
+
+int edge_between(const cf::Polyhedron& m, int v0, int v1) {
+  for (std::size_t e = 0; e < m.num_edges(); ++e) {
+    const cf::Edge& E = m.edges()[e];
+    if ((E.v0.value() == v0 && E.v1.value() == v1) || (E.v0.value() == v1 && E.v1.value() == v0))
+      return static_cast<int>(e);
+  }
+  return -1;
+}
+
+void check_frame(const cf::ContactPc& c) {
+  CHECK((c.R_WT.transpose() * c.R_WT - Eigen::Matrix3d::Identity()).norm() < 1e-12);
+  CHECK(c.R_WT.determinant() == Approx(1.0).margin(1e-12));
+}
+
+}  // namespace
+
+TEST_CASE("cube resting flat on the slab: one plane, f-f undominated", "[detector]") {
+  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  // Cube face 2 (y = -15) 0.3 mm above the slab top (B face 4, y = 20).
+  det.detect(pose(Eigen::Matrix3d::Identity(), {70, 35.3, 40}), cs);
+  REQUIRE(cs.size() == 9);  // f-f, 4 e-f, 4 v-f
+  CHECK(cs.num_planes() == 1);
+  CHECK(count(cs, PcType::kFF) == 1);
+  CHECK(count(cs, PcType::kEF) == 4);
+  CHECK(count(cs, PcType::kVF) == 4);
+  const cf::ContactPc* ff = find(cs, PcType::kFF, 2, 4);
+  REQUIRE(ff);
+  CHECK_FALSE(ff->dominated);
+  CHECK(ff->distance == Approx(0.3).margin(kTol));
+  CHECK((ff->origin_W - Vec3(70, 20, 40)).norm() < kTol);  // centroid of the overlap
+  CHECK((ff->p_W - Vec3(70, 20.3, 40)).norm() < kTol);
+  CHECK((ff->R_WT.col(1) - Vec3(0, 1, 0)).norm() < kTol);
+  check_frame(*ff);
+  for (const cf::ContactPc& c : cs) {
+    if (c.pc.type != PcType::kFF) CHECK(c.dominated);
+    CHECK(c.misfit >= ff->misfit);
+    CHECK(c.distance == Approx(0.3).margin(kTol));
+  }
+}
+
+TEST_CASE("cube half over the slab's edge: overlap centroid of the shared part", "[detector]") {
+  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  // Cube x in [110, 140]: overlap with the slab top x in [110, 120], z in [25, 55].
+  det.detect(pose(Eigen::Matrix3d::Identity(), {125, 35.5, 40}), cs);
+  const cf::ContactPc* ff = find(cs, PcType::kFF, 2, 4);
+  REQUIRE(ff);
+  CHECK((ff->origin_W - Vec3(115, 20, 40)).norm() < kTol);
+  CHECK(ff->distance == Approx(0.5).margin(kTol));
+  // The slab's edge at x = 120 under the cube's face: f-e, same plane.
+  const int e = edge_between(b, 2, 8);
+  const cf::ContactPc* fe = find(cs, PcType::kFE, 2, e);
+  REQUIRE(fe);
+  CHECK(fe->plane == ff->plane);
+  CHECK((fe->origin_W - Vec3(120, 20.5, 40)).norm() < kTol);
+  CHECK((fe->R_WT.col(0).cross(Vec3(0, 0, 1))).norm() < kTol);  // x along the edge
+  check_frame(*fe);
+}
+
+TEST_CASE("cube in the corner of the L: two contact planes", "[detector]") {
+  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  det.detect(pose(Eigen::Matrix3d::Identity(), {35.2, 35.4, 40}), cs);
+  CHECK(cs.num_planes() == 2);
+  const cf::ContactPc* slab = find(cs, PcType::kFF, 2, 4);
+  const cf::ContactPc* wall = find(cs, PcType::kFF, 5, 5);  // cube face x = -15 on x = 20
+  REQUIRE(slab);
+  REQUIRE(wall);
+  CHECK(slab->distance == Approx(0.4).margin(kTol));
+  CHECK(wall->distance == Approx(0.2).margin(kTol));
+  CHECK((wall->R_WT.col(1) - Vec3(1, 0, 0)).norm() < kTol);
+  CHECK(slab->plane != wall->plane);
+}
+
+TEST_CASE("cube on an edge: e-f with the task frame along the edge", "[detector]") {
+  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  // Rotated 45 degrees about z: the edge through A's vertices 0 and 4 (x = y = -15, along z)
+  // is lowest, at height 15 sqrt(2) below the centre.
+  const double h = 15 * std::sqrt(2.0);
+  det.detect(pose(rot(M_PI / 4, {0, 0, 1}), {70, 20 + h + 0.25, 40}), cs);
+  REQUIRE(count(cs, PcType::kEF) == 1);
+  const cf::ContactPc& c = *std::find_if(cs.begin(), cs.end(),
+                                         [](const cf::ContactPc& x) { return x.pc.type == PcType::kEF; });
+  CHECK(c.pc.a == edge_between(a, 0, 4));  // x = y = -15 turns to (0, -15 sqrt 2)
+  CHECK(c.pc.b == 4);
+  CHECK(c.distance == Approx(0.25).margin(kTol));
+  CHECK((c.origin_W - Vec3(70, 20, 40)).norm() < kTol);
+  CHECK((c.p_W - Vec3(70, 20.25, 40)).norm() < kTol);
+  CHECK(std::abs(c.R_WT.col(0).dot(Vec3(0, 0, 1))) == Approx(1).margin(kTol));
+  check_frame(c);
+  CHECK(count(cs, PcType::kVF) == 2);  // its end vertices, dominated
+  CHECK(cs.num_planes() == 1);
+}
+
+TEST_CASE("a slightly tilted edge gives e-f and the v-f of its lower end (paper Fig. 3)", "[detector]") {
+  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  const Eigen::Matrix3d R = rot(0.01, {1, 0, 0}) * rot(M_PI / 4, {0, 0, 1});
+  const double h = 15 * std::sqrt(2.0);
+  det.detect(pose(R, {70, 20 + h + 0.2, 40}), cs);
+  const cf::ContactPc* ef = nullptr;
+  for (const cf::ContactPc& c : cs)
+    if (c.pc.type == PcType::kEF) ef = &c;
+  REQUIRE(ef);
+  // The edge's end vertex that is lower (z = -15 end tilts down for +x rotation? whichever):
+  // exactly one of the two end vertices is within epsilon and dominated by the e-f.
+  int vfs = 0;
+  for (const cf::ContactPc& c : cs)
+    if (c.pc.type == PcType::kVF) {
+      ++vfs;
+      CHECK(c.dominated);
+      CHECK(c.misfit > ef->misfit);
+    }
+  CHECK(vfs >= 1);
+  CHECK(ef->misfit > 0);
+}
+
+TEST_CASE("cube on a corner: a single v-f", "[detector]") {
+  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  // Turn the diagonal to vertex 0 (-15,-15,-15) straight down.
+  const Eigen::Matrix3d R =
+      Eigen::Quaterniond::FromTwoVectors(Vec3(-1, -1, -1).normalized(), Vec3(0, -1, 0)).toRotationMatrix();
+  const Vec3 v0 = R * Vec3(-15, -15, -15);
+  det.detect(pose(R, Vec3(70, 20.4, 40) - v0), cs);
+  REQUIRE(cs.size() == 1);
+  CHECK(cs[0].pc == cf::Pc{PcType::kVF, 0, 4});
+  CHECK(cs[0].distance == Approx(0.4).margin(kTol));
+  CHECK((cs[0].p_W - Vec3(70, 20.4, 40)).norm() < kTol);
+  CHECK((cs[0].origin_W - Vec3(70, 20, 40)).norm() < kTol);
+  CHECK_FALSE(cs[0].dominated);
+}
+
+TEST_CASE("a face of A on a vertex of B: f-v", "[detector]") {
+  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  // A's bottom face (2, normal -y in A) tilted so that it slopes away beyond the wall's
+  // corner vertex 11 = (0, 80, 80).
+  const Vec3 n = Vec3(0.3, -1, -0.2).normalized();
+  const Eigen::Matrix3d R = Eigen::Quaterniond::FromTwoVectors(Vec3(0, -1, 0), n).toRotationMatrix();
+  const Vec3 q(0, 80, 80);
+  const double h = 0.6;
+  det.detect(pose(R, q - h * n - R * Vec3(0, -15, 0)), cs);
+  REQUIRE(cs.size() == 1);
+  CHECK(cs[0].pc == cf::Pc{PcType::kFV, 2, 11});
+  CHECK(cs[0].distance == Approx(h).margin(kTol));
+  CHECK((cs[0].R_WT.col(1) + n).norm() < kTol);
+  CHECK((cs[0].p_W - (q - h * n)).norm() < kTol);
+  check_frame(cs[0]);
+}
+
+TEST_CASE("an edge of A crossing the slab's edge: e-e", "[detector]") {
+  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  // After Rx(45) the edge from (-15,-15,15) to (15,-15,15) is lowest; Rz(-30) tilts it down
+  // towards +x. Its midpoint is put 0.5 mm above the slab's edge x = 120, y = 20.
+  const Eigen::Matrix3d R = rot(-M_PI / 6, {0, 0, 1}) * rot(M_PI / 4, {1, 0, 0});
+  const Vec3 mid_A(0, -15, 15);
+  det.detect(pose(R, Vec3(120, 20.5, 40) - R * mid_A), cs);
+  REQUIRE(cs.size() == 1);
+  const cf::ContactPc& c = cs[0];
+  CHECK(c.pc.type == PcType::kEE);
+  CHECK(c.pc.a == edge_between(a, 4, 5));
+  CHECK(c.pc.b == edge_between(b, 2, 8));
+  CHECK(c.distance == Approx(0.5 * std::cos(M_PI / 6)).margin(kTol));
+  CHECK((c.R_WT.col(1) - Vec3(0.5, std::cos(M_PI / 6), 0)).norm() < kTol);
+  check_frame(c);
+}
+
+TEST_CASE("no contact far away; a deep penetration is not a contact", "[detector]") {
+  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  det.detect(pose(Eigen::Matrix3d::Identity(), {70, 60, 40}), cs);
+  CHECK(cs.empty());
+  det.detect(pose(Eigen::Matrix3d::Identity(), {70, 36.01, 40}), cs);  // 1.01 mm apart
+  CHECK(cs.empty());
+  det.detect(pose(Eigen::Matrix3d::Identity(), {70, 34.5, 40}), cs);  // 0.5 mm deep
+  CHECK(count(cs, PcType::kFF) == 1);
+  CHECK(find(cs, PcType::kFF, 2, 4)->distance == Approx(-0.5).margin(kTol));
+}
+
+TEST_CASE("bad parameters are rejected with their name", "[detector]") {
+  cf::DetectionParams p;
+  p.epsilon = -1;
+  CHECK_THROWS_WITH(cf::ContactDetector(tm::cube(), tm::l_block(), p),
+                    Catch::Contains("parameter epsilon must be positive"));
+}
+
+TEST_CASE("overlap of polygons with holes matches Boost.Geometry", "[detector]") {
+  namespace bg = boost::geometry;
+  using BPoint = bg::model::d2::point_xy<double>;
+  using BPoly = bg::model::polygon<BPoint, false>;  // counter-clockwise outer rings
+  // P: 10 x 10 square with a 4 x 4 hole; Q: an L-shaped hexagon, shifted around.
+  std::vector<cf::detail::Vec2> p = {{0, 0}, {10, 0}, {10, 10}, {0, 10}, {3, 3}, {3, 7}, {7, 7}, {7, 3}};
+  const int plb[] = {0, 4, 8};
+  const cf::detail::Poly2 P{p.data(), plb, 2};
+  BPoly bp;
+  bg::read_wkt("POLYGON((0 0,10 0,10 10,0 10,0 0),(3 3,3 7,7 7,7 3,3 3))", bp);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-8, 8);
+  std::vector<double> scratch(64);
+  for (int k = 0; k < 200; ++k) {
+    const double dx = U(rng), dy = U(rng);
+    std::vector<cf::detail::Vec2> q = {{0, 0}, {8, 0}, {8, 3}, {3, 3}, {3, 8}, {0, 8}};
+    for (auto& v : q) v += cf::detail::Vec2(dx, dy);
+    if (k % 10 == 0)  // exact edge coincidences
+      for (auto& v : q) v -= cf::detail::Vec2(dx, dy);
+    const int qlb[] = {0, 6};
+    const cf::detail::Poly2 Q{q.data(), qlb, 1};
+    const cf::detail::Overlap2 ov = cf::detail::overlap(P, Q, 1e-9, scratch.data(), [](const auto&) {});
+    BPoly bq;
+    for (const auto& v : q) bg::append(bq.outer(), BPoint(v.x(), v.y()));
+    bg::append(bq.outer(), BPoint(q[0].x(), q[0].y()));
+    std::vector<BPoly> inter;
+    bg::intersection(bp, bq, inter);
+    double area = 0, cx = 0, cy = 0;
+    for (const BPoly& g : inter) {
+      const double ag = bg::area(g);
+      BPoint c(0, 0);
+      bg::centroid(g, c);
+      area += ag;
+      cx += ag * c.x();
+      cy += ag * c.y();
+    }
+    INFO("shift " << dx << ", " << dy);
+    CHECK(ov.area == Approx(area).margin(1e-9));
+    if (area > 1e-6) {
+      CHECK(ov.centroid.x() == Approx(cx / area).margin(1e-9));
+      CHECK(ov.centroid.y() == Approx(cy / area).margin(1e-9));
+    }
+  }
+}
+
+TEST_CASE("the BVH finds what all pairs find on faceted spheres", "[detector]") {
+  // 600 and 672 faces: enough for the culling to matter, small enough for all pairs.
+  const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30);
+  const cf::Polyhedron b = tm::faceted_sphere(50, 21, 32);
+  cf::DetectionParams all;
+  all.use_bvh = false;
+  cf::ContactDetector fast(a, b), slow(a, b, all);
+  cf::ContactSet x, y;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> U(-1, 1);
+  int contacts = 0;
+  for (int k = 0; k < 12; ++k) {
+    const Vec3 dir = Vec3(U(rng), U(rng), U(rng)).normalized();
+    const Eigen::Matrix3d R = rot(3 * U(rng), Vec3(U(rng), U(rng), U(rng)));
+    const cf::Pose p = pose(R, dir * (80 + 0.5 * U(rng) - 0.3));
+    fast.detect(p, x);
+    slow.detect(p, y);
+    REQUIRE(x.size() == y.size());
+    for (int i = 0; i < x.size(); ++i) CHECK(x[i].pc == y[i].pc);
+    contacts += x.size();
+    CHECK(fast.last_pairs_tested() * 100 < slow.last_pairs_tested());
+  }
+  CHECK(contacts > 0);
+}
