@@ -1,0 +1,217 @@
+// HapticRenderer: status and motion bookkeeping over a small graph, the full servo step on
+// the paper's cube and L-block, and no heap allocation inside step().
+
+#include <cf/renderer.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <set>
+
+// Counts every allocation of this process (the test is single-threaded).
+static std::atomic<long> g_allocations{0};
+void* operator new(std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace {
+
+constexpr double kTol = 1e-9;
+
+// A polyhedron from its vertices and face loops (every loop side is an edge).
+cf::Polyhedron from_loops(const std::string& name, const std::vector<cf::Vec3>& v,
+                          const std::vector<std::vector<int>>& faces) {
+  std::set<std::array<int, 2>> edges;
+  std::vector<std::vector<std::vector<int>>> loops;
+  for (const auto& f : faces) {
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      const int a = f[i], b = f[(i + 1) % f.size()];
+      edges.insert({std::min(a, b), std::max(a, b)});
+    }
+    loops.push_back({f});
+  }
+  return cf::Polyhedron::from_features(name, v, {edges.begin(), edges.end()}, loops);
+}
+
+// data/models/cube.off: 30 mm, centred on its origin.
+cf::Polyhedron cube() {
+  return from_loops("cube",
+                    {{-15, -15, -15}, {15, -15, -15}, {15, 15, -15}, {-15, 15, -15},
+                     {-15, -15, 15}, {15, -15, 15}, {15, 15, 15}, {-15, 15, 15}},
+                    {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}});
+}
+
+// data/models/l_block.off: slab y in [0,20] over x in [0,120], wall x in [0,20] up to
+// y = 80, z in [0,80]. Face 4 is the floor (y = 20), face 5 the inner wall (x = 20).
+cf::Polyhedron l_block() {
+  return from_loops("l_block",
+                    {{0, 0, 0}, {120, 0, 0}, {120, 20, 0}, {20, 20, 0}, {20, 80, 0}, {0, 80, 0},
+                     {0, 0, 80}, {120, 0, 80}, {120, 20, 80}, {20, 20, 80}, {20, 80, 80}, {0, 80, 80}},
+                    {{5, 4, 3, 2, 1, 0}, {6, 7, 8, 9, 10, 11}, {0, 1, 7, 6}, {1, 2, 8, 7},
+                     {2, 3, 9, 8}, {3, 4, 10, 9}, {4, 5, 11, 10}, {5, 0, 6, 11}});
+}
+
+const cf::Pc kFloor{cf::PcType::kFF, 2, 4};  // cube bottom on the floor
+const cf::Pc kWall{cf::PcType::kFF, 5, 5};   // cube -x face on the inner wall
+
+cf::Pose at(double x, double y, double z) {
+  cf::Pose p;
+  p.t_BA = {x, y, z};
+  return p;
+}
+
+// Floor, wall and corner CFs with their gain/lose transitions.
+cf::CfGraph corner_graph() {
+  std::vector<cf::CfRecord> cfs(3);
+  cfs[0].pcs = cf::PcSet({kFloor});
+  cfs[0].witness = at(70, 35, 40);
+  cfs[1].pcs = cf::PcSet({kWall});
+  cfs[1].witness = at(35, 60, 40);
+  cfs[2].pcs = cf::PcSet({kFloor, kWall});
+  cfs[2].witness = at(35, 35, 40);
+  std::vector<cf::Transition> tr = {{cf::CfId(0), cf::CfId(2), cf::TransitionKind::kGain},
+                                    {cf::CfId(2), cf::CfId(0), cf::TransitionKind::kLose},
+                                    {cf::CfId(1), cf::CfId(2), cf::TransitionKind::kGain},
+                                    {cf::CfId(2), cf::CfId(1), cf::TransitionKind::kLose}};
+  return cf::CfGraph::from_parts(cube(), l_block(), std::move(cfs), std::move(tr));
+}
+
+cf::ContactPc floor_pc(const cf::Pose& p) {
+  cf::ContactPc c;
+  c.pc = kFloor;
+  c.p_W = p.apply({0, -15, 0});
+  c.distance = c.p_W.y() - 20;
+  c.origin_W = c.p_W - cf::Vec3(0, c.distance, 0);
+  c.R_WT.col(0) = cf::Vec3(1, 0, 0);
+  c.R_WT.col(1) = cf::Vec3(0, 1, 0);
+  c.R_WT.col(2) = cf::Vec3(0, 0, 1);
+  return c;
+}
+cf::ContactPc wall_pc(const cf::Pose& p) {
+  cf::ContactPc c;
+  c.pc = kWall;
+  c.p_W = p.apply({-15, 0, 0});
+  c.distance = c.p_W.x() - 20;
+  c.origin_W = c.p_W - cf::Vec3(c.distance, 0, 0);
+  c.R_WT.col(0) = cf::Vec3(0, 0, 1);
+  c.R_WT.col(1) = cf::Vec3(1, 0, 0);
+  c.R_WT.col(2) = cf::Vec3(0, 1, 0);
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("renderer bookkeeping: CF, motion and status over given identifications", "[renderer]") {
+  const cf::CfGraph g = corner_graph();
+  cf::HapticRenderer r(g);
+  double t = 0;
+  auto tick = [&](const cf::Pose& p, int cf, std::vector<cf::ContactPc> pcs) -> const cf::HapticResult& {
+    t += 0.001;
+    return r.step_identified(p, t, cf::CfId(cf), pcs.data(), static_cast<int>(pcs.size()), pcs.data(),
+                             static_cast<int>(pcs.size()));
+  };
+  const cf::HapticResult& a = tick(at(70, 40, 40), -1, {});
+  CHECK(a.status == cf::RenderStatus::kNoContact);
+  CHECK(a.motion == cf::MotionType::kNone);
+  CHECK((a.F_W - cf::Vec3(0, -4.9, 0)).norm() < kTol);
+
+  const cf::HapticResult& b = tick(at(70, 35.5, 40), 0, {floor_pc(at(70, 35.5, 40))});
+  CHECK(b.status == cf::RenderStatus::kOk);
+  CHECK(b.motion == cf::MotionType::kMT1);
+  CHECK(b.cf == cf::CfId(0));
+  CHECK(b.force->pcs[0].F_cy == Approx(1.15).margin(kTol));
+
+  CHECK(tick(at(70, 35.5, 40), 0, {floor_pc(at(70, 35.5, 40))}).motion == cf::MotionType::kMT2a);
+
+  const cf::Pose c = at(35.4, 35.5, 40);
+  const cf::HapticResult& gain = tick(c, 2, {wall_pc(c), floor_pc(c)});  // any order
+  CHECK(gain.motion == cf::MotionType::kMT4);
+  CHECK(gain.status == cf::RenderStatus::kOk);
+  CHECK(gain.pcs.size() == 2);
+  CHECK(gain.force->pcs[1].pc == kWall);
+  CHECK(gain.force->pcs[1].gained);
+
+  const cf::HapticResult& lose = tick(at(36.0, 35.5, 40), 0, {floor_pc(at(36.0, 35.5, 40))});
+  CHECK(lose.motion == cf::MotionType::kMT5);
+
+  // CF 0 -> CF 1 is not a transition of the graph: rendered conservatively and flagged.
+  const cf::HapticResult& jump = tick(at(35.5, 60, 40), 1, {wall_pc(at(35.5, 60, 40))});
+  CHECK(jump.status == cf::RenderStatus::kUnlistedTransition);
+  CHECK(jump.motion == cf::MotionType::kNone);
+  CHECK(jump.force->conservative);
+  CHECK(jump.force->pcs[0].regime == cf::Regime::kKinetic);
+
+  // Contacts that no CF fits.
+  std::vector<cf::ContactPc> odd = {floor_pc(at(35.5, 35.5, 40))};
+  t += 0.001;
+  const cf::HapticResult& nf = r.step_identified(at(35.5, 35.5, 40), t, cf::CfId(), nullptr, 0, odd.data(), 1);
+  CHECK(nf.status == cf::RenderStatus::kNoFittingCf);
+  CHECK(nf.cf == cf::CfId());
+  CHECK(nf.force->num_pcs == 1);
+  CHECK(std::string(cf::to_string(nf.status)) == "no_fitting_cf");
+}
+
+TEST_CASE("full servo step: the cube lands on the L-block floor and slides into the corner", "[renderer]") {
+  const cf::CfGraph g = corner_graph();
+  cf::HapticRenderer r(g);
+  double t = 0;
+  // Descend from 5 mm above the floor to a 0.5 mm overlap of the threshold band, 10 um/tick.
+  cf::Pose p = at(70, 40, 40);
+  const cf::HapticResult* res = nullptr;
+  bool saw_mt1 = false;
+  for (int i = 0; i <= 450; ++i) {
+    p.t_BA.y() = 40 - 0.01 * i;
+    res = &r.step(p, t += 0.001);
+    saw_mt1 = saw_mt1 || res->motion == cf::MotionType::kMT1;
+  }
+  CHECK(saw_mt1);
+  REQUIRE(res->cf == cf::CfId(0));
+  CHECK(res->motion == cf::MotionType::kMT2a);
+  CHECK(res->force->pcs[0].distance == Approx(0.5).margin(1e-9));
+  CHECK(res->F_W.y() == Approx(1.15 - 4.9).margin(1e-9));
+  // Slide towards the wall, 20 um per tick, until the -x face is within 0.5 mm of it.
+  bool saw_kinetic = false, saw_gain = false;
+  while (p.t_BA.x() > 35.5 + 1e-9) {
+    p.t_BA.x() -= 0.02;
+    res = &r.step(p, t += 0.001);
+    for (int k = 0; k < res->force->num_pcs; ++k)
+      saw_kinetic = saw_kinetic || res->force->pcs[k].regime == cf::Regime::kKinetic;
+    saw_gain = saw_gain || res->motion == cf::MotionType::kMT4;
+  }
+  CHECK(saw_kinetic);
+  CHECK(saw_gain);
+  CHECK(res->cf == cf::CfId(2));
+  CHECK(res->status == cf::RenderStatus::kOk);
+}
+
+TEST_CASE("the servo step allocates nothing", "[renderer]") {
+  const cf::CfGraph g = corner_graph();
+  cf::HapticRenderer r(g);
+  cf::Pose p = at(70, 40, 40);
+  double t = 0;
+  r.step(p, t += 0.001);  // warm-up outside the count
+  const long before = g_allocations.load();
+  for (int i = 0; i < 3000; ++i) {
+    if (i < 450) p.t_BA.y() -= 0.01;                   // land
+    else if (p.t_BA.x() > 35.6) p.t_BA.x() -= 0.02;   // slide into the corner
+    else p.t_BA.y() += 0.01;                           // lift off the floor
+    r.step(p, t += 0.001);
+  }
+  const cf::ContactPc c = floor_pc(at(70, 35.5, 40));
+  r.step_identified(at(70, 35.5, 40), t += 0.001, cf::CfId(0), &c, 1, &c, 1);
+  CHECK(g_allocations.load() - before == 0);
+}
