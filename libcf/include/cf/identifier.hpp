@@ -1,0 +1,87 @@
+#pragma once
+/// @file
+/// Run-time CF identification (SPEC section 6, paper section 4.1): detect the candidate PCs
+/// at a pose and choose among their consistent interpretations a PC set that is a CF of the
+/// graph, preferring the previous CF, then a graph neighbour of it, then the best geometric
+/// fit. Bounded time, no heap allocation per step. docs/runtime.md describes the rules.
+
+#include <cf/contact.hpp>
+#include <cf/detector.hpp>
+#include <cf/graph.hpp>
+
+#include <array>
+#include <cstdint>
+
+namespace cf {
+
+/// Parameters of identification.
+struct IdentificationParams {
+  DetectionParams detection;
+  /// Most interpretations (one candidate or none per contact plane) examined per step;
+  /// enumeration goes from the best-fitting candidates down, so a cap drops the worst.
+  int max_combinations = 4096;
+};
+
+/// Outcome of one identification step.
+enum class IdStatus : std::uint8_t {
+  kMatchedPrevious,   ///< the previous CF still explains the contacts (MT2)
+  kMatchedNeighbour,  ///< a graph neighbour of the previous CF (MT3-MT5)
+  kMatchedByFit,      ///< no previous CF (first contact): the best geometric fit
+  kNoContact,         ///< nothing within epsilon
+  /// A CF of the graph fits, but it is neither the previous CF nor its neighbour (a jump,
+  /// e.g. fast motion). `cf` is set to the best fit; callers may treat it with caution.
+  kNonNeighbourJump,
+  kOutsideGraph,      ///< contacts detected, but no interpretation is a CF of the graph
+  kTooManyPlanes,     ///< more than 3 contact planes and no subset explains them
+};
+/// "matched-previous", "matched-neighbour", "matched-by-fit", "no-contact",
+/// "non-neighbour-jump", "outside-graph", "too-many-planes".
+const char* to_string(IdStatus status);
+
+/// Result of CfIdentifier::step. Fixed capacity; lives inside the identifier.
+struct Identification {
+  IdStatus status = IdStatus::kNoContact;
+  CfId cf;        ///< the identified CF; invalid when none fits or no contact
+  PcSet pcs;      ///< its PCs (canonical order); empty when cf is invalid
+  /// The CF's PCs with geometry, in the order of `pcs`; num_cf_pcs entries are valid.
+  std::array<ContactPc, PcSet::kMaxPcs> cf_pcs{};
+  int num_cf_pcs = 0;
+  /// Every candidate detected at this pose (capacity ContactSet::kCapacity, overflow flagged).
+  ContactSet contacts;
+  double misfit = 0;         ///< total misfit of the chosen interpretation
+  int combinations = 0;      ///< interpretations examined
+  bool capped = false;       ///< the enumeration hit max_combinations
+  /// True when the chosen CF does not cover every contact plane: the other planes' contacts
+  /// were explained as alternative readings of the chosen PCs (degenerate touches).
+  bool partial_cover = false;
+  bool has_cf() const { return cf.valid(); }
+};
+
+/// Identifies the CF at each servo tick. Create one per thread; the graph is shared,
+/// read-only, and must outlive the identifier.
+class CfIdentifier {
+ public:
+  explicit CfIdentifier(const CfGraph& graph, const IdentificationParams& params = {});
+  ~CfIdentifier();
+  CfIdentifier(CfIdentifier&&) noexcept;
+  CfIdentifier& operator=(CfIdentifier&&) noexcept;
+
+  /// Detects and identifies at `pose`. No heap allocation. The reference stays valid until
+  /// the next step or reset.
+  const Identification& step(const Pose& pose);
+  /// Forgets the previous CF (the next match is by fit).
+  void reset();
+  /// The CF preferred at the next step: the last identified CF, kept across ticks whose
+  /// contacts fit no CF, cleared when there is no contact.
+  CfId previous() const;
+  const Identification& last() const;
+  const CfGraph& graph() const;
+  const ContactDetector& detector() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace cf

@@ -1,0 +1,262 @@
+#include <cf/identifier.hpp>
+
+#include <algorithm>
+#include <string>
+
+namespace cf {
+
+const char* to_string(IdStatus status) {
+  switch (status) {
+    case IdStatus::kMatchedPrevious: return "matched-previous";
+    case IdStatus::kMatchedNeighbour: return "matched-neighbour";
+    case IdStatus::kMatchedByFit: return "matched-by-fit";
+    case IdStatus::kNoContact: return "no-contact";
+    case IdStatus::kNonNeighbourJump: return "non-neighbour-jump";
+    case IdStatus::kOutsideGraph: return "outside-graph";
+    case IdStatus::kTooManyPlanes: return "too-many-planes";
+  }
+  return "?";
+}
+
+namespace {
+
+constexpr int kMaxGroups = 8;  // contact planes examined; more cannot be explained anyway
+
+// Vertices of an element's closure, as a small view.
+struct Closure {
+  const VertexId* v = nullptr;
+  int n = 0;
+  VertexId own[2];
+};
+
+Closure closure(const Polyhedron& m, ElementKind k, int i) {
+  Closure c;
+  switch (k) {
+    case ElementKind::kVertex:
+      c.own[0] = VertexId(i);
+      c.v = c.own;
+      c.n = 1;
+      break;
+    case ElementKind::kEdge:
+      c.own[0] = m.edges()[static_cast<std::size_t>(i)].v0;
+      c.own[1] = m.edges()[static_cast<std::size_t>(i)].v1;
+      if (c.own[1] < c.own[0]) std::swap(c.own[0], c.own[1]);
+      c.v = c.own;
+      c.n = 2;
+      break;
+    case ElementKind::kFace: {
+      const auto& vs = m.faces()[static_cast<std::size_t>(i)].vertices;  // ascending
+      c.v = vs.data();
+      c.n = static_cast<int>(vs.size());
+      break;
+    }
+  }
+  return c;
+}
+
+bool closures_meet(const Polyhedron& m, ElementKind ki, int i, ElementKind kj, int j) {
+  Closure x = closure(m, ki, i), y = closure(m, kj, j);
+  if (ki == ElementKind::kEdge || ki == ElementKind::kVertex) x.v = x.own;
+  if (kj == ElementKind::kEdge || kj == ElementKind::kVertex) y.v = y.own;
+  int p = 0, q = 0;  // both ascending
+  while (p < x.n && q < y.n) {
+    if (x.v[p] == y.v[q]) return true;
+    if (x.v[p] < y.v[q]) ++p;
+    else ++q;
+  }
+  return false;
+}
+
+}  // namespace
+
+struct CfIdentifier::Impl {
+  const CfGraph* graph;
+  IdentificationParams prm;
+  ContactDetector detector;
+  Identification res;
+  CfId prev;
+  // Per step scratch (fixed size).
+  std::array<std::array<std::int16_t, ContactSet::kCapacity>, kMaxGroups> members{};
+  std::array<int, kMaxGroups> count{};
+
+  Impl(const CfGraph& g, const IdentificationParams& p)
+      : graph(&g), prm(p), detector(g.model_a(), g.model_b(), p.detection) {}
+
+  // Is contact c an alternative reading of contact s (their elements' closures meet on
+  // both sides)? Used to let a chosen PC explain another plane's contacts.
+  bool related(const ContactPc& c, const ContactPc& s) const {
+    return closures_meet(graph->model_a(), a_kind(c.pc.type), c.pc.a, a_kind(s.pc.type), s.pc.a) &&
+           closures_meet(graph->model_b(), b_kind(c.pc.type), c.pc.b, b_kind(s.pc.type), s.pc.b);
+  }
+
+  // Every contact of group g is related to one of the chosen contacts.
+  bool explained(int g, const int* chosen, int nchosen) const {
+    const ContactSet& cs = res.contacts;
+    for (int k = 0; k < count[static_cast<std::size_t>(g)]; ++k) {
+      const ContactPc& c = cs[members[static_cast<std::size_t>(g)][static_cast<std::size_t>(k)]];
+      bool ok = false;
+      for (int s = 0; s < nchosen && !ok; ++s) ok = related(c, cs[chosen[s]]);
+      if (!ok) return false;
+    }
+    return true;
+  }
+
+  void set_result(IdStatus st, CfId id, const int* chosen, int n, double misfit, bool partial) {
+    res.status = st;
+    res.cf = id;
+    res.misfit = misfit;
+    res.partial_cover = partial;
+    res.pcs = PcSet();
+    for (int i = 0; i < n; ++i) res.pcs.insert(res.contacts[chosen[i]].pc);
+    res.num_cf_pcs = 0;
+    for (const Pc& pc : res.pcs)
+      for (int i = 0; i < n; ++i)
+        if (res.contacts[chosen[i]].pc == pc) res.cf_pcs[static_cast<std::size_t>(res.num_cf_pcs++)] = res.contacts[chosen[i]];
+  }
+
+  const Identification& step(const Pose& pose) {
+    ContactSet& cs = res.contacts;
+    detector.detect(pose, cs);
+    res.combinations = 0;
+    res.capped = false;
+    res.num_cf_pcs = 0;
+    res.pcs = PcSet();
+    res.cf = CfId();
+    res.misfit = 0;
+    res.partial_cover = false;
+    if (cs.empty()) {
+      res.status = IdStatus::kNoContact;
+      prev = CfId();
+      return res;
+    }
+    const int G = cs.num_planes();
+    if (G > kMaxGroups) {
+      res.status = IdStatus::kTooManyPlanes;
+      return res;
+    }
+    // Members of each plane, best fit first (ties: canonical PC order, as detected).
+    count.fill(0);
+    for (int i = 0; i < cs.size(); ++i) {
+      const auto g = static_cast<std::size_t>(cs[i].plane);
+      members[g][static_cast<std::size_t>(count[g]++)] = static_cast<std::int16_t>(i);
+    }
+    for (int g = 0; g < G; ++g) {
+      auto& m = members[static_cast<std::size_t>(g)];
+      // Insertion sort (stable, and std::stable_sort may allocate).
+      for (int i = 1; i < count[static_cast<std::size_t>(g)]; ++i) {
+        const std::int16_t v = m[static_cast<std::size_t>(i)];
+        int j = i - 1;
+        while (j >= 0 && cs[m[static_cast<std::size_t>(j)]].misfit > cs[v].misfit) {
+          m[static_cast<std::size_t>(j + 1)] = m[static_cast<std::size_t>(j)];
+          --j;
+        }
+        m[static_cast<std::size_t>(j + 1)] = v;
+      }
+    }
+
+    // Enumerate one member or none per plane (none last), at most 3 chosen, every skipped
+    // plane explained. Rank: full cover first, then fewest dominated PCs (a v-f beside the
+    // e-f of its edge is only taken when the e-f cannot form a CF), then previous /
+    // neighbour / other, then total misfit, then enumeration order.
+    std::array<int, kMaxGroups> digit{};  // index into members, count[g] means "none"
+    int best_tier = 2, best_dom = 4, best_cat = 3;
+    double best_misfit = 0;
+    int best_chosen[3] = {-1, -1, -1};
+    int best_n = 0;
+    CfId best_id;
+    // Also bound the walk itself: combinations with more than 3 planes chosen are skipped
+    // without counting.
+    long walk = 0;
+    const long walk_cap = 16L * prm.max_combinations;
+    for (;;) {
+      if (++walk > walk_cap) {
+        res.capped = true;
+        break;
+      }
+      int chosen[3];
+      int n = 0;
+      bool too_many = false;
+      for (int g = 0; g < G && !too_many; ++g) {
+        const int d = digit[static_cast<std::size_t>(g)];
+        if (d < count[static_cast<std::size_t>(g)]) {
+          if (n == 3) too_many = true;
+          else chosen[n++] = members[static_cast<std::size_t>(g)][static_cast<std::size_t>(d)];
+        }
+      }
+      if (!too_many && n > 0) {
+        if (res.combinations >= prm.max_combinations) {
+          res.capped = true;
+          break;
+        }
+        ++res.combinations;
+        const int tier = n == G ? 0 : 1;
+        bool ok = tier <= best_tier;
+        if (ok && tier == 1)
+          for (int g = 0; g < G && ok; ++g)
+            if (digit[static_cast<std::size_t>(g)] == count[static_cast<std::size_t>(g)]) ok = explained(g, chosen, n);
+        if (ok) {
+          PcSet key;
+          for (int i = 0; i < n; ++i) key.insert(cs[chosen[i]].pc);
+          if (const std::optional<CfId> id = graph->find(key)) {
+            const int cat = (prev.valid() && *id == prev) ? 0
+                            : (prev.valid() && graph->adjacent(prev, *id)) ? 1 : 2;
+            double mis = 0;
+            int dom = 0;
+            for (int i = 0; i < n; ++i) {
+              mis += cs[chosen[i]].misfit;
+              dom += cs[chosen[i]].dominated;
+            }
+            const bool better =
+                tier != best_tier ? tier < best_tier
+                : dom != best_dom ? dom < best_dom
+                : cat != best_cat ? cat < best_cat
+                                  : mis < best_misfit;
+            if (better) {
+              best_tier = tier;
+              best_dom = dom;
+              best_cat = cat;
+              best_misfit = mis;
+              best_n = n;
+              std::copy(chosen, chosen + n, best_chosen);
+              best_id = *id;
+              if (tier == 0 && dom == 0 && cat == 0) break;  // cannot be beaten
+            }
+          }
+        }
+      }
+      // Next combination (mixed radix, last plane fastest).
+      int g = G - 1;
+      while (g >= 0 && ++digit[static_cast<std::size_t>(g)] > count[static_cast<std::size_t>(g)]) digit[static_cast<std::size_t>(g--)] = 0;
+      if (g < 0) break;
+    }
+    if (!best_id.valid()) {
+      res.status = G > 3 ? IdStatus::kTooManyPlanes : IdStatus::kOutsideGraph;
+      return res;
+    }
+    IdStatus st = best_cat == 0   ? IdStatus::kMatchedPrevious
+                  : best_cat == 1 ? IdStatus::kMatchedNeighbour
+                  : prev.valid()  ? IdStatus::kNonNeighbourJump
+                                  : IdStatus::kMatchedByFit;
+    set_result(st, best_id, best_chosen, best_n, best_misfit, best_tier == 1);
+    prev = best_id;
+    return res;
+  }
+};
+
+CfIdentifier::CfIdentifier(const CfGraph& graph, const IdentificationParams& params)
+    : impl_(std::make_unique<Impl>(graph, params)) {
+  if (params.max_combinations < 1)
+    throw Error("CfIdentifier: parameter max_combinations must be at least 1, got " +
+                std::to_string(params.max_combinations));
+}
+CfIdentifier::~CfIdentifier() = default;
+CfIdentifier::CfIdentifier(CfIdentifier&&) noexcept = default;
+CfIdentifier& CfIdentifier::operator=(CfIdentifier&&) noexcept = default;
+const Identification& CfIdentifier::step(const Pose& pose) { return impl_->step(pose); }
+void CfIdentifier::reset() { impl_->prev = CfId(); }
+CfId CfIdentifier::previous() const { return impl_->prev; }
+const Identification& CfIdentifier::last() const { return impl_->res; }
+const CfGraph& CfIdentifier::graph() const { return *impl_->graph; }
+const ContactDetector& CfIdentifier::detector() const { return impl_->detector; }
+
+}  // namespace cf

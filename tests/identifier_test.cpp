@@ -1,0 +1,209 @@
+#include <cf/identifier.hpp>
+
+#include "../bench/runtime_models.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <thread>
+
+// Counts every global allocation of this program, to prove that steps allocate nothing.
+namespace {
+std::atomic<long> g_news{0};
+}
+void* operator new(std::size_t n) {
+  g_news.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) { return operator new(n); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace {
+
+using cf::CfId;
+using cf::IdStatus;
+using cf::Pc;
+using cf::PcType;
+using cf::Vec3;
+namespace tm = cf::testmodels;
+
+cf::Pose pose(const Eigen::Matrix3d& R, const Vec3& t) {
+  cf::Pose p;
+  p.R_BA = R;
+  p.t_BA = t;
+  return p;
+}
+
+int edge_between(const cf::Polyhedron& m, int v0, int v1) {
+  for (std::size_t e = 0; e < m.num_edges(); ++e) {
+    const cf::Edge& E = m.edges()[e];
+    if ((E.v0.value() == v0 && E.v1.value() == v1) || (E.v0.value() == v1 && E.v1.value() == v0))
+      return static_cast<int>(e);
+  }
+  return -1;
+}
+
+cf::CfRecord record(std::vector<Pc> pcs) {
+  cf::CfRecord r;
+  r.pcs = cf::PcSet(pcs);
+  return r;
+}
+
+// Cube (A) on the L-block (B), a hand-built graph:
+//   0 {f-f 2:4}               cube flat on the slab top
+//   1 {e-f e04:4}             on the edge x = y = -15 (A), after a 45-degree turn about z
+//   2 {v-f 4:4}               on the end vertex (-15,-15,15) of that edge
+//   3 {f-f 2:4, f-f 5:5}      in the corner: slab top and wall side
+//   4 {v-f 0:4}               on the corner vertex 0
+// Transitions (both ways): 0-1 change, 1-2 change, 1-4 change, 0-3 gain/lose.
+struct Fixture {
+  cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  int e04 = edge_between(a, 0, 4);
+  cf::CfGraph graph;
+  Fixture() {
+    std::vector<cf::CfRecord> cfs = {record({{PcType::kFF, 2, 4}}), record({{PcType::kEF, e04, 4}}),
+                                     record({{PcType::kVF, 4, 4}}),
+                                     record({{PcType::kFF, 2, 4}, {PcType::kFF, 5, 5}}),
+                                     record({{PcType::kVF, 0, 4}})};
+    using K = cf::TransitionKind;
+    std::vector<cf::Transition> tr = {{CfId(0), CfId(1), K::kChange}, {CfId(1), CfId(0), K::kChange},
+                                      {CfId(1), CfId(2), K::kChange}, {CfId(2), CfId(1), K::kChange},
+                                      {CfId(0), CfId(3), K::kGain},   {CfId(3), CfId(0), K::kLose},
+                                      {CfId(1), CfId(4), K::kChange}, {CfId(4), CfId(1), K::kChange}};
+    graph = cf::CfGraph::from_parts(a, b, cfs, tr);
+  }
+};
+
+const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+const double kEdgeDrop = 15 * std::sqrt(2.0);  // centre height over the lowest edge at 45 deg
+
+cf::Pose flat() { return pose(I, {70, 35.3, 40}); }
+cf::Pose on_edge() {
+  return pose(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()).toRotationMatrix(), {70, 20 + kEdgeDrop + 0.2, 40});
+}
+// On the same edge, tilted so that its end at z = -15 (vertex 0) is lower (paper Fig. 3).
+cf::Pose tilted_edge() {
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(-0.01, Vec3::UnitX()).toRotationMatrix() *
+                            Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()).toRotationMatrix();
+  return pose(R, {70, 20 + kEdgeDrop + 0.2, 40});
+}
+cf::Pose corner() { return pose(I, {35.2, 35.4, 40}); }
+cf::Pose far() { return pose(I, {70, 80, 40}); }
+cf::Pose on_vertex0() {
+  const Eigen::Matrix3d R =
+      Eigen::Quaterniond::FromTwoVectors(Vec3(-1, -1, -1).normalized(), Vec3(0, -1, 0)).toRotationMatrix();
+  return pose(R, Vec3(70, 20.4, 40) - R * Vec3(-15, -15, -15));
+}
+cf::Pose on_vertex6() {  // vertex 6 (15,15,15) down: not in the graph
+  const Eigen::Matrix3d R =
+      Eigen::Quaterniond::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3(0, -1, 0)).toRotationMatrix();
+  return pose(R, Vec3(70, 20.4, 40) - R * Vec3(15, 15, 15));
+}
+
+}  // namespace
+
+TEST_CASE("identification prefers the previous CF, then a neighbour, else the best fit", "[identifier]") {
+  Fixture fx;
+  cf::CfIdentifier id(fx.graph);
+
+  const cf::Identification& r = id.step(flat());
+  CHECK(r.status == IdStatus::kMatchedByFit);
+  CHECK(r.cf == CfId(0));
+  REQUIRE(r.num_cf_pcs == 1);
+  CHECK(r.cf_pcs[0].pc == Pc{PcType::kFF, 2, 4});
+  CHECK(r.cf_pcs[0].distance == Approx(0.3).margin(1e-9));
+  CHECK(r.contacts.size() == 9);
+  CHECK_FALSE(r.partial_cover);
+
+  CHECK(id.step(flat()).status == IdStatus::kMatchedPrevious);
+  CHECK(id.previous() == CfId(0));
+
+  // Into the corner: the wall's plane is gained.
+  CHECK(id.step(corner()).status == IdStatus::kMatchedNeighbour);
+  CHECK(id.last().cf == CfId(3));
+  CHECK(id.last().num_cf_pcs == 2);
+  CHECK(id.step(flat()).status == IdStatus::kMatchedNeighbour);  // lose
+  CHECK(id.last().cf == CfId(0));
+
+  CHECK(id.step(far()).status == IdStatus::kNoContact);
+  CHECK_FALSE(id.last().has_cf());
+  CHECK_FALSE(id.previous().valid());
+}
+
+TEST_CASE("the ambiguity of paper Fig. 3: the undominated reading wins, else history", "[identifier]") {
+  Fixture fx;
+  cf::CfIdentifier id(fx.graph);
+  // The edge tilted by 0.01 rad (within the angular tolerance): e-f, with the v-f of its
+  // lower end vertex 0 as a dominated alternative. From nothing: e-f.
+  const cf::Identification& r = id.step(tilted_edge());
+  CHECK(r.status == IdStatus::kMatchedByFit);
+  CHECK(r.cf == CfId(1));
+  bool vf0 = false;
+  for (const cf::ContactPc& c : r.contacts) vf0 |= c.pc == Pc{PcType::kVF, 0, 4} && c.dominated;
+  CHECK(vf0);
+  // Standing on vertex 0 first (CF 4), then tilting down onto the edge: the e-f is a
+  // neighbour (change) and is not dominated, so it takes over.
+  id.reset();
+  CHECK(id.step(on_vertex0()).cf == CfId(4));
+  CHECK(id.step(tilted_edge()).status == IdStatus::kMatchedNeighbour);
+  CHECK(id.last().cf == CfId(1));
+  CHECK(id.step(on_edge()).status == IdStatus::kMatchedPrevious);
+}
+
+TEST_CASE("contacts outside the graph and jumps are reported, not hidden", "[identifier]") {
+  Fixture fx;
+  cf::CfIdentifier id(fx.graph);
+  const cf::Identification& r = id.step(on_vertex6());
+  CHECK(r.status == IdStatus::kOutsideGraph);
+  CHECK_FALSE(r.has_cf());
+  REQUIRE(r.contacts.size() == 1);
+  CHECK(r.contacts[0].pc == Pc{PcType::kVF, 6, 4});
+
+  id.step(on_vertex0());
+  CHECK(id.last().status == IdStatus::kMatchedByFit);
+  CHECK(id.last().cf == CfId(4));
+  // From the corner vertex straight to the L's corner: CF 3 fits, but is no neighbour.
+  CHECK(id.step(corner()).status == IdStatus::kNonNeighbourJump);
+  CHECK(id.last().cf == CfId(3));
+  CHECK(std::string(cf::to_string(IdStatus::kNonNeighbourJump)) == "non-neighbour-jump");
+}
+
+TEST_CASE("identification steps allocate nothing", "[identifier]") {
+  Fixture fx;
+  cf::CfIdentifier id(fx.graph);
+  const cf::Pose poses[] = {flat(), corner(), on_edge(), tilted_edge(), far(), on_vertex0(), on_vertex6()};
+  id.step(flat());  // warm up (nothing is lazily allocated, but be fair)
+  const long before = g_news.load();
+  for (int k = 0; k < 50; ++k)
+    for (const cf::Pose& p : poses) id.step(p);
+  CHECK(g_news.load() - before == 0);
+}
+
+TEST_CASE("one identifier per thread over one shared graph", "[identifier]") {
+  Fixture fx;
+  const cf::Pose poses[] = {flat(), corner(), on_edge(), tilted_edge(), far(), on_vertex0()};
+  std::vector<int> expect;
+  {
+    cf::CfIdentifier id(fx.graph);
+    for (int k = 0; k < 20; ++k)
+      for (const cf::Pose& p : poses) expect.push_back(id.step(p).cf.value());
+  }
+  std::vector<int> got[2];
+  auto run = [&](int t) {
+    cf::CfIdentifier id(fx.graph);
+    for (int k = 0; k < 20; ++k)
+      for (const cf::Pose& p : poses) got[t].push_back(id.step(p).cf.value());
+  };
+  std::thread t0(run, 0), t1(run, 1);
+  t0.join();
+  t1.join();
+  CHECK(got[0] == expect);
+  CHECK(got[1] == expect);
+}
