@@ -312,14 +312,36 @@ TEST_CASE("save writes JSON or CBOR whole and load reads it back", "[graph]") {
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("schema validation can be skipped for trusted large files", "[graph]") {
-  cf::GraphLoadOptions fast;
-  fast.validate_schema = false;
-  check_same(CfGraph::load(kFixture), CfGraph::load(kFixture, fast));
-  // The extra member is only a schema complaint, so the fast path accepts the file...
-  CHECK_NOTHROW(CfGraph::load(bad("schema_violation.json"), fast));
-  // ... while every structural fault is still caught.
-  CHECK_THROWS_WITH(CfGraph::load(bad("index_out_of_range.json"), fast), Catch::Contains("/cfs/3/pcs/0/b"));
+TEST_CASE("schema validation can be skipped or made exhaustive", "[graph]") {
+  cf::GraphLoadOptions none, full;
+  none.validate_schema = false;
+  full.full_schema_check = true;
+  check_same(CfGraph::load(kFixture), CfGraph::load(kFixture, none));
+  check_same(CfGraph::load(kFixture), CfGraph::load(kFixture, full));
+  // Metadata is free-form to the reader; only the schema says "stats" is an object...
+  CHECK_NOTHROW(CfGraph::load(bad("schema_violation.json"), none));
+  // ... while every structural fault is caught without it.
+  CHECK_THROWS_WITH(CfGraph::load(bad("index_out_of_range.json"), none), Catch::Contains("/cfs/3/pcs/0/b"));
+  CHECK_THROWS_WITH(CfGraph::load(bad("witness_extra_member.json"), none), Catch::Contains("/cfs/2/witness"));
+}
+
+TEST_CASE("a written graph passes the full schema check, as JSON and as CBOR", "[graph]") {
+  const CfGraph g = cf_test::box_l_graph();
+  cf::GraphLoadOptions full;
+  full.full_schema_check = true;
+  check_same(g, CfGraph::from_bytes(g.to_json(), "g.json", false, full));
+  const auto dir = scratch_dir("cbor_schema");
+  const std::string cbor_path = (dir / "g.cbor").string();
+  g.save(cbor_path);
+  check_same(g, CfGraph::load(cbor_path, full));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("members are read in any order", "[graph]") {
+  // box_l.json with its keys sorted, as Python's json.dump(sort_keys=True) writes it: cfs
+  // come before format and models, and every PC's a and b before its type.
+  const CfGraph g = cf_test::box_l_graph();
+  check_same(g, CfGraph::load(kGraphDir + "/box_l_sorted.json"));
 }
 
 // ---- from_parts rejects inconsistent parts --------------------------------------------
@@ -489,8 +511,24 @@ TEST_CASE("load: a broken model", "[graph][bad]") {
                     Catch::Contains("'" + bad("bad_model.json") + "' at /models/B/faces/0/loops/0/1: expected a non-negative integer index"));
 }
 
+TEST_CASE("load: an unknown member in a witness", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("witness_extra_member.json")),
+                    Catch::Contains("'" + bad("witness_extra_member.json") +
+                                    "' at /cfs/2/witness: unexpected member \"q\" (a witness has R and t)"));
+}
+
+TEST_CASE("load: a CF with more than 3 PCs", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("pc_count.json")),
+                    Catch::Contains("'" + bad("pc_count.json") + "' at /cfs/2/pcs: a CF has 1 to 3 PCs, got 4"));
+}
+
+TEST_CASE("load: a missing top-level member", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("missing_transitions.json")),
+                    Catch::Contains("'" + bad("missing_transitions.json") + "' at /: missing member \"transitions\""));
+}
+
 TEST_CASE("load: a schema violation the reader itself would let through", "[graph][bad]") {
   CHECK_THROWS_WITH(CfGraph::load(bad("schema_violation.json")),
                     Catch::Contains("'" + bad("schema_violation.json") +
-                                    "' at /cfs/2/witness: does not match the cf-graph schema:"));
+                                    "' at /stats: does not match the cf-graph schema: Value type not permitted by 'type' constraint."));
 }

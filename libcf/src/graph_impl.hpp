@@ -75,3 +75,10 @@ std::string check_metadata(const nlohmann::json& meta);
 /// @throws cf::Error naming the file and the system's reason.
 void write_file_atomically(const std::string& path, const std::string& bytes, const char* what);
 }  // namespace cf::detail
+
+namespace cf::detail {
+/// Reads a graph file's bytes (graph_reader.cpp): one streaming pass, then the checks.
+/// @throws cf::Error naming `source`, the JSON pointer and the problem.
+std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::string& source, bool cbor,
+                                          const GraphLoadOptions& options);
+}  // namespace cf::detail

@@ -108,10 +108,15 @@ struct Transition {
 
 /// Options of CfGraph::load.
 struct GraphLoadOptions {
-  /// Check the file against schemas/cf-graph.schema.json (embedded in the library). The
-  /// structural and consistency checks run either way; turning this off only saves time
-  /// on very large graphs that a trusted program has just written.
+  /// Check the file against schemas/cf-graph.schema.json (embedded in the library) with
+  /// valijson. By default valijson checks the document without the items of `cfs` and
+  /// `transitions` (the models, the metadata, the top level), and the reader checks those
+  /// items itself against the same rules (required members, types, ranges, no unknown
+  /// members in PCs and witnesses), which keeps 100,000 CFs well under a second.
   bool validate_schema = true;
+  /// Also run valijson over every CF and transition (several times slower; cfinspect
+  /// does this).
+  bool full_schema_check = false;
 };
 
 /// The CF graph of a model pair (SPEC section 5). Immutable; share one `const CfGraph`

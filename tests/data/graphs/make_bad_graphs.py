@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the bad graph files in bad/ from box_l.json (graph_test and cfinspect_test read
+"""Writes box_l_sorted.json and the bad graph files in bad/ from box_l.json (graph_test and cfinspect_test read
 them). Each file has exactly one fault; the comment says which. Re-run after box_l.json
 changes: python3 make_bad_graphs.py"""
 import copy
@@ -25,6 +25,11 @@ def variant(name, change):
     write(name, doc)
 
 
+# A good file with its keys sorted: readers must not depend on member order.
+with open(os.path.join(HERE, "box_l_sorted.json"), "w") as f:
+    json.dump(good, f, indent=1, sort_keys=True)
+    f.write("\n")
+
 # Not JSON / not a graph at all.
 open(os.path.join(out, "truncated.json"), "w").write("\n".join(good_text.split("\n")[:6]))
 open(os.path.join(out, "empty.json"), "w").write("")
@@ -46,5 +51,9 @@ variant("id_mismatch.json", lambda d: d["cfs"][1].update(id=7))
 variant("not_rotation.json",
         lambda d: d["cfs"][0]["witness"].update(R=[[2.0, 0, 0], [0, 2.0, 0], [0, 0, 2.0]]))
 variant("bad_model.json", lambda d: d["models"]["B"]["faces"][0]["loops"][0].__setitem__(1, -1))
-# Accepted by the reader (it ignores unknown members), rejected by the schema.
-variant("schema_violation.json", lambda d: d["cfs"][2]["witness"].update(q=[1, 0, 0, 0]))
+variant("witness_extra_member.json", lambda d: d["cfs"][2]["witness"].update(q=[1, 0, 0, 0]))
+variant("pc_count.json", lambda d: d["cfs"][2]["pcs"].extend([{"type": "v-f", "a": 1, "b": 4}, {"type": "v-f", "a": 2, "b": 4}]))
+variant("missing_transitions.json", lambda d: d.pop("transitions"))
+# Accepted by the reader (metadata is free-form to it), rejected by the schema: "stats"
+# must be an object.
+variant("schema_violation.json", lambda d: d.update(stats="none"))

@@ -1,0 +1,979 @@
+// Reading a graph file in one streaming pass (nlohmann's SAX interface, JSON or CBOR).
+//
+// Why not the DOM: a graph of 100,000 CFs is ~50 MB of JSON, and a std::map-based DOM of it
+// costs seconds in malloc/free alone. Here the `cfs` and `transitions` arrays go straight into
+// CfRecords and Transitions; only the small members (models, metadata) become a DOM, the
+// "skeleton", which is validated against the schema with valijson. The item-level checks
+// below mirror the schema's definitions of a CF, a PC, a pose and a transition (required
+// members, types, ranges, no unknown members in PCs and witnesses); GraphLoadOptions::
+// full_schema_check runs valijson over the whole document as well.
+
+#include "graph_impl.hpp"
+#include "graph_schema.hpp"
+#include "json_util.hpp"
+#include "polyhedron_json.hpp"
+
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <cstdint>
+#include <cstring>
+#include <cmath>
+#include <sstream>
+
+namespace cf::detail {
+
+namespace {
+
+constexpr std::size_t kNoFault = static_cast<std::size_t>(-1);
+
+/// A PC as the file gives it, before the models are known.
+struct RawCf {
+  std::array<Pc, PcSet::kMaxPcs> pcs{};
+  int num_pcs = 0;  // as given; > 3 is reported at the end of the array
+  CfRecord record;
+};
+
+/// One scalar event, kept light (strings by pointer) so that the hot path allocates nothing.
+struct Scalar {
+  enum Type : std::uint8_t { kNull, kBool, kInt, kUint, kFloat, kString } type = kNull;
+  bool b = false;
+  std::int64_t i = 0;
+  std::uint64_t u = 0;
+  double d = 0;
+  const std::string* s = nullptr;
+
+  bool is_number() const { return type == kInt || type == kUint || type == kFloat; }
+  bool is_integer() const { return type == kInt || type == kUint; }
+  double number() const { return type == kInt ? static_cast<double>(i) : type == kUint ? static_cast<double>(u) : d; }
+  json to_json() const {
+    switch (type) {
+      case kNull: return json(nullptr);
+      case kBool: return json(b);
+      case kInt: return json(i);
+      case kUint: return json(u);
+      case kFloat: return json(d);
+      default: return json(*s);
+    }
+  }
+  std::string shown() const { return json_short(to_json()); }
+};
+
+enum class Ctx : std::uint8_t {
+  kDocument,    // expecting the root value
+  kRoot,        // in the root object
+  kCapture,     // inside a DOM-captured container (models, metadata)
+  kSkip,        // inside a container whose content is ignored
+  kCfs,         // in the cfs array
+  kCf,          // in a CF object
+  kPcs,         // in a CF's pcs array
+  kPc,          // in a PC object
+  kWitness,     // in a witness object
+  kR,           // in witness.R
+  kRRow,        // in a row of witness.R
+  kT,           // in witness.t
+  kTransitions, // in the transitions array
+  kTransition,  // in a transition object
+};
+
+/// What the next value is, set by the preceding key.
+enum class Field : std::uint8_t {
+  kNone, kRootOther, kRootCfs, kRootTransitions,
+  kCfId, kCfPcs, kCfWitness, kCfDof, kCfTdof, kCfPure, kCfOther,
+  kPcType, kPcA, kPcB, kPcOther,
+  kWR, kWT, kWOther,
+  kTrFrom, kTrTo, kTrKind, kTrOther,
+};
+
+class GraphSax {
+ public:
+  GraphSax(const std::string& source, bool cbor) : source_(source), cbor_(cbor) {
+    stack_.reserve(16);
+    stack_.push_back(Ctx::kDocument);
+  }
+
+  // --- nlohmann SAX interface -----------------------------------------------------------
+  bool null() { Scalar s; s.type = Scalar::kNull; return scalar(s); }
+  bool boolean(bool v) { Scalar s; s.type = Scalar::kBool; s.b = v; return scalar(s); }
+  bool number_integer(std::int64_t v) { Scalar s; s.type = Scalar::kInt; s.i = v; return scalar(s); }
+  bool number_unsigned(std::uint64_t v) { Scalar s; s.type = Scalar::kUint; s.u = v; return scalar(s); }
+  bool number_float(double v, const std::string&) { Scalar s; s.type = Scalar::kFloat; s.d = v; return scalar(s); }
+  bool string(std::string& v) { Scalar s; s.type = Scalar::kString; s.s = &v; return scalar(s); }
+  bool binary(json::binary_t&) {
+    Scalar s;
+    s.type = Scalar::kNull;
+    return scalar(s);
+  }
+  bool start_object(std::size_t) { return start(true); }
+  bool start_array(std::size_t) { return start(false); }
+  bool end_object() { return end(); }
+  bool end_array() { return end(); }
+  bool key(std::string& k);
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) {
+    throw Error("reading '" + source_ + "': not valid " + (cbor_ ? "CBOR" : "JSON") + ": " + e.what());
+  }
+
+  // --- results --------------------------------------------------------------------------
+  json skeleton = json::object();  ///< every root member except the cfs and transitions items
+  std::vector<RawCf> cfs;
+  std::vector<Transition> transitions;
+  bool have_cfs = false, have_transitions = false;
+  std::string fault_pointer;  ///< first item-level fault, reported after the parse
+  std::string fault_what;
+  bool faulted() const { return !fault_what.empty(); }
+
+ private:
+  bool scalar(const Scalar& s);
+  bool start(bool object);
+  bool end();
+
+  /// Records the first fault; later item-level events are then only tracked structurally.
+  void fault(std::string pointer, std::string what) {
+    if (!faulted()) {
+      fault_pointer = std::move(pointer);
+      fault_what = std::move(what);
+    }
+  }
+  std::string cf_ptr() const { return "/cfs/" + std::to_string(cfs.size() - 1); }
+  std::string pc_ptr() const { return cf_ptr() + "/pcs/" + std::to_string(pc_count_ - 1); }
+  std::string tr_ptr() const { return "/transitions/" + std::to_string(transitions.size() - 1); }
+  std::string field_ptr() const;
+  static const char* container_name(bool object) { return object ? "an object" : "an array"; }
+
+  void capture_value(json value);
+  bool item_context(Ctx c) const { return c != Ctx::kDocument && c != Ctx::kRoot && c != Ctx::kCapture; }
+
+  const std::string& source_;
+  bool cbor_;
+  std::vector<Ctx> stack_;
+  Field field_ = Field::kNone;
+  std::string root_key_;
+  // Capture state: the DOM containers being filled and the key inside each object.
+  std::vector<json*> capture_;
+  std::string capture_key_;
+  // Per-item state.
+  int pc_count_ = 0, row_ = 0, col_ = 0, t_count_ = 0;
+  bool has_id_ = false, has_pcs_ = false, has_witness_ = false;
+  bool has_type_ = false, has_a_ = false, has_b_ = false, has_R_ = false, has_t_ = false;
+  bool has_from_ = false, has_to_ = false, has_kind_ = false;
+  Pc pc_;
+};
+
+std::string GraphSax::field_ptr() const {
+  switch (field_) {
+    case Field::kCfId: return cf_ptr() + "/id";
+    case Field::kCfPcs: return cf_ptr() + "/pcs";
+    case Field::kCfWitness: return cf_ptr() + "/witness";
+    case Field::kCfDof: return cf_ptr() + "/dof";
+    case Field::kCfTdof: return cf_ptr() + "/translation_dof";
+    case Field::kCfPure: return cf_ptr() + "/pure_rotation";
+    case Field::kPcType: return pc_ptr() + "/type";
+    case Field::kPcA: return pc_ptr() + "/a";
+    case Field::kPcB: return pc_ptr() + "/b";
+    case Field::kWR: return cf_ptr() + "/witness/R";
+    case Field::kWT: return cf_ptr() + "/witness/t";
+    case Field::kTrFrom: return tr_ptr() + "/from";
+    case Field::kTrTo: return tr_ptr() + "/to";
+    case Field::kTrKind: return tr_ptr() + "/kind";
+    case Field::kRootCfs: return "/cfs";
+    case Field::kRootTransitions: return "/transitions";
+    default: return "/";
+  }
+}
+
+void GraphSax::capture_value(json value) {
+  json* top = capture_.back();
+  if (top->is_object()) {
+    (*top)[capture_key_] = std::move(value);
+  } else {
+    top->push_back(std::move(value));
+  }
+}
+
+bool GraphSax::key(std::string& k) {
+  switch (stack_.back()) {
+    case Ctx::kRoot:
+      root_key_ = k;
+      field_ = k == "cfs" ? Field::kRootCfs : k == "transitions" ? Field::kRootTransitions : Field::kRootOther;
+      break;
+    case Ctx::kCapture: capture_key_ = k; break;
+    case Ctx::kCf:
+      field_ = k == "id" ? Field::kCfId
+               : k == "pcs" ? Field::kCfPcs
+               : k == "witness" ? Field::kCfWitness
+               : k == "dof" ? Field::kCfDof
+               : k == "translation_dof" ? Field::kCfTdof
+               : k == "pure_rotation" ? Field::kCfPure
+                                      : Field::kCfOther;  // CFs may carry extra members
+      break;
+    case Ctx::kPc:
+      field_ = k == "type" ? Field::kPcType : k == "a" ? Field::kPcA : k == "b" ? Field::kPcB : Field::kPcOther;
+      if (field_ == Field::kPcOther) fault(pc_ptr(), "unexpected member \"" + k + "\" (a PC has type, a and b)");
+      break;
+    case Ctx::kWitness:
+      field_ = k == "R" ? Field::kWR : k == "t" ? Field::kWT : Field::kWOther;
+      if (field_ == Field::kWOther)
+        fault(cf_ptr() + "/witness", "unexpected member \"" + k + "\" (a witness has R and t)");
+      break;
+    case Ctx::kTransition:
+      field_ = k == "from" ? Field::kTrFrom : k == "to" ? Field::kTrTo : k == "kind" ? Field::kTrKind : Field::kTrOther;
+      break;
+    default: break;  // kSkip
+  }
+  return true;
+}
+
+bool GraphSax::scalar(const Scalar& s) {
+  const Ctx c = stack_.back();
+  if (c == Ctx::kDocument) {
+    skeleton = s.to_json();  // reported as "not an object" after the parse
+    return true;
+  }
+  if (c == Ctx::kRoot) {
+    if (field_ == Field::kRootOther) skeleton[root_key_] = s.to_json();
+    else fault(field_ptr(), std::string("expected an array, got ") + s.shown());
+    return true;
+  }
+  if (c == Ctx::kCapture) {
+    capture_value(s.to_json());
+    return true;
+  }
+  if (faulted() || c == Ctx::kSkip) return true;
+
+  auto index = [&](std::int32_t& out) {
+    if (s.is_integer() && (s.type == Scalar::kUint ? s.u <= 2147483647ULL : (s.i >= 0 && s.i <= 2147483647LL))) {
+      out = static_cast<std::int32_t>(s.type == Scalar::kUint ? s.u : static_cast<std::uint64_t>(s.i));
+      return true;
+    }
+    fault(field_ptr(), "expected a non-negative integer index, got " + s.shown());
+    return false;
+  };
+  auto small_int = [&](int lo, int hi, int& out) {
+    const bool ok = s.is_integer() && (s.type == Scalar::kUint ? s.u <= static_cast<std::uint64_t>(hi)
+                                                               : (s.i >= lo && s.i <= hi));
+    if (!ok) {
+      fault(field_ptr(), "expected an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + s.shown());
+      return;
+    }
+    out = static_cast<int>(s.type == Scalar::kUint ? static_cast<std::int64_t>(s.u) : s.i);
+  };
+
+  switch (c) {
+    case Ctx::kCfs:
+      cfs.emplace_back();
+      fault(cf_ptr(), "expected a CF object, got " + s.shown());
+      break;
+    case Ctx::kCf: {
+      RawCf& r = cfs.back();
+      switch (field_) {
+        case Field::kCfId: {
+          has_id_ = true;
+          const auto expected = static_cast<std::int64_t>(cfs.size() - 1);
+          if (!s.is_integer() || (s.type == Scalar::kInt ? s.i : static_cast<std::int64_t>(s.u)) != expected)
+            fault(field_ptr(), "id " + s.shown() + " should be " + std::to_string(expected) +
+                                   " (CF ids are the array positions)");
+          break;
+        }
+        case Field::kCfPcs: has_pcs_ = true; fault(field_ptr(), "expected an array, got " + s.shown()); break;
+        case Field::kCfWitness: has_witness_ = true; fault(field_ptr(), "expected an object, got " + s.shown()); break;
+        case Field::kCfDof: small_int(0, 6, r.record.dof); break;
+        case Field::kCfTdof: small_int(0, 3, r.record.translation_dof); break;
+        case Field::kCfPure:
+          if (s.type != Scalar::kBool) fault(field_ptr(), "expected true or false, got " + s.shown());
+          else r.record.pure_rotation = s.b;
+          break;
+        default: break;
+      }
+      break;
+    }
+    case Ctx::kPcs:
+      ++pc_count_;
+      fault(pc_ptr(), "expected a PC object, got " + s.shown());
+      break;
+    case Ctx::kPc:
+      switch (field_) {
+        case Field::kPcType: {
+          has_type_ = true;
+          if (s.type != Scalar::kString) {
+            fault(field_ptr(), "expected a string, got " + s.shown());
+            break;
+          }
+          const auto type = pc_type_from_string(*s.s);
+          if (!type)
+            fault(field_ptr(), "unknown PC type \"" + *s.s + "\" (expected one of f-f, e-f, f-e, v-f, f-v, e-e)");
+          else
+            pc_.type = *type;
+          break;
+        }
+        case Field::kPcA: has_a_ = true; index(pc_.a); break;
+        case Field::kPcB: has_b_ = true; index(pc_.b); break;
+        default: break;
+      }
+      break;
+    case Ctx::kWitness:
+      if (field_ == Field::kWR) has_R_ = true;
+      if (field_ == Field::kWT) has_t_ = true;
+      fault(field_ptr(), "expected an array, got " + s.shown());
+      break;
+    case Ctx::kR:
+      fault(cf_ptr() + "/witness/R/" + std::to_string(row_), "expected a row of 3 numbers, got " + s.shown());
+      ++row_;
+      break;
+    case Ctx::kRRow: {
+      const std::string where = cf_ptr() + "/witness/R/" + std::to_string(row_ - 1);
+      if (!s.is_number()) fault(where + "/" + std::to_string(col_), "expected a number, got " + s.shown());
+      else if (col_ < 3) cfs.back().record.witness.R_BA(row_ - 1, col_) = s.number();
+      ++col_;
+      break;
+    }
+    case Ctx::kT:
+      if (!s.is_number()) fault(cf_ptr() + "/witness/t/" + std::to_string(t_count_), "expected a number, got " + s.shown());
+      else if (t_count_ < 3) cfs.back().record.witness.t_BA(t_count_) = s.number();
+      ++t_count_;
+      break;
+    case Ctx::kTransitions:
+      transitions.emplace_back();
+      fault(tr_ptr(), "expected a transition object, got " + s.shown());
+      break;
+    case Ctx::kTransition: {
+      Transition& t = transitions.back();
+      std::int32_t v = -1;
+      switch (field_) {
+        case Field::kTrFrom: has_from_ = true; if (index(v)) t.from = CfId(v); break;
+        case Field::kTrTo: has_to_ = true; if (index(v)) t.to = CfId(v); break;
+        case Field::kTrKind: {
+          has_kind_ = true;
+          if (s.type != Scalar::kString) {
+            fault(field_ptr(), "expected a string, got " + s.shown());
+            break;
+          }
+          const auto kind = transition_kind_from_string(*s.s);
+          if (!kind) fault(field_ptr(), "unknown transition kind \"" + *s.s + "\" (expected gain, lose or change)");
+          else t.kind = *kind;
+          break;
+        }
+        default: break;
+      }
+      break;
+    }
+    default: break;
+  }
+  return true;
+}
+
+bool GraphSax::start(bool object) {
+  const Ctx c = stack_.back();
+  if (c == Ctx::kDocument) {
+    if (!object) {
+      skeleton = json::array();  // reported after the parse; the rest is ignored
+      stack_.push_back(Ctx::kSkip);
+      return true;
+    }
+    stack_.push_back(Ctx::kRoot);
+    return true;
+  }
+  if (c == Ctx::kRoot) {
+    if (field_ == Field::kRootOther) {
+      json& slot = skeleton[root_key_];
+      slot = object ? json::object() : json::array();
+      capture_.push_back(&slot);
+      stack_.push_back(Ctx::kCapture);
+    } else if (!object && field_ == Field::kRootCfs) {
+      have_cfs = true;
+      stack_.push_back(Ctx::kCfs);
+    } else if (!object && field_ == Field::kRootTransitions) {
+      have_transitions = true;
+      stack_.push_back(Ctx::kTransitions);
+    } else {
+      if (field_ == Field::kRootCfs) have_cfs = true;
+      else have_transitions = true;
+      fault(field_ptr(), std::string("expected an array, got ") + container_name(object));
+      stack_.push_back(Ctx::kSkip);
+    }
+    return true;
+  }
+  if (c == Ctx::kCapture) {
+    json* top = capture_.back();
+    json* child;
+    if (top->is_object()) {
+      json& slot = (*top)[capture_key_];
+      slot = object ? json::object() : json::array();
+      child = &slot;
+    } else {
+      top->push_back(object ? json::object() : json::array());
+      child = &top->back();
+    }
+    capture_.push_back(child);
+    stack_.push_back(Ctx::kCapture);
+    return true;
+  }
+  if (faulted() || c == Ctx::kSkip) {
+    stack_.push_back(Ctx::kSkip);
+    return true;
+  }
+
+  Ctx next = Ctx::kSkip;
+  switch (c) {
+    case Ctx::kCfs:
+      cfs.emplace_back();
+      if (object) {
+        next = Ctx::kCf;
+        has_id_ = has_pcs_ = has_witness_ = false;
+      } else {
+        fault(cf_ptr(), "expected a CF object, got an array");
+      }
+      break;
+    case Ctx::kCf:
+      if (field_ == Field::kCfPcs && !object) {
+        has_pcs_ = true;
+        pc_count_ = 0;
+        next = Ctx::kPcs;
+      } else if (field_ == Field::kCfWitness && object) {
+        has_witness_ = true;
+        has_R_ = has_t_ = false;
+        next = Ctx::kWitness;
+      } else if (field_ == Field::kCfOther) {
+        next = Ctx::kSkip;  // extra members of a CF are allowed and ignored
+      } else {
+        if (field_ == Field::kCfPcs) has_pcs_ = true;
+        if (field_ == Field::kCfWitness) has_witness_ = true;
+        const char* want = field_ == Field::kCfPcs ? "an array" : field_ == Field::kCfWitness ? "an object" : "a scalar";
+        fault(field_ptr(), std::string("expected ") + want + ", got " + container_name(object));
+      }
+      break;
+    case Ctx::kPcs:
+      ++pc_count_;
+      if (object) {
+        next = Ctx::kPc;
+        has_type_ = has_a_ = has_b_ = false;
+        pc_ = Pc{};
+      } else {
+        fault(pc_ptr(), "expected a PC object, got an array");
+      }
+      break;
+    case Ctx::kPc:
+      fault(field_ptr(), std::string("expected a scalar, got ") + container_name(object));
+      break;
+    case Ctx::kWitness:
+      if (field_ == Field::kWR) has_R_ = true;
+      if (field_ == Field::kWT) has_t_ = true;
+      if (!object && field_ == Field::kWR) {
+        row_ = 0;
+        next = Ctx::kR;
+      } else if (!object && field_ == Field::kWT) {
+        t_count_ = 0;
+        next = Ctx::kT;
+      } else {
+        fault(field_ptr(), std::string("expected an array, got ") + container_name(object));
+      }
+      break;
+    case Ctx::kR:
+      ++row_;
+      if (!object && row_ <= 3) {
+        col_ = 0;
+        next = Ctx::kRRow;
+      } else if (object) {
+        fault(cf_ptr() + "/witness/R/" + std::to_string(row_ - 1), "expected a row of 3 numbers, got an object");
+      }
+      break;
+    case Ctx::kRRow:
+      fault(cf_ptr() + "/witness/R/" + std::to_string(row_ - 1) + "/" + std::to_string(col_),
+            std::string("expected a number, got ") + container_name(object));
+      break;
+    case Ctx::kT:
+      fault(cf_ptr() + "/witness/t/" + std::to_string(t_count_), std::string("expected a number, got ") + container_name(object));
+      break;
+    case Ctx::kTransitions:
+      transitions.emplace_back();
+      if (object) {
+        next = Ctx::kTransition;
+        has_from_ = has_to_ = has_kind_ = false;
+      } else {
+        fault(tr_ptr(), "expected a transition object, got an array");
+      }
+      break;
+    case Ctx::kTransition:
+      if (field_ == Field::kTrOther) break;  // extra members allowed, skipped
+      fault(field_ptr(), std::string("expected a scalar, got ") + container_name(object));
+      break;
+    default: break;
+  }
+  stack_.push_back(next);
+  return true;
+}
+
+bool GraphSax::end() {
+  const Ctx c = stack_.back();
+  stack_.pop_back();
+  if (c == Ctx::kCapture) {
+    capture_.pop_back();
+    return true;
+  }
+  if (faulted() || c == Ctx::kSkip) return true;
+  // The pointer is built only for a fault: this runs once per CF, PC and transition.
+  auto missing = [&](auto where, bool has, const char* name) {
+    if (!has) fault(where(), std::string("missing member \"") + name + "\"");
+  };
+  const auto at_cf = [&] { return cf_ptr(); };
+  const auto at_pc = [&] { return pc_ptr(); };
+  const auto at_witness = [&] { return cf_ptr() + "/witness"; };
+  const auto at_tr = [&] { return tr_ptr(); };
+  switch (c) {
+    case Ctx::kCf:
+      missing(at_cf, has_id_, "id");
+      missing(at_cf, has_pcs_, "pcs");
+      missing(at_cf, has_witness_, "witness");
+      break;
+    case Ctx::kPcs:
+      if (pc_count_ < 1 || pc_count_ > PcSet::kMaxPcs)
+        fault(cf_ptr() + "/pcs", "a CF has 1 to 3 PCs, got " + std::to_string(pc_count_));
+      break;
+    case Ctx::kPc: {
+      missing(at_pc, has_type_, "type");
+      missing(at_pc, has_a_, "a");
+      missing(at_pc, has_b_, "b");
+      RawCf& r = cfs.back();
+      if (pc_count_ <= PcSet::kMaxPcs) r.pcs[static_cast<std::size_t>(pc_count_ - 1)] = pc_;
+      r.num_pcs = pc_count_;
+      break;
+    }
+    case Ctx::kWitness: {
+      missing(at_witness, has_R_, "R");
+      missing(at_witness, has_t_, "t");
+      if (faulted()) break;
+      const Mat3& R = cfs.back().record.witness.R_BA;
+      // Witnesses are written with full double precision; 1e-6 leaves room for hand-written
+      // files with 7 significant digits while still catching a scaled or sheared matrix.
+      constexpr double kRotationTol = 1e-6;
+      const double ortho = (R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff();
+      const double det = R.determinant();
+      if (!(ortho <= kRotationTol) || !(det > 0)) {
+        std::ostringstream s;
+        s << "not a rotation matrix (max |R^T R - I| = " << ortho << ", det R = " << det << ")";
+        fault(cf_ptr() + "/witness/R", s.str());
+      }
+      break;
+    }
+    case Ctx::kR:
+      if (row_ != 3) fault(cf_ptr() + "/witness/R", "expected 3 rows, got " + std::to_string(row_));
+      break;
+    case Ctx::kRRow:
+      if (col_ != 3)
+        fault(cf_ptr() + "/witness/R/" + std::to_string(row_ - 1), "expected 3 numbers, got " + std::to_string(col_));
+      break;
+    case Ctx::kT:
+      if (t_count_ != 3) fault(cf_ptr() + "/witness/t", "expected 3 numbers, got " + std::to_string(t_count_));
+      break;
+    case Ctx::kTransition:
+      missing(at_tr, has_from_, "from");
+      missing(at_tr, has_to_, "to");
+      missing(at_tr, has_kind_, "kind");
+      break;
+    default: break;
+  }
+  return true;
+}
+
+/// A strict JSON (RFC 8259) parser that drives a SAX handler, several times faster than
+/// nlohmann's lexer on number-heavy graph files (std::from_chars, no per-character token
+/// buffer). Syntax errors give the line and column. CBOR still goes through nlohmann.
+class FastJsonParser {
+ public:
+  FastJsonParser(const std::string& text, const std::string& source)
+      : begin_(text.data()), p_(text.data()), end_(text.data() + text.size()), source_(source) {}
+
+  template <class Sax>
+  void parse(Sax& sax) {
+    skip_ws();
+    if (p_ == end_) fail("empty input, expected a JSON value");
+    value(sax, 0);
+    skip_ws();
+    if (p_ != end_) fail("unexpected content after the JSON value");
+  }
+
+ private:
+  static constexpr int kMaxDepth = 256;
+
+  [[noreturn]] void fail(const std::string& what) const {
+    std::size_t line = 1, col = 1;
+    for (const char* q = begin_; q < p_ && q < end_; ++q) {
+      if (*q == '\n') {
+        ++line;
+        col = 1;
+      } else {
+        ++col;
+      }
+    }
+    std::string near;
+    if (p_ < end_) {
+      const unsigned char c = static_cast<unsigned char>(*p_);
+      near = c >= 0x20 && c < 0x7f ? std::string(" near '") + *p_ + "'" : " near byte " + std::to_string(c);
+    } else {
+      near = " at the end of the input";
+    }
+    throw Error("reading '" + source_ + "': not valid JSON: syntax error at line " + std::to_string(line) +
+                ", column " + std::to_string(col) + near + ": " + what);
+  }
+
+  void skip_ws() {
+    while (p_ < end_ && (*p_ == ' ' || *p_ == '\n' || *p_ == '\r' || *p_ == '\t')) ++p_;
+  }
+
+  void expect(char c, const char* what) {
+    skip_ws();
+    if (p_ == end_ || *p_ != c) fail(what);
+    ++p_;
+  }
+
+  template <class Sax>
+  void value(Sax& sax, int depth) {
+    if (depth > kMaxDepth) fail("nesting deeper than " + std::to_string(kMaxDepth) + " levels");
+    skip_ws();
+    if (p_ == end_) fail("unexpected end of input, expected a value");
+    switch (*p_) {
+      case '{': {
+        ++p_;
+        sax.start_object(static_cast<std::size_t>(-1));
+        skip_ws();
+        if (p_ < end_ && *p_ == '}') {
+          ++p_;
+          sax.end_object();
+          return;
+        }
+        for (;;) {
+          skip_ws();
+          if (p_ == end_ || *p_ != '"') fail("expected a member name in double quotes");
+          string();
+          sax.key(buf_);
+          expect(':', "expected ':' after a member name");
+          value(sax, depth + 1);
+          skip_ws();
+          if (p_ < end_ && *p_ == ',') {
+            ++p_;
+            continue;
+          }
+          if (p_ < end_ && *p_ == '}') {
+            ++p_;
+            sax.end_object();
+            return;
+          }
+          fail("expected ',' or '}' in an object");
+        }
+      }
+      case '[': {
+        ++p_;
+        sax.start_array(static_cast<std::size_t>(-1));
+        skip_ws();
+        if (p_ < end_ && *p_ == ']') {
+          ++p_;
+          sax.end_array();
+          return;
+        }
+        for (;;) {
+          value(sax, depth + 1);
+          skip_ws();
+          if (p_ < end_ && *p_ == ',') {
+            ++p_;
+            continue;
+          }
+          if (p_ < end_ && *p_ == ']') {
+            ++p_;
+            sax.end_array();
+            return;
+          }
+          fail("expected ',' or ']' in an array");
+        }
+      }
+      case '"':
+        string();
+        sax.string(buf_);
+        return;
+      case 't': literal("true"); sax.boolean(true); return;
+      case 'f': literal("false"); sax.boolean(false); return;
+      case 'n': literal("null"); sax.null(); return;
+      default: number(sax);
+    }
+  }
+
+  void literal(const char* word) {
+    const std::size_t n = std::strlen(word);
+    if (static_cast<std::size_t>(end_ - p_) < n || std::memcmp(p_, word, n) != 0) fail("invalid literal");
+    p_ += n;
+  }
+
+  template <class Sax>
+  void number(Sax& sax) {
+    const char* start = p_;
+    const char* q = p_;
+    if (q < end_ && *q == '-') ++q;
+    if (q == end_ || !std::isdigit(static_cast<unsigned char>(*q))) fail("expected a value");
+    if (*q == '0') {
+      ++q;
+    } else {
+      while (q < end_ && std::isdigit(static_cast<unsigned char>(*q))) ++q;
+    }
+    bool integer = true;
+    if (q < end_ && *q == '.') {
+      integer = false;
+      ++q;
+      if (q == end_ || !std::isdigit(static_cast<unsigned char>(*q))) {
+        p_ = q;
+        fail("expected a digit after the decimal point");
+      }
+      while (q < end_ && std::isdigit(static_cast<unsigned char>(*q))) ++q;
+    }
+    if (q < end_ && (*q == 'e' || *q == 'E')) {
+      integer = false;
+      ++q;
+      if (q < end_ && (*q == '+' || *q == '-')) ++q;
+      if (q == end_ || !std::isdigit(static_cast<unsigned char>(*q))) {
+        p_ = q;
+        fail("expected a digit in the exponent");
+      }
+      while (q < end_ && std::isdigit(static_cast<unsigned char>(*q))) ++q;
+    }
+    p_ = q;
+    if (integer) {
+      if (*start != '-') {
+        std::uint64_t u = 0;
+        const auto r = std::from_chars(start, q, u);
+        if (r.ec == std::errc() && r.ptr == q) {
+          if (u <= static_cast<std::uint64_t>(INT64_MAX)) sax.number_integer(static_cast<std::int64_t>(u));
+          else sax.number_unsigned(u);
+          return;
+        }
+      } else {
+        std::int64_t i = 0;
+        const auto r = std::from_chars(start, q, i);
+        if (r.ec == std::errc() && r.ptr == q) {
+          sax.number_integer(i);
+          return;
+        }
+      }
+      // Too large for 64 bits: a floating-point number, as nlohmann reads it.
+    }
+    double d = 0;
+    const auto r = std::from_chars(start, q, d);
+    if (r.ec != std::errc() || r.ptr != q) {
+      p_ = start;
+      fail("number out of the range of a double");
+    }
+    sax.number_float(d, kEmpty);
+  }
+
+  static unsigned hex(char c) {
+    if (c >= '0' && c <= '9') return static_cast<unsigned>(c - '0');
+    if (c >= 'a' && c <= 'f') return static_cast<unsigned>(c - 'a' + 10);
+    if (c >= 'A' && c <= 'F') return static_cast<unsigned>(c - 'A' + 10);
+    return 16;
+  }
+
+  unsigned hex4() {
+    if (end_ - p_ < 4) fail("incomplete \\u escape");
+    unsigned v = 0;
+    for (int k = 0; k < 4; ++k) {
+      const unsigned h = hex(p_[k]);
+      if (h == 16) fail("invalid \\u escape");
+      v = v * 16 + h;
+    }
+    p_ += 4;
+    return v;
+  }
+
+  void put_utf8(unsigned cp) {
+    if (cp < 0x80) {
+      buf_ += static_cast<char>(cp);
+    } else if (cp < 0x800) {
+      buf_ += static_cast<char>(0xC0 | (cp >> 6));
+      buf_ += static_cast<char>(0x80 | (cp & 0x3F));
+    } else if (cp < 0x10000) {
+      buf_ += static_cast<char>(0xE0 | (cp >> 12));
+      buf_ += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
+      buf_ += static_cast<char>(0x80 | (cp & 0x3F));
+    } else {
+      buf_ += static_cast<char>(0xF0 | (cp >> 18));
+      buf_ += static_cast<char>(0x80 | ((cp >> 12) & 0x3F));
+      buf_ += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
+      buf_ += static_cast<char>(0x80 | (cp & 0x3F));
+    }
+  }
+
+  /// Length of the valid UTF-8 sequence at p_ (lead byte >= 0x80), or 0.
+  std::size_t utf8_length() const {
+    const auto* u = reinterpret_cast<const unsigned char*>(p_);
+    const std::size_t avail = static_cast<std::size_t>(end_ - p_);
+    auto cont = [&](std::size_t k) { return k < avail && (u[k] & 0xC0) == 0x80; };
+    if (u[0] >= 0xC2 && u[0] <= 0xDF) return cont(1) ? 2 : 0;
+    if (u[0] >= 0xE0 && u[0] <= 0xEF) {
+      if (!cont(1) || !cont(2)) return 0;
+      if (u[0] == 0xE0 && u[1] < 0xA0) return 0;  // overlong
+      if (u[0] == 0xED && u[1] > 0x9F) return 0;  // surrogate
+      return 3;
+    }
+    if (u[0] >= 0xF0 && u[0] <= 0xF4) {
+      if (!cont(1) || !cont(2) || !cont(3)) return 0;
+      if (u[0] == 0xF0 && u[1] < 0x90) return 0;
+      if (u[0] == 0xF4 && u[1] > 0x8F) return 0;
+      return 4;
+    }
+    return 0;
+  }
+
+  /// Reads the string at p_ (on its opening quote) into buf_.
+  void string() {
+    ++p_;
+    buf_.clear();
+    for (;;) {
+      const char* run = p_;
+      while (p_ < end_ && *p_ != '"' && *p_ != '\\' && static_cast<unsigned char>(*p_) >= 0x20 &&
+             static_cast<unsigned char>(*p_) < 0x80)
+        ++p_;
+      buf_.append(run, static_cast<std::size_t>(p_ - run));
+      if (p_ == end_) fail("unterminated string");
+      const unsigned char c = static_cast<unsigned char>(*p_);
+      if (c == '"') {
+        ++p_;
+        return;
+      }
+      if (c < 0x20) fail("control character in a string (escape it)");
+      if (c >= 0x80) {
+        const std::size_t n = utf8_length();
+        if (n == 0) fail("invalid UTF-8 in a string");
+        buf_.append(p_, n);
+        p_ += n;
+        continue;
+      }
+      ++p_;  // backslash
+      if (p_ == end_) fail("unterminated string");
+      const char e = *p_++;
+      switch (e) {
+        case '"': buf_ += '"'; break;
+        case '\\': buf_ += '\\'; break;
+        case '/': buf_ += '/'; break;
+        case 'b': buf_ += '\b'; break;
+        case 'f': buf_ += '\f'; break;
+        case 'n': buf_ += '\n'; break;
+        case 'r': buf_ += '\r'; break;
+        case 't': buf_ += '\t'; break;
+        case 'u': {
+          unsigned cp = hex4();
+          if (cp >= 0xD800 && cp <= 0xDBFF) {
+            if (end_ - p_ < 2 || p_[0] != '\\' || p_[1] != 'u') fail("unpaired UTF-16 surrogate in a \\u escape");
+            p_ += 2;
+            const unsigned lo = hex4();
+            if (lo < 0xDC00 || lo > 0xDFFF) fail("unpaired UTF-16 surrogate in a \\u escape");
+            cp = 0x10000 + ((cp - 0xD800) << 10) + (lo - 0xDC00);
+          } else if (cp >= 0xDC00 && cp <= 0xDFFF) {
+            fail("unpaired UTF-16 surrogate in a \\u escape");
+          }
+          put_utf8(cp);
+          break;
+        }
+        default: --p_; fail("invalid escape in a string");
+      }
+    }
+  }
+
+  inline static const std::string kEmpty;
+  const char* begin_;
+  const char* p_;
+  const char* end_;
+  const std::string& source_;
+  std::string buf_;
+};
+
+class JsonLocator final : public FaultLocator {
+ public:
+  explicit JsonLocator(const JsonWhere& root) : root_(root) {}
+  [[noreturn]] void cf_fault(std::size_t cf, const std::string& what) const override {
+    json_fail(root_ / "cfs" / cf, what);
+  }
+  [[noreturn]] void pc_fault(std::size_t cf, std::size_t pc, const char* field,
+                             const std::string& what) const override {
+    json_fail(root_ / "cfs" / cf / "pcs" / pc / field, what);
+  }
+  [[noreturn]] void transition_fault(std::size_t t, const char* field, const std::string& what) const override {
+    json_fail(root_ / "transitions" / t / field, what);
+  }
+  [[noreturn]] void metadata_fault(const std::string& what) const override { json_fail(root_, what); }
+
+ private:
+  const JsonWhere& root_;
+};
+
+bool is_reserved(const std::string& key) {
+  return key == "format" || key == "version" || key == "units" || key == "models" || key == "cfs" ||
+         key == "transitions";
+}
+
+}  // namespace
+
+std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::string& source, bool cbor,
+                                          const GraphLoadOptions& options) {
+  GraphSax sax(source, cbor);
+  if (cbor)
+    json::sax_parse(bytes.begin(), bytes.end(), &sax, json::input_format_t::cbor);
+  else
+    FastJsonParser(bytes, source).parse(sax);
+
+  const JsonWhere root{source, ""};
+  const json& j = sax.skeleton;
+  if (!j.is_object()) json_fail(root, "expected a cf-graph object, got " + json_short(j));
+  {
+    const auto it = j.find("format");
+    if (it == j.end()) json_fail(root, "missing member \"format\": not a cf-graph file");
+    if (!it->is_string() || it->get<std::string>() != "cf-graph")
+      json_fail(root / "format", "format is " + json_short(*it) + ", expected \"cf-graph\"");
+    const json& v = json_member(j, "version", root);
+    if (!v.is_number_integer() || v.get<long long>() != 1)
+      json_fail(root / "version", "version " + json_short(v) + " is not supported (this library reads version 1)");
+    const json& u = json_member(j, "units", root);
+    if (!u.is_string() || u.get<std::string>() != "mm")
+      json_fail(root / "units", "units " + json_short(u) + " are not supported, expected \"mm\"");
+  }
+  if (sax.faulted()) throw Error("reading '" + source + "' at " + sax.fault_pointer + ": " + sax.fault_what);
+  const JsonWhere wm = root / "models";
+  const json& jm = json_member(j, "models", root);
+  if (!sax.have_cfs) json_fail(root, "missing member \"cfs\"");
+  if (!sax.have_transitions) json_fail(root, "missing member \"transitions\"");
+  auto impl = std::make_unique<CfGraph::Impl>();
+  impl->a = polyhedron_from_json(json_member(jm, "A", wm), wm / "A");
+  impl->b = polyhedron_from_json(json_member(jm, "B", wm), wm / "B");
+
+  const JsonLocator where(root);
+  impl->cfs.reserve(sax.cfs.size());
+  for (std::size_t i = 0; i < sax.cfs.size(); ++i) {
+    RawCf& r = sax.cfs[i];
+    for (int k = 0; k < r.num_pcs; ++k) {
+      const Pc& pc = r.pcs[static_cast<std::size_t>(k)];
+      const char* field = "";
+      if (std::string why = check_pc(pc, impl->a, impl->b, &field); !why.empty())
+        where.pc_fault(i, static_cast<std::size_t>(k), field, why);
+      if (!r.record.pcs.insert(pc))
+        json_fail(root / "cfs" / i / "pcs" / static_cast<std::size_t>(k), "PC " + to_string(pc) + " is repeated in this CF");
+    }
+    impl->cfs.push_back(r.record);
+  }
+  sax.cfs = {};
+
+  if (options.validate_schema) {
+    if (options.full_schema_check) {
+      validate_graph_schema(cbor ? json::from_cbor(bytes) : json::parse(bytes), source);
+    } else {
+      json skeleton = j;
+      skeleton["cfs"] = json::array();
+      skeleton["transitions"] = json::array();
+      validate_graph_schema(skeleton, source);
+    }
+  }
+
+  json meta = json::object();
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (!is_reserved(it.key())) meta[it.key()] = it.value();
+  impl->metadata = meta.dump();
+  impl->transitions = std::move(sax.transitions);
+  impl->build(where);
+  return impl;
+}
+
+}  // namespace cf::detail
