@@ -116,7 +116,16 @@ PolygonSoup read_polygon_soup(const std::string& path) {
     ok = CGAL::IO::read_PLY(path, points, polygons, np);
   }
   if (!ok) fail(path, "parse error: not a readable " + format + " file");
-  if (points.empty() || polygons.empty()) fail(path, "the file contains no facets");
+  if (points.empty() || polygons.empty()) {
+    // CGAL's STL reader gives up silently (no facets) on text that is neither ascii nor
+    // binary STL; only a blank file is truly without facets.
+    std::ifstream in(path, std::ios::binary);
+    char c;
+    bool blank = true;
+    while (blank && in.get(c)) blank = std::isspace(static_cast<unsigned char>(c)) != 0;
+    if (format == "STL" && !blank) fail(path, "parse error: not a readable STL file");
+    fail(path, "the file contains no facets");
+  }
 
   // Merge points with identical coordinates into the first occurrence. Every point keeps its
   // input index (duplicates are left unused), so messages and index rules use file order.

@@ -1,0 +1,307 @@
+// Model input: every reader (OFF, OBJ, STL ascii and binary, PLY) and every rejection path of
+// tools/mesh/model_loader, with the messages checked.
+
+#include "mesh/model_loader.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using cf::tools::load_model;
+
+namespace {
+
+// Values computed from small exact integers: a few ulps of 1000.
+constexpr double kExact = 1e-12;
+
+const std::string kModels = std::string(CF_TEST_DATA_DIR) + "/models/";
+
+// A scratch directory per test run for files written by the tests.
+fs::path scratch() {
+  static const fs::path dir = [] {
+    fs::path d = fs::temp_directory_path() /
+                 ("cf_mesh_io_test_" + std::to_string(static_cast<long>(::getpid())));
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+std::string write_file(const std::string& name, const std::string& text) {
+  const fs::path p = scratch() / name;
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+  return p.string();
+}
+
+// The 10 mm cube of tests/data/models/cube.off as points and quads.
+const std::vector<cf::Vec3> kCubeV = {{0, 0, 0},   {10, 0, 0},  {10, 10, 0}, {0, 10, 0},
+                                      {0, 0, 10}, {10, 0, 10}, {10, 10, 10}, {0, 10, 10}};
+const std::vector<std::vector<int>> kCubeF = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                              {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
+
+std::string off_text(const std::vector<cf::Vec3>& v, const std::vector<std::vector<int>>& f) {
+  std::ostringstream os;
+  os << "OFF\n" << v.size() << ' ' << f.size() << " 0\n";
+  for (const auto& p : v) os << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+  for (const auto& poly : f) {
+    os << poly.size();
+    for (int i : poly) os << ' ' << i;
+    os << '\n';
+  }
+  return os.str();
+}
+
+std::vector<std::vector<int>> triangulate(const std::vector<std::vector<int>>& quads) {
+  std::vector<std::vector<int>> t;
+  for (const auto& q : quads) {
+    t.push_back({q[0], q[1], q[2]});
+    t.push_back({q[0], q[2], q[3]});
+  }
+  return t;
+}
+
+// Binary STL: 80-byte header, count, then per triangle normal, 3 corners, attribute.
+std::string binary_stl(const std::vector<cf::Vec3>& v, const std::vector<std::vector<int>>& tris,
+                       const std::string& header) {
+  std::string s(80, ' ');
+  std::memcpy(&s[0], header.data(), std::min<std::size_t>(header.size(), 80));
+  auto put = [&s](const void* p, std::size_t n) { s.append(static_cast<const char*>(p), n); };
+  const std::uint32_t n = static_cast<std::uint32_t>(tris.size());
+  put(&n, 4);
+  for (const auto& t : tris) {
+    const cf::Vec3 nrm = (v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]).normalized();
+    for (int k = 0; k < 3; ++k) {
+      const float x = static_cast<float>(nrm[k]);
+      put(&x, 4);
+    }
+    for (int i : t)
+      for (int k = 0; k < 3; ++k) {
+        const float x = static_cast<float>(v[i][k]);
+        put(&x, 4);
+      }
+    const std::uint16_t attr = 0;
+    put(&attr, 2);
+  }
+  return s;
+}
+
+// Checks a loaded 10 mm cube: counts, volume, and that its vertices are the cube's corners.
+void check_cube(const cf::Polyhedron& m) {
+  CHECK(m.num_vertices() == 8);
+  CHECK(m.num_edges() == 12);
+  CHECK(m.num_faces() == 6);
+  CHECK(m.volume() == Approx(1000).epsilon(kExact));
+  for (const cf::Vertex& v : m.vertices()) {
+    bool corner = false;
+    for (const auto& c : kCubeV) corner = corner || (v.p - c).norm() < kExact;
+    CHECK(corner);
+  }
+  for (const cf::Face& f : m.faces()) {
+    CHECK(f.loops.size() == 1);
+    CHECK(f.loops[0].size() == 4);
+    CHECK(f.area == Approx(100).epsilon(kExact));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("every reader loads the cube", "[mesh_io]") {
+  SECTION("OFF, polygonal") { check_cube(load_model(kModels + "cube.off")); }
+  SECTION("OFF, triangulated") { check_cube(load_model(kModels + "cube_tri.off")); }
+  SECTION("OBJ with texture and normal references") { check_cube(load_model(kModels + "cube.obj")); }
+  SECTION("STL ascii") { check_cube(load_model(kModels + "cube_ascii.stl")); }
+  SECTION("STL binary") {
+    check_cube(load_model(write_file("cube_binary.stl", binary_stl(kCubeV, triangulate(kCubeF), "binary cube"))));
+  }
+  SECTION("STL binary whose header starts with 'solid'") {
+    // Some exporters do this; the reader falls back from ascii to binary.
+    check_cube(load_model(
+        write_file("cube_solid_header.stl", binary_stl(kCubeV, triangulate(kCubeF), "solid cube"))));
+  }
+  SECTION("PLY ascii, polygonal") { check_cube(load_model(kModels + "cube.ply")); }
+  SECTION("extension in upper case") {
+    fs::copy_file(kModels + "cube.off", scratch() / "CUBE.OFF", fs::copy_options::overwrite_existing);
+    check_cube(load_model((scratch() / "CUBE.OFF").string()));
+  }
+}
+
+TEST_CASE("formats that keep the vertex order give identical features", "[mesh_io]") {
+  const std::string ref = cf::to_json(load_model(kModels + "cube.off", {"cube"}));
+  CHECK(cf::to_json(load_model(kModels + "cube_tri.off", {"cube"})) == ref);
+  CHECK(cf::to_json(load_model(kModels + "cube.obj", {"cube"})) == ref);
+  CHECK(cf::to_json(load_model(kModels + "cube.ply", {"cube"})) == ref);
+}
+
+TEST_CASE("the model's name is the file stem unless given", "[mesh_io]") {
+  CHECK(load_model(kModels + "cube.off").name() == "cube");
+  cf::tools::LoadOptions opt;
+  opt.name = "A";
+  CHECK(load_model(kModels + "cube.off", opt).name() == "A");
+}
+
+TEST_CASE("identical points are merged, keeping input indices", "[mesh_io]") {
+  // Facet 1 uses point 8, a copy of point 4: after merging the cube is closed.
+  std::vector<cf::Vec3> v = kCubeV;
+  v.push_back(v[4]);
+  auto f = kCubeF;
+  f[1] = {8, 5, 6, 7};
+  const cf::Polyhedron m = load_model(write_file("dup_point.off", off_text(v, f)));
+  check_cube(m);
+}
+
+TEST_CASE("files that cannot be read are rejected, naming the file", "[mesh_io]") {
+  const std::string missing = (scratch() / "missing.off").string();
+  CHECK_THROWS_WITH(load_model(missing),
+                    Catch::Contains("loading '" + missing + "': cannot open file: no such file"));
+  fs::create_directories(scratch() / "dir.off");
+  CHECK_THROWS_WITH(load_model((scratch() / "dir.off").string()),
+                    Catch::Contains("dir.off': cannot open file: not a regular file"));
+  const std::string empty = write_file("empty.off", "");
+  CHECK_THROWS_WITH(load_model(empty), Catch::Contains("loading '" + empty + "': the file is empty"));
+  const std::string xyz = write_file("cube.xyz", off_text(kCubeV, kCubeF));
+  CHECK_THROWS_WITH(load_model(xyz),
+                    Catch::Contains("cube.xyz': unknown file extension '.xyz' (expected .off, .obj, .stl or .ply)"));
+  const std::string noext = write_file("cube", off_text(kCubeV, kCubeF));
+  CHECK_THROWS_WITH(load_model(noext), Catch::Contains("unknown file extension ''"));
+}
+
+TEST_CASE("malformed files are parse errors", "[mesh_io]") {
+  CHECK_THROWS_WITH(load_model(write_file("bad.off", "OFF\n8 6 0\n0 0 zero\n")),
+                    Catch::Contains("bad.off': parse error: not a readable OFF file"));
+  CHECK_THROWS_WITH(load_model(write_file("bad.obj", "v 0 0 0\nbogus line\n")),
+                    Catch::Contains("bad.obj': parse error: not a readable OBJ file"));
+  CHECK_THROWS_WITH(load_model(write_file("bad.stl", "solid x\n  facet normal 0 0 1\n    outer loop\n"
+                                                    "      vertex 0 0 nope\n")),
+                    Catch::Contains("bad.stl': parse error: not a readable STL file"));
+  CHECK_THROWS_WITH(load_model(write_file("bad.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
+                                                    "property float x\nend_header\n1\n")),
+                    Catch::Contains("bad.ply': parse error: not a readable PLY file"));
+  // A facet index beyond the vertex list: CGAL's OFF reader rejects it; its OBJ reader lets
+  // index n (one past the end) through, which the loader catches.
+  auto f = kCubeF;
+  f[0] = {0, 3, 2, 9};
+  CHECK_THROWS_WITH(load_model(write_file("index.off", off_text(kCubeV, f))),
+                    Catch::Contains("index.off': parse error: not a readable OFF file"));
+  CHECK_THROWS_WITH(load_model(write_file("index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n")),
+                    Catch::Contains("index.obj': parse error: facet 0 refers to vertex 3 but the file has 3 vertices"));
+}
+
+TEST_CASE("a file without facets is rejected", "[mesh_io]") {
+  CHECK_THROWS_WITH(load_model(write_file("nofacets.off", "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n")),
+                    Catch::Contains("nofacets.off': the file contains no facets"));
+  CHECK_THROWS_WITH(load_model(write_file("blank.stl", "   \n")),
+                    Catch::Contains("blank.stl': the file contains no facets"));
+}
+
+TEST_CASE("broken solids are rejected with the reason", "[mesh_io]") {
+  SECTION("open boundary") {
+    auto f = kCubeF;
+    f.pop_back();  // no x = 0 side
+    CHECK_THROWS_WITH(load_model(write_file("open.off", off_text(kCubeV, f))),
+                      Catch::Contains("open.off': open boundary: edge 0-3 belongs to facet 0 only"));
+  }
+  SECTION("non-manifold edge: two cubes sharing an edge") {
+    // Second cube [10,20] x [10,20] x [0,10] shares the cube's edge 2-6 (x = y = 10).
+    std::vector<cf::Vec3> v = kCubeV;
+    for (int i = 0; i < 8; ++i) v.push_back(kCubeV[i] + cf::Vec3(10, 10, 0));
+    auto f = kCubeF;
+    for (auto q : kCubeF) {
+      for (int& i : q) i += 8;
+      f.push_back(q);
+    }
+    // Weld the second cube's corners (10,10,z) = points 8 and 12 onto points 2 and 6.
+    for (auto& q : f)
+      for (int& i : q) i = i == 8 ? 2 : i == 12 ? 6 : i;
+    CHECK_THROWS_WITH(load_model(write_file("nm_edge.off", off_text(v, f))),
+                      Catch::Contains("nm_edge.off': non-manifold edge: edge 2-6 is shared by 4 facets"));
+  }
+  SECTION("non-manifold vertex: two cubes sharing a corner") {
+    std::vector<cf::Vec3> v = kCubeV;
+    for (int i = 0; i < 8; ++i) v.push_back(kCubeV[i] + cf::Vec3(10, 10, 10));
+    auto f = kCubeF;
+    for (auto q : kCubeF) {
+      for (int& i : q) i = i == 0 ? 6 : i + 8;  // its corner 0 is the cube's corner 6
+      f.push_back(q);
+    }
+    CHECK_THROWS_WITH(load_model(write_file("nm_vertex.off", off_text(v, f))),
+                      Catch::Contains("nm_vertex.off': non-manifold vertex: vertex 6 joins separate fans"));
+  }
+  SECTION("inconsistent orientation: one facet flipped") {
+    auto f = kCubeF;
+    std::reverse(f[1].begin(), f[1].end());
+    CHECK_THROWS_WITH(load_model(write_file("flipped.off", off_text(kCubeV, f))),
+                      Catch::Contains("flipped.off': inconsistent orientation: facets 1 and 2 both run edge"));
+  }
+  SECTION("inward orientation") {
+    auto f = kCubeF;
+    for (auto& q : f) std::reverse(q.begin(), q.end());
+    CHECK_THROWS_WITH(load_model(write_file("inward.off", off_text(kCubeV, f))),
+                      Catch::Contains("inward.off': inward orientation: the enclosed volume is -1000 mm^3"));
+  }
+  SECTION("self-intersection") {
+    // Triangulated cube with its top corner (10,10,10) pulled down through the bottom.
+    std::vector<cf::Vec3> v = kCubeV;
+    v[6] = {5, 5, -5};
+    CHECK_THROWS_WITH(load_model(write_file("selfx.off", off_text(v, triangulate(kCubeF)))),
+                      Catch::Contains("selfx.off': self-intersection: facets"));
+  }
+  SECTION("degenerate facet: repeated vertex") {
+    auto f = kCubeF;
+    f[0] = {0, 3, 3, 2, 1};
+    CHECK_THROWS_WITH(load_model(write_file("repeat.off", off_text(kCubeV, f))),
+                      Catch::Contains("repeat.off': degenerate facet: facet 0 uses vertex 3 more than once"));
+  }
+  SECTION("degenerate facet: fewer than 3 vertices") {
+    auto f = kCubeF;
+    f.push_back({0, 1});
+    CHECK_THROWS_WITH(load_model(write_file("two.off", off_text(kCubeV, f))),
+                      Catch::Contains("two.off': degenerate facet: facet 6 has only 2 vertices"));
+  }
+  SECTION("degenerate facet: zero area") {
+    // Point 8 is the midpoint of edge 4-5; the side face runs 5 -> 8 -> 4, and the sliver
+    // triangle 4-8-5 closes the gap against the top face's edge 4-5.
+    std::vector<cf::Vec3> v = kCubeV;
+    v.push_back({5, 0, 10});
+    auto f = kCubeF;
+    f[2] = {0, 1, 5, 8, 4};
+    f.push_back({4, 8, 5});
+    CHECK_THROWS_WITH(load_model(write_file("sliver.off", off_text(v, f))),
+                      Catch::Contains("sliver.off': degenerate facet: facet 6 has zero area"));
+  }
+  SECTION("non-planar facet") {
+    std::vector<cf::Vec3> v = kCubeV;
+    v[6].z() = 10.5;
+    CHECK_THROWS_WITH(load_model(write_file("warped.off", off_text(v, kCubeF))),
+                      Catch::Contains("warped.off': non-planar facet: vertex"));
+  }
+  SECTION("two separate solids") {
+    std::vector<cf::Vec3> v = kCubeV;
+    for (int i = 0; i < 8; ++i) v.push_back(kCubeV[i] + cf::Vec3(20, 0, 0));
+    auto f = kCubeF;
+    for (auto q : kCubeF) {
+      for (int& i : q) i += 8;
+      f.push_back(q);
+    }
+    CHECK_THROWS_WITH(load_model(write_file("two_cubes.off", off_text(v, f))),
+                      Catch::Contains("two_cubes.off': the file holds 2 separate solids"));
+  }
+}
+
+TEST_CASE("model_from_soup validates in-memory soups too", "[mesh_io]") {
+  cf::tools::PolygonSoup soup{kCubeV, kCubeF};
+  check_cube(cf::tools::model_from_soup(soup, "memory"));
+  soup.polygons.pop_back();
+  CHECK_THROWS_WITH(cf::tools::model_from_soup(soup, "memory"),
+                    Catch::Contains("loading 'memory': open boundary"));
+}
