@@ -7,6 +7,7 @@
 #include <CGAL/QP_functions.h>
 #include <CGAL/QP_models.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
 #include <algorithm>
 #include <map>

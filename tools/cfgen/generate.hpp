@@ -4,6 +4,8 @@
 /// main.cpp parses the command line; run_generate does the work (generate.cpp, built when
 /// present, which defines CF_HAVE_GENERATOR).
 
+#include "cfgen/witness.hpp"
+
 #include <string>
 
 namespace cf::tools {
@@ -15,6 +17,8 @@ struct GenerateArgs {
   std::string out_path;  ///< graph file to write, whole or not at all
   int threads = 0;       ///< worker threads; 0 = hardware concurrency
   bool quiet = false;    ///< no progress on stderr
+  int max_pcs = 3;       ///< largest CFs to enumerate (1..3)
+  gen::SearchParams search;  ///< tolerances and search limits of the witness search
 };
 
 /// Generates the CF graph of A against B and writes it to args.out_path.

@@ -7,6 +7,7 @@
 
 #include <cf/graph.hpp>
 
+#include <string>
 #include <vector>
 
 namespace cf::gen {
@@ -41,7 +42,7 @@ class WitnessSearch {
   /// dominated by one of them), locally without penetration, pairwise distinct contact
   /// planes, every other pair at least min_clearance apart, neither solid inside the other.
   /// Returns the clearance, or a negative number when the pose is not a witness.
-  double verify(const PcSet& pcs, const Pose& pose) const;
+  double verify(const PcSet& pcs, const Pose& pose, std::string* why = nullptr) const;
 
   /// Cheap necessary conditions on a candidate set (no geometry search).
   bool plausible(const PcSet& pcs) const;
@@ -55,13 +56,17 @@ class WitnessSearch {
  private:
   std::vector<Mat3> rotation_candidates(const PcSet& pcs, const std::vector<Mat3>& seeds) const;
   double local_margin(const PcSet& pcs, const Mat3& R) const;
-  bool solve_translation(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces,
-                         Vec3& t, double& margin) const;
+  LinearProgram build_lp(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces) const;
+  // Candidate translations for rotation R, best first; empty when the contacts cannot hold
+  // with min_margin. `margin` receives the largest margin.
+  std::vector<Vec3> translations(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces,
+                                 double& margin) const;
 
   const ModelInfo& A_;
   const ModelInfo& B_;
   SearchParams p_;
   double scale_;
+  bool debug_;  // CFGEN_DEBUG set: explain every attempt on stderr
 };
 
 }  // namespace cf::gen

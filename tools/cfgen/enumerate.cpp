@@ -1,0 +1,318 @@
+#include "enumerate.hpp"
+
+#include <cf/geometry.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <thread>
+#include <unordered_map>
+
+namespace cf::gen {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct PcSetHash {
+  std::size_t operator()(const PcSet& s) const { return s.hash(); }
+};
+
+int element_count(const Polyhedron& m, ElementKind k) {
+  return static_cast<int>(k == ElementKind::kVertex ? m.num_vertices()
+                          : k == ElementKind::kEdge ? m.num_edges()
+                                                    : m.num_faces());
+}
+
+// Vertices of an element's closure.
+std::vector<Vec3> closure_points(const Polyhedron& m, ElementKind k, int i) {
+  std::vector<Vec3> out;
+  if (k == ElementKind::kVertex) out.push_back(m.vertices()[i].p);
+  else if (k == ElementKind::kEdge) {
+    out.push_back(m.edge_point(EdgeId(i), 0));
+    out.push_back(m.edge_point(EdgeId(i), 1));
+  } else
+    for (VertexId v : m.faces()[i].vertices) out.push_back(m.vertex(v).p);
+  return out;
+}
+
+// Rigid-body necessary condition for two PCs: the distance between the two touching points
+// is the same measured in A and in B, so the [min, max] distance ranges of the A elements and
+// of the B elements must meet.
+class DistanceFilter {
+ public:
+  DistanceFilter(const Polyhedron& A, const Polyhedron& B) : A_(A), B_(B) {}
+  bool compatible(const Pc& x, const Pc& y) const {
+    const auto [amin, amax] = range(A_, a_kind(x.type), x.a, a_kind(y.type), y.a);
+    const auto [bmin, bmax] = range(B_, b_kind(x.type), x.b, b_kind(y.type), y.b);
+    const double tol = 1e-9 * std::max(A_.size(), B_.size());
+    return amin <= bmax + tol && bmin <= amax + tol;
+  }
+
+ private:
+  static std::pair<double, double> range(const Polyhedron& m, ElementKind k1, int i1,
+                                         ElementKind k2, int i2) {
+    const double dmin = element_distance(m, Pose(), k1, i1, m, k2, i2).distance;
+    double dmax = 0;
+    for (const Vec3& p : closure_points(m, k1, i1))
+      for (const Vec3& q : closure_points(m, k2, i2)) dmax = std::max(dmax, (p - q).norm());
+    return {dmin, dmax};
+  }
+  const Polyhedron& A_;
+  const Polyhedron& B_;
+};
+
+// Runs fn(i) for i in [0, n) on `threads` threads; results are written by index, so the
+// output does not depend on the thread count.
+void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& fn,
+                  const std::function<void(std::size_t)>& tick) {
+  std::atomic<std::size_t> next{0}, done{0};
+  auto work = [&] {
+    for (std::size_t i; (i = next++) < n;) {
+      fn(i);
+      ++done;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int k = 1; k < threads; ++k) pool.emplace_back(work);
+  std::thread reporter;
+  std::atomic<bool> stop{false};
+  if (tick)
+    reporter = std::thread([&] {
+      while (!stop) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(250));
+        tick(done.load());
+      }
+    });
+  work();
+  for (auto& t : pool) t.join();
+  stop = true;
+  if (reporter.joinable()) reporter.join();
+}
+
+}  // namespace
+
+std::vector<Pc> neighbouring_pcs(const Pc& pc, const Polyhedron& A, const Polyhedron& B) {
+  std::vector<Pc> out;
+  auto add = [&](PcType t, int a, int b) { out.push_back({t, a, b}); };
+  auto edges_of_face = [](const Polyhedron& m, int f) { return m.faces()[f].edges; };
+  auto faces_of_edge = [](const Polyhedron& m, int e) {
+    return std::vector<int>{m.edges()[e].left.value(), m.edges()[e].right.value()};
+  };
+  auto ends_of_edge = [](const Polyhedron& m, int e) {
+    return std::vector<int>{m.edges()[e].v0.value(), m.edges()[e].v1.value()};
+  };
+  switch (pc.type) {
+    case PcType::kFF:
+      for (EdgeId e : edges_of_face(A, pc.a)) add(PcType::kEF, e.value(), pc.b);
+      for (EdgeId e : edges_of_face(B, pc.b)) add(PcType::kFE, pc.a, e.value());
+      break;
+    case PcType::kEF:
+      for (int f : faces_of_edge(A, pc.a)) add(PcType::kFF, f, pc.b);
+      for (int v : ends_of_edge(A, pc.a)) add(PcType::kVF, v, pc.b);
+      for (EdgeId e : edges_of_face(B, pc.b)) add(PcType::kEE, pc.a, e.value());
+      break;
+    case PcType::kFE:
+      for (int f : faces_of_edge(B, pc.b)) add(PcType::kFF, pc.a, f);
+      for (int v : ends_of_edge(B, pc.b)) add(PcType::kFV, pc.a, v);
+      for (EdgeId e : edges_of_face(A, pc.a)) add(PcType::kEE, e.value(), pc.b);
+      break;
+    case PcType::kVF:
+      for (EdgeId ea : A.vertices()[pc.a].edges) {
+        add(PcType::kEF, ea.value(), pc.b);
+        for (EdgeId eb : edges_of_face(B, pc.b)) add(PcType::kEE, ea.value(), eb.value());
+      }
+      break;
+    case PcType::kFV:
+      for (EdgeId eb : B.vertices()[pc.b].edges) {
+        add(PcType::kFE, pc.a, eb.value());
+        for (EdgeId ea : edges_of_face(A, pc.a)) add(PcType::kEE, ea.value(), eb.value());
+      }
+      break;
+    case PcType::kEE:
+      for (int f : faces_of_edge(B, pc.b)) add(PcType::kEF, pc.a, f);
+      for (int f : faces_of_edge(A, pc.a)) add(PcType::kFE, f, pc.b);
+      for (int v : ends_of_edge(A, pc.a))
+        for (int f : faces_of_edge(B, pc.b)) add(PcType::kVF, v, f);
+      for (int v : ends_of_edge(B, pc.b))
+        for (int f : faces_of_edge(A, pc.a)) add(PcType::kFV, f, v);
+      break;
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+std::vector<Transition> transitions_between(const std::vector<CfRecord>& cfs, const Polyhedron& A,
+                                            const Polyhedron& B) {
+  std::unordered_map<PcSet, int, PcSetHash> index;
+  for (std::size_t i = 0; i < cfs.size(); ++i) index.emplace(cfs[i].pcs, static_cast<int>(i));
+  std::vector<Transition> out;
+  auto push = [&](int from, int to, TransitionKind k) {
+    out.push_back({CfId(from), CfId(to), k});
+  };
+  std::map<Pc, std::vector<Pc>> nb_cache;
+  auto neighbours = [&](const Pc& pc) -> const std::vector<Pc>& {
+    auto it = nb_cache.find(pc);
+    if (it == nb_cache.end()) it = nb_cache.emplace(pc, neighbouring_pcs(pc, A, B)).first;
+    return it->second;
+  };
+  for (std::size_t i = 0; i < cfs.size(); ++i) {
+    const PcSet& s = cfs[i].pcs;
+    const int me = static_cast<int>(i);
+    // gain / lose: drop one PC of a larger CF.
+    if (s.size() > 1)
+      for (int k = 0; k < s.size(); ++k) {
+        PcSet sub;
+        for (int j = 0; j < s.size(); ++j)
+          if (j != k) sub.insert(s[j]);
+        auto it = index.find(sub);
+        if (it != index.end()) {
+          push(it->second, me, TransitionKind::kGain);
+          push(me, it->second, TransitionKind::kLose);
+        }
+      }
+    // change: replace one or more PCs by neighbouring PCs, keeping the count.
+    std::vector<std::vector<Pc>> options(static_cast<std::size_t>(s.size()));
+    for (int k = 0; k < s.size(); ++k) {
+      options[k].push_back(s[k]);
+      for (const Pc& q : neighbours(s[k])) options[k].push_back(q);
+    }
+    std::vector<std::size_t> pick(options.size(), 0);
+    while (true) {
+      std::size_t d = 0;
+      while (d < pick.size() && ++pick[d] == options[d].size()) pick[d++] = 0;
+      if (d == pick.size()) break;
+      PcSet t;
+      bool ok = true;
+      for (std::size_t k = 0; k < pick.size() && ok; ++k) ok = t.insert(options[k][pick[k]]);
+      if (!ok || t.size() != s.size()) continue;
+      auto it = index.find(t);
+      if (it != index.end() && it->second != me) push(me, it->second, TransitionKind::kChange);
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const Transition& x, const Transition& y) {
+    if (x.from != y.from) return x.from < y.from;
+    if (x.to != y.to) return x.to < y.to;
+    return x.kind < y.kind;
+  });
+  out.erase(std::unique(out.begin(), out.end(),
+                        [](const Transition& x, const Transition& y) {
+                          return x.from == y.from && x.to == y.to && x.kind == y.kind;
+                        }),
+            out.end());
+  return out;
+}
+
+Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateOptions& opt) {
+  const Polyhedron& A = *Ai.model;
+  const Polyhedron& B = *Bi.model;
+  const WitnessSearch search(Ai, Bi, opt.search);
+  const int threads = opt.threads > 0 ? opt.threads
+                                      : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  Enumeration out;
+  std::vector<std::pair<PcSet, Witness>> valid[3];
+
+  auto run_level = [&](int level, const std::vector<PcSet>& cands,
+                       const std::function<std::vector<Mat3>(const PcSet&)>& seeds_of) {
+    const auto t0 = Clock::now();
+    std::vector<Witness> res(cands.size());
+    std::function<void(std::size_t)> tick;
+    if (opt.progress)
+      tick = [&](std::size_t done) {
+        std::ostringstream os;
+        os << "level " << level + 1 << ": " << done << "/" << cands.size() << " candidate sets, "
+           << std::chrono::duration<double>(Clock::now() - t0).count() << " s";
+        opt.progress(os.str());
+      };
+    parallel_for(cands.size(), threads, [&](std::size_t i) { res[i] = search.find(cands[i], seeds_of(cands[i])); },
+                 tick);
+    for (std::size_t i = 0; i < cands.size(); ++i)
+      if (res[i].found) valid[level].push_back({cands[i], res[i]});
+    out.levels[level] = {cands.size(), valid[level].size(),
+                         std::chrono::duration<double>(Clock::now() - t0).count()};
+  };
+
+  // Level 1: every element pair that local convexity allows.
+  std::vector<PcSet> c1;
+  const PcType types[] = {PcType::kFF, PcType::kEF, PcType::kFE, PcType::kVF, PcType::kFV, PcType::kEE};
+  for (PcType t : types) {
+    const int na = element_count(A, a_kind(t)), nb = element_count(B, b_kind(t));
+    for (int a = 0; a < na; ++a)
+      for (int b = 0; b < nb; ++b) {
+        if ((t == PcType::kEF || t == PcType::kEE) && !A.edges()[a].convex) continue;
+        if ((t == PcType::kFE || t == PcType::kEE) && !B.edges()[b].convex) continue;
+        if (t == PcType::kVF && !Ai.cones[a].pointed) continue;
+        if (t == PcType::kFV && !Bi.cones[b].pointed) continue;
+        c1.push_back(PcSet({Pc{t, a, b}}));
+      }
+  }
+  run_level(0, c1, [](const PcSet&) { return std::vector<Mat3>{}; });
+
+  std::unordered_map<PcSet, Mat3, PcSetHash> witness_rot;
+  for (int l = 0; l < 1; ++l)
+    for (const auto& [s, w] : valid[l]) witness_rot.emplace(s, w.pose.R_BA);
+  auto seeds_from_subsets = [&](const PcSet& s) {
+    std::vector<Mat3> seeds;
+    for (int k = 0; k < s.size(); ++k) {
+      PcSet sub;
+      for (int j = 0; j < s.size(); ++j)
+        if (j != k) sub.insert(s[j]);
+      auto it = witness_rot.find(sub);
+      if (it != witness_rot.end()) seeds.push_back(it->second);
+    }
+    return seeds;
+  };
+
+  if (opt.max_pcs >= 2) {
+    const DistanceFilter dist(A, B);
+    std::vector<PcSet> c2;
+    for (std::size_t i = 0; i < valid[0].size(); ++i)
+      for (std::size_t j = i + 1; j < valid[0].size(); ++j) {
+        const Pc& x = valid[0][i].first[0];
+        const Pc& y = valid[0][j].first[0];
+        PcSet s({x, y});
+        if (!search.plausible(s) || !dist.compatible(x, y)) continue;
+        c2.push_back(s);
+      }
+    run_level(1, c2, seeds_from_subsets);
+    for (const auto& [s, w] : valid[1]) witness_rot.emplace(s, w.pose.R_BA);
+  }
+  if (opt.max_pcs >= 3) {
+    std::unordered_map<PcSet, int, PcSetHash> pairs;
+    for (const auto& [s, w] : valid[1]) pairs.emplace(s, 0);
+    std::vector<PcSet> c3;
+    for (const auto& [s, w] : valid[1])
+      for (const auto& [s1, w1] : valid[0]) {
+        const Pc& z = s1[0];
+        if (!(s[1] < z)) continue;  // z beyond both, so each triple is built once
+        if (!pairs.count(PcSet({s[0], z})) || !pairs.count(PcSet({s[1], z}))) continue;
+        PcSet t({s[0], s[1], z});
+        if (search.plausible(t)) c3.push_back(t);
+      }
+    run_level(2, c3, seeds_from_subsets);
+  }
+
+  out.min_clearance = std::numeric_limits<double>::infinity();
+  for (int l = 0; l < 3; ++l) {
+    std::sort(valid[l].begin(), valid[l].end(), [](const auto& x, const auto& y) {
+      for (int k = 0; k < x.first.size(); ++k)
+        if (x.first[k] != y.first[k]) return x.first[k] < y.first[k];
+      return false;
+    });
+    for (const auto& [s, w] : valid[l]) {
+      CfRecord r;
+      r.pcs = s;
+      r.witness = w.pose;
+      search.freedoms(s, w.pose, r);
+      out.cfs.push_back(r);
+      out.min_clearance = std::min(out.min_clearance, w.clearance);
+    }
+  }
+  out.transitions = transitions_between(out.cfs, A, B);
+  return out;
+}
+
+}  // namespace cf::gen

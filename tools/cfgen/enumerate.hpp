@@ -1,0 +1,46 @@
+#pragma once
+// Level-by-level enumeration of the valid contact formations of a model pair, and the
+// transitions between them (SPEC section 4).
+
+#include "witness.hpp"
+
+#include <cf/graph.hpp>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace cf::gen {
+
+struct EnumerateOptions {
+  SearchParams search;
+  int threads = 0;       // 0: all hardware threads
+  int max_pcs = 3;       // 1..3
+  /// Called now and then with a one-line status; empty to stay quiet.
+  std::function<void(const std::string&)> progress;
+};
+
+struct LevelStats {
+  std::size_t candidates = 0;  // sets that reached the witness search
+  std::size_t valid = 0;
+  double seconds = 0;
+};
+
+struct Enumeration {
+  std::vector<CfRecord> cfs;          // canonical order: by number of PCs, then PC set
+  std::vector<Transition> transitions;
+  LevelStats levels[3];
+  double min_clearance = 0;           // mm, smallest witness clearance in the graph
+};
+
+Enumeration enumerate(const ModelInfo& A, const ModelInfo& B, const EnumerateOptions& options);
+
+/// PCs neighbouring `pc` (SPEC section 4): one step through a degenerate touch, under the
+/// boundary relations of the two models.
+std::vector<Pc> neighbouring_pcs(const Pc& pc, const Polyhedron& A, const Polyhedron& B);
+
+/// Transitions (gain, lose, change) between the given CFs.
+std::vector<Transition> transitions_between(const std::vector<CfRecord>& cfs, const Polyhedron& A,
+                                            const Polyhedron& B);
+
+}  // namespace cf::gen

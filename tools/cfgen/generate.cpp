@@ -1,0 +1,80 @@
+#include "cfgen/generate.hpp"
+
+#include "cfgen/enumerate.hpp"
+#include "mesh/model_loader.hpp"
+
+#include <cf/graph.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <iostream>
+#include <thread>
+
+namespace cf::tools {
+
+int run_generate(const GenerateArgs& args) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Polyhedron A = load_model(args.a_path);
+  const Polyhedron B = load_model(args.b_path);
+  const gen::ModelInfo ai = gen::analyse_model(A);
+  const gen::ModelInfo bi = gen::analyse_model(B);
+
+  gen::EnumerateOptions opt;
+  opt.threads = args.threads;
+  opt.search = args.search;
+  opt.max_pcs = args.max_pcs;
+  bool progress_shown = false;
+  if (!args.quiet)
+    opt.progress = [&](const std::string& line) {
+      // Only runs over a couple of seconds get a progress display.
+      if (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(2)) return;
+      std::cerr << "\rcfgen: " << line << "    " << std::flush;
+      progress_shown = true;
+    };
+  const gen::Enumeration e = gen::enumerate(ai, bi, opt);
+  if (progress_shown) std::cerr << '\n';
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  nlohmann::json meta;
+  nlohmann::json by_count = nlohmann::json::object(), by_type = nlohmann::json::object();
+  for (const CfRecord& r : e.cfs) {
+    by_count[std::to_string(r.pcs.size())] = by_count.value(std::to_string(r.pcs.size()), 0) + 1;
+    for (const Pc& pc : r.pcs) by_type[to_string(pc.type)] = by_type.value(to_string(pc.type), 0) + 1;
+  }
+  nlohmann::json by_kind = nlohmann::json::object();
+  for (const Transition& t : e.transitions)
+    by_kind[to_string(t.kind)] = by_kind.value(to_string(t.kind), 0) + 1;
+  nlohmann::json levels = nlohmann::json::array();
+  for (const auto& l : e.levels)
+    levels.push_back({{"candidates", l.candidates}, {"valid", l.valid}});
+  meta["stats"] = {{"cfs", e.cfs.size()},
+                   {"cfs_by_pc_count", by_count},
+                   {"pcs_by_type", by_type},
+                   {"transitions", e.transitions.size()},
+                   {"transitions_by_kind", by_kind},
+                   {"levels", levels},
+                   {"min_witness_clearance_mm", e.cfs.empty() ? 0.0 : e.min_clearance}};
+  // Timing goes to stderr, not into the file, so that the same input gives the same bytes.
+  const auto& s = opt.search;
+  meta["parameters"] = {{"touch_tol_mm", s.touch_tol},
+                        {"min_clearance_mm", s.min_clearance},
+                        {"good_clearance_mm", s.good_clearance},
+                        {"min_margin_mm", s.min_margin},
+                        {"angle_margin_rad", s.angle_margin},
+                        {"theta_samples", s.theta_samples},
+                        {"max_rotations", s.max_rotations},
+                        {"max_pcs", opt.max_pcs}};
+  meta["generator"] = {{"name", "cfgen"}, {"a_model", args.a_path}, {"b_model", args.b_path}};
+
+  const std::size_t n_cfs = e.cfs.size(), n_tr = e.transitions.size();
+  const CfGraph graph = CfGraph::from_parts(A, B, e.cfs, e.transitions, meta.dump());
+  graph.save(args.out_path);
+  if (!args.quiet)
+    std::cerr << "cfgen: " << n_cfs << " CFs (" << e.levels[0].valid << " + " << e.levels[1].valid
+              << " + " << e.levels[2].valid << "), " << n_tr << " transitions, " << seconds
+              << " s -> " << args.out_path << '\n';
+  return 0;
+}
+
+}  // namespace cf::tools

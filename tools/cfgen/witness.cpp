@@ -1,0 +1,687 @@
+#include "witness.hpp"
+
+#include "touch.hpp"
+
+#include <cf/geometry.hpp>
+
+#include <Eigen/SVD>
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+
+namespace cf::gen {
+namespace {
+
+using Rel = LinearProgram::Rel;
+
+struct RotConstraints {
+  std::vector<std::pair<Vec3, Vec3>> align;  // R a == b
+  std::vector<std::pair<Vec3, Vec3>> perp;   // (R u) . w == 0
+};
+
+constexpr double kRotTol = 1e-9;  // residual accepted for rotational contact conditions
+
+bool satisfies(const RotConstraints& c, const Mat3& R) {
+  for (const auto& [a, b] : c.align)
+    if ((R * a - b).norm() > 10 * kRotTol) return false;
+  for (const auto& [u, w] : c.perp)
+    if (std::abs((R * u).dot(w)) > 10 * kRotTol) return false;
+  return true;
+}
+
+// Solutions theta of a cos(theta) + b sin(theta) == d; `all` when it holds for every theta.
+bool trig_solve(double a, double b, double d, std::vector<double>& out, bool& all) {
+  const double r = std::hypot(a, b);
+  all = false;
+  if (r < 1e-12) {
+    all = std::abs(d) < kRotTol;
+    return all;
+  }
+  double c = d / r;
+  if (std::abs(c) > 1 + 1e-9) return false;
+  c = std::clamp(c, -1.0, 1.0);
+  const double phi = std::atan2(b, a);
+  const double delta = std::acos(c);
+  out.push_back(phi + delta);
+  if (delta > 1e-9 && delta < M_PI - 1e-9) out.push_back(phi - delta);
+  return true;
+}
+
+void add_unique(std::vector<Mat3>& out, const Mat3& R) {
+  for (const Mat3& Q : out)
+    if ((Q - R).norm() < 1e-7) return;
+  out.push_back(R);
+}
+
+// theta maximising trace(S^T Rot(axis, theta) R0): the family member closest to S.
+double closest_theta(const Vec3& axis, const Mat3& R0, const Mat3& S) {
+  const Mat3 Q = R0 * S.transpose();
+  Mat3 K;
+  K << 0, -axis.z(), axis.y(), axis.z(), 0, -axis.x(), -axis.y(), axis.x(), 0;
+  const double c = Q.trace() - axis.dot(Q * axis);
+  const double s = (Q * K).trace();
+  return std::atan2(s, c);
+}
+
+// Rotations R = Rot(axis, theta) * R0 satisfying all constraints; finitely many or samples.
+std::vector<Mat3> align_family(const RotConstraints& c, const std::vector<Mat3>& seeds,
+                               int samples) {
+  const Vec3 a1 = c.align[0].first, axis = c.align[0].second;
+  const Mat3 R0 = align(a1, axis);
+  std::vector<double> thetas;
+  bool finite = false;
+  auto consider = [&](const Vec3& u0, const Vec3& w, double target) {
+    const Vec3 u = R0 * u0;
+    const Vec3 u_par = u.dot(axis) * axis;
+    const double A = (u - u_par).dot(w);
+    const double B = axis.cross(u).dot(w);
+    const double C = u_par.dot(w);
+    std::vector<double> sol;
+    bool all = false;
+    if (!trig_solve(A, B, target - C, sol, all)) return false;
+    if (all) return true;
+    if (!finite) {
+      thetas = sol;
+      finite = true;
+    }
+    return true;
+  };
+  for (std::size_t i = 1; i < c.align.size(); ++i)
+    if (!consider(c.align[i].first, c.align[i].second, 1.0)) return {};
+  for (const auto& [u, w] : c.perp)
+    if (!consider(u, w, 0.0)) return {};
+  if (!finite) {
+    for (const Mat3& S : seeds) thetas.push_back(closest_theta(axis, R0, S));
+    for (int k = 0; k < samples; ++k) thetas.push_back(0.1 + 2 * M_PI * k / samples);
+  }
+  std::vector<Mat3> out;
+  for (double th : thetas) {
+    const Mat3 R = axis_angle(axis, th) * R0;
+    if (satisfies(c, R)) add_unique(out, R);
+  }
+  return out;
+}
+
+// Gauss-Newton projection of R onto { (R u_i) . w_i == 0 }.
+bool project_perp(const RotConstraints& c, Mat3& R) {
+  const int k = static_cast<int>(c.perp.size());
+  for (int it = 0; it < 40; ++it) {
+    Eigen::VectorXd r(k);
+    Eigen::MatrixXd J(k, 3);
+    for (int i = 0; i < k; ++i) {
+      const Vec3 Ru = R * c.perp[i].first;
+      r[i] = Ru.dot(c.perp[i].second);
+      J.row(i) = Ru.cross(c.perp[i].second).transpose();
+    }
+    if (r.cwiseAbs().maxCoeff() < 1e-14) return true;
+    const Eigen::Vector3d d = -J.completeOrthogonalDecomposition().solve(r);
+    if (!d.allFinite() || d.norm() < 1e-16) break;
+    const double ang = std::min(d.norm(), 0.5);
+    R = axis_angle(d.normalized(), ang) * R;
+  }
+  return satisfies(c, R);
+}
+
+}  // namespace
+
+WitnessSearch::WitnessSearch(const ModelInfo& a, const ModelInfo& b, const SearchParams& p)
+    : A_(a), B_(b), p_(p), scale_(std::max(a.model->size(), b.model->size())),
+      debug_(std::getenv("CFGEN_DEBUG") != nullptr) {}
+
+namespace {
+
+RotConstraints rotation_constraints(const PcSet& pcs, const Polyhedron& A, const Polyhedron& B) {
+  RotConstraints c;
+  for (const Pc& pc : pcs) {
+    switch (pc.type) {
+      case PcType::kFF:
+        c.align.push_back({A.faces()[pc.a].normal, -B.faces()[pc.b].normal});
+        break;
+      case PcType::kEF:
+        c.perp.push_back({A.edges()[pc.a].dir, B.faces()[pc.b].normal});
+        break;
+      case PcType::kFE:
+        c.perp.push_back({A.faces()[pc.a].normal, B.edges()[pc.b].dir});
+        break;
+      default:
+        break;
+    }
+  }
+  return c;
+}
+
+}  // namespace
+
+std::vector<Mat3> WitnessSearch::rotation_candidates(const PcSet& pcs,
+                                                     const std::vector<Mat3>& seeds) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  // Each PC's preferred one-parameter family: its local conditions hold with most slack.
+  std::vector<Mat3> prefs;
+  const int n = std::max(4, p_.theta_samples / std::max(1, pcs.size()));
+  for (const Pc& pc : pcs) {
+    Vec3 x, y;  // align A-frame x to world y, then spin about y
+    switch (pc.type) {
+      case PcType::kFF: x = A.faces()[pc.a].normal; y = -B.faces()[pc.b].normal; break;
+      case PcType::kVF: x = A_.cones[pc.a].center; y = B.faces()[pc.b].normal; break;
+      case PcType::kFV: x = A.faces()[pc.a].normal; y = B_.cones[pc.b].center; break;
+      case PcType::kEF: x = A_.wedges[pc.a].bisector; y = -B.faces()[pc.b].normal; break;
+      case PcType::kFE: x = A.faces()[pc.a].normal; y = -B_.wedges[pc.b].bisector; break;
+      case PcType::kEE: x = A_.wedges[pc.a].bisector; y = -B_.wedges[pc.b].bisector; break;
+    }
+    if (x.norm() < 0.5 || y.norm() < 0.5) continue;
+    const Mat3 R0 = align(x, y);
+    for (int k = 0; k < n; ++k) prefs.push_back(axis_angle(y, 0.05 + 2 * M_PI * k / n) * R0);
+  }
+  std::vector<Mat3> all_seeds = seeds;
+  all_seeds.insert(all_seeds.end(), prefs.begin(), prefs.end());
+
+  const RotConstraints c = rotation_constraints(pcs, A, B);
+  std::vector<Mat3> rots;
+  if (!c.align.empty()) {
+    rots = align_family(c, all_seeds, p_.theta_samples);
+  } else if (!c.perp.empty()) {
+    for (Mat3 R : all_seeds)
+      if (project_perp(c, R)) add_unique(rots, R);
+  } else {
+    for (const Mat3& R : all_seeds) add_unique(rots, R);
+  }
+  // Most local slack first; drop rotations that are locally penetrating.
+  std::vector<std::pair<double, std::size_t>> order;
+  for (std::size_t i = 0; i < rots.size(); ++i) {
+    const double m = local_margin(pcs, rots[i]);
+    if (m > std::sin(p_.angle_margin)) order.push_back({-m, i});
+  }
+  std::stable_sort(order.begin(), order.end());
+  std::vector<Mat3> out;
+  for (std::size_t i = 0; i < order.size() && static_cast<int>(out.size()) < p_.max_rotations; ++i)
+    out.push_back(rots[order[i].second]);
+  return out;
+}
+
+double WitnessSearch::local_margin(const PcSet& pcs, const Mat3& R) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  double m = 1.0;
+  for (const Pc& pc : pcs) {
+    switch (pc.type) {
+      case PcType::kFF:
+        m = std::min(m, 1.0 - (R * A.faces()[pc.a].normal + B.faces()[pc.b].normal).norm());
+        break;
+      case PcType::kVF: {
+        const auto& cone = A_.cones[pc.a];
+        if (!cone.pointed) return -1;
+        const Vec3 nb = R.transpose() * B.faces()[pc.b].normal;
+        for (const Vec3& r : cone.rays) m = std::min(m, r.dot(nb));
+        break;
+      }
+      case PcType::kFV: {
+        const auto& cone = B_.cones[pc.b];
+        if (!cone.pointed) return -1;
+        const Vec3 na = R * A.faces()[pc.a].normal;
+        for (const Vec3& r : cone.rays) m = std::min(m, r.dot(na));
+        break;
+      }
+      case PcType::kEF: {
+        if (!A.edges()[pc.a].convex) return -1;
+        const Vec3 nb = R.transpose() * B.faces()[pc.b].normal;
+        m = std::min({m, A_.wedges[pc.a].into_left.dot(nb), A_.wedges[pc.a].into_right.dot(nb)});
+        break;
+      }
+      case PcType::kFE: {
+        if (!B.edges()[pc.b].convex) return -1;
+        const Vec3 na = R * A.faces()[pc.a].normal;
+        m = std::min({m, B_.wedges[pc.b].into_left.dot(na), B_.wedges[pc.b].into_right.dot(na)});
+        break;
+      }
+      case PcType::kEE: {
+        if (!A.edges()[pc.a].convex || !B.edges()[pc.b].convex) return -1;
+        Vec3 N = (R * A.edges()[pc.a].dir).cross(B.edges()[pc.b].dir);
+        const double sin_cross = N.norm();
+        if (sin_cross < 1e-9) return -1;
+        N /= sin_cross;
+        auto side = [&](const Vec3& n) {
+          return std::min({-B_.wedges[pc.b].into_left.dot(n), -B_.wedges[pc.b].into_right.dot(n),
+                           (R * A_.wedges[pc.a].into_left).dot(n),
+                           (R * A_.wedges[pc.a].into_right).dot(n)});
+        };
+        m = std::min({m, sin_cross, std::max(side(N), side(-N))});
+        break;
+      }
+    }
+  }
+  return m;
+}
+
+namespace {
+
+// Affine point P(x) = p0 + sum_j coef_j x_j (3D), constrained to a convex face piece given in
+// the (u, v) frame: every side with margin s (variable s_var) when it is real boundary.
+struct AffinePoint {
+  Vec3 p0 = Vec3::Zero();
+  std::vector<std::pair<int, Vec3>> coef;
+};
+
+void add_piece_rows(LinearProgram& lp, const ConvexPiece& piece, const Vec3& u, const Vec3& v,
+                    const AffinePoint& P, int s_var) {
+  const std::size_t n = piece.points.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Eigen::Vector2d& a = piece.points[k];
+    const Eigen::Vector2d& b = piece.points[(k + 1) % n];
+    Eigen::Vector2d g(-(b - a).y(), (b - a).x());
+    const double len = g.norm();
+    if (len < 1e-12) continue;
+    g /= len;
+    std::vector<std::pair<int, double>> row;
+    for (const auto& [j, cvec] : P.coef) row.push_back({j, g.x() * u.dot(cvec) + g.y() * v.dot(cvec)});
+    if (piece.boundary[k]) row.push_back({s_var, -1.0});
+    lp.add(std::move(row), Rel::kGreaterEq, g.dot(a) - (g.x() * u.dot(P.p0) + g.y() * v.dot(P.p0)));
+  }
+}
+
+void add_eq(LinearProgram& lp, const Vec3& n, const AffinePoint& P, double rhs) {
+  std::vector<std::pair<int, double>> row;
+  for (const auto& [j, cvec] : P.coef) row.push_back({j, n.dot(cvec)});
+  lp.add(std::move(row), Rel::kEq, rhs - n.dot(P.p0));
+}
+
+AffinePoint plus_t(Vec3 p0, double sign = 1.0) {
+  AffinePoint P;
+  P.p0 = p0;
+  for (int i = 0; i < 3; ++i) P.coef.push_back({i, sign * Vec3::Unit(i)});
+  return P;
+}
+
+}  // namespace
+
+LinearProgram WitnessSearch::build_lp(const PcSet& pcs, const Mat3& R,
+                                      const std::vector<int>& pieces) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  int nv = 4;  // t (0..2), s (3), then per-PC auxiliaries
+  for (const Pc& pc : pcs)
+    nv += pc.type == PcType::kEF || pc.type == PcType::kFE ? 1
+          : pc.type == PcType::kFF || pc.type == PcType::kEE ? 2
+                                                              : 0;
+  LinearProgram lp(nv);
+  const int S = 3;
+  lp.lower[S] = {true, 0.0};
+  lp.upper[S] = {true, scale_};
+  lp.c[S] = -1.0;
+  int aux = 4;
+  std::size_t slot = 0;
+  auto bounded_param = [&](int var, double len) {
+    lp.add({{var, 1.0}, {S, -1.0}}, Rel::kGreaterEq, 0.0);
+    lp.add({{var, 1.0}, {S, 1.0}}, Rel::kLessEq, len);
+  };
+  for (const Pc& pc : pcs) {
+    switch (pc.type) {
+      case PcType::kVF: {
+        const Face& fb = B.faces()[pc.b];
+        const AffinePoint P = plus_t(R * A.vertices()[pc.a].p);
+        add_eq(lp, fb.normal, P, fb.offset);
+        add_piece_rows(lp, B_.pieces[pc.b][pieces[slot++]], fb.u, fb.v, P, S);
+        break;
+      }
+      case PcType::kFV: {
+        const Face& fa = A.faces()[pc.a];
+        const AffinePoint P = plus_t(B.vertices()[pc.b].p, -1.0);  // vb - t, in A's rotated frame
+        add_eq(lp, R * fa.normal, P, fa.offset);
+        add_piece_rows(lp, A_.pieces[pc.a][pieces[slot++]], R * fa.u, R * fa.v, P, S);
+        break;
+      }
+      case PcType::kEF: {
+        const Face& fb = B.faces()[pc.b];
+        const Edge& ea = A.edges()[pc.a];
+        AffinePoint P = plus_t(R * A.vertices()[ea.v0.index()].p);
+        P.coef.push_back({aux, R * ea.dir});
+        add_eq(lp, fb.normal, P, fb.offset);
+        add_piece_rows(lp, B_.pieces[pc.b][pieces[slot++]], fb.u, fb.v, P, S);
+        bounded_param(aux++, ea.length);
+        break;
+      }
+      case PcType::kFE: {
+        const Face& fa = A.faces()[pc.a];
+        const Edge& eb = B.edges()[pc.b];
+        AffinePoint P = plus_t(B.vertices()[eb.v0.index()].p, -1.0);
+        P.coef.push_back({aux, eb.dir});
+        add_eq(lp, R * fa.normal, P, fa.offset);
+        add_piece_rows(lp, A_.pieces[pc.a][pieces[slot++]], R * fa.u, R * fa.v, P, S);
+        bounded_param(aux++, eb.length);
+        break;
+      }
+      case PcType::kFF: {
+        const Face& fa = A.faces()[pc.a];
+        const Face& fb = B.faces()[pc.b];
+        add_eq(lp, fb.normal, plus_t(R * fa.centroid), fb.offset);
+        AffinePoint Q;  // a common point q on B's face plane
+        Q.p0 = fb.offset * fb.normal;
+        Q.coef = {{aux, fb.u}, {aux + 1, fb.v}};
+        add_piece_rows(lp, B_.pieces[pc.b][pieces[slot++]], fb.u, fb.v, Q, S);
+        AffinePoint QA = Q;  // q - t, read in A's rotated face frame
+        for (int i = 0; i < 3; ++i) QA.coef.push_back({i, -Vec3::Unit(i)});
+        add_piece_rows(lp, A_.pieces[pc.a][pieces[slot++]], R * fa.u, R * fa.v, QA, S);
+        aux += 2;
+        break;
+      }
+      case PcType::kEE: {
+        const Edge& ea = A.edges()[pc.a];
+        const Edge& eb = B.edges()[pc.b];
+        const Vec3 pa = R * A.vertices()[ea.v0.index()].p;
+        const Vec3 da = R * ea.dir;
+        const Vec3& pb = B.vertices()[eb.v0.index()].p;
+        for (int i = 0; i < 3; ++i)
+          lp.add({{i, 1.0}, {aux, da[i]}, {aux + 1, -eb.dir[i]}}, Rel::kEq, pb[i] - pa[i]);
+        bounded_param(aux, ea.length);
+        bounded_param(aux + 1, eb.length);
+        aux += 2;
+        break;
+      }
+    }
+  }
+  return lp;
+}
+
+std::vector<Vec3> WitnessSearch::translations(const PcSet& pcs, const Mat3& R,
+                                              const std::vector<int>& pieces,
+                                              double& margin) const {
+  LinearProgram lp = build_lp(pcs, R, pieces);
+  const LpResult best = solve(lp);
+  margin = best.status == LpResult::Status::kOptimal ? best.x[3] : 0.0;
+  if (best.status != LpResult::Status::kOptimal || margin < p_.min_margin) return {};
+  // The largest margin is reached on a whole face of the feasible polytope and the solver
+  // returns one of its corners, where A tends to graze other features. Keep half the margin
+  // and move to the mean of the extreme translations along +-x, +-y, +-z: a point well inside
+  // the region of translations that keep the contacts.
+  lp.lower[3] = {true, 0.5 * margin};
+  lp.c[3] = 0.0;
+  std::vector<Eigen::VectorXd> extremes;
+  for (int axis = 0; axis < 3; ++axis)
+    for (double sign : {1.0, -1.0}) {
+      lp.c[axis] = sign;
+      const LpResult r = solve(lp);
+      lp.c[axis] = 0.0;
+      if (r.status == LpResult::Status::kOptimal) extremes.push_back(r.x);
+    }
+  if (extremes.empty()) return {best.x.head<3>()};
+  Eigen::VectorXd center = Eigen::VectorXd::Zero(best.x.size());
+  for (const auto& x : extremes) center += x;
+  center /= static_cast<double>(extremes.size());
+  std::vector<Vec3> out{center.head<3>()};
+  for (const auto& x : extremes) out.push_back((0.5 * (center + x)).head<3>());
+  out.push_back(best.x.head<3>());
+  return out;
+}
+
+std::pair<Vec3, double> WitnessSearch::contact_plane(const Pc& pc, const Pose& pose) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  switch (pc.type) {
+    case PcType::kFF:
+    case PcType::kEF:
+    case PcType::kVF: {
+      const Face& fb = B.faces()[pc.b];
+      return {fb.normal, fb.offset};
+    }
+    case PcType::kFE:
+    case PcType::kFV: {
+      const Face& fa = A.faces()[pc.a];
+      const Vec3 n = -(pose.R_BA * fa.normal);
+      return {n, n.dot(pose.apply(fa.centroid))};
+    }
+    case PcType::kEE: {
+      const Edge& ea = A.edges()[pc.a];
+      const Edge& eb = B.edges()[pc.b];
+      Vec3 n = (pose.R_BA * ea.dir).cross(eb.dir).normalized();
+      if (B_.wedges[pc.b].bisector.dot(n) < 0) n = -n;  // into A, away from B
+      return {n, n.dot(B.vertices()[eb.v0.index()].p)};
+    }
+  }
+  return {Vec3::UnitY(), 0.0};
+}
+
+namespace {
+
+// Is element (kx, x) of a model in the closure of element (ky, y)?
+bool in_closure(const Polyhedron& m, ElementKind kx, int x, ElementKind ky, int y) {
+  if (kx == ky) return x == y;
+  if (ky == ElementKind::kFace) {
+    if (kx == ElementKind::kEdge) return m.edge_bounds_face(EdgeId(x), FaceId(y));
+    return m.vertex_on_face(VertexId(x), FaceId(y));
+  }
+  if (ky == ElementKind::kEdge && kx == ElementKind::kVertex)
+    return m.vertex_ends_edge(VertexId(x), EdgeId(y));
+  return false;
+}
+
+int count(const Polyhedron& m, ElementKind k) {
+  return static_cast<int>(k == ElementKind::kVertex ? m.num_vertices()
+                          : k == ElementKind::kEdge ? m.num_edges()
+                                                    : m.num_faces());
+}
+
+std::string kind_name(ElementKind k) {
+  return k == ElementKind::kVertex ? "v" : k == ElementKind::kEdge ? "e" : "f";
+}
+
+Pc pc_of(const PcSet& pcs, ElementKind ka, int a, ElementKind kb, int b) {
+  for (const Pc& pc : pcs)
+    if (a_kind(pc.type) == ka && b_kind(pc.type) == kb && pc.a == a && pc.b == b) return pc;
+  return {};
+}
+
+constexpr ElementKind kKinds[] = {ElementKind::kVertex, ElementKind::kEdge, ElementKind::kFace};
+
+}  // namespace
+
+double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* why) const {
+  auto reject = [&](const std::string& reason) {
+    if (why) *why = reason;
+    return -1.0;
+  };
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  if (local_margin(pcs, pose.R_BA) < std::sin(p_.angle_margin) * 0.5)
+    return reject("locally penetrating");
+  // Pairwise distinct contact planes.
+  for (int i = 0; i < pcs.size(); ++i)
+    for (int j = i + 1; j < pcs.size(); ++j) {
+      const auto [ni, di] = contact_plane(pcs[i], pose);
+      const auto [nj, dj] = contact_plane(pcs[j], pose);
+      const double c = ni.dot(nj);
+      if (std::abs(c) > 1 - 1e-9 && std::abs(di - (c > 0 ? dj : -dj)) < 1e-6 * scale_)
+        return reject("two PCs share a contact plane");
+    }
+  double clearance = std::numeric_limits<double>::infinity();
+  std::vector<double> a_vertex_gap(A.num_vertices(), clearance);
+  std::vector<double> b_vertex_gap(B.num_vertices(), clearance);
+  int touching_pcs = 0;
+  for (ElementKind ka : kKinds)
+    for (ElementKind kb : kKinds) {
+      const int na = count(A, ka), nb = count(B, kb);
+      for (int a = 0; a < na; ++a)
+        for (int b = 0; b < nb; ++b) {
+          const double d = element_distance(A, pose, ka, a, B, kb, b).distance;
+          if (ka == ElementKind::kVertex) a_vertex_gap[a] = std::min(a_vertex_gap[a], d);
+          if (kb == ElementKind::kVertex) b_vertex_gap[b] = std::min(b_vertex_gap[b], d);
+          bool covered = false, is_pc = false;
+          for (const Pc& pc : pcs) {
+            if (a_kind(pc.type) == ka && b_kind(pc.type) == kb && pc.a == a && pc.b == b)
+              is_pc = true;
+            if (in_closure(A, ka, a, a_kind(pc.type), pc.a) &&
+                in_closure(B, kb, b, b_kind(pc.type), pc.b))
+              covered = true;
+          }
+          if (is_pc) {
+            if (d > p_.touch_tol) return reject("PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " apart by " + std::to_string(d));
+            ++touching_pcs;
+          } else if (!covered) {
+            // Closed elements that meet only on their boundaries do not touch: their boundary
+            // elements do, and those pairs are judged on their own.
+            if (d <= p_.touch_tol && !open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
+            if (d < p_.min_clearance)
+              return reject("extra contact " + kind_name(ka) + std::to_string(a) + "-" + kind_name(kb) + std::to_string(b) + " at " + std::to_string(d));
+            clearance = std::min(clearance, d);
+          }
+        }
+    }
+  if (touching_pcs != pcs.size()) return reject("a PC is not touching");
+  // Neither solid inside the other: test the vertex of each farthest from the other solid.
+  const auto ia = std::max_element(a_vertex_gap.begin(), a_vertex_gap.end()) - a_vertex_gap.begin();
+  const auto ib = std::max_element(b_vertex_gap.begin(), b_vertex_gap.end()) - b_vertex_gap.begin();
+  if (a_vertex_gap[ia] > p_.touch_tol &&
+      point_inside(B, pose.apply(A.vertices()[ia].p), p_.touch_tol))
+    return reject("A inside B");
+  if (b_vertex_gap[ib] > p_.touch_tol &&
+      point_inside(A, pose.inverse_apply(B.vertices()[ib].p), p_.touch_tol))
+    return reject("B inside A");
+  return clearance;
+}
+
+bool WitnessSearch::plausible(const PcSet& pcs) const {
+  // A point lies in at most one open element: one vertex cannot make two PCs.
+  for (int i = 0; i < pcs.size(); ++i)
+    for (int j = i + 1; j < pcs.size(); ++j) {
+      const Pc& x = pcs[i];
+      const Pc& y = pcs[j];
+      if (a_kind(x.type) == ElementKind::kVertex && a_kind(y.type) == ElementKind::kVertex &&
+          x.a == y.a)
+        return false;
+      if (b_kind(x.type) == ElementKind::kVertex && b_kind(y.type) == ElementKind::kVertex &&
+          x.b == y.b)
+        return false;
+      // Two PCs on one plane of B, or one plane of A, share their contact plane.
+      const bool xb = b_kind(x.type) == ElementKind::kFace, yb = b_kind(y.type) == ElementKind::kFace;
+      if (xb && yb && B_.face_plane[x.b] == B_.face_plane[y.b]) return false;
+      const bool xa = a_kind(x.type) == ElementKind::kFace, ya = a_kind(y.type) == ElementKind::kFace;
+      if (xa && ya && A_.face_plane[x.a] == A_.face_plane[y.a]) return false;
+    }
+  return true;
+}
+
+Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) const {
+  Witness best;
+  if (!plausible(pcs)) return best;
+  const std::vector<Mat3> rots = rotation_candidates(pcs, seeds);
+  if (debug_) std::cerr << "find " << to_string(pcs[0]) << (pcs.size() > 1 ? " +" : "") << ": " << rots.size() << " rotations\n";
+  // Face-piece slots, in the order solve_translation consumes them.
+  std::vector<int> slot_sizes;
+  for (const Pc& pc : pcs) {
+    switch (pc.type) {
+      case PcType::kVF: case PcType::kEF: slot_sizes.push_back(int(B_.pieces[pc.b].size())); break;
+      case PcType::kFV: case PcType::kFE: slot_sizes.push_back(int(A_.pieces[pc.a].size())); break;
+      case PcType::kFF:
+        slot_sizes.push_back(int(B_.pieces[pc.b].size()));
+        slot_sizes.push_back(int(A_.pieces[pc.a].size()));
+        break;
+      case PcType::kEE: break;
+    }
+  }
+  for (const Mat3& R : rots) {
+    std::vector<int> choice(slot_sizes.size(), 0);
+    for (int combo = 0; combo < p_.max_piece_combinations; ++combo) {
+      double margin = 0;
+      const std::vector<Vec3> ts = translations(pcs, R, choice, margin);
+      if (debug_) std::cerr << "  rotation " << (&R - rots.data()) << " LP " << ts.size() << " margin " << margin << "\n";
+      for (const Vec3& t : ts) {
+        Pose pose;
+        pose.R_BA = R;
+        pose.t_BA = t;
+        std::string why;
+        const double clearance = verify(pcs, pose, debug_ ? &why : nullptr);
+        if (debug_) std::cerr << "    t " << t.transpose() << " clearance " << clearance << " " << why << "\n";
+        if (clearance >= p_.min_clearance && clearance > best.clearance) {
+          best.found = true;
+          best.pose = pose;
+          best.clearance = clearance;
+          best.margin = margin;
+          if (clearance >= p_.good_clearance) return best;
+        }
+        if (clearance >= p_.min_clearance) break;  // a witness for this rotation; try others
+      }
+      // Next combination of pieces (odometer); stop when all tried.
+      std::size_t i = 0;
+      while (i < choice.size() && ++choice[i] == slot_sizes[i]) choice[i++] = 0;
+      if (i == choice.size()) break;
+    }
+  }
+  return best;
+}
+
+void WitnessSearch::freedoms(const PcSet& pcs, const Pose& pose, CfRecord& out) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  std::vector<std::pair<Vec3, Vec3>> pts;  // (point, normal), world frame
+  for (const Pc& pc : pcs) {
+    const Vec3 n = contact_plane(pc, pose).first;
+    switch (pc.type) {
+      case PcType::kVF: pts.push_back({pose.apply(A.vertices()[pc.a].p), n}); break;
+      case PcType::kFV: pts.push_back({B.vertices()[pc.b].p, n}); break;
+      case PcType::kEF:
+        pts.push_back({pose.apply(A.edge_point(EdgeId(pc.a), 0)), n});
+        pts.push_back({pose.apply(A.edge_point(EdgeId(pc.a), 1)), n});
+        break;
+      case PcType::kFE:
+        pts.push_back({B.edge_point(EdgeId(pc.b), 0), n});
+        pts.push_back({B.edge_point(EdgeId(pc.b), 1), n});
+        break;
+      case PcType::kFF: {
+        const Face& fa = A.faces()[pc.a];
+        const Vec3 c = fa.centroid;
+        pts.push_back({pose.apply(c), n});
+        pts.push_back({pose.apply(c + fa.u * 10.0), n});
+        pts.push_back({pose.apply(c + fa.v * 10.0), n});
+        break;
+      }
+      case PcType::kEE: {
+        const auto cp = element_distance(A, pose, ElementKind::kEdge, pc.a, B, ElementKind::kEdge, pc.b);
+        pts.push_back({cp.p_b, n});
+        break;
+      }
+    }
+  }
+  Vec3 ref = Vec3::Zero();
+  for (const auto& pn : pts) ref += pn.first;
+  ref /= static_cast<double>(pts.size());
+  // Rows n . (v + w x (p - ref)); rotational columns scaled by the model size to balance units.
+  Eigen::MatrixXd J(pts.size(), 6);
+  Eigen::MatrixXd N(pts.size(), 3);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const Vec3 r = (pts[i].first - ref) / scale_;
+    J.row(i) << pts[i].second.transpose(), r.cross(pts[i].second).transpose();
+    N.row(i) = pts[i].second.transpose();
+  }
+  constexpr double kRankTol = 1e-9;
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
+  int rank = 0;
+  for (int i = 0; i < svd.singularValues().size(); ++i)
+    if (svd.singularValues()[i] > kRankTol) ++rank;
+  Eigen::JacobiSVD<Eigen::MatrixXd> svdn(N);
+  int rank_n = 0;
+  for (int i = 0; i < svdn.singularValues().size(); ++i)
+    if (svdn.singularValues()[i] > kRankTol) ++rank_n;
+  out.dof = 6 - rank;
+  out.translation_dof = 3 - rank_n;
+  out.pure_rotation = false;
+  const int k = 6 - rank;
+  if (k == 0) return;
+  const Eigen::MatrixXd Z = svd.matrixV().rightCols(k);
+  const Eigen::MatrixXd Zv = Z.topRows(3), Zw = Z.bottomRows(3);
+  if (Zw.norm() < kRankTol) return;
+  // Zero-pitch twists: c with (Zv c).(Zw c) == 0 and Zw c != 0 (twists about `ref` scaled).
+  const Eigen::MatrixXd Q = 0.5 * (Zv.transpose() * Zw + Zw.transpose() * Zv);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Q);
+  const auto& ev = es.eigenvalues();
+  if (ev.minCoeff() < -kRankTol && ev.maxCoeff() > kRankTol) {
+    out.pure_rotation = true;
+    return;
+  }
+  for (int i = 0; i < k; ++i)
+    if (std::abs(ev[i]) <= kRankTol && (Zw * es.eigenvectors().col(i)).norm() > 1e-6)
+      out.pure_rotation = true;
+}
+
+}  // namespace cf::gen
