@@ -130,6 +130,25 @@ TEST_CASE("every reader loads the cube", "[mesh_io]") {
         write_file("cube_solid_header.stl", binary_stl(kCubeV, triangulate(kCubeF), "solid cube"))));
   }
   SECTION("PLY ascii, polygonal") { check_cube(load_model(kModels + "cube.ply")); }
+  SECTION("PLY binary little-endian, polygonal") {
+    std::string ply =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 8\nproperty float x\n"
+        "property float y\nproperty float z\nelement face 6\n"
+        "property list uchar int vertex_indices\nend_header\n";
+    for (const auto& p : kCubeV)
+      for (int k = 0; k < 3; ++k) {
+        const float x = static_cast<float>(p[k]);
+        ply.append(reinterpret_cast<const char*>(&x), 4);
+      }
+    for (const auto& q : kCubeF) {
+      ply.push_back(static_cast<char>(q.size()));
+      for (const int i : q) {
+        const std::int32_t i32 = i;  // little-endian host assumed (x86-64, aarch64)
+        ply.append(reinterpret_cast<const char*>(&i32), 4);
+      }
+    }
+    check_cube(load_model(write_file("cube_binary.ply", ply)));
+  }
   SECTION("extension in upper case") {
     fs::copy_file(kModels + "cube.off", scratch() / "CUBE.OFF", fs::copy_options::overwrite_existing);
     check_cube(load_model((scratch() / "CUBE.OFF").string()));
