@@ -1,17 +1,23 @@
 // HapticRenderer: status and motion bookkeeping over a small graph, the full servo step on
 // the paper's cube and L-block, and no heap allocation inside step().
 
+#include <cf/detector.hpp>
 #include <cf/renderer.hpp>
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <atomic>
+#include <cstdio>
+#include <memory>
 #include <cmath>
 #include <cstdlib>
 #include <new>
 #include <set>
 
-// Counts every allocation of this process (the test is single-threaded).
+// Counts every allocation of this process (the test is single-threaded). malloc/free pair
+// up here; GCC cannot see that through the replaced operators.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 static std::atomic<long> g_allocations{0};
 void* operator new(std::size_t n) {
   ++g_allocations;
@@ -214,4 +220,173 @@ TEST_CASE("the servo step allocates nothing", "[renderer]") {
   const cf::ContactPc c = floor_pc(at(70, 35.5, 40));
   r.step_identified(at(70, 35.5, 40), t += 0.001, cf::CfId(0), &c, 1, &c, 1);
   CHECK(g_allocations.load() - before == 0);
+}
+
+namespace {
+
+// data/models/corner_block.off: floor top y = 20 over x, z in [20, 120], inner walls x = 20
+// and z = 20 up to y = 80.
+cf::Polyhedron corner_block() {
+  return from_loops("corner_block",
+                    {{0, 0, 0}, {120, 0, 0}, {120, 0, 120}, {0, 0, 120}, {0, 80, 0}, {120, 80, 0}, {120, 80, 20},
+                     {20, 80, 20}, {20, 80, 120}, {0, 80, 120}, {20, 20, 20}, {120, 20, 20}, {120, 20, 120},
+                     {20, 20, 120}},
+                    {{0, 1, 2, 3}, {9, 8, 7, 6, 5, 4}, {13, 12, 11, 10}, {0, 3, 9, 4}, {0, 4, 5, 1},
+                     {1, 5, 6, 11, 12, 2}, {3, 2, 12, 13, 8, 9}, {10, 7, 8, 13}, {10, 11, 6, 7}});
+}
+
+// Places A (rotation R) so that its lowest vertex is `gap` above y = 20 and, when walls
+// are given, its extreme vertices `gap` off the planes x = 20 and z = 20.
+cf::Pose seat(const cf::Mat3& R, bool wall_x, bool wall_z, double x, double z, double gap = 0.5) {
+  const cf::Polyhedron A = cube();
+  cf::Vec3 lo = cf::Vec3::Constant(1e9);
+  for (const cf::Vertex& v : A.vertices()) lo = lo.cwiseMin(R * v.p);
+  cf::Pose p;
+  p.R_BA = R;
+  p.t_BA = {wall_x ? 20 + gap - lo.x() : x, 20 + gap - lo.y(), wall_z ? 20 + gap - lo.z() : z};
+  return p;
+}
+
+// Runs poses through a renderer whose graph is made from what the detector finds at them:
+// every distinct set of best-fitting non-dominated contacts (one per contact plane) is a
+// CF, consecutive sets are joined by gain / lose / change transitions. Returns the last
+// result.
+struct Scenario {
+  std::unique_ptr<cf::CfGraph> graph;
+  std::unique_ptr<cf::HapticRenderer> renderer;
+  const cf::HapticResult* last = nullptr;
+};
+Scenario run_scenario(const cf::Polyhedron& B, const std::vector<cf::Pose>& poses,
+                      cf::MotionType stop_at = cf::MotionType::kNone) {
+  const cf::Polyhedron A = cube();
+  cf::ContactDetector det(A, B);
+  auto set = std::make_unique<cf::ContactSet>();
+  std::vector<cf::CfRecord> cfs;
+  std::vector<cf::Transition> tr;
+  int prev = -1;
+  for (const cf::Pose& p : poses) {
+    det.detect(p, *set);
+    std::vector<int> best(static_cast<std::size_t>(set->num_planes()), -1);
+    for (int i = 0; i < set->size(); ++i) {
+      const cf::ContactPc& c = (*set)[i];
+      if (c.dominated || c.plane < 0) continue;
+      int& b = best[static_cast<std::size_t>(c.plane)];
+      if (b < 0 || c.misfit < (*set)[b].misfit) b = i;
+    }
+    cf::PcSet pcs;
+    for (int b : best)
+      if (b >= 0) pcs.insert((*set)[b].pc);
+    if (pcs.empty()) {
+      prev = -1;
+      continue;
+    }
+    int id = -1;
+    for (std::size_t k = 0; k < cfs.size(); ++k)
+      if (cfs[k].pcs == pcs) id = static_cast<int>(k);
+    if (id < 0) {
+      id = static_cast<int>(cfs.size());
+      cf::CfRecord rec;
+      rec.pcs = pcs;
+      rec.witness = p;
+      cfs.push_back(rec);
+    }
+    if (prev >= 0 && prev != id) {
+      const cf::PcSet& a = cfs[static_cast<std::size_t>(prev)].pcs;
+      const cf::TransitionKind k = pcs.size() > a.size()   ? cf::TransitionKind::kGain
+                                   : pcs.size() < a.size() ? cf::TransitionKind::kLose
+                                                           : cf::TransitionKind::kChange;
+      bool have = false;
+      for (const auto& t : tr) have = have || (t.from == cf::CfId(prev) && t.to == cf::CfId(id));
+      if (!have) tr.push_back({cf::CfId(prev), cf::CfId(id), k});
+    }
+    prev = id;
+  }
+  Scenario s;
+  s.graph = std::make_unique<cf::CfGraph>(cf::CfGraph::from_parts(A, B, std::move(cfs), std::move(tr)));
+  s.renderer = std::make_unique<cf::HapticRenderer>(*s.graph);
+  double t = 0;
+  for (const cf::Pose& p : poses) {
+    s.last = &s.renderer->step(p, t += 0.001);
+    if (stop_at != cf::MotionType::kNone && s.last->motion == stop_at) break;
+  }
+  return s;
+}
+
+std::string types(const cf::HapticResult& r) {
+  std::vector<std::string> v;
+  for (const cf::Pc& pc : r.pcs) v.push_back(cf::to_string(pc.type));
+  std::sort(v.begin(), v.end());
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : " ") + x;
+  return s;
+}
+
+void print_row(const char* name, const cf::HapticResult& r) {
+  if (std::getenv("CF_PRINT_PAPER_ROWS") == nullptr) return;
+  std::printf("%-28s %-14s %-6s F = %9.5f %9.5f %9.5f   M = %10.5f %10.5f %10.5f   Fc = %8.5f %8.5f %8.5f  [", name,
+              types(r).c_str(), cf::to_string(r.motion), r.F_W.x(), r.F_W.y(), r.F_W.z(), r.M_W.x(), r.M_W.y(),
+              r.M_W.z(), r.force->F_contact_W.x(), r.force->F_contact_W.y(), r.force->F_contact_W.z());
+  for (int k = 0; k < r.force->num_pcs; ++k)
+    std::printf("%s%s", k ? " " : "", cf::to_string(r.force->pcs[k].regime));
+  std::printf("]\n");
+}
+
+cf::Mat3 rot(double ax, double ay, double az) {
+  return (Eigen::AngleAxisd(ay, cf::Vec3::UnitY()) * Eigen::AngleAxisd(ax, cf::Vec3::UnitX()) *
+          Eigen::AngleAxisd(az, cf::Vec3::UnitZ()))
+      .toRotationMatrix();
+}
+
+}  // namespace
+
+TEST_CASE("the paper's force table rows as scripted cases (docs/force-model.md)", "[renderer][paper]") {
+  SECTION("row 1: {e-f, v-f} by MT4 against the L-block") {
+    // An edge of the tilted, turned cube rests on the floor; it moves towards the inner wall
+    // 0.1 mm per tick until a vertex touches it.
+    const cf::Mat3 R = rot(0.3, 0.4, 0.0);
+    std::vector<cf::Pose> poses;
+    for (int i = 0; i <= 30; ++i) poses.push_back(seat(R, false, false, 0, 40));
+    const double x_touch = seat(R, true, false, 0, 40).t_BA.x();
+    for (int i = 0; i < 30; ++i) poses[static_cast<std::size_t>(i)].t_BA.x() = x_touch + 0.1 * (29 - i) + 0.6;
+    poses.back().t_BA.x() = x_touch;
+    const Scenario s = run_scenario(l_block(), poses, cf::MotionType::kMT4);
+    print_row("row 1 (L-block)", *s.last);
+    CHECK(types(*s.last) == "e-f v-f");
+    CHECK(s.last->motion == cf::MotionType::kMT4);
+  }
+  SECTION("row 2: three f-f in the corner block's seat") {
+    const cf::Mat3 R = cf::Mat3::Identity();
+    std::vector<cf::Pose> poses;
+    for (int i = 0; i < 5; ++i) poses.push_back(seat(R, true, true, 0, 0));
+    for (int i = 1; i <= 5; ++i) {  // pressed diagonally into the seat, 0.02 mm per tick
+      cf::Pose p = seat(R, true, true, 0, 0);
+      p.t_BA -= cf::Vec3(0.02, 0.02, 0.02) * i;
+      poses.push_back(p);
+    }
+    const Scenario s = run_scenario(corner_block(), poses);
+    print_row("row 2 (corner, pressed)", *s.last);
+    CHECK(types(*s.last) == "f-f f-f f-f");
+    for (int k = 0; k < 3; ++k) CHECK(s.last->force->pcs[k].regime == cf::Regime::kStick);
+    CHECK(s.last->motion == cf::MotionType::kMT2a);  // the paper prints MT2.b: see the docs
+  }
+  SECTION("row 3: {e-f, e-f, f-f} at rest in the corner block") {
+    const cf::Mat3 R = rot(0.0, M_PI / 4, 0.0);  // vertical edges against both walls
+    std::vector<cf::Pose> poses(5, seat(R, true, true, 0, 0));
+    const Scenario s = run_scenario(corner_block(), poses);
+    print_row("row 3 (corner, resting)", *s.last);
+    CHECK(types(*s.last) == "e-f e-f f-f");
+    CHECK(s.last->motion == cf::MotionType::kMT2a);
+  }
+  SECTION("row 4: {v-f, v-f, v-f} by MT3 in the corner block") {
+    // An edge on the floor and vertices on both walls; then the cube tips about a
+    // horizontal axis so that the edge on the floor becomes a vertex.
+    const cf::Mat3 R0 = rot(0.25, 0.5, 0.0);
+    std::vector<cf::Pose> poses(5, seat(R0, true, true, 0, 0));
+    for (int i = 1; i <= 3; ++i)
+      poses.push_back(seat(Eigen::AngleAxisd(0.02 * i, cf::Vec3(1, 0, 1).normalized()) * R0, true, true, 0, 0));
+    const Scenario s = run_scenario(corner_block(), poses, cf::MotionType::kMT3);
+    print_row("row 4 (corner, tipping)", *s.last);
+    CHECK(types(*s.last) == "v-f v-f v-f");
+    CHECK(s.last->motion == cf::MotionType::kMT3);
+  }
 }

@@ -222,12 +222,9 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
 
   // --- Friction regime per the rules of section 4.4 ---
   if (m > 0) {
-    const bool need_freedoms = !conservative && (r.motion == MotionType::kMT2a ||
-                                                 r.motion == MotionType::kMT3);
-    if (need_freedoms) {
-      // The freedoms need the PCs contiguous; idx is the identity when not conservative.
-      r.freedoms = compute_freedoms(pcs, m, *A_, *B_, pose, P);
-    }
+    // The freedoms (an SVD-sized eigenproblem) only when a rule needs them. The PCs are
+    // contiguous here: idx is the identity when not conservative.
+    auto freedoms = [&]() { r.freedoms = compute_freedoms(pcs, m, *A_, *B_, pose, P); };
     if (conservative) {
       set_all(Regime::kKinetic);
     } else {
@@ -239,9 +236,12 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
         case MotionType::kMT2a:
         case MotionType::kMT2b:
         case MotionType::kMT2c: {
-          if (has_prev_) r.check = check_motion(r.freedoms, prev_pose_, pose, P);
           bool all_stick = true;
           for (int k = 0; k < m; ++k) all_stick = all_stick && sticks(k);
+          if (!all_stick) {
+            freedoms();
+            if (has_prev_) r.check = check_motion(r.freedoms, prev_pose_, pose, P);
+          }
           if (all_stick) {
             r.motion = MotionType::kMT2a;  // first situation: every PC static, eq. (4)
             set_all(Regime::kStick);
@@ -258,6 +258,7 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
           break;
         }
         case MotionType::kMT3:
+          freedoms();
           if (!r.freedoms.pure_rotation) set_all(Regime::kKinetic);
           else rotation_rule();
           break;

@@ -54,8 +54,10 @@ struct ForceResult {
   /// Rendered with the conservative laws (normal force eq. (1) + kinetic friction eq. (5)
   /// on the non-dominated contacts) because no CF or transition of the graph fits.
   bool conservative = false;
-  Freedoms freedoms;  ///< of the current PCs (computed for MT2 and MT3)
-  MotionCheck check;  ///< pose change against the freedoms (MT2)
+  /// Of the current PCs; computed for MT3, and for MT2 when some PC fails eq. (3) (with all
+  /// PCs static the case is MT2.a whatever the freedoms). Default (6 dof) otherwise.
+  Freedoms freedoms;
+  MotionCheck check;  ///< pose change against the freedoms (MT2, when computed)
   Vec3 reference_W = Vec3::Zero();  ///< moment reference point, mm
   Vec3 centroid_W = Vec3::Zero();   ///< p_g, mm
   Vec3 F_contact_W = Vec3::Zero();  ///< eq. (7) in the world (after interpolation)
