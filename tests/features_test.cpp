@@ -47,6 +47,13 @@ fs::path scratch() {
     fs::create_directories(d);
     return d;
   }();
+  // Removed when the test program exits.
+  static const struct Cleanup {
+    ~Cleanup() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } cleanup;
   return dir;
 }
 
