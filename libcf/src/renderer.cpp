@@ -25,7 +25,7 @@ struct HapticRenderer::Impl {
   const CfGraph* graph;
   Params params;
   ForceModel force;
-  detail::Identification ident;
+  detail::IdentAdapter ident;
   CfId prev_cf;
   PcSet prev_pcs;
   std::array<ContactPc, PcSet::kMaxPcs> ordered{};
@@ -94,8 +94,8 @@ const HapticResult& HapticRenderer::step_identified(const Pose& pose, double t_s
   } else if (n_detected > 0 && detected != nullptr) {
     r.status = RenderStatus::kNoFittingCf;
     fr = &m.force.step(pose, t_s, detected, n_detected, PriorMotion(), true);
-    m.prev_cf = CfId();
-    m.prev_pcs = PcSet();
+    // The previous CF is kept, as CfIdentifier keeps preferring it: coming back to it is
+    // MT2, moving on to a neighbour MT3-MT5.
   } else {
     r.status = RenderStatus::kNoContact;
     fr = &m.force.step(pose, t_s, nullptr, 0, PriorMotion(), false);

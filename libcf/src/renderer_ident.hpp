@@ -1,14 +1,11 @@
 #pragma once
-// Identification as the renderer uses it: the chosen CF, its PCs and every detected contact.
-// A thin adapter so that the renderer does not depend on how identification is done.
+// Identification as the renderer uses it: the chosen CF, its PCs and every detected contact,
+// from cf::CfIdentifier (SPEC section 6's preference: previous CF, neighbour, best fit).
 
 #include <cf/contact.hpp>
-#include <cf/detector.hpp>
 #include <cf/graph.hpp>
+#include <cf/identifier.hpp>
 #include <cf/params.hpp>
-
-#include <array>
-#include <memory>
 
 namespace cf::detail {
 
@@ -21,20 +18,15 @@ struct IdentView {
   const char* status = "";
 };
 
-class Identification {
+class IdentAdapter {
  public:
-  Identification(const CfGraph& graph, const Params& params);
-  void reset();
+  IdentAdapter(const CfGraph& graph, const Params& params);
+  void reset() { ident_.reset(); }
   /// No heap allocation.
   IdentView step(const Pose& pose);
 
  private:
-  bool all_detected(CfId id, double* misfit);
-  const CfGraph* graph_;
-  ContactDetector detector_;
-  std::unique_ptr<ContactSet> contacts_;
-  std::array<ContactPc, PcSet::kMaxPcs> chosen_{};
-  CfId prev_;
+  CfIdentifier ident_;
 };
 
 }  // namespace cf::detail
