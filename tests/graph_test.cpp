@@ -421,6 +421,10 @@ TEST_CASE("load: a missing file", "[graph][bad]") {
                     Catch::Contains("reading '" + bad("no_such_file.json") + "': cannot open: No such file or directory"));
 }
 
+TEST_CASE("load: a directory", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(kGraphDir), Catch::Contains("reading '" + kGraphDir + "': is a directory, not a graph file"));
+}
+
 TEST_CASE("load: truncated JSON gives the line and column", "[graph][bad]") {
   CHECK_THROWS_WITH(CfGraph::load(bad("truncated.json")),
                     Catch::Contains("reading '" + bad("truncated.json") + "': not valid JSON:") &&

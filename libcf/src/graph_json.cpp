@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -172,6 +173,8 @@ CfGraph CfGraph::load(const std::string& path) { return load(path, GraphLoadOpti
 CfGraph CfGraph::load(const std::string& path, const GraphLoadOptions& options) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("reading '" + path + "': cannot open: " + errno_text());
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw Error("reading '" + path + "': is a directory, not a graph file");
   in.seekg(0, std::ios::end);
   const std::streamoff size = in.tellg();
   in.seekg(0, std::ios::beg);

@@ -1,0 +1,405 @@
+// cfinspect: validates a CF graph file against the schema and summarises it, answers
+// queries (CFs holding a PC, a CF's transitions, one CF, the CF at a pose) and exports
+// Graphviz DOT (SPEC section 5b). One translation unit, no CGAL.
+
+#include <cf/graph.hpp>
+#include <cf/identifier.hpp>
+
+#include "graph_impl.hpp"    // Boost.Graph view, atomic file writing (libcf private)
+#include "graph_schema.hpp"  // the embedded schema text
+
+#include <CLI/CLI.hpp>
+#include <boost/graph/connected_components.hpp>
+#include <boost/graph/graphviz.hpp>
+#include <nlohmann/json.hpp>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using ojson = nlohmann::ordered_json;
+
+/// A user-facing failure: printed as one line, exit status 1.
+struct Failure {
+  std::string message;
+};
+
+struct Summary {
+  std::array<std::size_t, 4> cfs_by_size{};        // index = number of PCs
+  std::array<std::size_t, 6> pcs_by_type{};        // PCs over all CFs
+  std::array<std::size_t, 6> cfs_with_type{};      // CFs holding at least one PC of a type
+  std::array<std::size_t, 3> transitions_by_kind{};
+  std::size_t unpaired = 0;  // transitions whose reverse is not in the graph
+  std::size_t min_out = 0, max_out = 0;
+  double mean_out = 0;
+  std::size_t components = 0, largest_component = 0, isolated = 0;
+};
+
+std::size_t reflex_edges(const cf::Polyhedron& m) {
+  return static_cast<std::size_t>(
+      std::count_if(m.edges().begin(), m.edges().end(), [](const cf::Edge& e) { return !e.convex; }));
+}
+
+Summary summarise(const cf::CfGraph& g) {
+  Summary s;
+  const std::size_t n = g.num_cfs();
+  for (std::size_t i = 0; i < n; ++i) {
+    const cf::PcSet& pcs = g.cf(cf::CfId(static_cast<int>(i))).pcs;
+    ++s.cfs_by_size[static_cast<std::size_t>(pcs.size())];
+    std::array<bool, 6> seen{};
+    for (const cf::Pc& pc : pcs) {
+      const auto t = static_cast<std::size_t>(pc.type);
+      ++s.pcs_by_type[t];
+      seen[t] = true;
+    }
+    for (std::size_t t = 0; t < 6; ++t) s.cfs_with_type[t] += seen[t] ? 1 : 0;
+  }
+  for (std::size_t i = 0; i < g.num_transitions(); ++i) {
+    const cf::Transition& t = g.transition(i);
+    ++s.transitions_by_kind[static_cast<std::size_t>(t.kind)];
+    if (!g.adjacent(t.to, t.from)) ++s.unpaired;
+  }
+  if (n > 0) {
+    s.min_out = static_cast<std::size_t>(-1);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t d = g.out_transitions(cf::CfId(static_cast<int>(i))).size();
+      s.min_out = std::min(s.min_out, d);
+      s.max_out = std::max(s.max_out, d);
+    }
+    s.mean_out = static_cast<double>(g.num_transitions()) / static_cast<double>(n);
+    // Components of the undirected view: CFs reachable from each other by any transitions.
+    boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS> u(n);
+    for (std::size_t i = 0; i < g.num_transitions(); ++i)
+      boost::add_edge(g.transition(i).from.index(), g.transition(i).to.index(), u);
+    std::vector<std::size_t> comp(n);
+    s.components = static_cast<std::size_t>(boost::connected_components(u, comp.data()));
+    std::vector<std::size_t> sizes(s.components, 0);
+    for (std::size_t c : comp) ++sizes[c];
+    s.largest_component = *std::max_element(sizes.begin(), sizes.end());
+    s.isolated = static_cast<std::size_t>(std::count(sizes.begin(), sizes.end(), std::size_t{1}));
+  }
+  return s;
+}
+
+const char* kTypeNames[] = {"f-f", "e-f", "f-e", "v-f", "f-v", "e-e"};
+const char* kKindNames[] = {"gain", "lose", "change"};
+
+ojson model_json(const cf::Polyhedron& m) {
+  ojson j = ojson::object();
+  j["name"] = m.name();
+  j["vertices"] = m.num_vertices();
+  j["edges"] = m.num_edges();
+  j["reflex_edges"] = reflex_edges(m);
+  j["faces"] = m.num_faces();
+  return j;
+}
+
+ojson summary_json(const std::string& path, const cf::CfGraph& g, const Summary& s, bool full_check) {
+  ojson j = ojson::object();
+  j["file"] = path;
+  j["valid"] = true;
+  j["schema_check"] = full_check ? "full" : "skeleton";
+  j["models"] = {{"A", model_json(g.model_a())}, {"B", model_json(g.model_b())}};
+  ojson by_size = ojson::object();
+  for (std::size_t k = 1; k <= 3; ++k) by_size[std::to_string(k)] = s.cfs_by_size[k];
+  ojson by_type = ojson::object(), with_type = ojson::object();
+  for (std::size_t t = 0; t < 6; ++t) {
+    by_type[kTypeNames[t]] = s.pcs_by_type[t];
+    with_type[kTypeNames[t]] = s.cfs_with_type[t];
+  }
+  j["cfs"] = {{"count", g.num_cfs()}, {"by_num_pcs", by_size}, {"pcs_by_type", by_type}, {"cfs_with_type", with_type}};
+  ojson by_kind = ojson::object();
+  for (std::size_t k = 0; k < 3; ++k) by_kind[kKindNames[k]] = s.transitions_by_kind[k];
+  j["transitions"] = {{"count", g.num_transitions()}, {"by_kind", by_kind}, {"without_reverse", s.unpaired}};
+  j["out_degree"] = {{"min", s.min_out}, {"mean", s.mean_out}, {"max", s.max_out}};
+  j["components"] = {{"count", s.components}, {"largest", s.largest_component}, {"isolated_cfs", s.isolated}};
+  j["metadata"] = ojson::parse(g.metadata_json());
+  return j;
+}
+
+void print_summary(std::ostream& out, const std::string& path, const cf::CfGraph& g, const Summary& s,
+                   bool full_check) {
+  auto model_line = [&](const char* which, const cf::Polyhedron& m) {
+    out << "model " << which << " '" << m.name() << "': " << m.num_vertices() << " vertices, " << m.num_edges()
+        << " edges (" << reflex_edges(m) << " reflex), " << m.num_faces() << " faces\n";
+  };
+  out << path << ": valid cf-graph v1 (" << (full_check ? "full schema check" : "schema check of the skeleton")
+      << ")\n";
+  model_line("A", g.model_a());
+  model_line("B", g.model_b());
+  out << "CFs: " << g.num_cfs() << "\n";
+  out << "  by number of PCs:";
+  for (std::size_t k = 1; k <= 3; ++k) out << " " << k << ": " << s.cfs_by_size[k] << (k < 3 ? "," : "\n");
+  out << "  PCs by type (CFs holding one):";
+  for (std::size_t t = 0; t < 6; ++t)
+    out << " " << kTypeNames[t] << " " << s.pcs_by_type[t] << " (" << s.cfs_with_type[t] << ")" << (t < 5 ? "," : "\n");
+  out << "transitions: " << g.num_transitions() << " (gain " << s.transitions_by_kind[0] << ", lose "
+      << s.transitions_by_kind[1] << ", change " << s.transitions_by_kind[2] << "), " << s.unpaired
+      << " without their reverse\n";
+  out << "out-degree: min " << s.min_out << ", mean " << std::fixed << std::setprecision(2) << s.mean_out
+      << ", max " << s.max_out << "\n";
+  out.unsetf(std::ios::floatfield);
+  out << "connected components: " << s.components << " (largest " << s.largest_component << " CFs, "
+      << s.isolated << " isolated CFs)\n";
+  const auto meta = nlohmann::json::parse(g.metadata_json());
+  out << "metadata:";
+  if (meta.empty()) out << " none";
+  for (auto it = meta.begin(); it != meta.end(); ++it) out << " " << it.key();
+  out << "\n";
+}
+
+cf::CfId parse_cf_id(const cf::CfGraph& g, const std::string& path, long long id) {
+  if (id < 0 || static_cast<std::size_t>(id) >= g.num_cfs())
+    throw Failure{"'" + path + "': CF " + std::to_string(id) + " does not exist (the graph has " +
+                  std::to_string(g.num_cfs()) + " CFs)"};
+  return cf::CfId(static_cast<int>(id));
+}
+
+ojson pcs_json(const cf::PcSet& pcs) {
+  ojson a = ojson::array();
+  for (const cf::Pc& pc : pcs) a.push_back(cf::to_string(pc));
+  return a;
+}
+
+ojson pose_json(const cf::Pose& p) {
+  ojson R = ojson::array();
+  for (int i = 0; i < 3; ++i) R.push_back({p.R_BA(i, 0), p.R_BA(i, 1), p.R_BA(i, 2)});
+  return {{"R", R}, {"t", {p.t_BA.x(), p.t_BA.y(), p.t_BA.z()}}};
+}
+
+ojson cf_json(const cf::CfGraph& g, cf::CfId id) {
+  const cf::CfRecord& r = g.cf(id);
+  ojson j = ojson::object();
+  j["id"] = id.value();
+  j["pcs"] = pcs_json(r.pcs);
+  j["witness"] = pose_json(r.witness);
+  if (r.dof >= 0) j["dof"] = r.dof;
+  if (r.translation_dof >= 0) j["translation_dof"] = r.translation_dof;
+  if (r.dof >= 0 || r.translation_dof >= 0) j["pure_rotation"] = r.pure_rotation;
+  ojson out = ojson::array();
+  for (const cf::Transition& t : g.out_transitions(id))
+    out.push_back({{"to", t.to.value()}, {"kind", cf::to_string(t.kind)}, {"pcs", pcs_json(g.cf(t.to).pcs)}});
+  j["transitions"] = out;
+  return j;
+}
+
+void print_cf(std::ostream& out, const cf::CfGraph& g, cf::CfId id) {
+  const cf::CfRecord& r = g.cf(id);
+  out << "CF " << id.value() << ": " << cf::to_string(r.pcs) << "\n";
+  const Eigen::IOFormat fmt(Eigen::FullPrecision, 0, ", ", "\n", "    [", "]");
+  out << "  witness R (rows):\n" << r.witness.R_BA.format(fmt) << "\n";
+  out << "  witness t (mm): " << r.witness.t_BA.transpose().format(Eigen::IOFormat(Eigen::FullPrecision, 0, ", ", "", "", "", "[", "]")) << "\n";
+  if (r.dof >= 0 || r.translation_dof >= 0)
+    out << "  freedoms: dof " << r.dof << ", translation dof " << r.translation_dof << ", pure rotation "
+        << (r.pure_rotation ? "yes" : "no") << "\n";
+  out << "  transitions out: " << g.out_transitions(id).size() << "\n";
+}
+
+void print_neighbours(std::ostream& out, const cf::CfGraph& g, cf::CfId id) {
+  const auto& list = g.out_transitions(id);
+  out << "CF " << id.value() << " {" << cf::to_string(g.cf(id).pcs) << "}: " << list.size() << " transitions\n";
+  for (const cf::Transition& t : list)
+    out << "  -> CF " << t.to.value() << " " << cf::to_string(t.kind) << " {" << cf::to_string(g.cf(t.to).pcs) << "}\n";
+}
+
+std::vector<cf::CfId> holding(const cf::CfGraph& g, const cf::Pc& pc) {
+  std::vector<cf::CfId> ids;
+  for (std::size_t i = 0; i < g.num_cfs(); ++i)
+    if (g.cf(cf::CfId(static_cast<int>(i))).pcs.contains(pc)) ids.push_back(cf::CfId(static_cast<int>(i)));
+  return ids;
+}
+
+std::string dot_text(const cf::CfGraph& g) {
+  const auto& bg = cf::detail::boost_graph(g);
+  std::ostringstream dot;
+  auto vertex_label = [&g](std::ostream& os, std::size_t v) {
+    os << "[label=\"" << v << ": " << cf::to_string(g.cf(cf::CfId(static_cast<int>(v))).pcs) << "\"]";
+  };
+  auto edge_label = [&bg](std::ostream& os, const cf::detail::BoostCfGraph::edge_descriptor& e) {
+    const cf::TransitionKind k = bg[e].kind;
+    const char* style = k == cf::TransitionKind::kGain ? "solid" : k == cf::TransitionKind::kLose ? "dashed" : "dotted";
+    os << "[label=\"" << cf::to_string(k) << "\", style=" << style << "]";
+  };
+  auto graph_attrs = [](std::ostream& os) { os << "node [shape=box, fontname=\"monospace\"];\n"; };
+  boost::write_graphviz(dot, bg, vertex_label, edge_label, graph_attrs);
+  return dot.str();
+}
+
+/// "tx,ty,tz,qw,qx,qy,qz" (mm, unit quaternion of R), as a row of cfreplay's POSES.csv.
+cf::Pose parse_pose(const std::string& text) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    std::size_t used = 0;
+    double x = 0;
+    try {
+      x = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    while (used < item.size() && item[used] == ' ') ++used;
+    if (item.empty() || used != item.size())
+      throw Failure{"--pose '" + text + "': '" + item + "' is not a number"};
+    v.push_back(x);
+  }
+  if (v.size() != 7) throw Failure{"--pose '" + text + "': expected 7 numbers tx,ty,tz,qw,qx,qy,qz, got " + std::to_string(v.size())};
+  Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
+  // Same tolerance as a hand-typed quaternion needs: 4 significant digits.
+  constexpr double kUnitTol = 1e-3;
+  if (std::abs(q.norm() - 1) > kUnitTol)
+    throw Failure{"--pose '" + text + "': the quaternion's norm is " + std::to_string(q.norm()) + ", not 1"};
+  cf::Pose p;
+  p.R_BA = q.normalized().toRotationMatrix();
+  p.t_BA = cf::Vec3(v[0], v[1], v[2]);
+  return p;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{"cfinspect: validate a CF graph file against the schema, summarise it, answer queries, export DOT"};
+  app.set_version_flag("--version", "cfinspect 0.1 (cf-graph format version 1)");
+  std::string path, holding_text, dot_path, pose_text;
+  long long neighbours_id = -1, cf_id = -1;
+  bool as_json = false, fast = false, print_schema = false;
+  double epsilon = 1.0;
+  app.add_option("graph", path, "CF graph file (.json, or .cbor)");
+  app.add_option("--holding", holding_text, "list the CFs that hold this PC, TYPE:A:B (e.g. v-f:3:5)");
+  app.add_option("--neighbours,--neighbors", neighbours_id, "list the transitions leaving CF ID");
+  app.add_option("--cf", cf_id, "print CF ID with its witness pose and freedoms");
+  app.add_option("--dot", dot_path, "write the graph as Graphviz DOT (labels: PC lists; edges: kinds)");
+  app.add_option("--pose", pose_text,
+                 "identify the CF at the pose tx,ty,tz,qw,qx,qy,qz of A (mm, unit quaternion; as in POSES.csv)");
+  app.add_option("--epsilon", epsilon, "contact threshold for --pose, mm (default 1.0, the paper's)")->check(CLI::PositiveNumber);
+  app.add_flag("--json", as_json, "machine-readable output (the summary or the query's answer)");
+  app.add_flag("--fast", fast, "check the items of cfs/transitions with the reader's rules instead of the full schema");
+  app.add_flag("--print-schema", print_schema, "print the JSON Schema of graph files (schemas/cf-graph.schema.json) and exit");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "cfinspect: " << e.what() << " (see --help)\n";
+    return 2;
+  }
+  if (print_schema) {
+    std::cout << cf::detail::graph_schema_text();
+    return 0;
+  }
+  if (path.empty()) {
+    std::cerr << "cfinspect: no graph file given (see --help)\n";
+    return 2;
+  }
+  // Parse the query arguments before the (possibly long) load, so typos fail fast.
+  std::optional<cf::Pc> holding_pc;
+  if (!holding_text.empty()) {
+    holding_pc = cf::pc_from_string(holding_text);
+    if (!holding_pc) throw Failure{"--holding '" + holding_text + "': expected TYPE:A:B such as v-f:3:5"};
+  }
+  std::optional<cf::Pose> pose;
+  if (!pose_text.empty()) pose = parse_pose(pose_text);
+
+  if (std::filesystem::is_directory(path)) throw Failure{"reading '" + path + "': is a directory, not a graph file"};
+  cf::GraphLoadOptions options;
+  options.full_schema_check = !fast;
+  const cf::CfGraph g = cf::CfGraph::load(path, options);
+
+  bool queried = false;
+  ojson answer = ojson::object();
+  if (holding_pc) {
+    queried = true;
+    const cf::Pc& pc = *holding_pc;
+    const char* field = "";
+    if (std::string why = cf::detail::check_pc(pc, g.model_a(), g.model_b(), &field); !why.empty())
+      throw Failure{"--holding '" + holding_text + "': " + why};
+    const auto ids = holding(g, pc);
+    if (as_json) {
+      ojson list = ojson::array();
+      for (cf::CfId id : ids) list.push_back({{"id", id.value()}, {"pcs", pcs_json(g.cf(id).pcs)}});
+      answer["holding"] = {{"pc", cf::to_string(pc)}, {"cfs", list}};
+    } else {
+      std::cout << ids.size() << " CFs hold " << cf::to_string(pc) << "\n";
+      for (cf::CfId id : ids) std::cout << "  CF " << id.value() << ": " << cf::to_string(g.cf(id).pcs) << "\n";
+    }
+  }
+  if (neighbours_id != -1 || app.count("--neighbours")) {
+    queried = true;
+    const cf::CfId id = parse_cf_id(g, path, neighbours_id);
+    if (as_json) answer["neighbours"] = cf_json(g, id)["transitions"];
+    else print_neighbours(std::cout, g, id);
+  }
+  if (cf_id != -1 || app.count("--cf")) {
+    queried = true;
+    const cf::CfId id = parse_cf_id(g, path, cf_id);
+    if (as_json) answer["cf"] = cf_json(g, id);
+    else print_cf(std::cout, g, id);
+  }
+  if (pose) {
+    queried = true;
+    cf::IdentificationParams params;
+    params.detection.epsilon = epsilon;
+    cf::CfIdentifier identifier(g, params);
+    const cf::Identification& r = identifier.step(*pose);
+    if (as_json) {
+      ojson candidates = ojson::array();
+      for (int i = 0; i < r.contacts.size(); ++i) {
+        const cf::ContactPc& c = r.contacts[i];
+        candidates.push_back({{"pc", cf::to_string(c.pc)}, {"distance", c.distance}});
+      }
+      answer["pose"] = {{"status", cf::to_string(r.status)},
+                        {"cf", r.has_cf() ? r.cf.value() : -1},
+                        {"pcs", pcs_json(r.pcs)},
+                        {"candidates", candidates}};
+    } else {
+      std::cout << "pose: " << cf::to_string(r.status) << ", CF " << (r.has_cf() ? r.cf.value() : -1);
+      if (r.has_cf()) std::cout << " {" << cf::to_string(r.pcs) << "}";
+      std::cout << ", " << r.contacts.size() << " candidate PCs within " << epsilon << " mm\n";
+      for (int i = 0; i < r.contacts.size(); ++i)
+        std::cout << "  " << cf::to_string(r.contacts[i].pc) << " at " << r.contacts[i].distance << " mm\n";
+    }
+  }
+  if (!dot_path.empty()) {
+    cf::detail::write_file_atomically(dot_path, dot_text(g), "writing DOT");
+    if (!as_json) std::cout << "wrote " << dot_path << " (" << g.num_cfs() << " nodes, " << g.num_transitions() << " edges)\n";
+    else answer["dot"] = dot_path;
+  }
+  if (!queried) {  // no query: the summary (also after --dot)
+    const Summary s = summarise(g);
+    if (as_json) {
+      ojson summary = summary_json(path, g, s, !fast);
+      for (auto it = answer.begin(); it != answer.end(); ++it) summary[it.key()] = it.value();
+      answer = std::move(summary);
+    } else {
+      print_summary(std::cout, path, g, s, !fast);
+    }
+  }
+  if (as_json) std::cout << answer.dump(2) << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const Failure& f) {
+    std::cerr << "cfinspect: " << f.message << "\n";
+  } catch (const cf::Error& e) {
+    std::cerr << "cfinspect: " << e.what() << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "cfinspect: unexpected error: " << e.what() << "\n";
+  }
+  return 1;
+}
