@@ -159,7 +159,9 @@ struct ContactDetector::Impl {
     bvh_a = detail::Bvh(ma, 0.0);
     // B's boxes grow by the deepest band and the in-plane allowance, so that every pair the
     // exact tests could accept has overlapping boxes.
-    bvh_b = detail::Bvh(mb, std::max(eps, depth) + in_plane + geo_tol);
+    // A pair the tests accept is within max(eps, depth) across the plane and in_plane along
+    // it, so within max(eps, depth, hypot(eps, in_plane)) of B's element.
+    bvh_b = detail::Bvh(mb, std::max({eps, depth, std::hypot(eps, in_plane)}) + geo_tol);
     stack.resize(detail::stack_capacity(bvh_a, bvh_b));
     q_pts.resize(static_cast<std::size_t>(flat_a.max_face_points));
     std::size_t max_loops = 1;

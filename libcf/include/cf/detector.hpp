@@ -20,7 +20,7 @@ struct DetectionParams {
   double epsilon = 1.0;
   /// Deepest interpenetration still reported as a contact (distance down to -max_penetration).
   /// Deeper pairs are taken as the far side of the other solid, not a contact.
-  double max_penetration = 2.0;
+  double max_penetration = 1.0;
   /// How far outside a face (in its plane) or beyond an edge's end a contact may fall and
   /// still count, so that degenerate touches (v-v, v-e, e-v, collinear e-e) yield their
   /// neighbouring non-degenerate interpretations. <= 0 means `epsilon`.
