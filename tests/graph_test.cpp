@@ -531,6 +531,12 @@ TEST_CASE("load: a missing top-level member", "[graph][bad]") {
                     Catch::Contains("'" + bad("missing_transitions.json") + "' at /: missing member \"transitions\""));
 }
 
+TEST_CASE("load: a model that breaks the model schema", "[graph][bad]") {
+  CHECK_THROWS_WITH(CfGraph::load(bad("model_schema_violation.json")),
+                    Catch::Contains("'" + bad("model_schema_violation.json") +
+                                    "' at /models/A/faces/0/area: does not match the cf-graph schema:"));
+}
+
 TEST_CASE("load: a schema violation the reader itself would let through", "[graph][bad]") {
   CHECK_THROWS_WITH(CfGraph::load(bad("schema_violation.json")),
                     Catch::Contains("'" + bad("schema_violation.json") +

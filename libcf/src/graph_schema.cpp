@@ -25,7 +25,15 @@ const valijson::Schema& graph_schema() {
     const nlohmann::json doc = nlohmann::json::parse(graph_schema_text());
     valijson::SchemaParser parser(valijson::SchemaParser::kDraft7);
     valijson::adapters::NlohmannJsonAdapter adapter(doc);
-    parser.populateSchema(adapter, *s);
+    // The only external reference is the model schema, embedded next to this one.
+    const auto fetch = [](const std::string& uri) -> const nlohmann::json* {
+      const std::string name = "model.schema.json";
+      if (uri.size() >= name.size() && uri.compare(uri.size() - name.size(), name.size(), name) == 0)
+        return new nlohmann::json(nlohmann::json::parse(model_schema_text()));
+      return nullptr;
+    };
+    const auto free_doc = [](const nlohmann::json* d) { delete d; };
+    parser.populateSchema(adapter, *s, fetch, free_doc);
     return s;
   }();
   return *schema;

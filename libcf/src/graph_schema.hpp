@@ -10,6 +10,8 @@ namespace cf::detail {
 
 /// The text of schemas/cf-graph.schema.json as it was when the library was built.
 const char* graph_schema_text();
+/// The text of schemas/model.schema.json, which the graph schema refers to for models.A/B.
+const char* model_schema_text();
 
 /// Validates a whole graph document against the schema.
 /// @throws cf::Error "reading '<source>' at <JSON pointer>: does not match the cf-graph

@@ -57,3 +57,6 @@ variant("missing_transitions.json", lambda d: d.pop("transitions"))
 # Accepted by the reader (metadata is free-form to it), rejected by the schema: "stats"
 # must be an object.
 variant("schema_violation.json", lambda d: d.update(stats="none"))
+# Rejected by the model schema (schemas/model.schema.json, referred to by the graph schema):
+# a face's derived area must be positive; the model reader ignores derived members.
+variant("model_schema_violation.json", lambda d: d["models"]["A"]["faces"][0].update(area=0))
