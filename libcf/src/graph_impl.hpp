@@ -79,6 +79,6 @@ void write_file_atomically(const std::string& path, const std::string& bytes, co
 namespace cf::detail {
 /// Reads a graph file's bytes (graph_reader.cpp): one streaming pass, then the checks.
 /// @throws cf::Error naming `source`, the JSON pointer and the problem.
-std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::string& source, bool cbor,
-                                          const GraphLoadOptions& options);
+std::unique_ptr<CfGraph::Impl> read_graph(const char* data, std::size_t size, const std::string& source,
+                                          bool cbor, const GraphLoadOptions& options);
 }  // namespace cf::detail

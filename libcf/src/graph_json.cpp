@@ -178,16 +178,20 @@ CfGraph CfGraph::load(const std::string& path, const GraphLoadOptions& options) 
   in.seekg(0, std::ios::end);
   const std::streamoff size = in.tellg();
   in.seekg(0, std::ios::beg);
-  std::string bytes(size > 0 ? static_cast<std::size_t>(size) : 0, '\0');
-  if (size > 0) in.read(bytes.data(), size);
-  if (in.bad() || size < 0) throw Error("reading '" + path + "': read failed: " + errno_text());
-  return from_bytes(bytes, path, is_cbor_path(path), options);
+  if (size < 0) throw Error("reading '" + path + "': cannot determine its size");
+  // Uninitialised buffer: zero-filling 50 MB first would be wasted work.
+  const auto n = static_cast<std::size_t>(size);
+  std::unique_ptr<char[]> bytes(new char[n > 0 ? n : 1]);
+  if (n > 0 && !in.read(bytes.get(), size)) throw Error("reading '" + path + "': read failed: " + errno_text());
+  CfGraph g;
+  g.impl_ = detail::read_graph(bytes.get(), n, path, is_cbor_path(path), options);
+  return g;
 }
 
 CfGraph CfGraph::from_bytes(const std::string& bytes, const std::string& source, bool cbor,
                             const GraphLoadOptions& options) {
   CfGraph g;
-  g.impl_ = detail::read_graph(bytes, source, cbor, options);
+  g.impl_ = detail::read_graph(bytes.data(), bytes.size(), source, cbor, options);
   return g;
 }
 

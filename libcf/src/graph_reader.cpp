@@ -27,11 +27,11 @@ namespace {
 
 constexpr std::size_t kNoFault = static_cast<std::size_t>(-1);
 
-/// A PC as the file gives it, before the models are known.
-struct RawCf {
+/// A CF's PCs as the file gives them (order kept for error pointers), checked against the
+/// models once those are read.
+struct RawPcs {
   std::array<Pc, PcSet::kMaxPcs> pcs{};
   int num_pcs = 0;  // as given; > 3 is reported at the end of the array
-  CfRecord record;
 };
 
 /// One scalar event, kept light (strings by pointer) so that the hot path allocates nothing.
@@ -115,7 +115,8 @@ class GraphSax {
 
   // --- results --------------------------------------------------------------------------
   json skeleton = json::object();  ///< every root member except the cfs and transitions items
-  std::vector<RawCf> cfs;
+  std::vector<CfRecord> cfs;  ///< PC sets still empty: filled from raw_pcs after the parse
+  std::vector<RawPcs> raw_pcs;
   std::vector<Transition> transitions;
   bool have_cfs = false, have_transitions = false;
   std::string fault_pointer;  ///< first item-level fault, reported after the parse
@@ -261,10 +262,11 @@ bool GraphSax::scalar(const Scalar& s) {
   switch (c) {
     case Ctx::kCfs:
       cfs.emplace_back();
+      raw_pcs.emplace_back();
       fault(cf_ptr(), "expected a CF object, got " + s.shown());
       break;
     case Ctx::kCf: {
-      RawCf& r = cfs.back();
+      CfRecord& r = cfs.back();
       switch (field_) {
         case Field::kCfId: {
           has_id_ = true;
@@ -276,11 +278,11 @@ bool GraphSax::scalar(const Scalar& s) {
         }
         case Field::kCfPcs: has_pcs_ = true; fault(field_ptr(), "expected an array, got " + s.shown()); break;
         case Field::kCfWitness: has_witness_ = true; fault(field_ptr(), "expected an object, got " + s.shown()); break;
-        case Field::kCfDof: small_int(0, 6, r.record.dof); break;
-        case Field::kCfTdof: small_int(0, 3, r.record.translation_dof); break;
+        case Field::kCfDof: small_int(0, 6, r.dof); break;
+        case Field::kCfTdof: small_int(0, 3, r.translation_dof); break;
         case Field::kCfPure:
           if (s.type != Scalar::kBool) fault(field_ptr(), "expected true or false, got " + s.shown());
-          else r.record.pure_rotation = s.b;
+          else r.pure_rotation = s.b;
           break;
         default: break;
       }
@@ -322,13 +324,13 @@ bool GraphSax::scalar(const Scalar& s) {
     case Ctx::kRRow: {
       const std::string where = cf_ptr() + "/witness/R/" + std::to_string(row_ - 1);
       if (!s.is_number()) fault(where + "/" + std::to_string(col_), "expected a number, got " + s.shown());
-      else if (col_ < 3) cfs.back().record.witness.R_BA(row_ - 1, col_) = s.number();
+      else if (col_ < 3) cfs.back().witness.R_BA(row_ - 1, col_) = s.number();
       ++col_;
       break;
     }
     case Ctx::kT:
       if (!s.is_number()) fault(cf_ptr() + "/witness/t/" + std::to_string(t_count_), "expected a number, got " + s.shown());
-      else if (t_count_ < 3) cfs.back().record.witness.t_BA(t_count_) = s.number();
+      else if (t_count_ < 3) cfs.back().witness.t_BA(t_count_) = s.number();
       ++t_count_;
       break;
     case Ctx::kTransitions:
@@ -416,6 +418,7 @@ bool GraphSax::start(bool object) {
   switch (c) {
     case Ctx::kCfs:
       cfs.emplace_back();
+      raw_pcs.emplace_back();
       if (object) {
         next = Ctx::kCf;
         has_id_ = has_pcs_ = has_witness_ = false;
@@ -532,7 +535,7 @@ bool GraphSax::end() {
       missing(at_pc, has_type_, "type");
       missing(at_pc, has_a_, "a");
       missing(at_pc, has_b_, "b");
-      RawCf& r = cfs.back();
+      RawPcs& r = raw_pcs.back();
       if (pc_count_ <= PcSet::kMaxPcs) r.pcs[static_cast<std::size_t>(pc_count_ - 1)] = pc_;
       r.num_pcs = pc_count_;
       break;
@@ -541,7 +544,7 @@ bool GraphSax::end() {
       missing(at_witness, has_R_, "R");
       missing(at_witness, has_t_, "t");
       if (faulted()) break;
-      const Mat3& R = cfs.back().record.witness.R_BA;
+      const Mat3& R = cfs.back().witness.R_BA;
       // Witnesses are written with full double precision; 1e-6 leaves room for hand-written
       // files with 7 significant digits while still catching a scaled or sheared matrix.
       constexpr double kRotationTol = 1e-6;
@@ -579,8 +582,8 @@ bool GraphSax::end() {
 /// buffer). Syntax errors give the line and column. CBOR still goes through nlohmann.
 class FastJsonParser {
  public:
-  FastJsonParser(const std::string& text, const std::string& source)
-      : begin_(text.data()), p_(text.data()), end_(text.data() + text.size()), source_(source) {}
+  FastJsonParser(const char* data, std::size_t size, const std::string& source)
+      : begin_(data), p_(data), end_(data + size), source_(source) {}
 
   template <class Sax>
   void parse(Sax& sax) {
@@ -908,13 +911,13 @@ bool is_reserved(const std::string& key) {
 
 }  // namespace
 
-std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::string& source, bool cbor,
-                                          const GraphLoadOptions& options) {
+std::unique_ptr<CfGraph::Impl> read_graph(const char* data, std::size_t size, const std::string& source,
+                                          bool cbor, const GraphLoadOptions& options) {
   GraphSax sax(source, cbor);
   if (cbor)
-    json::sax_parse(bytes.begin(), bytes.end(), &sax, json::input_format_t::cbor);
+    json::sax_parse(data, data + size, &sax, json::input_format_t::cbor);
   else
-    FastJsonParser(bytes, source).parse(sax);
+    FastJsonParser(data, size, source).parse(sax);
 
   const JsonWhere root{source, ""};
   const json& j = sax.skeleton;
@@ -941,24 +944,24 @@ std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::s
   impl->b = polyhedron_from_json(json_member(jm, "B", wm), wm / "B");
 
   const JsonLocator where(root);
-  impl->cfs.reserve(sax.cfs.size());
-  for (std::size_t i = 0; i < sax.cfs.size(); ++i) {
-    RawCf& r = sax.cfs[i];
+  impl->cfs = std::move(sax.cfs);
+  for (std::size_t i = 0; i < impl->cfs.size(); ++i) {
+    const RawPcs& r = sax.raw_pcs[i];
+    PcSet& set = impl->cfs[i].pcs;
     for (int k = 0; k < r.num_pcs; ++k) {
       const Pc& pc = r.pcs[static_cast<std::size_t>(k)];
       const char* field = "";
       if (std::string why = check_pc(pc, impl->a, impl->b, &field); !why.empty())
         where.pc_fault(i, static_cast<std::size_t>(k), field, why);
-      if (!r.record.pcs.insert(pc))
+      if (!set.insert(pc))
         json_fail(root / "cfs" / i / "pcs" / static_cast<std::size_t>(k), "PC " + to_string(pc) + " is repeated in this CF");
     }
-    impl->cfs.push_back(r.record);
   }
-  sax.cfs = {};
+  sax.raw_pcs = {};
 
   if (options.validate_schema) {
     if (options.full_schema_check) {
-      validate_graph_schema(cbor ? json::from_cbor(bytes) : json::parse(bytes), source);
+      validate_graph_schema(cbor ? json::from_cbor(data, data + size) : json::parse(data, data + size), source);
     } else {
       json skeleton = j;
       skeleton["cfs"] = json::array();

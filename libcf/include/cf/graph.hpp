@@ -126,8 +126,12 @@ class CfGraph {
   /// Builds and checks a graph from its parts (what cfgen produces).
   /// @param metadata_json  a JSON object text with extra top-level members to write
   ///   (statistics, parameters); "{}" for none.
-  /// @throws cf::Error when an index is out of range, a PC type does not match the element
-  ///   kinds, a PC set repeats, or a transition names a missing CF.
+  /// @throws cf::Error when an index is out of range for the element kind its PC type
+  ///   names, a CF has no PC, two PCs of a CF share a contact plane (the same face of A or
+  ///   of B), a PC set repeats, dof/translation_dof are out of 0..6/0..3, a transition
+  ///   names a missing CF, loops, repeats, or its kind does not fit the two PC sets
+  ///   (gain: to = from + one PC; lose: the reverse; change: same count), or the metadata
+  ///   is not a JSON object or overrides a member of the graph itself.
   static CfGraph from_parts(Polyhedron a, Polyhedron b, std::vector<CfRecord> cfs,
                             std::vector<Transition> transitions,
                             const std::string& metadata_json = "{}");
@@ -145,7 +149,9 @@ class CfGraph {
   /// renames it into place, so that the file is whole or absent.
   /// @throws cf::Error when the file cannot be written.
   void save(const std::string& path) const;
-  /// The JSON text of the graph file; deterministic for the same graph.
+  /// The JSON text of the graph file; deterministic for the same graph. indent < 0: one
+  /// line; otherwise one member per line at the top level, short containers inline, one
+  /// line per CF and per transition (the layout save() writes, with indent 1).
   std::string to_json(int indent = -1) const;
 
   CfGraph();
@@ -156,15 +162,18 @@ class CfGraph {
   const Polyhedron& model_a() const;
   const Polyhedron& model_b() const;
   std::size_t num_cfs() const;
+  /// @pre id.index() < num_cfs()
   const CfRecord& cf(CfId id) const;
   std::size_t num_transitions() const;
+  /// In file order. @pre i < num_transitions()
   const Transition& transition(std::size_t i) const;
 
   /// The CF with exactly this PC set, in constant time.
   std::optional<CfId> find(const PcSet& pcs) const;
-  /// Transitions leaving `id` (to, kind), sorted by target id.
+  /// Transitions leaving `id` (to, kind), sorted by target id. @pre id.index() < num_cfs()
   const std::vector<Transition>& out_transitions(CfId id) const;
-  /// True when the graph has a transition from `from` to `to`.
+  /// True when the graph has a transition from `from` to `to` (false for invalid ids);
+  /// O(log out-degree).
   bool adjacent(CfId from, CfId to) const;
   /// The extra top-level members of the file (statistics, parameters) as JSON text.
   const std::string& metadata_json() const;
