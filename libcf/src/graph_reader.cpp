@@ -322,8 +322,9 @@ bool GraphSax::scalar(const Scalar& s) {
       ++row_;
       break;
     case Ctx::kRRow: {
-      const std::string where = cf_ptr() + "/witness/R/" + std::to_string(row_ - 1);
-      if (!s.is_number()) fault(where + "/" + std::to_string(col_), "expected a number, got " + s.shown());
+      if (!s.is_number())
+        fault(cf_ptr() + "/witness/R/" + std::to_string(row_ - 1) + "/" + std::to_string(col_),
+              "expected a number, got " + s.shown());
       else if (col_ < 3) cfs.back().witness.R_BA(row_ - 1, col_) = s.number();
       ++col_;
       break;
