@@ -381,6 +381,12 @@ TEST_CASE("from_parts rejects empty, repeated and coplanar PC sets", "[graph]") 
   CHECK_THROWS_WITH(build({rec({pc(PcType::kFF, 2, 4), pc(PcType::kFV, 2, 3)})}),
                     Catch::Contains("share the contact plane of A's face 2"));
   cf::CfRecord r = rec({pc(PcType::kVF, 0, 4)});
+  r.witness.R_BA *= 1.01;  // what from_parts accepts must load back: witnesses are poses
+  CHECK_THROWS_WITH(build({r}), Catch::Contains("CF 0: witness R: not a rotation matrix"));
+  r.witness.R_BA = cf::Mat3::Identity();
+  r.witness.t_BA.x() = std::nan("");
+  CHECK_THROWS_WITH(build({r}), Catch::Contains("CF 0: witness t: translation is not finite"));
+  r.witness.t_BA.x() = 0;
   r.dof = 7;
   CHECK_THROWS_WITH(build({r}), Catch::Contains("CF 0: dof = 7 is not in 0..6"));
 }

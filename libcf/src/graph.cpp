@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cassert>
 #include <charconv>
+#include <cmath>
+#include <sstream>
 #include <utility>
 
 namespace cf {
@@ -173,6 +175,26 @@ std::string check_pc(const Pc& pc, const Polyhedron& a, const Polyhedron& b, con
   return r;
 }
 
+std::string check_witness(const Pose& pose, const char** field) {
+  // Witnesses are written with full double precision; 1e-6 leaves room for hand-written
+  // files with 7 significant digits while still catching a scaled or sheared matrix.
+  constexpr double kRotationTol = 1e-6;
+  if (!pose.t_BA.allFinite()) {
+    *field = "t";
+    return "translation is not finite";
+  }
+  const Mat3& R = pose.R_BA;
+  const double ortho = R.allFinite() ? (R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff() : HUGE_VAL;
+  const double det = R.determinant();
+  if (!(ortho <= kRotationTol) || !(det > 0)) {
+    *field = "R";
+    std::ostringstream s;
+    s << "not a rotation matrix (max |R^T R - I| = " << ortho << ", det R = " << det << ")";
+    return s.str();
+  }
+  return {};
+}
+
 const BoostCfGraph& boost_graph(const CfGraph& graph) { return graph.impl().bgraph; }
 
 }  // namespace detail
@@ -322,6 +344,11 @@ CfGraph CfGraph::from_parts(Polyhedron a, Polyhedron b, std::vector<CfRecord> cf
       const char* field = "";
       if (std::string why = detail::check_pc(r.pcs[p], a, b, &field); !why.empty())
         where.pc_fault(i, static_cast<std::size_t>(p), field, why);
+    }
+    {
+      const char* field = "";
+      if (std::string why = detail::check_witness(r.witness, &field); !why.empty())
+        where.cf_fault(i, std::string("witness ") + field + ": " + why);
     }
     if (r.dof < -1 || r.dof > 6) where.cf_fault(i, "dof = " + std::to_string(r.dof) + " is not in 0..6");
     if (r.translation_dof < -1 || r.translation_dof > 3)

@@ -41,6 +41,10 @@ class FaultLocator {
   [[noreturn]] virtual void metadata_fault(const std::string& what) const = 0;
 };
 
+/// Empty when the witness is a rigid pose (R a rotation within 1e-6, everything finite),
+/// else the reason. `field` is set to "R" or "t".
+std::string check_witness(const Pose& pose, const char** field);
+
 /// Checks one PC against the models: the indices are in range for the kinds its type names.
 /// Returns an empty string when fine, else the reason; `field` is set to "a" or "b".
 std::string check_pc(const Pc& pc, const Polyhedron& a, const Polyhedron& b, const char** field);

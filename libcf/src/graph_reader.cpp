@@ -545,17 +545,9 @@ bool GraphSax::end() {
       missing(at_witness, has_R_, "R");
       missing(at_witness, has_t_, "t");
       if (faulted()) break;
-      const Mat3& R = cfs.back().witness.R_BA;
-      // Witnesses are written with full double precision; 1e-6 leaves room for hand-written
-      // files with 7 significant digits while still catching a scaled or sheared matrix.
-      constexpr double kRotationTol = 1e-6;
-      const double ortho = (R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff();
-      const double det = R.determinant();
-      if (!(ortho <= kRotationTol) || !(det > 0)) {
-        std::ostringstream s;
-        s << "not a rotation matrix (max |R^T R - I| = " << ortho << ", det R = " << det << ")";
-        fault(cf_ptr() + "/witness/R", s.str());
-      }
+      const char* field = "";
+      if (std::string why = check_witness(cfs.back().witness, &field); !why.empty())
+        fault(cf_ptr() + "/witness/" + field, why);
       break;
     }
     case Ctx::kR:
