@@ -282,6 +282,44 @@ TEST_CASE("to_json round-trips exactly and is deterministic", "[graph]") {
   CHECK(compact.find(R"({"id":1,"pcs":[{"type":"f-f","a":5,"b":5}],"witness":{"R":[[1.0,0.0,0.0],[0.0,1.0,0.0],[0.0,0.0,1.0]],"t":[10.0,20.0,5.0]}})") != std::string::npos);
 }
 
+TEST_CASE("witnesses with arbitrary doubles round-trip exactly through JSON and CBOR", "[graph]") {
+  // Every single PC between the cube and the L-block, each with a random rotation and
+  // translation: numbers with 16-17 significant digits, tiny and huge exponents.
+  std::vector<cf::CfRecord> cfs;
+  std::uint64_t state = 42;
+  auto uniform = [&state] {  // splitmix64 -> [0, 1)
+    state += 0x9e3779b97f4a7c15ULL;
+    std::uint64_t z = state;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+  };
+  const cf::Polyhedron a = cf_test::box(10, 10, 10), b = cf_test::l_block();
+  const double scales[] = {1e-300, 1e-7, 1e-4, 1.0, 1e15, 1e17, 1e300};
+  for (int t = 0; t < 6; ++t)
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < 8; ++j) {
+        const auto type = static_cast<PcType>(t);
+        if (cf::a_kind(type) == cf::ElementKind::kFace && i >= 6) continue;
+        cf::CfRecord r;
+        r.pcs = PcSet({pc(type, i, j)});
+        r.witness.R_BA = Eigen::Quaterniond(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5, uniform() - 0.5)
+                             .normalized()
+                             .toRotationMatrix();
+        const double s = scales[cfs.size() % 7];
+        r.witness.t_BA = cf::Vec3(s * (uniform() - 0.5), -s * uniform(), s);
+        cfs.push_back(r);
+      }
+  const CfGraph g = CfGraph::from_parts(a, b, std::move(cfs), {});
+  REQUIRE(g.num_cfs() == 288);
+  check_same(g, CfGraph::from_bytes(g.to_json(), "r.json", false));
+  check_same(g, CfGraph::from_bytes(g.to_json(2), "r.json", false));
+  const auto dir = scratch_dir("doubles");
+  g.save((dir / "r.cbor").string());
+  check_same(g, CfGraph::load((dir / "r.cbor").string()));
+  std::filesystem::remove_all(dir);
+}
+
 TEST_CASE("the committed fixture is the graph the code builds", "[graph]") {
   const CfGraph g = cf_test::box_l_graph();
   if (std::getenv("CF_WRITE_GRAPH_FIXTURES")) g.save(kFixture);

@@ -6,7 +6,9 @@
 #include "json_util.hpp"
 #include "polyhedron_json.hpp"
 
+#include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -71,8 +73,9 @@ ojson transition_json(const Transition& t) {
 }
 
 /// The whole file as one ordered value: format, version, units, metadata (sorted by key),
-/// models, cfs, transitions.
-ojson graph_json(const CfGraph::Impl& g) {
+/// models, cfs, transitions. Without items, cfs and transitions are empty arrays (the JSON
+/// writer appends them itself: a DOM of 100,000 CFs costs seconds of malloc).
+ojson graph_json(const CfGraph::Impl& g, bool with_items = true) {
   ojson root = ojson::object();
   root["format"] = "cf-graph";
   root["version"] = 1;
@@ -84,12 +87,146 @@ ojson graph_json(const CfGraph::Impl& g) {
   models["B"] = ojson(detail::polyhedron_to_json(g.b));
   root["models"] = std::move(models);
   ojson cfs = ojson::array();
-  for (std::size_t i = 0; i < g.cfs.size(); ++i) cfs.push_back(cf_json(i, g.cfs[i]));
-  root["cfs"] = std::move(cfs);
   ojson tr = ojson::array();
-  for (const Transition& t : g.transitions) tr.push_back(transition_json(t));
+  if (with_items) {
+    for (std::size_t i = 0; i < g.cfs.size(); ++i) cfs.push_back(cf_json(i, g.cfs[i]));
+    for (const Transition& t : g.transitions) tr.push_back(transition_json(t));
+  }
+  root["cfs"] = std::move(cfs);
   root["transitions"] = std::move(tr);
   return root;
+}
+
+// --- direct writing of the items, byte for byte what nlohmann's dump() writes -----------
+
+void append_int(std::string& out, long long v) {
+  char buf[24];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, static_cast<std::size_t>(r.ptr - buf));
+}
+
+/// Shortest round-trip digits (std::to_chars), laid out by nlohmann's rules
+/// (dtoa_impl::format_buffer): plain decimals for exponents -4 < n <= 15, else d.ddde+XX.
+void append_double(std::string& out, double v) {
+  if (!std::isfinite(v)) {
+    out += "null";
+    return;
+  }
+  if (v == 0) {
+    out += std::signbit(v) ? "-0.0" : "0.0";
+    return;
+  }
+  char buf[48];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::scientific);
+  const char* p = buf;
+  if (*p == '-') {
+    out += '-';
+    ++p;
+  }
+  const char* e = std::find(p, static_cast<const char*>(r.ptr), 'e');
+  char digits[24];
+  int k = 0;
+  for (const char* q = p; q < e && k < 24; ++q)
+    if (*q != '.') digits[k++] = *q;
+  int exp10 = 0;
+  std::from_chars(e[1] == '+' ? e + 2 : e + 1, r.ptr, exp10);
+  const int n = exp10 + 1;  // value = 0.d1d2...dk * 10^n
+  constexpr int kMinExp = -4, kMaxExp = 15;
+  if (k <= n && n <= kMaxExp) {
+    out.append(digits, static_cast<std::size_t>(k));
+    out.append(static_cast<std::size_t>(n - k), '0');
+    out += ".0";
+  } else if (0 < n && n <= kMaxExp) {
+    out.append(digits, static_cast<std::size_t>(n));
+    out += '.';
+    out.append(digits + n, static_cast<std::size_t>(k - n));
+  } else if (kMinExp < n && n <= 0) {
+    out += "0.";
+    out.append(static_cast<std::size_t>(-n), '0');
+    out.append(digits, static_cast<std::size_t>(k));
+  } else {
+    out += digits[0];
+    if (k > 1) {
+      out += '.';
+      out.append(digits + 1, static_cast<std::size_t>(k - 1));
+    }
+    out += 'e';
+    int x = n - 1;
+    out += x < 0 ? '-' : '+';
+    x = x < 0 ? -x : x;
+    if (x < 10) out += '0';
+    append_int(out, x);
+  }
+}
+
+void append_vec3(std::string& out, double x, double y, double z) {
+  out += '[';
+  append_double(out, x);
+  out += ',';
+  append_double(out, y);
+  out += ',';
+  append_double(out, z);
+  out += ']';
+}
+
+/// One CF as one line, the same bytes as cf_json(id, r).dump().
+void append_cf(std::string& out, std::size_t id, const CfRecord& r) {
+  out += "{\"id\":";
+  append_int(out, static_cast<long long>(id));
+  out += ",\"pcs\":[";
+  bool first = true;
+  for (const Pc& pc : r.pcs) {
+    if (!first) out += ',';
+    first = false;
+    out += "{\"type\":\"";
+    out += to_string(pc.type);
+    out += "\",\"a\":";
+    append_int(out, pc.a);
+    out += ",\"b\":";
+    append_int(out, pc.b);
+    out += '}';
+  }
+  out += "],\"witness\":{\"R\":[";
+  const Mat3& R = r.witness.R_BA;
+  for (int i = 0; i < 3; ++i) {
+    if (i > 0) out += ',';
+    append_vec3(out, R(i, 0), R(i, 1), R(i, 2));
+  }
+  out += "],\"t\":";
+  append_vec3(out, r.witness.t_BA.x(), r.witness.t_BA.y(), r.witness.t_BA.z());
+  out += '}';
+  if (r.dof >= 0) {
+    out += ",\"dof\":";
+    append_int(out, r.dof);
+  }
+  if (r.translation_dof >= 0) {
+    out += ",\"translation_dof\":";
+    append_int(out, r.translation_dof);
+  }
+  if (r.dof >= 0 || r.translation_dof >= 0 || r.pure_rotation)
+    out += r.pure_rotation ? ",\"pure_rotation\":true" : ",\"pure_rotation\":false";
+  out += '}';
+}
+
+void append_transition(std::string& out, const Transition& t) {
+  out += "{\"from\":";
+  append_int(out, t.from.value());
+  out += ",\"to\":";
+  append_int(out, t.to.value());
+  out += ",\"kind\":\"";
+  out += to_string(t.kind);
+  out += "\"}";
+}
+
+/// Appends the items, `sep` between them (",", or ",\n" plus padding).
+void append_items(std::string& out, const CfGraph::Impl& g, bool cfs, const std::string& before,
+                  const std::string& sep) {
+  const std::size_t n = cfs ? g.cfs.size() : g.transitions.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    out += i == 0 ? before : sep;
+    if (cfs) append_cf(out, i, g.cfs[i]);
+    else append_transition(out, g.transitions[i]);
+  }
 }
 
 /// Pretty printing that stays readable for large graphs: containers whose one-line form is
@@ -149,11 +286,42 @@ std::string errno_text() { return std::strerror(errno); }
 }  // namespace
 
 std::string CfGraph::to_json(int indent) const {
-  const ojson j = graph_json(impl());
-  if (indent < 0) return j.dump();
+  const Impl& g = impl();
+  const ojson head = graph_json(g, false);
   std::string out;
-  print(j, indent, 0, true, out);
-  out += '\n';
+  out.reserve(4096 + g.cfs.size() * 400 + g.transitions.size() * 48);
+  if (indent < 0) {
+    out = head.dump();
+    const std::string tail = ",\"cfs\":[],\"transitions\":[]}";
+    if (!ends_with(out, tail)) return graph_json(g).dump();  // cannot happen: keys are ours
+    out.resize(out.size() - tail.size());
+    out += ",\"cfs\":[";
+    append_items(out, g, true, "", ",");
+    out += "],\"transitions\":[";
+    append_items(out, g, false, "", ",");
+    out += "]}";
+    return out;
+  }
+  print(head, indent, 0, true, out);
+  const std::string pad(static_cast<std::size_t>(indent), ' ');
+  const std::string tail = ",\n" + pad + "\"cfs\": [],\n" + pad + "\"transitions\": []\n}";
+  if (!ends_with(out, tail)) {  // cannot happen: keys are ours
+    out.clear();
+    print(graph_json(g), indent, 0, true, out);
+    return out + '\n';
+  }
+  out.resize(out.size() - tail.size());
+  const std::string item_pad = "\n" + pad + pad;
+  for (const bool cfs : {true, false}) {
+    const bool empty = cfs ? g.cfs.empty() : g.transitions.empty();
+    out += ",\n" + pad + (cfs ? "\"cfs\": [" : "\"transitions\": [");
+    if (!empty) {
+      append_items(out, g, cfs, item_pad, "," + item_pad);
+      out += "\n" + pad;
+    }
+    out += ']';
+  }
+  out += "\n}\n";
   return out;
 }
 
