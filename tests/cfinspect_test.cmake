@@ -93,3 +93,11 @@ cfinspect_test(bad_pose fail "${_g}/box_l.json --pose 1,2,x,1,0,0,0" "--pose '1,
 cfinspect_test(dot_unwritable fail "${_g}/box_l.json --dot ${_out}/no/such/dir/x.dot" "writing DOT '.*x.dot': cannot create a temporary file")
 cfinspect_test(no_args fail "" "no graph file given")
 cfinspect_test(bad_option fail "${_g}/box_l.json --bogus" "--bogus")
+
+# Every graph shipped in data/graphs must pass the full schema check (SPEC section 5: "every
+# written graph validates"). Globbed at configure time: re-run cmake after adding one.
+file(GLOB _data_graphs ${PROJECT_SOURCE_DIR}/data/graphs/*.json ${PROJECT_SOURCE_DIR}/data/graphs/*.cbor)
+foreach(_graph IN LISTS _data_graphs)
+  get_filename_component(_name ${_graph} NAME)
+  cfinspect_test(data_${_name} ok "${_graph}" "valid cf-graph v1 \\(full schema check\\)")
+endforeach()
