@@ -140,6 +140,23 @@ ModelInfo analyse_model(const Polyhedron& m) {
     });
     info.pieces[f] = std::move(pieces);
   }
+  for (const Vertex& V : m.vertices()) info.spheres[0].push_back({V.p, 0.0});
+  for (std::size_t e = 0; e < m.num_edges(); ++e) {
+    const Vec3 a = m.edge_point(EdgeId(static_cast<int>(e)), 0);
+    const Vec3 b = m.edge_point(EdgeId(static_cast<int>(e)), 1);
+    info.spheres[1].push_back({0.5 * (a + b), 0.5 * (b - a).norm()});
+  }
+  for (const Face& F : m.faces()) {
+    Vec3 lo = m.vertex(F.vertices[0]).p, hi = lo;
+    for (VertexId v : F.vertices) {
+      lo = lo.cwiseMin(m.vertex(v).p);
+      hi = hi.cwiseMax(m.vertex(v).p);
+    }
+    const Vec3 c = 0.5 * (lo + hi);
+    double r = 0;
+    for (VertexId v : F.vertices) r = std::max(r, (m.vertex(v).p - c).norm());
+    info.spheres[2].push_back({c, r});
+  }
   info.face_plane.assign(m.num_faces(), -1);
   int next = 0;
   const double ptol = 1e-7 * m.size();

@@ -3,6 +3,7 @@
 // convex partitions of faces, coplanar face groups, and a point-in-solid test.
 
 #include "cgal_support.hpp"
+#include "lp.hpp"
 
 #include <cf/polyhedron.hpp>
 
@@ -28,6 +29,9 @@ struct ModelInfo {
   std::vector<EdgeWedge> wedges;
   std::vector<std::vector<ConvexPiece>> pieces;  // per face, largest piece first
   std::vector<int> face_plane;  // faces lying in one plane (same orientation) share an id
+  // Bounding spheres (center in the model frame, radius, mm) of every element, indexed by
+  // kind (vertex, edge, face) then element, for cheap distance lower bounds.
+  std::vector<std::pair<Vec3, double>> spheres[3];
 };
 
 /// @throws cf::Error when the model has a face that cannot be partitioned.

@@ -3,9 +3,6 @@
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Gmpzf.h>
-#include <CGAL/QP_functions.h>
-#include <CGAL/QP_models.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
@@ -14,38 +11,6 @@
 #include <set>
 
 namespace cf::gen {
-
-LpResult solve(const LinearProgram& lp) {
-  using Program = CGAL::Quadratic_program<double>;
-  Program qp(CGAL::EQUAL, false, 0, false, 0);
-  for (int j = 0; j < lp.num_vars; ++j) {
-    qp.set_l(j, lp.lower[j].first, lp.lower[j].second);
-    qp.set_u(j, lp.upper[j].first, lp.upper[j].second);
-    qp.set_c(j, lp.c[j]);
-  }
-  for (std::size_t i = 0; i < lp.rows.size(); ++i) {
-    const auto& r = lp.rows[i];
-    const int ii = static_cast<int>(i);
-    for (const auto& [j, v] : r.a) qp.set_a(j, ii, v);
-    qp.set_b(ii, r.b);
-    qp.set_r(ii, r.rel == LinearProgram::Rel::kLessEq ? CGAL::SMALLER
-                 : r.rel == LinearProgram::Rel::kEq   ? CGAL::EQUAL
-                                                      : CGAL::LARGER);
-  }
-  const auto s = CGAL::solve_linear_program(qp, CGAL::Gmpzf());
-  LpResult out;
-  if (s.is_infeasible()) return out;
-  if (s.is_unbounded()) {
-    out.status = LpResult::Status::kUnbounded;
-    return out;
-  }
-  out.status = LpResult::Status::kOptimal;
-  out.x.resize(lp.num_vars);
-  int j = 0;
-  for (auto it = s.variable_values_begin(); it != s.variable_values_end(); ++it, ++j)
-    out.x[j] = CGAL::to_double(*it);
-  return out;
-}
 
 namespace {
 

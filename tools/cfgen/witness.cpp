@@ -504,6 +504,12 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
       const int na = count(A, ka), nb = count(B, kb);
       for (int a = 0; a < na; ++a)
         for (int b = 0; b < nb; ++b) {
+          // Pairs whose bounding spheres are farther apart than good_clearance can neither
+          // touch nor lower the clearance below what counts as good: skip the exact test.
+          const auto& sa = A_.spheres[static_cast<int>(ka)][a];
+          const auto& sb = B_.spheres[static_cast<int>(kb)][b];
+          const double lower = (pose.apply(sa.first) - sb.first).norm() - sa.second - sb.second;
+          if (lower > p_.good_clearance) continue;
           const double d = element_distance(A, pose, ka, a, B, kb, b).distance;
           if (ka == ElementKind::kVertex) a_vertex_gap[a] = std::min(a_vertex_gap[a], d);
           if (kb == ElementKind::kVertex) b_vertex_gap[b] = std::min(b_vertex_gap[b], d);

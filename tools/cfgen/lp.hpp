@@ -1,0 +1,40 @@
+#pragma once
+// Small linear programs for the witness search (translation with the largest margin).
+
+#include <Eigen/Core>
+
+#include <utility>
+#include <vector>
+
+namespace cf::gen {
+
+/// minimise c.x subject to rows (a_i . x  REL_i  b_i) and per-variable bounds.
+struct LinearProgram {
+  enum class Rel { kLessEq, kEq, kGreaterEq };
+  struct Row {
+    std::vector<std::pair<int, double>> a;  // sparse coefficients (variable, value)
+    Rel rel;
+    double b;
+  };
+  int num_vars = 0;
+  std::vector<Row> rows;
+  std::vector<double> c;                  // objective, size num_vars
+  std::vector<std::pair<bool, double>> lower, upper;  // (finite?, value) per variable
+
+  explicit LinearProgram(int n)
+      : num_vars(n), c(n, 0.0), lower(n, {false, 0.0}), upper(n, {false, 0.0}) {}
+  void add(std::vector<std::pair<int, double>> a, Rel rel, double b) {
+    rows.push_back({std::move(a), rel, b});
+  }
+};
+
+struct LpResult {
+  enum class Status { kOptimal, kInfeasible, kUnbounded } status = Status::kInfeasible;
+  Eigen::VectorXd x;  // the optimum, rounded to double from the exact solution
+};
+
+/// Solves with GLPK's primal simplex in double precision. Exactness is not needed here: every
+/// pose built from a solution is verified on its own before it is accepted.
+LpResult solve(const LinearProgram& lp);
+
+}  // namespace cf::gen
