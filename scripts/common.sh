@@ -22,7 +22,9 @@ cf_install_deps() {
 }
 
 cf_configure() {
-  local args=(-S "$CF_ROOT" -B "$CF_BUILD_DIR" "-DCMAKE_BUILD_TYPE=$CF_BUILD_TYPE")
+  # Everything on, explicitly: a reused build tree may carry older choices in its cache.
+  local args=(-S "$CF_ROOT" -B "$CF_BUILD_DIR" "-DCMAKE_BUILD_TYPE=$CF_BUILD_TYPE"
+              -DCF_BUILD_TOOLS=ON -DCF_BUILD_TESTS=ON -DCF_BUILD_BENCH=ON)
   # The generator of an existing build tree cannot change; only pick Ninja for a new one.
   # Ccache, when installed, is picked up by the top-level CMakeLists.txt.
   if [[ ! -f "$CF_BUILD_DIR/CMakeCache.txt" ]]; then args+=(-G Ninja); fi

@@ -4,54 +4,36 @@
 # default models. Knobs: see scripts/common.sh.
 set -euo pipefail
 
-# The bundled default models the main job runs on (paths relative to the repo root).
-DEFAULT_MODELS=(
-  data/models/cube.off
-  data/models/l_block.off
-  data/models/corner_block.off
-  data/models/peg.off
-  data/models/block_with_hole.off
+# The bundled default model pairs (A B graph), paths relative to the repo root.
+DEFAULT_PAIRS=(
+  "data/models/cube.off data/models/l_block.off data/graphs/cube_l_block.json"
+  "data/models/cube.off data/models/corner_block.off data/graphs/cube_corner_block.json"
+  "data/models/peg.off data/models/hole_block.off data/graphs/peg_hole_block.json"
 )
+# The replay the main job runs (trajectory, graph, output prefix).
+DEFAULT_REPLAY="data/trajectories/cube_lblock_corner.csv data/graphs/cube_l_block.json"
 
 # shellcheck source=scripts/common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 # ---------------------------------------------------------------------------------------
-# MAIN JOB. For now: extract the features (faces, edges, vertices) of each default model
-# with cfgen and write them to build/features/<name>.json.
-# TODO(lead): replace with graph generation (cfgen A B -o GRAPH) + replay (cfreplay).
+# MAIN JOB: the CF graph of every default pair (cfgen), then one scripted trajectory replayed
+# through the run-time loop (cfreplay) with its force/moment CSV and SVG plot.
 # ---------------------------------------------------------------------------------------
 main_job() {
-  local cfgen="$CF_BUILD_DIR/tools/cfgen/cfgen"
-  local outdir="$CF_BUILD_DIR/features"
-  if [[ ! -x "$cfgen" ]]; then
-    cf_log "main job skipped: $cfgen was not built (tools/ not there yet, or CF_BUILD_TOOLS=OFF)"
-    return 0
-  fi
-  mkdir -p "$outdir"
-  local model name out failures=0 done_count=0
-  cf_log "main job: features of the default models -> $outdir/"
-  for model in "${DEFAULT_MODELS[@]}"; do
-    if [[ ! -f "$model" ]]; then
-      echo "  skip  $model: file not found (default model not bundled yet)"
-      continue
-    fi
-    name="$(basename "$model")"
-    name="${name%.*}"
-    out="$outdir/$name.json"
-    # Written whole or not at all.
-    if "$cfgen" --features "$model" >"$out.tmp"; then
-      mv -f "$out.tmp" "$out"
-      printf '  ok    %-28s -> %s (%s bytes)\n' "$model" "$out" "$(wc -c <"$out" | tr -d ' ')"
-      done_count=$((done_count + 1))
-    else
-      rm -f "$out.tmp"
-      echo "  FAIL  $model: cfgen --features exited non-zero (message above)"
-      failures=$((failures + 1))
-    fi
+  local cfgen="$CF_BUILD_DIR/tools/cfgen" cfreplay="$CF_BUILD_DIR/tools/cfreplay"
+  local pair a b graph
+  for pair in "${DEFAULT_PAIRS[@]}"; do
+    read -r a b graph <<<"$pair"
+    cf_log "main job: cfgen $a $b -o $graph"
+    "$cfgen" "$a" "$b" -o "$graph"
   done
-  cf_log "main job: $done_count written, $failures failed, $((${#DEFAULT_MODELS[@]} - done_count - failures)) skipped"
-  ((failures == 0))
+  local traj replay_graph out="$CF_BUILD_DIR/replay"
+  read -r traj replay_graph <<<"$DEFAULT_REPLAY"
+  mkdir -p "$out"
+  cf_log "main job: cfreplay --graph $replay_graph --trajectory $traj"
+  "$cfreplay" --graph "$replay_graph" --trajectory "$traj" -o "$out/replay.csv" --plot "$out/replay.svg"
+  cf_log "main job: wrote $out/replay.csv ($(($(wc -l <"$out/replay.csv") - 1)) ticks) and $out/replay.svg"
 }
 
 cf_install_deps

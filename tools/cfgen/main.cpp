@@ -47,10 +47,45 @@ int main(int argc, char** argv) {
   auto* threads = app.add_option("-j,--threads", gen.threads, "worker threads (0: all cores)")
                       ->check(CLI::NonNegativeNumber);
   auto* quiet = app.add_flag("-q,--quiet", gen.quiet, "no progress messages");
+  // Witness-search tolerances and limits (docs/generator.md explains each).
+  auto& sp = gen.search;
+  std::vector<CLI::Option*> gen_opts{threads, quiet};
+  gen_opts.push_back(app.add_option("--max-pcs", gen.max_pcs, "largest CFs to enumerate")
+                         ->check(CLI::Range(1, 3))
+                         ->capture_default_str());
+  gen_opts.push_back(app.add_option("--touch-tol", sp.touch_tol,
+                                    "mm: element pairs closer than this touch")
+                         ->check(CLI::Range(1e-12, 1e-3))
+                         ->capture_default_str());
+  gen_opts.push_back(app.add_option("--min-clearance", sp.min_clearance,
+                                    "mm: at a witness, every pair not part of a PC is at least this far apart")
+                         ->check(CLI::Range(1e-9, 100.0))
+                         ->capture_default_str());
+  gen_opts.push_back(app.add_option("--good-clearance", sp.good_clearance,
+                                    "mm: stop searching a CF's witness once it is this clear")
+                         ->check(CLI::Range(1e-9, 1000.0))
+                         ->capture_default_str());
+  gen_opts.push_back(app.add_option("--min-margin", sp.min_margin,
+                                    "mm: contact point at least this far inside its elements")
+                         ->check(CLI::Range(1e-9, 100.0))
+                         ->capture_default_str());
+  gen_opts.push_back(app.add_option("--angle-margin", sp.angle_margin,
+                                    "rad: local non-penetration slack at each PC")
+                         ->check(CLI::Range(1e-9, 0.5))
+                         ->capture_default_str());
+  gen_opts.push_back(app.add_option("--theta-samples", sp.theta_samples,
+                                    "samples of a one-parameter rotation family")
+                         ->check(CLI::Range(1, 1000))
+                         ->capture_default_str());
+  gen_opts.push_back(app.add_option("--max-rotations", sp.max_rotations,
+                                    "rotations tried per candidate set before it is declared invalid")
+                         ->check(CLI::Range(1, 10000))
+                         ->capture_default_str());
   app.add_option("--coplanar-tol", coplanar_tol,
                  "coplanarity tolerance relative to the model's bounding-box diagonal")
       ->check(CLI::Range(1e-12, 0.1));
-  features->excludes(pos)->excludes(out)->excludes(threads)->excludes(quiet);
+  features->excludes(pos)->excludes(out);
+  for (CLI::Option* o : gen_opts) features->excludes(o);
 
   try {
     app.parse(argc, argv);
