@@ -61,6 +61,14 @@ ojson cf_json(std::size_t id, const CfRecord& r) {
   if (r.dof >= 0) c["dof"] = r.dof;
   if (r.translation_dof >= 0) c["translation_dof"] = r.translation_dof;
   if (r.dof >= 0 || r.translation_dof >= 0 || r.pure_rotation) c["pure_rotation"] = r.pure_rotation;
+  if (r.num_planes > 0) {
+    ojson planes = ojson::array();
+    for (int i = 0; i < r.num_planes; ++i) {
+      const auto& q = r.planes[static_cast<std::size_t>(i)];
+      planes.push_back({q[0], q[1], q[2], q[3]});
+    }
+    c["planes"] = std::move(planes);
+  }
   return c;
 }
 
@@ -205,6 +213,20 @@ void append_cf(std::string& out, std::size_t id, const CfRecord& r) {
   }
   if (r.dof >= 0 || r.translation_dof >= 0 || r.pure_rotation)
     out += r.pure_rotation ? ",\"pure_rotation\":true" : ",\"pure_rotation\":false";
+  if (r.num_planes > 0) {
+    out += ",\"planes\":[";
+    for (int i = 0; i < r.num_planes; ++i) {
+      const auto& q = r.planes[static_cast<std::size_t>(i)];
+      if (i > 0) out += ',';
+      out += '[';
+      for (int k = 0; k < 4; ++k) {
+        if (k > 0) out += ',';
+        append_double(out, q[static_cast<std::size_t>(k)]);
+      }
+      out += ']';
+    }
+    out += ']';
+  }
   out += '}';
 }
 

@@ -307,6 +307,11 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
       r.pcs = s;
       r.witness = w.pose;
       search.freedoms(s, w.pose, r);
+      for (int k = 0; k < s.size(); ++k) {
+        const auto [n, d] = search.contact_plane(s[k], w.pose);
+        r.planes[static_cast<std::size_t>(k)] = {n.x(), n.y(), n.z(), d};
+      }
+      r.num_planes = s.size();
       out.cfs.push_back(r);
       out.min_clearance = std::min(out.min_clearance, w.clearance);
     }

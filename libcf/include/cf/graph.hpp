@@ -97,6 +97,12 @@ struct CfRecord {
   int dof = -1;              ///< -1 when not stored in the file
   int translation_dof = -1;  ///< -1 when not stored
   bool pure_rotation = false;
+  /// Contact plane of each PC (in PC order) at the witness, world frame: {n_x, n_y, n_z, d}
+  /// with n the unit normal pointing into A and n . x == d (mm). Written by cfgen for
+  /// inspection and for applications; num_planes == 0 when not stored (the run time
+  /// recomputes planes at the current pose).
+  std::array<std::array<double, 4>, 3> planes{};
+  int num_planes = 0;
 };
 
 /// A directed graph edge between two CFs.
