@@ -156,13 +156,15 @@ RotConstraints rotation_constraints(const PcSet& pcs, const Polyhedron& A, const
 }  // namespace
 
 std::vector<Mat3> WitnessSearch::rotation_candidates(const PcSet& pcs,
-                                                     const std::vector<Mat3>& seeds) const {
+                                                     const std::vector<Mat3>& seeds,
+                                                     bool generic_seeds) const {
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
   // Each PC's preferred one-parameter family: its local conditions hold with most slack.
   std::vector<Mat3> prefs;
   const int n = std::max(4, p_.theta_samples / std::max(1, pcs.size()));
   for (const Pc& pc : pcs) {
+    if (!generic_seeds) break;
     Vec3 x, y;  // align A-frame x to world y, then spin about y
     switch (pc.type) {
       case PcType::kFF: x = A.faces()[pc.a].normal; y = -B.faces()[pc.b].normal; break;
@@ -178,11 +180,27 @@ std::vector<Mat3> WitnessSearch::rotation_candidates(const PcSet& pcs,
   }
   std::vector<Mat3> all_seeds = seeds;
   all_seeds.insert(all_seeds.end(), prefs.begin(), prefs.end());
+  // Spread-out seeds so that constrained families are covered beyond the preferred ones:
+  // the 24 rotations of the cube's symmetry group, tilted by a fixed generic rotation so that
+  // none sits exactly on a special alignment.
+  static const std::vector<Mat3> kSpread = [] {
+    std::vector<Mat3> out;
+    const Mat3 tilt = axis_angle(Vec3(0.3, 0.5, 0.8), 0.37);
+    for (int perm = 0; perm < 6; ++perm)
+      for (int signs = 0; signs < 8; ++signs) {
+        static const int P[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+        Mat3 M = Mat3::Zero();
+        for (int r = 0; r < 3; ++r) M(r, P[perm][r]) = (signs >> r & 1) ? -1.0 : 1.0;
+        if (M.determinant() > 0) out.push_back(tilt * M);
+      }
+    return out;
+  }();
+  if (generic_seeds) all_seeds.insert(all_seeds.end(), kSpread.begin(), kSpread.end());
 
   const RotConstraints c = rotation_constraints(pcs, A, B);
   std::vector<Mat3> rots;
   if (!c.align.empty()) {
-    rots = align_family(c, all_seeds, p_.theta_samples);
+    rots = align_family(c, all_seeds, generic_seeds ? p_.theta_samples : 0);
   } else if (!c.perp.empty()) {
     for (Mat3 R : all_seeds)
       if (project_perp(c, R)) add_unique(rots, R);
@@ -586,12 +604,14 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
       case PcType::kEE: break;
     }
   }
-  for (const Mat3& R : rots) {
+  std::vector<Mat3> near;  // rotations where the contacts held but the pose failed
+  auto try_rotation = [&](const Mat3& R) {
     std::vector<int> choice(slot_sizes.size(), 0);
     for (int combo = 0; combo < p_.max_piece_combinations; ++combo) {
       double margin = 0;
       const std::vector<Vec3> ts = translations(pcs, R, choice, margin);
-      if (debug_) std::cerr << "  rotation " << (&R - rots.data()) << " LP " << ts.size() << " margin " << margin << "\n";
+      if (!ts.empty() && near.size() < 4) near.push_back(R);
+      if (debug_) std::cerr << "  rotation: " << ts.size() << " translations, margin " << margin << "\n";
       for (const Vec3& t : ts) {
         Pose pose;
         pose.R_BA = R;
@@ -604,7 +624,7 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
           best.pose = pose;
           best.clearance = clearance;
           best.margin = margin;
-          if (clearance >= p_.good_clearance) return best;
+          if (clearance >= p_.good_clearance) return true;
         }
         if (clearance >= p_.min_clearance) break;  // a witness for this rotation; try others
       }
@@ -613,7 +633,20 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
       while (i < choice.size() && ++choice[i] == slot_sizes[i]) choice[i++] = 0;
       if (i == choice.size()) break;
     }
-  }
+    return false;
+  };
+  for (const Mat3& R : rots)
+    if (try_rotation(R)) return best;
+  if (best.found || near.empty()) return best;
+  // The contacts could be placed but the pose touched something else: look closer around
+  // those rotations, where valid sets with a narrow range of orientations live.
+  std::vector<Mat3> around;
+  for (const Mat3& R : near)
+    for (double ang : {0.04, 0.12, 0.3})
+      for (int ax = 0; ax < 3; ++ax)
+        for (double sg : {1.0, -1.0}) around.push_back(axis_angle(sg * Vec3::Unit(ax), ang) * R);
+  for (const Mat3& R : rotation_candidates(pcs, around, false))
+    if (try_rotation(R)) return best;
   return best;
 }
 

@@ -54,7 +54,9 @@ class WitnessSearch {
   std::pair<Vec3, double> contact_plane(const Pc& pc, const Pose& pose) const;
 
  private:
-  std::vector<Mat3> rotation_candidates(const PcSet& pcs, const std::vector<Mat3>& seeds) const;
+  // generic_seeds: add each PC's preferred family and a spread of rotations to `seeds`.
+  std::vector<Mat3> rotation_candidates(const PcSet& pcs, const std::vector<Mat3>& seeds,
+                                        bool generic_seeds = true) const;
   double local_margin(const PcSet& pcs, const Mat3& R) const;
   LinearProgram build_lp(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces) const;
   // Candidate translations for rotation R, best first; empty when the contacts cannot hold
