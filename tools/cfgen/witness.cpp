@@ -207,16 +207,29 @@ std::vector<Mat3> WitnessSearch::rotation_candidates(const PcSet& pcs,
   } else {
     for (const Mat3& R : all_seeds) add_unique(rots, R);
   }
-  // Most local slack first; drop rotations that are locally penetrating.
+  // Drop rotations that are locally penetrating; try the sub-sets' witnesses first, then the
+  // rest by decreasing local slack, skipping near-duplicates so that the budget of
+  // max_rotations covers different orientations rather than one well-liked family.
+  const std::size_t n_subset = std::min(seeds.size(), rots.size());
   std::vector<std::pair<double, std::size_t>> order;
   for (std::size_t i = 0; i < rots.size(); ++i) {
     const double m = local_margin(pcs, rots[i]);
-    if (m > std::sin(p_.angle_margin)) order.push_back({-m, i});
+    if (m > std::sin(p_.angle_margin)) order.push_back({i < n_subset && generic_seeds ? -2.0 : -m, i});
   }
   std::stable_sort(order.begin(), order.end());
+  constexpr double kMinSeparation = 0.15;  // rad between two rotations tried
+  const double min_trace = 1 + 2 * std::cos(kMinSeparation);
   std::vector<Mat3> out;
-  for (std::size_t i = 0; i < order.size() && static_cast<int>(out.size()) < p_.max_rotations; ++i)
-    out.push_back(rots[order[i].second]);
+  for (std::size_t i = 0; i < order.size() && static_cast<int>(out.size()) < p_.max_rotations; ++i) {
+    const Mat3& R = rots[order[i].second];
+    bool distinct = true;
+    for (const Mat3& Q : out)
+      if ((Q.transpose() * R).trace() > min_trace) {
+        distinct = false;
+        break;
+      }
+    if (distinct || !generic_seeds) out.push_back(R);
+  }
   return out;
 }
 

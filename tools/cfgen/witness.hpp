@@ -18,8 +18,8 @@ struct SearchParams {
   double good_clearance = 1.0;   // mm: stop searching once a witness is this clear
   double min_margin = 1e-2;      // mm: contact point at least this far inside its elements
   double angle_margin = 1e-3;    // rad: local non-penetration with this much slack
-  int theta_samples = 12;        // samples of a one-parameter rotation family
-  int max_rotations = 24;        // rotations tried per candidate
+  int theta_samples = 24;        // samples of a one-parameter rotation family
+  int max_rotations = 64;        // rotations tried per candidate
   int max_piece_combinations = 4;
 };
 
