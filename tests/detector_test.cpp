@@ -146,24 +146,92 @@ TEST_CASE("a slightly tilted edge gives e-f and the v-f of its lower end (paper 
   const cf::Polyhedron a = tm::cube(), b = tm::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
-  const Eigen::Matrix3d R = rot(0.01, {1, 0, 0}) * rot(M_PI / 4, {0, 0, 1});
   const double h = 15 * std::sqrt(2.0);
-  det.detect(pose(R, {70, 20 + h + 0.2, 40}), cs);
-  const cf::ContactPc* ef = nullptr;
-  for (const cf::ContactPc& c : cs)
-    if (c.pc.type == PcType::kEF) ef = &c;
-  REQUIRE(ef);
-  // The edge's end vertex that is lower (z = -15 end tilts down for +x rotation? whichever):
-  // exactly one of the two end vertices is within epsilon and dominated by the e-f.
-  int vfs = 0;
-  for (const cf::ContactPc& c : cs)
-    if (c.pc.type == PcType::kVF) {
-      ++vfs;
-      CHECK(c.dominated);
-      CHECK(c.misfit > ef->misfit);
+  // The e-f's angular tolerance: atan(epsilon / 30 mm) = 0.0333 rad (the whole edge is over
+  // the slab). It dominates its end vertices' v-f up to a quarter of that
+  // (DetectionParams::dominance_fit): 0.005 rad does, 0.015 rad does not.
+  for (const double tilt : {0.005, 0.015}) {
+    INFO("tilt " << tilt << " rad");
+    const Eigen::Matrix3d R = rot(tilt, {1, 0, 0}) * rot(M_PI / 4, {0, 0, 1});
+    det.detect(pose(R, {70, 20 + h + 0.2, 40}), cs);
+    const cf::ContactPc* ef = nullptr;
+    for (const cf::ContactPc& c : cs)
+      if (c.pc.type == PcType::kEF) ef = &c;
+    REQUIRE(ef);
+    const double shape = ef->misfit - std::abs(ef->distance);  // angle / tolerance (epsilon = 1)
+    CHECK(shape == Approx(tilt / std::atan(1.0 / 30)).epsilon(1e-6));
+    CHECK_FALSE(ef->dominated);
+    // The lower end vertex is within epsilon (the upper one too at 0.005 rad): dominated by
+    // the e-f, and worse by the penalty, only at the small tilt.
+    int vfs = 0;
+    for (const cf::ContactPc& c : cs)
+      if (c.pc.type == PcType::kVF) {
+        ++vfs;
+        CHECK(c.dominated == (tilt < 0.01));
+        CHECK(c.misfit == Approx(std::abs(c.distance) + (tilt < 0.01 ? 1.0 : 0.0)).margin(1e-9));
+      }
+    CHECK(vfs >= 1);
+  }
+}
+
+TEST_CASE("the f-f tolerance follows the overlap's extent along the tilt, whatever the yaw", "[detector]") {
+  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  // The cube's bottom face (2) over the slab's top (4), tilted about one of its edges'
+  // directions: the heights spread over its 30 mm side, so the tolerance is atan(1/30),
+  // however the cube is turned about the slab's normal (a bounding box of the overlap in
+  // the slab's frame would give up to atan(1/60) at 45 degrees).
+  const double tol = std::atan(1.0 / 30);
+  for (const double yaw : {0.0, 0.5, M_PI / 4}) {
+    for (const double fraction : {0.9, 1.1}) {
+      INFO("yaw " << yaw << ", tilt " << fraction << " x tolerance");
+      const Eigen::Matrix3d R = rot(yaw, {0, 1, 0}) * rot(fraction * tol, {1, 0, 0});
+      double low = 1e9;
+      for (const Vec3& v : {Vec3(-15, -15, -15), Vec3(15, -15, -15), Vec3(15, -15, 15), Vec3(-15, -15, 15)})
+        low = std::min(low, (R * v).y());
+      det.detect(pose(R, {70, 20 + 0.2 - low, 40}), cs);
+      const cf::ContactPc* ff = find(cs, PcType::kFF, 2, 4);
+      if (fraction < 1) {
+        REQUIRE(ff);
+        CHECK(ff->distance == Approx(0.2).margin(kTol));
+        // The overlap's extent along the tilt, measured in the slab's plane: 30 cos(tilt).
+        const double angle = fraction * tol;
+        CHECK(ff->misfit == Approx(angle / std::atan(1.0 / (30 * std::cos(angle))) + 0.2).epsilon(1e-9));
+      } else {
+        CHECK_FALSE(ff);
+      }
     }
-  CHECK(vfs >= 1);
-  CHECK(ef->misfit > 0);
+  }
+}
+
+TEST_CASE("the e-f tolerance follows the part of the edge over the face", "[detector]") {
+  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  // The cube on its edge x = y = -15 (vertices 0-4, along z), turned 45 degrees about z, the
+  // edge tilted by 0.05 rad and over the slab's top (z from 0 to 80) for only its last 10 mm:
+  // heights 0.1 to 0.6 mm there. The tolerance is atan(1/10) = 0.0997 rad, not the whole
+  // edge's atan(1/30) = 0.0333 rad.
+  const double tilt = 0.05;
+  const Eigen::Matrix3d R = rot(-tilt, {1, 0, 0}) * rot(M_PI / 4, {0, 0, 1});
+  const Vec3 mid_A(-15, -15, 0);  // the edge's midpoint
+  const Vec3 dir = R * Vec3(0, 0, 1);
+  // Edge point at parameter u (mm along the edge from its midpoint): t + R mid_A + u dir.
+  // Its far end (u = 15) at z = 10, its point at z = 0 (the slab's front edge) 0.1 mm above
+  // the slab's top.
+  Vec3 t(70, 0, 0);
+  t.z() = 10 - (R * mid_A).z() - 15 * dir.z();
+  const double u0 = (0 - t.z() - (R * mid_A).z()) / dir.z();  // at z = 0
+  t.y() = 20.1 - (R * mid_A).y() - u0 * dir.y();
+  det.detect(pose(R, t), cs);
+  const int e04 = edge_between(a, 0, 4);
+  const cf::ContactPc* ef = find(cs, PcType::kEF, e04, 4);
+  REQUIRE(ef);
+  CHECK(ef->distance == Approx(0.1).margin(1e-6));
+  const double region = 10 / dir.z();  // the part of the edge over the face
+  CHECK(ef->misfit - ef->distance == Approx(tilt / std::atan(1.0 / region)).epsilon(1e-6));
+  CHECK(ef->p_W.z() == Approx(5).margin(1e-6));  // the region's centroid
 }
 
 TEST_CASE("cube on a corner: a single v-f", "[detector]") {

@@ -147,6 +147,7 @@ struct ContactDetector::Impl {
     check(p.min_angular_tolerance, "min_angular_tolerance", true);
     check(p.max_angular_tolerance, "max_angular_tolerance", true);
     check(p.dominance_penalty, "dominance_penalty", false);
+    check(p.dominance_fit, "dominance_fit", false);
     if (!std::isfinite(p.in_plane_tolerance) || !std::isfinite(p.angular_tolerance))
       throw Error("ContactDetector: in_plane_tolerance and angular_tolerance must be finite");
     eps = p.epsilon;
@@ -174,6 +175,10 @@ struct ContactDetector::Impl {
     for (const Face& F : ma.faces()) extent_a.push_back(std::sqrt(F.area));
     for (const Face& F : mb.faces()) extent_b.push_back(std::sqrt(F.area));
   }
+
+  // The largest angular tolerance any pair can get: a cheap early out before the contact
+  // region, and with it the pair's own tolerance, is known.
+  double max_tol() const { return prm.angular_tolerance > 0 ? prm.angular_tolerance : prm.max_angular_tolerance; }
 
   double tol_for(double extent) const {
     if (prm.angular_tolerance > 0) return prm.angular_tolerance;
@@ -248,24 +253,29 @@ struct ContactDetector::Impl {
   // Line contact of segment s0->s1 (in the face's model frame) against face f of model m
   // (flat f): shared by e-f (m = B, segment world) and f-e (m = A, segment in A's frame).
   // Returns false when not a contact; else the region's centroid parameter, its deepest
-  // height and the in-plane gap.
+  // height, the in-plane gap and the region's extent as a share of the segment (from the
+  // first to the last point over the face; 0 beside the face).
   bool line_on_face(const Polyhedron& m, const FlatFaces& flat, int f, const Vec3& s0,
-                    const Vec3& s1, double* t_c, double* d, double* gap) {
+                    const Vec3& s1, double* t_c, double* d, double* gap, double* span) {
     const Face& F = m.faces()[static_cast<std::size_t>(f)];
     const double h0 = F.normal.dot(s0) - F.offset, h1 = F.normal.dot(s1) - F.offset;
     if (std::min(h0, h1) > eps || std::max(h0, h1) < -depth) return false;
     const Vec2 a2(F.u.dot(s0), F.v.dot(s0)), b2(F.u.dot(s1), F.v.dot(s1));
     double len = 0, moment = 0, dmin = std::numeric_limits<double>::infinity();
+    double first = 1, last = 0;
     detail::clip_segment(a2, b2, flat.poly(f), geo_tol, detail::OnBoundary::kInclude,
                          params.data(), [&](double t0, double t1) {
                            len += t1 - t0;
                            moment += 0.5 * (t1 * t1 - t0 * t0);
                            dmin = std::min({dmin, h0 + t0 * (h1 - h0), h0 + t1 * (h1 - h0)});
+                           first = std::min(first, t0);
+                           last = std::max(last, t1);
                          });
     if (len > 1e-12) {
       *t_c = moment / len;
       *d = dmin;
       *gap = 0;
+      *span = last - first;
     } else {
       // Beside the face: the nearest in-plane approach to its boundary.
       const detail::Poly2 P = flat.poly(f);
@@ -281,6 +291,7 @@ struct ContactDetector::Impl {
       *t_c = tb;
       *d = h0 + tb * (h1 - h0);
       *gap = best;
+      *span = 0;
     }
     return in_band(*d);
   }
@@ -294,14 +305,17 @@ struct ContactDetector::Impl {
     const Vec3& p1 = world(E.v1);
     const Vec3 dW = pose.R_BA * E.dir;
     const double ang = std::asin(std::min(1.0, std::abs(dW.dot(F.normal))));
-    const double tol = tol_for(E.length);
-    if (ang > tol) return;
+    if (ang > max_tol()) return;
     const EdgeWings& w = wings_a[static_cast<std::size_t>(e)];
     if (F.normal.dot(pose.R_BA * w.left) < -std::sin(tol_for(extent_a[E.left.index()])) ||
         F.normal.dot(pose.R_BA * w.right) < -std::sin(tol_for(extent_a[E.right.index()])))
       return;
-    double tc, d, gap;
-    if (!line_on_face(b, flat_b, fb, p0, p1, &tc, &d, &gap)) return;
+    double tc, d, gap, span;
+    if (!line_on_face(b, flat_b, fb, p0, p1, &tc, &d, &gap, &span)) return;
+    // The tilt at which the part of the edge over the face stays within epsilon (the whole
+    // edge beside the face).
+    const double tol = tol_for(span > 0 ? span * E.length : E.length);
+    if (ang > tol) return;
     const Vec3 p = p0 + tc * (p1 - p0);
     const double hc = F.normal.dot(p) - F.offset;
     emit(PcType::kEF, e, fb, d, p, p - hc * F.normal, task_frame(F.normal, dW),
@@ -316,8 +330,7 @@ struct ContactDetector::Impl {
     const Mat3 Rt = pose.R_BA.transpose();
     const Vec3 dA = Rt * E.dir;
     const double ang = std::asin(std::min(1.0, std::abs(dA.dot(F.normal))));
-    const double tol = tol_for(E.length);
-    if (ang > tol) return;
+    if (ang > max_tol()) return;
     const EdgeWings& w = wings_b[static_cast<std::size_t>(e)];
     if (F.normal.dot(Rt * w.left) < -std::sin(tol_for(extent_b[E.left.index()])) ||
         F.normal.dot(Rt * w.right) < -std::sin(tol_for(extent_b[E.right.index()])))
@@ -325,8 +338,10 @@ struct ContactDetector::Impl {
     const Vec3& q0 = b.vertex(E.v0).p;
     const Vec3& q1 = b.vertex(E.v1).p;
     const Vec3 q0A = pose.inverse_apply(q0), q1A = pose.inverse_apply(q1);
-    double tc, d, gap;
-    if (!line_on_face(a, flat_a, fa, q0A, q1A, &tc, &d, &gap)) return;
+    double tc, d, gap, span;
+    if (!line_on_face(a, flat_a, fa, q0A, q1A, &tc, &d, &gap, &span)) return;
+    const double tol = tol_for(span > 0 ? span * E.length : E.length);
+    if (ang > tol) return;
     const Vec3 qcA = q0A + tc * (q1A - q0A);
     const Vec3 onA = pose.apply(qcA - (F.normal.dot(qcA) - F.offset) * F.normal);
     emit(PcType::kFE, fa, e, d, onA, onA, task_frame(-(pose.R_BA * F.normal), E.dir),
@@ -339,8 +354,7 @@ struct ContactDetector::Impl {
     const Face& FB = b.faces()[static_cast<std::size_t>(fb)];
     const Vec3 nA = pose.R_BA * FA.normal;
     const double c = -nA.dot(FB.normal);
-    const double tol_cap = prm.angular_tolerance > 0 ? prm.angular_tolerance : prm.max_angular_tolerance;
-    if (c < std::cos(tol_cap)) return;
+    if (c < std::cos(max_tol())) return;
     double hmin = std::numeric_limits<double>::infinity(), hmax = -hmin;
     for (VertexId v : FA.vertices) {
       const double h = FB.normal.dot(world(v)) - FB.offset;
@@ -364,11 +378,21 @@ struct ContactDetector::Impl {
     const double offA = nA.dot(pose.t_BA) + FA.offset;
     const double ku = nA.dot(FB.u) / nn, kv = nA.dot(FB.v) / nn, k0 = offA / nn - FB.offset;
     auto height = [&](const Vec2& q) { return k0 - ku * q.x() - kv * q.y(); };
+    // The tilt's direction in B's plane: the overlap's extent along it is what the tilt
+    // raises (orientation-independent, unlike a bounding box of the overlap).
+    const Vec2 grad(ku, kv);
+    const Vec2 g_dir = grad.norm() > 1e-12 ? Vec2(grad.normalized()) : Vec2(1, 0);
     double dmin = std::numeric_limits<double>::infinity();
-    const detail::Overlap2 ov = detail::overlap(flat_b.poly(fb), Q, geo_tol, params.data(),
-                                                [&](const Vec2& q) { dmin = std::min(dmin, height(q)); });
+    double s_lo = std::numeric_limits<double>::infinity(), s_hi = -s_lo;
+    const detail::Overlap2 ov = detail::overlap(flat_b.poly(fb), Q, geo_tol, params.data(), [&](const Vec2& q) {
+      dmin = std::min(dmin, height(q));
+      const double s = q.dot(g_dir);
+      s_lo = std::min(s_lo, s);
+      s_hi = std::max(s_hi, s);
+    });
     if (!(ov.area > area_tol)) return;
-    const double tol = tol_for((ov.hi - ov.lo).norm());
+    // The tilt at which the whole overlap stays within epsilon.
+    const double tol = tol_for(s_hi - s_lo);
     const double ang = std::acos(std::min(1.0, c));
     if (ang > tol || !in_band(dmin)) return;
     const Vec3 origin = ov.centroid.x() * FB.u + ov.centroid.y() * FB.v + FB.offset * FB.normal;
@@ -448,18 +472,26 @@ struct ContactDetector::Impl {
   void finish(ContactSet& cs) {
     std::sort(cs.begin(), cs.end(), [](const ContactPc& x, const ContactPc& y) { return x.pc < y.pc; });
     const int n = cs.size();
+    // Dominance (SPEC 4) by a contact whose shape fits well: its misfit without the distance
+    // term (angle / tolerance + in-plane gap / epsilon) is at most dominance_fit. A looser
+    // dominator (a face tilted by more than that share of its tolerance over an edge that
+    // touches exactly) does not settle the reading: both stand and the previous CF or the fit
+    // decides (a hysteresis band instead of a flip at the tolerance). misfit is not changed
+    // until every flag is set, so the shapes below are the emitted ones.
     for (int i = 0; i < n; ++i) {
       ContactPc& ci = cs[i];
       const ElementKind ai = a_kind(ci.pc.type), bi = b_kind(ci.pc.type);
       for (int j = 0; j < n && !ci.dominated; ++j) {
         if (j == i) continue;
         const ContactPc& cj = cs[j];
-        if (within(a, ai, ci.pc.a, a_kind(cj.pc.type), cj.pc.a) &&
+        const double shape_j = cj.misfit - std::abs(cj.distance) / eps;
+        if (shape_j <= prm.dominance_fit && within(a, ai, ci.pc.a, a_kind(cj.pc.type), cj.pc.a) &&
             within(b, bi, ci.pc.b, b_kind(cj.pc.type), cj.pc.b))
           ci.dominated = true;
       }
-      if (ci.dominated) ci.misfit += prm.dominance_penalty;
     }
+    for (ContactPc& c : cs)
+      if (c.dominated) c.misfit += prm.dominance_penalty;
     // Contact planes: greedy clustering in canonical order.
     const double cos_tol = std::cos(prm.angular_tolerance > 0 ? prm.angular_tolerance
                                                               : prm.max_angular_tolerance);

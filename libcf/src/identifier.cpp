@@ -1,6 +1,7 @@
 #include <cf/identifier.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 namespace cf {
@@ -89,16 +90,24 @@ struct CfIdentifier::Impl {
            closures_meet(graph->model_b(), b_kind(c.pc.type), c.pc.b, b_kind(s.pc.type), s.pc.b);
   }
 
-  // Every contact of group g is related to one of the chosen contacts.
-  bool explained(int g, const int* chosen, int nchosen) const {
+  // Group g, from which nothing is chosen, is accounted for: each of its contacts is apart
+  // (beyond apart_beyond: farther than touching and than every chosen PC, by more than
+  // touch_distance; the CF says those touch and this does not, which only a nearer contact
+  // can say) or related to a chosen contact (another reading of the same degenerate touch).
+  // Returns 0 when every contact is apart, 1 when some need explaining, 2 when one is
+  // neither.
+  int accounted(int g, const int* chosen, int nchosen, double apart_beyond) const {
     const ContactSet& cs = res.contacts;
+    int worst = 0;
     for (int k = 0; k < count[static_cast<std::size_t>(g)]; ++k) {
       const ContactPc& c = cs[members[static_cast<std::size_t>(g)][static_cast<std::size_t>(k)]];
+      if (c.distance > apart_beyond) continue;
       bool ok = false;
       for (int s = 0; s < nchosen && !ok; ++s) ok = related(c, cs[chosen[s]]);
-      if (!ok) return false;
+      if (!ok) return 2;
+      worst = 1;
     }
-    return true;
+    return worst;
   }
 
   void set_result(IdStatus st, CfId id, const int* chosen, int n, double misfit, bool partial) {
@@ -155,11 +164,15 @@ struct CfIdentifier::Impl {
     }
 
     // Enumerate one member or none per plane (none last), at most 3 chosen, every skipped
-    // plane explained. Rank: full cover first, then fewest dominated PCs (a v-f beside the
-    // e-f of its edge is only taken when the e-f cannot form a CF), then previous /
-    // neighbour / other, then total misfit, then enumeration order.
+    // plane accounted for (apart or explained). Rank: no plane left to an explanation
+    // (another reading of a chosen touch, closures meeting: loose, so only when no CF holds
+    // a PC in that plane), then fewest dominated PCs (a v-f beside the e-f of its edge is
+    // only taken when the e-f cannot form a CF), then previous / neighbour / other, then
+    // total misfit (which favours the exact CF over one that also holds a pair 0.05 mm
+    // away), then enumeration order.
     std::array<int, kMaxGroups> digit{};  // index into members, count[g] means "none"
     int best_tier = 2, best_dom = 4, best_cat = 3;
+    bool best_partial = false;
     double best_misfit = 0;
     int best_chosen[3] = {-1, -1, -1};
     int best_n = 0;
@@ -189,12 +202,15 @@ struct CfIdentifier::Impl {
           break;
         }
         ++res.combinations;
-        const int tier = n == G ? 0 : 1;
-        bool ok = tier <= best_tier;
-        if (ok && tier == 1)
-          for (int g = 0; g < G && ok; ++g)
-            if (digit[static_cast<std::size_t>(g)] == count[static_cast<std::size_t>(g)]) ok = explained(g, chosen, n);
-        if (ok) {
+        const bool partial = n < G;
+        double farthest = 0;
+        for (int i = 0; i < n; ++i) farthest = std::max(farthest, cs[chosen[i]].distance);
+        const double apart_beyond = farthest + prm.touch_distance;
+        int tier = 0;  // 1: some plane explained, 2: some plane neither chosen nor accounted for
+        for (int g = 0; g < G && tier < 2 && partial; ++g)
+          if (digit[static_cast<std::size_t>(g)] == count[static_cast<std::size_t>(g)])
+            tier = std::max(tier, accounted(g, chosen, n, apart_beyond));
+        if (tier <= best_tier && tier < 2) {
           PcSet key;
           for (int i = 0; i < n; ++i) key.insert(cs[chosen[i]].pc);
           if (const std::optional<CfId> id = graph->find(key)) {
@@ -206,13 +222,13 @@ struct CfIdentifier::Impl {
               mis += cs[chosen[i]].misfit;
               dom += cs[chosen[i]].dominated;
             }
-            const bool better =
-                tier != best_tier ? tier < best_tier
-                : dom != best_dom ? dom < best_dom
-                : cat != best_cat ? cat < best_cat
-                                  : mis < best_misfit;
+            const bool better = tier != best_tier ? tier < best_tier
+                                : dom != best_dom ? dom < best_dom
+                                : cat != best_cat ? cat < best_cat
+                                                  : mis < best_misfit;
             if (better) {
               best_tier = tier;
+              best_partial = partial;
               best_dom = dom;
               best_cat = cat;
               best_misfit = mis;
@@ -237,7 +253,7 @@ struct CfIdentifier::Impl {
                   : best_cat == 1 ? IdStatus::kMatchedNeighbour
                   : prev.valid()  ? IdStatus::kNonNeighbourJump
                                   : IdStatus::kMatchedByFit;
-    set_result(st, best_id, best_chosen, best_n, best_misfit, best_tier == 1);
+    set_result(st, best_id, best_chosen, best_n, best_misfit, best_partial);
     prev = best_id;
     return res;
   }
@@ -248,6 +264,9 @@ CfIdentifier::CfIdentifier(const CfGraph& graph, const IdentificationParams& par
   if (params.max_combinations < 1)
     throw Error("CfIdentifier: parameter max_combinations must be at least 1, got " +
                 std::to_string(params.max_combinations));
+  if (!std::isfinite(params.touch_distance) || params.touch_distance < 0)
+    throw Error("CfIdentifier: parameter touch_distance must be finite and non-negative, got " +
+                std::to_string(params.touch_distance));
 }
 CfIdentifier::~CfIdentifier() = default;
 CfIdentifier::CfIdentifier(CfIdentifier&&) noexcept = default;

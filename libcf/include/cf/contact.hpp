@@ -39,7 +39,10 @@ struct ContactPc {
   double misfit = 0;
   /// True when another detected contact dominates this one (SPEC section 4: its elements
   /// are those of the other or lie on their boundaries), e.g. a v-f beside the e-f of an
-  /// edge ending at that vertex. Dominated contacts remain candidates (paper Fig. 3).
+  /// edge ending at that vertex, and that contact's shape fits within
+  /// DetectionParams::dominance_fit of its tolerances (a face tilted by most of its
+  /// tolerance does not dominate the edge touching under it). Dominated contacts remain
+  /// candidates (paper Fig. 3).
   bool dominated = false;
   /// Index of the contact plane group at this pose (contacts whose planes coincide within
   /// tolerance share it; a CF takes at most one contact per group); -1 before grouping.

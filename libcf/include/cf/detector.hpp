@@ -34,6 +34,13 @@ struct DetectionParams {
   double max_angular_tolerance = 0.1;   ///< rad (about 5.7 degrees)
   /// Added to the misfit of a contact that another detected contact dominates.
   double dominance_penalty = 1.0;
+  /// A detected contact dominates another (ContactPc::dominated) only when its shape fits
+  /// within this share of its tolerances: its misfit without the distance term (angle /
+  /// angular tolerance + in-plane gap / epsilon) is at most this. Between this and the
+  /// tolerance both readings stand (e.g. an edge touching exactly under a face tilted by
+  /// 0.7 of the face's tolerance: e-f and f-f), and the previous CF, else the fit, decides:
+  /// a hysteresis band rather than a flip at one angle.
+  double dominance_fit = 0.25;
   /// Cull element pairs with bounding volume hierarchies (the default). false tests all
   /// pairs: for checking the culling and for comparison only.
   bool use_bvh = true;

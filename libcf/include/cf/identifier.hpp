@@ -20,6 +20,14 @@ struct IdentificationParams {
   /// Most interpretations (one candidate or none per contact plane) examined per step;
   /// enumeration goes from the best-fitting candidates down, so a cap drops the worst.
   int max_combinations = 4096;
+  /// mm. Which detected contacts a CF must hold: those within touch_distance of touching
+  /// (distance <= touch_distance) or of the CF's farthest PC (<= its distance +
+  /// touch_distance), unless they are another reading of one of its touches. Farther ones
+  /// (up to epsilon) may be left out as apart. So at a witness the exact CF wins over one
+  /// that also holds a pair 0.05 mm away (best fit), and a CF is kept while a new contact
+  /// approaches, which is gained once it touches. The default is far above rounding (1e-9 mm
+  /// at the generator's witnesses) and far below their clearance of non-contacts (0.01 mm).
+  double touch_distance = 0.001;
 };
 
 /// Outcome of one identification step.
@@ -52,7 +60,8 @@ struct Identification {
   int combinations = 0;      ///< interpretations examined
   bool capped = false;       ///< the enumeration hit max_combinations
   /// True when the chosen CF does not cover every contact plane: the other planes' contacts
-  /// were explained as alternative readings of the chosen PCs (degenerate touches).
+  /// are apart (farther than every PC of the CF, and than touch_distance) or alternative
+  /// readings of the chosen PCs (degenerate touches).
   bool partial_cover = false;
   bool has_cf() const { return cf.valid(); }
 };
