@@ -52,7 +52,7 @@ bool trig_solve(double a, double b, double d, std::vector<double>& out, bool& al
 
 void add_unique(std::vector<Mat3>& out, const Mat3& R) {
   for (const Mat3& Q : out)
-    if ((Q - R).norm() < 1e-7) return;
+    if ((Q - R).squaredNorm() < 1e-14) return;
   out.push_back(R);
 }
 
@@ -108,9 +108,12 @@ std::vector<Mat3> align_family(const RotConstraints& c, const std::vector<Mat3>&
 // Gauss-Newton projection of R onto { (R u_i) . w_i == 0 }.
 bool project_perp(const RotConstraints& c, Mat3& R) {
   const int k = static_cast<int>(c.perp.size());
+  // At most three conditions: fixed-capacity matrices keep this hot loop off the heap.
+  using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
+  using Jac = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 3, 3>;
   for (int it = 0; it < 40; ++it) {
-    Eigen::VectorXd r(k);
-    Eigen::MatrixXd J(k, 3);
+    Vec r(k);
+    Jac J(k, 3);
     for (int i = 0; i < k; ++i) {
       const Vec3 Ru = R * c.perp[i].first;
       r[i] = Ru.dot(c.perp[i].second);
@@ -181,18 +184,20 @@ std::vector<Mat3> WitnessSearch::rotation_candidates(const PcSet& pcs,
   std::vector<Mat3> all_seeds = seeds;
   all_seeds.insert(all_seeds.end(), prefs.begin(), prefs.end());
   // Spread-out seeds so that constrained families are covered beyond the preferred ones:
-  // the 24 rotations of the cube's symmetry group, tilted by a fixed generic rotation so that
-  // none sits exactly on a special alignment.
+  // the 24 rotations of the cube's symmetry group, each tilted twice by fixed generic
+  // rotations so that none sits exactly on a special alignment.
   static const std::vector<Mat3> kSpread = [] {
     std::vector<Mat3> out;
-    const Mat3 tilt = axis_angle(Vec3(0.3, 0.5, 0.8), 0.37);
-    for (int perm = 0; perm < 6; ++perm)
-      for (int signs = 0; signs < 8; ++signs) {
-        static const int P[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-        Mat3 M = Mat3::Zero();
-        for (int r = 0; r < 3; ++r) M(r, P[perm][r]) = (signs >> r & 1) ? -1.0 : 1.0;
-        if (M.determinant() > 0) out.push_back(tilt * M);
-      }
+    // Two tilts: a large one, and a small one for narrow places (a vertex or an edge of A
+    // just lowest while A still fits a slot barely wider than itself).
+    for (const Mat3& tilt : {axis_angle(Vec3(0.3, 0.5, 0.8), 0.37), axis_angle(Vec3(0.7, -0.2, 0.4), 0.09)})
+      for (int perm = 0; perm < 6; ++perm)
+        for (int signs = 0; signs < 8; ++signs) {
+          static const int P[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+          Mat3 M = Mat3::Zero();
+          for (int r = 0; r < 3; ++r) M(r, P[perm][r]) = (signs >> r & 1) ? -1.0 : 1.0;
+          if (M.determinant() > 0) out.push_back(tilt * M);
+        }
     return out;
   }();
   if (generic_seeds) all_seeds.insert(all_seeds.end(), kSpread.begin(), kSpread.end());
@@ -417,8 +422,8 @@ LinearProgram WitnessSearch::build_lp(const PcSet& pcs, const Mat3& R,
 }
 
 std::vector<Vec3> WitnessSearch::translations(const PcSet& pcs, const Mat3& R,
-                                              const std::vector<int>& pieces,
-                                              double& margin) const {
+                                              const std::vector<int>& pieces, double& margin,
+                                              bool near_boundary) const {
   LinearProgram lp = build_lp(pcs, R, pieces);
   const LpResult best = solve(lp);
   margin = best.status == LpResult::Status::kOptimal ? best.x[3] : 0.0;
@@ -427,21 +432,42 @@ std::vector<Vec3> WitnessSearch::translations(const PcSet& pcs, const Mat3& R,
   // returns one of its corners, where A tends to graze other features. Keep half the margin
   // and move to the mean of the extreme translations along +-x, +-y, +-z: a point well inside
   // the region of translations that keep the contacts.
-  lp.lower[3] = {true, 0.5 * margin};
   lp.c[3] = 0.0;
-  std::vector<Eigen::VectorXd> extremes;
-  for (int axis = 0; axis < 3; ++axis)
-    for (double sign : {1.0, -1.0}) {
-      lp.c[axis] = sign;
-      const LpResult r = solve(lp);
-      lp.c[axis] = 0.0;
-      if (r.status == LpResult::Status::kOptimal) extremes.push_back(r.x);
-    }
+  auto extremes_at = [&](double floor) {
+    lp.lower[3] = {true, floor};
+    std::vector<Eigen::VectorXd> ext;
+    for (int axis = 0; axis < 3; ++axis)
+      for (double sign : {1.0, -1.0}) {
+        lp.c[axis] = sign;
+        const LpResult r = solve(lp);
+        lp.c[axis] = 0.0;
+        if (r.status == LpResult::Status::kOptimal) ext.push_back(r.x);
+      }
+    return ext;
+  };
+  const std::vector<Eigen::VectorXd> extremes = extremes_at(0.5 * margin);
   if (extremes.empty()) return {best.x.head<3>()};
+  if (near_boundary) {
+    // Near a wall the contact may have to sit close to its element's boundary: extremes that
+    // keep only 5% of the margin (still at least min_margin), pulled a little towards the
+    // centre of the first set.
+    Eigen::VectorXd c0 = Eigen::VectorXd::Zero(best.x.size());
+    for (const auto& x : extremes) c0 += x;
+    c0 /= static_cast<double>(extremes.size());
+    std::vector<Vec3> out;
+    for (const auto& x : extremes_at(std::max(p_.min_margin, 0.05 * margin)))
+      out.push_back((0.9 * x + 0.1 * c0).head<3>());
+    return out;
+  }
   Eigen::VectorXd center = Eigen::VectorXd::Zero(best.x.size());
   for (const auto& x : extremes) center += x;
   center /= static_cast<double>(extremes.size());
   std::vector<Vec3> out{center.head<3>()};
+  // Midway between the two extremes along each axis: centred along that axis, and feasible
+  // (the region is convex), where the mean of all six may sit off-centre in a narrow place.
+  if (extremes.size() == 6)
+    for (int axis = 0; axis < 3; ++axis)
+      out.push_back((0.5 * (extremes[2 * axis] + extremes[2 * axis + 1])).head<3>());
   for (const auto& x : extremes) out.push_back((0.5 * (center + x)).head<3>());
   out.push_back(best.x.head<3>());
   return out;
@@ -621,25 +647,30 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
   auto try_rotation = [&](const Mat3& R) {
     std::vector<int> choice(slot_sizes.size(), 0);
     for (int combo = 0; combo < p_.max_piece_combinations; ++combo) {
-      double margin = 0;
-      const std::vector<Vec3> ts = translations(pcs, R, choice, margin);
-      if (!ts.empty() && near.size() < 4) near.push_back(R);
-      if (debug_) std::cerr << "  rotation: " << ts.size() << " translations, margin " << margin << "\n";
-      for (const Vec3& t : ts) {
-        Pose pose;
-        pose.R_BA = R;
-        pose.t_BA = t;
-        std::string why;
-        const double clearance = verify(pcs, pose, debug_ ? &why : nullptr);
-        if (debug_) std::cerr << "    t " << t.transpose() << " clearance " << clearance << " " << why << "\n";
-        if (clearance >= p_.min_clearance && clearance > best.clearance) {
-          best.found = true;
-          best.pose = pose;
-          best.clearance = clearance;
-          best.margin = margin;
-          if (clearance >= p_.good_clearance) return true;
+      // Pass 0: centred translations; pass 1 (only when pass 0 placed the contacts but found
+      // no witness): translations close to the elements' boundaries.
+      for (int pass = 0; pass < 2; ++pass) {
+        double margin = 0;
+        const std::vector<Vec3> ts = translations(pcs, R, choice, margin, pass == 1);
+        if (pass == 0 && !ts.empty() && near.size() < 4) near.push_back(R);
+        if (debug_) std::cerr << "  rotation, pass " << pass << ": " << ts.size() << " translations, margin " << margin << "\n";
+        for (const Vec3& t : ts) {
+          Pose pose;
+          pose.R_BA = R;
+          pose.t_BA = t;
+          std::string why;
+          const double clearance = verify(pcs, pose, debug_ ? &why : nullptr);
+          if (debug_) std::cerr << "    t " << t.transpose() << " clearance " << clearance << " " << why << "\n";
+          if (clearance >= p_.min_clearance && clearance > best.clearance) {
+            best.found = true;
+            best.pose = pose;
+            best.clearance = clearance;
+            best.margin = margin;
+            if (clearance >= p_.good_clearance) return true;
+          }
+          if (clearance >= p_.min_clearance) break;  // a witness for this rotation; try others
         }
-        if (clearance >= p_.min_clearance) break;  // a witness for this rotation; try others
+        if (ts.empty() || best.found) break;
       }
       // Next combination of pieces (odometer); stop when all tried.
       std::size_t i = 0;

@@ -61,8 +61,10 @@ class WitnessSearch {
   LinearProgram build_lp(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces) const;
   // Candidate translations for rotation R, best first; empty when the contacts cannot hold
   // with min_margin. `margin` receives the largest margin.
+  // near_boundary: instead, extremes that keep only 5% of the margin (a contact that must sit
+  // close to its element's boundary, e.g. A in a slot barely wider than itself).
   std::vector<Vec3> translations(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces,
-                                 double& margin) const;
+                                 double& margin, bool near_boundary) const;
 
   const ModelInfo& A_;
   const ModelInfo& B_;
