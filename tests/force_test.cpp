@@ -5,6 +5,7 @@
 // floor is the plane y = 0 (normal +y), walls are given per test. Defaults: K = 2.3 N/mm,
 // K_p = 1.6 N/mm, mu = 0.7, mu_D = 0.08, eps = 1 mm, m g = 4.9 N along -y.
 
+#include "fixtures.hpp"
 #include <cf/force.hpp>
 
 #include <catch2/catch.hpp>
@@ -18,16 +19,7 @@ namespace {
 // round-off.
 constexpr double kTol = 1e-9;
 
-cf::Polyhedron box(const cf::Vec3& lo, const cf::Vec3& hi) {
-  std::vector<cf::Vec3> v = {{lo.x(), lo.y(), lo.z()}, {hi.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), lo.z()},
-                             {lo.x(), hi.y(), lo.z()}, {lo.x(), lo.y(), hi.z()}, {hi.x(), lo.y(), hi.z()},
-                             {hi.x(), hi.y(), hi.z()}, {lo.x(), hi.y(), hi.z()}};
-  std::vector<std::vector<std::vector<int>>> f = {
-      {{0, 3, 2, 1}}, {{4, 5, 6, 7}}, {{0, 1, 5, 4}}, {{2, 3, 7, 6}}, {{1, 2, 6, 5}}, {{0, 4, 7, 3}}};
-  std::vector<std::array<int, 2>> e = {{0, 1}, {1, 2}, {2, 3}, {0, 3}, {4, 5}, {5, 6},
-                                       {6, 7}, {4, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
-  return cf::Polyhedron::from_features("box", v, e, f);
-}
+using cf::test::box;
 
 const cf::Vec3 X(1, 0, 0), Y(0, 1, 0), Z(0, 0, 1);
 

@@ -1,3 +1,4 @@
+#include "fixtures.hpp"
 #include <cf/geometry.hpp>
 
 #include <catch2/catch.hpp>
@@ -12,15 +13,7 @@ constexpr double kTol = 1e-9;
 using cf::ElementKind;
 using cf::Vec3;
 
-cf::Polyhedron box(double sx, double sy, double sz) {
-  std::vector<Vec3> v = {{0, 0, 0},  {sx, 0, 0},  {sx, sy, 0},  {0, sy, 0},
-                         {0, 0, sz}, {sx, 0, sz}, {sx, sy, sz}, {0, sy, sz}};
-  std::vector<std::vector<std::vector<int>>> f = {
-      {{0, 3, 2, 1}}, {{4, 5, 6, 7}}, {{0, 1, 5, 4}}, {{2, 3, 7, 6}}, {{1, 2, 6, 5}}, {{0, 4, 7, 3}}};
-  std::vector<std::array<int, 2>> e = {{0, 1}, {1, 2}, {2, 3}, {0, 3}, {4, 5}, {5, 6},
-                                       {6, 7}, {4, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
-  return cf::Polyhedron::from_features("box", v, e, f);
-}
+cf::Polyhedron box(double sx, double sy, double sz) { return cf::test::box(sx, sy, sz); }
 
 // A 30 x 30 x 10 square frame with a 10 x 10 through-hole at [10,20]^2: its top face
 // (index 1) has a hole.

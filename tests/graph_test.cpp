@@ -2,6 +2,7 @@
 // (a floor 40 x 10 and a wall 10 x 40 in the x-y profile, y up, extruded 20 in z).
 // Every witness below realises exactly its CF (checked by hand; see the comments).
 
+#include "fixtures.hpp"
 #include <cf/graph.hpp>
 
 #include <catch2/catch.hpp>
@@ -22,15 +23,7 @@ namespace cf_test {
 // Axis-aligned box [0,sx] x [0,sy] x [0,sz]. Faces: 0 z=0, 1 z=sz, 2 y=0, 3 y=sy, 4 x=sx,
 // 5 x=0. Edges: 0 (0,1), 1 (1,2), 2 (2,3), 3 (0,3), 4 (4,5), 5 (5,6), 6 (6,7), 7 (4,7),
 // 8 (0,4), 9 (1,5), 10 (2,6), 11 (3,7).
-cf::Polyhedron box(double sx, double sy, double sz) {
-  std::vector<cf::Vec3> v = {{0, 0, 0},  {sx, 0, 0},  {sx, sy, 0},  {0, sy, 0},
-                             {0, 0, sz}, {sx, 0, sz}, {sx, sy, sz}, {0, sy, sz}};
-  std::vector<std::vector<std::vector<int>>> f = {
-      {{0, 3, 2, 1}}, {{4, 5, 6, 7}}, {{0, 1, 5, 4}}, {{2, 3, 7, 6}}, {{1, 2, 6, 5}}, {{0, 4, 7, 3}}};
-  std::vector<std::array<int, 2>> e = {{0, 1}, {1, 2}, {2, 3}, {0, 3}, {4, 5}, {5, 6},
-                                       {6, 7}, {4, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
-  return cf::Polyhedron::from_features("cube", v, e, f);
-}
+cf::Polyhedron box(double sx, double sy, double sz) { return cf::test::box(sx, sy, sz, "cube"); }
 
 // L profile (0,0) (40,0) (40,10) (10,10) (10,40) (0,40), vertices 0..5 at z=0 and 6..11 at
 // z=20. Faces: 0 z=0, 1 z=20, then side i+2 over profile edge i -> i+1: 2 y=0 (bottom),

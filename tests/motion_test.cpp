@@ -1,6 +1,7 @@
 // Freedoms of CFs from the contact constraints, the "approximately along" test of paper
 // Fig. 10, and the prior-motion classification of paper section 4.2.
 
+#include "fixtures.hpp"
 #include <cf/motion.hpp>
 
 #include <catch2/catch.hpp>
@@ -12,16 +13,7 @@ namespace {
 // Round-off of 6x6 eigen decompositions of unit-scale matrices.
 constexpr double kTol = 1e-9;
 
-cf::Polyhedron box(const cf::Vec3& lo, const cf::Vec3& hi) {
-  std::vector<cf::Vec3> v = {{lo.x(), lo.y(), lo.z()}, {hi.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), lo.z()},
-                             {lo.x(), hi.y(), lo.z()}, {lo.x(), lo.y(), hi.z()}, {hi.x(), lo.y(), hi.z()},
-                             {hi.x(), hi.y(), hi.z()}, {lo.x(), hi.y(), hi.z()}};
-  std::vector<std::vector<std::vector<int>>> f = {
-      {{0, 3, 2, 1}}, {{4, 5, 6, 7}}, {{0, 1, 5, 4}}, {{2, 3, 7, 6}}, {{1, 2, 6, 5}}, {{0, 4, 7, 3}}};
-  std::vector<std::array<int, 2>> e = {{0, 1}, {1, 2}, {2, 3}, {0, 3}, {4, 5}, {5, 6},
-                                       {6, 7}, {4, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
-  return cf::Polyhedron::from_features("box", v, e, f);
-}
+using cf::test::box;
 
 cf::ContactPc contact(cf::PcType type, int a, int b, const cf::Vec3& p, const cf::Vec3& x,
                       const cf::Vec3& y) {

@@ -1,3 +1,4 @@
+#include "fixtures.hpp"
 #include <cf/polyhedron.hpp>
 
 #include <catch2/catch.hpp>
@@ -8,15 +9,7 @@ namespace {
 constexpr double kExact = 1e-12;
 
 // Axis-aligned box [0,sx] x [0,sy] x [0,sz] with outward-oriented faces.
-cf::Polyhedron box(double sx, double sy, double sz) {
-  std::vector<cf::Vec3> v = {{0, 0, 0},  {sx, 0, 0},  {sx, sy, 0},  {0, sy, 0},
-                             {0, 0, sz}, {sx, 0, sz}, {sx, sy, sz}, {0, sy, sz}};
-  std::vector<std::vector<std::vector<int>>> f = {
-      {{0, 3, 2, 1}}, {{4, 5, 6, 7}}, {{0, 1, 5, 4}}, {{2, 3, 7, 6}}, {{1, 2, 6, 5}}, {{0, 4, 7, 3}}};
-  std::vector<std::array<int, 2>> e = {{0, 1}, {1, 2}, {2, 3}, {0, 3}, {4, 5}, {5, 6},
-                                       {6, 7}, {4, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
-  return cf::Polyhedron::from_features("box", v, e, f);
-}
+cf::Polyhedron box(double sx, double sy, double sz) { return cf::test::box(sx, sy, sz); }
 
 }  // namespace
 

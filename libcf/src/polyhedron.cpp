@@ -1,5 +1,7 @@
 #include <cf/polyhedron.hpp>
 
+#include <cf/geometry.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -27,14 +29,6 @@ double signed_area_2d(const std::vector<Eigen::Vector2d>& loop) {
   return 0.5 * a;
 }
 
-double segment_distance_2d(const Eigen::Vector2d& q, const Eigen::Vector2d& a,
-                           const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  double s = len2 > 0 ? (q - a).dot(ab) / len2 : 0.0;
-  s = std::clamp(s, 0.0, 1.0);
-  return (a + s * ab - q).norm();
-}
 
 }  // namespace
 
@@ -243,22 +237,7 @@ bool Polyhedron::vertex_on_face(VertexId v, FaceId f) const {
 }
 
 double Polyhedron::face_inset_2d(FaceId f, const Eigen::Vector2d& q) const {
-  const Face& F = faces_[f.index()];
-  double dmin = std::numeric_limits<double>::infinity();
-  bool inside = false;
-  for (const auto& loop : F.loops_2d) {
-    for (std::size_t i = 0, n = loop.size(); i < n; ++i) {
-      const Eigen::Vector2d& a = loop[i];
-      const Eigen::Vector2d& b = loop[(i + 1) % n];
-      dmin = std::min(dmin, segment_distance_2d(q, a, b));
-      // even-odd crossing test along +u
-      if ((a.y() > q.y()) != (b.y() > q.y())) {
-        const double x = a.x() + (q.y() - a.y()) / (b.y() - a.y()) * (b.x() - a.x());
-        if (x > q.x()) inside = !inside;
-      }
-    }
-  }
-  return inside ? dmin : -dmin;
+  return locate_in_face(*this, f, q).inset();
 }
 
 double Polyhedron::face_inset(FaceId f, const Vec3& p) const {
