@@ -1,8 +1,12 @@
 #pragma once
 // Private: an axis-aligned bounding box tree over the elements (vertices, edges, faces) of
 // one polyhedron, in its own frame, and the simultaneous descent of two such trees with
-// one of them posed (boxes of the posed tree are mapped as oriented boxes and bounded by
-// their world-axis boxes). Built once; queries allocate nothing.
+// one of them posed. Built once; queries allocate nothing.
+//
+// The top levels split by element kind (vertices | edges, faces), so that each node knows
+// which kinds lie below it and a descent skips node pairs that cannot hold a PC type
+// (vertex against vertex or edge, edge against vertex) without opening them. Leaves hold one
+// element.
 
 #include <cf/polyhedron.hpp>
 #include <cf/types.hpp>
@@ -18,20 +22,32 @@ struct BvhElement {
   std::int32_t index;
 };
 
+/// Bit of an element kind in BvhNode::kinds.
+inline std::uint8_t kind_bit(ElementKind k) { return static_cast<std::uint8_t>(1u << static_cast<unsigned>(k)); }
+
+/// A node: an axis-aligned box (single precision, rounded outwards, so it still bounds its
+/// elements; 32 bytes so that descents stay in cache) and either two children (`child`,
+/// `child + 1`) or a few elements of one kind (leaf).
 struct BvhNode {
-  Vec3 center;  // box centre, model frame
-  Vec3 half;    // half extents, >= 0
-  // Inner node: children left/right. Leaf: elements [first, first + count).
-  std::int32_t left = -1, right = -1;
-  std::int32_t first = 0, count = 0;
-  bool leaf() const { return count > 0; }
+  Eigen::Vector3f center;  // mm, model frame
+  Eigen::Vector3f half;    // mm, half extents, >= 0
+  std::int32_t child = 0;  // inner: index of the first child; leaf: ~(first element index)
+  std::uint8_t kinds = 0;  // kind_bit of every element below
+  std::uint8_t count = 0;  // leaf: number of elements
+  bool leaf() const { return child < 0; }
+  std::int32_t left() const { return child; }
+  std::int32_t right() const { return child + 1; }
+  std::int32_t element() const { return ~child; }
 };
+
+/// Sets `c`, `h` to a single-precision box that contains the box (center, half).
+void round_out(const Vec3& center, const Vec3& half, Eigen::Vector3f& c, Eigen::Vector3f& h);
 
 class Bvh {
  public:
   Bvh() = default;
   /// `inflate` mm is added to every box on each side.
-  Bvh(const Polyhedron& m, double inflate, int leaf_size = 2);
+  Bvh(const Polyhedron& m, double inflate, int leaf_size);
   const std::vector<BvhNode>& nodes() const { return nodes_; }
   const std::vector<BvhElement>& elements() const { return elements_; }
   int depth() const { return depth_; }
@@ -42,10 +58,6 @@ class Bvh {
   int depth_ = 0;
 };
 
-/// Calls visit(const BvhElement& a, const BvhElement& b) for every pair of leaf elements
-/// whose boxes overlap, where tree `a` is posed by `pose` into tree `b`'s frame.
-/// `stack` is caller-owned scratch of at least `stack_capacity(a, b)` entries.
-/// Returns false when the stack overflowed (some pairs were skipped).
 struct NodePair {
   std::int32_t a, b;
 };
@@ -53,12 +65,27 @@ inline std::size_t stack_capacity(const Bvh& a, const Bvh& b) {
   return static_cast<std::size_t>(4 * (a.depth() + b.depth()) + 8);
 }
 
-template <class Visit>
-bool descend(const Bvh& ta, const Pose& pose, const Bvh& tb, NodePair* stack, std::size_t cap,
+/// Can an element of a kind in mask `ka` (of A) and one in mask `kb` (of B) form a PC type
+/// (v-f, e-f, e-e, f-f, f-e, f-v)?
+inline bool kinds_can_touch(std::uint8_t ka, std::uint8_t kb) {
+  const std::uint8_t V = kind_bit(ElementKind::kVertex), E = kind_bit(ElementKind::kEdge),
+                     F = kind_bit(ElementKind::kFace);
+  // Per kind of A, the kinds of B it pairs with.
+  const std::uint8_t with = static_cast<std::uint8_t>(((ka & V) ? F : 0) | ((ka & E) ? (E | F) : 0) |
+                                                      ((ka & F) ? (V | E | F) : 0));
+  return (with & kb) != 0;
+}
+
+/// Calls visit(const BvhElement& a, const BvhElement& b) for every pair of leaf elements
+/// of kinds that can touch whose bounding volumes overlap, where tree `a` is posed into tree
+/// `b`'s frame: `overlap(node_a, node_b)` tells whether A's node (posed; the caller caches
+/// its posed box) overlaps B's node. `stack` is caller-owned scratch of at least
+/// `stack_capacity(a, b)` entries. Returns false when the stack overflowed (some pairs were
+/// skipped).
+template <class Overlap, class Visit>
+bool descend(const Bvh& ta, const Bvh& tb, Overlap&& overlap, NodePair* stack, std::size_t cap,
              Visit&& visit) {
   if (ta.nodes().empty() || tb.nodes().empty()) return true;
-  const Mat3& R = pose.R_BA;
-  const Mat3 absR = R.cwiseAbs();
   const auto& na = ta.nodes();
   const auto& nb = tb.nodes();
   std::size_t top = 0;
@@ -68,17 +95,12 @@ bool descend(const Bvh& ta, const Pose& pose, const Bvh& tb, NodePair* stack, st
     const NodePair p = stack[--top];
     const BvhNode& A = na[static_cast<std::size_t>(p.a)];
     const BvhNode& B = nb[static_cast<std::size_t>(p.b)];
-    const Vec3 c = R * A.center + pose.t_BA;
-    const Vec3 h = absR * A.half;
-    if (std::abs(c.x() - B.center.x()) > h.x() + B.half.x() ||
-        std::abs(c.y() - B.center.y()) > h.y() + B.half.y() ||
-        std::abs(c.z() - B.center.z()) > h.z() + B.half.z())
-      continue;
+    if (!kinds_can_touch(A.kinds, B.kinds) || !overlap(p.a, A, B)) continue;
     if (A.leaf() && B.leaf()) {
       for (int i = 0; i < A.count; ++i)
         for (int j = 0; j < B.count; ++j)
-          visit(ta.elements()[static_cast<std::size_t>(A.first + i)],
-                tb.elements()[static_cast<std::size_t>(B.first + j)]);
+          visit(ta.elements()[static_cast<std::size_t>(A.element() + i)],
+                tb.elements()[static_cast<std::size_t>(B.element() + j)]);
       continue;
     }
     if (top + 2 > cap) {
@@ -88,11 +110,11 @@ bool descend(const Bvh& ta, const Pose& pose, const Bvh& tb, NodePair* stack, st
     // Split the bigger box (or the only inner node).
     const bool split_a = B.leaf() || (!A.leaf() && A.half.squaredNorm() >= B.half.squaredNorm());
     if (split_a) {
-      stack[top++] = {A.right, p.b};
-      stack[top++] = {A.left, p.b};
+      stack[top++] = {A.right(), p.b};
+      stack[top++] = {A.left(), p.b};
     } else {
-      stack[top++] = {p.a, B.right};
-      stack[top++] = {p.a, B.left};
+      stack[top++] = {p.a, B.right()};
+      stack[top++] = {p.a, B.left()};
     }
   }
   return ok;

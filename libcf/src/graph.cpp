@@ -203,6 +203,7 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
   const std::size_t n = cfs.size();
   index.clear();
   index.reserve(n + n / 4);
+  held.clear();
   for (std::size_t i = 0; i < n; ++i) {
     const PcSet& pcs = cfs[i].pcs;
     if (pcs.empty()) where.cf_fault(i, "a CF needs 1 to 3 PCs, this one has none");
@@ -223,6 +224,7 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
                                              : "A's face " + std::to_string(x.a)) +
                                 "; the PCs of a CF have distinct contact planes");
       }
+    for (const Pc& pc : pcs) held.insert(pc);
     const auto [it, inserted] = index.emplace(pcs, CfId(static_cast<std::int32_t>(i)));
     if (!inserted)
       where.cf_fault(i, "PC set {" + to_string(pcs) + "} repeats CF " + std::to_string(it->second.value()));
@@ -394,6 +396,11 @@ std::optional<CfId> CfGraph::find(const PcSet& pcs) const {
   const auto it = index.find(pcs);
   if (it == index.end()) return std::nullopt;
   return it->second;
+}
+
+bool CfGraph::holds(const Pc& pc) const {
+  const auto& held = impl().held;
+  return held.find(pc) != held.end();
 }
 
 const std::vector<Transition>& CfGraph::out_transitions(CfId id) const {

@@ -10,9 +10,19 @@
 #include <cstddef>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 namespace cf::detail {
+
+/// Hash of one PC (type and both indices).
+struct PcHash {
+  std::size_t operator()(const Pc& pc) const noexcept {
+    const std::uint64_t k = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(pc.a)) << 32) |
+                            static_cast<std::uint32_t>(pc.b);
+    return std::hash<std::uint64_t>()(k * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint64_t>(pc.type));
+  }
+};
 
 /// Bundled edge property of the Boost.Graph view: which transition this edge is.
 struct GraphEdge {
@@ -58,6 +68,7 @@ struct CfGraph::Impl {
   std::vector<CfRecord> cfs;
   std::vector<Transition> transitions;
   std::unordered_map<PcSet, CfId> index;          ///< PC set -> CF, for constant-time find
+  std::unordered_set<Pc, detail::PcHash> held;    ///< every PC some CF holds
   std::vector<std::vector<Transition>> out;       ///< per CF, sorted by target id
   detail::BoostCfGraph bgraph;
   std::string metadata;                           ///< JSON object text, canonical dump

@@ -79,6 +79,9 @@ struct CfIdentifier::Impl {
   // Per step scratch (fixed size).
   std::array<std::array<std::int16_t, ContactSet::kCapacity>, kMaxGroups> members{};
   std::array<int, kMaxGroups> count{};
+  // The members some CF of the graph holds (best fit first): only these can be chosen.
+  std::array<std::array<std::int16_t, ContactSet::kCapacity>, kMaxGroups> choosable{};
+  std::array<int, kMaxGroups> nchoose{};
 
   Impl(const CfGraph& g, const IdentificationParams& p)
       : graph(&g), prm(p), detector(g.model_a(), g.model_b(), p.detection) {}
@@ -108,6 +111,78 @@ struct CfIdentifier::Impl {
       worst = 1;
     }
     return worst;
+  }
+
+  // An interpretation that is a CF, with its rank keys (docs/runtime.md, Identification).
+  struct Ranked {
+    int tier = 2;    // 0: every skipped plane apart; 1: some explained
+    int dom = 4;     // dominated PCs chosen
+    int cat = 3;     // 0 previous CF, 1 its neighbour, 2 other
+    double misfit = 0;
+    CfId id;
+    int n = 0;
+    bool partial = false;
+    bool better_than(const Ranked& o) const {
+      return tier != o.tier ? tier < o.tier : dom != o.dom ? dom < o.dom : cat != o.cat ? cat < o.cat : misfit < o.misfit;
+    }
+    // Nothing can rank above: the previous CF is one PC set, so one interpretation.
+    bool unbeatable() const { return tier == 0 && dom == 0 && cat == 0; }
+  };
+
+  // Ranks the interpretation `chosen` (contact indices; taken[g]: plane g has one of them).
+  // False when a skipped plane is not accounted for, when its tier is worse than
+  // `tier_bound`, or when no CF has this PC set.
+  bool rank(const int* chosen, int n, const bool* taken, int G, int tier_bound, Ranked& r) const {
+    const ContactSet& cs = res.contacts;
+    r.partial = n < G;
+    double farthest = 0;
+    for (int i = 0; i < n; ++i) farthest = std::max(farthest, cs[chosen[i]].distance);
+    const double apart_beyond = farthest + prm.touch_distance;
+    r.tier = 0;
+    for (int g = 0; g < G && r.tier < 2 && r.partial; ++g)
+      if (!taken[g]) r.tier = std::max(r.tier, accounted(g, chosen, n, apart_beyond));
+    if (r.tier >= 2 || r.tier > tier_bound) return false;
+    PcSet key;
+    for (int i = 0; i < n; ++i) key.insert(cs[chosen[i]].pc);
+    const std::optional<CfId> id = graph->find(key);
+    if (!id) return false;
+    r.id = *id;
+    r.cat = (prev.valid() && *id == prev) ? 0 : (prev.valid() && graph->adjacent(prev, *id)) ? 1 : 2;
+    r.misfit = 0;
+    r.dom = 0;
+    for (int i = 0; i < n; ++i) {
+      r.misfit += cs[chosen[i]].misfit;
+      r.dom += cs[chosen[i]].dominated;
+    }
+    r.n = n;
+    return true;
+  }
+
+  // The previous CF, tried before the enumeration: when all its PCs are detected in
+  // distinct planes and it ranks unbeatable (every other plane apart, nothing dominated),
+  // the enumeration would end on it anyway (it is one interpretation), so it is the result.
+  bool try_previous(int G) {
+    if (!prev.valid()) return false;
+    const ContactSet& cs = res.contacts;
+    const PcSet& want = graph->cf(prev).pcs;
+    int chosen[3];
+    int n = 0;
+    std::array<bool, kMaxGroups> taken{};
+    for (const Pc& pc : want) {
+      int found = -1;
+      for (int i = 0; i < cs.size() && found < 0; ++i)
+        if (cs[i].pc == pc) found = i;
+      if (found < 0) return false;
+      const auto g = static_cast<std::size_t>(cs[found].plane);
+      if (taken[g]) return false;  // two PCs in one plane: not an interpretation
+      taken[g] = true;
+      chosen[n++] = found;
+    }
+    Ranked r;
+    if (!rank(chosen, n, taken.data(), G, 0, r) || !r.unbeatable()) return false;
+    res.combinations = 1;
+    set_result(IdStatus::kMatchedPrevious, r.id, chosen, n, r.misfit, r.partial);
+    return true;
   }
 
   void set_result(IdStatus st, CfId id, const int* chosen, int n, double misfit, bool partial) {
@@ -161,22 +236,25 @@ struct CfIdentifier::Impl {
         }
         m[static_cast<std::size_t>(j + 1)] = v;
       }
+      auto& c = choosable[static_cast<std::size_t>(g)];
+      int& nc = nchoose[static_cast<std::size_t>(g)];
+      nc = 0;
+      for (int i = 0; i < count[static_cast<std::size_t>(g)]; ++i)
+        if (graph->holds(cs[m[static_cast<std::size_t>(i)]].pc)) c[static_cast<std::size_t>(nc++)] = m[static_cast<std::size_t>(i)];
     }
+    if (try_previous(G)) return res;
 
-    // Enumerate one member or none per plane (none last), at most 3 chosen, every skipped
-    // plane accounted for (apart or explained). Rank: no plane left to an explanation
-    // (another reading of a chosen touch, closures meeting: loose, so only when no CF holds
-    // a PC in that plane), then fewest dominated PCs (a v-f beside the e-f of its edge is
-    // only taken when the e-f cannot form a CF), then previous / neighbour / other, then
-    // total misfit (which favours the exact CF over one that also holds a pair 0.05 mm
+    // Enumerate one choosable member or none per plane (none last), at most 3 chosen, every
+    // skipped plane accounted for (apart or explained). Rank: no plane left to an
+    // explanation (another reading of a chosen touch, closures meeting: loose, so only when
+    // no CF holds a PC in that plane), then fewest dominated PCs (a v-f beside the e-f of its
+    // edge is only taken when the e-f cannot form a CF), then previous / neighbour / other,
+    // then total misfit (which favours the exact CF over one that also holds a pair 0.05 mm
     // away), then enumeration order.
-    std::array<int, kMaxGroups> digit{};  // index into members, count[g] means "none"
-    int best_tier = 2, best_dom = 4, best_cat = 3;
-    bool best_partial = false;
-    double best_misfit = 0;
+    std::array<int, kMaxGroups> digit{};  // index into choosable, nchoose[g] means "none"
+    std::array<bool, kMaxGroups> taken{};
+    Ranked best;
     int best_chosen[3] = {-1, -1, -1};
-    int best_n = 0;
-    CfId best_id;
     // Also bound the walk itself: combinations with more than 3 planes chosen are skipped
     // without counting.
     long walk = 0;
@@ -191,9 +269,10 @@ struct CfIdentifier::Impl {
       bool too_many = false;
       for (int g = 0; g < G && !too_many; ++g) {
         const int d = digit[static_cast<std::size_t>(g)];
-        if (d < count[static_cast<std::size_t>(g)]) {
+        taken[static_cast<std::size_t>(g)] = d < nchoose[static_cast<std::size_t>(g)];
+        if (taken[static_cast<std::size_t>(g)]) {
           if (n == 3) too_many = true;
-          else chosen[n++] = members[static_cast<std::size_t>(g)][static_cast<std::size_t>(d)];
+          else chosen[n++] = choosable[static_cast<std::size_t>(g)][static_cast<std::size_t>(d)];
         }
       }
       if (!too_many && n > 0) {
@@ -202,49 +281,23 @@ struct CfIdentifier::Impl {
           break;
         }
         ++res.combinations;
-        const bool partial = n < G;
-        double farthest = 0;
-        for (int i = 0; i < n; ++i) farthest = std::max(farthest, cs[chosen[i]].distance);
-        const double apart_beyond = farthest + prm.touch_distance;
-        int tier = 0;  // 1: some plane explained, 2: some plane neither chosen nor accounted for
-        for (int g = 0; g < G && tier < 2 && partial; ++g)
-          if (digit[static_cast<std::size_t>(g)] == count[static_cast<std::size_t>(g)])
-            tier = std::max(tier, accounted(g, chosen, n, apart_beyond));
-        if (tier <= best_tier && tier < 2) {
-          PcSet key;
-          for (int i = 0; i < n; ++i) key.insert(cs[chosen[i]].pc);
-          if (const std::optional<CfId> id = graph->find(key)) {
-            const int cat = (prev.valid() && *id == prev) ? 0
-                            : (prev.valid() && graph->adjacent(prev, *id)) ? 1 : 2;
-            double mis = 0;
-            int dom = 0;
-            for (int i = 0; i < n; ++i) {
-              mis += cs[chosen[i]].misfit;
-              dom += cs[chosen[i]].dominated;
-            }
-            const bool better = tier != best_tier ? tier < best_tier
-                                : dom != best_dom ? dom < best_dom
-                                : cat != best_cat ? cat < best_cat
-                                                  : mis < best_misfit;
-            if (better) {
-              best_tier = tier;
-              best_partial = partial;
-              best_dom = dom;
-              best_cat = cat;
-              best_misfit = mis;
-              best_n = n;
-              std::copy(chosen, chosen + n, best_chosen);
-              best_id = *id;
-              if (tier == 0 && dom == 0 && cat == 0) break;  // cannot be beaten
-            }
-          }
+        Ranked r;
+        if (rank(chosen, n, taken.data(), G, best.tier, r) && r.better_than(best)) {
+          best = r;
+          std::copy(chosen, chosen + n, best_chosen);
+          if (best.unbeatable()) break;
         }
       }
       // Next combination (mixed radix, last plane fastest).
       int g = G - 1;
-      while (g >= 0 && ++digit[static_cast<std::size_t>(g)] > count[static_cast<std::size_t>(g)]) digit[static_cast<std::size_t>(g--)] = 0;
+      while (g >= 0 && ++digit[static_cast<std::size_t>(g)] > nchoose[static_cast<std::size_t>(g)]) digit[static_cast<std::size_t>(g--)] = 0;
       if (g < 0) break;
     }
+    const CfId best_id = best.id;
+    const int best_n = best.n;
+    const bool best_partial = best.partial;
+    const double best_misfit = best.misfit;
+    const int best_cat = best.cat;
     if (!best_id.valid()) {
       res.status = G > 3 ? IdStatus::kTooManyPlanes : IdStatus::kOutsideGraph;
       return res;

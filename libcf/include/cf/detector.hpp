@@ -41,8 +41,9 @@ struct DetectionParams {
   /// 0.7 of the face's tolerance: e-f and f-f), and the previous CF, else the fit, decides:
   /// a hysteresis band rather than a flip at one angle.
   double dominance_fit = 0.25;
-  /// Cull element pairs with bounding volume hierarchies (the default). false tests all
-  /// pairs: for checking the culling and for comparison only.
+  /// Cull element pairs with bounding volume hierarchies and cheap necessary conditions
+  /// (the default). false runs the exact tests on all pairs: for checking the culling and
+  /// for comparison only.
   bool use_bvh = true;
 };
 

@@ -176,6 +176,8 @@ class CfGraph {
 
   /// The CF with exactly this PC set, in constant time.
   std::optional<CfId> find(const PcSet& pcs) const;
+  /// True when some CF of the graph holds this PC, in constant time.
+  bool holds(const Pc& pc) const;
   /// Transitions leaving `id` (to, kind), sorted by target id. @pre id.index() < num_cfs()
   const std::vector<Transition>& out_transitions(CfId id) const;
   /// True when the graph has a transition from `from` to `to` (false for invalid ids);
