@@ -23,7 +23,7 @@ void round_out(const Vec3& center, const Vec3& half, Eigen::Vector3f& c, Eigen::
   }
 }
 
-Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
+Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, bool split_kinds) {
   leaf_size = std::clamp(leaf_size, 1, 255);
   std::vector<Item> items;
   items.reserve(m.num_vertices() + m.num_edges() + m.num_faces());
@@ -73,7 +73,8 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
     for (std::int32_t i = t.begin; i < t.end; ++i) n.kinds |= kind_bit(items[static_cast<std::size_t>(i)].e.kind);
     const ElementKind k0 = items[static_cast<std::size_t>(t.begin)].e.kind;
     std::int32_t mid = t.begin;
-    while (mid < t.end && items[static_cast<std::size_t>(mid)].e.kind == k0) ++mid;
+    while (split_kinds && mid < t.end && items[static_cast<std::size_t>(mid)].e.kind == k0) ++mid;
+    if (!split_kinds) mid = t.end;
     if (mid == t.end && t.end - t.begin <= leaf_size) {
       n.child = ~t.begin;
       n.count = static_cast<std::uint8_t>(t.end - t.begin);
@@ -90,6 +91,7 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
                        [axis](const Item& x, const Item& y) {
                          const double cx = x.lo[axis] + x.hi[axis], cy = y.lo[axis] + y.hi[axis];
                          if (cx != cy) return cx < cy;
+                         if (x.e.kind != y.e.kind) return x.e.kind < y.e.kind;
                          return x.e.index < y.e.index;
                        });
     }
@@ -101,7 +103,12 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
     tasks.push_back({l + 1, mid, t.end, t.depth + 1});
   }
   elements_.reserve(items.size());
-  for (const Item& it : items) elements_.push_back(it.e);
+  for (const Item& it : items) {
+    elements_.push_back(it.e);
+    elem_c_.emplace_back();
+    elem_h_.emplace_back();
+    round_out(0.5 * (it.lo + it.hi), 0.5 * (it.hi - it.lo) + Vec3::Constant(inflate), elem_c_.back(), elem_h_.back());
+  }
 }
 
 }  // namespace cf::detail

@@ -47,7 +47,12 @@ class Bvh {
  public:
   Bvh() = default;
   /// `inflate` mm is added to every box on each side.
-  Bvh(const Polyhedron& m, double inflate, int leaf_size);
+  /// `split_kinds`: the top levels split by element kind, leaves hold one kind; else
+  /// leaves mix the kinds of spatially close elements.
+  Bvh(const Polyhedron& m, double inflate, int leaf_size, bool split_kinds = true);
+  /// Per element (in elements() order), its own box (inflated like the nodes').
+  const std::vector<Eigen::Vector3f>& element_centers() const { return elem_c_; }
+  const std::vector<Eigen::Vector3f>& element_halves() const { return elem_h_; }
   const std::vector<BvhNode>& nodes() const { return nodes_; }
   const std::vector<BvhElement>& elements() const { return elements_; }
   int depth() const { return depth_; }
@@ -55,6 +60,7 @@ class Bvh {
  private:
   std::vector<BvhNode> nodes_;
   std::vector<BvhElement> elements_;
+  std::vector<Eigen::Vector3f> elem_c_, elem_h_;
   int depth_ = 0;
 };
 
@@ -76,8 +82,8 @@ inline bool kinds_can_touch(std::uint8_t ka, std::uint8_t kb) {
   return (with & kb) != 0;
 }
 
-/// Calls visit(const BvhElement& a, const BvhElement& b) for every pair of leaf elements
-/// of kinds that can touch whose bounding volumes overlap, where tree `a` is posed into tree
+/// Calls visit(int a, int b) (positions in elements()) for every pair of elements in leaves
+/// whose bounding volumes overlap and whose kinds can touch, where tree `a` is posed into tree
 /// `b`'s frame: `overlap(node_a, node_b)` tells whether A's node (posed; the caller caches
 /// its posed box) overlaps B's node. `stack` is caller-owned scratch of at least
 /// `stack_capacity(a, b)` entries. Returns false when the stack overflowed (some pairs were
@@ -98,9 +104,7 @@ bool descend(const Bvh& ta, const Bvh& tb, Overlap&& overlap, NodePair* stack, s
     if (!kinds_can_touch(A.kinds, B.kinds) || !overlap(p.a, A, B)) continue;
     if (A.leaf() && B.leaf()) {
       for (int i = 0; i < A.count; ++i)
-        for (int j = 0; j < B.count; ++j)
-          visit(ta.elements()[static_cast<std::size_t>(A.element() + i)],
-                tb.elements()[static_cast<std::size_t>(B.element() + j)]);
+        for (int j = 0; j < B.count; ++j) visit(A.element() + i, B.element() + j);
       continue;
     }
     if (top + 2 > cap) {

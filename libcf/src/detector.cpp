@@ -113,10 +113,15 @@ double segment_segment_2d(const Vec2& a, const Vec2& b, const Vec2& c, const Vec
 
 }  // namespace
 
-// Elements per BVH leaf. One: with more, leaf boxes of coarse models (the paper's cube and
-// L-block) overlap everything and the pairs tested grow 15-fold; on 2,000-face spheres 2 or 3
-// measured the same as 1 within the noise.
-constexpr int kLeafSize = 1;
+// BVH leaves of a model: one element, and the top levels split by kind, for small models
+// (with bigger leaves, leaf boxes of the paper's cube and L-block overlap everything and
+// detection took 1.5x as long); leaves of 4 spatially close elements of any kind for big
+// models, whose deep trees cost more node visits than the element boxes tested in the
+// leaves (2,000-face spheres: 0.68x the time). docs/performance.md has the figures.
+constexpr std::size_t kBigModelElements = 256;
+int leaf_size_for(const Polyhedron& m) {
+  return m.num_vertices() + m.num_edges() + m.num_faces() >= kBigModelElements ? 4 : 1;
+}
 
 struct ContactDetector::Impl {
   Polyhedron a, b;
@@ -135,7 +140,8 @@ struct ContactDetector::Impl {
     Eigen::Vector3f c, h;  // mm, B's frame
     std::uint32_t stamp = 0;
   };
-  std::vector<PosedBox> a_box;
+  std::vector<PosedBox> a_box, a_elem_box;
+  bool element_boxes = false;  // leaves hold several elements: test their own boxes too
   Mat3 absR = Mat3::Identity();
   // Compact copies of what the cheap rejections read (most pairs the boxes pass are not
   // contacts: on 2,000-face spheres about 1 in 80 is), so that a rejection touches a few
@@ -190,7 +196,7 @@ struct ContactDetector::Impl {
     // Coincidence tolerance for boundaries in 2D: far below any feature, far above rounding.
     geo_tol = 1e-9 * std::max(scale, 1.0);
     area_tol = 1e-12 * std::max(scale * scale, 1.0);
-    bvh_a = detail::Bvh(ma, 0.0, kLeafSize);
+    bvh_a = detail::Bvh(ma, 0.0, leaf_size_for(ma), leaf_size_for(ma) == 1);
     // The boxes are single precision: widen B's by far more than the rounding of the
     // overlap test's few float operations on coordinates of this scale.
     double reach = ma.size() + mb.size();
@@ -200,7 +206,9 @@ struct ContactDetector::Impl {
     // exact tests could accept has overlapping boxes.
     // A pair the tests accept is within max(eps, depth) across the plane and in_plane along
     // it, so within max(eps, depth, hypot(eps, in_plane)) of B's element.
-    bvh_b = detail::Bvh(mb, std::max({eps, depth, std::hypot(eps, in_plane)}) + geo_tol + float_slack, kLeafSize);
+    bvh_b = detail::Bvh(mb, std::max({eps, depth, std::hypot(eps, in_plane)}) + geo_tol + float_slack, leaf_size_for(mb),
+                        leaf_size_for(mb) == 1);
+    element_boxes = leaf_size_for(ma) > 1 || leaf_size_for(mb) > 1;
     stack.resize(detail::stack_capacity(bvh_a, bvh_b));
     q_pts.resize(static_cast<std::size_t>(flat_a.max_face_points));
     std::size_t max_loops = 1;
@@ -219,6 +227,7 @@ struct ContactDetector::Impl {
     sin_max_tol = std::sin(max_tol());
     cos_max_tol = std::cos(max_tol());
     a_box.resize(bvh_a.nodes().size());
+    a_elem_box.resize(bvh_a.elements().size());
     for (const Face& F : mb.faces()) plane_b.push_back({F.normal, F.offset, 0});
     for (const Edge& E : mb.edges()) seg_b.push_back({mb.vertex(E.v0).p, E.dir, E.length, 0});
     plane_a.resize(ma.num_faces());
@@ -245,32 +254,50 @@ struct ContactDetector::Impl {
     return true;
   }
 
+  // Grows [lo, hi] by A's element x at the current pose (B's frame).
+  void grow_by_element(const detail::BvhElement& x, Vec3& lo, Vec3& hi) {
+    auto add = [&](VertexId v) {
+      const Vec3& p = world(v);
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    };
+    switch (x.kind) {
+      case ElementKind::kVertex:
+        add(VertexId(x.index));
+        break;
+      case ElementKind::kEdge:
+        add(a.edges()[static_cast<std::size_t>(x.index)].v0);
+        add(a.edges()[static_cast<std::size_t>(x.index)].v1);
+        break;
+      case ElementKind::kFace:
+        for (VertexId v : a.faces()[static_cast<std::size_t>(x.index)].vertices) add(v);
+        break;
+    }
+  }
+
+  // Does A's element at position ia of its BVH (posed) overlap B's element at ib?
+  bool element_boxes_overlap(int ia, int ib) {
+    PosedBox& P = a_elem_box[static_cast<std::size_t>(ia)];
+    if (P.stamp != stamp) {
+      P.stamp = stamp;
+      Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+      grow_by_element(bvh_a.elements()[static_cast<std::size_t>(ia)], lo, hi);
+      detail::round_out(0.5 * (lo + hi), 0.5 * (hi - lo), P.c, P.h);
+    }
+    const Eigen::Vector3f& c = bvh_b.element_centers()[static_cast<std::size_t>(ib)];
+    const Eigen::Vector3f& h = bvh_b.element_halves()[static_cast<std::size_t>(ib)];
+    return std::abs(P.c.x() - c.x()) <= P.h.x() + h.x() && std::abs(P.c.y() - c.y()) <= P.h.y() + h.y() &&
+           std::abs(P.c.z() - c.z()) <= P.h.z() + h.z();
+  }
+
   __attribute__((noinline)) void pose_box(PosedBox& P, const detail::BvhNode& N) {
     P.stamp = stamp;
     Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
     if (N.leaf()) {
       lo = Vec3::Constant(std::numeric_limits<double>::infinity());
       hi = -lo;
-      auto add = [&](VertexId v) {
-        const Vec3& p = world(v);
-        lo = lo.cwiseMin(p);
-        hi = hi.cwiseMax(p);
-      };
-      for (int k = 0; k < N.count; ++k) {
-        const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(N.element() + k)];
-        switch (x.kind) {
-          case ElementKind::kVertex:
-            add(VertexId(x.index));
-            break;
-          case ElementKind::kEdge:
-            add(a.edges()[static_cast<std::size_t>(x.index)].v0);
-            add(a.edges()[static_cast<std::size_t>(x.index)].v1);
-            break;
-          case ElementKind::kFace:
-            for (VertexId v : a.faces()[static_cast<std::size_t>(x.index)].vertices) add(v);
-            break;
-        }
-      }
+      for (int k = 0; k < N.count; ++k)
+        grow_by_element(bvh_a.elements()[static_cast<std::size_t>(N.element() + k)], lo, hi);
       detail::round_out(0.5 * (lo + hi), 0.5 * (hi - lo), P.c, P.h);
     } else {
       detail::round_out(pose.apply(N.center.cast<double>()), absR * N.half.cast<double>(), P.c, P.h);
@@ -602,7 +629,12 @@ struct ContactDetector::Impl {
     return near_band(A.n.dot(b.vertex(VertexId(ib)).p) - A.off);  // f-v
   }
 
-  void pair(const detail::BvhElement& x, const detail::BvhElement& y) {
+  // Elements at positions ia, ib of the two BVHs' element lists, in leaves that overlap.
+  void pair(int ia, int ib) {
+    const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
+    const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];
+    if (!detail::kinds_can_touch(detail::kind_bit(x.kind), detail::kind_bit(y.kind))) return;
+    if (element_boxes && !element_boxes_overlap(ia, ib)) return;
     ++pairs;
     if (may_touch(x.kind, x.index, y.kind, y.index)) exact(x, y);
   }
@@ -691,6 +723,7 @@ struct ContactDetector::Impl {
     if (++stamp == 0) {
       std::fill(aw_stamp.begin(), aw_stamp.end(), 0);
       for (PosedBox& P : a_box) P.stamp = 0;
+      for (PosedBox& P : a_elem_box) P.stamp = 0;
       for (Plane& P : plane_a) P.stamp = 0;
       for (Seg& S : seg_a) S.stamp = 0;
       stamp = 1;
@@ -714,7 +747,7 @@ struct ContactDetector::Impl {
     detail::descend(
         bvh_a, bvh_b,
         [this](std::int32_t ia, const detail::BvhNode& A, const detail::BvhNode& B) { return overlap(ia, A, B); },
-        stack.data(), stack.size(), [this](const detail::BvhElement& x, const detail::BvhElement& y) { pair(x, y); });
+        stack.data(), stack.size(), [this](int ia, int ib) { pair(ia, ib); });
     finish(cs);
     out = nullptr;
   }
