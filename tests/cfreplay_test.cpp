@@ -173,7 +173,8 @@ TEST_CASE("over whole trajectories: friction <= mu F_cy, and F and M recomputed 
       cf::Vec3 F = Fg;
       const cf::Vec3 o = s.pose.t_BA;  // moments about A's origin
       cf::Vec3 M = (s.pose.apply(pg_A) - o).cross(Fg);
-      for (int k = 0; k < r.force->num_pcs; ++k) {
+      // The PCs and the approaching contacts: each pushes by eq. (1) and adds to the totals.
+      for (int k = 0; k < r.force->num_pcs + r.force->num_approaching; ++k) {
         const cf::PcForce& f = r.force->pcs[k];
         const cf::Vec3 normal = f.R_WT.col(1);
         const double fn = f.F_W.dot(normal);

@@ -157,12 +157,20 @@ TEST_CASE("a contact farther than the CF's own is apart until it touches; the CF
   CHECK(r.cf == CfId(0));
   CHECK(r.partial_cover);
   CHECK(r.contacts.num_planes() == 2);
+  // The wall's contact is reported as approaching: the face pair, 0.3 mm away, its normal
+  // (into A) along +x.
+  REQUIRE(r.num_approaching == 1);
+  CHECK(r.approaching[0].pc.type == PcType::kFF);
+  CHECK(r.approaching[0].distance == Approx(0.3).margin(1e-9));
+  CHECK(r.approaching[0].R_WT.col(1).x() == Approx(1).margin(1e-12));
   // Approaching: still apart at 0.01 mm (witnesses keep non-contacts at least that far).
   CHECK(id.step(at(-0.1, 0.01)).status == IdStatus::kMatchedPrevious);
-  // Touching (within touch_distance = 0.001 mm): gained.
+  CHECK(id.last().num_approaching == 1);
+  // Touching (within touch_distance = 0.001 mm): gained, no longer approaching.
   CHECK(id.step(at(-0.1, 0.0005)).status == IdStatus::kMatchedNeighbour);
   CHECK(id.last().cf == CfId(3));
   CHECK_FALSE(id.last().partial_cover);
+  CHECK(id.last().num_approaching == 0);
   // Leaving: the CF is kept while the wall's contact is within epsilon.
   CHECK(id.step(at(-0.1, 0.5)).status == IdStatus::kMatchedPrevious);
   CHECK(id.last().cf == CfId(3));

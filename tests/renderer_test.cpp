@@ -204,6 +204,49 @@ TEST_CASE("full servo step: the cube lands on the L-block floor and slides into 
   CHECK(res->status == cf::RenderStatus::kOk);
 }
 
+TEST_CASE("a second plane's contact pushes from epsilon on, without a step at its gain", "[renderer]") {
+  // The cube resting 0.5 mm into the floor's band slides towards the wall, 10 um per tick,
+  // from 3 mm away to 0.2 mm into it. The wall's normal force (of its PC, or of its contact
+  // while approaching) must follow eq. (1) tick by tick: at most K * 10 um of change per
+  // tick. Without approaching contacts it steps at the gain, which comes when the wall is as
+  // near as the CF's own PC (docs/runtime.md, Identification).
+  const cf::CfGraph g = corner_graph();
+  auto wall_push = [](const cf::HapticResult& res) {
+    double f = 0;
+    for (int k = 0; k < res.force->num_pcs + res.force->num_approaching; ++k) {
+      const cf::PcForce& pf = res.force->pcs[k];
+      if (pf.R_WT.col(1).x() > 0.99) f += pf.F_cy;
+    }
+    return f;
+  };
+  for (const bool approaching : {true, false}) {
+    cf::Params P;
+    P.render_approaching = approaching;
+    cf::HapticRenderer r(g, P);
+    double t = 0, prev = 0, max_step = 0, first_push_gap = -1;
+    bool gained = false;
+    for (int i = 0; i <= 320; ++i) {
+      const double gap = 3.0 - 0.01 * i;  // mm between the cube's -x face and the wall
+      const cf::HapticResult& res = r.step(at(35 + gap, 35.5, 40), t += 0.001);
+      const double f = wall_push(res);
+      if (i > 0) max_step = std::max(max_step, std::abs(f - prev));
+      if (f > 0 && first_push_gap < 0) first_push_gap = gap;
+      gained = gained || res.cf == cf::CfId(2);
+      prev = f;
+    }
+    CHECK(gained);
+    CHECK(prev == Approx(2.3 * 1.2).margin(1e-9));  // 0.2 mm deep: K (epsilon - d)
+    if (approaching) {
+      CHECK(first_push_gap < 1.0);
+      CHECK(first_push_gap > 0.98);
+      CHECK(max_step <= 2.3 * 0.01 + 1e-9);
+    } else {
+      // Gained when as near as the floor's PC (0.5 mm, + touch_distance): K (1 - 0.501).
+      CHECK(max_step > 1.1);
+    }
+  }
+}
+
 TEST_CASE("the servo step allocates nothing", "[renderer]") {
   const cf::CfGraph g = corner_graph();
   cf::HapticRenderer r(g);

@@ -16,6 +16,7 @@ const char* to_string(Regime regime) {
     case Regime::kStick: return "stick";
     case Regime::kMaxStatic: return "max_static";
     case Regime::kKinetic: return "kinetic";
+    case Regime::kApproaching: return "approaching";
   }
   return "none";
 }
@@ -110,7 +111,8 @@ bool ForceModel::dominated(const ContactPc& x, const ContactPc& y) const {
 }
 
 const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactPc* pcs, int n,
-                                    const PriorMotion& prior, bool conservative) {
+                                    const PriorMotion& prior, bool conservative,
+                                    const ContactPc* approaching, int n_approaching) {
   const Params& P = params_;
   ForceResult& r = result_;
   r.num_pcs = 0;
@@ -299,7 +301,8 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
         break;
       case Regime::kMaxStatic: Ff = -P.mu_static * f.F_cy * task_dir(dir_static[k]); break;  // eq. (6)
       case Regime::kKinetic: Ff = -P.mu_kinetic * f.F_cy * task_dir(dir_kinetic[k]); break;  // eq. (5)
-      case Regime::kNone: break;
+      case Regime::kNone:
+      case Regime::kApproaching: break;
     }
     f.F_T = Vec3(Ff.x(), f.F_cy, Ff.z());
     f.F_W = f.R_WT * f.F_T;
@@ -322,6 +325,32 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
     }
   }
   r.num_pcs = m;
+  // Approaching contacts: eq. (1) along their normals, nothing else (no slot: when gained a
+  // PC starts with a fresh anchor, as any new PC does).
+  r.num_approaching = 0;
+  if (!conservative && P.render_approaching && approaching != nullptr) {
+    for (int i = 0; i < n_approaching; ++i) {
+      if (m + r.num_approaching == ForceResult::kMaxPcs) {
+        r.truncated = true;
+        break;
+      }
+      const ContactPc& c = approaching[i];
+      PcForce& f = r.pcs[static_cast<std::size_t>(m + r.num_approaching++)];
+      f = PcForce();
+      f.pc = c.pc;
+      f.extent = pc_extent(c.pc.type);
+      f.R_WT = c.R_WT;
+      f.origin_W = c.origin_W;
+      f.p_W = c.p_W;
+      f.distance = c.distance;
+      f.F_cy = std::max(0.0, P.stiffness_N_per_mm * (P.epsilon_mm - c.distance));
+      f.regime = Regime::kApproaching;
+      f.F_T = Vec3(0.0, f.F_cy, 0.0);
+      f.F_W = f.R_WT * f.F_T;
+      F_c += f.F_W;
+      M_c += (f.p_W - r.reference_W).cross(f.F_W);
+    }
+  }
   for (Slot& s : slots_)
     if (s.used && !s.seen) s = Slot();
 

@@ -186,6 +186,25 @@ struct CfIdentifier::Impl {
   }
 
   void set_result(IdStatus st, CfId id, const int* chosen, int n, double misfit, bool partial) {
+    // The planes the CF leaves apart: their nearest contacts approach.
+    const ContactSet& cs = res.contacts;
+    double farthest = 0;
+    std::array<bool, kMaxGroups> held{};
+    for (int i = 0; i < n; ++i) {
+      farthest = std::max(farthest, cs[chosen[i]].distance);
+      held[static_cast<std::size_t>(cs[chosen[i]].plane)] = true;
+    }
+    res.num_approaching = 0;
+    for (int g = 0; g < cs.num_planes() && partial; ++g) {
+      if (held[static_cast<std::size_t>(g)] || accounted(g, chosen, n, farthest + prm.touch_distance) != 0) continue;
+      int best = -1;
+      for (int k = 0; k < count[static_cast<std::size_t>(g)]; ++k) {
+        const int i = members[static_cast<std::size_t>(g)][static_cast<std::size_t>(k)];
+        if (best < 0 || cs[i].distance < cs[best].distance) best = i;
+      }
+      if (best >= 0 && res.num_approaching < static_cast<int>(res.approaching.size()))
+        res.approaching[static_cast<std::size_t>(res.num_approaching++)] = cs[best];
+    }
     res.status = st;
     res.cf = id;
     res.misfit = misfit;
@@ -208,6 +227,7 @@ struct CfIdentifier::Impl {
     res.cf = CfId();
     res.misfit = 0;
     res.partial_cover = false;
+    res.num_approaching = 0;
     if (cs.empty()) {
       res.status = IdStatus::kNoContact;
       prev = CfId();

@@ -53,13 +53,15 @@ void HapticRenderer::reset() {
 const HapticResult& HapticRenderer::step(const Pose& pose, double t_s) {
   Impl& m = *impl_;
   const detail::IdentView v = m.ident.step(pose);
-  return step_identified(pose, t_s, v.cf, v.cf_pcs, v.n_cf, v.detected, v.n_detected, v.status);
+  return step_identified(pose, t_s, v.cf, v.cf_pcs, v.n_cf, v.detected, v.n_detected, v.status, v.approaching,
+                         v.n_approaching);
 }
 
 const HapticResult& HapticRenderer::step_identified(const Pose& pose, double t_s, CfId cf,
                                                     const ContactPc* cf_pcs, int n_cf,
                                                     const ContactPc* detected, int n_detected,
-                                                    const char* identification) {
+                                                    const char* identification, const ContactPc* approaching,
+                                                    int n_approaching) {
   Impl& m = *impl_;
   HapticResult& r = m.result;
   r.t_s = t_s;
@@ -82,7 +84,7 @@ const HapticResult& HapticRenderer::step_identified(const Pose& pose, double t_s
     r.pcs = cur;
     if (pm.transition_in_graph) {
       r.status = RenderStatus::kOk;
-      fr = &m.force.step(pose, t_s, m.ordered.data(), n, pm, false);
+      fr = &m.force.step(pose, t_s, m.ordered.data(), n, pm, false, approaching, n_approaching);
     } else {
       r.status = RenderStatus::kUnlistedTransition;
       const bool have_detected = n_detected > 0 && detected != nullptr;

@@ -24,6 +24,8 @@ IdentView IdentAdapter::step(const Pose& pose) {
   v.detected = id.contacts.begin();
   v.n_detected = id.contacts.size();
   v.status = to_string(id.status);
+  v.approaching = id.approaching.data();
+  v.n_approaching = id.has_cf() ? id.num_approaching : 0;
   return v;
 }
 

@@ -16,6 +16,8 @@ struct IdentView {
   const ContactPc* detected = nullptr;
   int n_detected = 0;
   const char* status = "";
+  const ContactPc* approaching = nullptr;
+  int n_approaching = 0;
 };
 
 class IdentAdapter {

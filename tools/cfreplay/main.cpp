@@ -21,7 +21,8 @@ int main(int argc, char** argv) {
       "moment of every servo tick.\n"
       "  POSES.csv: header t,tx,ty,tz,qw,qx,qy,qz (s, mm, unit quaternion of R; x_B = R x_A + t)\n"
       "  OUT.csv:   t,cf,pcs,motion,Fx,Fy,Fz,Mx,My,Mz (world; N, N mm), then the same in A's\n"
-      "             frame (FAx..MAz), the status and the per-PC friction regimes.\n"
+      "             frame (FAx..MAz), the status and the per-PC friction regimes\n"
+      "             (then approaching:PC for each contact pushing by eq. (1) alone).\n"
       "Defaults are the paper's: m 0.5 kg, g 9.8 N/kg along -y, K 2.3 N/mm, K_p 1.6 N/mm,\n"
       "mu 0.7, mu_D 0.08, epsilon 1 mm (docs/force-model.md).",
       "cfreplay"};

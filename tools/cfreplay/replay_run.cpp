@@ -18,8 +18,12 @@ Row make_row(const HapticResult& r) {
   row.F_A = r.F_A;
   row.M_A = r.M_A;
   row.status = to_string(r.status);
-  if (r.force != nullptr)
+  if (r.force != nullptr) {
     for (int k = 0; k < r.force->num_pcs; ++k) row.regimes += (k ? ";" : "") + std::string(to_string(r.force->pcs[k].regime));
+    // Approaching contacts (eq. (1) only) follow, named, as they are not among the pcs.
+    for (int k = r.force->num_pcs; k < r.force->num_pcs + r.force->num_approaching; ++k)
+      row.regimes += (k ? ";" : "") + std::string("approaching:") + to_string(r.force->pcs[k].pc);
+  }
   return row;
 }
 

@@ -22,8 +22,11 @@ enum class Regime : std::uint8_t {
   kStick,         ///< eq. (4): static friction -K_p s_pj, with eq. (3) holding
   kMaxStatic,     ///< eq. (6): largest static friction mu F_cy
   kKinetic,       ///< eq. (5): kinetic friction mu_D F_cy
+  /// Not a PC of the CF: a contact approaching within epsilon in a plane the CF leaves
+  /// apart, rendered with eq. (1) alone (no friction) so that its gain does not step.
+  kApproaching,
 };
-/// "none", "impact_static", "stick", "max_static", "kinetic".
+/// "none", "impact_static", "stick", "max_static", "kinetic", "approaching".
 const char* to_string(Regime regime);
 
 /// Per-PC diagnostics and force.
@@ -47,8 +50,10 @@ struct PcForce {
 /// Result of one force evaluation. Fixed capacity: no heap.
 struct ForceResult {
   static constexpr int kMaxPcs = 16;
+  /// The rendered PCs (num_pcs), then the approaching contacts (regime kApproaching).
   std::array<PcForce, kMaxPcs> pcs{};
   int num_pcs = 0;
+  int num_approaching = 0;  ///< entries after the PCs; num_pcs + num_approaching <= kMaxPcs
   bool truncated = false;  ///< more contacts than kMaxPcs were given; the rest are ignored
   MotionType motion = MotionType::kNone;
   /// Rendered with the conservative laws (normal force eq. (1) + kinetic friction eq. (5)
@@ -87,8 +92,12 @@ class ForceModel {
   ///                      here); ignored when conservative.
   /// @param conservative  no CF or transition of the graph fits: normal force + kinetic
   ///                      friction on the contacts that no other contact dominates.
+  /// @param approaching, n_approaching  contacts within epsilon that the CF leaves apart
+  ///                      (Identification::approaching): eq. (1) normal force only, when
+  ///                      Params::render_approaching; ignored when conservative.
   const ForceResult& step(const Pose& pose, double t_s, const ContactPc* pcs, int n,
-                          const PriorMotion& prior, bool conservative = false);
+                          const PriorMotion& prior, bool conservative = false,
+                          const ContactPc* approaching = nullptr, int n_approaching = 0);
 
   const ForceResult& result() const { return result_; }
   const Params& params() const { return params_; }

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 
 namespace cf {
 
@@ -63,6 +64,12 @@ struct Identification {
   /// are apart (farther than every PC of the CF, and than touch_distance) or alternative
   /// readings of the chosen PCs (degenerate touches).
   bool partial_cover = false;
+  /// Contacts approaching within epsilon that the CF leaves apart: of each contact plane
+  /// the CF does not hold and whose contacts are all apart, the nearest one (best fit among
+  /// equals). A renderer gives them eq. (1)'s normal force so that the force does not step
+  /// when they are gained (docs/force-model.md). Empty when no CF was identified.
+  std::array<ContactPc, 8> approaching{};
+  int num_approaching = 0;
   bool has_cf() const { return cf.valid(); }
 };
 

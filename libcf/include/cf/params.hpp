@@ -57,6 +57,14 @@ struct Params {
   /// motion at all (they pass the "along" test trivially).
   double motion_noise_mm = 1e-9;
 
+  // --- Contacts approaching in a plane the CF leaves apart ---
+  /// Identification gains a contact of a new plane when it touches (within
+  /// IdentificationParams::touch_distance), not when it comes within epsilon; true renders
+  /// such approaching contacts with eq. (1) meanwhile (normal force only), so that the force
+  /// rises from 0 at epsilon as eq. (1) intends instead of stepping by up to K epsilon at the
+  /// gain. false: only the CF's PCs push (docs/force-model.md).
+  bool render_approaching = true;
+
   // --- Smoothing (paper section 4.5). Both off by default so that eq. (1) holds exactly. ---
   /// N. When > 0 and the prior motion is compliant (MT2..MT5), a PC keeps its previous F_cy
   /// while the new eq. (1) value differs from the held one by less than this (a deadband

@@ -59,11 +59,13 @@ class HapticRenderer {
 
   /// The same without detection: renders given identification results. `cf` is the chosen
   /// CF (invalid when none fits), `cf_pcs` its PCs, `detected` every candidate contact (used
-  /// for the conservative rendering when no CF fits). For tests and for applications with
-  /// their own identification.
+  /// for the conservative rendering when no CF fits), `approaching` the contacts within
+  /// epsilon in planes the CF leaves apart (Identification::approaching; eq. (1) only). For
+  /// tests and for applications with their own identification.
   const HapticResult& step_identified(const Pose& pose, double t_s, CfId cf, const ContactPc* cf_pcs,
                                       int n_cf, const ContactPc* detected, int n_detected,
-                                      const char* identification = "");
+                                      const char* identification = "", const ContactPc* approaching = nullptr,
+                                      int n_approaching = 0);
 
   /// Forgets the history (previous CF, anchors, filters).
   void reset();
