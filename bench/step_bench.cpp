@@ -277,7 +277,8 @@ void BM_ServoStepIntrinsic(benchmark::State& state) {
       a = std::chrono::steady_clock::now();
       const cf::HapticResult& r = split.step_identified(k.pose, k.t, id.cf, id.cf_pcs.data(),
                                                         id.has_cf() ? id.num_cf_pcs : 0, id.contacts.begin(),
-                                                        id.contacts.size(), cf::to_string(id.status));
+                                                        id.contacts.size(), cf::to_string(id.status),
+                                                        id.approaching.data(), id.has_cf() ? id.num_approaching : 0);
       b = std::chrono::steady_clock::now();
       t.force_ns = std::min(t.force_ns, elapsed_ns(a, b));
       nondet += !(t.F_W == r.F_W);

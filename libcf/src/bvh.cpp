@@ -14,16 +14,7 @@ struct Item {
 
 }  // namespace
 
-void round_out(const Vec3& center, const Vec3& half, Eigen::Vector3f& c, Eigen::Vector3f& h) {
-  // Rounding to float errs by at most 2^-24 relative: widen by the centre's error
-  // (< 1.2e-7 |center|) and then by 3e-7 relative, more than the half extent's own rounding.
-  for (int k = 0; k < 3; ++k) {
-    c[k] = static_cast<float>(center[k]);
-    h[k] = static_cast<float>(half[k] + 1.2e-7 * std::abs(center[k])) * 1.0000003f;
-  }
-}
-
-Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, bool split_kinds) {
+Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
   leaf_size = std::clamp(leaf_size, 1, 255);
   std::vector<Item> items;
   items.reserve(m.num_vertices() + m.num_edges() + m.num_faces());
@@ -71,30 +62,22 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, bool split_kinds) {
     BvhNode& n = nodes_[static_cast<std::size_t>(t.node)];
     round_out(0.5 * (lo + hi), 0.5 * (hi - lo) + Vec3::Constant(inflate), n.center, n.half);
     for (std::int32_t i = t.begin; i < t.end; ++i) n.kinds |= kind_bit(items[static_cast<std::size_t>(i)].e.kind);
-    const ElementKind k0 = items[static_cast<std::size_t>(t.begin)].e.kind;
-    std::int32_t mid = t.begin;
-    while (split_kinds && mid < t.end && items[static_cast<std::size_t>(mid)].e.kind == k0) ++mid;
-    if (!split_kinds) mid = t.end;
-    if (mid == t.end && t.end - t.begin <= leaf_size) {
+    if (t.end - t.begin <= leaf_size) {
       n.child = ~t.begin;
       n.count = static_cast<std::uint8_t>(t.end - t.begin);
       continue;
     }
-    // Items are sorted by kind: while a range holds several kinds, split off its first kind
-    // (vertices | edges, faces; then edges | faces), so that subtrees are of one kind.
-    if (mid == t.end) {
-      // One kind: median split along the longest axis of the centroids.
-      int axis = 0;
-      (chi - clo).maxCoeff(&axis);
-      mid = (t.begin + t.end) / 2;
-      std::nth_element(items.begin() + t.begin, items.begin() + mid, items.begin() + t.end,
-                       [axis](const Item& x, const Item& y) {
-                         const double cx = x.lo[axis] + x.hi[axis], cy = y.lo[axis] + y.hi[axis];
-                         if (cx != cy) return cx < cy;
-                         if (x.e.kind != y.e.kind) return x.e.kind < y.e.kind;
-                         return x.e.index < y.e.index;
-                       });
-    }
+    // Median split along the longest axis of the centroids.
+    int axis = 0;
+    (chi - clo).maxCoeff(&axis);
+    const std::int32_t mid = (t.begin + t.end) / 2;
+    std::nth_element(items.begin() + t.begin, items.begin() + mid, items.begin() + t.end,
+                     [axis](const Item& x, const Item& y) {
+                       const double cx = x.lo[axis] + x.hi[axis], cy = y.lo[axis] + y.hi[axis];
+                       if (cx != cy) return cx < cy;
+                       if (x.e.kind != y.e.kind) return x.e.kind < y.e.kind;
+                       return x.e.index < y.e.index;
+                     });
     const auto l = static_cast<std::int32_t>(nodes_.size());
     nodes_.emplace_back();
     nodes_.emplace_back();

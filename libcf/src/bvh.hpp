@@ -3,10 +3,9 @@
 // one polyhedron, in its own frame, and the simultaneous descent of two such trees with
 // one of them posed. Built once; queries allocate nothing.
 //
-// The top levels split by element kind (vertices | edges, faces), so that each node knows
-// which kinds lie below it and a descent skips node pairs that cannot hold a PC type
-// (vertex against vertex or edge, edge against vertex) without opening them. Leaves hold one
-// element.
+// Each node knows which element kinds lie below it, so that a descent skips node pairs that
+// cannot hold a PC type (vertex against vertex or edge, edge against vertex) without opening
+// them.
 
 #include <cf/polyhedron.hpp>
 #include <cf/types.hpp>
@@ -27,7 +26,7 @@ inline std::uint8_t kind_bit(ElementKind k) { return static_cast<std::uint8_t>(1
 
 /// A node: an axis-aligned box (single precision, rounded outwards, so it still bounds its
 /// elements; 32 bytes so that descents stay in cache) and either two children (`child`,
-/// `child + 1`) or a few elements of one kind (leaf).
+/// `child + 1`) or a few elements (leaf).
 struct BvhNode {
   Eigen::Vector3f center;  // mm, model frame
   Eigen::Vector3f half;    // mm, half extents, >= 0
@@ -40,16 +39,20 @@ struct BvhNode {
   std::int32_t element() const { return ~child; }
 };
 
-/// Sets `c`, `h` to a single-precision box that contains the box (center, half).
-void round_out(const Vec3& center, const Vec3& half, Eigen::Vector3f& c, Eigen::Vector3f& h);
+/// Sets `c`, `h` to a single-precision box that contains the box (center, half). Rounding
+/// to float errs by at most 2^-24 relative: widen by the centre's error (< 1.2e-7 |center|)
+/// and then by 3e-7 relative, more than the half extent's own rounding.
+inline void round_out(const Vec3& center, const Vec3& half, Eigen::Vector3f& c, Eigen::Vector3f& h) {
+  c = center.cast<float>();
+  h = ((half + 1.2e-7 * center.cwiseAbs()).cast<float>() * 1.0000003f);
+}
 
 class Bvh {
  public:
   Bvh() = default;
   /// `inflate` mm is added to every box on each side.
-  /// `split_kinds`: the top levels split by element kind, leaves hold one kind; else
-  /// leaves mix the kinds of spatially close elements.
-  Bvh(const Polyhedron& m, double inflate, int leaf_size, bool split_kinds = true);
+  /// Leaves of at most `leaf_size` spatially close elements of any kind.
+  Bvh(const Polyhedron& m, double inflate, int leaf_size);
   /// Per element (in elements() order), its own box (inflated like the nodes').
   const std::vector<Eigen::Vector3f>& element_centers() const { return elem_c_; }
   const std::vector<Eigen::Vector3f>& element_halves() const { return elem_h_; }

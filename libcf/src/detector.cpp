@@ -113,10 +113,10 @@ double segment_segment_2d(const Vec2& a, const Vec2& b, const Vec2& c, const Vec
 
 }  // namespace
 
-// BVH leaves of a model: one element, and the top levels split by kind, for small models
-// (with bigger leaves, leaf boxes of the paper's cube and L-block overlap everything and
-// detection took 1.5x as long); leaves of 4 spatially close elements of any kind for big
-// models, whose deep trees cost more node visits than the element boxes tested in the
+// BVH leaves of a model: one element for small models (with bigger leaves, leaf boxes of the
+// paper's cube and L-block overlap everything), posed like inner nodes (cheaper than exact
+// boxes there: 2.4 against 2.8 us per tick); leaves of 4 spatially close elements for big
+// models, whose deep trees cost more node visits than the element boxes then tested in the
 // leaves (2,000-face spheres: 0.68x the time). docs/performance.md has the figures.
 constexpr std::size_t kBigModelElements = 256;
 int leaf_size_for(const Polyhedron& m) {
@@ -196,7 +196,7 @@ struct ContactDetector::Impl {
     // Coincidence tolerance for boundaries in 2D: far below any feature, far above rounding.
     geo_tol = 1e-9 * std::max(scale, 1.0);
     area_tol = 1e-12 * std::max(scale * scale, 1.0);
-    bvh_a = detail::Bvh(ma, 0.0, leaf_size_for(ma), leaf_size_for(ma) == 1);
+    bvh_a = detail::Bvh(ma, 0.0, leaf_size_for(ma));
     // The boxes are single precision: widen B's by far more than the rounding of the
     // overlap test's few float operations on coordinates of this scale.
     double reach = ma.size() + mb.size();
@@ -206,8 +206,7 @@ struct ContactDetector::Impl {
     // exact tests could accept has overlapping boxes.
     // A pair the tests accept is within max(eps, depth) across the plane and in_plane along
     // it, so within max(eps, depth, hypot(eps, in_plane)) of B's element.
-    bvh_b = detail::Bvh(mb, std::max({eps, depth, std::hypot(eps, in_plane)}) + geo_tol + float_slack, leaf_size_for(mb),
-                        leaf_size_for(mb) == 1);
+    bvh_b = detail::Bvh(mb, std::max({eps, depth, std::hypot(eps, in_plane)}) + geo_tol + float_slack, leaf_size_for(mb));
     element_boxes = leaf_size_for(ma) > 1 || leaf_size_for(mb) > 1;
     stack.resize(detail::stack_capacity(bvh_a, bvh_b));
     q_pts.resize(static_cast<std::size_t>(flat_a.max_face_points));
@@ -234,9 +233,10 @@ struct ContactDetector::Impl {
     seg_a.resize(ma.num_edges());
   }
 
-  // Does A's BVH node `ia` (posed) overlap B's node `B`? A leaf's box in B's frame is exact
-  // (from its element's posed vertices); an inner node is an oriented box, tested on B's
-  // axes and its own (6 of the 15 separating axes: the cross axes add little here).
+  // Does A's BVH node `ia` (posed) overlap B's node `B`? With element boxes (big models) a
+  // leaf's box in B's frame is exact (from its elements' posed vertices); other nodes are
+  // oriented boxes, tested on B's axes and, inner nodes, on their own (6 of the 15
+  // separating axes: the cross axes add little here).
   __attribute__((always_inline)) bool overlap(std::int32_t ia, const detail::BvhNode& A, const detail::BvhNode& B) {
     PosedBox& P = a_box[static_cast<std::size_t>(ia)];
     if (P.stamp != stamp) pose_box(P, A);
@@ -293,7 +293,7 @@ struct ContactDetector::Impl {
   __attribute__((noinline)) void pose_box(PosedBox& P, const detail::BvhNode& N) {
     P.stamp = stamp;
     Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
-    if (N.leaf()) {
+    if (N.leaf() && element_boxes) {
       lo = Vec3::Constant(std::numeric_limits<double>::infinity());
       hi = -lo;
       for (int k = 0; k < N.count; ++k)
