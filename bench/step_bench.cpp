@@ -21,6 +21,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -143,18 +144,24 @@ void BM_DetectOnly(benchmark::State& state) {
 }
 BENCHMARK(BM_DetectOnly)->MinTime(1.0)->Unit(benchmark::kMicrosecond);
 
-// The force model alone (two f-f PCs sliding along the L-block's corner: MT2.b with the
-// freedoms computed every tick, the costliest case).
-void BM_ForceOnly(benchmark::State& state) {
-  const cf::Polyhedron A = cf::testmodels::cube(), B = cf::testmodels::l_block();
-  cf::ForceModel model(A, B);
-  cf::ContactPc cs[2];
+// The cube's floor and wall f-f PCs in the L-block's inner corner, 0.5 mm into the band.
+std::array<cf::ContactPc, 2> corner_pcs() {
+  std::array<cf::ContactPc, 2> cs;
   cs[0].pc = {cf::PcType::kFF, 2, 4};
   cs[0].distance = 0.5;
   cs[0].R_WT << 1, 0, 0, 0, 1, 0, 0, 0, 1;
   cs[1].pc = {cf::PcType::kFF, 5, 5};
   cs[1].distance = 0.5;
   cs[1].R_WT << 0, 1, 0, 0, 0, 1, 1, 0, 0;
+  return cs;
+}
+
+// The force model alone (two f-f PCs sliding along the L-block's corner: MT2.b with the
+// freedoms computed every tick, the costliest case).
+void BM_ForceOnly(benchmark::State& state) {
+  const cf::Polyhedron A = cf::testmodels::cube(), B = cf::testmodels::l_block();
+  cf::ForceModel model(A, B);
+  std::array<cf::ContactPc, 2> cs = corner_pcs();
   cf::PriorMotion pm;
   pm.type = cf::MotionType::kMT2a;
   double t = 0, z = 40;
@@ -168,7 +175,7 @@ void BM_ForceOnly(benchmark::State& state) {
     z += 0.02;
     if (z > 60) z = 20;
     const auto a = std::chrono::steady_clock::now();
-    const cf::ForceResult& r = model.step(p, t += 0.001, cs, 2, pm);
+    const cf::ForceResult& r = model.step(p, t += 0.001, cs.data(), 2, pm);
     const auto b = std::chrono::steady_clock::now();
     benchmark::DoNotOptimize(r.F_W.data());
     if (ns.size() < ns.capacity()) ns.push_back(std::chrono::duration<double, std::nano>(b - a).count());
@@ -334,13 +341,7 @@ BENCHMARK(BM_ServoStepIntrinsic)->Iterations(static_cast<benchmark::IterationCou
 void BM_ForceOnlyIntrinsic(benchmark::State& state) {
   const cf::Polyhedron A = cf::testmodels::cube(), B = cf::testmodels::l_block();
   cf::ForceModel model(A, B);
-  cf::ContactPc cs[2];
-  cs[0].pc = {cf::PcType::kFF, 2, 4};
-  cs[0].distance = 0.5;
-  cs[0].R_WT << 1, 0, 0, 0, 1, 0, 0, 0, 1;
-  cs[1].pc = {cf::PcType::kFF, 5, 5};
-  cs[1].distance = 0.5;
-  cs[1].R_WT << 0, 1, 0, 0, 0, 1, 1, 0, 0;
+  std::array<cf::ContactPc, 2> cs = corner_pcs();
   cf::PriorMotion pm;
   pm.type = cf::MotionType::kMT2a;
   constexpr int kTicks = 2000;
@@ -356,7 +357,7 @@ void BM_ForceOnlyIntrinsic(benchmark::State& state) {
       z += 0.02;
       if (z > 60) z = 20;
       const auto a = std::chrono::steady_clock::now();
-      const cf::ForceResult& r = model.step(p, 0.001 * (i + 1), cs, 2, pm);
+      const cf::ForceResult& r = model.step(p, 0.001 * (i + 1), cs.data(), 2, pm);
       const auto b = std::chrono::steady_clock::now();
       benchmark::DoNotOptimize(r.F_W.data());
       ns[static_cast<std::size_t>(i)] = std::min(ns[static_cast<std::size_t>(i)], elapsed_ns(a, b));

@@ -104,6 +104,20 @@ ForceModel::Slot* ForceModel::new_slot(const Pc& pc) {
   return nullptr;
 }
 
+namespace {
+// A PcForce carrying the contact's geometry (type, task frame, point, distance), no force yet.
+PcForce with_geometry(const ContactPc& c) {
+  PcForce f;
+  f.pc = c.pc;
+  f.extent = pc_extent(c.pc.type);
+  f.R_WT = c.R_WT;
+  f.origin_W = c.origin_W;
+  f.p_W = c.p_W;
+  f.distance = c.distance;
+  return f;
+}
+}  // namespace
+
 bool ForceModel::dominated(const ContactPc& x, const ContactPc& y) const {
   if (x.pc == y.pc) return false;
   return on_closure(*A_, kind_a(x.pc.type), x.pc.a, kind_a(y.pc.type), y.pc.a) &&
@@ -153,13 +167,7 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
   for (int k = 0; k < m; ++k) {
     const ContactPc& c = pcs[idx[k]];
     PcForce& f = r.pcs[static_cast<std::size_t>(k)];
-    f = PcForce();
-    f.pc = c.pc;
-    f.extent = pc_extent(c.pc.type);
-    f.R_WT = c.R_WT;
-    f.origin_W = c.origin_W;
-    f.p_W = c.p_W;
-    f.distance = c.distance;
+    f = with_geometry(c);
     const Vec3 nrm = c.R_WT.col(1);
 
     // Motion of the material point of A at p_j over the tick.
@@ -336,13 +344,7 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
       }
       const ContactPc& c = approaching[i];
       PcForce& f = r.pcs[static_cast<std::size_t>(m + r.num_approaching++)];
-      f = PcForce();
-      f.pc = c.pc;
-      f.extent = pc_extent(c.pc.type);
-      f.R_WT = c.R_WT;
-      f.origin_W = c.origin_W;
-      f.p_W = c.p_W;
-      f.distance = c.distance;
+      f = with_geometry(c);
       f.F_cy = std::max(0.0, P.stiffness_N_per_mm * (P.epsilon_mm - c.distance));
       f.regime = Regime::kApproaching;
       f.F_T = Vec3(0.0, f.F_cy, 0.0);
