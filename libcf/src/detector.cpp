@@ -130,7 +130,6 @@ struct ContactDetector::Impl {
   detail::Bvh bvh_a, bvh_b;
   FlatFaces flat_a, flat_b;
   std::vector<EdgeWings> wings_a, wings_b;
-  std::vector<double> extent_a, extent_b;  // per face, sqrt(area): scale of its tilt
   // sin of the angular tolerance of each face (from its extent) and edge (from its length):
   // the trigonometry of the per-pair tests, done once.
   std::vector<double> sin_tol_face_a, sin_tol_face_b, sin_tol_edge_a, sin_tol_edge_b;
@@ -217,10 +216,9 @@ struct ContactDetector::Impl {
         4 + 4 * std::max(flat_a.max_face_points, flat_b.max_face_points)));
     aw.resize(ma.num_vertices());
     aw_stamp.assign(ma.num_vertices(), 0);
-    for (const Face& F : ma.faces()) extent_a.push_back(std::sqrt(F.area));
-    for (const Face& F : mb.faces()) extent_b.push_back(std::sqrt(F.area));
-    for (double x : extent_a) sin_tol_face_a.push_back(std::sin(tol_for(x)));
-    for (double x : extent_b) sin_tol_face_b.push_back(std::sin(tol_for(x)));
+    // A face's tilt scale is its size, sqrt(area).
+    for (const Face& F : ma.faces()) sin_tol_face_a.push_back(std::sin(tol_for(std::sqrt(F.area))));
+    for (const Face& F : mb.faces()) sin_tol_face_b.push_back(std::sin(tol_for(std::sqrt(F.area))));
     for (const Edge& E : ma.edges()) sin_tol_edge_a.push_back(std::sin(tol_for(E.length)));
     for (const Edge& E : mb.edges()) sin_tol_edge_b.push_back(std::sin(tol_for(E.length)));
     sin_max_tol = std::sin(max_tol());
@@ -312,6 +310,13 @@ struct ContactDetector::Impl {
     if (prm.angular_tolerance > 0) return prm.angular_tolerance;
     const double t = std::atan(eps / std::max(extent, 1e-12));
     return std::clamp(t, prm.min_angular_tolerance, prm.max_angular_tolerance);
+  }
+
+  // Does the solid around edge E stay on the +n side of a contact plane (n in E's model
+  // frame)? Both wings (the in-face directions into its faces) may dip below the plane by
+  // at most their face's angular tolerance.
+  static bool wedge_above(const Vec3& n, const EdgeWings& w, const Edge& E, const std::vector<double>& sin_tol_face) {
+    return n.dot(w.left) >= -sin_tol_face[E.left.index()] && n.dot(w.right) >= -sin_tol_face[E.right.index()];
   }
 
   const Vec3& world(VertexId v) {
@@ -434,9 +439,7 @@ struct ContactDetector::Impl {
     const Vec3 dW = pose.R_BA * E.dir;
     const double sin_ang = std::min(1.0, std::abs(dW.dot(F.normal)));
     if (sin_ang > sin_max_tol) return;
-    const EdgeWings& w = wings_a[static_cast<std::size_t>(e)];
-    if (F.normal.dot(pose.R_BA * w.left) < -sin_tol_face_a[E.left.index()] ||
-        F.normal.dot(pose.R_BA * w.right) < -sin_tol_face_a[E.right.index()])
+    if (!wedge_above(pose.R_BA.transpose() * F.normal, wings_a[static_cast<std::size_t>(e)], E, sin_tol_face_a))
       return;
     double tc, d, gap, span;
     if (!line_on_face(b, flat_b, fb, p0, p1, &tc, &d, &gap, &span)) return;
@@ -460,10 +463,7 @@ struct ContactDetector::Impl {
     const Vec3 dA = Rt * E.dir;
     const double sin_ang = std::min(1.0, std::abs(dA.dot(F.normal)));
     if (sin_ang > sin_max_tol) return;
-    const EdgeWings& w = wings_b[static_cast<std::size_t>(e)];
-    if (F.normal.dot(Rt * w.left) < -sin_tol_face_b[E.left.index()] ||
-        F.normal.dot(Rt * w.right) < -sin_tol_face_b[E.right.index()])
-      return;
+    if (!wedge_above(pose.R_BA * F.normal, wings_b[static_cast<std::size_t>(e)], E, sin_tol_face_b)) return;
     const Vec3& q0 = b.vertex(E.v0).p;
     const Vec3& q1 = b.vertex(E.v1).p;
     const Vec3 q0A = pose.inverse_apply(q0), q1A = pose.inverse_apply(q1);
@@ -561,12 +561,8 @@ struct ContactDetector::Impl {
     const double d = (pA - pB).dot(n);
     if (!in_band(d)) return;
     // The wedges of the two edges must lie on their own sides of the contact plane.
-    const EdgeWings& wa = wings_a[static_cast<std::size_t>(ea)];
-    const EdgeWings& wb = wings_b[static_cast<std::size_t>(eb)];
-    if (n.dot(pose.R_BA * wa.left) < -sin_tol_face_a[EA.left.index()] ||
-        n.dot(pose.R_BA * wa.right) < -sin_tol_face_a[EA.right.index()] ||
-        n.dot(wb.left) > sin_tol_face_b[EB.left.index()] ||
-        n.dot(wb.right) > sin_tol_face_b[EB.right.index()])
+    if (!wedge_above(pose.R_BA.transpose() * n, wings_a[static_cast<std::size_t>(ea)], EA, sin_tol_face_a) ||
+        !wedge_above(-n, wings_b[static_cast<std::size_t>(eb)], EB, sin_tol_face_b))
       return;
     emit(PcType::kEE, ea, eb, d, pA, pB, task_frame(n, uB), std::abs(d) / eps + over / eps);
   }

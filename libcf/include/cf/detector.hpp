@@ -65,7 +65,8 @@ class ContactDetector {
   const DetectionParams& params() const;
   const Polyhedron& model_a() const;
   const Polyhedron& model_b() const;
-  /// Element pairs the last `detect` passed to the exact tests (after BVH culling).
+  /// Element pairs of kinds that can touch whose bounding boxes overlapped in the last
+  /// `detect` (before the cheap rejections and the exact tests); all pairs with use_bvh off.
   std::size_t last_pairs_tested() const;
 
   struct Impl;
