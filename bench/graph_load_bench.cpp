@@ -3,6 +3,7 @@
 // full-precision witnesses. Measures load() of JSON and CBOR, with and without the schema
 // check, and find(). Figures go to docs/performance.md, "Graph loading".
 
+#include "../tests/fixtures.hpp"
 #include <cf/graph.hpp>
 
 #include <benchmark/benchmark.h>
@@ -18,34 +19,6 @@
 
 namespace {
 
-cf::Polyhedron box(double s) {
-  std::vector<cf::Vec3> v = {{0, 0, 0}, {s, 0, 0}, {s, s, 0}, {0, s, 0},
-                             {0, 0, s}, {s, 0, s}, {s, s, s}, {0, s, s}};
-  std::vector<std::vector<std::vector<int>>> f = {
-      {{0, 3, 2, 1}}, {{4, 5, 6, 7}}, {{0, 1, 5, 4}}, {{2, 3, 7, 6}}, {{1, 2, 6, 5}}, {{0, 4, 7, 3}}};
-  std::vector<std::array<int, 2>> e = {{0, 1}, {1, 2}, {2, 3}, {0, 3}, {4, 5}, {5, 6},
-                                       {6, 7}, {4, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
-  return cf::Polyhedron::from_features("cube", v, e, f);
-}
-
-cf::Polyhedron l_block() {
-  const double px[6] = {0, 40, 40, 10, 10, 0};
-  const double py[6] = {0, 0, 10, 10, 40, 40};
-  std::vector<cf::Vec3> v;
-  for (double z : {0.0, 20.0})
-    for (int i = 0; i < 6; ++i) v.emplace_back(px[i], py[i], z);
-  std::vector<std::vector<std::vector<int>>> f = {{{0, 5, 4, 3, 2, 1}}, {{6, 7, 8, 9, 10, 11}}};
-  for (int i = 0; i < 6; ++i) f.push_back({{i, (i + 1) % 6, (i + 1) % 6 + 6, i + 6}});
-  std::vector<std::array<int, 2>> e;
-  for (int ring : {0, 6})
-    for (int i = 0; i < 6; ++i) {
-      const int a = ring + i, b = ring + (i + 1) % 6;
-      e.push_back({std::min(a, b), std::max(a, b)});
-    }
-  for (int i = 0; i < 6; ++i) e.push_back({i, i + 6});
-  return cf::Polyhedron::from_features("L-block", v, e, f);
-}
-
 bool share_plane(const cf::Pc& x, const cf::Pc& y) {
   using K = cf::ElementKind;
   return (cf::a_kind(x.type) == K::kFace && cf::a_kind(y.type) == K::kFace && x.a == y.a) ||
@@ -53,7 +26,7 @@ bool share_plane(const cf::Pc& x, const cf::Pc& y) {
 }
 
 cf::CfGraph synthetic_graph(std::size_t num_cfs) {
-  const cf::Polyhedron a = box(10), b = l_block();
+  const cf::Polyhedron a = cf::test::box(10, 10, 10, "cube"), b = cf::test::small_l_block();
   std::vector<cf::Pc> singles;
   for (int t = 0; t < 6; ++t) {
     const auto type = static_cast<cf::PcType>(t);
@@ -136,8 +109,8 @@ void report(benchmark::State& state, const std::string& path) {
   state.counters["MB"] = static_cast<double>(std::filesystem::file_size(path)) / 1e6;
 }
 
-void BM_LoadJson(benchmark::State& state) {
-  const std::string& path = files().json;
+// Loads `path` (JSON or CBOR by its name); argument 0: the schema check off or on.
+void load(benchmark::State& state, const std::string& path) {
   cf::GraphLoadOptions options;
   options.validate_schema = state.range(0) != 0;
   for (auto _ : state) {
@@ -146,18 +119,11 @@ void BM_LoadJson(benchmark::State& state) {
   }
   report(state, path);
 }
+
+void BM_LoadJson(benchmark::State& state) { load(state, files().json); }
 BENCHMARK(BM_LoadJson)->Arg(0)->Arg(1)->ArgName("schema")->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
-void BM_LoadCbor(benchmark::State& state) {
-  const std::string& path = files().cbor;
-  cf::GraphLoadOptions options;
-  options.validate_schema = state.range(0) != 0;
-  for (auto _ : state) {
-    cf::CfGraph g = cf::CfGraph::load(path, options);
-    benchmark::DoNotOptimize(g.num_cfs());
-  }
-  report(state, path);
-}
+void BM_LoadCbor(benchmark::State& state) { load(state, files().cbor); }
 BENCHMARK(BM_LoadCbor)->Arg(0)->Arg(1)->ArgName("schema")->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 void BM_Save(benchmark::State& state) {

@@ -156,6 +156,18 @@ std::array<cf::ContactPc, 2> corner_pcs() {
   return cs;
 }
 
+// The cube at z along the corner line (its PCs' points with it); z then advances 20 um,
+// wrapping from 60 back to 20 mm.
+cf::Pose slide_along_corner(double& z, std::array<cf::ContactPc, 2>& cs) {
+  cf::Pose p;
+  p.t_BA = {35.5, 35.5, z};
+  cs[0].p_W = {35.5, 20.5, z};
+  cs[1].p_W = {20.5, 35.5, z};
+  z += 0.02;
+  if (z > 60) z = 20;
+  return p;
+}
+
 // The force model alone (two f-f PCs sliding along the L-block's corner: MT2.b with the
 // freedoms computed every tick, the costliest case).
 void BM_ForceOnly(benchmark::State& state) {
@@ -168,12 +180,7 @@ void BM_ForceOnly(benchmark::State& state) {
   std::vector<double> ns;
   ns.reserve(2'000'000);
   for (auto _ : state) {
-    cf::Pose p;
-    p.t_BA = {35.5, 35.5, z};
-    cs[0].p_W = {35.5, 20.5, z};
-    cs[1].p_W = {20.5, 35.5, z};
-    z += 0.02;
-    if (z > 60) z = 20;
+    const cf::Pose p = slide_along_corner(z, cs);
     const auto a = std::chrono::steady_clock::now();
     const cf::ForceResult& r = model.step(p, t += 0.001, cs.data(), 2, pm);
     const auto b = std::chrono::steady_clock::now();
@@ -350,12 +357,7 @@ void BM_ForceOnlyIntrinsic(benchmark::State& state) {
     model.reset();
     double z = 40;
     for (int i = 0; i < kTicks; ++i) {
-      cf::Pose p;
-      p.t_BA = {35.5, 35.5, z};
-      cs[0].p_W = {35.5, 20.5, z};
-      cs[1].p_W = {20.5, 35.5, z};
-      z += 0.02;
-      if (z > 60) z = 20;
+      const cf::Pose p = slide_along_corner(z, cs);
       const auto a = std::chrono::steady_clock::now();
       const cf::ForceResult& r = model.step(p, 0.001 * (i + 1), cs.data(), 2, pm);
       const auto b = std::chrono::steady_clock::now();

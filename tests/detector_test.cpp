@@ -2,6 +2,7 @@
 #include <cf/geometry.hpp>
 
 #include "../bench/runtime_models.hpp"
+#include "fixtures.hpp"
 #include "detector_poly.hpp"
 
 #include <boost/geometry.hpp>
@@ -42,14 +43,7 @@ const cf::ContactPc* find(const cf::ContactSet& cs, PcType type, int a, int b) {
   return nullptr;
 }
 
-int edge_between(const cf::Polyhedron& m, int v0, int v1) {
-  for (std::size_t e = 0; e < m.num_edges(); ++e) {
-    const cf::Edge& E = m.edges()[e];
-    if ((E.v0.value() == v0 && E.v1.value() == v1) || (E.v0.value() == v1 && E.v1.value() == v0))
-      return static_cast<int>(e);
-  }
-  return -1;
-}
+using cf::test::edge_between;
 
 void check_frame(const cf::ContactPc& c) {
   CHECK((c.R_WT.transpose() * c.R_WT - Eigen::Matrix3d::Identity()).norm() < 1e-12);

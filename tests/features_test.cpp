@@ -3,6 +3,8 @@
 
 #include "mesh/model_loader.hpp"
 
+#include "scratch.hpp"
+
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 #include <valijson/adapters/nlohmann_json_adapter.hpp>
@@ -40,29 +42,8 @@ constexpr double kFloat = 1e-4;
 const std::string kData = std::string(CF_SOURCE_DIR) + "/data/models/";
 const std::string kFixtures = std::string(CF_TEST_DATA_DIR) + "/models/";
 
-fs::path scratch() {
-  static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() /
-                 ("cf_features_test_" + std::to_string(static_cast<long>(::getpid())));
-    fs::create_directories(d);
-    return d;
-  }();
-  // Removed when the test program exits.
-  static const struct Cleanup {
-    ~Cleanup() {
-      std::error_code ec;
-      fs::remove_all(dir, ec);
-    }
-  } cleanup;
-  return dir;
-}
-
-std::string write_file(const std::string& name, const std::string& text) {
-  const fs::path p = scratch() / name;
-  std::ofstream out(p, std::ios::binary);
-  out << text;
-  return p.string();
-}
+using cf::test::scratch;
+using cf::test::write_file;
 
 std::string binary_stl(const std::vector<Vec3>& v, const std::vector<std::vector<int>>& tris) {
   std::string s(80, ' ');

@@ -25,28 +25,8 @@ namespace cf_test {
 // 8 (0,4), 9 (1,5), 10 (2,6), 11 (3,7).
 cf::Polyhedron box(double sx, double sy, double sz) { return cf::test::box(sx, sy, sz, "cube"); }
 
-// L profile (0,0) (40,0) (40,10) (10,10) (10,40) (0,40), vertices 0..5 at z=0 and 6..11 at
-// z=20. Faces: 0 z=0, 1 z=20, then side i+2 over profile edge i -> i+1: 2 y=0 (bottom),
-// 3 x=40, 4 y=10 (floor top), 5 x=10 (wall, facing +x), 6 y=40 (wall top), 7 x=0.
-// Edges 0..5 bottom ring, 6..11 top ring, 12..17 verticals; edge 15 (3,9) is the reflex
-// corner between floor and wall.
-cf::Polyhedron l_block() {
-  const double px[6] = {0, 40, 40, 10, 10, 0};
-  const double py[6] = {0, 0, 10, 10, 40, 40};
-  std::vector<cf::Vec3> v;
-  for (double z : {0.0, 20.0})
-    for (int i = 0; i < 6; ++i) v.emplace_back(px[i], py[i], z);
-  std::vector<std::vector<std::vector<int>>> f = {{{0, 5, 4, 3, 2, 1}}, {{6, 7, 8, 9, 10, 11}}};
-  for (int i = 0; i < 6; ++i) f.push_back({{i, (i + 1) % 6, (i + 1) % 6 + 6, i + 6}});
-  std::vector<std::array<int, 2>> e;
-  for (int ring : {0, 6})
-    for (int i = 0; i < 6; ++i) {
-      const int a = ring + i, b = ring + (i + 1) % 6;
-      e.push_back({std::min(a, b), std::max(a, b)});
-    }
-  for (int i = 0; i < 6; ++i) e.push_back({i, i + 6});
-  return cf::Polyhedron::from_features("L-block", v, e, f);
-}
+// The small L-block of fixtures.hpp (its comment gives the face and edge indices).
+cf::Polyhedron l_block() { return cf::test::small_l_block(); }
 
 cf::Pose pose(const cf::Mat3& R, const cf::Vec3& t) {
   cf::Pose p;

@@ -1,6 +1,7 @@
 #include <cf/identifier.hpp>
 
 #include "../bench/runtime_models.hpp"
+#include "fixtures.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -46,14 +47,7 @@ cf::Pose pose(const Eigen::Matrix3d& R, const Vec3& t) {
   return p;
 }
 
-int edge_between(const cf::Polyhedron& m, int v0, int v1) {
-  for (std::size_t e = 0; e < m.num_edges(); ++e) {
-    const cf::Edge& E = m.edges()[e];
-    if ((E.v0.value() == v0 && E.v1.value() == v1) || (E.v0.value() == v1 && E.v1.value() == v0))
-      return static_cast<int>(e);
-  }
-  return -1;
-}
+using cf::test::edge_between;
 
 cf::CfRecord record(std::vector<Pc> pcs) {
   cf::CfRecord r;

@@ -3,6 +3,8 @@
 
 #include "mesh/model_loader.hpp"
 
+#include "scratch.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <array>
@@ -26,30 +28,8 @@ constexpr double kExact = 1e-12;
 
 const std::string kModels = std::string(CF_TEST_DATA_DIR) + "/models/";
 
-// A scratch directory per test run for files written by the tests.
-fs::path scratch() {
-  static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() /
-                 ("cf_mesh_io_test_" + std::to_string(static_cast<long>(::getpid())));
-    fs::create_directories(d);
-    return d;
-  }();
-  // Removed when the test program exits.
-  static const struct Cleanup {
-    ~Cleanup() {
-      std::error_code ec;
-      fs::remove_all(dir, ec);
-    }
-  } cleanup;
-  return dir;
-}
-
-std::string write_file(const std::string& name, const std::string& text) {
-  const fs::path p = scratch() / name;
-  std::ofstream out(p, std::ios::binary);
-  out << text;
-  return p.string();
-}
+using cf::test::scratch;
+using cf::test::write_file;
 
 // The 10 mm cube of tests/data/models/cube.off as points and quads.
 const std::vector<cf::Vec3> kCubeV = {{0, 0, 0},   {10, 0, 0},  {10, 10, 0}, {0, 10, 0},

@@ -4,6 +4,8 @@
 #include <cf/detector.hpp>
 #include <cf/renderer.hpp>
 
+#include "fixtures.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -38,20 +40,7 @@ namespace {
 
 constexpr double kTol = 1e-9;
 
-// A polyhedron from its vertices and face loops (every loop side is an edge).
-cf::Polyhedron from_loops(const std::string& name, const std::vector<cf::Vec3>& v,
-                          const std::vector<std::vector<int>>& faces) {
-  std::set<std::array<int, 2>> edges;
-  std::vector<std::vector<std::vector<int>>> loops;
-  for (const auto& f : faces) {
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      const int a = f[i], b = f[(i + 1) % f.size()];
-      edges.insert({std::min(a, b), std::max(a, b)});
-    }
-    loops.push_back({f});
-  }
-  return cf::Polyhedron::from_features(name, v, {edges.begin(), edges.end()}, loops);
-}
+using cf::test::from_loops;
 
 // data/models/cube.off: 30 mm, centred on its origin.
 cf::Polyhedron cube() {
