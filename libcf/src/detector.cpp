@@ -137,7 +137,7 @@ struct ContactDetector::Impl {
   // A's nodes' boxes in B's frame at the current pose (computed on first use per call).
   struct PosedBox {
     Eigen::Vector3f c, h;  // mm, B's frame
-    std::uint32_t stamp = 0;
+    std::uint64_t stamp = 0;
   };
   std::vector<PosedBox> a_box, a_elem_box;
   bool element_boxes = false;  // leaves hold several elements: test their own boxes too
@@ -149,12 +149,12 @@ struct ContactDetector::Impl {
   struct Plane {
     Vec3 n;             // unit outward normal, B's frame
     double off = 0;     // mm: plane { x : n . x == off }
-    std::uint32_t stamp = 0;
+    std::uint64_t stamp = 0;
   };
   struct Seg {
     Vec3 p0, dir;       // mm, B's frame; dir unit
     double len = 0;     // mm
-    std::uint32_t stamp = 0;
+    std::uint64_t stamp = 0;
   };
   std::vector<Plane> plane_b, plane_a;
   std::vector<Seg> seg_b, seg_a;
@@ -165,8 +165,8 @@ struct ContactDetector::Impl {
   std::vector<int> q_lb;
   std::vector<double> params;
   std::vector<Vec3> aw;  // A's vertices in the world at the current pose
-  std::vector<std::uint32_t> aw_stamp;
-  std::uint32_t stamp = 0;
+  std::vector<std::uint64_t> aw_stamp;
+  std::uint64_t stamp = 0;
   // Per call.
   Pose pose;
   ContactSet* out = nullptr;
@@ -716,14 +716,7 @@ struct ContactDetector::Impl {
     out = &cs;
     cs.clear();
     pairs = 0;
-    if (++stamp == 0) {
-      std::fill(aw_stamp.begin(), aw_stamp.end(), 0);
-      for (PosedBox& P : a_box) P.stamp = 0;
-      for (PosedBox& P : a_elem_box) P.stamp = 0;
-      for (Plane& P : plane_a) P.stamp = 0;
-      for (Seg& S : seg_a) S.stamp = 0;
-      stamp = 1;
-    }
+    ++stamp;  // 64 bits: never wraps, so the per-pose caches need no reset
     if (!prm.use_bvh) {
       // Every pair straight to the exact tests: the reference for the culling (boxes and
       // the cheap rejections alike).
