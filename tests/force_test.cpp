@@ -89,6 +89,22 @@ TEST_CASE("a cube resting face-down: MT2.a, eq. (1), gravity, moment", "[force]"
     CHECK((r.M_W - cf::Vec3(37.5, 0, -37.5)).norm() < kTol);
     CHECK((r.M_A - r.M_W).norm() < kTol);  // R = I
   }
+  SECTION("about a point the application chooses: M_q = M_origin - (q - origin) x F") {
+    const cf::Pose pose = at(0, 0.5, 0);
+    const cf::ContactPc c = floor_pc(pose);
+    cf::ForceModel about_origin(fx.A, fx.B, P);
+    about_origin.step(pose, 0.000, &c, 1, prior(cf::MotionType::kMT1));
+    const cf::ForceResult r0 = about_origin.step(pose, 0.001, &c, 1, prior(cf::MotionType::kMT2a));
+    P.moment_reference = cf::MomentReference::kAPoint;
+    P.moment_point_A = cf::Vec3(3, 25, -7);  // any point fixed in A, here outside it
+    cf::ForceModel about_q(fx.A, fx.B, P);
+    about_q.step(pose, 0.000, &c, 1, prior(cf::MotionType::kMT1));
+    const cf::ForceResult& rq = about_q.step(pose, 0.001, &c, 1, prior(cf::MotionType::kMT2a));
+    const cf::Vec3 q_W = pose.apply(P.moment_point_A);
+    CHECK((rq.reference_W - q_W).norm() < kTol);
+    CHECK((rq.F_W - r0.F_W).norm() < kTol);
+    CHECK((rq.M_W - (r0.M_W - (q_W - pose.t_BA).cross(r0.F_W))).norm() < kTol);
+  }
   SECTION("about the centroid the moment vanishes") {
     P.moment_reference = cf::MomentReference::kACentroid;
     cf::ForceModel model(fx.A, fx.B, P);

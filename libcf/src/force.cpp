@@ -293,7 +293,11 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
   Vec3 F_c = Vec3::Zero();
   Vec3 M_c = Vec3::Zero();
   r.centroid_W = pose.apply(centroid_A_);
-  r.reference_W = P.moment_reference == MomentReference::kACentroid ? r.centroid_W : pose.t_BA;
+  switch (P.moment_reference) {
+    case MomentReference::kAOrigin: r.reference_W = pose.t_BA; break;
+    case MomentReference::kACentroid: r.reference_W = r.centroid_W; break;
+    case MomentReference::kAPoint: r.reference_W = pose.apply(P.moment_point_A); break;
+  }
   for (int k = 0; k < m; ++k) {
     PcForce& f = r.pcs[static_cast<std::size_t>(k)];
     const Vec3 x = f.R_WT.col(0);

@@ -14,6 +14,7 @@
 #include <iostream>
 #include <map>
 #include <string>
+#include <vector>
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -45,8 +46,12 @@ int main(int argc, char** argv) {
   app.add_option("--tau", P.interpolation_time_constant_s,
                  "low-pass time constant of the total contact force and moment (s); 0: off")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--moment-ref", moment_ref, "moment about A's 'origin' (paper eq. (9)) or its 'centroid'")
-      ->check(CLI::IsMember({"origin", "centroid"}));
+  app.add_option("--moment-ref", moment_ref,
+                 "moment about A's 'origin' (paper eq. (9)), its 'centroid', or the 'point' given by --moment-point")
+      ->check(CLI::IsMember({"origin", "centroid", "point"}));
+  std::vector<double> moment_point;
+  app.add_option("--moment-point", moment_point, "X Y Z: the moment's reference point, mm in A's frame (implies --moment-ref point)")
+      ->expected(3);
   app.add_option("--centroid", centroid, "mass centre: 'vertex' mean (paper) or 'volume' centroid")
       ->check(CLI::IsMember({"vertex", "volume"}));
   app.add_option("--mass", P.mass_kg, "m, kg")->check(CLI::NonNegativeNumber);
@@ -67,6 +72,13 @@ int main(int argc, char** argv) {
   P.friction_displacement =
       friction == "per-tick" ? cf::FrictionDisplacement::kPerTick : cf::FrictionDisplacement::kStickAnchor;
   P.moment_reference = moment_ref == "centroid" ? cf::MomentReference::kACentroid : cf::MomentReference::kAOrigin;
+  if (!moment_point.empty()) {
+    P.moment_reference = cf::MomentReference::kAPoint;
+    P.moment_point_A = cf::Vec3(moment_point[0], moment_point[1], moment_point[2]);
+  } else if (moment_ref == "point") {
+    std::cerr << "cfreplay: --moment-ref point needs --moment-point X Y Z (see cfreplay --help)\n";
+    return 2;
+  }
   P.centroid = centroid == "volume" ? cf::CentroidChoice::kVolume : cf::CentroidChoice::kVertexMean;
 
   try {

@@ -24,7 +24,11 @@ enum class FrictionDisplacement : std::uint8_t {
 enum class CentroidChoice : std::uint8_t { kVertexMean, kVolume };
 
 /// About which point the haptic moment is reported (paper section 5 uses A's frame origin).
-enum class MomentReference : std::uint8_t { kAOrigin, kACentroid };
+enum class MomentReference : std::uint8_t {
+  kAOrigin,    ///< A's frame origin (paper eq. (9))
+  kACentroid,  ///< A's mass centre (Params::centroid)
+  kAPoint,     ///< Params::moment_point_A, a point fixed in A (e.g. where the device holds it)
+};
 
 /// All parameters of contact detection thresholds, friction, gravity and smoothing.
 struct Params {
@@ -43,6 +47,7 @@ struct Params {
   // --- Mass centre and moment ---
   CentroidChoice centroid = CentroidChoice::kVertexMean;
   MomentReference moment_reference = MomentReference::kAOrigin;
+  Vec3 moment_point_A = Vec3::Zero();  ///< mm, A's frame; the reference with kAPoint
 
   // --- Freedoms and the "approximately along" test of paper Fig. 10 ---
   /// Relative singular-value tolerance for the null space of the contact constraints: a
