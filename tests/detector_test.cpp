@@ -349,24 +349,30 @@ TEST_CASE("overlap of polygons with holes matches Boost.Geometry", "[detector]")
 }
 
 TEST_CASE("the BVH finds what all pairs find on faceted spheres", "[detector]") {
-  // 600 and 672 faces: enough for the culling to matter, small enough for all pairs.
+  // 600 and 672 faces: enough for the culling to matter (leaves of several elements and
+  // oriented boxes), small enough for all pairs. The paper's threshold and one scaled to the
+  // facets (2 to 7 mm here): the boxes' inflation changes by ten.
+  const double eps = GENERATE(1.0, 0.1);
   const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30);
   const cf::Polyhedron b = tm::faceted_sphere(50, 21, 32);
-  cf::DetectionParams all;
+  cf::DetectionParams prm;
+  prm.epsilon = prm.max_penetration = eps;
+  cf::DetectionParams all = prm;
   all.use_bvh = false;
-  cf::ContactDetector fast(a, b), slow(a, b, all);
+  cf::ContactDetector fast(a, b, prm), slow(a, b, all);
   cf::ContactSet x, y;
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> U(-1, 1);
   int contacts = 0;
-  // Gaps from 1.1 mm apart (nothing) to 1.1 mm deep (beyond max_penetration): the band's
-  // edges on both sides.
-  for (int k = 0; k < 24; ++k) {
+  // Gaps from 1.1 epsilon apart (nothing) to 1.1 epsilon deep (beyond max_penetration):
+  // the band's edges on both sides.
+  for (int k = 0; k < 32; ++k) {
     const Vec3 dir = Vec3(U(rng), U(rng), U(rng)).normalized();
     const Eigen::Matrix3d R = rot(3 * U(rng), Vec3(U(rng), U(rng), U(rng)));
-    const cf::Pose p = pose(R, dir * (80 + 1.1 * U(rng)));
+    const cf::Pose p = pose(R, dir * (80 + 1.1 * eps * U(rng)));
     fast.detect(p, x);
     slow.detect(p, y);
+    INFO("epsilon " << eps << ", pose " << k);
     REQUIRE(x.size() == y.size());
     for (int i = 0; i < x.size(); ++i) {
       CHECK(x[i].pc == y[i].pc);

@@ -1,5 +1,7 @@
 #include "bvh.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 
@@ -11,6 +13,34 @@ struct Item {
   Vec3 lo, hi;
   Vec3 centroid() const { return 0.5 * (lo + hi); }
 };
+
+// The oriented box of points: principal axes of their spread, extents from the points.
+Obb obb_of(const std::vector<Vec3>& pts, double inflate) {
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& p : pts) mean += p;
+  mean /= static_cast<double>(pts.size());
+  Mat3 cov = Mat3::Zero();
+  for (const Vec3& p : pts) cov += (p - mean) * (p - mean).transpose();
+  Mat3 axes = Eigen::SelfAdjointEigenSolver<Mat3>(cov).eigenvectors();
+  if (!axes.allFinite()) axes = Mat3::Identity();
+  axes.col(2) = axes.col(0).cross(axes.col(1)).normalized();
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Vec3& p : pts) {
+    const Vec3 q = axes.transpose() * p;
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  Obb o;
+  o.axes = axes.cast<float>();
+  // The float axes are off by about 1e-7 rad: widen by that much of the box's reach.
+  const Vec3 centre_local = 0.5 * (lo + hi);
+  const double reach = (0.5 * (hi - lo)).norm() + 1.0;
+  Eigen::Vector3f c, h;
+  round_out(axes * centre_local, 0.5 * (hi - lo) + Vec3::Constant(inflate + 1e-6 * reach), c, h);
+  o.center = c;
+  o.half = h;
+  return o;
+}
 
 }  // namespace
 
@@ -44,13 +74,15 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
     std::int32_t node, begin, end, depth;
   };
   std::vector<Task> tasks;
+  std::vector<Vec3> pts;
   nodes_.emplace_back();
   tasks.push_back({0, 0, static_cast<std::int32_t>(items.size()), 1});
   while (!tasks.empty()) {
     const Task t = tasks.back();
     tasks.pop_back();
     depth_ = std::max(depth_, t.depth);
-    Vec3 lo = items[static_cast<std::size_t>(t.begin)].lo, hi = items[static_cast<std::size_t>(t.begin)].hi;
+    Vec3 lo = items[static_cast<std::size_t>(t.begin)].lo,
+         hi = items[static_cast<std::size_t>(t.begin)].hi;
     Vec3 clo = items[static_cast<std::size_t>(t.begin)].centroid(), chi = clo;
     for (std::int32_t i = t.begin; i < t.end; ++i) {
       const Item& it = items[static_cast<std::size_t>(i)];
@@ -61,7 +93,24 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
     }
     BvhNode& n = nodes_[static_cast<std::size_t>(t.node)];
     round_out(0.5 * (lo + hi), 0.5 * (hi - lo) + Vec3::Constant(inflate), n.center, n.half);
-    for (std::int32_t i = t.begin; i < t.end; ++i) n.kinds |= kind_bit(items[static_cast<std::size_t>(i)].e.kind);
+    pts.clear();
+    for (std::int32_t i = t.begin; i < t.end; ++i) {
+      const BvhElement& x = items[static_cast<std::size_t>(i)].e;
+      if (x.kind == ElementKind::kVertex) {
+        pts.push_back(m.vertices()[static_cast<std::size_t>(x.index)].p);
+      } else if (x.kind == ElementKind::kEdge) {
+        pts.push_back(m.edge_point(EdgeId(x.index), 0));
+        pts.push_back(m.edge_point(EdgeId(x.index), 1));
+      } else {
+        for (VertexId v : m.faces()[static_cast<std::size_t>(x.index)].vertices)
+          pts.push_back(m.vertex(v).p);
+      }
+    }
+    if (obbs_.size() <= static_cast<std::size_t>(t.node))
+      obbs_.resize(static_cast<std::size_t>(t.node) + 1);
+    obbs_[static_cast<std::size_t>(t.node)] = obb_of(pts, inflate);
+    for (std::int32_t i = t.begin; i < t.end; ++i)
+      n.kinds |= kind_bit(items[static_cast<std::size_t>(i)].e.kind);
     if (t.end - t.begin <= leaf_size) {
       n.child = ~t.begin;
       n.count = static_cast<std::uint8_t>(t.end - t.begin);
@@ -85,12 +134,14 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
     tasks.push_back({l, t.begin, mid, t.depth + 1});
     tasks.push_back({l + 1, mid, t.end, t.depth + 1});
   }
+  obbs_.resize(nodes_.size());
   elements_.reserve(items.size());
   for (const Item& it : items) {
     elements_.push_back(it.e);
     elem_c_.emplace_back();
     elem_h_.emplace_back();
-    round_out(0.5 * (it.lo + it.hi), 0.5 * (it.hi - it.lo) + Vec3::Constant(inflate), elem_c_.back(), elem_h_.back());
+    round_out(0.5 * (it.lo + it.hi), 0.5 * (it.hi - it.lo) + Vec3::Constant(inflate),
+              elem_c_.back(), elem_h_.back());
   }
 }
 

@@ -22,7 +22,9 @@ struct BvhElement {
 };
 
 /// Bit of an element kind in BvhNode::kinds.
-inline std::uint8_t kind_bit(ElementKind k) { return static_cast<std::uint8_t>(1u << static_cast<unsigned>(k)); }
+inline std::uint8_t kind_bit(ElementKind k) {
+  return static_cast<std::uint8_t>(1u << static_cast<unsigned>(k));
+}
 
 /// A node: an axis-aligned box (single precision, rounded outwards, so it still bounds its
 /// elements; 32 bytes so that descents stay in cache) and either two children (`child`,
@@ -42,10 +44,20 @@ struct BvhNode {
 /// Sets `c`, `h` to a single-precision box that contains the box (center, half). Rounding
 /// to float errs by at most 2^-24 relative: widen by the centre's error (< 1.2e-7 |center|)
 /// and then by 3e-7 relative, more than the half extent's own rounding.
-inline void round_out(const Vec3& center, const Vec3& half, Eigen::Vector3f& c, Eigen::Vector3f& h) {
+inline void round_out(const Vec3& center, const Vec3& half, Eigen::Vector3f& c,
+                      Eigen::Vector3f& h) {
   c = center.cast<float>();
   h = ((half + 1.2e-7 * center.cwiseAbs()).cast<float>() * 1.0000003f);
 }
+
+/// An oriented box (single precision, rounded outwards): the principal axes of a node's
+/// points, which for a patch of surface put one axis along its normal, where the patch is
+/// thin; an axis-aligned box of a tilted patch is as thick as it is wide.
+struct Obb {
+  Eigen::Vector3f center;  // mm, model frame
+  Eigen::Matrix3f axes;    // unit columns, model frame
+  Eigen::Vector3f half;    // mm, half extents along the axes, >= 0
+};
 
 class Bvh {
  public:
@@ -57,11 +69,14 @@ class Bvh {
   const std::vector<Eigen::Vector3f>& element_centers() const { return elem_c_; }
   const std::vector<Eigen::Vector3f>& element_halves() const { return elem_h_; }
   const std::vector<BvhNode>& nodes() const { return nodes_; }
+  /// Per node, its oriented box (inflated like the node's).
+  const std::vector<Obb>& obbs() const { return obbs_; }
   const std::vector<BvhElement>& elements() const { return elements_; }
   int depth() const { return depth_; }
 
  private:
   std::vector<BvhNode> nodes_;
+  std::vector<Obb> obbs_;
   std::vector<BvhElement> elements_;
   std::vector<Eigen::Vector3f> elem_c_, elem_h_;
   int depth_ = 0;
@@ -80,15 +95,15 @@ inline bool kinds_can_touch(std::uint8_t ka, std::uint8_t kb) {
   const std::uint8_t V = kind_bit(ElementKind::kVertex), E = kind_bit(ElementKind::kEdge),
                      F = kind_bit(ElementKind::kFace);
   // Per kind of A, the kinds of B it pairs with.
-  const std::uint8_t with = static_cast<std::uint8_t>(((ka & V) ? F : 0) | ((ka & E) ? (E | F) : 0) |
-                                                      ((ka & F) ? (V | E | F) : 0));
+  const std::uint8_t with = static_cast<std::uint8_t>(
+      ((ka & V) ? F : 0) | ((ka & E) ? (E | F) : 0) | ((ka & F) ? (V | E | F) : 0));
   return (with & kb) != 0;
 }
 
 /// Calls visit(int a, int b) (positions in elements()) for every pair of elements in leaves
 /// whose bounding volumes overlap and whose kinds can touch, where tree `a` is posed into tree
-/// `b`'s frame: `overlap(node_a, node_b)` tells whether A's node (posed; the caller caches
-/// its posed box) overlaps B's node. `stack` is caller-owned scratch of at least
+/// `b`'s frame: `overlap(ia, ib, node_a, node_b)` tells whether A's node `ia` (posed; the
+/// caller caches its posed box) overlaps B's node `ib`. `stack` is caller-owned scratch of at least
 /// `stack_capacity(a, b)` entries. Returns false when the stack overflowed (some pairs were
 /// skipped).
 template <class Overlap, class Visit>
@@ -104,7 +119,7 @@ bool descend(const Bvh& ta, const Bvh& tb, Overlap&& overlap, NodePair* stack, s
     const NodePair p = stack[--top];
     const BvhNode& A = na[static_cast<std::size_t>(p.a)];
     const BvhNode& B = nb[static_cast<std::size_t>(p.b)];
-    if (!kinds_can_touch(A.kinds, B.kinds) || !overlap(p.a, A, B)) continue;
+    if (!kinds_can_touch(A.kinds, B.kinds) || !overlap(p.a, p.b, A, B)) continue;
     if (A.leaf() && B.leaf()) {
       for (int i = 0; i < A.count; ++i)
         for (int j = 0; j < B.count; ++j) visit(A.element() + i, B.element() + j);
