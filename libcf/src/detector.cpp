@@ -115,16 +115,15 @@ double segment_segment_2d(const Vec2& a, const Vec2& b, const Vec2& c, const Vec
 
 // BVH leaves of a model: one element for small models (with bigger leaves, leaf boxes of the
 // paper's cube and L-block overlap everything), posed like inner nodes (cheaper than exact
-// boxes there: 2.4 against 2.8 us per tick); leaves of 4 spatially close elements for big
-// models, whose deep trees cost more node visits than the element boxes then tested in the
-// leaves (2,000-face spheres: 0.68x the time). Big models' nodes are also tested as oriented
+// boxes there: 2.4 against 2.8 us per tick). Big models' nodes are also tested as oriented
 // boxes: a curved surface's patches are tilted, and the axis-aligned box of a tilted patch
-// is as thick as it is wide, so that two surfaces in contact overlap over many patches
-// (2,000-face spheres: 0.4x to 0.8x the time). docs/performance.md has the figures.
+// is as thick as it is wide, so that two surfaces in contact overlap over many patches; and
+// their leaves hold 2 spatially close elements, each with its own box tested in the leaf
+// (fewer node visits; leaves of 1, 4 or 8 cost 1.2x to 1.8x the time on 2,000-face spheres).
+// docs/performance.md has the figures.
 constexpr std::size_t kBigModelElements = 256;
-int leaf_size_for(const Polyhedron& m) {
-  return m.num_vertices() + m.num_edges() + m.num_faces() >= kBigModelElements ? 4 : 1;
-}
+bool is_big(const Polyhedron& m) { return m.num_vertices() + m.num_edges() + m.num_faces() >= kBigModelElements; }
+int leaf_size_for(const Polyhedron& m) { return is_big(m) ? 2 : 1; }
 
 struct ContactDetector::Impl {
   Polyhedron a, b;
@@ -146,6 +145,7 @@ struct ContactDetector::Impl {
   };
   std::vector<PosedBox> a_box, a_elem_box;
   bool element_boxes = false;  // leaves hold several elements: test their own boxes too
+  bool oriented = false;       // big models: nodes are tested as oriented boxes too
   Mat3 absR = Mat3::Identity();
   // Compact copies of what the cheap rejections read (most pairs the boxes pass are not
   // contacts: on 2,000-face spheres about 1 in 80 is), so that a rejection touches a few
@@ -212,6 +212,7 @@ struct ContactDetector::Impl {
     // it, so within max(eps, depth, hypot(eps, in_plane)) of B's element.
     bvh_b = detail::Bvh(mb, std::max({eps, depth, std::hypot(eps, in_plane)}) + geo_tol + float_slack, leaf_size_for(mb));
     element_boxes = leaf_size_for(ma) > 1 || leaf_size_for(mb) > 1;
+    oriented = is_big(ma) || is_big(mb);
     stack.resize(detail::stack_capacity(bvh_a, bvh_b));
     q_pts.resize(static_cast<std::size_t>(flat_a.max_face_points));
     std::size_t max_loops = 1;
@@ -247,7 +248,7 @@ struct ContactDetector::Impl {
     if (std::abs(d.x()) > P.h.x() + B.half.x() || std::abs(d.y()) > P.h.y() + B.half.y() ||
         std::abs(d.z()) > P.h.z() + B.half.z())
       return false;
-    if (!element_boxes) {
+    if (!oriented) {
       if (A.leaf()) return true;
       // B's box on A's axes: centre offset R^T d, half extents |R^T| B.half.
       for (int k = 0; k < 3; ++k) {
@@ -320,7 +321,7 @@ struct ContactDetector::Impl {
     P.stamp = stamp;
     const Vec3 c = pose.apply(N.center.cast<double>());
     const Vec3 h = absR * N.half.cast<double>();
-    if (!element_boxes) {
+    if (!oriented) {
       detail::round_out(c, h, P.c, P.h);
       return;
     }
