@@ -164,20 +164,22 @@ Pair& cube_l() {
   static Pair p{tm::cube(), tm::l_block(), cube_l_poses()};
   return p;
 }
-// The paper's epsilon of 1 mm on facets of 2.4 to 6.5 mm: a contact spans dozens of
-// candidate PCs (about 47 per tick), more than any CF holds: a stress case.
+// Spheres of 2,000 (r = 30) and 2,016 faces (r = 50), facets of 2.4 to 6.5 mm, at a contact
+// threshold eps (and max_penetration) with poses whose gaps scale with it.
+Pair sphere_pair(double eps) {
+  return {tm::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000"),
+          tm::faceted_sphere(50, 42, 48, Vec3::Zero(), "sphere2016"), sphere_poses(30, 50, eps), with_epsilon(eps)};
+}
+// The paper's epsilon of 1 mm: a contact spans dozens of candidate PCs (about 47 per tick),
+// more than any CF holds: a stress case.
 Pair& spheres() {
-  static Pair p{tm::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000"),
-                tm::faceted_sphere(50, 42, 48, Vec3::Zero(), "sphere2016"), sphere_poses(30, 50, 1.0),
-                with_epsilon(1.0)};
+  static Pair p = sphere_pair(1.0);
   return p;
 }
-// The same spheres with epsilon scaled to their facets (0.1 mm, with max_penetration): a
-// contact spans a few PCs, as the contact formations of the method assume.
+// Epsilon scaled to the facets (0.1 mm): a contact spans a few PCs, as the contact
+// formations of the method assume.
 Pair& spheres_fine() {
-  static Pair p{tm::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000"),
-                tm::faceted_sphere(50, 42, 48, Vec3::Zero(), "sphere2016"), sphere_poses(30, 50, 0.1),
-                with_epsilon(0.1)};
+  static Pair p = sphere_pair(0.1);
   return p;
 }
 

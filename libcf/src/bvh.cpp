@@ -14,6 +14,23 @@ struct Item {
   Vec3 centroid() const { return 0.5 * (lo + hi); }
 };
 
+// Appends the points that span element e (its vertex, its edge's ends, its face's vertices).
+void points_of(const Polyhedron& m, const BvhElement& e, std::vector<Vec3>& pts) {
+  const auto i = static_cast<std::size_t>(e.index);
+  switch (e.kind) {
+    case ElementKind::kVertex:
+      pts.push_back(m.vertices()[i].p);
+      break;
+    case ElementKind::kEdge:
+      pts.push_back(m.edge_point(EdgeId(e.index), 0));
+      pts.push_back(m.edge_point(EdgeId(e.index), 1));
+      break;
+    case ElementKind::kFace:
+      for (VertexId v : m.faces()[i].vertices) pts.push_back(m.vertex(v).p);
+      break;
+  }
+}
+
 // The oriented box of points: principal axes of their spread, extents from the points.
 Obb obb_of(const std::vector<Vec3>& pts, double inflate) {
   Vec3 mean = Vec3::Zero();
@@ -48,25 +65,21 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
   leaf_size = std::clamp(leaf_size, 1, 255);
   std::vector<Item> items;
   items.reserve(m.num_vertices() + m.num_edges() + m.num_faces());
-  for (std::size_t i = 0; i < m.num_vertices(); ++i) {
-    const Vec3& p = m.vertices()[i].p;
-    items.push_back({{ElementKind::kVertex, static_cast<std::int32_t>(i)}, p, p});
-  }
-  for (std::size_t i = 0; i < m.num_edges(); ++i) {
-    const EdgeId e(static_cast<std::int32_t>(i));
-    const Vec3& p = m.edge_point(e, 0);
-    const Vec3& q = m.edge_point(e, 1);
-    items.push_back({{ElementKind::kEdge, e.value()}, p.cwiseMin(q), p.cwiseMax(q)});
-  }
-  for (std::size_t i = 0; i < m.num_faces(); ++i) {
-    const Face& F = m.faces()[i];
-    Vec3 lo = m.vertex(F.vertices[0]).p, hi = lo;
-    for (VertexId v : F.vertices) {
-      lo = lo.cwiseMin(m.vertex(v).p);
-      hi = hi.cwiseMax(m.vertex(v).p);
+  std::vector<Vec3> pts;
+  auto add = [&](ElementKind kind, std::size_t i) {
+    const BvhElement e{kind, static_cast<std::int32_t>(i)};
+    pts.clear();
+    points_of(m, e, pts);
+    Vec3 lo = pts[0], hi = lo;
+    for (const Vec3& p : pts) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
     }
-    items.push_back({{ElementKind::kFace, static_cast<std::int32_t>(i)}, lo, hi});
-  }
+    items.push_back({e, lo, hi});
+  };
+  for (std::size_t i = 0; i < m.num_vertices(); ++i) add(ElementKind::kVertex, i);
+  for (std::size_t i = 0; i < m.num_edges(); ++i) add(ElementKind::kEdge, i);
+  for (std::size_t i = 0; i < m.num_faces(); ++i) add(ElementKind::kFace, i);
   if (items.empty()) return;
   nodes_.reserve(2 * items.size());
   // Iterative top-down build: median split along the longest axis of the centroids.
@@ -74,8 +87,8 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
     std::int32_t node, begin, end, depth;
   };
   std::vector<Task> tasks;
-  std::vector<Vec3> pts;
   nodes_.emplace_back();
+  obbs_.resize(2 * items.size());  // a binary tree over n items has fewer than 2n nodes
   tasks.push_back({0, 0, static_cast<std::int32_t>(items.size()), 1});
   while (!tasks.empty()) {
     const Task t = tasks.back();
@@ -94,20 +107,7 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
     BvhNode& n = nodes_[static_cast<std::size_t>(t.node)];
     round_out(0.5 * (lo + hi), 0.5 * (hi - lo) + Vec3::Constant(inflate), n.center, n.half);
     pts.clear();
-    for (std::int32_t i = t.begin; i < t.end; ++i) {
-      const BvhElement& x = items[static_cast<std::size_t>(i)].e;
-      if (x.kind == ElementKind::kVertex) {
-        pts.push_back(m.vertices()[static_cast<std::size_t>(x.index)].p);
-      } else if (x.kind == ElementKind::kEdge) {
-        pts.push_back(m.edge_point(EdgeId(x.index), 0));
-        pts.push_back(m.edge_point(EdgeId(x.index), 1));
-      } else {
-        for (VertexId v : m.faces()[static_cast<std::size_t>(x.index)].vertices)
-          pts.push_back(m.vertex(v).p);
-      }
-    }
-    if (obbs_.size() <= static_cast<std::size_t>(t.node))
-      obbs_.resize(static_cast<std::size_t>(t.node) + 1);
+    for (std::int32_t i = t.begin; i < t.end; ++i) points_of(m, items[static_cast<std::size_t>(i)].e, pts);
     obbs_[static_cast<std::size_t>(t.node)] = obb_of(pts, inflate);
     for (std::int32_t i = t.begin; i < t.end; ++i)
       n.kinds |= kind_bit(items[static_cast<std::size_t>(i)].e.kind);

@@ -144,8 +144,9 @@ struct ContactDetector::Impl {
     std::uint64_t stamp = 0;
   };
   std::vector<PosedBox> a_box, a_elem_box;
-  bool element_boxes = false;  // leaves hold several elements: test their own boxes too
-  bool oriented = false;       // big models: nodes are tested as oriented boxes too
+  // A model of kBigModelElements or more: leaves of several elements, each element's own box
+  // tested in the leaf, and nodes tested as oriented boxes too.
+  bool big = false;
   Mat3 absR = Mat3::Identity();
   // Compact copies of what the cheap rejections read (most pairs the boxes pass are not
   // contacts: on 2,000-face spheres about 1 in 80 is), so that a rejection touches a few
@@ -211,8 +212,7 @@ struct ContactDetector::Impl {
     // A pair the tests accept is within max(eps, depth) across the plane and in_plane along
     // it, so within max(eps, depth, hypot(eps, in_plane)) of B's element.
     bvh_b = detail::Bvh(mb, std::max({eps, depth, std::hypot(eps, in_plane)}) + geo_tol + float_slack, leaf_size_for(mb));
-    element_boxes = leaf_size_for(ma) > 1 || leaf_size_for(mb) > 1;
-    oriented = is_big(ma) || is_big(mb);
+    big = is_big(ma) || is_big(mb);
     stack.resize(detail::stack_capacity(bvh_a, bvh_b));
     q_pts.resize(static_cast<std::size_t>(flat_a.max_face_points));
     std::size_t max_loops = 1;
@@ -248,7 +248,7 @@ struct ContactDetector::Impl {
     if (std::abs(d.x()) > P.h.x() + B.half.x() || std::abs(d.y()) > P.h.y() + B.half.y() ||
         std::abs(d.z()) > P.h.z() + B.half.z())
       return false;
-    if (!oriented) {
+    if (!big) {
       if (A.leaf()) return true;
       // B's box on A's axes: centre offset R^T d, half extents |R^T| B.half.
       for (int k = 0; k < 3; ++k) {
@@ -321,7 +321,7 @@ struct ContactDetector::Impl {
     P.stamp = stamp;
     const Vec3 c = pose.apply(N.center.cast<double>());
     const Vec3 h = absR * N.half.cast<double>();
-    if (!oriented) {
+    if (!big) {
       detail::round_out(c, h, P.c, P.h);
       return;
     }
@@ -663,7 +663,7 @@ struct ContactDetector::Impl {
     const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
     const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];
     if (!detail::kinds_can_touch(detail::kind_bit(x.kind), detail::kind_bit(y.kind))) return;
-    if (element_boxes && !element_boxes_overlap(ia, ib)) return;
+    if (big && !element_boxes_overlap(ia, ib)) return;
     ++pairs;
     if (may_touch(x.kind, x.index, y.kind, y.index)) exact(x, y);
   }
