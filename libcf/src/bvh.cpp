@@ -31,8 +31,9 @@ void points_of(const Polyhedron& m, const BvhElement& e, std::vector<Vec3>& pts)
   }
 }
 
-// The oriented box of points: principal axes of their spread, extents from the points.
-Obb obb_of(const std::vector<Vec3>& pts, double inflate) {
+// Sets o's oriented box to that of points: principal axes of their spread, extents from the
+// points.
+void obb_of(const std::vector<Vec3>& pts, double inflate, NodeBox& o) {
   Vec3 mean = Vec3::Zero();
   for (const Vec3& p : pts) mean += p;
   mean /= static_cast<double>(pts.size());
@@ -47,16 +48,18 @@ Obb obb_of(const std::vector<Vec3>& pts, double inflate) {
     lo = lo.cwiseMin(q);
     hi = hi.cwiseMax(q);
   }
-  Obb o;
-  o.axes = axes.cast<float>();
+  const Eigen::Matrix3f axes_f = axes.cast<float>();
+  for (int k = 0; k < 3; ++k) {
+    o.ax[k] << axes_f.col(k), 0.0f;
+    o.axt[k] << axes_f.row(k).transpose(), 0.0f;
+  }
   // The float axes are off by about 1e-7 rad: widen by that much of the box's reach.
   const Vec3 centre_local = 0.5 * (lo + hi);
   const double reach = (0.5 * (hi - lo)).norm() + 1.0;
   Eigen::Vector3f c, h;
   round_out(axes * centre_local, 0.5 * (hi - lo) + Vec3::Constant(inflate + 1e-6 * reach), c, h);
-  o.center = c;
-  o.half = h;
-  return o;
+  o.oc << c, 0.0f;
+  o.oh << h, 0.0f;
 }
 
 }  // namespace
@@ -88,7 +91,7 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
   };
   std::vector<Task> tasks;
   nodes_.emplace_back();
-  obbs_.resize(2 * items.size());  // a binary tree over n items has fewer than 2n nodes
+  boxes_.resize(2 * items.size());  // a binary tree over n items has fewer than 2n nodes
   tasks.push_back({0, 0, static_cast<std::int32_t>(items.size()), 1});
   while (!tasks.empty()) {
     const Task t = tasks.back();
@@ -108,7 +111,10 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
     round_out(0.5 * (lo + hi), 0.5 * (hi - lo) + Vec3::Constant(inflate), n.center, n.half);
     pts.clear();
     for (std::int32_t i = t.begin; i < t.end; ++i) points_of(m, items[static_cast<std::size_t>(i)].e, pts);
-    obbs_[static_cast<std::size_t>(t.node)] = obb_of(pts, inflate);
+    NodeBox& box = boxes_[static_cast<std::size_t>(t.node)];
+    obb_of(pts, inflate, box);
+    box.c << n.center, 0.0f;
+    box.h << n.half, 0.0f;
     for (std::int32_t i = t.begin; i < t.end; ++i)
       n.kinds |= kind_bit(items[static_cast<std::size_t>(i)].e.kind);
     if (t.end - t.begin <= leaf_size) {
@@ -134,7 +140,7 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
     tasks.push_back({l, t.begin, mid, t.depth + 1});
     tasks.push_back({l + 1, mid, t.end, t.depth + 1});
   }
-  obbs_.resize(nodes_.size());
+  boxes_.resize(nodes_.size());
   elements_.reserve(items.size());
   for (const Item& it : items) {
     elements_.push_back(it.e);

@@ -136,14 +136,18 @@ struct ContactDetector::Impl {
   // the trigonometry of the per-pair tests, done once.
   std::vector<double> sin_tol_face_a, sin_tol_face_b, sin_tol_edge_a, sin_tol_edge_b;
   double sin_max_tol = 0, cos_max_tol = 1;
-  // A's nodes' boxes in B's frame at the current pose (computed on first use per call).
+  // A's nodes' (and elements') boxes in B's frame at the current pose (computed on first
+  // use per call).
   struct PosedBox {
     Eigen::Vector3f c, h;  // mm, B's frame
-    Eigen::Vector3f oc;    // mm, the oriented box's centre, B's frame
-    Eigen::Matrix3f oax;   // the oriented box's axes, B's frame
     std::uint64_t stamp = 0;
   };
   std::vector<PosedBox> a_box, a_elem_box;
+  struct PosedNode {  // big models
+    detail::NodeBox box;  // B's frame
+    std::uint64_t stamp = 0;
+  };
+  std::vector<PosedNode> a_node;
   // A model of kBigModelElements or more: leaves of several elements, each element's own box
   // tested in the leaf, and nodes tested as oriented boxes too.
   bool big = false;
@@ -165,6 +169,7 @@ struct ContactDetector::Impl {
   std::vector<Plane> plane_b, plane_a;
   std::vector<Seg> seg_b, seg_a;
   Eigen::Matrix3f Rf = Eigen::Matrix3f::Identity(), absRf = Eigen::Matrix3f::Identity();
+  Eigen::Array4f Rcol[3], absRcol[3];  // R_BA's columns and their absolute values, lane 3 zero
   // Scratch (sized once).
   std::vector<detail::NodePair> stack;
   std::vector<Vec2> q_pts;
@@ -229,7 +234,8 @@ struct ContactDetector::Impl {
     for (const Edge& E : mb.edges()) sin_tol_edge_b.push_back(std::sin(tol_for(E.length)));
     sin_max_tol = std::sin(max_tol());
     cos_max_tol = std::cos(max_tol());
-    a_box.resize(bvh_a.nodes().size());
+    if (big) a_node.resize(bvh_a.nodes().size());
+    else a_box.resize(bvh_a.nodes().size());
     a_elem_box.resize(bvh_a.elements().size());
     for (const Face& F : mb.faces()) plane_b.push_back({F.normal, F.offset, 0});
     for (const Edge& E : mb.edges()) seg_b.push_back({mb.vertex(E.v0).p, E.dir, E.length, 0});
@@ -237,44 +243,29 @@ struct ContactDetector::Impl {
     seg_a.resize(ma.num_edges());
   }
 
-  // Does A's BVH node `ia` (posed) overlap B's node `ib`? First the axis-aligned boxes in
-  // B's frame. Small models: then, for inner nodes, B's box on A's node's own axes. Big
-  // models: then the two nodes' oriented boxes.
+  // Does A's BVH node `ia` (posed) overlap B's node `ib`? Small models: the axis-aligned
+  // boxes in B's frame, then, for inner nodes, B's box on A's node's own axes. Big models:
+  // the nodes' axis-aligned and oriented boxes (detail::boxes_apart).
   __attribute__((always_inline)) bool overlap(std::int32_t ia, std::int32_t ib, const detail::BvhNode& A,
                                               const detail::BvhNode& B) {
+    if (big) {
+      PosedNode& P = a_node[static_cast<std::size_t>(ia)];
+      if (P.stamp != stamp) pose_node(P, ia);
+      return !detail::boxes_apart(P.box, bvh_b.boxes()[static_cast<std::size_t>(ib)]);
+    }
     PosedBox& P = a_box[static_cast<std::size_t>(ia)];
-    if (P.stamp != stamp) pose_box(P, A, ia);
+    if (P.stamp != stamp) pose_box(P, A);
     const Eigen::Vector3f d = P.c - B.center;
     if (std::abs(d.x()) > P.h.x() + B.half.x() || std::abs(d.y()) > P.h.y() + B.half.y() ||
         std::abs(d.z()) > P.h.z() + B.half.z())
       return false;
-    if (!big) {
-      if (A.leaf()) return true;
-      // B's box on A's axes: centre offset R^T d, half extents |R^T| B.half.
-      for (int k = 0; k < 3; ++k) {
-        const float dk = Rf(0, k) * d.x() + Rf(1, k) * d.y() + Rf(2, k) * d.z();
-        const float hk = absRf(0, k) * B.half.x() + absRf(1, k) * B.half.y() + absRf(2, k) * B.half.z();
-        if (std::abs(dk) > A.half[k] + hk) return false;
-      }
-      return true;
+    if (A.leaf()) return true;
+    // B's box on A's axes: centre offset R^T d, half extents |R^T| B.half.
+    for (int k = 0; k < 3; ++k) {
+      const float dk = Rf(0, k) * d.x() + Rf(1, k) * d.y() + Rf(2, k) * d.z();
+      const float hk = absRf(0, k) * B.half.x() + absRf(1, k) * B.half.y() + absRf(2, k) * B.half.z();
+      if (std::abs(dk) > A.half[k] + hk) return false;
     }
-    return obbs_overlap(P, bvh_a.obbs()[static_cast<std::size_t>(ia)].half, bvh_b.obbs()[static_cast<std::size_t>(ib)]);
-  }
-
-  // The oriented boxes on their six face axes (the nine cross axes add little here), the
-  // thin axes first: column 0 is each box's smallest spread, a patch's normal.
-  __attribute__((always_inline)) static bool apart_on(const Eigen::Vector3f& u, float hu, const Eigen::Matrix3f& axes,
-                                                      const Eigen::Vector3f& half, const Eigen::Vector3f& d) {
-    const float r = std::abs(u.dot(axes.col(0))) * half.x() + std::abs(u.dot(axes.col(1))) * half.y() +
-                    std::abs(u.dot(axes.col(2))) * half.z();
-    return std::abs(u.dot(d)) > hu + r;
-  }
-  __attribute__((always_inline)) static bool obbs_overlap(const PosedBox& P, const Eigen::Vector3f& ha,
-                                                          const detail::Obb& B) {
-    const Eigen::Vector3f d = P.oc - B.center;
-    for (int k = 0; k < 3; ++k)
-      if (apart_on(B.axes.col(k), B.half[k], P.oax, ha, d) || apart_on(P.oax.col(k), ha[k], B.axes, B.half, d))
-        return false;
     return true;
   }
 
@@ -314,25 +305,41 @@ struct ContactDetector::Impl {
            std::abs(P.c.z() - c.z()) <= P.h.z() + h.z();
   }
 
-  // A's node i at the current pose: its box in B's frame and, for big models, its oriented
-  // box. The posed box of the oriented box bounds the node as well: the two boxes' overlap
-  // (in double precision, then rounded outwards) is kept.
-  __attribute__((noinline)) void pose_box(PosedBox& P, const detail::BvhNode& N, std::int32_t i) {
+  // A's node at the current pose: its box in B's frame.
+  __attribute__((noinline)) void pose_box(PosedBox& P, const detail::BvhNode& N) {
     P.stamp = stamp;
-    const Vec3 c = pose.apply(N.center.cast<double>());
-    const Vec3 h = absR * N.half.cast<double>();
-    if (!big) {
-      detail::round_out(c, h, P.c, P.h);
-      return;
+    detail::round_out(pose.apply(N.center.cast<double>()), absR * N.half.cast<double>(), P.c, P.h);
+  }
+
+  // A big model's node i at the current pose, in B's frame. The centres are posed in double
+  // (A's coordinates may be far from its origin); the rest in single precision, whose
+  // rounding (a few parts in 1e7 of the coordinates) B's boxes' float slack covers. The posed
+  // axis-aligned box of the oriented box bounds the node as well: the overlap of the two
+  // is kept.
+  __attribute__((noinline)) void pose_node(PosedNode& P, std::int32_t i) {
+    using V = Eigen::Array4f;
+    P.stamp = stamp;
+    const detail::NodeBox& N = bvh_a.boxes()[static_cast<std::size_t>(i)];
+    detail::NodeBox& Q = P.box;
+    const auto posed_point = [&](const V& p) {
+      V q;
+      q << pose.apply(p.head<3>().cast<double>()).cast<float>(), 0.0f;
+      return q;
+    };
+    const V c = posed_point(N.c), oc = posed_point(N.oc);
+    const V h = absRcol[0] * N.h[0] + absRcol[1] * N.h[1] + absRcol[2] * N.h[2];
+    V oh_aligned = V::Zero();
+    for (int k = 0; k < 3; ++k) {
+      Q.ax[k] = Rcol[0] * N.ax[k][0] + Rcol[1] * N.ax[k][1] + Rcol[2] * N.ax[k][2];
+      Q.axt[k] = N.axt[0] * Rf(k, 0) + N.axt[1] * Rf(k, 1) + N.axt[2] * Rf(k, 2);
+      oh_aligned += Q.ax[k].abs() * N.oh[k];
     }
-    const detail::Obb& O = bvh_a.obbs()[static_cast<std::size_t>(i)];
-    const Mat3 axes = pose.R_BA * O.axes.cast<double>();
-    const Vec3 oc = pose.apply(O.center.cast<double>());
-    const Vec3 oh = axes.cwiseAbs() * O.half.cast<double>();
-    const Vec3 lo = (c - h).cwiseMax(oc - oh), hi = (c + h).cwiseMin(oc + oh);
-    detail::round_out(0.5 * (lo + hi), 0.5 * (hi - lo).cwiseMax(0.0), P.c, P.h);
-    P.oc = oc.cast<float>();
-    P.oax = axes.cast<float>();
+    const V lo = (c - h).max(oc - oh_aligned), hi = (c + h).min(oc + oh_aligned);
+    Q.c = 0.5f * (lo + hi);
+    // Widened by the rounding of the midpoint and of the half difference.
+    Q.h = ((0.5f * (hi - lo)).max(0.0f) + 2.4e-7f * Q.c.abs()) * 1.0000003f;
+    Q.oc = oc;
+    Q.oh = N.oh;
   }
 
   // The largest angular tolerance any pair can get: a cheap early out before the contact
@@ -766,6 +773,10 @@ struct ContactDetector::Impl {
     absR = pose.R_BA.cwiseAbs();
     Rf = pose.R_BA.cast<float>();
     absRf = absR.cast<float>();
+    for (int k = 0; k < 3; ++k) {
+      Rcol[k] << Rf.col(k), 0.0f;
+      absRcol[k] << absRf.col(k), 0.0f;
+    }
     detail::descend(
         bvh_a, bvh_b,
         [this](std::int32_t ia, std::int32_t ib, const detail::BvhNode& A, const detail::BvhNode& B) {
