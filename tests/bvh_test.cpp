@@ -80,11 +80,13 @@ cf::detail::NodeBox random_box(std::mt19937& rng, const Vec3& c, double aabb_gro
 }  // namespace
 
 TEST_CASE("every node's boxes hold the points of every element below it", "[bvh]") {
-  const cf::Polyhedron m = tm::faceted_sphere(30, 40, 50, Vec3(100, -20, 5), "sphere2000");
+  // Off its frame's origin, with the boxes' centres relative to the sphere's centre.
+  const Vec3 centre(100, -20, 5);
+  const cf::Polyhedron m = tm::faceted_sphere(30, 40, 50, centre, "sphere2000");
   for (int leaf : {1, 2, 4}) {
     for (double inflate : {0.0, 0.25}) {
       CAPTURE(leaf, inflate);
-      const cf::detail::Bvh t(m, inflate, leaf);
+      const cf::detail::Bvh t(m, inflate, leaf, centre);
       const auto& nodes = t.nodes();
       REQUIRE(t.boxes().size() == nodes.size());
       // Walk down from the root, carrying the chain of ancestors.
@@ -108,12 +110,12 @@ TEST_CASE("every node's boxes hold the points of every element below it", "[bvh]
               ++checked;
               // Inflated boxes hold the points with the inflation to spare.
               const cf::detail::NodeBox& b = t.boxes()[static_cast<std::size_t>(a)];
-              if (!in_boxes(b, p)) ++outside;
+              if (!in_boxes(b, p - centre)) ++outside;
               if (inflate > 0) {
                 cf::detail::NodeBox shrunk = b;
                 shrunk.h -= static_cast<float>(inflate) * Eigen::Array4f(1, 1, 1, 0);
                 shrunk.oh -= static_cast<float>(inflate) * Eigen::Array4f(1, 1, 1, 0);
-                if (!in_boxes(shrunk, p)) ++outside;
+                if (!in_boxes(shrunk, p - centre)) ++outside;
               }
             }
         }

@@ -33,7 +33,7 @@ void points_of(const Polyhedron& m, const BvhElement& e, std::vector<Vec3>& pts)
 
 // Sets o's oriented box to that of points: principal axes of their spread, extents from the
 // points.
-void obb_of(const std::vector<Vec3>& pts, double inflate, NodeBox& o) {
+void obb_of(const std::vector<Vec3>& pts, double inflate, const Vec3& origin, NodeBox& o) {
   Vec3 mean = Vec3::Zero();
   for (const Vec3& p : pts) mean += p;
   mean /= static_cast<double>(pts.size());
@@ -57,14 +57,14 @@ void obb_of(const std::vector<Vec3>& pts, double inflate, NodeBox& o) {
   const Vec3 centre_local = 0.5 * (lo + hi);
   const double reach = (0.5 * (hi - lo)).norm() + 1.0;
   Eigen::Vector3f c, h;
-  round_out(axes * centre_local, 0.5 * (hi - lo) + Vec3::Constant(inflate + 1e-6 * reach), c, h);
+  round_out(axes * centre_local - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate + 1e-6 * reach), c, h);
   o.oc << c, 0.0f;
   o.oh << h, 0.0f;
 }
 
 }  // namespace
 
-Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
+Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin) : origin_(origin) {
   leaf_size = std::clamp(leaf_size, 1, 255);
   std::vector<Item> items;
   items.reserve(m.num_vertices() + m.num_edges() + m.num_faces());
@@ -112,11 +112,14 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size) {
     pts.clear();
     for (std::int32_t i = t.begin; i < t.end; ++i) points_of(m, items[static_cast<std::size_t>(i)].e, pts);
     NodeBox& box = boxes_[static_cast<std::size_t>(t.node)];
-    obb_of(pts, inflate, box);
-    box.c << n.center, 0.0f;
-    box.h << n.half, 0.0f;
+    obb_of(pts, inflate, origin, box);
+    Eigen::Vector3f c, h;
+    round_out(0.5 * (lo + hi) - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate), c, h);
+    box.c << c, 0.0f;
+    box.h << h, 0.0f;
     for (std::int32_t i = t.begin; i < t.end; ++i)
       n.kinds |= kind_bit(items[static_cast<std::size_t>(i)].e.kind);
+    n.touchable = touchable_by_a(n.kinds);
     if (t.end - t.begin <= leaf_size) {
       n.child = ~t.begin;
       n.count = static_cast<std::uint8_t>(t.end - t.begin);

@@ -37,6 +37,7 @@ struct BvhNode {
   Eigen::Vector3f half;    // mm, half extents, >= 0
   std::int32_t child = 0;  // inner: index of the first child; leaf: ~(first element index)
   std::uint8_t kinds = 0;  // kind_bit of every element below
+  std::uint8_t touchable = 0;  // touchable_by_a(kinds), for the descent
   std::uint8_t count = 0;  // leaf: number of elements
   bool leaf() const { return child < 0; }
   std::int32_t left() const { return child; }
@@ -99,12 +100,17 @@ class Bvh {
   Bvh() = default;
   /// `inflate` mm is added to every box on each side.
   /// Leaves of at most `leaf_size` spatially close elements of any kind.
-  Bvh(const Polyhedron& m, double inflate, int leaf_size);
+  /// boxes()' centres are relative to `origin` (mm, model frame), so that single-precision
+  /// arithmetic on them errs relative to the model's size, not to its distance from its
+  /// frame's origin.
+  Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin = Vec3::Zero());
+  const Vec3& origin() const { return origin_; }
   /// Per element (in elements() order), its own box (inflated like the nodes').
   const std::vector<Eigen::Vector3f>& element_centers() const { return elem_c_; }
   const std::vector<Eigen::Vector3f>& element_halves() const { return elem_h_; }
   const std::vector<BvhNode>& nodes() const { return nodes_; }
-  /// Per node, its axis-aligned and oriented boxes (inflated alike).
+  /// Per node, its axis-aligned and oriented boxes (inflated alike), centres relative to
+  /// origin().
   const std::vector<NodeBox>& boxes() const { return boxes_; }
   const std::vector<BvhElement>& elements() const { return elements_; }
   int depth() const { return depth_; }
@@ -112,6 +118,7 @@ class Bvh {
  private:
   std::vector<BvhNode> nodes_;
   std::vector<NodeBox> boxes_;
+  Vec3 origin_ = Vec3::Zero();
   std::vector<BvhElement> elements_;
   std::vector<Eigen::Vector3f> elem_c_, elem_h_;
   int depth_ = 0;
@@ -124,16 +131,16 @@ inline std::size_t stack_capacity(const Bvh& a, const Bvh& b) {
   return static_cast<std::size_t>(4 * (a.depth() + b.depth()) + 8);
 }
 
-/// Can an element of a kind in mask `ka` (of A) and one in mask `kb` (of B) form a PC type
-/// (v-f, e-f, e-e, f-f, f-e, f-v)?
-inline bool kinds_can_touch(std::uint8_t ka, std::uint8_t kb) {
+/// The kinds (mask) of B's elements that an element of a kind in mask `ka` of A can form a
+/// PC type with (v-f, e-f, e-e, f-f, f-e, f-v).
+inline std::uint8_t touchable_by_a(std::uint8_t ka) {
   const std::uint8_t V = kind_bit(ElementKind::kVertex), E = kind_bit(ElementKind::kEdge),
                      F = kind_bit(ElementKind::kFace);
-  // Per kind of A, the kinds of B it pairs with.
-  const std::uint8_t with = static_cast<std::uint8_t>(
-      ((ka & V) ? F : 0) | ((ka & E) ? (E | F) : 0) | ((ka & F) ? (V | E | F) : 0));
-  return (with & kb) != 0;
+  return static_cast<std::uint8_t>(((ka & V) ? F : 0) | ((ka & E) ? (E | F) : 0) | ((ka & F) ? (V | E | F) : 0));
 }
+
+/// Can an element of a kind in mask `ka` (of A) and one in mask `kb` (of B) form a PC type?
+inline bool kinds_can_touch(std::uint8_t ka, std::uint8_t kb) { return (touchable_by_a(ka) & kb) != 0; }
 
 /// Calls visit(int a, int b) (positions in elements()) for every pair of elements in leaves
 /// whose bounding volumes overlap and whose kinds can touch, where tree `a` is posed into tree
@@ -154,7 +161,7 @@ bool descend(const Bvh& ta, const Bvh& tb, Overlap&& overlap, NodePair* stack, s
     const NodePair p = stack[--top];
     const BvhNode& A = na[static_cast<std::size_t>(p.a)];
     const BvhNode& B = nb[static_cast<std::size_t>(p.b)];
-    if (!kinds_can_touch(A.kinds, B.kinds) || !overlap(p.a, p.b, A, B)) continue;
+    if (!(A.touchable & B.kinds) || !overlap(p.a, p.b, A, B)) continue;
     if (A.leaf() && B.leaf()) {
       for (int i = 0; i < A.count; ++i)
         for (int j = 0; j < B.count; ++j) visit(A.element() + i, B.element() + j);

@@ -32,6 +32,7 @@ struct FlatFaces {
   std::vector<Vec2> pts;
   std::vector<int> loop_begin;  // per loop, plus a sentinel
   std::vector<int> face_first;  // per face, its first loop index, plus a sentinel
+  std::vector<char> convex;     // per face, detail::is_convex
   int max_face_points = 0;
 
   explicit FlatFaces(const Polyhedron& m) {
@@ -47,6 +48,7 @@ struct FlatFaces {
     }
     face_first.push_back(static_cast<int>(loop_begin.size()));
     loop_begin.push_back(static_cast<int>(pts.size()));
+    for (std::size_t f = 0; f < m.num_faces(); ++f) convex.push_back(detail::is_convex(poly(static_cast<int>(f))));
   }
   FlatFaces() = default;
   detail::Poly2 poly(int f) const {
@@ -170,11 +172,14 @@ struct ContactDetector::Impl {
   std::vector<Seg> seg_b, seg_a;
   Eigen::Matrix3f Rf = Eigen::Matrix3f::Identity(), absRf = Eigen::Matrix3f::Identity();
   Eigen::Array4f Rcol[3], absRcol[3];  // R_BA's columns and their absolute values, lane 3 zero
+  Eigen::Array4f a_origin;              // mm, bvh_a's origin posed, B's frame
   // Scratch (sized once).
   std::vector<detail::NodePair> stack;
   std::vector<Vec2> q_pts;
   std::vector<int> q_lb;
   std::vector<double> params;
+  std::vector<Vec2> clip_buf;  // 2 * clip_cap points
+  int clip_cap = 0;
   std::vector<Vec3> aw;  // A's vertices in the world at the current pose
   std::vector<std::uint64_t> aw_stamp;
   std::uint64_t stamp = 0;
@@ -206,7 +211,7 @@ struct ContactDetector::Impl {
     // Coincidence tolerance for boundaries in 2D: far below any feature, far above rounding.
     geo_tol = 1e-9 * std::max(scale, 1.0);
     area_tol = 1e-12 * std::max(scale * scale, 1.0);
-    bvh_a = detail::Bvh(ma, 0.0, leaf_size_for(ma));
+    bvh_a = detail::Bvh(ma, 0.0, leaf_size_for(ma), 0.5 * (ma.bbox_min() + ma.bbox_max()));
     // The boxes are single precision: widen B's by far more than the rounding of the
     // overlap test's few float operations on coordinates of this scale.
     double reach = ma.size() + mb.size();
@@ -225,6 +230,8 @@ struct ContactDetector::Impl {
     q_lb.resize(max_loops + 1);
     params.resize(static_cast<std::size_t>(
         4 + 4 * std::max(flat_a.max_face_points, flat_b.max_face_points)));
+    clip_cap = flat_a.max_face_points + flat_b.max_face_points;
+    clip_buf.resize(2 * static_cast<std::size_t>(clip_cap));
     aw.resize(ma.num_vertices());
     aw_stamp.assign(ma.num_vertices(), 0);
     // A face's tilt scale is its size, sqrt(area).
@@ -311,22 +318,18 @@ struct ContactDetector::Impl {
     detail::round_out(pose.apply(N.center.cast<double>()), absR * N.half.cast<double>(), P.c, P.h);
   }
 
-  // A big model's node i at the current pose, in B's frame. The centres are posed in double
-  // (A's coordinates may be far from its origin); the rest in single precision, whose
-  // rounding (a few parts in 1e7 of the coordinates) B's boxes' float slack covers. The posed
-  // axis-aligned box of the oriented box bounds the node as well: the overlap of the two
-  // is kept.
+  // A big model's node i at the current pose, in B's frame, in single precision. Its centres
+  // are relative to bvh_a's origin (within A's size), whose posed place is computed in double
+  // once per call, so the rounding (a few parts in 1e7 of A's size plus that place) stays far
+  // below B's boxes' float slack wherever the two boxes could overlap. The posed axis-aligned
+  // box of the oriented box bounds the node as well: the overlap of the two is kept.
   __attribute__((noinline)) void pose_node(PosedNode& P, std::int32_t i) {
     using V = Eigen::Array4f;
     P.stamp = stamp;
     const detail::NodeBox& N = bvh_a.boxes()[static_cast<std::size_t>(i)];
     detail::NodeBox& Q = P.box;
-    const auto posed_point = [&](const V& p) {
-      V q;
-      q << pose.apply(p.head<3>().cast<double>()).cast<float>(), 0.0f;
-      return q;
-    };
-    const V c = posed_point(N.c), oc = posed_point(N.oc);
+    const V c = Rcol[0] * N.c[0] + Rcol[1] * N.c[1] + Rcol[2] * N.c[2] + a_origin;
+    const V oc = Rcol[0] * N.oc[0] + Rcol[1] * N.oc[1] + Rcol[2] * N.oc[2] + a_origin;
     const V h = absRcol[0] * N.h[0] + absRcol[1] * N.h[1] + absRcol[2] * N.h[2];
     V oh_aligned = V::Zero();
     for (int k = 0; k < 3; ++k) {
@@ -554,12 +557,16 @@ struct ContactDetector::Impl {
     const Vec2 g_dir = grad.norm() > 1e-12 ? Vec2(grad.normalized()) : Vec2(1, 0);
     double dmin = std::numeric_limits<double>::infinity();
     double s_lo = std::numeric_limits<double>::infinity(), s_hi = -s_lo;
-    const detail::Overlap2 ov = detail::overlap(flat_b.poly(fb), Q, geo_tol, params.data(), [&](const Vec2& q) {
+    const auto visit = [&](const Vec2& q) {
       dmin = std::min(dmin, height(q));
       const double s = q.dot(g_dir);
       s_lo = std::min(s_lo, s);
       s_hi = std::max(s_hi, s);
-    });
+    };
+    detail::Overlap2 ov;
+    if (!(flat_a.convex[static_cast<std::size_t>(fa)] && flat_b.convex[static_cast<std::size_t>(fb)] &&
+          detail::overlap_convex(flat_b.poly(fb), Q, clip_buf.data(), clip_cap, ov, visit)))
+      ov = detail::overlap(flat_b.poly(fb), Q, geo_tol, params.data(), visit);
     if (!(ov.area > area_tol)) return;
     // The tilt at which the whole overlap stays within epsilon.
     const double tol = tol_for(s_hi - s_lo);
@@ -777,6 +784,7 @@ struct ContactDetector::Impl {
       Rcol[k] << Rf.col(k), 0.0f;
       absRcol[k] << absRf.col(k), 0.0f;
     }
+    a_origin << pose.apply(bvh_a.origin()).cast<float>(), 0.0f;
     detail::descend(
         bvh_a, bvh_b,
         [this](std::int32_t ia, std::int32_t ib, const detail::BvhNode& A, const detail::BvhNode& B) {
