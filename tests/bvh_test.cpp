@@ -79,16 +79,32 @@ cf::detail::NodeBox random_box(std::mt19937& rng, const Vec3& c, double aabb_gro
 
 }  // namespace
 
-TEST_CASE("every node's boxes hold the points of every element below it", "[bvh]") {
+TEST_CASE("every element is in one leaf, and every node's boxes hold it", "[bvh]") {
   // Off its frame's origin, with the boxes' centres relative to the sphere's centre.
   const Vec3 centre(100, -20, 5);
   const cf::Polyhedron m = tm::faceted_sphere(30, 40, 50, centre, "sphere2000");
+  const auto leaves = GENERATE(cf::detail::Leaves::kElements, cf::detail::Leaves::kFaceGroups);
   for (int leaf : {1, 2, 4}) {
     for (double inflate : {0.0, 0.25}) {
-      CAPTURE(leaf, inflate);
-      const cf::detail::Bvh t(m, inflate, leaf, centre);
+      CAPTURE(leaves == cf::detail::Leaves::kFaceGroups, leaf, inflate);
+      const cf::detail::Bvh t(m, inflate, leaf, centre, leaves);
       const auto& nodes = t.nodes();
       REQUIRE(t.boxes().size() == nodes.size());
+      const std::size_t n_elements = m.num_vertices() + m.num_edges() + m.num_faces();
+      REQUIRE(t.elements().size() == n_elements);
+      REQUIRE(t.element_boxes().size() == n_elements);
+      // Each (kind, index) once among the leaves' elements.
+      std::vector<int> seen(n_elements, 0);
+      for (const cf::detail::BvhNode& n : nodes)
+        if (n.leaf())
+          for (int e = 0; e < n.count; ++e) {
+            const cf::detail::BvhElement& x = t.elements()[static_cast<std::size_t>(n.element() + e)];
+            const std::size_t base = x.kind == cf::ElementKind::kVertex ? 0
+                                     : x.kind == cf::ElementKind::kEdge ? m.num_vertices()
+                                                                         : m.num_vertices() + m.num_edges();
+            ++seen[base + static_cast<std::size_t>(x.index)];
+          }
+      CHECK(std::count(seen.begin(), seen.end(), 1) == static_cast<std::ptrdiff_t>(n_elements));
       // Walk down from the root, carrying the chain of ancestors.
       std::vector<std::pair<std::int32_t, std::vector<std::int32_t>>> todo{{0, {}}};
       std::vector<Vec3> pts;
@@ -104,7 +120,20 @@ TEST_CASE("every node's boxes hold the points of every element below it", "[bvh]
           continue;
         }
         for (int e = 0; e < n.count; ++e) {
-          points(m, t.elements()[static_cast<std::size_t>(n.element() + e)], pts);
+          const auto pos = static_cast<std::size_t>(n.element() + e);
+          points(m, t.elements()[pos], pts);
+          // The element's own box too.
+          cf::detail::NodeBox own;
+          own.c = t.element_boxes()[pos].c;
+          own.h = t.element_boxes()[pos].h;
+          own.oc = own.c;
+          own.oh = own.h;
+          for (int k = 0; k < 3; ++k) {
+            own.ax[k] = Eigen::Array4f::Zero();
+            own.ax[k][k] = 1;
+          }
+          for (const Vec3& p : pts)
+            if (!in_boxes(own, p - centre)) ++outside;
           for (const Vec3& p : pts)
             for (std::int32_t a : chain) {
               ++checked;

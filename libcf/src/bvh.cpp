@@ -8,8 +8,9 @@
 namespace cf::detail {
 namespace {
 
+// A unit of the build: one element, or a face with the edges and vertices it owns.
 struct Item {
-  BvhElement e;
+  std::int32_t first, count;  // its elements: members[first, first + count)
   Vec3 lo, hi;
   Vec3 centroid() const { return 0.5 * (lo + hi); }
 };
@@ -64,25 +65,70 @@ void obb_of(const std::vector<Vec3>& pts, double inflate, const Vec3& origin, No
 
 }  // namespace
 
-Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin) : origin_(origin) {
-  leaf_size = std::clamp(leaf_size, 1, 255);
+// A face owns the edges it has on its left and the vertices for which it is the first
+// incident face: each element is owned once, and lies on its owner's boundary, so a face's
+// group has the face's own box. Groups of more than kMaxGroup elements are cut into pieces.
+constexpr std::int32_t kMaxGroup = 8;
+
+Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin, Leaves leaves)
+    : origin_(origin) {
+  leaf_size = std::clamp(leaf_size, 1, leaves == Leaves::kFaceGroups ? 255 / kMaxGroup : 255);
+  std::vector<BvhElement> members;
   std::vector<Item> items;
-  items.reserve(m.num_vertices() + m.num_edges() + m.num_faces());
+  members.reserve(m.num_vertices() + m.num_edges() + m.num_faces());
   std::vector<Vec3> pts;
-  auto add = [&](ElementKind kind, std::size_t i) {
-    const BvhElement e{kind, static_cast<std::int32_t>(i)};
+  // Closes the item of members[first, end).
+  auto close_item = [&](std::int32_t first) {
+    const auto end = static_cast<std::int32_t>(members.size());
+    if (end == first) return;
     pts.clear();
-    points_of(m, e, pts);
+    for (std::int32_t i = first; i < end; ++i) points_of(m, members[static_cast<std::size_t>(i)], pts);
     Vec3 lo = pts[0], hi = lo;
     for (const Vec3& p : pts) {
       lo = lo.cwiseMin(p);
       hi = hi.cwiseMax(p);
     }
-    items.push_back({e, lo, hi});
+    items.push_back({first, end - first, lo, hi});
   };
-  for (std::size_t i = 0; i < m.num_vertices(); ++i) add(ElementKind::kVertex, i);
-  for (std::size_t i = 0; i < m.num_edges(); ++i) add(ElementKind::kEdge, i);
-  for (std::size_t i = 0; i < m.num_faces(); ++i) add(ElementKind::kFace, i);
+  if (leaves == Leaves::kElements) {
+    auto add = [&](ElementKind kind, std::size_t i) {
+      const auto first = static_cast<std::int32_t>(members.size());
+      members.push_back({kind, static_cast<std::int32_t>(i)});
+      close_item(first);
+    };
+    for (std::size_t i = 0; i < m.num_vertices(); ++i) add(ElementKind::kVertex, i);
+    for (std::size_t i = 0; i < m.num_edges(); ++i) add(ElementKind::kEdge, i);
+    for (std::size_t i = 0; i < m.num_faces(); ++i) add(ElementKind::kFace, i);
+  } else {
+    std::vector<std::vector<BvhElement>> owned(m.num_faces());
+    for (std::size_t e = 0; e < m.num_edges(); ++e)
+      owned[m.edges()[e].left.index()].push_back({ElementKind::kEdge, static_cast<std::int32_t>(e)});
+    for (std::size_t v = 0; v < m.num_vertices(); ++v)
+      if (!m.vertices()[v].faces.empty())
+        owned[m.vertices()[v].faces.front().index()].push_back({ElementKind::kVertex, static_cast<std::int32_t>(v)});
+    for (std::size_t f = 0; f < m.num_faces(); ++f) {
+      auto first = static_cast<std::int32_t>(members.size());
+      members.push_back({ElementKind::kFace, static_cast<std::int32_t>(f)});
+      for (const BvhElement& e : owned[f]) {
+        if (static_cast<std::int32_t>(members.size()) - first == kMaxGroup) {
+          close_item(first);
+          first = static_cast<std::int32_t>(members.size());
+        }
+        members.push_back(e);
+      }
+      close_item(first);
+    }
+    // Elements no face owns (a vertex on no face): items of their own.
+    std::vector<char> seen(m.num_vertices(), 0);
+    for (const BvhElement& e : members)
+      if (e.kind == ElementKind::kVertex) seen[static_cast<std::size_t>(e.index)] = 1;
+    for (std::size_t v = 0; v < m.num_vertices(); ++v)
+      if (!seen[v]) {
+        const auto first = static_cast<std::int32_t>(members.size());
+        members.push_back({ElementKind::kVertex, static_cast<std::int32_t>(v)});
+        close_item(first);
+      }
+  }
   if (items.empty()) return;
   nodes_.reserve(2 * items.size());
   // Iterative top-down build: median split along the longest axis of the centroids.
@@ -110,18 +156,22 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin)
     BvhNode& n = nodes_[static_cast<std::size_t>(t.node)];
     round_out(0.5 * (lo + hi), 0.5 * (hi - lo) + Vec3::Constant(inflate), n.center, n.half);
     pts.clear();
-    for (std::int32_t i = t.begin; i < t.end; ++i) points_of(m, items[static_cast<std::size_t>(i)].e, pts);
+    for (std::int32_t i = t.begin; i < t.end; ++i) {
+      const Item& it = items[static_cast<std::size_t>(i)];
+      for (std::int32_t k = it.first; k < it.first + it.count; ++k) {
+        points_of(m, members[static_cast<std::size_t>(k)], pts);
+        n.kinds |= kind_bit(members[static_cast<std::size_t>(k)].kind);
+      }
+    }
     NodeBox& box = boxes_[static_cast<std::size_t>(t.node)];
     obb_of(pts, inflate, origin, box);
     Eigen::Vector3f c, h;
     round_out(0.5 * (lo + hi) - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate), c, h);
     box.c << c, 0.0f;
     box.h << h, 0.0f;
-    for (std::int32_t i = t.begin; i < t.end; ++i)
-      n.kinds |= kind_bit(items[static_cast<std::size_t>(i)].e.kind);
     n.touchable = touchable_by_a(n.kinds);
     if (t.end - t.begin <= leaf_size) {
-      n.child = ~t.begin;
+      n.child = ~t.begin;  // items for now; elements below
       n.count = static_cast<std::uint8_t>(t.end - t.begin);
       continue;
     }
@@ -130,11 +180,13 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin)
     (chi - clo).maxCoeff(&axis);
     const std::int32_t mid = (t.begin + t.end) / 2;
     std::nth_element(items.begin() + t.begin, items.begin() + mid, items.begin() + t.end,
-                     [axis](const Item& x, const Item& y) {
+                     [axis, &members](const Item& x, const Item& y) {
                        const double cx = x.lo[axis] + x.hi[axis], cy = y.lo[axis] + y.hi[axis];
                        if (cx != cy) return cx < cy;
-                       if (x.e.kind != y.e.kind) return x.e.kind < y.e.kind;
-                       return x.e.index < y.e.index;
+                       const BvhElement& ex = members[static_cast<std::size_t>(x.first)];
+                       const BvhElement& ey = members[static_cast<std::size_t>(y.first)];
+                       if (ex.kind != ey.kind) return ex.kind < ey.kind;
+                       return ex.index < ey.index;
                      });
     const auto l = static_cast<std::int32_t>(nodes_.size());
     nodes_.emplace_back();
@@ -144,14 +196,36 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin)
     tasks.push_back({l + 1, mid, t.end, t.depth + 1});
   }
   boxes_.resize(nodes_.size());
-  elements_.reserve(items.size());
-  for (const Item& it : items) {
-    elements_.push_back(it.e);
-    elem_c_.emplace_back();
-    elem_h_.emplace_back();
-    round_out(0.5 * (it.lo + it.hi), 0.5 * (it.hi - it.lo) + Vec3::Constant(inflate),
-              elem_c_.back(), elem_h_.back());
+  // Elements in the items' final order; leaves from item ranges to element ranges.
+  std::vector<std::int32_t> offset(items.size() + 1, 0);
+  elements_.reserve(members.size());
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    offset[i] = static_cast<std::int32_t>(elements_.size());
+    const Item& it = items[i];
+    for (std::int32_t k = it.first; k < it.first + it.count; ++k) {
+      const BvhElement& e = members[static_cast<std::size_t>(k)];
+      elements_.push_back(e);
+      pts.clear();
+      points_of(m, e, pts);
+      Vec3 lo = pts[0], hi = lo;
+      for (const Vec3& p : pts) {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+      Eigen::Vector3f c, h;
+      round_out(0.5 * (lo + hi) - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate), c, h);
+      ElemBox& b = elem_boxes_.emplace_back();
+      b.c << c, 0.0f;
+      b.h << h, 0.0f;
+    }
   }
+  offset[items.size()] = static_cast<std::int32_t>(elements_.size());
+  for (BvhNode& n : nodes_)
+    if (n.leaf()) {
+      const std::int32_t b = ~n.child, e = b + n.count;
+      n.child = ~offset[static_cast<std::size_t>(b)];
+      n.count = static_cast<std::uint8_t>(offset[static_cast<std::size_t>(e)] - offset[static_cast<std::size_t>(b)]);
+    }
 }
 
 }  // namespace cf::detail

@@ -66,6 +66,12 @@ struct alignas(16) NodeBox {
   Eigen::Array4f axt[3];  // the same transposed: axt[i][k] == ax[k][i]
 };
 
+/// An element's axis-aligned box as 4-lane rows (lane 3 zero). Single precision, rounded
+/// outwards.
+struct alignas(16) ElemBox {
+  Eigen::Array4f c, h;  // mm: centre and half extents
+};
+
 /// Is some lane of x greater than y's? (Eigen's any() on a comparison reduces lane by lane.)
 __attribute__((always_inline)) inline bool any_greater(const Eigen::Array4f& x, const Eigen::Array4f& y) {
 #if defined(__SSE__)
@@ -73,6 +79,11 @@ __attribute__((always_inline)) inline bool any_greater(const Eigen::Array4f& x, 
 #else
   return (x > y).any();
 #endif
+}
+
+/// Are two element boxes (in one frame) disjoint?
+__attribute__((always_inline)) inline bool boxes_apart(const ElemBox& p, const ElemBox& q) {
+  return any_greater((p.c - q.c).abs(), p.h + q.h);
 }
 
 /// Are two node boxes (in one frame) disjoint? The axis-aligned boxes first, then the
@@ -95,19 +106,25 @@ __attribute__((always_inline)) inline bool boxes_apart(const NodeBox& p, const N
   return any_greater(tp.abs(), p.oh + rq);
 }
 
+/// What a leaf holds: a few elements of any kind, or a few faces each with the edges and
+/// vertices it owns (for fine meshes: leaves that tile the surface, so that sibling boxes
+/// overlap less).
+enum class Leaves { kElements, kFaceGroups };
+
 class Bvh {
  public:
   Bvh() = default;
   /// `inflate` mm is added to every box on each side.
-  /// Leaves of at most `leaf_size` spatially close elements of any kind.
+  /// Leaves of at most `leaf_size` spatially close elements, or face groups.
   /// boxes()' centres are relative to `origin` (mm, model frame), so that single-precision
   /// arithmetic on them errs relative to the model's size, not to its distance from its
   /// frame's origin.
-  Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin = Vec3::Zero());
+  Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin = Vec3::Zero(),
+      Leaves leaves = Leaves::kElements);
   const Vec3& origin() const { return origin_; }
-  /// Per element (in elements() order), its own box (inflated like the nodes').
-  const std::vector<Eigen::Vector3f>& element_centers() const { return elem_c_; }
-  const std::vector<Eigen::Vector3f>& element_halves() const { return elem_h_; }
+  /// Per element (in elements() order), its own box (inflated like the nodes'), centre
+  /// relative to origin().
+  const std::vector<ElemBox>& element_boxes() const { return elem_boxes_; }
   const std::vector<BvhNode>& nodes() const { return nodes_; }
   /// Per node, its axis-aligned and oriented boxes (inflated alike), centres relative to
   /// origin().
@@ -120,7 +137,7 @@ class Bvh {
   std::vector<NodeBox> boxes_;
   Vec3 origin_ = Vec3::Zero();
   std::vector<BvhElement> elements_;
-  std::vector<Eigen::Vector3f> elem_c_, elem_h_;
+  std::vector<ElemBox> elem_boxes_;
   int depth_ = 0;
 };
 

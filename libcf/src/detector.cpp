@@ -118,14 +118,17 @@ double segment_segment_2d(const Vec2& a, const Vec2& b, const Vec2& c, const Vec
 // BVH leaves of a model: one element for small models (with bigger leaves, leaf boxes of the
 // paper's cube and L-block overlap everything), posed like inner nodes (cheaper than exact
 // boxes there: 2.4 against 2.8 us per tick). Big models' nodes are also tested as oriented
-// boxes: a curved surface's patches are tilted, and the axis-aligned box of a tilted patch
-// is as thick as it is wide, so that two surfaces in contact overlap over many patches; and
-// their leaves hold 2 spatially close elements, each with its own box tested in the leaf
-// (fewer node visits; leaves of 1, 4 or 8 cost 1.2x to 1.8x the time on 2,000-face spheres).
-// docs/performance.md has the figures.
+// boxes (detail::boxes_apart): a curved surface's patches are tilted, and the axis-aligned
+// box of a tilted patch is as thick as it is wide, so that two surfaces in contact overlap
+// over many patches; and their leaves hold one face with the edges and vertices it owns,
+// which tile the surface, each element with its own box tested in the leaf (on 2,000-face
+// spheres 7% fewer instructions than leaves of 2 elements of any kind, 15% fewer at the
+// paper's epsilon). docs/performance.md has the figures.
 constexpr std::size_t kBigModelElements = 256;
 bool is_big(const Polyhedron& m) { return m.num_vertices() + m.num_edges() + m.num_faces() >= kBigModelElements; }
-int leaf_size_for(const Polyhedron& m) { return is_big(m) ? 2 : 1; }
+detail::Leaves leaves_for(const Polyhedron& m) {
+  return is_big(m) ? detail::Leaves::kFaceGroups : detail::Leaves::kElements;
+}
 
 struct ContactDetector::Impl {
   Polyhedron a, b;
@@ -144,13 +147,25 @@ struct ContactDetector::Impl {
     Eigen::Vector3f c, h;  // mm, B's frame
     std::uint64_t stamp = 0;
   };
-  std::vector<PosedBox> a_box, a_elem_box;
+  std::vector<PosedBox> a_box;
   struct PosedNode {  // big models
     detail::NodeBox box;  // B's frame
     std::uint64_t stamp = 0;
   };
   std::vector<PosedNode> a_node;
-  // A model of kBigModelElements or more: leaves of several elements, each element's own box
+  // Big models: A's elements' boxes, from A's vertices posed in single precision.
+  struct PosedElem {
+    detail::ElemBox box;  // B's frame
+    std::uint64_t stamp = 0;
+  };
+  std::vector<PosedElem> a_elem;
+  std::vector<Eigen::Array4f> a_vert;  // mm, A's vertices relative to bvh_a.origin(), A's frame
+  struct PosedVertex {
+    Eigen::Array4f p;  // mm, B's frame
+    std::uint64_t stamp = 0;
+  };
+  std::vector<PosedVertex> a_vert_posed;
+  // A model of kBigModelElements or more: leaves of face groups, each element's own box
   // tested in the leaf, and nodes tested as oriented boxes too.
   bool big = false;
   Mat3 absR = Mat3::Identity();
@@ -211,7 +226,7 @@ struct ContactDetector::Impl {
     // Coincidence tolerance for boundaries in 2D: far below any feature, far above rounding.
     geo_tol = 1e-9 * std::max(scale, 1.0);
     area_tol = 1e-12 * std::max(scale * scale, 1.0);
-    bvh_a = detail::Bvh(ma, 0.0, leaf_size_for(ma), 0.5 * (ma.bbox_min() + ma.bbox_max()));
+    bvh_a = detail::Bvh(ma, 0.0, 1, 0.5 * (ma.bbox_min() + ma.bbox_max()), leaves_for(ma));
     // The boxes are single precision: widen B's by far more than the rounding of the
     // overlap test's few float operations on coordinates of this scale.
     double reach = ma.size() + mb.size();
@@ -221,7 +236,7 @@ struct ContactDetector::Impl {
     // exact tests could accept has overlapping boxes.
     // A pair the tests accept is within max(eps, depth) across the plane and in_plane along
     // it, so within max(eps, depth, hypot(eps, in_plane)) of B's element.
-    bvh_b = detail::Bvh(mb, std::max({eps, depth, std::hypot(eps, in_plane)}) + geo_tol + float_slack, leaf_size_for(mb));
+    bvh_b = detail::Bvh(mb, std::max({eps, depth, std::hypot(eps, in_plane)}) + geo_tol + float_slack, 1, Vec3::Zero(), leaves_for(mb));
     big = is_big(ma) || is_big(mb);
     stack.resize(detail::stack_capacity(bvh_a, bvh_b));
     q_pts.resize(static_cast<std::size_t>(flat_a.max_face_points));
@@ -243,7 +258,11 @@ struct ContactDetector::Impl {
     cos_max_tol = std::cos(max_tol());
     if (big) a_node.resize(bvh_a.nodes().size());
     else a_box.resize(bvh_a.nodes().size());
-    a_elem_box.resize(bvh_a.elements().size());
+    if (big) {
+      a_elem.resize(bvh_a.elements().size());
+      for (const Vertex& v : ma.vertices()) a_vert.emplace_back() << (v.p - bvh_a.origin()).cast<float>(), 0.0f;
+      a_vert_posed.resize(ma.num_vertices());
+    }
     for (const Face& F : mb.faces()) plane_b.push_back({F.normal, F.offset, 0});
     for (const Edge& E : mb.edges()) seg_b.push_back({mb.vertex(E.v0).p, E.dir, E.length, 0});
     plane_a.resize(ma.num_faces());
@@ -276,13 +295,27 @@ struct ContactDetector::Impl {
     return true;
   }
 
-  // Grows [lo, hi] by A's element x at the current pose (B's frame).
-  void grow_by_element(const detail::BvhElement& x, Vec3& lo, Vec3& hi) {
+  // A's vertex v posed, single precision (rounding as in pose_node).
+  const Eigen::Array4f& posed_vertex(VertexId v) {
+    PosedVertex& P = a_vert_posed[v.index()];
+    if (P.stamp != stamp) {
+      const Eigen::Array4f& q = a_vert[v.index()];
+      P.p = Rcol[0] * q[0] + Rcol[1] * q[1] + Rcol[2] * q[2] + a_origin;
+      P.stamp = stamp;
+    }
+    return P.p;
+  }
+
+  // A big model's element at position i of its BVH, posed: the box of its posed vertices.
+  __attribute__((noinline)) void pose_element(PosedElem& P, int i) {
+    P.stamp = stamp;
+    Eigen::Array4f lo = Eigen::Array4f::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
     auto add = [&](VertexId v) {
-      const Vec3& p = world(v);
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
+      const Eigen::Array4f& p = posed_vertex(v);
+      lo = lo.min(p);
+      hi = hi.max(p);
     };
+    const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(i)];
     switch (x.kind) {
       case ElementKind::kVertex:
         add(VertexId(x.index));
@@ -295,21 +328,15 @@ struct ContactDetector::Impl {
         for (VertexId v : a.faces()[static_cast<std::size_t>(x.index)].vertices) add(v);
         break;
     }
+    P.box.c = 0.5f * (lo + hi);
+    P.box.h = (0.5f * (hi - lo) + 2.4e-7f * P.box.c.abs()) * 1.0000003f;
   }
 
   // Does A's element at position ia of its BVH (posed) overlap B's element at ib?
   bool element_boxes_overlap(int ia, int ib) {
-    PosedBox& P = a_elem_box[static_cast<std::size_t>(ia)];
-    if (P.stamp != stamp) {
-      P.stamp = stamp;
-      Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-      grow_by_element(bvh_a.elements()[static_cast<std::size_t>(ia)], lo, hi);
-      detail::round_out(0.5 * (lo + hi), 0.5 * (hi - lo), P.c, P.h);
-    }
-    const Eigen::Vector3f& c = bvh_b.element_centers()[static_cast<std::size_t>(ib)];
-    const Eigen::Vector3f& h = bvh_b.element_halves()[static_cast<std::size_t>(ib)];
-    return std::abs(P.c.x() - c.x()) <= P.h.x() + h.x() && std::abs(P.c.y() - c.y()) <= P.h.y() + h.y() &&
-           std::abs(P.c.z() - c.z()) <= P.h.z() + h.z();
+    PosedElem& P = a_elem[static_cast<std::size_t>(ia)];
+    if (P.stamp != stamp) pose_element(P, ia);
+    return !detail::boxes_apart(P.box, bvh_b.element_boxes()[static_cast<std::size_t>(ib)]);
   }
 
   // A's node at the current pose: its box in B's frame.
