@@ -203,6 +203,8 @@ struct ContactDetector::Impl {
   ContactSet* out = nullptr;
   std::size_t pairs = 0;
   std::array<int, ContactSet::kCapacity> reps{};  // first member of each plane group
+  std::array<ElementKind, ContactSet::kCapacity> kind_a{}, kind_b{};
+  std::array<bool, ContactSet::kCapacity> may_dominate{};
 
   Impl(const Polyhedron& ma, const Polyhedron& mb, const DetectionParams& p)
       : a(ma), b(mb), prm(p), flat_a(ma), flat_b(mb), wings_a(wings_of(ma)), wings_b(wings_of(mb)) {
@@ -746,15 +748,22 @@ struct ContactDetector::Impl {
     // touches exactly) does not settle the reading: both stand and the previous CF or the fit
     // decides (a hysteresis band instead of a flip at the tolerance). misfit is not changed
     // until every flag is set, so the shapes below are the emitted ones.
+    // Per contact, its kinds and whether it fits well enough to dominate; a dominator's
+    // elements hold this one's, so they are of the same or a higher dimension.
+    for (int j = 0; j < n; ++j) {
+      const ContactPc& cj = cs[j];
+      kind_a[static_cast<std::size_t>(j)] = a_kind(cj.pc.type);
+      kind_b[static_cast<std::size_t>(j)] = b_kind(cj.pc.type);
+      may_dominate[static_cast<std::size_t>(j)] = cj.misfit - std::abs(cj.distance) / eps <= prm.dominance_fit;
+    }
     for (int i = 0; i < n; ++i) {
       ContactPc& ci = cs[i];
-      const ElementKind ai = a_kind(ci.pc.type), bi = b_kind(ci.pc.type);
+      const ElementKind ai = kind_a[static_cast<std::size_t>(i)], bi = kind_b[static_cast<std::size_t>(i)];
       for (int j = 0; j < n && !ci.dominated; ++j) {
-        if (j == i) continue;
+        const auto uj = static_cast<std::size_t>(j);
+        if (j == i || !may_dominate[uj] || kind_a[uj] < ai || kind_b[uj] < bi) continue;
         const ContactPc& cj = cs[j];
-        const double shape_j = cj.misfit - std::abs(cj.distance) / eps;
-        if (shape_j <= prm.dominance_fit && within(a, ai, ci.pc.a, a_kind(cj.pc.type), cj.pc.a) &&
-            within(b, bi, ci.pc.b, b_kind(cj.pc.type), cj.pc.b))
+        if (within(a, ai, ci.pc.a, kind_a[uj], cj.pc.a) && within(b, bi, ci.pc.b, kind_b[uj], cj.pc.b))
           ci.dominated = true;
       }
     }
