@@ -1,8 +1,10 @@
 // Detection + identification per servo tick (SPEC section 7), side by side with FCL's
 // distance query on the same meshes and poses: the cube against the L-block, and two
 // faceted spheres of 2,000 and 2,016 faces (with the paper's epsilon of 1 mm, and with one
-// scaled to their facets, 0.1 mm). Each benchmark times every call itself and
-// reports the median and the 99.9th percentile as counters (median_us, p999_us).
+// scaled to their facets, 0.1 mm), on poses far apart (each tick from scratch) and on a
+// servo loop's trajectory (where pairs kept between nearby poses serve; "Cold" without
+// them). Each benchmark times every call itself and reports the median and the 99.9th
+// percentile as counters (median_us, p999_us).
 #include <cf/identifier.hpp>
 
 #include "runtime_models.hpp"
@@ -65,6 +67,23 @@ std::vector<cf::Pose> sphere_poses(double ra, double rb, double eps) {
                          .normalized();
     const Eigen::Matrix3d R = Eigen::AngleAxisd(6.283 * s * 2, Vec3(1, 2, 3).normalized()).toRotationMatrix();
     const double gap = (i % 3 == 2) ? 5.0 : eps * (0.5 * std::sin(6.283 * s * 13) - 0.3);
+    p.push_back(make_pose(R, dir * (ra + rb + gap)));
+  }
+  return p;
+}
+
+// A servo loop's poses: A's sphere sliding and rolling over B's at a hand's pace at 1 kHz
+// (0.05 mm along the surface and 0.5 mrad of rotation per tick), the gap swinging slowly
+// through the band (from 0.8 epsilon deep to 0.2 apart, plus the facets' sagitta).
+std::vector<cf::Pose> sphere_trajectory(double ra, double rb, double eps) {
+  std::vector<cf::Pose> p;
+  const int n = 4000;
+  for (int i = 0; i < n; ++i) {
+    const double s = static_cast<double>(i) / n;
+    const double phi = 0.05 * i / (ra + rb);
+    const Vec3 dir = Vec3(std::cos(phi), 0.1 * std::sin(6.283 * s * 3), std::sin(phi)).normalized();
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(0.0005 * i, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+    const double gap = eps * (0.5 * std::sin(6.283 * s * 20) - 0.3);
     p.push_back(make_pose(R, dir * (ra + rb + gap)));
   }
   return p;
@@ -183,7 +202,24 @@ Pair& spheres_fine() {
   return p;
 }
 
-void run_cf(benchmark::State& state, Pair& pr) {
+// The same spheres on the servo trajectory.
+Pair& spheres_servo() {
+  static Pair p{spheres().a, spheres().b, sphere_trajectory(30, 50, 1.0), with_epsilon(1.0)};
+  return p;
+}
+Pair& spheres_fine_servo() {
+  static Pair p{spheres_fine().a, spheres_fine().b, sphere_trajectory(30, 50, 0.1), with_epsilon(0.1)};
+  return p;
+}
+
+// Without the pairs kept between nearby poses (DetectionParams::reuse_margin 0).
+Pair cold(const Pair& pr) {
+  Pair c = pr;
+  c.detection.reuse_margin = 0;
+  return c;
+}
+
+void run_cf(benchmark::State& state, const Pair& pr) {
   const cf::CfGraph g = timing_graph(pr.a, pr.b);
   cf::IdentificationParams ip;
   ip.detection = pr.detection;
@@ -204,28 +240,30 @@ void run_cf(benchmark::State& state, Pair& pr) {
   report(state, ns);
 }
 
-void run_detect(benchmark::State& state, Pair& pr) {
+void run_detect(benchmark::State& state, const Pair& pr) {
   cf::ContactDetector det(pr.a, pr.b, pr.detection);
   cf::ContactSet cs;
   std::vector<double> ns;
   ns.reserve(1 << 22);
-  std::size_t i = 0, pairs = 0, planes = 0;
+  std::size_t i = 0, pairs = 0, planes = 0, reused = 0;
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
     det.detect(pr.poses[i], cs);
     const auto t1 = std::chrono::steady_clock::now();
     benchmark::DoNotOptimize(&cs);
     pairs += det.last_pairs_tested();
+    reused += det.last_reused_pairs() ? 1 : 0;
     planes += static_cast<std::size_t>(cs.num_planes());
     if (ns.size() < ns.capacity()) ns.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count());
     if (++i == pr.poses.size()) i = 0;
   }
   state.counters["pairs_per_tick"] = static_cast<double>(pairs) / static_cast<double>(state.iterations());
   state.counters["planes_per_tick"] = static_cast<double>(planes) / static_cast<double>(state.iterations());
+  state.counters["reused_share"] = static_cast<double>(reused) / static_cast<double>(state.iterations());
   report(state, ns);
 }
 
-void run_fcl(benchmark::State& state, Pair& pr) {
+void run_fcl(benchmark::State& state, const Pair& pr) {
   auto ma = fcl_model(pr.a), mb = fcl_model(pr.b);
   fcl::CollisionObjectd oa(ma), ob(mb);
   ob.setTransform(fcl::Transform3d::Identity());
@@ -261,6 +299,13 @@ void BM_Spheres2000_FclDistance(benchmark::State& s) { run_fcl(s, spheres()); }
 void BM_Spheres2000Fine_DetectIdentify(benchmark::State& s) { run_cf(s, spheres_fine()); }
 void BM_Spheres2000Fine_DetectOnly(benchmark::State& s) { run_detect(s, spheres_fine()); }
 void BM_Spheres2000Fine_FclDistance(benchmark::State& s) { run_fcl(s, spheres_fine()); }
+void BM_Spheres2000Servo_DetectIdentify(benchmark::State& s) { run_cf(s, spheres_servo()); }
+void BM_Spheres2000Servo_DetectIdentifyCold(benchmark::State& s) { run_cf(s, cold(spheres_servo())); }
+void BM_Spheres2000Servo_FclDistance(benchmark::State& s) { run_fcl(s, spheres_servo()); }
+void BM_Spheres2000FineServo_DetectIdentify(benchmark::State& s) { run_cf(s, spheres_fine_servo()); }
+void BM_Spheres2000FineServo_DetectIdentifyCold(benchmark::State& s) { run_cf(s, cold(spheres_fine_servo())); }
+void BM_Spheres2000FineServo_DetectOnly(benchmark::State& s) { run_detect(s, spheres_fine_servo()); }
+void BM_Spheres2000FineServo_FclDistance(benchmark::State& s) { run_fcl(s, spheres_fine_servo()); }
 
 }  // namespace
 
@@ -273,5 +318,12 @@ BENCHMARK(BM_Spheres2000_FclDistance)->MinTime(2.0);
 BENCHMARK(BM_Spheres2000Fine_DetectIdentify)->MinTime(2.0);
 BENCHMARK(BM_Spheres2000Fine_DetectOnly)->MinTime(2.0);
 BENCHMARK(BM_Spheres2000Fine_FclDistance)->MinTime(2.0);
+BENCHMARK(BM_Spheres2000Servo_DetectIdentify)->MinTime(2.0);
+BENCHMARK(BM_Spheres2000Servo_DetectIdentifyCold)->MinTime(2.0);
+BENCHMARK(BM_Spheres2000Servo_FclDistance)->MinTime(2.0);
+BENCHMARK(BM_Spheres2000FineServo_DetectIdentify)->MinTime(2.0);
+BENCHMARK(BM_Spheres2000FineServo_DetectIdentifyCold)->MinTime(2.0);
+BENCHMARK(BM_Spheres2000FineServo_DetectOnly)->MinTime(2.0);
+BENCHMARK(BM_Spheres2000FineServo_FclDistance)->MinTime(2.0);
 
 BENCHMARK_MAIN();

@@ -468,3 +468,65 @@ TEST_CASE("the BVH finds what all pairs find on faceted spheres", "[detector]") 
   }
   CHECK(contacts > 0);
 }
+
+TEST_CASE("pairs kept between nearby poses give what the hierarchy gives", "[detector]") {
+  // A 600-face sphere rolling and sliding over a 672-face one in small steps (about 0.06 mm
+  // and 0.5 mrad per tick, a hand's speed at a servo rate, plus the gap's change), with
+  // jumps of 5 mm now and then: every result must equal the one without kept pairs, and most
+  // ticks must reuse.
+  const double eps = GENERATE(1.0, 0.1);
+  const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30);
+  const cf::Polyhedron b = tm::faceted_sphere(50, 21, 32);
+  cf::DetectionParams prm;
+  prm.epsilon = prm.max_penetration = eps;
+  cf::DetectionParams cold = prm;
+  cold.reuse_margin = 0;
+  REQUIRE(prm.reuse_margin > 0);
+  cf::ContactDetector warm_det(a, b, prm), cold_det(a, b, cold);
+  cf::ContactSet x, y;
+  int reused = 0, contacts = 0;
+  const int n = 400;
+  for (int k = 0; k < n; ++k) {
+    const double s = static_cast<double>(k) / n;
+    const Vec3 dir = Vec3(std::cos(0.3 * s), 0.03 * std::sin(1.7 * s), std::sin(0.3 * s)).normalized();
+    const Eigen::Matrix3d R = rot(0.2 * s, Vec3(1, 2, 3));
+    // The facets lie up to 0.4 mm (sagittas 0.15 and 0.25) inside the spheres: centre gaps
+    // swinging by an epsilon around 0.15 mm deep keep the meshes in or near the band.
+    const double gap = (k % 100 == 50) ? 5.0 : eps * 0.5 * std::sin(20 * s) - 0.15;
+    const cf::Pose p = pose(R, dir * (80 + gap));
+    warm_det.detect(p, x);
+    cold_det.detect(p, y);
+    INFO("epsilon " << eps << ", tick " << k);
+    REQUIRE(x.size() == y.size());
+    for (int i = 0; i < x.size(); ++i) {
+      CHECK(x[i].pc == y[i].pc);
+      CHECK(x[i].distance == y[i].distance);
+      CHECK(x[i].dominated == y[i].dominated);
+      CHECK(x[i].plane == y[i].plane);
+    }
+    CHECK_FALSE(cold_det.last_reused_pairs());
+    reused += warm_det.last_reused_pairs() ? 1 : 0;
+    contacts += x.size();
+  }
+  CAPTURE(contacts, reused);
+  CHECK(contacts > 50);  // contacts on a good share of the ticks (over 100 at either epsilon)
+  CHECK(reused > n / 2);
+  // Poses far apart are never served from kept pairs.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (int k = 0; k < 20; ++k) {
+    const cf::Pose p = pose(rot(3 * U(rng), Vec3(U(rng), U(rng), U(rng))), Vec3(U(rng), U(rng), U(rng)).normalized() * 80);
+    warm_det.detect(p, x);
+    cold_det.detect(p, y);
+    CHECK_FALSE(warm_det.last_reused_pairs());
+    REQUIRE(x.size() == y.size());
+    for (int i = 0; i < x.size(); ++i) CHECK(x[i].pc == y[i].pc);
+  }
+}
+
+TEST_CASE("a negative reuse margin is refused", "[detector]") {
+  cf::DetectionParams p;
+  p.reuse_margin = -0.1;
+  CHECK_THROWS_WITH(cf::ContactDetector(tm::cube(), tm::l_block(), p),
+                    Catch::Contains("parameter reuse_margin must be non-negative"));
+}

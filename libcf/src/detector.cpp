@@ -203,6 +203,18 @@ struct ContactDetector::Impl {
   ContactSet* out = nullptr;
   std::size_t pairs = 0;
   std::array<int, ContactSet::kCapacity> reps{};  // first member of each plane group
+  // Temporal coherence (big models, DetectionParams::reuse_margin): the element pairs whose
+  // boxes overlapped with A's boxes grown by the margin at kept_pose. Every pair that can
+  // touch at a pose where no point of A is further than the margin from where it was at
+  // kept_pose is among them, so such a pose tests only those.
+  static constexpr std::size_t kMaxKept = 1 << 14;
+  std::vector<detail::NodePair> kept;  // (A position, B position) in the BVHs' element lists
+  std::size_t num_kept = 0;
+  bool kept_valid = false, recording = false, kept_overflow = false, reused = false;
+  Pose kept_pose, last_pose;
+  bool have_last = false;
+  float grow = 0;    // mm, added to A's posed boxes in this call
+  double r_a = 0;    // mm, A's furthest vertex from bvh_a's origin
   std::array<ElementKind, ContactSet::kCapacity> kind_a{}, kind_b{};
   std::array<bool, ContactSet::kCapacity> may_dominate{};
 
@@ -219,6 +231,7 @@ struct ContactDetector::Impl {
     check(p.max_angular_tolerance, "max_angular_tolerance", true);
     check(p.dominance_penalty, "dominance_penalty", false);
     check(p.dominance_fit, "dominance_fit", false);
+    check(p.reuse_margin, "reuse_margin", false);
     if (!std::isfinite(p.in_plane_tolerance) || !std::isfinite(p.angular_tolerance))
       throw Error("ContactDetector: in_plane_tolerance and angular_tolerance must be finite");
     eps = p.epsilon;
@@ -264,6 +277,8 @@ struct ContactDetector::Impl {
       a_elem.resize(bvh_a.elements().size());
       for (const Vertex& v : ma.vertices()) a_vert.emplace_back() << (v.p - bvh_a.origin()).cast<float>(), 0.0f;
       a_vert_posed.resize(ma.num_vertices());
+      if (prm.use_bvh && prm.reuse_margin > 0) kept.resize(kMaxKept);
+      for (const Vertex& v : ma.vertices()) r_a = std::max(r_a, (v.p - bvh_a.origin()).norm());
     }
     for (const Face& F : mb.faces()) plane_b.push_back({F.normal, F.offset, 0});
     for (const Edge& E : mb.edges()) seg_b.push_back({mb.vertex(E.v0).p, E.dir, E.length, 0});
@@ -331,7 +346,7 @@ struct ContactDetector::Impl {
         break;
     }
     P.box.c = 0.5f * (lo + hi);
-    P.box.h = (0.5f * (hi - lo) + 2.4e-7f * P.box.c.abs()) * 1.0000003f;
+    P.box.h = (0.5f * (hi - lo) + 2.4e-7f * P.box.c.abs()) * 1.0000003f + Eigen::Array4f(grow, grow, grow, 0.0f);
   }
 
   // Does A's element at position ia of its BVH (posed) overlap B's element at ib?
@@ -372,6 +387,11 @@ struct ContactDetector::Impl {
     Q.h = ((0.5f * (hi - lo)).max(0.0f) + 2.4e-7f * Q.c.abs()) * 1.0000003f;
     Q.oc = oc;
     Q.oh = N.oh;
+    if (grow > 0) {
+      const V g(grow, grow, grow, 0.0f);
+      Q.h += g;
+      Q.oh += g;
+    }
   }
 
   // The largest angular tolerance any pair can get: a cheap early out before the contact
@@ -707,8 +727,20 @@ struct ContactDetector::Impl {
     const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];
     if (!detail::kinds_can_touch(detail::kind_bit(x.kind), detail::kind_bit(y.kind))) return;
     if (big && !element_boxes_overlap(ia, ib)) return;
+    if (recording) {
+      if (num_kept < kept.size()) kept[num_kept++] = {ia, ib};
+      else kept_overflow = true;
+    }
     ++pairs;
     if (may_touch(x.kind, x.index, y.kind, y.index)) exact(x, y);
+  }
+
+  // Bounds how far any point of A moves from pose p0 to p1 (mm): the move of bvh_a's origin
+  // plus |R1 - R0| times A's reach from it (Frobenius norm, a bound of the spectral norm for
+  // any matrices).
+  double motion_bound(const Pose& p0, const Pose& p1) const {
+    const Vec3& o = bvh_a.origin();
+    return (p1.apply(o) - p0.apply(o)).norm() + (p1.R_BA - p0.R_BA).norm() * r_a;
   }
 
   void exact(const detail::BvhElement& x, const detail::BvhElement& y) {
@@ -812,7 +844,6 @@ struct ContactDetector::Impl {
       out = nullptr;
       return;
     }
-    // The stack is sized for the trees' depths, so descend cannot overflow it.
     absR = pose.R_BA.cwiseAbs();
     Rf = pose.R_BA.cast<float>();
     absRf = absR.cast<float>();
@@ -821,12 +852,42 @@ struct ContactDetector::Impl {
       absRcol[k] << absRf.col(k), 0.0f;
     }
     a_origin << pose.apply(bvh_a.origin()).cast<float>(), 0.0f;
+    reused = false;
+    grow = 0;
+    recording = false;
+    if (!kept.empty()) {
+      const double moved = have_last ? motion_bound(last_pose, pose) : std::numeric_limits<double>::infinity();
+      last_pose = pose;
+      have_last = true;
+      if (kept_valid && motion_bound(kept_pose, pose) <= prm.reuse_margin) {
+        reused = true;
+        for (std::size_t k = 0; k < num_kept; ++k) pair(kept[k].a, kept[k].b);
+        finish(cs);
+        out = nullptr;
+        return;
+      }
+      // Keep pairs for the next poses only while A moves slowly enough for them to serve a
+      // few; otherwise (poses far apart) the grown boxes would only cost.
+      kept_valid = false;
+      recording = moved <= 0.5 * prm.reuse_margin;
+      if (recording) {
+        grow = static_cast<float>(prm.reuse_margin);
+        num_kept = 0;
+        kept_overflow = false;
+      }
+    }
+    // The stack is sized for the trees' depths, so descend cannot overflow it.
     detail::descend(
         bvh_a, bvh_b,
         [this](std::int32_t ia, std::int32_t ib, const detail::BvhNode& A, const detail::BvhNode& B) {
           return overlap(ia, ib, A, B);
         },
         stack.data(), stack.size(), [this](int ia, int ib) { pair(ia, ib); });
+    if (recording && !kept_overflow) {
+      kept_valid = true;
+      kept_pose = pose;
+    }
+    recording = false;
     finish(cs);
     out = nullptr;
   }
@@ -843,5 +904,6 @@ const DetectionParams& ContactDetector::params() const { return impl_->prm; }
 const Polyhedron& ContactDetector::model_a() const { return impl_->a; }
 const Polyhedron& ContactDetector::model_b() const { return impl_->b; }
 std::size_t ContactDetector::last_pairs_tested() const { return impl_->pairs; }
+bool ContactDetector::last_reused_pairs() const { return impl_->reused; }
 
 }  // namespace cf

@@ -45,10 +45,19 @@ struct DetectionParams {
   /// (the default). false runs the exact tests on all pairs: for checking the culling and
   /// for comparison only.
   bool use_bvh = true;
+  /// mm. Temporal coherence for models of 256 features or more in a servo loop: when A
+  /// has moved less than half this since the previous call, `detect` keeps the element
+  /// pairs that come within this margin of each other, and at the following poses, while no
+  /// point of A is further than the margin from where it was then (bounded from the
+  /// translation and the change of rotation), it tests only those, skipping the hierarchy.
+  /// The results are the same for any value; 0 turns it off. A larger margin keeps more
+  /// pairs for more ticks.
+  double reuse_margin = 0.3;
 };
 
 /// Finds the candidate PCs between A (moving) and B (fixed) at a pose. Immutable after
-/// construction except for per-call scratch space, so use one instance per thread.
+/// construction except for per-call scratch space and the pairs kept for the next call
+/// (DetectionParams::reuse_margin), so use one instance per thread.
 class ContactDetector {
  public:
   /// Builds the bounding volume hierarchies of both models (copied).
@@ -68,6 +77,9 @@ class ContactDetector {
   /// Element pairs of kinds that can touch whose bounding boxes overlapped in the last
   /// `detect` (before the cheap rejections and the exact tests); all pairs with use_bvh off.
   std::size_t last_pairs_tested() const;
+  /// Whether the last `detect` tested only the pairs kept at an earlier pose
+  /// (DetectionParams::reuse_margin) instead of descending the hierarchies.
+  bool last_reused_pairs() const;
 
   struct Impl;
 
