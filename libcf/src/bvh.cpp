@@ -32,6 +32,15 @@ void points_of(const Polyhedron& m, const BvhElement& e, std::vector<Vec3>& pts)
   }
 }
 
+// The axis-aligned bounds of points (at least one).
+void bounds_of(const std::vector<Vec3>& pts, Vec3& lo, Vec3& hi) {
+  lo = hi = pts[0];
+  for (const Vec3& p : pts) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+}
+
 // Sets o's oriented box to that of points: principal axes of their spread, extents from the
 // points.
 void obb_of(const std::vector<Vec3>& pts, double inflate, const Vec3& origin, NodeBox& o) {
@@ -83,11 +92,8 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin,
     if (end == first) return;
     pts.clear();
     for (std::int32_t i = first; i < end; ++i) points_of(m, members[static_cast<std::size_t>(i)], pts);
-    Vec3 lo = pts[0], hi = lo;
-    for (const Vec3& p : pts) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
+    Vec3 lo, hi;
+    bounds_of(pts, lo, hi);
     items.push_back({first, end - first, lo, hi});
   };
   if (leaves == Leaves::kElements) {
@@ -101,11 +107,14 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin,
     for (std::size_t i = 0; i < m.num_faces(); ++i) add(ElementKind::kFace, i);
   } else {
     std::vector<std::vector<BvhElement>> owned(m.num_faces());
+    std::vector<std::int32_t> faceless;  // vertices on no face: items of their own
     for (std::size_t e = 0; e < m.num_edges(); ++e)
       owned[m.edges()[e].left.index()].push_back({ElementKind::kEdge, static_cast<std::int32_t>(e)});
-    for (std::size_t v = 0; v < m.num_vertices(); ++v)
-      if (!m.vertices()[v].faces.empty())
-        owned[m.vertices()[v].faces.front().index()].push_back({ElementKind::kVertex, static_cast<std::int32_t>(v)});
+    for (std::size_t v = 0; v < m.num_vertices(); ++v) {
+      const auto iv = static_cast<std::int32_t>(v);
+      if (m.vertices()[v].faces.empty()) faceless.push_back(iv);
+      else owned[m.vertices()[v].faces.front().index()].push_back({ElementKind::kVertex, iv});
+    }
     for (std::size_t f = 0; f < m.num_faces(); ++f) {
       auto first = static_cast<std::int32_t>(members.size());
       members.push_back({ElementKind::kFace, static_cast<std::int32_t>(f)});
@@ -118,16 +127,11 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin,
       }
       close_item(first);
     }
-    // Elements no face owns (a vertex on no face): items of their own.
-    std::vector<char> seen(m.num_vertices(), 0);
-    for (const BvhElement& e : members)
-      if (e.kind == ElementKind::kVertex) seen[static_cast<std::size_t>(e.index)] = 1;
-    for (std::size_t v = 0; v < m.num_vertices(); ++v)
-      if (!seen[v]) {
-        const auto first = static_cast<std::int32_t>(members.size());
-        members.push_back({ElementKind::kVertex, static_cast<std::int32_t>(v)});
-        close_item(first);
-      }
+    for (std::int32_t v : faceless) {
+      const auto first = static_cast<std::int32_t>(members.size());
+      members.push_back({ElementKind::kVertex, v});
+      close_item(first);
+    }
   }
   if (items.empty()) return;
   nodes_.reserve(2 * items.size());
@@ -207,11 +211,8 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin,
       elements_.push_back(e);
       pts.clear();
       points_of(m, e, pts);
-      Vec3 lo = pts[0], hi = lo;
-      for (const Vec3& p : pts) {
-        lo = lo.cwiseMin(p);
-        hi = hi.cwiseMax(p);
-      }
+      Vec3 lo, hi;
+      bounds_of(pts, lo, hi);
       Eigen::Vector3f c, h;
       round_out(0.5 * (lo + hi) - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate), c, h);
       ElemBox& b = elem_boxes_.emplace_back();

@@ -271,14 +271,17 @@ struct ContactDetector::Impl {
     for (const Edge& E : mb.edges()) sin_tol_edge_b.push_back(std::sin(tol_for(E.length)));
     sin_max_tol = std::sin(max_tol());
     cos_max_tol = std::cos(max_tol());
-    if (big) a_node.resize(bvh_a.nodes().size());
-    else a_box.resize(bvh_a.nodes().size());
     if (big) {
+      a_node.resize(bvh_a.nodes().size());
       a_elem.resize(bvh_a.elements().size());
-      for (const Vertex& v : ma.vertices()) a_vert.emplace_back() << (v.p - bvh_a.origin()).cast<float>(), 0.0f;
+      for (const Vertex& v : ma.vertices()) {
+        a_vert.emplace_back() << (v.p - bvh_a.origin()).cast<float>(), 0.0f;
+        r_a = std::max(r_a, (v.p - bvh_a.origin()).norm());
+      }
       a_vert_posed.resize(ma.num_vertices());
       if (prm.use_bvh && prm.reuse_margin > 0) kept.resize(kMaxKept);
-      for (const Vertex& v : ma.vertices()) r_a = std::max(r_a, (v.p - bvh_a.origin()).norm());
+    } else {
+      a_box.resize(bvh_a.nodes().size());
     }
     for (const Face& F : mb.faces()) plane_b.push_back({F.normal, F.offset, 0});
     for (const Edge& E : mb.edges()) seg_b.push_back({mb.vertex(E.v0).p, E.dir, E.length, 0});
@@ -721,8 +724,9 @@ struct ContactDetector::Impl {
     return near_band(A.n.dot(b.vertex(VertexId(ib)).p) - A.off);  // f-v
   }
 
-  // Elements at positions ia, ib of the two BVHs' element lists, in leaves that overlap.
-  void pair(int ia, int ib) {
+  // Elements at positions ia, ib of the two BVHs' element lists, in leaves that overlap (or kept
+  // from an earlier pose). Inlined into both callers: a call per pair cost 4% on fine spheres.
+  __attribute__((always_inline)) void pair(int ia, int ib) {
     const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
     const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];
     if (!detail::kinds_can_touch(detail::kind_bit(x.kind), detail::kind_bit(y.kind))) return;
