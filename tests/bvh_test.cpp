@@ -202,3 +202,47 @@ TEST_CASE("the SIMD box test agrees with a double-precision separating-axis test
   CHECK(overlap > 20000);
   CHECK(near_ties < 2000);
 }
+
+TEST_CASE("face-group leaves hold their element boxes on lanes, tested like one box each", "[bvh]") {
+  const cf::Polyhedron m = tm::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000");
+  const cf::detail::Bvh t(m, 0.5, 1, Vec3::Zero(), cf::detail::Leaves::kFaceGroups);
+  // Only face-group trees with one group per leaf carry lanes.
+  CHECK(cf::detail::Bvh(m, 0.5, 1, Vec3::Zero(), cf::detail::Leaves::kElements).leaf_boxes().empty());
+  CHECK(cf::detail::Bvh(m, 0.5, 2, Vec3::Zero(), cf::detail::Leaves::kFaceGroups).leaf_boxes().empty());
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> off(-2.5, 2.5), half(0, 2);
+  std::size_t leaves = 0, hits = 0, misses = 0;
+  for (const cf::detail::BvhNode& n : t.nodes()) {
+    if (!n.leaf()) continue;
+    ++leaves;
+    const cf::detail::LeafBoxes& L = t.leaf_boxes()[static_cast<std::size_t>(t.leaf_index(n))];
+    for (int ka = 0; ka < 3; ++ka) {
+      unsigned want = 0;
+      for (int j = 0; j < n.count; ++j)
+        if (cf::detail::kinds_can_touch(cf::detail::kind_bit(static_cast<cf::ElementKind>(ka)),
+                                        cf::detail::kind_bit(t.elements()[static_cast<std::size_t>(n.element() + j)].kind)))
+          want |= 1u << j;
+      CHECK(L.touchable_by[ka] == want);
+    }
+    // A few random boxes around the leaf: each lane's answer is its element's box test, and
+    // lanes past the leaf's elements never overlap.
+    const cf::detail::ElemBox& first = t.element_boxes()[static_cast<std::size_t>(n.element())];
+    for (int r = 0; r < 4; ++r) {
+      cf::detail::ElemBox p;
+      p.c = first.c + Eigen::Array4f(static_cast<float>(off(rng)), static_cast<float>(off(rng)), static_cast<float>(off(rng)), 0);
+      p.h = Eigen::Array4f(static_cast<float>(half(rng)), static_cast<float>(half(rng)), static_cast<float>(half(rng)), 0);
+      const unsigned got = cf::detail::overlapping_lanes(p, L);
+      for (int j = 0; j < cf::detail::LeafBoxes::kLanes; ++j) {
+        const bool lane = (got >> j) & 1u;
+        const bool want = j < n.count && !cf::detail::boxes_apart(p, t.element_boxes()[static_cast<std::size_t>(n.element() + j)]);
+        CHECK(lane == want);
+        (want ? hits : misses) += 1;
+      }
+    }
+  }
+  CHECK(leaves == t.leaf_boxes().size());
+  // Both answers are exercised in earnest.
+  CAPTURE(hits, misses);
+  CHECK(hits > 5000);
+  CHECK(misses > 5000);
+}

@@ -221,11 +221,32 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin,
     }
   }
   offset[items.size()] = static_cast<std::int32_t>(elements_.size());
+  const bool lanes = leaves == Leaves::kFaceGroups && leaf_size == 1;
+  if (lanes) leaf_of_element_.assign(elements_.size(), -1);
   for (BvhNode& n : nodes_)
     if (n.leaf()) {
       const std::int32_t b = ~n.child, e = b + n.count;
       n.child = ~offset[static_cast<std::size_t>(b)];
       n.count = static_cast<std::uint8_t>(offset[static_cast<std::size_t>(e)] - offset[static_cast<std::size_t>(b)]);
+      if (!lanes) continue;
+      // One group: at most kMaxGroup == LeafBoxes::kLanes elements.
+      static_assert(kMaxGroup <= LeafBoxes::kLanes);
+      leaf_of_element_[static_cast<std::size_t>(n.element())] = static_cast<std::int32_t>(leaf_boxes_.size());
+      LeafBoxes& L = leaf_boxes_.emplace_back();
+      for (int i = 0; i < 3; ++i) {
+        L.c[i].setZero();
+        L.h[i].setConstant(-1e30f);  // unused lanes: apart from every box
+      }
+      for (int j = 0; j < n.count; ++j) {
+        const auto k = static_cast<std::size_t>(n.element() + j);
+        for (int i = 0; i < 3; ++i) {
+          L.c[i][j] = elem_boxes_[k].c[i];
+          L.h[i][j] = elem_boxes_[k].h[i];
+        }
+        for (int ka = 0; ka < 3; ++ka)
+          if (kinds_can_touch(kind_bit(static_cast<ElementKind>(ka)), kind_bit(elements_[k].kind)))
+            L.touchable_by[ka] = static_cast<std::uint8_t>(L.touchable_by[ka] | (1u << j));
+      }
     }
 }
 

@@ -72,6 +72,18 @@ struct alignas(16) ElemBox {
   Eigen::Array4f c, h;  // mm: centre and half extents
 };
 
+/// A face-group leaf's element boxes on SIMD lanes, lane j for its j-th element, so that
+/// one element of the other model is tested against all of them at once. Unused lanes
+/// never overlap anything.
+struct alignas(32) LeafBoxes {
+  static constexpr int kLanes = 8;
+  using Lanes = Eigen::Array<float, kLanes, 1>;
+  Lanes c[3], h[3];  // mm: centres (relative to the tree's origin) and half extents, per axis
+  /// Per kind of an element of the other model (posed as A): the lanes whose elements it
+  /// can form a PC type with (bit j for lane j).
+  std::uint8_t touchable_by[3] = {0, 0, 0};
+};
+
 /// Is some lane of x greater than y's? (Eigen's any() on a comparison reduces lane by lane.)
 __attribute__((always_inline)) inline bool any_greater(const Eigen::Array4f& x, const Eigen::Array4f& y) {
 #if defined(__SSE__)
@@ -79,6 +91,25 @@ __attribute__((always_inline)) inline bool any_greater(const Eigen::Array4f& x, 
 #else
   return (x > y).any();
 #endif
+}
+
+/// Bit j set where lane j of x is greater than y's.
+__attribute__((always_inline)) inline unsigned greater_mask(const LeafBoxes::Lanes& x, const LeafBoxes::Lanes& y) {
+#if defined(__SSE__)
+  return static_cast<unsigned>(_mm_movemask_ps(_mm_cmpgt_ps(_mm_load_ps(x.data()), _mm_load_ps(y.data()))) |
+                               (_mm_movemask_ps(_mm_cmpgt_ps(_mm_load_ps(x.data() + 4), _mm_load_ps(y.data() + 4))) << 4));
+#else
+  unsigned m = 0;
+  for (int j = 0; j < LeafBoxes::kLanes; ++j) m |= (x[j] > y[j] ? 1u : 0u) << j;
+  return m;
+#endif
+}
+
+/// The lanes of leaf boxes q whose boxes overlap box p (same frame), as bits.
+__attribute__((always_inline)) inline unsigned overlapping_lanes(const ElemBox& p, const LeafBoxes& q) {
+  unsigned apart = 0;
+  for (int i = 0; i < 3; ++i) apart |= greater_mask((q.c[i] - p.c[i]).abs(), q.h[i] + p.h[i]);
+  return ~apart & ((1u << LeafBoxes::kLanes) - 1);
 }
 
 /// Are two element boxes (in one frame) disjoint?
@@ -125,6 +156,10 @@ class Bvh {
   /// Per element (in elements() order), its own box (inflated like the nodes'), centre
   /// relative to origin().
   const std::vector<ElemBox>& element_boxes() const { return elem_boxes_; }
+  /// Face-group trees with leaves of one group: per leaf, its elements' boxes on lanes
+  /// (empty otherwise); leaf_boxes()[leaf_index(n)] for leaf node n.
+  const std::vector<LeafBoxes>& leaf_boxes() const { return leaf_boxes_; }
+  std::int32_t leaf_index(const BvhNode& n) const { return leaf_of_element_[static_cast<std::size_t>(n.element())]; }
   const std::vector<BvhNode>& nodes() const { return nodes_; }
   /// Per node, its axis-aligned and oriented boxes (inflated alike), centres relative to
   /// origin().
@@ -138,6 +173,8 @@ class Bvh {
   Vec3 origin_ = Vec3::Zero();
   std::vector<BvhElement> elements_;
   std::vector<ElemBox> elem_boxes_;
+  std::vector<LeafBoxes> leaf_boxes_;
+  std::vector<std::int32_t> leaf_of_element_;  // leaf_boxes_ index of the leaf starting at an element
   int depth_ = 0;
 };
 
@@ -159,15 +196,15 @@ inline std::uint8_t touchable_by_a(std::uint8_t ka) {
 /// Can an element of a kind in mask `ka` (of A) and one in mask `kb` (of B) form a PC type?
 inline bool kinds_can_touch(std::uint8_t ka, std::uint8_t kb) { return (touchable_by_a(ka) & kb) != 0; }
 
-/// Calls visit(int a, int b) (positions in elements()) for every pair of elements in leaves
-/// whose bounding volumes overlap and whose kinds can touch, where tree `a` is posed into tree
-/// `b`'s frame: `overlap(ia, ib, node_a, node_b)` tells whether A's node `ia` (posed; the
-/// caller caches its posed box) overlaps B's node `ib`. `stack` is caller-owned scratch of at least
+/// Calls leaves(const BvhNode& a, const BvhNode& b) for every pair of leaves whose bounding
+/// volumes overlap and whose kinds can touch, where tree `a` is posed into tree `b`'s frame:
+/// `overlap(ia, ib, node_a, node_b)` tells whether A's node `ia` (posed; the caller caches
+/// its posed box) overlaps B's node `ib`. `stack` is caller-owned scratch of at least
 /// `stack_capacity(a, b)` entries. Returns false when the stack overflowed (some pairs were
 /// skipped).
-template <class Overlap, class Visit>
+template <class Overlap, class LeafPair>
 bool descend(const Bvh& ta, const Bvh& tb, Overlap&& overlap, NodePair* stack, std::size_t cap,
-             Visit&& visit) {
+             LeafPair&& leaves) {
   if (ta.nodes().empty() || tb.nodes().empty()) return true;
   const auto& na = ta.nodes();
   const auto& nb = tb.nodes();
@@ -180,8 +217,7 @@ bool descend(const Bvh& ta, const Bvh& tb, Overlap&& overlap, NodePair* stack, s
     const BvhNode& B = nb[static_cast<std::size_t>(p.b)];
     if (!(A.touchable & B.kinds) || !overlap(p.a, p.b, A, B)) continue;
     if (A.leaf() && B.leaf()) {
-      for (int i = 0; i < A.count; ++i)
-        for (int j = 0; j < B.count; ++j) visit(A.element() + i, B.element() + j);
+      leaves(A, B);
       continue;
     }
     if (top + 2 > cap) {

@@ -713,7 +713,13 @@ struct ContactDetector::Impl {
       const double sn = n.norm();
       if (sn <= std::max(sin_tol_edge_a[static_cast<std::size_t>(ia)], sin_tol_edge_b[static_cast<std::size_t>(ib)]) - 1e-12)
         return false;
-      return std::abs(n.dot(A.p0 - B.p0)) <= (std::max(eps, depth) + geo_tol) * sn;
+      const Vec3 r = A.p0 - B.p0;
+      if (std::abs(n.dot(r)) > (std::max(eps, depth) + geo_tol) * sn) return false;
+      // The lines' closest points (as in ee) beyond the segments by at most in_plane.
+      const double bb = A.dir.dot(B.dir), c = A.dir.dot(r), f = B.dir.dot(r);
+      const double den = 1 - bb * bb;
+      const double s = (bb * f - c) / den, t = (f - bb * c) / den;
+      return std::max({0.0, -s, s - A.len}) + std::max({0.0, -t, t - B.len}) <= in_plane + geo_tol;
     }
     const Plane& A = posed_plane_a(ia);
     if (kb == K::kFace) return -A.n.dot(plane_b[static_cast<std::size_t>(ib)].n) >= cos_max_tol - 1e-12;  // f-f
@@ -731,6 +737,38 @@ struct ContactDetector::Impl {
     const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];
     if (!detail::kinds_can_touch(detail::kind_bit(x.kind), detail::kind_bit(y.kind))) return;
     if (big && !element_boxes_overlap(ia, ib)) return;
+    boxed_pair(ia, ib, x, y);
+  }
+
+  // Leaves of the two BVHs whose boxes overlap: their element pairs whose kinds can touch
+  // and whose own boxes overlap. B's face-group leaves hold their element boxes on SIMD
+  // lanes: each of A's elements is tested against all of them at once.
+  void leaf_pair(const detail::BvhNode& A, const detail::BvhNode& B) {
+    if (bvh_b.leaf_boxes().empty()) {
+      for (int i = 0; i < A.count; ++i)
+        for (int j = 0; j < B.count; ++j) pair(A.element() + i, B.element() + j);
+      return;
+    }
+    const detail::LeafBoxes& L = bvh_b.leaf_boxes()[static_cast<std::size_t>(bvh_b.leaf_index(B))];
+    for (int i = 0; i < A.count; ++i) {
+      const int ia = A.element() + i;
+      const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
+      unsigned lanes = L.touchable_by[static_cast<std::size_t>(x.kind)];
+      if (lanes == 0) continue;
+      PosedElem& P = a_elem[static_cast<std::size_t>(ia)];
+      if (P.stamp != stamp) pose_element(P, ia);
+      lanes &= detail::overlapping_lanes(P.box, L);
+      while (lanes != 0) {
+        const int ib = B.element() + __builtin_ctz(lanes);
+        lanes &= lanes - 1;
+        boxed_pair(ia, ib, x, bvh_b.elements()[static_cast<std::size_t>(ib)]);
+      }
+    }
+  }
+
+  // A pair past the kinds and the boxes.
+  __attribute__((always_inline)) void boxed_pair(int ia, int ib, const detail::BvhElement& x,
+                                                 const detail::BvhElement& y) {
     if (recording) {
       if (num_kept < kept.size()) kept[num_kept++] = {ia, ib};
       else kept_overflow = true;
@@ -886,7 +924,8 @@ struct ContactDetector::Impl {
         [this](std::int32_t ia, std::int32_t ib, const detail::BvhNode& A, const detail::BvhNode& B) {
           return overlap(ia, ib, A, B);
         },
-        stack.data(), stack.size(), [this](int ia, int ib) { pair(ia, ib); });
+        stack.data(), stack.size(),
+        [this](const detail::BvhNode& A, const detail::BvhNode& B) { leaf_pair(A, B); });
     if (recording && !kept_overflow) {
       kept_valid = true;
       kept_pose = pose;
