@@ -1,6 +1,6 @@
 // The bounding volume tree's boxes (libcf/src/bvh.*): every node's axis-aligned and oriented
-// boxes hold the points of the elements below it, and the SIMD box test agrees with a plain
-// double-precision separating-axis test.
+// boxes hold the points of the elements below it, the 4-wide tree holds every node once,
+// and the SIMD box tests agree with plain double-precision ones.
 #include "../bench/runtime_models.hpp"
 #include "bvh.hpp"
 
@@ -67,7 +67,6 @@ cf::detail::NodeBox random_box(std::mt19937& rng, const Vec3& c, double aabb_gro
   cf::detail::NodeBox b;
   for (int k = 0; k < 3; ++k) {
     b.ax[k] << R.col(k).cast<float>(), 0.0f;
-    b.axt[k] << R.row(k).transpose().cast<float>(), 0.0f;
   }
   b.oc << c.cast<float>(), 0.0f;
   b.oh << half.cast<float>(), 0.0f;
@@ -173,34 +172,59 @@ TEST_CASE("oriented boxes of a curved surface's patches are thin along the norma
   CHECK(thin_sum < 0.25 * aabb_sum);
 }
 
-TEST_CASE("the SIMD box test agrees with a double-precision separating-axis test", "[bvh]") {
+// Lane j of a Box4 set from a NodeBox.
+void set_lane(cf::detail::Box4& b, int j, const cf::detail::NodeBox& n) {
+  for (int i = 0; i < 3; ++i) {
+    b.c[i][j] = n.c[i];
+    b.h[i][j] = n.h[i];
+    b.oc[i][j] = n.oc[i];
+    b.oh[i][j] = n.oh[i];
+    for (int k = 0; k < 3; ++k) b.ax[k][i][j] = n.ax[k][i];
+  }
+}
+
+TEST_CASE("the 4-lane box test agrees with a double-precision separating-axis test", "[bvh]") {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> off(-6, 6), grow(0, 1);
   std::size_t apart = 0, overlap = 0, near_ties = 0;
-  for (int i = 0; i < 200000; ++i) {
-    const cf::detail::NodeBox p = random_box(rng, Vec3(off(rng), off(rng), off(rng)), grow(rng));
-    const cf::detail::NodeBox q = random_box(rng, Vec3::Zero(), grow(rng));
-    const bool ref = apart_reference(p, q);
-    // Float and double may differ within rounding of a tie: find those by nudging p.
-    cf::detail::NodeBox p_in = p, p_out = p;
-    const Eigen::Array4f e(1e-4f, 1e-4f, 1e-4f, 0);
-    p_in.h += e;
-    p_in.oh += e;
-    p_out.h -= e;
-    p_out.oh -= e;
-    if (apart_reference(p_in, q) != apart_reference(p_out, q)) {
-      ++near_ties;
-      continue;
+  for (int i = 0; i < 50000; ++i) {
+    // Lane s of p against the four lanes of q, both ways round.
+    cf::detail::NodeBox ps[4], qs[4];
+    cf::detail::Box4 p, q;
+    for (int j = 0; j < 4; ++j) {
+      ps[j] = random_box(rng, Vec3(off(rng), off(rng), off(rng)), grow(rng));
+      qs[j] = random_box(rng, Vec3::Zero(), grow(rng));
+      set_lane(p, j, ps[j]);
+      set_lane(q, j, qs[j]);
     }
-    CHECK(cf::detail::boxes_apart(p, q) == ref);
-    CHECK(cf::detail::boxes_apart(q, p) == ref);
-    (ref ? apart : overlap) += 1;
+    const int s = i % 4;
+    const unsigned got = cf::detail::overlapping_lanes(p, s, q), got_back = cf::detail::overlapping_lanes(q, s, p);
+    for (int j = 0; j < 4; ++j) {
+      const bool ref = apart_reference(ps[s], qs[j]), ref_back = apart_reference(qs[s], ps[j]);
+      // Float and double may differ within rounding of a tie: find those by nudging the box.
+      const auto tie = [&](const cf::detail::NodeBox& x, const cf::detail::NodeBox& y) {
+        cf::detail::NodeBox x_in = x, x_out = x;
+        const Eigen::Array4f e(1e-4f, 1e-4f, 1e-4f, 0);
+        x_in.h += e;
+        x_in.oh += e;
+        x_out.h -= e;
+        x_out.oh -= e;
+        return apart_reference(x_in, y) != apart_reference(x_out, y);
+      };
+      if (tie(ps[s], qs[j]) || tie(qs[s], ps[j])) {
+        ++near_ties;
+        continue;
+      }
+      CHECK(((got >> j) & 1u) == (ref ? 0u : 1u));
+      CHECK(((got_back >> j) & 1u) == (ref_back ? 0u : 1u));
+      (ref ? apart : overlap) += 1;
+    }
   }
   // Both outcomes are exercised in earnest.
   CAPTURE(apart, overlap, near_ties);
   CHECK(apart > 50000);
   CHECK(overlap > 20000);
-  CHECK(near_ties < 2000);
+  CHECK(near_ties < 4000);
 }
 
 TEST_CASE("face-group leaves hold their element boxes on lanes, tested like one box each", "[bvh]") {
@@ -245,4 +269,80 @@ TEST_CASE("face-group leaves hold their element boxes on lanes, tested like one 
   CAPTURE(hits, misses);
   CHECK(hits > 5000);
   CHECK(misses > 5000);
+}
+
+TEST_CASE("the 4-wide tree holds every node once, each inner lane opening into its subtree", "[bvh]") {
+  const cf::Polyhedron m = tm::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000");
+  const auto leaves = GENERATE(cf::detail::Leaves::kElements, cf::detail::Leaves::kFaceGroups);
+  const cf::detail::Bvh t(m, 0.25, 1, Vec3::Zero(), leaves);
+  const auto& nodes = t.nodes();
+  const auto& wide = t.wide();
+  REQUIRE(!wide.empty());
+  CHECK(wide[0].node[0] == 0);
+  CHECK(wide[0].node[1] == -1);
+  // Under the root, every node is a lane of exactly one wide node or was opened into one.
+  std::vector<int> as_lane(nodes.size(), 0);
+  std::size_t leaf_lanes = 0;
+  for (std::size_t w = 0; w < wide.size(); ++w) {
+    const cf::detail::WideNode& W = wide[w];
+    for (int j = 0; j < 4; ++j) {
+      if (W.node[j] < 0) {
+        CHECK(W.wide[j] == -1);
+        for (unsigned mask = 1; mask < 8; ++mask) CHECK(((W.lanes_holding[mask] | W.lanes_touching[mask]) >> j & 1u) == 0);
+        continue;
+      }
+      const cf::detail::BvhNode& n = nodes[static_cast<std::size_t>(W.node[j])];
+      ++as_lane[static_cast<std::size_t>(W.node[j])];
+      for (unsigned mask = 1; mask < 8; ++mask) {
+        CHECK(((W.lanes_holding[mask] >> j) & 1u) == ((n.kinds & mask) ? 1u : 0u));
+        CHECK(((W.lanes_touching[mask] >> j) & 1u) == ((n.touchable & mask) ? 1u : 0u));
+      }
+      // The lane's boxes are the node's.
+      const cf::detail::NodeBox& b = t.boxes()[static_cast<std::size_t>(W.node[j])];
+      for (int i = 0; i < 3; ++i) {
+        CHECK(W.box.c[i][j] == b.c[i]);
+        CHECK(W.box.oh[i][j] == b.oh[i]);
+      }
+      if (n.leaf()) {
+        ++leaf_lanes;
+        CHECK(W.wide[j] == -1);
+        continue;
+      }
+      // An inner lane's wide node holds 2 to 4 of its descendants, which together hold all
+      // its leaves' elements.
+      REQUIRE(W.wide[j] > 0);
+      const cf::detail::WideNode& C = wide[static_cast<std::size_t>(W.wide[j])];
+      int count = 0, elements = 0;
+      std::vector<std::int32_t> todo{W.node[j]};
+      int below = 0;
+      while (!todo.empty()) {
+        const cf::detail::BvhNode& x = nodes[static_cast<std::size_t>(todo.back())];
+        todo.pop_back();
+        if (x.leaf()) below += x.count;
+        else todo.insert(todo.end(), {x.left(), x.right()});
+      }
+      for (int k = 0; k < 4; ++k) {
+        if (C.node[k] < 0) continue;
+        ++count;
+        todo.push_back(C.node[k]);
+        while (!todo.empty()) {
+          const cf::detail::BvhNode& x = nodes[static_cast<std::size_t>(todo.back())];
+          todo.pop_back();
+          if (x.leaf()) elements += x.count;
+          else todo.insert(todo.end(), {x.left(), x.right()});
+        }
+      }
+      CHECK(count >= 2);
+      CHECK(elements == below);
+    }
+  }
+  std::size_t leaves_count = 0;
+  for (const auto& n : nodes) leaves_count += n.leaf() ? 1 : 0;
+  CHECK(leaf_lanes == leaves_count);
+  // Each leaf is a lane once; inner nodes are lanes at most once (the ones opened through
+  // are not lanes).
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    CHECK(as_lane[i] <= 1);
+    if (nodes[i].leaf()) CHECK(as_lane[i] == 1);
+  }
 }

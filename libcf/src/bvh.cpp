@@ -61,7 +61,6 @@ void obb_of(const std::vector<Vec3>& pts, double inflate, const Vec3& origin, No
   const Eigen::Matrix3f axes_f = axes.cast<float>();
   for (int k = 0; k < 3; ++k) {
     o.ax[k] << axes_f.col(k), 0.0f;
-    o.axt[k] << axes_f.row(k).transpose(), 0.0f;
   }
   // The float axes are off by about 1e-7 rad: widen by that much of the box's reach.
   const Vec3 centre_local = 0.5 * (lo + hi);
@@ -248,6 +247,70 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin,
             L.touchable_by[ka] = static_cast<std::uint8_t>(L.touchable_by[ka] | (1u << j));
       }
     }
+  const std::int32_t root = 0;
+  wide_.reserve(nodes_.size() / 2 + 1);
+  add_wide(&root, 1);
+}
+
+std::int32_t Bvh::add_wide(const std::int32_t* members, int count) {
+  const auto w = static_cast<std::int32_t>(wide_.size());
+  wide_.emplace_back();
+  {
+    WideNode& W = wide_.back();
+    Box4& b = W.box;
+    for (int i = 0; i < 3; ++i) {
+      b.c[i].setZero();
+      b.h[i].setZero();
+      b.oc[i].setZero();
+      b.oh[i].setZero();
+      for (int k = 0; k < 3; ++k) b.ax[i][k].setZero();
+    }
+    for (int j = 0; j < 4; ++j) {
+      W.node[j] = -1;
+      W.wide[j] = -1;
+    }
+    for (int k = 0; k < 8; ++k) W.lanes_holding[k] = W.lanes_touching[k] = 0;
+    for (int j = 0; j < count; ++j) {
+      const std::int32_t n = members[j];
+      const BvhNode& N = nodes_[static_cast<std::size_t>(n)];
+      const NodeBox& B = boxes_[static_cast<std::size_t>(n)];
+      W.node[j] = n;
+      for (int i = 0; i < 3; ++i) {
+        b.c[i][j] = B.c[i];
+        b.h[i][j] = B.h[i];
+        b.oc[i][j] = B.oc[i];
+        b.oh[i][j] = B.oh[i];
+        for (int k = 0; k < 3; ++k) b.ax[k][i][j] = B.ax[k][i];
+      }
+      for (unsigned mask = 1; mask < 8; ++mask) {
+        if (N.kinds & mask) W.lanes_holding[mask] = static_cast<std::uint8_t>(W.lanes_holding[mask] | (1u << j));
+        if (N.touchable & mask) W.lanes_touching[mask] = static_cast<std::uint8_t>(W.lanes_touching[mask] | (1u << j));
+      }
+    }
+  }
+  // Each inner lane opens into up to four nodes: its children, the larger (by box) of them
+  // split again while there is room.
+  for (int j = 0; j < count; ++j) {
+    const BvhNode& N = nodes_[static_cast<std::size_t>(members[j])];
+    if (N.leaf()) continue;
+    std::int32_t open[4] = {N.left(), N.right(), -1, -1};
+    int n_open = 2;
+    while (n_open < 4) {
+      int pick = -1;
+      float best = -1;
+      for (int k = 0; k < n_open; ++k) {
+        const BvhNode& C = nodes_[static_cast<std::size_t>(open[k])];
+        if (!C.leaf() && C.half.squaredNorm() > best) best = C.half.squaredNorm(), pick = k;
+      }
+      if (pick < 0) break;
+      const BvhNode& C = nodes_[static_cast<std::size_t>(open[pick])];
+      open[pick] = C.left();
+      open[n_open++] = C.right();
+    }
+    const std::int32_t child = add_wide(open, n_open);
+    wide_[static_cast<std::size_t>(w)].wide[j] = child;  // wide_ may have moved: index again
+  }
+  return w;
 }
 
 }  // namespace cf::detail

@@ -19,6 +19,9 @@
 
 namespace cf::detail {
 
+// Unrolls the next loop of 3 (GCC and Clang): -O2 does not.
+#define CF_UNROLL3 _Pragma("GCC unroll 3")
+
 struct BvhElement {
   ElementKind kind;
   std::int32_t index;
@@ -54,16 +57,14 @@ inline void round_out(const Vec3& center, const Vec3& half, Eigen::Vector3f& c,
   h = ((half + 1.2e-7 * center.cwiseAbs()).cast<float>() * 1.0000003f);
 }
 
-/// What a big model's node test reads, as 4-lane rows (lane 3 zero) so that the test runs
-/// on SIMD registers: the node's axis-aligned box and its oriented box, the principal axes
-/// of its points, which for a patch of surface put one axis along its normal, where the
-/// patch is thin (an axis-aligned box of a tilted patch is as thick as it is wide). Single
-/// precision, rounded outwards.
+/// A node's boxes (4-lane rows, lane 3 zero), from which the wide nodes' lanes are filled:
+/// its axis-aligned box and its oriented box, the principal axes of its points, which for a
+/// patch of surface put one axis along its normal, where the patch is thin (an axis-aligned
+/// box of a tilted patch is as thick as it is wide). Single precision, rounded outwards.
 struct alignas(16) NodeBox {
   Eigen::Array4f c, h;    // mm, axis-aligned box: centre and half extents
   Eigen::Array4f oc, oh;  // mm, oriented box: centre, and half extents along ax[k]
   Eigen::Array4f ax[3];   // the oriented box's unit axes; ax[0] the thinnest spread
-  Eigen::Array4f axt[3];  // the same transposed: axt[i][k] == ax[k][i]
 };
 
 /// An element's axis-aligned box as 4-lane rows (lane 3 zero). Single precision, rounded
@@ -84,17 +85,24 @@ struct alignas(32) LeafBoxes {
   std::uint8_t touchable_by[3] = {0, 0, 0};
 };
 
-/// Is some lane of x greater than y's? (Eigen's any() on a comparison reduces lane by lane.)
-__attribute__((always_inline)) inline bool any_greater(const Eigen::Array4f& x, const Eigen::Array4f& y) {
+/// Bit j set where lane j of x is greater than y's.
+__attribute__((always_inline)) inline unsigned greater_mask4(const Eigen::Array4f& x, const Eigen::Array4f& y) {
 #if defined(__SSE__)
-  return _mm_movemask_ps(_mm_cmpgt_ps(_mm_load_ps(x.data()), _mm_load_ps(y.data()))) != 0;
+  return static_cast<unsigned>(_mm_movemask_ps(_mm_cmpgt_ps(_mm_load_ps(x.data()), _mm_load_ps(y.data()))));
 #else
-  return (x > y).any();
+  unsigned m = 0;
+  for (int j = 0; j < 4; ++j) m |= (x[j] > y[j] ? 1u : 0u) << j;
+  return m;
 #endif
 }
 
+/// Is some lane of x greater than y's?
+__attribute__((always_inline)) inline bool any_greater(const Eigen::Array4f& x, const Eigen::Array4f& y) {
+  return greater_mask4(x, y) != 0;
+}
+
 /// Bit j set where lane j of x is greater than y's.
-__attribute__((always_inline)) inline unsigned greater_mask(const LeafBoxes::Lanes& x, const LeafBoxes::Lanes& y) {
+__attribute__((always_inline)) inline unsigned greater_mask8(const LeafBoxes::Lanes& x, const LeafBoxes::Lanes& y) {
 #if defined(__SSE__)
   return static_cast<unsigned>(_mm_movemask_ps(_mm_cmpgt_ps(_mm_load_ps(x.data()), _mm_load_ps(y.data()))) |
                                (_mm_movemask_ps(_mm_cmpgt_ps(_mm_load_ps(x.data() + 4), _mm_load_ps(y.data() + 4))) << 4));
@@ -108,7 +116,7 @@ __attribute__((always_inline)) inline unsigned greater_mask(const LeafBoxes::Lan
 /// The lanes of leaf boxes q whose boxes overlap box p (same frame), as bits.
 __attribute__((always_inline)) inline unsigned overlapping_lanes(const ElemBox& p, const LeafBoxes& q) {
   unsigned apart = 0;
-  for (int i = 0; i < 3; ++i) apart |= greater_mask((q.c[i] - p.c[i]).abs(), q.h[i] + p.h[i]);
+  for (int i = 0; i < 3; ++i) apart |= greater_mask8((q.c[i] - p.c[i]).abs(), q.h[i] + p.h[i]);
   return ~apart & ((1u << LeafBoxes::kLanes) - 1);
 }
 
@@ -117,24 +125,94 @@ __attribute__((always_inline)) inline bool boxes_apart(const ElemBox& p, const E
   return any_greater((p.c - q.c).abs(), p.h + q.h);
 }
 
-/// Are two node boxes (in one frame) disjoint? The axis-aligned boxes first, then the
-/// oriented boxes on their six face axes (the nine cross axes add little for patches), all
-/// of one box's axes at once.
-__attribute__((always_inline)) inline bool boxes_apart(const NodeBox& p, const NodeBox& q) {
-  using V = Eigen::Array4f;
-  if (any_greater((p.c - q.c).abs(), p.h + q.h)) return true;
-  const V d = p.oc - q.oc;
-  // On q's axes: the centres' offset, and p's half extents (|q^T p.ax[j]| p.oh[j]).
-  const V tq = q.axt[0] * d[0] + q.axt[1] * d[1] + q.axt[2] * d[2];
-  V rp = V::Zero();
-  for (int j = 0; j < 3; ++j)
-    rp += (q.axt[0] * p.ax[j][0] + q.axt[1] * p.ax[j][1] + q.axt[2] * p.ax[j][2]).abs() * p.oh[j];
-  if (any_greater(tq.abs(), q.oh + rp)) return true;
-  const V tp = p.axt[0] * d[0] + p.axt[1] * d[1] + p.axt[2] * d[2];
-  V rq = V::Zero();
+/// Four nodes' boxes side by side, one node per SIMD lane (structure of arrays): the
+/// axis-aligned box and the oriented box of each, as in NodeBox.
+struct alignas(16) Box4 {
+  Eigen::Array4f c[3], h[3];    // mm: axis-aligned box, centre and half extents, per axis
+  Eigen::Array4f oc[3], oh[3];  // mm: oriented box, centre per axis, half extent along ax[k]
+  Eigen::Array4f ax[3][3];      // ax[k][i]: component i of the oriented box's axis k
+};
+
+/// A node of the 4-wide tree: up to four nodes of the binary tree (children or
+/// grandchildren of one node), tested at once.
+struct WideNode {
+  Box4 box;                       // lane j: binary node node[j]'s boxes
+  std::int32_t node[4];           // binary node per lane
+  std::int32_t wide[4];           // its wide node when inner; -1 for a leaf or an unused lane
+  /// By a mask of element kinds (kind_bit bits): the lanes holding some of those kinds, and
+  /// the lanes holding elements that can touch some of them (empty for unused lanes).
+  std::uint8_t lanes_holding[8];
+  std::uint8_t lanes_touching[8];
+};
+
+/// The lanes of q whose boxes overlap lane s of p (same frame), as bits: the axis-aligned
+/// boxes, then the oriented boxes on their six face axes (the nine cross axes add little
+/// for patches). Unused lanes of q give any answer: the caller masks them.
+__attribute__((always_inline)) inline unsigned overlapping_lanes(const Box4& p, int s, const Box4& q) {
+#if defined(__SSE__)
+  // Written on SSE registers and unrolled (the project builds at -O2, which keeps these
+  // loops and spills their arrays to memory: 540 instead of about 150 instructions).
+  const __m128 sign = _mm_set1_ps(-0.0f);
+  const auto ld = [](const Eigen::Array4f& v) { return _mm_load_ps(v.data()); };
+  const auto abs = [&](__m128 x) { return _mm_andnot_ps(sign, x); };
+  const auto bc = [&](const Eigen::Array4f& v) { return _mm_set1_ps(v[s]); };
+  __m128 apart = _mm_setzero_ps();
+  CF_UNROLL3
+  for (int i = 0; i < 3; ++i)
+    apart = _mm_or_ps(apart, _mm_cmpgt_ps(abs(_mm_sub_ps(ld(q.c[i]), bc(p.c[i]))), _mm_add_ps(ld(q.h[i]), bc(p.h[i]))));
+  if (_mm_movemask_ps(apart) == 0xF) return 0;
+  __m128 d[3], pa[3][3], po[3], qa[3][3];
+  CF_UNROLL3
+  for (int i = 0; i < 3; ++i) {
+    d[i] = _mm_sub_ps(ld(q.oc[i]), bc(p.oc[i]));
+    po[i] = bc(p.oh[i]);
+    CF_UNROLL3
+    for (int k = 0; k < 3; ++k) {
+      pa[k][i] = bc(p.ax[k][i]);
+      qa[k][i] = ld(q.ax[k][i]);
+    }
+  }
+  const auto dot = [](const __m128* x, const __m128* y) {
+    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(x[0], y[0]), _mm_mul_ps(x[1], y[1])), _mm_mul_ps(x[2], y[2]));
+  };
+  __m128 C[3][3];  // |q's axis k . p's axis j|
+  CF_UNROLL3
   for (int k = 0; k < 3; ++k)
-    rq += (p.axt[0] * q.ax[k][0] + p.axt[1] * q.ax[k][1] + p.axt[2] * q.ax[k][2]).abs() * q.oh[k];
-  return any_greater(tp.abs(), p.oh + rq);
+    CF_UNROLL3
+    for (int j = 0; j < 3; ++j) C[k][j] = abs(dot(qa[k], pa[j]));
+  CF_UNROLL3
+  for (int k = 0; k < 3; ++k) {  // q's axes
+    const __m128 r = _mm_add_ps(ld(q.oh[k]), dot(C[k], po));
+    apart = _mm_or_ps(apart, _mm_cmpgt_ps(abs(dot(qa[k], d)), r));
+  }
+  const __m128 qo[3] = {ld(q.oh[0]), ld(q.oh[1]), ld(q.oh[2])};
+  CF_UNROLL3
+  for (int k = 0; k < 3; ++k) {  // p's axes
+    const __m128 ck[3] = {C[0][k], C[1][k], C[2][k]};
+    const __m128 r = _mm_add_ps(po[k], dot(ck, qo));
+    apart = _mm_or_ps(apart, _mm_cmpgt_ps(abs(dot(pa[k], d)), r));
+  }
+  return ~static_cast<unsigned>(_mm_movemask_ps(apart)) & 0xFu;
+#else
+  using V = Eigen::Array4f;
+  unsigned apart = 0;
+  for (int i = 0; i < 3; ++i) apart |= greater_mask4((q.c[i] - p.c[i][s]).abs(), q.h[i] + p.h[i][s]);
+  if (apart == 0xFu) return 0;
+  const V d[3] = {q.oc[0] - p.oc[0][s], q.oc[1] - p.oc[1][s], q.oc[2] - p.oc[2][s]};
+  V C[3][3];  // |q's axis k . p's axis j|
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j)
+      C[k][j] = (q.ax[k][0] * p.ax[j][0][s] + q.ax[k][1] * p.ax[j][1][s] + q.ax[k][2] * p.ax[j][2][s]).abs();
+  for (int k = 0; k < 3; ++k) {  // q's axes
+    const V t = q.ax[k][0] * d[0] + q.ax[k][1] * d[1] + q.ax[k][2] * d[2];
+    apart |= greater_mask4(t.abs(), q.oh[k] + C[k][0] * p.oh[0][s] + C[k][1] * p.oh[1][s] + C[k][2] * p.oh[2][s]);
+  }
+  for (int k = 0; k < 3; ++k) {  // p's axes
+    const V t = d[0] * p.ax[k][0][s] + d[1] * p.ax[k][1][s] + d[2] * p.ax[k][2][s];
+    apart |= greater_mask4(t.abs(), C[0][k] * q.oh[0] + C[1][k] * q.oh[1] + C[2][k] * q.oh[2] + p.oh[k][s]);
+  }
+  return ~apart & 0xFu;
+#endif
 }
 
 /// What a leaf holds: a few elements of any kind, or a few faces each with the edges and
@@ -164,12 +242,19 @@ class Bvh {
   /// Per node, its axis-aligned and oriented boxes (inflated alike), centres relative to
   /// origin().
   const std::vector<NodeBox>& boxes() const { return boxes_; }
+  /// The 4-wide tree over the same nodes: wide()[0] holds the root alone (lane 0), so that a
+  /// descent starts from a lane like every other step.
+  const std::vector<WideNode>& wide() const { return wide_; }
   const std::vector<BvhElement>& elements() const { return elements_; }
   int depth() const { return depth_; }
 
  private:
+  // Appends the wide node for lanes `members` (binary nodes), and below it those of its
+  // inner lanes; returns its index.
+  std::int32_t add_wide(const std::int32_t* members, int count);
   std::vector<BvhNode> nodes_;
   std::vector<NodeBox> boxes_;
+  std::vector<WideNode> wide_;
   Vec3 origin_ = Vec3::Zero();
   std::vector<BvhElement> elements_;
   std::vector<ElemBox> elem_boxes_;
@@ -232,6 +317,55 @@ bool descend(const Bvh& ta, const Bvh& tb, Overlap&& overlap, NodePair* stack, s
     } else {
       stack[top++] = {p.a, B.right()};
       stack[top++] = {p.a, B.left()};
+    }
+  }
+  return ok;
+}
+
+/// As descend, over the 4-wide trees (Bvh::wide()): a step tests one lane of one tree
+/// against the four lanes of a wide node of the other at once. `posed_a(w)` returns tree
+/// `a`'s wide node w's boxes posed into `b`'s frame (the caller caches them).
+template <class PosedA, class LeafPair>
+bool descend_wide(const Bvh& ta, const Bvh& tb, PosedA&& posed_a, NodePair* stack, std::size_t cap,
+                  LeafPair&& leaves) {
+  if (ta.wide().empty() || tb.wide().empty()) return true;
+  const auto& wa = ta.wide();
+  const auto& wb = tb.wide();
+  const auto& na = ta.nodes();
+  const auto& nb = tb.nodes();
+  // Stack entries are lanes, 4 * wide node + lane; the roots are lane 0 of wide node 0.
+  if (!(wb[0].lanes_holding[na[0].touchable] & overlapping_lanes(posed_a(0), 0, wb[0].box) & 1u)) return true;
+  std::size_t top = 0;
+  stack[top++] = {0, 0};
+  bool ok = true;
+  while (top > 0) {
+    const NodePair p = stack[--top];
+    const std::int32_t ia = p.a >> 2, ib = p.b >> 2;
+    const int la = p.a & 3, lb = p.b & 3;
+    const WideNode& WA = wa[static_cast<std::size_t>(ia)];
+    const WideNode& WB = wb[static_cast<std::size_t>(ib)];
+    const BvhNode& A = na[static_cast<std::size_t>(WA.node[la])];
+    const BvhNode& B = nb[static_cast<std::size_t>(WB.node[lb])];
+    if (A.leaf() && B.leaf()) {
+      leaves(A, B);
+      continue;
+    }
+    if (top + 4 > cap) {
+      ok = false;
+      continue;
+    }
+    // Open the bigger box (or the only inner node) into its wide node's lanes.
+    if (B.leaf() || (!A.leaf() && A.half.squaredNorm() >= B.half.squaredNorm())) {
+      const std::int32_t w = WA.wide[la];
+      unsigned lanes = wa[static_cast<std::size_t>(w)].lanes_touching[B.kinds];
+      if (lanes != 0) lanes &= overlapping_lanes(WB.box, lb, posed_a(w));
+      for (; lanes != 0; lanes &= lanes - 1) stack[top++] = {4 * w + __builtin_ctz(lanes), p.b};
+    } else {
+      const std::int32_t w = WB.wide[lb];
+      const WideNode& W = wb[static_cast<std::size_t>(w)];
+      unsigned lanes = W.lanes_holding[A.touchable];
+      if (lanes != 0) lanes &= overlapping_lanes(posed_a(ia), la, W.box);
+      for (; lanes != 0; lanes &= lanes - 1) stack[top++] = {p.a, 4 * w + __builtin_ctz(lanes)};
     }
   }
   return ok;

@@ -118,12 +118,12 @@ double segment_segment_2d(const Vec2& a, const Vec2& b, const Vec2& c, const Vec
 // BVH leaves of a model: one element for small models (with bigger leaves, leaf boxes of the
 // paper's cube and L-block overlap everything), posed like inner nodes (cheaper than exact
 // boxes there: 2.4 against 2.8 us per tick). Big models' nodes are also tested as oriented
-// boxes (detail::boxes_apart): a curved surface's patches are tilted, and the axis-aligned
-// box of a tilted patch is as thick as it is wide, so that two surfaces in contact overlap
-// over many patches; and their leaves hold one face with the edges and vertices it owns,
-// which tile the surface, each element with its own box tested in the leaf (on 2,000-face
-// spheres 7% fewer instructions than leaves of 2 elements of any kind, 15% fewer at the
-// paper's epsilon). docs/performance.md has the figures.
+// boxes, four at a time (detail::descend_wide): a curved surface's patches are tilted, and
+// the axis-aligned box of a tilted patch is as thick as it is wide, so that two surfaces in
+// contact overlap over many patches; and their leaves hold one face with the edges and
+// vertices it owns, which tile the surface, each element with its own box tested in the
+// leaf (on 2,000-face spheres 7% fewer instructions than leaves of 2 elements of any kind,
+// 15% fewer at the paper's epsilon). docs/performance.md has the figures.
 constexpr std::size_t kBigModelElements = 256;
 bool is_big(const Polyhedron& m) { return m.num_vertices() + m.num_edges() + m.num_faces() >= kBigModelElements; }
 detail::Leaves leaves_for(const Polyhedron& m) {
@@ -148,11 +148,11 @@ struct ContactDetector::Impl {
     std::uint64_t stamp = 0;
   };
   std::vector<PosedBox> a_box;
-  struct PosedNode {  // big models
-    detail::NodeBox box;  // B's frame
+  struct PosedWide {  // big models: a wide node's four boxes
+    detail::Box4 box;  // B's frame
     std::uint64_t stamp = 0;
   };
-  std::vector<PosedNode> a_node;
+  std::vector<PosedWide> a_wide;
   // Big models: A's elements' boxes, from A's vertices posed in single precision.
   struct PosedElem {
     detail::ElemBox box;  // B's frame
@@ -272,7 +272,7 @@ struct ContactDetector::Impl {
     sin_max_tol = std::sin(max_tol());
     cos_max_tol = std::cos(max_tol());
     if (big) {
-      a_node.resize(bvh_a.nodes().size());
+      a_wide.resize(bvh_a.wide().size());
       a_elem.resize(bvh_a.elements().size());
       for (const Vertex& v : ma.vertices()) {
         a_vert.emplace_back() << (v.p - bvh_a.origin()).cast<float>(), 0.0f;
@@ -289,16 +289,9 @@ struct ContactDetector::Impl {
     seg_a.resize(ma.num_edges());
   }
 
-  // Does A's BVH node `ia` (posed) overlap B's node `ib`? Small models: the axis-aligned
-  // boxes in B's frame, then, for inner nodes, B's box on A's node's own axes. Big models:
-  // the nodes' axis-aligned and oriented boxes (detail::boxes_apart).
-  __attribute__((always_inline)) bool overlap(std::int32_t ia, std::int32_t ib, const detail::BvhNode& A,
-                                              const detail::BvhNode& B) {
-    if (big) {
-      PosedNode& P = a_node[static_cast<std::size_t>(ia)];
-      if (P.stamp != stamp) pose_node(P, ia);
-      return !detail::boxes_apart(P.box, bvh_b.boxes()[static_cast<std::size_t>(ib)]);
-    }
+  // Small models: does A's BVH node `ia` (posed) overlap B's node? The axis-aligned boxes
+  // in B's frame, then, for inner nodes, B's box on A's node's own axes.
+  __attribute__((always_inline)) bool overlap(std::int32_t ia, const detail::BvhNode& A, const detail::BvhNode& B) {
     PosedBox& P = a_box[static_cast<std::size_t>(ia)];
     if (P.stamp != stamp) pose_box(P, A);
     const Eigen::Vector3f d = P.c - B.center;
@@ -315,7 +308,7 @@ struct ContactDetector::Impl {
     return true;
   }
 
-  // A's vertex v posed, single precision (rounding as in pose_node).
+  // A's vertex v posed, single precision (rounding as in pose_wide).
   const Eigen::Array4f& posed_vertex(VertexId v) {
     PosedVertex& P = a_vert_posed[v.index()];
     if (P.stamp != stamp) {
@@ -365,35 +358,35 @@ struct ContactDetector::Impl {
     detail::round_out(pose.apply(N.center.cast<double>()), absR * N.half.cast<double>(), P.c, P.h);
   }
 
-  // A big model's node i at the current pose, in B's frame, in single precision. Its centres
-  // are relative to bvh_a's origin (within A's size), whose posed place is computed in double
-  // once per call, so the rounding (a few parts in 1e7 of A's size plus that place) stays far
-  // below B's boxes' float slack wherever the two boxes could overlap. The posed axis-aligned
-  // box of the oriented box bounds the node as well: the overlap of the two is kept.
-  __attribute__((noinline)) void pose_node(PosedNode& P, std::int32_t i) {
+  // A big model's wide node w at the current pose, in B's frame, in single precision. Its
+  // centres are relative to bvh_a's origin (within A's size), whose posed place is computed
+  // in double once per call, so the rounding (a few parts in 1e7 of A's size plus that
+  // place) stays far below B's boxes' float slack wherever the two boxes could overlap. The
+  // posed axis-aligned box of the oriented box bounds the node as well: the overlap of the
+  // two is kept.
+  const detail::Box4& posed_wide(std::int32_t w) {
+    PosedWide& P = a_wide[static_cast<std::size_t>(w)];
+    if (P.stamp != stamp) pose_wide(P, w);
+    return P.box;
+  }
+  __attribute__((noinline)) void pose_wide(PosedWide& P, std::int32_t w) {
     using V = Eigen::Array4f;
     P.stamp = stamp;
-    const detail::NodeBox& N = bvh_a.boxes()[static_cast<std::size_t>(i)];
-    detail::NodeBox& Q = P.box;
-    const V c = Rcol[0] * N.c[0] + Rcol[1] * N.c[1] + Rcol[2] * N.c[2] + a_origin;
-    const V oc = Rcol[0] * N.oc[0] + Rcol[1] * N.oc[1] + Rcol[2] * N.oc[2] + a_origin;
-    const V h = absRcol[0] * N.h[0] + absRcol[1] * N.h[1] + absRcol[2] * N.h[2];
-    V oh_aligned = V::Zero();
-    for (int k = 0; k < 3; ++k) {
-      Q.ax[k] = Rcol[0] * N.ax[k][0] + Rcol[1] * N.ax[k][1] + Rcol[2] * N.ax[k][2];
-      Q.axt[k] = N.axt[0] * Rf(k, 0) + N.axt[1] * Rf(k, 1) + N.axt[2] * Rf(k, 2);
-      oh_aligned += Q.ax[k].abs() * N.oh[k];
-    }
-    const V lo = (c - h).max(oc - oh_aligned), hi = (c + h).min(oc + oh_aligned);
-    Q.c = 0.5f * (lo + hi);
-    // Widened by the rounding of the midpoint and of the half difference.
-    Q.h = ((0.5f * (hi - lo)).max(0.0f) + 2.4e-7f * Q.c.abs()) * 1.0000003f;
-    Q.oc = oc;
-    Q.oh = N.oh;
-    if (grow > 0) {
-      const V g(grow, grow, grow, 0.0f);
-      Q.h += g;
-      Q.oh += g;
+    const detail::Box4& N = bvh_a.wide()[static_cast<std::size_t>(w)].box;
+    detail::Box4& Q = P.box;
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < 3; ++i) Q.ax[k][i] = N.ax[k][0] * Rf(i, 0) + N.ax[k][1] * Rf(i, 1) + N.ax[k][2] * Rf(i, 2);
+    for (int i = 0; i < 3; ++i) {
+      const V c = N.c[0] * Rf(i, 0) + N.c[1] * Rf(i, 1) + N.c[2] * Rf(i, 2) + a_origin[i];
+      const V oc = N.oc[0] * Rf(i, 0) + N.oc[1] * Rf(i, 1) + N.oc[2] * Rf(i, 2) + a_origin[i];
+      const V h = N.h[0] * absRf(i, 0) + N.h[1] * absRf(i, 1) + N.h[2] * absRf(i, 2);
+      const V oh = Q.ax[0][i].abs() * N.oh[0] + Q.ax[1][i].abs() * N.oh[1] + Q.ax[2][i].abs() * N.oh[2];
+      const V lo = (c - h).max(oc - oh), hi = (c + h).min(oc + oh);
+      Q.c[i] = 0.5f * (lo + hi);
+      // Widened by the rounding of the midpoint and of the half difference.
+      Q.h[i] = ((0.5f * (hi - lo)).max(0.0f) + 2.4e-7f * Q.c[i].abs()) * 1.0000003f + grow;
+      Q.oc[i] = oc;
+      Q.oh[i] = N.oh[i] + grow;
     }
   }
 
@@ -918,14 +911,19 @@ struct ContactDetector::Impl {
         kept_overflow = false;
       }
     }
-    // The stack is sized for the trees' depths, so descend cannot overflow it.
-    detail::descend(
-        bvh_a, bvh_b,
-        [this](std::int32_t ia, std::int32_t ib, const detail::BvhNode& A, const detail::BvhNode& B) {
-          return overlap(ia, ib, A, B);
-        },
-        stack.data(), stack.size(),
-        [this](const detail::BvhNode& A, const detail::BvhNode& B) { leaf_pair(A, B); });
+    // The stack is sized for the trees' depths, so the descents cannot overflow it.
+    const auto leaves = [this](const detail::BvhNode& A, const detail::BvhNode& B) { leaf_pair(A, B); };
+    if (big)
+      detail::descend_wide(
+          bvh_a, bvh_b, [this](std::int32_t w) -> const detail::Box4& { return posed_wide(w); }, stack.data(),
+          stack.size(), leaves);
+    else
+      detail::descend(
+          bvh_a, bvh_b,
+          [this](std::int32_t ia, std::int32_t, const detail::BvhNode& A, const detail::BvhNode& B) {
+            return overlap(ia, A, B);
+          },
+          stack.data(), stack.size(), leaves);
     if (recording && !kept_overflow) {
       kept_valid = true;
       kept_pose = pose;
