@@ -7,6 +7,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -403,12 +404,14 @@ TEST_CASE("from_parts rejects empty, repeated and coplanar PC sets", "[graph]") 
 }
 
 TEST_CASE("from_parts rejects transitions that do not fit their CFs", "[graph]") {
+  // CF 3's cube edge 0 bounds the cube's face 2: e-f:0:4 neighbours f-f:2:4.
   const std::vector<cf::CfRecord> cfs = {rec({pc(PcType::kFF, 2, 4)}), rec({pc(PcType::kFF, 5, 5)}),
-                                         rec({pc(PcType::kFF, 2, 4), pc(PcType::kFF, 5, 5)})};
+                                         rec({pc(PcType::kFF, 2, 4), pc(PcType::kFF, 5, 5)}),
+                                         rec({pc(PcType::kEF, 0, 4)})};
   CHECK_NOTHROW(build(cfs, {tr(0, 2, TransitionKind::kGain), tr(2, 1, TransitionKind::kLose),
-                            tr(0, 1, TransitionKind::kChange)}));
-  CHECK_THROWS_WITH(build(cfs, {tr(0, 3, TransitionKind::kGain)}),
-                    Catch::Contains("transition 0: to = 3 is not a CF id (the graph has 3 CFs)"));
+                            tr(0, 3, TransitionKind::kChange)}));
+  CHECK_THROWS_WITH(build(cfs, {tr(0, 4, TransitionKind::kGain)}),
+                    Catch::Contains("transition 0: to = 4 is not a CF id (the graph has 4 CFs)"));
   CHECK_THROWS_WITH(build(cfs, {tr(-1, 0, TransitionKind::kGain)}),
                     Catch::Contains("transition 0: from = -1 is not a CF id"));
   CHECK_THROWS_WITH(build(cfs, {tr(1, 1, TransitionKind::kChange)}), Catch::Contains("from CF 1 to itself"));
@@ -418,9 +421,97 @@ TEST_CASE("from_parts rejects transitions that do not fit their CFs", "[graph]")
   CHECK_THROWS_WITH(build(cfs, {tr(0, 1, TransitionKind::kLose)}), Catch::Contains("kind 'lose' needs"));
   CHECK_THROWS_WITH(build(cfs, {tr(0, 2, TransitionKind::kChange)}),
                     Catch::Contains("kind 'change' needs the same number of PCs"));
-  CHECK_THROWS_WITH(build(cfs, {tr(0, 2, TransitionKind::kGain), tr(0, 1, TransitionKind::kChange),
+  CHECK_THROWS_WITH(build(cfs, {tr(0, 2, TransitionKind::kGain), tr(0, 3, TransitionKind::kChange),
                                 tr(0, 2, TransitionKind::kGain)}),
                     Catch::Contains("transition 2: transition CF 0 -> CF 2 is listed twice"));
+}
+
+TEST_CASE("neighbouring PCs follow the boundary relations and are symmetric", "[graph]") {
+  const cf::Polyhedron A = cf_test::box(10, 10, 10), B = cf_test::l_block();
+  const auto nb = [&](const Pc& x) { return cf::neighbouring_pcs(x, A, B); };
+  const auto has = [](const std::vector<Pc>& v, const Pc& x) {
+    return std::count(v.begin(), v.end(), x) == 1;
+  };
+  // The cube's edge 0 joins its vertices 0 and 1 and bounds its faces 0 (z = 0) and 2 (y = 0).
+  const std::vector<Pc> ff = nb(pc(PcType::kFF, 2, 4));
+  CHECK(has(ff, pc(PcType::kEF, 0, 4)));
+  CHECK_FALSE(has(ff, pc(PcType::kFF, 5, 5)));
+  CHECK_FALSE(has(ff, pc(PcType::kVF, 0, 4)));  // two steps away, through e-f
+  CHECK(std::is_sorted(ff.begin(), ff.end()));
+  const std::vector<Pc> ef = nb(pc(PcType::kEF, 0, 4));
+  CHECK(has(ef, pc(PcType::kFF, 0, 4)));
+  CHECK(has(ef, pc(PcType::kFF, 2, 4)));
+  CHECK(has(ef, pc(PcType::kVF, 0, 4)));
+  CHECK(has(ef, pc(PcType::kVF, 1, 4)));
+  CHECK_FALSE(has(ef, pc(PcType::kVF, 2, 4)));
+  // Every PC of the pair is a neighbour of each of its neighbours.
+  const PcType types[] = {PcType::kFF, PcType::kEF, PcType::kFE,
+                          PcType::kVF, PcType::kFV, PcType::kEE};
+  const auto count = [](const cf::Polyhedron& m, cf::ElementKind k) {
+    return static_cast<int>(k == cf::ElementKind::kVertex ? m.num_vertices()
+                            : k == cf::ElementKind::kEdge ? m.num_edges()
+                                                          : m.num_faces());
+  };
+  std::size_t pairs = 0;
+  for (PcType t : types)
+    for (int a = 0; a < count(A, cf::a_kind(t)); ++a)
+      for (int b = 0; b < count(B, cf::b_kind(t)); ++b)
+        for (const Pc& y : nb(pc(t, a, b))) {
+          INFO(cf::to_string(pc(t, a, b)) << " -> " << cf::to_string(y));
+          CHECK(has(nb(y), pc(t, a, b)));
+          ++pairs;
+        }
+  CHECK(pairs > 0);
+}
+
+TEST_CASE("from_parts accepts a change only where PCs are replaced by neighbouring PCs",
+          "[graph]") {
+  const cf::Polyhedron B = cf_test::l_block();
+  // The L-block's edge 2-3 runs along the floor top (face 4) at its bottom; its other face.
+  const int eb = cf::test::edge_between(B, 2, 3);
+  REQUIRE(eb >= 0);
+  const cf::Edge& E = B.edges()[static_cast<std::size_t>(eb)];
+  const int fb2 = E.left.value() == 4 ? E.right.value() : E.left.value();
+  REQUIRE((E.left.value() == 4 || E.right.value() == 4));
+  const std::vector<cf::CfRecord> cfs = {
+      rec({pc(PcType::kFF, 2, 4)}),                            // 0
+      rec({pc(PcType::kEF, 0, 4)}),                            // 1: f-f:2:4's edge 0 on the floor
+      rec({pc(PcType::kVF, 0, 4)}),                            // 2: edge 0's end on the floor
+      rec({pc(PcType::kFF, 5, 5)}),                            // 3: the wall
+      rec({pc(PcType::kFF, 2, 4), pc(PcType::kFF, 5, 5)}),     // 4
+      rec({pc(PcType::kEF, 0, 4), pc(PcType::kFF, 5, 5)}),     // 5: 4 with one PC replaced
+      rec({pc(PcType::kVF, 0, 4), pc(PcType::kFF, 5, 5)}),     // 6
+      rec({pc(PcType::kVF, 0, 4), pc(PcType::kEE, 0, eb)}),    // 7: v-f:0:4 and its neighbour e-e
+      rec({pc(PcType::kEF, 0, fb2), pc(PcType::kEE, 0, eb)}),  // 8: e-e's neighbour e-f
+  };
+  using K = TransitionKind;
+  // One PC replaced, both ways; one of two replaced; and a chain: v-f -> e-e (already held)
+  // while e-e -> e-f. cfgen builds that last one too (each PC kept or replaced by one of its
+  // neighbours, one for one), though e-f:0:fb2 is no neighbour of v-f:0:4.
+  CHECK_NOTHROW(build(
+      cfs, {tr(0, 1, K::kChange), tr(1, 0, K::kChange), tr(1, 2, K::kChange), tr(4, 5, K::kChange),
+            tr(5, 6, K::kChange), tr(7, 8, K::kChange), tr(8, 7, K::kChange)}));
+  // Not neighbours: the cube's face 2 on the floor and its face 5 on the wall.
+  CHECK_THROWS_WITH(
+      build(cfs, {tr(0, 1, K::kChange), tr(0, 3, K::kChange)}),
+      Catch::Contains("transition 1: kind 'change' needs the target to be the source with one or "
+                      "more PCs replaced by neighbouring PCs, one for one: CF 0 {f-f:2:4} -> "
+                      "CF 3 {f-f:5:5}"));
+  // Two steps apart (f-f -> e-f -> v-f), with a PC kept.
+  CHECK_THROWS_WITH(
+      build(cfs, {tr(0, 2, K::kChange)}),
+      Catch::Contains(
+          "kind 'change' needs the target to be the source with one or more PCs "
+          "replaced by neighbouring PCs, one for one: CF 0 {f-f:2:4} -> CF 2 {v-f:0:4}"));
+  CHECK_THROWS_WITH(
+      build(cfs, {tr(4, 6, K::kChange)}),
+      Catch::Contains(
+          "transition 0: kind 'change' needs the target to be the source with one or "
+          "more PCs replaced by neighbouring PCs, one for one: CF 4 {f-f:2:4;f-f:5:5} -> "
+          "CF 6 {f-f:5:5;v-f:0:4}"));
+  // The count rule still comes first.
+  CHECK_THROWS_WITH(build(cfs, {tr(0, 5, K::kChange)}),
+                    Catch::Contains("kind 'change' needs the same number of PCs"));
 }
 
 TEST_CASE("from_parts rejects metadata that is not an object or that overrides the graph", "[graph]") {
@@ -573,6 +664,20 @@ std::string fixture_with(const std::string& from, const std::string& to) {
 }
 
 }  // namespace
+
+TEST_CASE("load: a change between PCs that are not neighbours", "[graph][bad]") {
+  // CF 1 {f-f:5:5} (the wall) and CF 3 {e-f:0:4} (an edge on the floor): same count, but
+  // f-f:5:5 has no neighbouring PC in CF 3.
+  const std::string text =
+      fixture_with(R"({"from":3,"to":4,"kind":"change"})", R"({"from":1,"to":3,"kind":"change"})");
+  CHECK_THROWS_WITH(
+      CfGraph::from_bytes(text, "x.json", false),
+      Catch::Contains(
+          "reading 'x.json' at /transitions/6/kind: kind 'change' needs the target to be "
+          "the source with one or more PCs replaced by neighbouring PCs, one for one: "
+          "CF 1 {f-f:5:5} -> CF 3 {e-f:0:4}"));
+  CHECK_NOTHROW(CfGraph::from_bytes(slurp(kFixture), "x.json", false));
+}
 
 TEST_CASE("the reader takes every JSON value form in metadata and names", "[graph][json]") {
   // Escapes, a surrogate pair, raw UTF-8, exponents, -0, integers past int64, nesting.

@@ -5,11 +5,14 @@
 #include "json_util.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <charconv>
 #include <cmath>
 #include <sstream>
+#include <unordered_map>
 #include <utility>
+#include <vector>
 
 namespace cf {
 
@@ -88,6 +91,57 @@ std::optional<Pc> pc_from_string(std::string_view text) {
   if (!parse_index(text.substr(c1 + 1, c2 - c1 - 1), pc.a)) return std::nullopt;
   if (!parse_index(text.substr(c2 + 1), pc.b)) return std::nullopt;
   return pc;
+}
+
+std::vector<Pc> neighbouring_pcs(const Pc& pc, const Polyhedron& A, const Polyhedron& B) {
+  std::vector<Pc> out;
+  auto add = [&](PcType t, int a, int b) { out.push_back({t, a, b}); };
+  auto edges_of_face = [](const Polyhedron& m, int f) { return m.faces()[f].edges; };
+  auto faces_of_edge = [](const Polyhedron& m, int e) {
+    return std::vector<int>{m.edges()[e].left.value(), m.edges()[e].right.value()};
+  };
+  auto ends_of_edge = [](const Polyhedron& m, int e) {
+    return std::vector<int>{m.edges()[e].v0.value(), m.edges()[e].v1.value()};
+  };
+  switch (pc.type) {
+    case PcType::kFF:
+      for (EdgeId e : edges_of_face(A, pc.a)) add(PcType::kEF, e.value(), pc.b);
+      for (EdgeId e : edges_of_face(B, pc.b)) add(PcType::kFE, pc.a, e.value());
+      break;
+    case PcType::kEF:
+      for (int f : faces_of_edge(A, pc.a)) add(PcType::kFF, f, pc.b);
+      for (int v : ends_of_edge(A, pc.a)) add(PcType::kVF, v, pc.b);
+      for (EdgeId e : edges_of_face(B, pc.b)) add(PcType::kEE, pc.a, e.value());
+      break;
+    case PcType::kFE:
+      for (int f : faces_of_edge(B, pc.b)) add(PcType::kFF, pc.a, f);
+      for (int v : ends_of_edge(B, pc.b)) add(PcType::kFV, pc.a, v);
+      for (EdgeId e : edges_of_face(A, pc.a)) add(PcType::kEE, e.value(), pc.b);
+      break;
+    case PcType::kVF:
+      for (EdgeId ea : A.vertices()[pc.a].edges) {
+        add(PcType::kEF, ea.value(), pc.b);
+        for (EdgeId eb : edges_of_face(B, pc.b)) add(PcType::kEE, ea.value(), eb.value());
+      }
+      break;
+    case PcType::kFV:
+      for (EdgeId eb : B.vertices()[pc.b].edges) {
+        add(PcType::kFE, pc.a, eb.value());
+        for (EdgeId ea : edges_of_face(A, pc.a)) add(PcType::kEE, ea.value(), eb.value());
+      }
+      break;
+    case PcType::kEE:
+      for (int f : faces_of_edge(B, pc.b)) add(PcType::kEF, pc.a, f);
+      for (int f : faces_of_edge(A, pc.a)) add(PcType::kFE, f, pc.b);
+      for (int v : ends_of_edge(A, pc.a))
+        for (int f : faces_of_edge(B, pc.b)) add(PcType::kVF, v, f);
+      for (int v : ends_of_edge(B, pc.b))
+        for (int f : faces_of_edge(A, pc.a)) add(PcType::kFV, f, v);
+      break;
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -230,6 +284,28 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
       where.cf_fault(i, "PC set {" + to_string(pcs) + "} repeats CF " + std::to_string(it->second.value()));
   }
 
+  // `change` (SPEC section 4, MT3), as cfgen builds it: the target is the source with each
+  // PC kept or replaced by one of its neighbouring PCs, all distinct. So some one-to-one
+  // pairing maps every source PC to an equal or a neighbouring target PC (sizes are equal).
+  std::unordered_map<Pc, std::vector<Pc>, detail::PcHash> neighbours_of;
+  const auto replaced_by_neighbours = [&](const PcSet& f, const PcSet& g) {
+    std::array<int, PcSet::kMaxPcs> perm{0, 1, 2};
+    do {
+      bool ok = true;
+      for (int i = 0; i < f.size() && ok; ++i) {
+        const Pc& x = f[i];
+        const Pc& y = g[perm[static_cast<std::size_t>(i)]];
+        if (x == y) continue;
+        auto it = neighbours_of.find(x);
+        if (it == neighbours_of.end())
+          it = neighbours_of.emplace(x, neighbouring_pcs(x, a, b)).first;
+        ok = std::binary_search(it->second.begin(), it->second.end(), y);
+      }
+      if (ok) return true;
+    } while (std::next_permutation(perm.begin(), perm.begin() + g.size()));
+    return false;
+  };
+
   out.assign(n, {});
   for (std::size_t t = 0; t < transitions.size(); ++t) {
     const Transition& tr = transitions[t];
@@ -266,6 +342,12 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
       case TransitionKind::kChange:
         ok = f.size() == g.size();
         rule = "'change' needs the same number of PCs";
+        if (ok) {
+          ok = f != g && replaced_by_neighbours(f, g);
+          rule =
+              "'change' needs the target to be the source with one or more PCs replaced by "
+              "neighbouring PCs, one for one";
+        }
         break;
     }
     if (!ok)

@@ -94,57 +94,6 @@ void parallel_for(std::size_t n, int threads, const std::function<void(std::size
 
 }  // namespace
 
-std::vector<Pc> neighbouring_pcs(const Pc& pc, const Polyhedron& A, const Polyhedron& B) {
-  std::vector<Pc> out;
-  auto add = [&](PcType t, int a, int b) { out.push_back({t, a, b}); };
-  auto edges_of_face = [](const Polyhedron& m, int f) { return m.faces()[f].edges; };
-  auto faces_of_edge = [](const Polyhedron& m, int e) {
-    return std::vector<int>{m.edges()[e].left.value(), m.edges()[e].right.value()};
-  };
-  auto ends_of_edge = [](const Polyhedron& m, int e) {
-    return std::vector<int>{m.edges()[e].v0.value(), m.edges()[e].v1.value()};
-  };
-  switch (pc.type) {
-    case PcType::kFF:
-      for (EdgeId e : edges_of_face(A, pc.a)) add(PcType::kEF, e.value(), pc.b);
-      for (EdgeId e : edges_of_face(B, pc.b)) add(PcType::kFE, pc.a, e.value());
-      break;
-    case PcType::kEF:
-      for (int f : faces_of_edge(A, pc.a)) add(PcType::kFF, f, pc.b);
-      for (int v : ends_of_edge(A, pc.a)) add(PcType::kVF, v, pc.b);
-      for (EdgeId e : edges_of_face(B, pc.b)) add(PcType::kEE, pc.a, e.value());
-      break;
-    case PcType::kFE:
-      for (int f : faces_of_edge(B, pc.b)) add(PcType::kFF, pc.a, f);
-      for (int v : ends_of_edge(B, pc.b)) add(PcType::kFV, pc.a, v);
-      for (EdgeId e : edges_of_face(A, pc.a)) add(PcType::kEE, e.value(), pc.b);
-      break;
-    case PcType::kVF:
-      for (EdgeId ea : A.vertices()[pc.a].edges) {
-        add(PcType::kEF, ea.value(), pc.b);
-        for (EdgeId eb : edges_of_face(B, pc.b)) add(PcType::kEE, ea.value(), eb.value());
-      }
-      break;
-    case PcType::kFV:
-      for (EdgeId eb : B.vertices()[pc.b].edges) {
-        add(PcType::kFE, pc.a, eb.value());
-        for (EdgeId ea : edges_of_face(A, pc.a)) add(PcType::kEE, ea.value(), eb.value());
-      }
-      break;
-    case PcType::kEE:
-      for (int f : faces_of_edge(B, pc.b)) add(PcType::kEF, pc.a, f);
-      for (int f : faces_of_edge(A, pc.a)) add(PcType::kFE, f, pc.b);
-      for (int v : ends_of_edge(A, pc.a))
-        for (int f : faces_of_edge(B, pc.b)) add(PcType::kVF, v, f);
-      for (int v : ends_of_edge(B, pc.b))
-        for (int f : faces_of_edge(A, pc.a)) add(PcType::kFV, f, v);
-      break;
-  }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
-}
-
 std::vector<Transition> transitions_between(const std::vector<CfRecord>& cfs, const Polyhedron& A,
                                             const Polyhedron& B) {
   std::unordered_map<PcSet, int, PcSetHash> index;
@@ -156,7 +105,7 @@ std::vector<Transition> transitions_between(const std::vector<CfRecord>& cfs, co
   std::map<Pc, std::vector<Pc>> nb_cache;
   auto neighbours = [&](const Pc& pc) -> const std::vector<Pc>& {
     auto it = nb_cache.find(pc);
-    if (it == nb_cache.end()) it = nb_cache.emplace(pc, neighbouring_pcs(pc, A, B)).first;
+    if (it == nb_cache.end()) it = nb_cache.emplace(pc, cf::neighbouring_pcs(pc, A, B)).first;
     return it->second;
   };
   for (std::size_t i = 0; i < cfs.size(); ++i) {

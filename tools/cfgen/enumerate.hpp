@@ -35,10 +35,6 @@ struct Enumeration {
 
 Enumeration enumerate(const ModelInfo& A, const ModelInfo& B, const EnumerateOptions& options);
 
-/// PCs neighbouring `pc` (SPEC section 4): one step through a degenerate touch, under the
-/// boundary relations of the two models.
-std::vector<Pc> neighbouring_pcs(const Pc& pc, const Polyhedron& A, const Polyhedron& B);
-
 /// Transitions (gain, lose, change) between the given CFs.
 std::vector<Transition> transitions_between(const std::vector<CfRecord>& cfs, const Polyhedron& A,
                                             const Polyhedron& B);

@@ -50,6 +50,13 @@ std::string to_string(const Pc& pc);
 /// Parses "type:a:b" (e.g. "v-f:3:5"); std::nullopt when malformed. Ranges are not checked.
 std::optional<Pc> pc_from_string(std::string_view text);
 
+/// The PCs neighbouring `pc` (SPEC section 4): one step through a degenerate touch, under the
+/// boundary relations of A and B (edge bounds face, vertex ends edge; the table is in
+/// docs/generator.md). Sorted, without repeats; the relation is symmetric. This is the rule
+/// behind `change` transitions, for cfgen and for the graph reader's checks.
+/// @pre pc's indices are in range for the element kinds its type names in A and B.
+std::vector<Pc> neighbouring_pcs(const Pc& pc, const Polyhedron& A, const Polyhedron& B);
+
 /// Up to three PCs in canonical (sorted) order: the key of a CF. Fixed capacity, no heap.
 class PcSet {
  public:
