@@ -115,9 +115,25 @@ __attribute__((always_inline)) inline unsigned greater_mask8(const LeafBoxes::La
 
 /// The lanes of leaf boxes q whose boxes overlap box p (same frame), as bits.
 __attribute__((always_inline)) inline unsigned overlapping_lanes(const ElemBox& p, const LeafBoxes& q) {
+#if defined(__SSE__)
+  // On SSE registers, unrolled (as the wide nodes' test below).
+  static_assert(LeafBoxes::kLanes == 8);
+  const __m128 sign = _mm_set1_ps(-0.0f);
+  __m128 lo = _mm_setzero_ps(), hi = _mm_setzero_ps();  // apart, lanes 0-3 and 4-7
+  CF_UNROLL3
+  for (int i = 0; i < 3; ++i) {
+    const __m128 c = _mm_set1_ps(p.c[i]), h = _mm_set1_ps(p.h[i]);
+    const float* qc = q.c[i].data();
+    const float* qh = q.h[i].data();
+    lo = _mm_or_ps(lo, _mm_cmpgt_ps(_mm_andnot_ps(sign, _mm_sub_ps(_mm_load_ps(qc), c)), _mm_add_ps(_mm_load_ps(qh), h)));
+    hi = _mm_or_ps(hi, _mm_cmpgt_ps(_mm_andnot_ps(sign, _mm_sub_ps(_mm_load_ps(qc + 4), c)), _mm_add_ps(_mm_load_ps(qh + 4), h)));
+  }
+  return ~static_cast<unsigned>(_mm_movemask_ps(lo) | (_mm_movemask_ps(hi) << 4)) & 0xFFu;
+#else
   unsigned apart = 0;
   for (int i = 0; i < 3; ++i) apart |= greater_mask8((q.c[i] - p.c[i]).abs(), q.h[i] + p.h[i]);
   return ~apart & ((1u << LeafBoxes::kLanes) - 1);
+#endif
 }
 
 /// Are two element boxes (in one frame) disjoint?

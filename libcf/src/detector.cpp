@@ -216,7 +216,7 @@ struct ContactDetector::Impl {
   float grow = 0;    // mm, added to A's posed boxes in this call
   double r_a = 0;    // mm, A's furthest vertex from bvh_a's origin
   std::array<ElementKind, ContactSet::kCapacity> kind_a{}, kind_b{};
-  std::array<bool, ContactSet::kCapacity> may_dominate{};
+  std::array<int, ContactSet::kCapacity> dominators{};  // contacts that fit well enough to dominate
 
   Impl(const Polyhedron& ma, const Polyhedron& mb, const DetectionParams& p)
       : a(ma), b(mb), prm(p), flat_a(ma), flat_b(mb), wings_a(wings_of(ma)), wings_b(wings_of(mb)) {
@@ -817,18 +817,24 @@ struct ContactDetector::Impl {
     // until every flag is set, so the shapes below are the emitted ones.
     // Per contact, its kinds and whether it fits well enough to dominate; a dominator's
     // elements hold this one's, so they are of the same or a higher dimension.
+    // Two distinct PCs of the same kinds never hold one another: a dominator is of a higher
+    // dimension on one side at least.
+    int num_dominators = 0;
     for (int j = 0; j < n; ++j) {
       const ContactPc& cj = cs[j];
       kind_a[static_cast<std::size_t>(j)] = a_kind(cj.pc.type);
       kind_b[static_cast<std::size_t>(j)] = b_kind(cj.pc.type);
-      may_dominate[static_cast<std::size_t>(j)] = cj.misfit - std::abs(cj.distance) / eps <= prm.dominance_fit;
+      if (cj.pc.type != PcType::kVF && cj.pc.type != PcType::kFV &&
+          cj.misfit - std::abs(cj.distance) / eps <= prm.dominance_fit)
+        dominators[static_cast<std::size_t>(num_dominators++)] = j;
     }
-    for (int i = 0; i < n; ++i) {
+    for (int i = 0; i < n && num_dominators > 0; ++i) {
       ContactPc& ci = cs[i];
       const ElementKind ai = kind_a[static_cast<std::size_t>(i)], bi = kind_b[static_cast<std::size_t>(i)];
-      for (int j = 0; j < n && !ci.dominated; ++j) {
+      for (int k = 0; k < num_dominators && !ci.dominated; ++k) {
+        const int j = dominators[static_cast<std::size_t>(k)];
         const auto uj = static_cast<std::size_t>(j);
-        if (j == i || !may_dominate[uj] || kind_a[uj] < ai || kind_b[uj] < bi) continue;
+        if (j == i || kind_a[uj] < ai || kind_b[uj] < bi) continue;
         const ContactPc& cj = cs[j];
         if (within(a, ai, ci.pc.a, kind_a[uj], cj.pc.a) && within(b, bi, ci.pc.b, kind_b[uj], cj.pc.b))
           ci.dominated = true;
