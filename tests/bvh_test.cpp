@@ -44,7 +44,8 @@ void points(const cf::Polyhedron& m, const cf::detail::BvhElement& e, std::vecto
   }
 }
 
-// Separated on one of the six face axes, or by the axis-aligned boxes, in double precision.
+// Separated by the axis-aligned boxes, or on either oriented box's thinnest axis, in double
+// precision.
 bool apart_reference(const cf::detail::NodeBox& p, const cf::detail::NodeBox& q) {
   if (((head(p.c) - head(q.c)).cwiseAbs() - head(p.h) - head(q.h)).maxCoeff() > 0) return true;
   const Vec3 d = head(p.oc) - head(q.oc);
@@ -53,9 +54,7 @@ bool apart_reference(const cf::detail::NodeBox& p, const cf::detail::NodeBox& q)
     for (int k = 0; k < 3; ++k) r += std::abs(u.dot(head(p.ax[k]))) * p.oh[k] + std::abs(u.dot(head(q.ax[k]))) * q.oh[k];
     return std::abs(u.dot(d)) > r;
   };
-  for (int k = 0; k < 3; ++k)
-    if (apart_on(head(p.ax[k])) || apart_on(head(q.ax[k]))) return true;
-  return false;
+  return apart_on(head(p.ax[0])) || apart_on(head(q.ax[0]));
 }
 
 // A random box: oriented box at centre c with random axes and half extents, the axis-aligned
