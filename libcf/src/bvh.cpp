@@ -76,7 +76,7 @@ void obb_of(const std::vector<Vec3>& pts, double inflate, const Vec3& origin, No
 // A face owns the edges it has on its left and the vertices for which it is the first
 // incident face: each element is owned once, and lies on its owner's boundary, so a face's
 // group has the face's own box. Groups of more than kMaxGroup elements are cut into pieces.
-constexpr std::int32_t kMaxGroup = 8;
+constexpr std::int32_t kMaxGroup = LeafBoxes::kLanes;
 
 Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin, Leaves leaves)
     : origin_(origin) {

@@ -78,10 +78,9 @@ struct alignas(16) ElemBox {
 /// A face-group leaf's element boxes on SIMD lanes, lane j for its j-th element, so that
 /// one element of the other model is tested against all of them at once. Unused lanes
 /// never overlap anything.
-struct alignas(32) LeafBoxes {
-  static constexpr int kLanes = 8;
-  using Lanes = Eigen::Array<float, kLanes, 1>;
-  Lanes c[3], h[3];  // mm: centres (relative to the tree's origin) and half extents, per axis
+struct alignas(16) LeafBoxes {
+  static constexpr int kLanes = 4;
+  Eigen::Array4f c[3], h[3];  // mm: centres (relative to the tree's origin) and half extents, per axis
   /// Per kind of an element of the other model (posed as A): the lanes whose elements it
   /// can form a PC type with (bit j for lane j).
   std::uint8_t touchable_by[3] = {0, 0, 0};
@@ -103,38 +102,21 @@ __attribute__((always_inline)) inline bool any_greater(const Eigen::Array4f& x, 
   return greater_mask4(x, y) != 0;
 }
 
-/// Bit j set where lane j of x is greater than y's.
-__attribute__((always_inline)) inline unsigned greater_mask8(const LeafBoxes::Lanes& x, const LeafBoxes::Lanes& y) {
-#if defined(CF_SSE)
-  return static_cast<unsigned>(_mm_movemask_ps(_mm_cmpgt_ps(_mm_load_ps(x.data()), _mm_load_ps(y.data()))) |
-                               (_mm_movemask_ps(_mm_cmpgt_ps(_mm_load_ps(x.data() + 4), _mm_load_ps(y.data() + 4))) << 4));
-#else
-  unsigned m = 0;
-  for (int j = 0; j < LeafBoxes::kLanes; ++j) m |= (x[j] > y[j] ? 1u : 0u) << j;
-  return m;
-#endif
-}
-
 /// The lanes of leaf boxes q whose boxes overlap box p (same frame), as bits.
 __attribute__((always_inline)) inline unsigned overlapping_lanes(const ElemBox& p, const LeafBoxes& q) {
 #if defined(CF_SSE)
   // On SSE registers, unrolled (as the wide nodes' test below).
-  static_assert(LeafBoxes::kLanes == 8);
   const __m128 sign = _mm_set1_ps(-0.0f);
-  __m128 lo = _mm_setzero_ps(), hi = _mm_setzero_ps();  // apart, lanes 0-3 and 4-7
+  __m128 apart = _mm_setzero_ps();
   CF_UNROLL3
-  for (int i = 0; i < 3; ++i) {
-    const __m128 c = _mm_set1_ps(p.c[i]), h = _mm_set1_ps(p.h[i]);
-    const float* qc = q.c[i].data();
-    const float* qh = q.h[i].data();
-    lo = _mm_or_ps(lo, _mm_cmpgt_ps(_mm_andnot_ps(sign, _mm_sub_ps(_mm_load_ps(qc), c)), _mm_add_ps(_mm_load_ps(qh), h)));
-    hi = _mm_or_ps(hi, _mm_cmpgt_ps(_mm_andnot_ps(sign, _mm_sub_ps(_mm_load_ps(qc + 4), c)), _mm_add_ps(_mm_load_ps(qh + 4), h)));
-  }
-  return ~static_cast<unsigned>(_mm_movemask_ps(lo) | (_mm_movemask_ps(hi) << 4)) & 0xFFu;
+  for (int i = 0; i < 3; ++i)
+    apart = _mm_or_ps(apart, _mm_cmpgt_ps(_mm_andnot_ps(sign, _mm_sub_ps(_mm_load_ps(q.c[i].data()), _mm_set1_ps(p.c[i]))),
+                                          _mm_add_ps(_mm_load_ps(q.h[i].data()), _mm_set1_ps(p.h[i]))));
+  return ~static_cast<unsigned>(_mm_movemask_ps(apart)) & 0xFu;
 #else
   unsigned apart = 0;
-  for (int i = 0; i < 3; ++i) apart |= greater_mask8((q.c[i] - p.c[i]).abs(), q.h[i] + p.h[i]);
-  return ~apart & ((1u << LeafBoxes::kLanes) - 1);
+  for (int i = 0; i < 3; ++i) apart |= greater_mask4((q.c[i] - p.c[i]).abs(), q.h[i] + p.h[i]);
+  return ~apart & 0xFu;
 #endif
 }
 
