@@ -188,6 +188,9 @@ struct ContactDetector::Impl {
   Eigen::Matrix3f Rf = Eigen::Matrix3f::Identity(), absRf = Eigen::Matrix3f::Identity();
   Eigen::Array4f Rcol[3], absRcol[3];  // R_BA's columns and their absolute values, lane 3 zero
   Eigen::Array4f a_origin;              // mm, bvh_a's origin posed, B's frame
+  // The same on all four lanes (for the wide nodes' posing): R_BA(i, k), |R_BA(i, k)|, and
+  // a_origin[i].
+  Eigen::Array4f Rb[3][3], absRb[3][3], ob[3];
   // Scratch (sized once).
   std::vector<detail::NodePair> stack;
   std::vector<Vec2> q_pts;
@@ -374,12 +377,16 @@ struct ContactDetector::Impl {
     P.stamp = stamp;
     const detail::Box4& N = bvh_a.wide()[static_cast<std::size_t>(w)].box;
     detail::Box4& Q = P.box;
+    // Unrolled: at -O2 GCC keeps these loops of 3 and spills the temporaries.
+    CF_UNROLL3
     for (int k = 0; k < 3; ++k)
-      for (int i = 0; i < 3; ++i) Q.ax[k][i] = N.ax[k][0] * Rf(i, 0) + N.ax[k][1] * Rf(i, 1) + N.ax[k][2] * Rf(i, 2);
+      CF_UNROLL3
+      for (int i = 0; i < 3; ++i) Q.ax[k][i] = N.ax[k][0] * Rb[i][0] + N.ax[k][1] * Rb[i][1] + N.ax[k][2] * Rb[i][2];
+    CF_UNROLL3
     for (int i = 0; i < 3; ++i) {
-      const V c = N.c[0] * Rf(i, 0) + N.c[1] * Rf(i, 1) + N.c[2] * Rf(i, 2) + a_origin[i];
-      const V oc = N.oc[0] * Rf(i, 0) + N.oc[1] * Rf(i, 1) + N.oc[2] * Rf(i, 2) + a_origin[i];
-      const V h = N.h[0] * absRf(i, 0) + N.h[1] * absRf(i, 1) + N.h[2] * absRf(i, 2);
+      const V c = N.c[0] * Rb[i][0] + N.c[1] * Rb[i][1] + N.c[2] * Rb[i][2] + ob[i];
+      const V oc = N.oc[0] * Rb[i][0] + N.oc[1] * Rb[i][1] + N.oc[2] * Rb[i][2] + ob[i];
+      const V h = N.h[0] * absRb[i][0] + N.h[1] * absRb[i][1] + N.h[2] * absRb[i][2];
       const V oh = Q.ax[0][i].abs() * N.oh[0] + Q.ax[1][i].abs() * N.oh[1] + Q.ax[2][i].abs() * N.oh[2];
       const V lo = (c - h).max(oc - oh), hi = (c + h).min(oc + oh);
       Q.c[i] = 0.5f * (lo + hi);
@@ -893,6 +900,13 @@ struct ContactDetector::Impl {
       absRcol[k] << absRf.col(k), 0.0f;
     }
     a_origin << pose.apply(bvh_a.origin()).cast<float>(), 0.0f;
+    for (int i = 0; i < 3 && big; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        Rb[i][k].setConstant(Rf(i, k));
+        absRb[i][k].setConstant(absRf(i, k));
+      }
+      ob[i].setConstant(a_origin[i]);
+    }
     reused = false;
     grow = 0;
     recording = false;
