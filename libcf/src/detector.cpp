@@ -491,14 +491,19 @@ struct ContactDetector::Impl {
     const Vec2 a2(F.u.dot(s0), F.v.dot(s0)), b2(F.u.dot(s1), F.v.dot(s1));
     double len = 0, moment = 0, dmin = std::numeric_limits<double>::infinity();
     double first = 1, last = 0;
-    detail::clip_segment(a2, b2, flat.poly(f), geo_tol, detail::OnBoundary::kInclude,
-                         params.data(), [&](double t0, double t1) {
-                           len += t1 - t0;
-                           moment += 0.5 * (t1 * t1 - t0 * t0);
-                           dmin = std::min({dmin, h0 + t0 * (h1 - h0), h0 + t1 * (h1 - h0)});
-                           first = std::min(first, t0);
-                           last = std::max(last, t1);
-                         });
+    const auto piece = [&](double t0, double t1) {
+      len += t1 - t0;
+      moment += 0.5 * (t1 * t1 - t0 * t0);
+      dmin = std::min({dmin, h0 + t0 * (h1 - h0), h0 + t1 * (h1 - h0)});
+      first = std::min(first, t0);
+      last = std::max(last, t1);
+    };
+    if (flat.convex[static_cast<std::size_t>(f)]) {
+      double t0, t1;
+      if (detail::clip_segment_convex(a2, b2, flat.poly(f), geo_tol, &t0, &t1)) piece(t0, t1);
+    } else {
+      detail::clip_segment(a2, b2, flat.poly(f), geo_tol, detail::OnBoundary::kInclude, params.data(), piece);
+    }
     if (len > 1e-12) {
       *t_c = moment / len;
       *d = dmin;

@@ -181,6 +181,30 @@ Overlap2 overlap(const Poly2& P, const Poly2& Q, double tol, double* params, Vis
   return out;
 }
 
+/// clip_segment with OnBoundary::kInclude for a convex P (is_convex: one loop, counter-
+/// clockwise): the piece [*t0, *t1] of segment a->b within tol of P, cut by each edge's
+/// line moved out by tol (Cyrus-Beck). False when it is no longer than the general
+/// routine's shortest piece (1e-12).
+inline bool clip_segment_convex(const Vec2& a, const Vec2& b, const Poly2& P, double tol, double* t0, double* t1) {
+  const Vec2 r = b - a;
+  double lo = 0, hi = 1;
+  const int lb = P.lb[0], le = P.lb[1];
+  for (int i = lb; i < le; ++i) {
+    const Vec2& c = P.pts[i];
+    const Vec2 s = P.pts[i + 1 == le ? lb : i + 1] - c;
+    // Inside the moved line: f0 + t * fr >= 0 at a + t r.
+    const double f0 = cross2(s, a - c) + tol * s.norm();
+    const double fr = cross2(s, r);
+    if (fr > 0) lo = std::max(lo, -f0 / fr);
+    else if (fr < 0) hi = std::min(hi, -f0 / fr);
+    else if (f0 < 0) return false;
+    if (hi - lo <= 1e-12) return false;
+  }
+  *t0 = lo;
+  *t1 = hi;
+  return true;
+}
+
 /// Is P one loop without reflex corners (collinear corners allowed, within rounding)?
 inline bool is_convex(const Poly2& P) {
   if (P.num_loops != 1) return false;
