@@ -534,6 +534,48 @@ TEST_CASE("the BVH finds what all pairs find on faceted spheres", "[detector]") 
   CHECK(contacts > 0);
 }
 
+TEST_CASE("the BVH finds what all pairs find for a big model against a small one, either way", "[detector]") {
+  // A 600-face sphere (face-group leaves, wide nodes) against the paper's L-block and cube
+  // (one element per leaf): the culling mixes both kinds of tree.
+  const double eps = GENERATE(1.0, 0.1);
+  const int which = GENERATE(0, 1, 2);
+  const cf::Polyhedron sphere = tm::faceted_sphere(30, 20, 30, Vec3(5, -3, 2));
+  const cf::Polyhedron a = which == 0 ? sphere : which == 1 ? tm::cube() : tm::l_block();
+  const cf::Polyhedron b = which == 0 ? tm::l_block() : sphere;
+  cf::DetectionParams prm;
+  prm.epsilon = prm.max_penetration = eps;
+  cf::DetectionParams all = prm;
+  all.use_bvh = false;
+  cf::ContactDetector fast(a, b, prm), slow(a, b, all);
+  cf::ContactSet x, y;
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> U(-1, 1);
+  int contacts = 0;
+  for (int k = 0; k < 24; ++k) {
+    // A's lowest point along -dir on B's highest along dir, with a gap across the band: A
+    // lies beyond B's supporting plane, so it touches B there and nowhere deeper.
+    const Vec3 dir = Vec3(U(rng), U(rng), U(rng)).normalized();
+    const Eigen::Matrix3d R = rot(3 * U(rng), Vec3(U(rng), U(rng), U(rng)));
+    Vec3 top = b.vertex(cf::VertexId(0)).p, low = R * a.vertex(cf::VertexId(0)).p;
+    for (const cf::Vertex& v : b.vertices())
+      if (dir.dot(v.p) > dir.dot(top)) top = v.p;
+    for (const cf::Vertex& v : a.vertices())
+      if (dir.dot(R * v.p) < dir.dot(low)) low = R * v.p;
+    const cf::Pose p = pose(R, top + 1.1 * eps * U(rng) * dir - low);
+    fast.detect(p, x);
+    slow.detect(p, y);
+    INFO("epsilon " << eps << ", pair " << which << ", pose " << k);
+    REQUIRE(x.size() == y.size());
+    for (int i = 0; i < x.size(); ++i) {
+      CHECK(x[i].pc == y[i].pc);
+      CHECK(x[i].distance == y[i].distance);
+    }
+    contacts += x.size();
+    CHECK(fast.last_pairs_tested() * 10 < slow.last_pairs_tested());
+  }
+  CHECK(contacts > 24);
+}
+
 TEST_CASE("pairs kept between nearby poses give what the hierarchy gives", "[detector]") {
   // A 600-face sphere rolling and sliding over a 672-face one in small steps (about 0.06 mm
   // and 0.5 mrad per tick, a hand's speed at a servo rate, plus the gap's change), with
