@@ -700,7 +700,7 @@ struct ContactDetector::Impl {
   }
   // in_band with room for the rounding of a differently ordered computation.
   bool near_band(double d) const { return d <= eps + geo_tol && d >= -depth - geo_tol; }
-  bool may_touch(ElementKind ka, int ia, ElementKind kb, int ib) {
+  __attribute__((always_inline)) bool may_touch(ElementKind ka, int ia, ElementKind kb, int ib) {
     using K = ElementKind;
     if (ka == K::kVertex) {  // v-f
       const Plane& B = plane_b[static_cast<std::size_t>(ib)];
