@@ -576,6 +576,60 @@ TEST_CASE("the BVH finds what all pairs find for a big model against a small one
   CHECK(contacts > 24);
 }
 
+// A faceted torus about the z axis (major radius R, minor r): planar trapezoids, outward;
+// its inner half is saddle-shaped, with reflex edges.
+cf::Polyhedron faceted_torus(double R, double r, int around, int across) {
+  std::vector<Vec3> v;
+  for (int i = 0; i < around; ++i)
+    for (int j = 0; j < across; ++j) {
+      const double th = 2 * M_PI * i / around, ph = 2 * M_PI * j / across;
+      v.emplace_back((R + r * std::cos(ph)) * std::cos(th), (R + r * std::cos(ph)) * std::sin(th), r * std::sin(ph));
+    }
+  const auto at = [&](int i, int j) { return (i % around) * across + (j % across); };
+  std::vector<std::vector<int>> f;
+  for (int i = 0; i < around; ++i)
+    for (int j = 0; j < across; ++j) f.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+  return tm::from_loops("torus", v, f);
+}
+
+TEST_CASE("the BVH finds what all pairs find in a torus's hole", "[detector]") {
+  // A 384-face sphere in the hole of a 384-face torus, touching its inner, saddle-shaped
+  // side (reflex edges, non-convex surroundings) on one side and then another.
+  const double eps = GENERATE(1.0, 0.1);
+  const cf::Polyhedron a = tm::faceted_sphere(18, 16, 24), b = faceted_torus(30, 10, 24, 16);
+  cf::DetectionParams prm;
+  prm.epsilon = prm.max_penetration = eps;
+  cf::DetectionParams all = prm;
+  all.use_bvh = false;
+  cf::ContactDetector fast(a, b, prm), slow(a, b, all);
+  cf::ContactSet x, y;
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> U(-1, 1);
+  int contacts = 0, reflex = 0;
+  for (int k = 0; k < 8; ++k) {
+    // The hole's radius is 20 (less the facets' sagitta, ~0.2 mm): A's centre moved 1.6 to
+    // 2 mm towards the ring brings that side into the band.
+    const double az = M_PI * U(rng);
+    const Vec3 off = (1.8 + 0.2 * U(rng)) * Vec3(std::cos(az), std::sin(az), 0) + Vec3(0, 0, 2 * U(rng));
+    const cf::Pose p = pose(rot(3 * U(rng), Vec3(U(rng), U(rng), U(rng))), off);
+    fast.detect(p, x);
+    slow.detect(p, y);
+    INFO("epsilon " << eps << ", pose " << k);
+    // Within ContactSet's capacity: past it, which contacts are kept depends on the order
+    // they are found in.
+    REQUIRE(!y.overflow());
+    REQUIRE(x.size() == y.size());
+    for (int i = 0; i < x.size(); ++i) {
+      CHECK(x[i].pc == y[i].pc);
+      CHECK(x[i].distance == y[i].distance);
+      if (x[i].pc.type == PcType::kFE && !b.edges()[static_cast<std::size_t>(x[i].pc.b)].convex) ++reflex;
+    }
+    contacts += x.size();
+  }
+  CHECK(contacts > 8);
+  CHECK(reflex == 0);  // a face never touches a reflex edge as f-e
+}
+
 TEST_CASE("pairs kept between nearby poses give what the hierarchy gives", "[detector]") {
   // A 600-face sphere rolling and sliding over a 672-face one in small steps (about 0.06 mm
   // and 0.5 mrad per tick, a hand's speed at a servo rate, plus the gap's change), with
