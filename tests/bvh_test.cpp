@@ -171,17 +171,6 @@ TEST_CASE("oriented boxes of a curved surface's patches are thin along the norma
   CHECK(thin_sum < 0.25 * aabb_sum);
 }
 
-// Lane j of a Box4 set from a NodeBox.
-void set_lane(cf::detail::Box4& b, int j, const cf::detail::NodeBox& n) {
-  for (int i = 0; i < 3; ++i) {
-    b.c[i][j] = n.c[i];
-    b.h[i][j] = n.h[i];
-    b.oc[i][j] = n.oc[i];
-    b.oh[i][j] = n.oh[i];
-    for (int k = 0; k < 3; ++k) b.ax[k][i][j] = n.ax[k][i];
-  }
-}
-
 TEST_CASE("the 4-lane box test agrees with a double-precision separating-axis test", "[bvh]") {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> off(-6, 6), grow(0, 1);
@@ -193,8 +182,8 @@ TEST_CASE("the 4-lane box test agrees with a double-precision separating-axis te
     for (int j = 0; j < 4; ++j) {
       ps[j] = random_box(rng, Vec3(off(rng), off(rng), off(rng)), grow(rng));
       qs[j] = random_box(rng, Vec3::Zero(), grow(rng));
-      set_lane(p, j, ps[j]);
-      set_lane(q, j, qs[j]);
+      p.set_lane(j, ps[j]);
+      q.set_lane(j, qs[j]);
     }
     const int s = i % 4;
     const unsigned got = cf::detail::overlapping_lanes(p, s, q), got_back = cf::detail::overlapping_lanes(q, s, p);

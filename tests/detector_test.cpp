@@ -494,6 +494,17 @@ TEST_CASE("convexity: one loop, no reflex corner", "[detector]") {
   CHECK_FALSE(cf::detail::is_convex({holed.data(), lb44, 2}));
 }
 
+namespace {
+// Culled detection against all pairs: the same PCs, in the same order, at the same distances.
+void check_same_contacts(const cf::ContactSet& x, const cf::ContactSet& y) {
+  REQUIRE(x.size() == y.size());
+  for (int i = 0; i < x.size(); ++i) {
+    CHECK(x[i].pc == y[i].pc);
+    CHECK(x[i].distance == y[i].distance);
+  }
+}
+}  // namespace
+
 TEST_CASE("the BVH finds what all pairs find on faceted spheres", "[detector]") {
   // 600 and 672 faces: enough for the culling to matter (leaves of several elements and
   // oriented boxes), small enough for all pairs. The paper's threshold and one scaled to the
@@ -523,11 +534,7 @@ TEST_CASE("the BVH finds what all pairs find on faceted spheres", "[detector]") 
     fast.detect(p, x);
     slow.detect(p, y);
     INFO("epsilon " << eps << ", far " << far << ", pose " << k);
-    REQUIRE(x.size() == y.size());
-    for (int i = 0; i < x.size(); ++i) {
-      CHECK(x[i].pc == y[i].pc);
-      CHECK(x[i].distance == y[i].distance);
-    }
+    check_same_contacts(x, y);
     contacts += x.size();
     CHECK(fast.last_pairs_tested() * 100 < slow.last_pairs_tested());
   }
@@ -565,17 +572,14 @@ TEST_CASE("the BVH finds what all pairs find for a big model against a small one
     fast.detect(p, x);
     slow.detect(p, y);
     INFO("epsilon " << eps << ", pair " << which << ", pose " << k);
-    REQUIRE(x.size() == y.size());
-    for (int i = 0; i < x.size(); ++i) {
-      CHECK(x[i].pc == y[i].pc);
-      CHECK(x[i].distance == y[i].distance);
-    }
+    check_same_contacts(x, y);
     contacts += x.size();
     CHECK(fast.last_pairs_tested() * 10 < slow.last_pairs_tested());
   }
   CHECK(contacts > 24);
 }
 
+namespace {
 // A faceted torus about the z axis (major radius R, minor r): planar trapezoids, outward;
 // its inner half is saddle-shaped, with reflex edges.
 cf::Polyhedron faceted_torus(double R, double r, int around, int across) {
@@ -591,6 +595,8 @@ cf::Polyhedron faceted_torus(double R, double r, int around, int across) {
     for (int j = 0; j < across; ++j) f.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
   return tm::from_loops("torus", v, f);
 }
+
+}  // namespace
 
 TEST_CASE("the BVH finds what all pairs find in a torus's hole", "[detector]") {
   // A 384-face sphere in the hole of a 384-face torus, touching its inner, saddle-shaped
@@ -618,12 +624,9 @@ TEST_CASE("the BVH finds what all pairs find in a torus's hole", "[detector]") {
     // Within ContactSet's capacity: past it, which contacts are kept depends on the order
     // they are found in.
     REQUIRE(!y.overflow());
-    REQUIRE(x.size() == y.size());
-    for (int i = 0; i < x.size(); ++i) {
-      CHECK(x[i].pc == y[i].pc);
-      CHECK(x[i].distance == y[i].distance);
-      if (x[i].pc.type == PcType::kFE && !b.edges()[static_cast<std::size_t>(x[i].pc.b)].convex) ++reflex;
-    }
+    check_same_contacts(x, y);
+    for (const cf::ContactPc& c : x)
+      if (c.pc.type == PcType::kFE && !b.edges()[static_cast<std::size_t>(c.pc.b)].convex) ++reflex;
     contacts += x.size();
   }
   CHECK(contacts > 8);

@@ -257,31 +257,12 @@ std::int32_t Bvh::add_wide(const std::int32_t* members, int count) {
   wide_.emplace_back();
   {
     WideNode& W = wide_.back();
-    Box4& b = W.box;
-    for (int i = 0; i < 3; ++i) {
-      b.c[i].setZero();
-      b.h[i].setZero();
-      b.oc[i].setZero();
-      b.oh[i].setZero();
-      for (int k = 0; k < 3; ++k) b.ax[i][k].setZero();
-    }
-    for (int j = 0; j < 4; ++j) {
-      W.node[j] = -1;
-      W.wide[j] = -1;
-    }
-    for (int k = 0; k < 8; ++k) W.lanes_holding[k] = W.lanes_touching[k] = 0;
+    W.box.set_zero();
     for (int j = 0; j < count; ++j) {
       const std::int32_t n = members[j];
       const BvhNode& N = nodes_[static_cast<std::size_t>(n)];
-      const NodeBox& B = boxes_[static_cast<std::size_t>(n)];
       W.node[j] = n;
-      for (int i = 0; i < 3; ++i) {
-        b.c[i][j] = B.c[i];
-        b.h[i][j] = B.h[i];
-        b.oc[i][j] = B.oc[i];
-        b.oh[i][j] = B.oh[i];
-        for (int k = 0; k < 3; ++k) b.ax[k][i][j] = B.ax[k][i];
-      }
+      W.box.set_lane(j, boxes_[static_cast<std::size_t>(n)]);
       for (unsigned mask = 1; mask < 8; ++mask) {
         if (N.kinds & mask) W.lanes_holding[mask] = static_cast<std::uint8_t>(W.lanes_holding[mask] | (1u << j));
         if (N.touchable & mask) W.lanes_touching[mask] = static_cast<std::uint8_t>(W.lanes_touching[mask] | (1u << j));

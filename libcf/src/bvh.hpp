@@ -131,18 +131,39 @@ struct alignas(16) Box4 {
   Eigen::Array4f c[3], h[3];    // mm: axis-aligned box, centre and half extents, per axis
   Eigen::Array4f oc[3], oh[3];  // mm: oriented box, centre per axis, half extent along ax[k]
   Eigen::Array4f ax[3][3];      // ax[k][i]: component i of the oriented box's axis k
+
+  /// Every lane zero.
+  void set_zero() {
+    for (int i = 0; i < 3; ++i) {
+      c[i].setZero();
+      h[i].setZero();
+      oc[i].setZero();
+      oh[i].setZero();
+      for (int k = 0; k < 3; ++k) ax[k][i].setZero();
+    }
+  }
+  /// Lane j set to node box n.
+  void set_lane(int j, const NodeBox& n) {
+    for (int i = 0; i < 3; ++i) {
+      c[i][j] = n.c[i];
+      h[i][j] = n.h[i];
+      oc[i][j] = n.oc[i];
+      oh[i][j] = n.oh[i];
+      for (int k = 0; k < 3; ++k) ax[k][i][j] = n.ax[k][i];
+    }
+  }
 };
 
 /// A node of the 4-wide tree: up to four nodes of the binary tree (children or
 /// grandchildren of one node), tested at once.
 struct WideNode {
   Box4 box;                       // lane j: binary node node[j]'s boxes
-  std::int32_t node[4];           // binary node per lane
-  std::int32_t wide[4];           // its wide node when inner; -1 for a leaf or an unused lane
+  std::int32_t node[4] = {-1, -1, -1, -1};  // binary node per lane; -1 for an unused lane
+  std::int32_t wide[4] = {-1, -1, -1, -1};  // its wide node when inner; -1 for a leaf or an unused lane
   /// By a mask of element kinds (kind_bit bits): the lanes holding some of those kinds, and
   /// the lanes holding elements that can touch some of them (empty for unused lanes).
-  std::uint8_t lanes_holding[8];
-  std::uint8_t lanes_touching[8];
+  std::uint8_t lanes_holding[8] = {};
+  std::uint8_t lanes_touching[8] = {};
 };
 
 /// The lanes of q whose boxes overlap lane s of p (same frame), as bits: the axis-aligned

@@ -187,7 +187,7 @@ struct ContactDetector::Impl {
   std::vector<Plane> plane_b, plane_a;
   std::vector<Seg> seg_b, seg_a;
   Eigen::Matrix3f Rf = Eigen::Matrix3f::Identity(), absRf = Eigen::Matrix3f::Identity();
-  Eigen::Array4f Rcol[3], absRcol[3];  // R_BA's columns and their absolute values, lane 3 zero
+  Eigen::Array4f Rcol[3];  // R_BA's columns, lane 3 zero (A's vertices' posing)
   Eigen::Array4f a_origin;              // mm, bvh_a's origin posed, B's frame
   // The same on all four lanes (for the wide nodes' posing): R_BA(i, k), |R_BA(i, k)|, and
   // a_origin[i].
@@ -901,10 +901,7 @@ struct ContactDetector::Impl {
     absR = pose.R_BA.cwiseAbs();
     Rf = pose.R_BA.cast<float>();
     absRf = absR.cast<float>();
-    for (int k = 0; k < 3; ++k) {
-      Rcol[k] << Rf.col(k), 0.0f;
-      absRcol[k] << absRf.col(k), 0.0f;
-    }
+    for (int k = 0; k < 3; ++k) Rcol[k] << Rf.col(k), 0.0f;
     a_origin << pose.apply(bvh_a.origin()).cast<float>(), 0.0f;
     for (int i = 0; i < 3 && big; ++i) {
       for (int k = 0; k < 3; ++k) {
