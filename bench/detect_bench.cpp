@@ -301,6 +301,7 @@ void BM_Spheres2000Fine_DetectOnly(benchmark::State& s) { run_detect(s, spheres_
 void BM_Spheres2000Fine_FclDistance(benchmark::State& s) { run_fcl(s, spheres_fine()); }
 void BM_Spheres2000Servo_DetectIdentify(benchmark::State& s) { run_cf(s, spheres_servo()); }
 void BM_Spheres2000Servo_DetectIdentifyCold(benchmark::State& s) { run_cf(s, cold(spheres_servo())); }
+void BM_Spheres2000Servo_DetectOnly(benchmark::State& s) { run_detect(s, spheres_servo()); }
 void BM_Spheres2000Servo_FclDistance(benchmark::State& s) { run_fcl(s, spheres_servo()); }
 void BM_Spheres2000FineServo_DetectIdentify(benchmark::State& s) { run_cf(s, spheres_fine_servo()); }
 void BM_Spheres2000FineServo_DetectIdentifyCold(benchmark::State& s) { run_cf(s, cold(spheres_fine_servo())); }
@@ -320,6 +321,7 @@ BENCHMARK(BM_Spheres2000Fine_DetectOnly)->MinTime(2.0);
 BENCHMARK(BM_Spheres2000Fine_FclDistance)->MinTime(2.0);
 BENCHMARK(BM_Spheres2000Servo_DetectIdentify)->MinTime(2.0);
 BENCHMARK(BM_Spheres2000Servo_DetectIdentifyCold)->MinTime(2.0);
+BENCHMARK(BM_Spheres2000Servo_DetectOnly)->MinTime(2.0);
 BENCHMARK(BM_Spheres2000Servo_FclDistance)->MinTime(2.0);
 BENCHMARK(BM_Spheres2000FineServo_DetectIdentify)->MinTime(2.0);
 BENCHMARK(BM_Spheres2000FineServo_DetectIdentifyCold)->MinTime(2.0);

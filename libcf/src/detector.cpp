@@ -210,17 +210,46 @@ struct ContactDetector::Impl {
   // Temporal coherence (big models, DetectionParams::reuse_margin): the element pairs whose
   // boxes overlapped with A's boxes grown by the margin at kept_pose. Every pair that can
   // touch at a pose where no point of A is further than the margin from where it was at
-  // kept_pose is among them, so such a pose tests only those.
+  // kept_pose is among them, so such a pose tests only those. A kept pair turned away
+  // carries a certificate (Cert) from the pose it was turned away at (one of the epoch's
+  // poses): while A has moved or turned less since, the pair is skipped.
   static constexpr std::size_t kMaxKept = 1 << 14;
-  std::vector<detail::NodePair> kept;  // (A position, B position) in the BVHs' element lists
+  static constexpr int kEpochPoses = 64;  // the poses since kept_pose, kept_pose first
+  // A pair turned away stays turned away while A's points move less than `lin` (the
+  // motion bound, motion_bound) or A turns less than `rot` (|R1 - R0|_F, which bounds how
+  // far any unit vector of A, or of B seen from A, turns). <= 0: no certificate. Each
+  // keeps geo_tol in hand for rounding.
+  struct Cert {
+    double lin = 0;  // mm
+    double rot = 0;  // Frobenius norm of the change of R_BA
+  };
+  struct KeptPair {
+    std::int32_t a, b;  // positions in the BVHs' element lists
+    float lin, rot;     // the pair's Cert, from epoch_pose[slot], rounded down
+    std::int32_t slot;
+  };
+  Cert cert;  // set by the exact tests when they turn a pair away for its orientation
+  std::vector<KeptPair> kept;
   std::size_t num_kept = 0;
   bool kept_valid = false, recording = false, kept_overflow = false, reused = false;
   Pose kept_pose, last_pose;
+  std::array<Pose, kEpochPoses> epoch_pose;
+  // From epoch_pose[s] to the current pose: the motion bound (mm) and |R - R_s|_F.
+  std::array<double, kEpochPoses> moved_since{}, turned_since{};
+  int epoch_len = 0;
+  Vec3 origin_posed = Vec3::Zero();  // mm, bvh_a's origin at the current pose, B's frame
+  double float_slack = 0;            // mm, the float rounding allowance of the boxes
   bool have_last = false;
   float grow = 0;    // mm, added to A's posed boxes in this call
   double r_a = 0;    // mm, A's furthest vertex from bvh_a's origin
-  std::array<ElementKind, ContactSet::kCapacity> kind_a{}, kind_b{};
-  std::array<int, ContactSet::kCapacity> dominators{};  // contacts that fit well enough to dominate
+  // Per type of PC that can dominate (f-f, e-f, f-e), the contacts of that type that fit
+  // well enough to.
+  std::array<std::array<int, ContactSet::kCapacity>, 3> dominators{};
+  // sort_contacts' scratch. Its keys hold element indices in 24 bits.
+  static_assert(ContactSet::kCapacity <= 256, "a contact's position is 8 bits of its sort key");
+  bool small_indices = false;
+  std::array<std::uint64_t, ContactSet::kCapacity> sort_keys{};
+  std::array<ContactPc, ContactSet::kCapacity> sort_buf{};
 
   Impl(const Polyhedron& ma, const Polyhedron& mb, const DetectionParams& p)
       : a(ma), b(mb), prm(p), flat_a(ma), flat_b(mb), wings_a(wings_of(ma)), wings_b(wings_of(mb)) {
@@ -250,7 +279,7 @@ struct ContactDetector::Impl {
     // overlap test's few float operations on coordinates of this scale.
     double reach = ma.size() + mb.size();
     for (const Vertex& v : mb.vertices()) reach = std::max(reach, v.p.cwiseAbs().maxCoeff() + ma.size());
-    const double float_slack = 1e-5 * std::max(reach, 1.0);
+    float_slack = 1e-5 * std::max(reach, 1.0);
     // B's boxes grow by the deepest band and the in-plane allowance, so that every pair the
     // exact tests could accept has overlapping boxes.
     // A pair the tests accept is within max(eps, depth) across the plane and in_plane along
@@ -291,6 +320,9 @@ struct ContactDetector::Impl {
     for (const Edge& E : mb.edges()) seg_b.push_back({mb.vertex(E.v0).p, E.dir, E.length, 0});
     plane_a.resize(ma.num_faces());
     seg_a.resize(ma.num_edges());
+    constexpr std::size_t kKeyIndices = std::size_t{1} << 24;
+    small_indices = std::max({ma.num_vertices(), ma.num_edges(), ma.num_faces(), mb.num_vertices(),
+                              mb.num_edges(), mb.num_faces()}) < kKeyIndices;
   }
 
   // Small models: does A's BVH node `ia` (posed) overlap B's node? The axis-aligned boxes
@@ -414,6 +446,12 @@ struct ContactDetector::Impl {
   static bool wedge_above(const Vec3& n, const EdgeWings& w, const Edge& E, const std::vector<double>& sin_tol_face) {
     return n.dot(w.left) >= -sin_tol_face[E.left.index()] && n.dot(w.right) >= -sin_tol_face[E.right.index()];
   }
+  // How far the deeper wing dips below the tolerance (> 0 exactly when not wedge_above).
+  static double wedge_dip(const Vec3& n, const EdgeWings& w, const Edge& E, const std::vector<double>& sin_tol_face) {
+    return std::max(-sin_tol_face[E.left.index()] - n.dot(w.left), -sin_tol_face[E.right.index()] - n.dot(w.right));
+  }
+  // A pair turned away for good whatever the pose (a reflex edge).
+  void never() { cert.rot = std::numeric_limits<double>::infinity(); }
 
   const Vec3& world(VertexId v) {
     const std::size_t i = v.index();
@@ -448,7 +486,12 @@ struct ContactDetector::Impl {
     for (EdgeId e : a.vertex(VertexId(v)).edges) {
       const Edge& E = a.edge(e);
       const Vec3& q = world(E.v0 == VertexId(v) ? E.v1 : E.v0);
-      if (F.normal.dot(q - p) < -sin_tol_edge_a[e.index()] * E.length) return;
+      const double w = F.normal.dot(q - p), lim = -sin_tol_edge_a[e.index()] * E.length;
+      if (w < lim) {
+        // q - p, of length E.length, turns with A.
+        cert.rot = (lim - w) / E.length - geo_tol;
+        return;
+      }
     }
     const detail::Loc2 loc = detail::locate(flat_b.poly(fb), Vec2(F.u.dot(p), F.v.dot(p)));
     const double gap = (loc.inside || loc.dist <= geo_tol) ? 0.0 : loc.dist;
@@ -468,7 +511,11 @@ struct ContactDetector::Impl {
       const Edge& E = b.edge(e);
       const Vec3& o = b.vertex(E.v0 == VertexId(v) ? E.v1 : E.v0).p;
       const Vec3 wA = pose.R_BA.transpose() * (o - q);
-      if (F.normal.dot(wA) < -sin_tol_edge_b[e.index()] * E.length) return;
+      const double w = F.normal.dot(wA), lim = -sin_tol_edge_b[e.index()] * E.length;
+      if (w < lim) {
+        cert.rot = (lim - w) / E.length - geo_tol;
+        return;
+      }
     }
     const detail::Loc2 loc = detail::locate(flat_a.poly(fa), Vec2(F.u.dot(qA), F.v.dot(qA)));
     const double gap = (loc.inside || loc.dist <= geo_tol) ? 0.0 : loc.dist;
@@ -533,15 +580,18 @@ struct ContactDetector::Impl {
   // ---- e-f: edge of A on face of B ---------------------------------------------------------
   void ef(int e, int fb) {
     const Edge& E = a.edges()[static_cast<std::size_t>(e)];
-    if (!E.convex) return;
+    if (!E.convex) return never();
     const Face& F = b.faces()[static_cast<std::size_t>(fb)];
     const Vec3& p0 = world(E.v0);
     const Vec3& p1 = world(E.v1);
     const Vec3 dW = pose.R_BA * E.dir;
     const double sin_ang = std::min(1.0, std::abs(dW.dot(F.normal)));
     if (sin_ang > sin_max_tol) return;
-    if (!wedge_above(pose.R_BA.transpose() * F.normal, wings_a[static_cast<std::size_t>(e)], E, sin_tol_face_a))
+    const double dip = wedge_dip(pose.R_BA.transpose() * F.normal, wings_a[static_cast<std::size_t>(e)], E, sin_tol_face_a);
+    if (dip > 0) {
+      cert.rot = dip - geo_tol;
       return;
+    }
     double tc, d, gap, span;
     if (!line_on_face(b, flat_b, fb, p0, p1, &tc, &d, &gap, &span)) return;
     // The tilt at which the part of the edge over the face stays within epsilon (the whole
@@ -558,13 +608,17 @@ struct ContactDetector::Impl {
   // ---- f-e: face of A on edge of B ---------------------------------------------------------
   void fe(int fa, int e) {
     const Edge& E = b.edges()[static_cast<std::size_t>(e)];
-    if (!E.convex) return;
+    if (!E.convex) return never();
     const Face& F = a.faces()[static_cast<std::size_t>(fa)];
     const Mat3 Rt = pose.R_BA.transpose();
     const Vec3 dA = Rt * E.dir;
     const double sin_ang = std::min(1.0, std::abs(dA.dot(F.normal)));
     if (sin_ang > sin_max_tol) return;
-    if (!wedge_above(pose.R_BA * F.normal, wings_b[static_cast<std::size_t>(e)], E, sin_tol_face_b)) return;
+    const double dip = wedge_dip(pose.R_BA * F.normal, wings_b[static_cast<std::size_t>(e)], E, sin_tol_face_b);
+    if (dip > 0) {
+      cert.rot = dip - geo_tol;
+      return;
+    }
     const Vec3& q0 = b.vertex(E.v0).p;
     const Vec3& q1 = b.vertex(E.v1).p;
     const Vec3 q0A = pose.inverse_apply(q0), q1A = pose.inverse_apply(q1);
@@ -639,7 +693,7 @@ struct ContactDetector::Impl {
   void ee(int ea, int eb) {
     const Edge& EA = a.edges()[static_cast<std::size_t>(ea)];
     const Edge& EB = b.edges()[static_cast<std::size_t>(eb)];
-    if (!EA.convex || !EB.convex) return;
+    if (!EA.convex || !EB.convex) return never();
     const Vec3& p0 = world(EA.v0);
     const Vec3 uA = pose.R_BA * EA.dir;
     const Vec3& q0 = b.vertex(EB.v0).p;
@@ -661,14 +715,24 @@ struct ContactDetector::Impl {
     const Vec3 pA = p0 + std::clamp(s, 0.0, EA.length) * uA;
     const Vec3 pB = q0 + std::clamp(t, 0.0, EB.length) * uB;
     const Vec3 sumB = b.face(EB.left).normal + b.face(EB.right).normal;
-    const Vec3 sumA = pose.R_BA * (a.face(EA.left).normal + a.face(EA.right).normal);
-    if (n.dot(sumB - sumA) < 0) n = -n;
+    const Vec3 sA = a.face(EA.left).normal + a.face(EA.right).normal;
+    const Vec3 sumA = pose.R_BA * sA;
+    const double side = n.dot(sumB - sumA);
+    if (side < 0) n = -n;
     const double d = (pA - pB).dot(n);
     if (!in_band(d)) return;
     // The wedges of the two edges must lie on their own sides of the contact plane.
-    if (!wedge_above(pose.R_BA.transpose() * n, wings_a[static_cast<std::size_t>(ea)], EA, sin_tol_face_a) ||
-        !wedge_above(-n, wings_b[static_cast<std::size_t>(eb)], EB, sin_tol_face_b))
+    const double dip_a = wedge_dip(pose.R_BA.transpose() * n, wings_a[static_cast<std::size_t>(ea)], EA, sin_tol_face_a);
+    const double dip_b = wedge_dip(-n, wings_b[static_cast<std::size_t>(eb)], EB, sin_tol_face_b);
+    if (dip_a > 0 || dip_b > 0) {
+      // n = m / |m| (m = uA x uB, |m| = sn) turns by at most 2 |dm| / sn <= 2 rho / sn, A's
+      // view of it by rho more; `side` moves by at most rho (2 |sumB - sumA| / sn + |sA|),
+      // and n's sign holds while it does not reach 0.
+      const double turn = std::max(dip_a / (1 + 2 / sn), dip_b * sn / 2);
+      const double flip = std::abs(side) / (2 * (sumB - sumA).norm() / sn + sA.norm());
+      cert.rot = std::min(turn, flip) - geo_tol;
       return;
+    }
     emit(PcType::kEE, ea, eb, d, pA, pB, task_frame(n, uB), std::abs(d) / eps + over / eps);
   }
 
@@ -701,39 +765,96 @@ struct ContactDetector::Impl {
   }
   // in_band with room for the rounding of a differently ordered computation.
   bool near_band(double d) const { return d <= eps + geo_tol && d >= -depth - geo_tol; }
-  __attribute__((always_inline)) bool may_touch(ElementKind ka, int ia, ElementKind kb, int ib) {
+  // How far heights h0 <= h1 (or one height) lie outside near_band's band.
+  double band_gap(double lo, double hi) const { return std::max(lo - eps - geo_tol, -depth - geo_tol - hi); }
+
+  // With kCertify, a pair turned away also gets its certificate in *ct. A height over B's
+  // plane moves at most as far as A's points. A unit vector of A turns by at most
+  // |R1 - R0|_F, so a dot product's margin d is a rotational certificate d. A height over
+  // A's plane of B's point q is (R n_A).(q - o) up to a constant (o: A's origin posed), so
+  // it moves by at most the motion bound times max(1, |q - o| / r_a). Where two conditions
+  // fail, either one keeps the pair away.
+  template <bool kCertify>
+  __attribute__((always_inline)) bool may_touch(ElementKind ka, int ia, ElementKind kb, int ib, Cert* ct) {
     using K = ElementKind;
     if (ka == K::kVertex) {  // v-f
       const Plane& B = plane_b[static_cast<std::size_t>(ib)];
-      return near_band(B.n.dot(world(VertexId(ia))) - B.off);
+      const double h = B.n.dot(world(VertexId(ia))) - B.off;
+      if (near_band(h)) return true;
+      if constexpr (kCertify) ct->lin = band_gap(h, h) - geo_tol;
+      return false;
     }
     if (ka == K::kEdge) {
       const Seg& A = posed_seg_a(ia);
       if (kb == K::kFace) {  // e-f
         const Plane& B = plane_b[static_cast<std::size_t>(ib)];
-        return std::abs(A.dir.dot(B.n)) <= sin_max_tol + 1e-12 && segment_in_band(A.p0, A.dir, A.len, B.n, B.off);
+        const double tilt = std::abs(A.dir.dot(B.n)) - (sin_max_tol + 1e-12);
+        if constexpr (!kCertify) {
+          return tilt <= 0 && segment_in_band(A.p0, A.dir, A.len, B.n, B.off);
+        } else {
+          const double h0 = B.n.dot(A.p0) - B.off, h1 = h0 + A.len * B.n.dot(A.dir);
+          const double gap = band_gap(std::min(h0, h1), std::max(h0, h1));
+          if (tilt <= 0 && gap <= 0) return true;
+          ct->lin = gap - geo_tol;
+          ct->rot = tilt - geo_tol;
+          return false;
+        }
       }
       // e-e: not near-parallel, and the lines within the band of each other.
       const Seg& B = seg_b[static_cast<std::size_t>(ib)];
       const Vec3 n = A.dir.cross(B.dir);
       const double sn = n.norm();
-      if (sn <= std::max(sin_tol_edge_a[static_cast<std::size_t>(ia)], sin_tol_edge_b[static_cast<std::size_t>(ib)]) - 1e-12)
+      const double parallel =
+          std::max(sin_tol_edge_a[static_cast<std::size_t>(ia)], sin_tol_edge_b[static_cast<std::size_t>(ib)]) - 1e-12 - sn;
+      if (parallel >= 0) {
+        // n turns by at most as much as A's direction.
+        if constexpr (kCertify) ct->rot = parallel - geo_tol;
         return false;
+      }
       const Vec3 r = A.p0 - B.p0;
-      if (std::abs(n.dot(r)) > (std::max(eps, depth) + geo_tol) * sn) return false;
+      const double band = std::max(eps, depth) + geo_tol;
+      const double apart = std::abs(n.dot(r)) - band * sn;
+      if (apart > 0) {
+        // n.r moves by at most |dn| |r| + |dr| (|n| <= 1, |dn| <= bound / r_a, |dr| <=
+        // bound), band sn by band |dn|.
+        if constexpr (kCertify) ct->lin = apart / (1 + (r.norm() + band) / r_a) - geo_tol;
+        return false;
+      }
       // The lines' closest points (as in ee) beyond the segments by at most in_plane.
       const double bb = A.dir.dot(B.dir), c = A.dir.dot(r), f = B.dir.dot(r);
       const double den = 1 - bb * bb;
       const double s = (bb * f - c) / den, t = (f - bb * c) / den;
-      return std::max({0.0, -s, s - A.len}) + std::max({0.0, -t, t - B.len}) <= in_plane + geo_tol;
+      if (std::max({0.0, -s, s - A.len}) + std::max({0.0, -t, t - B.len}) <= in_plane + geo_tol) return true;
+      // No certificate: the closest points move too fast near parallel.
+      return false;
     }
     const Plane& A = posed_plane_a(ia);
-    if (kb == K::kFace) return -A.n.dot(plane_b[static_cast<std::size_t>(ib)].n) >= cos_max_tol - 1e-12;  // f-f
+    if (kb == K::kFace) {  // f-f
+      const double tilt = cos_max_tol - 1e-12 + A.n.dot(plane_b[static_cast<std::size_t>(ib)].n);
+      if (tilt <= 0) return true;
+      if constexpr (kCertify) ct->rot = tilt - geo_tol;
+      return false;
+    }
     if (kb == K::kEdge) {  // f-e
       const Seg& B = seg_b[static_cast<std::size_t>(ib)];
-      return std::abs(A.n.dot(B.dir)) <= sin_max_tol + 1e-12 && segment_in_band(B.p0, B.dir, B.len, A.n, A.off);
+      const double tilt = std::abs(A.n.dot(B.dir)) - (sin_max_tol + 1e-12);
+      if constexpr (!kCertify) {
+        return tilt <= 0 && segment_in_band(B.p0, B.dir, B.len, A.n, A.off);
+      } else {
+        const double h0 = A.n.dot(B.p0) - A.off, h1 = h0 + B.len * A.n.dot(B.dir);
+        const double gap = band_gap(std::min(h0, h1), std::max(h0, h1));
+        if (tilt <= 0 && gap <= 0) return true;
+        const double reach = std::max((B.p0 - origin_posed).norm(), (B.p0 + B.len * B.dir - origin_posed).norm());
+        ct->lin = gap / std::max(1.0, reach / r_a) - geo_tol;
+        ct->rot = tilt - geo_tol;
+        return false;
+      }
     }
-    return near_band(A.n.dot(b.vertex(VertexId(ib)).p) - A.off);  // f-v
+    const Vec3& q = b.vertex(VertexId(ib)).p;  // f-v
+    const double h = A.n.dot(q) - A.off;
+    if (near_band(h)) return true;
+    if constexpr (kCertify) ct->lin = band_gap(h, h) / std::max(1.0, (q - origin_posed).norm() / r_a) - geo_tol;
+    return false;
   }
 
   // Elements at positions ia, ib of the two BVHs' element lists, in leaves that overlap (or kept
@@ -744,6 +865,41 @@ struct ContactDetector::Impl {
     if (!detail::kinds_can_touch(detail::kind_bit(x.kind), detail::kind_bit(y.kind))) return;
     if (big && !element_boxes_overlap(ia, ib)) return;
     boxed_pair(ia, ib, x, y);
+  }
+
+  // A kept pair at a pose served from kept pairs (epoch slot `now`): the element boxes, the
+  // cheap rejections and the exact test, or nothing while its certificate holds.
+  __attribute__((always_inline)) void kept_pair(KeptPair& k, int now) {
+    const auto s = static_cast<std::size_t>(k.slot);
+    if (moved_since[s] < k.lin || turned_since[s] < k.rot) return;  // false for no certificate
+    const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(k.a)];
+    const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(k.b)];
+    PosedElem& P = a_elem[static_cast<std::size_t>(k.a)];
+    if (P.stamp != stamp) pose_element(P, k.a);
+    const detail::ElemBox& Q = bvh_b.element_boxes()[static_cast<std::size_t>(k.b)];
+    // Each vertex of A moves at most the bound, and with it the box of A's element; B's
+    // box is fixed. The float rounding of the gap is within the boxes' float slack.
+    const float gap = ((P.box.c - Q.c).abs() - P.box.h - Q.h).maxCoeff();
+    k.slot = now;
+    if (gap > 0) {
+      k.lin = gap - static_cast<float>(float_slack);
+      k.rot = 0;
+      return;
+    }
+    ++pairs;
+    Cert c;
+    if (may_touch<true>(x.kind, x.index, y.kind, y.index, &c)) {
+      cert = Cert{};
+      exact(x, y);
+      c = cert;
+    }
+    store(k, c);
+  }
+
+  // A certificate as kept: rounded down to float.
+  static void store(KeptPair& k, const Cert& c) {
+    k.lin = c.lin > 0 ? static_cast<float>(c.lin) * 0.999999f : 0.0f;
+    k.rot = c.rot > 0 ? static_cast<float>(c.rot) * 0.999999f : 0.0f;
   }
 
   // Leaves of the two BVHs whose boxes overlap: their element pairs whose kinds can touch
@@ -775,12 +931,23 @@ struct ContactDetector::Impl {
   // A pair past the kinds and the boxes.
   __attribute__((always_inline)) void boxed_pair(int ia, int ib, const detail::BvhElement& x,
                                                  const detail::BvhElement& y) {
-    if (recording) {
-      if (num_kept < kept.size()) kept[num_kept++] = {ia, ib};
-      else kept_overflow = true;
-    }
     ++pairs;
-    if (may_touch(x.kind, x.index, y.kind, y.index)) exact(x, y);
+    if (!recording) {
+      if (may_touch<false>(x.kind, x.index, y.kind, y.index, nullptr)) exact(x, y);
+      return;
+    }
+    Cert c;
+    if (may_touch<true>(x.kind, x.index, y.kind, y.index, &c)) {
+      cert = Cert{};
+      exact(x, y);
+      c = cert;
+    }
+    if (num_kept < kept.size()) {
+      kept[num_kept] = {ia, ib, 0, 0, 0};
+      store(kept[num_kept++], c);
+    } else {
+      kept_overflow = true;
+    }
   }
 
   // Bounds how far any point of A moves from pose p0 to p1 (mm): the move of bvh_a's origin
@@ -819,8 +986,31 @@ struct ContactDetector::Impl {
     return false;
   }
 
+  // Sorts the contacts by PC. On packed keys (type, a, b, position) and then one gather:
+  // an insertion sort moving 160-byte contacts cost half of finish() on 70 contacts.
+  void sort_contacts(ContactSet& cs) {
+    const int n = cs.size();
+    if (!small_indices) {
+      std::sort(cs.begin(), cs.end(), [](const ContactPc& x, const ContactPc& y) { return x.pc < y.pc; });
+      return;
+    }
+    for (int i = 0; i < n; ++i) {
+      const Pc& p = cs[i].pc;
+      sort_keys[static_cast<std::size_t>(i)] = static_cast<std::uint64_t>(p.type) << 56 |
+                                               static_cast<std::uint64_t>(p.a) << 32 |
+                                               static_cast<std::uint64_t>(p.b) << 8 | static_cast<std::uint64_t>(i);
+    }
+    std::sort(sort_keys.begin(), sort_keys.begin() + n);
+    int first_moved = 0;
+    while (first_moved < n && (sort_keys[static_cast<std::size_t>(first_moved)] & 0xFFu) == static_cast<std::uint64_t>(first_moved))
+      ++first_moved;
+    for (int i = first_moved; i < n; ++i)
+      sort_buf[static_cast<std::size_t>(i)] = cs[static_cast<int>(sort_keys[static_cast<std::size_t>(i)] & 0xFFu)];
+    for (int i = first_moved; i < n; ++i) cs[i] = sort_buf[static_cast<std::size_t>(i)];
+  }
+
   void finish(ContactSet& cs) {
-    std::sort(cs.begin(), cs.end(), [](const ContactPc& x, const ContactPc& y) { return x.pc < y.pc; });
+    sort_contacts(cs);
     const int n = cs.size();
     // Dominance (SPEC 4) by a contact whose shape fits well: its misfit without the distance
     // term (angle / tolerance + in-plane gap / epsilon) is at most dominance_fit. A looser
@@ -828,29 +1018,46 @@ struct ContactDetector::Impl {
     // touches exactly) does not settle the reading: both stand and the previous CF or the fit
     // decides (a hysteresis band instead of a flip at the tolerance). misfit is not changed
     // until every flag is set, so the shapes below are the emitted ones.
-    // Per contact, its kinds and whether it fits well enough to dominate; a dominator's
-    // elements hold this one's, so they are of the same or a higher dimension.
-    // Two distinct PCs of the same kinds never hold one another: a dominator is of a higher
-    // dimension on one side at least.
-    int num_dominators = 0;
+    // A dominator's elements hold this one's: of the same or a higher dimension on each
+    // side and a higher one on one side at least (two distinct PCs of the same kinds never
+    // hold one another). So only f-f, e-f and f-e dominate (below them: v-v, v-e and e-v,
+    // which are not PCs), and each type has its possible dominators' types.
+    std::array<int, 3> num_dom{};  // f-f, e-f, f-e: PcType's first three
+    static_assert(static_cast<int>(PcType::kFF) == 0 && static_cast<int>(PcType::kEF) == 1 &&
+                  static_cast<int>(PcType::kFE) == 2);
     for (int j = 0; j < n; ++j) {
       const ContactPc& cj = cs[j];
-      kind_a[static_cast<std::size_t>(j)] = a_kind(cj.pc.type);
-      kind_b[static_cast<std::size_t>(j)] = b_kind(cj.pc.type);
-      if (cj.pc.type != PcType::kVF && cj.pc.type != PcType::kFV &&
-          cj.misfit - std::abs(cj.distance) / eps <= prm.dominance_fit)
-        dominators[static_cast<std::size_t>(num_dominators++)] = j;
+      const auto t = static_cast<std::size_t>(cj.pc.type);
+      if (t < 3 && cj.misfit - std::abs(cj.distance) / eps <= prm.dominance_fit)
+        dominators[t][static_cast<std::size_t>(num_dom[t]++)] = j;
     }
-    for (int i = 0; i < n && num_dominators > 0; ++i) {
-      ContactPc& ci = cs[i];
-      const ElementKind ai = kind_a[static_cast<std::size_t>(i)], bi = kind_b[static_cast<std::size_t>(i)];
-      for (int k = 0; k < num_dominators && !ci.dominated; ++k) {
-        const int j = dominators[static_cast<std::size_t>(k)];
-        const auto uj = static_cast<std::size_t>(j);
-        if (j == i || kind_a[uj] < ai || kind_b[uj] < bi) continue;
-        const ContactPc& cj = cs[j];
-        if (within(a, ai, ci.pc.a, kind_a[uj], cj.pc.a) && within(b, bi, ci.pc.b, kind_b[uj], cj.pc.b))
-          ci.dominated = true;
+    const auto dominated_by = [&](const ContactPc& ci, PcType type) {
+      const auto t = static_cast<std::size_t>(type);
+      const ElementKind ai = a_kind(ci.pc.type), bi = b_kind(ci.pc.type), aj = a_kind(type), bj = b_kind(type);
+      for (int k = 0; k < num_dom[t]; ++k) {
+        const ContactPc& cj = cs[dominators[t][static_cast<std::size_t>(k)]];
+        if (within(a, ai, ci.pc.a, aj, cj.pc.a) && within(b, bi, ci.pc.b, bj, cj.pc.b)) return true;
+      }
+      return false;
+    };
+    for (ContactPc& ci : cs) {
+      switch (ci.pc.type) {
+        case PcType::kFF:
+          break;
+        case PcType::kEF:
+        case PcType::kFE:
+          ci.dominated = dominated_by(ci, PcType::kFF);
+          break;
+        case PcType::kVF:
+          ci.dominated = dominated_by(ci, PcType::kEF) || dominated_by(ci, PcType::kFF);
+          break;
+        case PcType::kFV:
+          ci.dominated = dominated_by(ci, PcType::kFE) || dominated_by(ci, PcType::kFF);
+          break;
+        case PcType::kEE:
+          ci.dominated = dominated_by(ci, PcType::kEF) || dominated_by(ci, PcType::kFE) ||
+                         dominated_by(ci, PcType::kFF);
+          break;
       }
     }
     for (ContactPc& c : cs)
@@ -902,7 +1109,8 @@ struct ContactDetector::Impl {
     Rf = pose.R_BA.cast<float>();
     absRf = absR.cast<float>();
     for (int k = 0; k < 3; ++k) Rcol[k] << Rf.col(k), 0.0f;
-    a_origin << pose.apply(bvh_a.origin()).cast<float>(), 0.0f;
+    origin_posed = pose.apply(bvh_a.origin());
+    a_origin << origin_posed.cast<float>(), 0.0f;
     for (int i = 0; i < 3 && big; ++i) {
       for (int k = 0; k < 3; ++k) {
         Rb[i][k].setConstant(Rf(i, k));
@@ -917,9 +1125,16 @@ struct ContactDetector::Impl {
       const double moved = have_last ? motion_bound(last_pose, pose) : std::numeric_limits<double>::infinity();
       last_pose = pose;
       have_last = true;
-      if (kept_valid && motion_bound(kept_pose, pose) <= prm.reuse_margin) {
+      if (kept_valid && epoch_len < kEpochPoses && motion_bound(kept_pose, pose) <= prm.reuse_margin) {
         reused = true;
-        for (std::size_t k = 0; k < num_kept; ++k) pair(kept[k].a, kept[k].b);
+        const int now = epoch_len++;
+        epoch_pose[static_cast<std::size_t>(now)] = pose;
+        for (int e = 0; e <= now; ++e) {
+          const Pose& q = epoch_pose[static_cast<std::size_t>(e)];
+          moved_since[static_cast<std::size_t>(e)] = motion_bound(q, pose);
+          turned_since[static_cast<std::size_t>(e)] = (pose.R_BA - q.R_BA).norm();
+        }
+        for (std::size_t k = 0; k < num_kept; ++k) kept_pair(kept[k], now);
         finish(cs);
         out = nullptr;
         return;
@@ -950,6 +1165,8 @@ struct ContactDetector::Impl {
     if (recording && !kept_overflow) {
       kept_valid = true;
       kept_pose = pose;
+      epoch_pose[0] = pose;
+      epoch_len = 1;
     }
     recording = false;
     finish(cs);
