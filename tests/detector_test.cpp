@@ -688,6 +688,121 @@ TEST_CASE("pairs kept between nearby poses give what the hierarchy gives", "[det
   }
 }
 
+namespace {
+// Detects along `poses` with kept pairs (warm) and without (cold): every result must be the
+// same. Returns the ticks served from kept pairs and, over those ticks, the pairs each
+// detector took past the boxes to the cheap rejections.
+struct WarmCold {
+  int reused = 0, contacts = 0;
+  std::size_t warm_pairs = 0, cold_pairs = 0;
+};
+WarmCold compare_warm_cold(const cf::Polyhedron& a, const cf::Polyhedron& b, double eps,
+                           const std::vector<cf::Pose>& poses, double reuse_margin = cf::DetectionParams{}.reuse_margin) {
+  cf::DetectionParams prm;
+  prm.epsilon = prm.max_penetration = eps;
+  prm.reuse_margin = reuse_margin;
+  cf::DetectionParams cold = prm;
+  cold.reuse_margin = 0;
+  cf::ContactDetector warm_det(a, b, prm), cold_det(a, b, cold);
+  cf::ContactSet x, y;
+  WarmCold r;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    warm_det.detect(poses[k], x);
+    cold_det.detect(poses[k], y);
+    INFO("epsilon " << eps << ", tick " << k);
+    REQUIRE(!y.overflow());
+    REQUIRE(x.size() == y.size());
+    for (int i = 0; i < x.size(); ++i) {
+      CHECK(x[i].pc == y[i].pc);
+      CHECK(x[i].distance == y[i].distance);
+      CHECK(x[i].dominated == y[i].dominated);
+      CHECK(x[i].plane == y[i].plane);
+    }
+    if (warm_det.last_reused_pairs()) {
+      ++r.reused;
+      r.warm_pairs += warm_det.last_pairs_tested();
+      r.cold_pairs += cold_det.last_pairs_tested();
+    }
+    r.contacts += x.size();
+  }
+  return r;
+}
+}  // namespace
+
+TEST_CASE("kept pairs' certificates never hide a contact", "[detector]") {
+  // Kept pairs turned away skip their tests while A has moved (or turned) less than their
+  // certificates allow; these trajectories turn A fast relative to its motion, so that the
+  // rotational certificates (edges and wedges dipping into the other solid) expire and
+  // renew all the time, and one puts reflex edges on A (turned away for good).
+  const double eps = GENERATE(1.0, 0.1);
+  const int n = 300;
+  SECTION("a sphere spinning on a sphere") {
+    // 1.5 mrad per tick about a slowly turning axis (0.045 mm of its facets' travel per tick,
+    // about the most for which pairs are still kept), the centre drifting 0.02 mm per tick,
+    // the gap swinging through the band (the facets lie up to 0.4 mm inside the spheres).
+    const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30), b = tm::faceted_sphere(50, 21, 32);
+    std::vector<cf::Pose> poses;
+    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+    for (int k = 0; k < n; ++k) {
+      const double s = static_cast<double>(k) / n;
+      R = rot(0.0015, Vec3(std::cos(3 * s), std::sin(3 * s), 0.5)) * R;
+      const Vec3 dir = Vec3(std::sin(0.02 * k / 80), 0.03 * std::sin(2 * s), 1).normalized();
+      const double gap = eps * 0.6 * std::sin(9 * s) - 0.2;
+      poses.push_back(pose(R, dir * (80 + gap)));
+    }
+    const WarmCold r = compare_warm_cold(a, b, eps, poses);
+    CAPTURE(r.contacts, r.reused, r.warm_pairs, r.cold_pairs);
+    CHECK(r.contacts > n / 4);  // at either epsilon (over 100)
+    CHECK(r.reused > n / 2);
+    // The certificates skip most pairs: the test exercises them.
+    CHECK(2 * r.warm_pairs < r.cold_pairs);
+  }
+  SECTION("a torus rocking and spinning on a sphere") {
+    // The torus (ring radius 30, tube 10) over a sphere of radius 50, its axis 8 mm off
+    // the sphere's centre: the nearest point of its tube's centre circle is 60 from the
+    // sphere's centre at a height of sqrt(60^2 - 22^2 - ...) = sqrt(2700 + 60 * 8 - 8^2)
+    // = 55.82, less 0.7 mm for the facets. The contact is on the inner,
+    // saddle-shaped side of the tube (reflex edges) over about a quarter of the ring. The
+    // torus spins 1 mrad per tick about its axis and rocks by up to 0.03 rad.
+    const cf::Polyhedron a = faceted_torus(30, 10, 24, 16), b = tm::faceted_sphere(50, 21, 32);
+    std::vector<cf::Pose> poses;
+    for (int k = 0; k < n; ++k) {
+      const double s = static_cast<double>(k) / n;
+      const Eigen::Matrix3d R = rot(0.03 * std::sin(7 * s), Vec3(std::cos(2 * s), std::sin(2 * s), 0)) *
+                                rot(0.001 * k, Vec3::UnitZ());
+      const double h = std::sqrt(2700.0 + 60 * 8 - 8 * 8) - 0.7 + eps * 0.6 * std::sin(11 * s);
+      poses.push_back(pose(R, Vec3(8, 0, h)));
+    }
+    const WarmCold r = compare_warm_cold(a, b, eps, poses);
+    CAPTURE(r.contacts, r.reused, r.warm_pairs, r.cold_pairs);
+    CHECK(r.contacts > n / 4);  // at either epsilon (over 200)
+    CHECK(r.reused > n / 2);
+    CHECK(2 * r.warm_pairs < r.cold_pairs);
+  }
+  SECTION("a sphere pressed in and drawn out, kept pairs serving for 1 mm") {
+    // Straight along the line of the centres, 0.04 mm per tick, from 1.5 epsilon apart to
+    // 0.8 epsilon deep (plus the facets' 0.4 mm) and back, with a slow turn: the heights
+    // change as fast as the motion bound allows, and a margin of 1 mm (beyond B's boxes'
+    // growth past the band, 0.41 epsilon) lets pairs kept apart by the boxes come into
+    // the band while their certificates are in use.
+    const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30), b = tm::faceted_sphere(50, 21, 32);
+    const Vec3 dir = Vec3(0.2, -0.3, 1).normalized();
+    std::vector<cf::Pose> poses;
+    double gap = 1.5 * eps;
+    double step = -0.04;
+    for (int k = 0; k < n; ++k) {
+      gap += step;
+      if (gap < -0.8 * eps - 0.4 || gap > 1.5 * eps) step = -step;
+      poses.push_back(pose(rot(0.0002 * k, Vec3(1, 1, 0)), dir * (80 + gap)));
+    }
+    const WarmCold r = compare_warm_cold(a, b, eps, poses, 1.0);
+    CAPTURE(r.contacts, r.reused, r.warm_pairs, r.cold_pairs);
+    CHECK(r.contacts > n / 4);
+    CHECK(r.reused > n / 2);
+    CHECK(2 * r.warm_pairs < r.cold_pairs);
+  }
+}
+
 TEST_CASE("a negative reuse margin is refused", "[detector]") {
   cf::DetectionParams p;
   p.reuse_margin = -0.1;
