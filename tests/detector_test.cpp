@@ -779,6 +779,30 @@ TEST_CASE("kept pairs' certificates never hide a contact", "[detector]") {
     CHECK(r.reused > n / 2);
     CHECK(2 * r.warm_pairs < r.cold_pairs);
   }
+  SECTION("a sphere toggling between two nearby poses") {
+    // A device's noise at its worst: back and forth between a pose and one 0.05 mm and
+    // 3 mrad from it. The pairs are kept at the first; a certificate earned at the second
+    // (a pair moved or turned away there) must not be read as if from the first when A is
+    // back at the first. 30 poses in contact at random, 6 ticks each: first, first (pairs
+    // kept), second, first, second, first.
+    const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30), b = tm::faceted_sphere(50, 21, 32);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> U(-1, 1);
+    std::vector<cf::Pose> poses;
+    for (int k = 0; k < 30; ++k) {
+      const Vec3 dir = Vec3(U(rng), U(rng), U(rng)).normalized();
+      const Eigen::Matrix3d R = rot(3 * U(rng), Vec3(U(rng), U(rng), U(rng)));
+      const cf::Pose first = pose(R, dir * (80 - 0.2 + 0.4 * eps * U(rng)));
+      const cf::Pose second = pose(rot(0.003, Vec3(U(rng), U(rng), U(rng))) * R,
+                                   first.t_BA + 0.05 * Vec3(U(rng), U(rng), U(rng)).normalized());
+      for (const cf::Pose* p : {&first, &first, &second, &first, &second, &first}) poses.push_back(*p);
+    }
+    const WarmCold r = compare_warm_cold(a, b, eps, poses);
+    CAPTURE(r.contacts, r.reused, r.warm_pairs, r.cold_pairs);
+    CHECK(r.contacts > static_cast<int>(poses.size()) / 4);
+    CHECK(r.reused == 4 * 30);  // all but the first two ticks at each pose
+    CHECK(2 * r.warm_pairs < r.cold_pairs);
+  }
   SECTION("a sphere pressed in and drawn out, kept pairs serving for 1 mm") {
     // Straight along the line of the centres, 0.04 mm per tick, from 1.5 epsilon apart to
     // 0.8 epsilon deep (plus the facets' 0.4 mm) and back, with a slow turn: the heights

@@ -211,32 +211,30 @@ struct ContactDetector::Impl {
   // boxes overlapped with A's boxes grown by the margin at kept_pose. Every pair that can
   // touch at a pose where no point of A is further than the margin from where it was at
   // kept_pose is among them, so such a pose tests only those. A kept pair turned away
-  // carries a certificate (Cert) from the pose it was turned away at (one of the epoch's
-  // poses): while A has moved or turned less since, the pair is skipped.
+  // carries a certificate (Cert): while A has moved and turned less than it allows, the
+  // pair is skipped.
   static constexpr std::size_t kMaxKept = 1 << 14;
-  static constexpr int kEpochPoses = 64;  // the poses since kept_pose, kept_pose first
   // A pair turned away stays turned away while A's points move less than `lin` (the
   // motion bound, motion_bound) or A turns less than `rot` (|R1 - R0|_F, which bounds how
-  // far any unit vector of A, or of B seen from A, turns). <= 0: no certificate. Each
-  // keeps geo_tol in hand for rounding.
+  // far any unit vector of A, or of B seen from A, turns) from the pose it was turned away
+  // at. <= 0: no certificate. Each keeps geo_tol in hand for rounding.
   struct Cert {
     double lin = 0;  // mm
     double rot = 0;  // Frobenius norm of the change of R_BA
   };
-  struct KeptPair {
-    std::int32_t a, b;  // positions in the BVHs' element lists
-    float lin, rot;     // the pair's Cert, from epoch_pose[slot], rounded down
-    std::int32_t slot;
-  };
   Cert cert;  // set by the exact tests when they turn a pair away for its orientation
-  std::vector<KeptPair> kept;
+  // The kept pairs, and their certificates counted from kept_pose (kept_lin, kept_rot,
+  // rounded down; side by side, so that four are checked at once): both measures are
+  // metrics, so a pair certified at a pose `lin` from kept_pose holds at any pose less
+  // than `lin` minus that from kept_pose. Tight while A moves on (the usual servo loop),
+  // and it makes the check two comparisons with this call's distances from kept_pose.
+  // Padded to a multiple of 4 with certificates that always hold.
+  std::vector<detail::NodePair> kept;  // (A position, B position) in the BVHs' element lists
+  std::vector<float> kept_lin, kept_rot;
   std::size_t num_kept = 0;
   bool kept_valid = false, recording = false, kept_overflow = false, reused = false;
   Pose kept_pose, last_pose;
-  std::array<Pose, kEpochPoses> epoch_pose;
-  // From epoch_pose[s] to the current pose: the motion bound (mm) and |R - R_s|_F.
-  std::array<double, kEpochPoses> moved_since{}, turned_since{};
-  int epoch_len = 0;
+  double moved_from_kept = 0, turned_from_kept = 0;  // this call's pose from kept_pose
   Vec3 origin_posed = Vec3::Zero();  // mm, bvh_a's origin at the current pose, B's frame
   double float_slack = 0;            // mm, the float rounding allowance of the boxes
   bool have_last = false;
@@ -312,7 +310,11 @@ struct ContactDetector::Impl {
         r_a = std::max(r_a, (v.p - bvh_a.origin()).norm());
       }
       a_vert_posed.resize(ma.num_vertices());
-      if (prm.use_bvh && prm.reuse_margin > 0) kept.resize(kMaxKept);
+      if (prm.use_bvh && prm.reuse_margin > 0) {
+        kept.resize(kMaxKept);
+        kept_lin.resize(kMaxKept + 3);
+        kept_rot.resize(kMaxKept + 3);
+      }
     } else {
       a_box.resize(bvh_a.nodes().size());
     }
@@ -867,39 +869,54 @@ struct ContactDetector::Impl {
     boxed_pair(ia, ib, x, y);
   }
 
-  // A kept pair at a pose served from kept pairs (epoch slot `now`): the element boxes, the
-  // cheap rejections and the exact test, or nothing while its certificate holds.
-  __attribute__((always_inline)) void kept_pair(KeptPair& k, int now) {
-    const auto s = static_cast<std::size_t>(k.slot);
-    if (moved_since[s] < k.lin || turned_since[s] < k.rot) return;  // false for no certificate
-    const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(k.a)];
-    const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(k.b)];
-    PosedElem& P = a_elem[static_cast<std::size_t>(k.a)];
-    if (P.stamp != stamp) pose_element(P, k.a);
-    const detail::ElemBox& Q = bvh_b.element_boxes()[static_cast<std::size_t>(k.b)];
+  // The kept pairs at a pose served from them: those whose certificates do not hold
+  // (four checked at once) go through the element boxes, the cheap rejections and the
+  // exact test, and get their new certificates.
+  void reuse_kept() {
+    // Rounded up, so that a skip is never wrong by rounding.
+    const float moved = static_cast<float>(moved_from_kept) * 1.000001f;
+    const float turned = static_cast<float>(turned_from_kept) * 1.000001f;
+    const Eigen::Array4f moved4 = Eigen::Array4f::Constant(moved), turned4 = Eigen::Array4f::Constant(turned);
+    for (std::size_t k = 0; k < num_kept; k += 4) {
+      const Eigen::Map<const Eigen::Array4f> lin(kept_lin.data() + k), rot(kept_rot.data() + k);
+      unsigned test = ~(detail::greater_mask4(lin, moved4) | detail::greater_mask4(rot, turned4)) & 0xFu;
+      while (test != 0) {
+        const std::size_t i = k + static_cast<std::size_t>(__builtin_ctz(test));
+        test &= test - 1;
+        kept_pair(i);
+      }
+    }
+  }
+
+  __attribute__((always_inline)) void kept_pair(std::size_t i) {
+    const int ia = kept[i].a, ib = kept[i].b;
+    const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
+    const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];
+    PosedElem& P = a_elem[static_cast<std::size_t>(ia)];
+    if (P.stamp != stamp) pose_element(P, ia);
+    const detail::ElemBox& Q = bvh_b.element_boxes()[static_cast<std::size_t>(ib)];
     // Each vertex of A moves at most the bound, and with it the box of A's element; B's
     // box is fixed. The float rounding of the gap is within the boxes' float slack.
     const float gap = ((P.box.c - Q.c).abs() - P.box.h - Q.h).maxCoeff();
-    k.slot = now;
-    if (gap > 0) {
-      k.lin = gap - static_cast<float>(float_slack);
-      k.rot = 0;
-      return;
-    }
-    ++pairs;
     Cert c;
-    if (may_touch<true>(x.kind, x.index, y.kind, y.index, &c)) {
-      cert = Cert{};
-      exact(x, y);
-      c = cert;
+    if (gap > 0) {
+      c.lin = gap - float_slack;
+    } else {
+      ++pairs;
+      if (may_touch<true>(x.kind, x.index, y.kind, y.index, &c)) {
+        cert = Cert{};
+        exact(x, y);
+        c = cert;
+      }
     }
-    store(k, c);
+    store(i, c);
   }
 
-  // A certificate as kept: rounded down to float.
-  static void store(KeptPair& k, const Cert& c) {
-    k.lin = c.lin > 0 ? static_cast<float>(c.lin) * 0.999999f : 0.0f;
-    k.rot = c.rot > 0 ? static_cast<float>(c.rot) * 0.999999f : 0.0f;
+  // Keeps pair i's certificate, from this call's pose, counted from kept_pose.
+  void store(std::size_t i, const Cert& c) {
+    const double lin = c.lin - moved_from_kept, rot = c.rot - turned_from_kept;
+    kept_lin[i] = lin > 0 ? static_cast<float>(lin) * 0.999999f : 0.0f;
+    kept_rot[i] = rot > 0 ? static_cast<float>(rot) * 0.999999f : 0.0f;
   }
 
   // Leaves of the two BVHs whose boxes overlap: their element pairs whose kinds can touch
@@ -943,8 +960,8 @@ struct ContactDetector::Impl {
       c = cert;
     }
     if (num_kept < kept.size()) {
-      kept[num_kept] = {ia, ib, 0, 0, 0};
-      store(kept[num_kept++], c);
+      kept[num_kept] = {ia, ib};
+      store(num_kept++, c);
     } else {
       kept_overflow = true;
     }
@@ -1125,16 +1142,11 @@ struct ContactDetector::Impl {
       const double moved = have_last ? motion_bound(last_pose, pose) : std::numeric_limits<double>::infinity();
       last_pose = pose;
       have_last = true;
-      if (kept_valid && epoch_len < kEpochPoses && motion_bound(kept_pose, pose) <= prm.reuse_margin) {
+      moved_from_kept = kept_valid ? motion_bound(kept_pose, pose) : std::numeric_limits<double>::infinity();
+      if (moved_from_kept <= prm.reuse_margin) {
         reused = true;
-        const int now = epoch_len++;
-        epoch_pose[static_cast<std::size_t>(now)] = pose;
-        for (int e = 0; e <= now; ++e) {
-          const Pose& q = epoch_pose[static_cast<std::size_t>(e)];
-          moved_since[static_cast<std::size_t>(e)] = motion_bound(q, pose);
-          turned_since[static_cast<std::size_t>(e)] = (pose.R_BA - q.R_BA).norm();
-        }
-        for (std::size_t k = 0; k < num_kept; ++k) kept_pair(kept[k], now);
+        turned_from_kept = (pose.R_BA - kept_pose.R_BA).norm();
+        reuse_kept();
         finish(cs);
         out = nullptr;
         return;
@@ -1147,6 +1159,7 @@ struct ContactDetector::Impl {
         grow = static_cast<float>(prm.reuse_margin);
         num_kept = 0;
         kept_overflow = false;
+        moved_from_kept = turned_from_kept = 0;  // this pose is the new kept_pose
       }
     }
     // The stack is sized for the trees' depths, so the descents cannot overflow it.
@@ -1165,8 +1178,8 @@ struct ContactDetector::Impl {
     if (recording && !kept_overflow) {
       kept_valid = true;
       kept_pose = pose;
-      epoch_pose[0] = pose;
-      epoch_len = 1;
+      // Padding that is always skipped.
+      for (std::size_t k = num_kept; k % 4 != 0; ++k) kept_lin[k] = std::numeric_limits<float>::infinity();
     }
     recording = false;
     finish(cs);
