@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace cf {
 
@@ -78,6 +79,7 @@ struct CfIdentifier::Impl {
   CfId prev;
   // Per step scratch (fixed size).
   std::array<std::array<std::int16_t, ContactSet::kCapacity>, kMaxGroups> members{};
+  std::array<std::pair<double, std::int16_t>, ContactSet::kCapacity> by_fit{};  // scratch: (misfit, position)
   std::array<int, kMaxGroups> count{};
   // The members some CF of the graph holds (best fit first): only these can be chosen.
   std::array<std::array<std::int16_t, ContactSet::kCapacity>, kMaxGroups> choosable{};
@@ -246,16 +248,16 @@ struct CfIdentifier::Impl {
     }
     for (int g = 0; g < G; ++g) {
       auto& m = members[static_cast<std::size_t>(g)];
-      // Insertion sort (stable, and std::stable_sort may allocate).
-      for (int i = 1; i < count[static_cast<std::size_t>(g)]; ++i) {
+      // Sorted on (misfit, position) keys: stable, without std::stable_sort's allocation,
+      // and without an insertion sort's quadratic reads of the contacts (a band of 70
+      // contacts on one plane cost 11k instructions per tick).
+      const int n = count[static_cast<std::size_t>(g)];
+      for (int i = 0; i < n; ++i) {
         const std::int16_t v = m[static_cast<std::size_t>(i)];
-        int j = i - 1;
-        while (j >= 0 && cs[m[static_cast<std::size_t>(j)]].misfit > cs[v].misfit) {
-          m[static_cast<std::size_t>(j + 1)] = m[static_cast<std::size_t>(j)];
-          --j;
-        }
-        m[static_cast<std::size_t>(j + 1)] = v;
+        by_fit[static_cast<std::size_t>(i)] = {cs[v].misfit, v};
       }
+      std::sort(by_fit.begin(), by_fit.begin() + n);
+      for (int i = 0; i < n; ++i) m[static_cast<std::size_t>(i)] = by_fit[static_cast<std::size_t>(i)].second;
       auto& c = choosable[static_cast<std::size_t>(g)];
       int& nc = nchoose[static_cast<std::size_t>(g)];
       nc = 0;
