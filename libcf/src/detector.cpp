@@ -870,8 +870,9 @@ struct ContactDetector::Impl {
   }
 
   // The kept pairs at a pose served from them: those whose certificates do not hold
-  // (four checked at once) go through the element boxes, the cheap rejections and the
-  // exact test, and get their new certificates.
+  // (four checked at once) go through the cheap rejections and the exact test, and get
+  // their new certificates. Not through the element boxes: with the certificates, posing
+  // A's elements for them cost more than the boxes saved (5% more instructions).
   void reuse_kept() {
     // Rounded up, so that a skip is never wrong by rounding.
     const float moved = static_cast<float>(moved_from_kept) * 1.000001f;
@@ -892,22 +893,12 @@ struct ContactDetector::Impl {
     const int ia = kept[i].a, ib = kept[i].b;
     const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
     const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];
-    PosedElem& P = a_elem[static_cast<std::size_t>(ia)];
-    if (P.stamp != stamp) pose_element(P, ia);
-    const detail::ElemBox& Q = bvh_b.element_boxes()[static_cast<std::size_t>(ib)];
-    // Each vertex of A moves at most the bound, and with it the box of A's element; B's
-    // box is fixed. The float rounding of the gap is within the boxes' float slack.
-    const float gap = ((P.box.c - Q.c).abs() - P.box.h - Q.h).maxCoeff();
     Cert c;
-    if (gap > 0) {
-      c.lin = gap - float_slack;
-    } else {
-      ++pairs;
-      if (may_touch<true>(x.kind, x.index, y.kind, y.index, &c)) {
-        cert = Cert{};
-        exact(x, y);
-        c = cert;
-      }
+    ++pairs;
+    if (may_touch<true>(x.kind, x.index, y.kind, y.index, &c)) {
+      cert = Cert{};
+      exact(x, y);
+      c = cert;
     }
     store(i, c);
   }

@@ -75,7 +75,9 @@ class ContactDetector {
   const Polyhedron& model_a() const;
   const Polyhedron& model_b() const;
   /// Element pairs of kinds that can touch whose bounding boxes overlapped in the last
-  /// `detect` (before the cheap rejections and the exact tests); all pairs with use_bvh off.
+  /// `detect` (before the cheap rejections and the exact tests); on a pose served from kept
+  /// pairs (last_reused_pairs), the kept pairs whose certificates did not hold; all pairs
+  /// with use_bvh off.
   std::size_t last_pairs_tested() const;
   /// Whether the last `detect` tested only the pairs kept at an earlier pose
   /// (DetectionParams::reuse_margin) instead of descending the hierarchies.
