@@ -780,7 +780,7 @@ TEST_CASE("kept pairs' certificates never hide a contact", "[detector]") {
     CHECK(2 * r.warm_pairs < r.cold_pairs);
   }
   SECTION("a sphere toggling between two nearby poses") {
-    // A device's noise at its worst: back and forth between a pose and one 0.05 mm and
+    // A device's noise at its worst: back and forth between a pose and one 0.1 mm and
     // 3 mrad from it. The pairs are kept at the first; a certificate earned at the second
     // (a pair moved or turned away there) must not be read as if from the first when A is
     // back at the first. 30 poses in contact at random, 6 ticks each: first, first (pairs
@@ -794,7 +794,7 @@ TEST_CASE("kept pairs' certificates never hide a contact", "[detector]") {
       const Eigen::Matrix3d R = rot(3 * U(rng), Vec3(U(rng), U(rng), U(rng)));
       const cf::Pose first = pose(R, dir * (80 - 0.2 + 0.4 * eps * U(rng)));
       const cf::Pose second = pose(rot(0.003, Vec3(U(rng), U(rng), U(rng))) * R,
-                                   first.t_BA + 0.05 * Vec3(U(rng), U(rng), U(rng)).normalized());
+                                   first.t_BA + 0.1 * Vec3(U(rng), U(rng), U(rng)).normalized());
       for (const cf::Pose* p : {&first, &first, &second, &first, &second, &first}) poses.push_back(*p);
     }
     const WarmCold r = compare_warm_cold(a, b, eps, poses);

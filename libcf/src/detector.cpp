@@ -222,7 +222,8 @@ struct ContactDetector::Impl {
     double lin = 0;  // mm
     double rot = 0;  // Frobenius norm of the change of R_BA
   };
-  Cert cert;  // set by the exact tests when they turn a pair away for its orientation
+  Cert cert;  // set by the exact tests when they turn a pair away (for kept pairs)
+  bool certifying = false;  // kept pairs are being recorded or served: the exact tests' certificates count
   // The kept pairs, and their certificates counted from kept_pose (kept_lin, kept_rot,
   // rounded down; side by side, so that four are checked at once): both measures are
   // metrics, so a pair certified at a pose `lin` from kept_pose holds at any pose less
@@ -497,7 +498,11 @@ struct ContactDetector::Impl {
     }
     const detail::Loc2 loc = detail::locate(flat_b.poly(fb), Vec2(F.u.dot(p), F.v.dot(p)));
     const double gap = (loc.inside || loc.dist <= geo_tol) ? 0.0 : loc.dist;
-    if (gap > in_plane) return;
+    if (gap > in_plane) {
+      // The vertex's projection on B's plane moves at most as far as the vertex.
+      cert.lin = gap - in_plane - geo_tol;
+      return;
+    }
     emit(PcType::kVF, v, fb, h, p, p - h * F.normal, task_frame(F.normal, F.u),
          std::abs(h) / eps + gap / eps);
   }
@@ -521,7 +526,12 @@ struct ContactDetector::Impl {
     }
     const detail::Loc2 loc = detail::locate(flat_a.poly(fa), Vec2(F.u.dot(qA), F.v.dot(qA)));
     const double gap = (loc.inside || loc.dist <= geo_tol) ? 0.0 : loc.dist;
-    if (gap > in_plane) return;
+    if (gap > in_plane) {
+      // B's vertex as A sees it, R^T (q - o) + const, moves at most the bound times
+      // max(1, |q - o| / r_a).
+      if (certifying) cert.lin = (gap - in_plane) / std::max(1.0, (q - origin_posed).norm() / r_a) - geo_tol;
+      return;
+    }
     const Vec3 nW = pose.R_BA * F.normal;
     const Vec3 onA = q - h * nW;
     emit(PcType::kFV, fa, v, h, onA, onA, task_frame(-nW, pose.R_BA * F.u),
@@ -532,12 +542,17 @@ struct ContactDetector::Impl {
   // (flat f): shared by e-f (m = B, segment world) and f-e (m = A, segment in A's frame).
   // Returns false when not a contact; else the region's centroid parameter, its deepest
   // height, the in-plane gap and the region's extent as a share of the segment (from the
-  // first to the last point over the face; 0 beside the face).
+  // first to the last point over the face; 0 beside the face). Turned away for the
+  // segment's heights or its in-plane gap, it leaves in cert.lin how far the segment must
+  // move (in the face's frame) to pass them.
   bool line_on_face(const Polyhedron& m, const FlatFaces& flat, int f, const Vec3& s0,
                     const Vec3& s1, double* t_c, double* d, double* gap, double* span) {
     const Face& F = m.faces()[static_cast<std::size_t>(f)];
     const double h0 = F.normal.dot(s0) - F.offset, h1 = F.normal.dot(s1) - F.offset;
-    if (std::min(h0, h1) > eps || std::max(h0, h1) < -depth) return false;
+    if (std::min(h0, h1) > eps || std::max(h0, h1) < -depth) {
+      cert.lin = std::max(std::min(h0, h1) - eps, -depth - std::max(h0, h1));
+      return false;
+    }
     const Vec2 a2(F.u.dot(s0), F.v.dot(s0)), b2(F.u.dot(s1), F.v.dot(s1));
     double len = 0, moment = 0, dmin = std::numeric_limits<double>::infinity();
     double first = 1, last = 0;
@@ -570,7 +585,10 @@ struct ContactDetector::Impl {
                                               P.pts[i + 1 == P.lb[l + 1] ? P.lb[l] : i + 1], &t);
           if (g < best) best = g, tb = t;
         }
-      if (best > in_plane) return false;
+      if (best > in_plane) {
+        cert.lin = best - in_plane;
+        return false;
+      }
       *t_c = tb;
       *d = h0 + tb * (h1 - h0);
       *gap = best;
@@ -595,7 +613,10 @@ struct ContactDetector::Impl {
       return;
     }
     double tc, d, gap, span;
-    if (!line_on_face(b, flat_b, fb, p0, p1, &tc, &d, &gap, &span)) return;
+    if (!line_on_face(b, flat_b, fb, p0, p1, &tc, &d, &gap, &span)) {
+      cert.lin -= geo_tol;  // A's segment moves at most the bound
+      return;
+    }
     // The tilt at which the part of the edge over the face stays within epsilon (the whole
     // edge beside the face).
     const double tol = tol_for(span > 0 ? span * E.length : E.length);
@@ -625,7 +646,12 @@ struct ContactDetector::Impl {
     const Vec3& q1 = b.vertex(E.v1).p;
     const Vec3 q0A = pose.inverse_apply(q0), q1A = pose.inverse_apply(q1);
     double tc, d, gap, span;
-    if (!line_on_face(a, flat_a, fa, q0A, q1A, &tc, &d, &gap, &span)) return;
+    if (!line_on_face(a, flat_a, fa, q0A, q1A, &tc, &d, &gap, &span)) {
+      // B's segment as A sees it moves at most the bound times max(1, |q - o| / r_a).
+      if (certifying)
+        cert.lin = cert.lin / std::max(1.0, std::max((q0 - origin_posed).norm(), (q1 - origin_posed).norm()) / r_a) - geo_tol;
+      return;
+    }
     const double tol = tol_for(span > 0 ? span * E.length : E.length);
     const double ang = std::asin(sin_ang);
     if (ang > tol) return;
@@ -1137,7 +1163,9 @@ struct ContactDetector::Impl {
       if (moved_from_kept <= prm.reuse_margin) {
         reused = true;
         turned_from_kept = (pose.R_BA - kept_pose.R_BA).norm();
+        certifying = true;
         reuse_kept();
+        certifying = false;
         finish(cs);
         out = nullptr;
         return;
@@ -1151,6 +1179,7 @@ struct ContactDetector::Impl {
         num_kept = 0;
         kept_overflow = false;
         moved_from_kept = turned_from_kept = 0;  // this pose is the new kept_pose
+        certifying = true;
       }
     }
     // The stack is sized for the trees' depths, so the descents cannot overflow it.
@@ -1172,7 +1201,7 @@ struct ContactDetector::Impl {
       // Padding that is always skipped.
       for (std::size_t k = num_kept; k % 4 != 0; ++k) kept_lin[k] = std::numeric_limits<float>::infinity();
     }
-    recording = false;
+    recording = certifying = false;
     finish(cs);
     out = nullptr;
   }
