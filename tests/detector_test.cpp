@@ -829,6 +829,43 @@ TEST_CASE("kept pairs' certificates never hide a contact", "[detector]") {
   }
 }
 
+TEST_CASE("kept pairs serve rotations, and rotations rounded to float", "[detector]") {
+  // A's sphere centred 500 mm from its frame's origin, so that R^T R - I, times that
+  // centre, shifts B's points as A sees them (the f-v and f-e certificates assume a
+  // rotation). Rotations rounded to float (1e-7 off) are served from kept pairs, results
+  // unchanged; rotations 1e-4 off orthonormal are detected from scratch, results unchanged.
+  const double eps = GENERATE(1.0, 0.1);
+  const Vec3 centre(300, -400, 0);
+  const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30, centre), b = tm::faceted_sphere(50, 21, 32);
+  const int n = 200;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (const bool far_off : {false, true}) {
+    std::vector<cf::Pose> poses;
+    for (int k = 0; k < n; ++k) {
+      const double s = static_cast<double>(k) / n;
+      Eigen::Matrix3d R = rot(0.0005 * k, Vec3(1, 2, 3));
+      if (far_off) {
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) R(i, j) += 1e-4 * U(rng);
+      } else {
+        R = R.cast<float>().cast<double>();
+      }
+      // A's centre (R centre + t) 80 mm from B's along a slowly turning direction (0.04
+      // mm per tick, and 0.5 mrad).
+      const Vec3 dir = Vec3(std::cos(0.1 * s), 0.02 * std::sin(3 * s), std::sin(0.1 * s)).normalized();
+      const double gap = eps * 0.6 * std::sin(9 * s) - 0.2;
+      poses.push_back(pose(R, dir * (80 + gap) - R * centre));
+    }
+    INFO((far_off ? "rotations 1e-4 off orthonormal" : "rotations rounded to float"));
+    const WarmCold r = compare_warm_cold(a, b, eps, poses);
+    CAPTURE(r.contacts, r.reused);
+    CHECK(r.contacts > n / 4);
+    if (far_off) CHECK(r.reused == 0);
+    else CHECK(r.reused > n / 2);
+  }
+}
+
 TEST_CASE("a negative reuse margin is refused", "[detector]") {
   cf::DetectionParams p;
   p.reuse_margin = -0.1;

@@ -236,6 +236,11 @@ struct ContactDetector::Impl {
   bool kept_valid = false, recording = false, kept_overflow = false, reused = false;
   Pose kept_pose, last_pose;
   double moved_from_kept = 0, turned_from_kept = 0;  // this call's pose from kept_pose
+  // mm: how far |(R^T R - I) o_A| (o_A: bvh_a's origin, A's frame) may be at a pose kept
+  // pairs serve or are kept at. The certificates of B's points seen from A hold for
+  // rotations; a rotation rounded to float (1e-7) is well within this, a pose further off
+  // orthonormal is detected from scratch.
+  double orth_allow = 0;
   Vec3 origin_posed = Vec3::Zero();  // mm, bvh_a's origin at the current pose, B's frame
   double float_slack = 0;            // mm, the float rounding allowance of the boxes
   bool have_last = false;
@@ -279,6 +284,7 @@ struct ContactDetector::Impl {
     double reach = ma.size() + mb.size();
     for (const Vertex& v : mb.vertices()) reach = std::max(reach, v.p.cwiseAbs().maxCoeff() + ma.size());
     float_slack = 1e-5 * std::max(reach, 1.0);
+    orth_allow = 1e-5 * std::max({reach, bvh_a.origin().norm(), 1.0});
     // B's boxes grow by the deepest band and the in-plane allowance, so that every pair the
     // exact tests could accept has overlapping boxes.
     // A pair the tests accept is within max(eps, depth) across the plane and in_plane along
@@ -453,6 +459,13 @@ struct ContactDetector::Impl {
   static double wedge_dip(const Vec3& n, const EdgeWings& w, const Edge& E, const std::vector<double>& sin_tol_face) {
     return std::max(-sin_tol_face[E.left.index()] - n.dot(w.left), -sin_tol_face[E.right.index()] - n.dot(w.right));
   }
+  // The certificate of a distance `gap` of B's point(s), at most `reach` from A's posed
+  // origin o, as A sees them: R^T (q - o) + R^T R o_A moves at most the motion bound times
+  // max(1, reach / r_a), plus the change of R^T R o_A, which is o_A for a rotation and at
+  // most orth_allow from it at the poses kept pairs serve.
+  double seen_from_a(double gap, double reach) const {
+    return (gap - 2 * orth_allow) / std::max(1.0, reach / r_a) - geo_tol;
+  }
   // A pair turned away for good whatever the pose (a reflex edge).
   void never() { cert.rot = std::numeric_limits<double>::infinity(); }
 
@@ -529,7 +542,7 @@ struct ContactDetector::Impl {
     if (gap > in_plane) {
       // B's vertex as A sees it, R^T (q - o) + const, moves at most the bound times
       // max(1, |q - o| / r_a).
-      if (certifying) cert.lin = (gap - in_plane) / std::max(1.0, (q - origin_posed).norm() / r_a) - geo_tol;
+      if (certifying) cert.lin = seen_from_a(gap - in_plane, (q - origin_posed).norm());
       return;
     }
     const Vec3 nW = pose.R_BA * F.normal;
@@ -648,8 +661,7 @@ struct ContactDetector::Impl {
     double tc, d, gap, span;
     if (!line_on_face(a, flat_a, fa, q0A, q1A, &tc, &d, &gap, &span)) {
       // B's segment as A sees it moves at most the bound times max(1, |q - o| / r_a).
-      if (certifying)
-        cert.lin = cert.lin / std::max(1.0, std::max((q0 - origin_posed).norm(), (q1 - origin_posed).norm()) / r_a) - geo_tol;
+      if (certifying) cert.lin = seen_from_a(cert.lin, std::max((q0 - origin_posed).norm(), (q1 - origin_posed).norm()));
       return;
     }
     const double tol = tol_for(span > 0 ? span * E.length : E.length);
@@ -873,7 +885,7 @@ struct ContactDetector::Impl {
         const double gap = band_gap(std::min(h0, h1), std::max(h0, h1));
         if (tilt <= 0 && gap <= 0) return true;
         const double reach = std::max((B.p0 - origin_posed).norm(), (B.p0 + B.len * B.dir - origin_posed).norm());
-        ct->lin = gap / std::max(1.0, reach / r_a) - geo_tol;
+        ct->lin = seen_from_a(gap, reach);
         ct->rot = tilt - geo_tol;
         return false;
       }
@@ -881,7 +893,7 @@ struct ContactDetector::Impl {
     const Vec3& q = b.vertex(VertexId(ib)).p;  // f-v
     const double h = A.n.dot(q) - A.off;
     if (near_band(h)) return true;
-    if constexpr (kCertify) ct->lin = band_gap(h, h) / std::max(1.0, (q - origin_posed).norm() / r_a) - geo_tol;
+    if constexpr (kCertify) ct->lin = seen_from_a(band_gap(h, h), (q - origin_posed).norm());
     return false;
   }
 
@@ -1162,8 +1174,9 @@ struct ContactDetector::Impl {
       const double moved = have_last ? motion_bound(last_pose, pose) : std::numeric_limits<double>::infinity();
       last_pose = pose;
       have_last = true;
+      const bool rotation = ((pose.R_BA.transpose() * pose.R_BA - Mat3::Identity()) * bvh_a.origin()).norm() <= orth_allow;
       moved_from_kept = kept_valid ? motion_bound(kept_pose, pose) : std::numeric_limits<double>::infinity();
-      if (moved_from_kept <= prm.reuse_margin) {
+      if (rotation && moved_from_kept <= prm.reuse_margin) {
         reused = true;
         turned_from_kept = (pose.R_BA - kept_pose.R_BA).norm();
         certifying = true;
@@ -1176,7 +1189,7 @@ struct ContactDetector::Impl {
       // Keep pairs for the next poses only while A moves slowly enough for them to serve a
       // few; otherwise (poses far apart) the grown boxes would only cost.
       kept_valid = false;
-      recording = moved <= 0.5 * prm.reuse_margin;
+      recording = rotation && moved <= 0.5 * prm.reuse_margin;
       if (recording) {
         grow = static_cast<float>(prm.reuse_margin);
         num_kept = 0;
