@@ -242,7 +242,6 @@ struct ContactDetector::Impl {
   // orthonormal is detected from scratch.
   double orth_allow = 0;
   Vec3 origin_posed = Vec3::Zero();  // mm, bvh_a's origin at the current pose, B's frame
-  double float_slack = 0;            // mm, the float rounding allowance of the boxes
   bool have_last = false;
   float grow = 0;    // mm, added to A's posed boxes in this call
   double r_a = 0;    // mm, A's furthest vertex from bvh_a's origin
@@ -283,7 +282,7 @@ struct ContactDetector::Impl {
     // overlap test's few float operations on coordinates of this scale.
     double reach = ma.size() + mb.size();
     for (const Vertex& v : mb.vertices()) reach = std::max(reach, v.p.cwiseAbs().maxCoeff() + ma.size());
-    float_slack = 1e-5 * std::max(reach, 1.0);
+    const double float_slack = 1e-5 * std::max(reach, 1.0);
     orth_allow = 1e-5 * std::max({reach, bvh_a.origin().norm(), 1.0});
     // B's boxes grow by the deepest band and the in-plane allowance, so that every pair the
     // exact tests could accept has overlapping boxes.
@@ -931,14 +930,20 @@ struct ContactDetector::Impl {
     const int ia = kept[i].a, ib = kept[i].b;
     const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
     const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];
-    Cert c;
     ++pairs;
+    store(i, certified_test(x, y));
+  }
+
+  // The cheap rejection and the exact test of a pair, for kept pairs: the certificate of
+  // whichever turned it away (none when it passed both).
+  __attribute__((always_inline)) Cert certified_test(const detail::BvhElement& x, const detail::BvhElement& y) {
+    Cert c;
     if (may_touch<true>(x.kind, x.index, y.kind, y.index, &c)) {
       cert = Cert{};
       exact(x, y);
       c = cert;
     }
-    store(i, c);
+    return c;
   }
 
   // Keeps pair i's certificate, from this call's pose, counted from kept_pose.
@@ -982,12 +987,7 @@ struct ContactDetector::Impl {
       if (may_touch<false>(x.kind, x.index, y.kind, y.index, nullptr)) exact(x, y);
       return;
     }
-    Cert c;
-    if (may_touch<true>(x.kind, x.index, y.kind, y.index, &c)) {
-      cert = Cert{};
-      exact(x, y);
-      c = cert;
-    }
+    const Cert c = certified_test(x, y);
     if (num_kept < kept.size()) {
       kept[num_kept] = {ia, ib};
       store(num_kept++, c);
