@@ -495,12 +495,47 @@ TEST_CASE("convexity: one loop, no reflex corner", "[detector]") {
 }
 
 namespace {
+cf::DetectionParams band(double eps) {
+  cf::DetectionParams p;
+  p.epsilon = p.max_penetration = eps;
+  return p;
+}
+cf::DetectionParams all_pairs(cf::DetectionParams p) {
+  p.use_bvh = false;
+  return p;
+}
+cf::DetectionParams not_kept(cf::DetectionParams p) {
+  p.reuse_margin = 0;
+  return p;
+}
+// One model pair under a detector and a reference detector (all pairs, or no kept pairs),
+// posed alike; x and y hold their last results.
+struct Twin {
+  cf::ContactDetector det, ref;
+  cf::ContactSet x, y;
+  Twin(const cf::Polyhedron& a, const cf::Polyhedron& b, const cf::DetectionParams& p, const cf::DetectionParams& q)
+      : det(a, b, p), ref(a, b, q) {}
+  void detect(const cf::Pose& pose) {
+    det.detect(pose, x);
+    ref.detect(pose, y);
+  }
+};
 // Culled detection against all pairs: the same PCs, in the same order, at the same distances.
 void check_same_contacts(const cf::ContactSet& x, const cf::ContactSet& y) {
   REQUIRE(x.size() == y.size());
   for (int i = 0; i < x.size(); ++i) {
     CHECK(x[i].pc == y[i].pc);
     CHECK(x[i].distance == y[i].distance);
+  }
+}
+// Kept pairs against none: that, and the same dominance and contact planes.
+void check_same_readings(const cf::ContactSet& x, const cf::ContactSet& y) {
+  REQUIRE(x.size() == y.size());
+  for (int i = 0; i < x.size(); ++i) {
+    CHECK(x[i].pc == y[i].pc);
+    CHECK(x[i].distance == y[i].distance);
+    CHECK(x[i].dominated == y[i].dominated);
+    CHECK(x[i].plane == y[i].plane);
   }
 }
 }  // namespace
@@ -516,12 +551,7 @@ TEST_CASE("the BVH finds what all pairs find on faceted spheres", "[detector]") 
   const Vec3 ca = far ? Vec3(4000, -3000, 2500) : Vec3::Zero(), cb = far ? Vec3(-2500, 1500, 3000) : Vec3::Zero();
   const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30, ca);
   const cf::Polyhedron b = tm::faceted_sphere(50, 21, 32, cb);
-  cf::DetectionParams prm;
-  prm.epsilon = prm.max_penetration = eps;
-  cf::DetectionParams all = prm;
-  all.use_bvh = false;
-  cf::ContactDetector fast(a, b, prm), slow(a, b, all);
-  cf::ContactSet x, y;
+  Twin t(a, b, band(eps), all_pairs(band(eps)));
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> U(-1, 1);
   int contacts = 0;
@@ -531,12 +561,11 @@ TEST_CASE("the BVH finds what all pairs find on faceted spheres", "[detector]") 
     const Vec3 dir = Vec3(U(rng), U(rng), U(rng)).normalized();
     const Eigen::Matrix3d R = rot(3 * U(rng), Vec3(U(rng), U(rng), U(rng)));
     const cf::Pose p = pose(R, cb + dir * (80 + 1.1 * eps * U(rng)) - R * ca);
-    fast.detect(p, x);
-    slow.detect(p, y);
+    t.detect(p);
     INFO("epsilon " << eps << ", far " << far << ", pose " << k);
-    check_same_contacts(x, y);
-    contacts += x.size();
-    CHECK(fast.last_pairs_tested() * 100 < slow.last_pairs_tested());
+    check_same_contacts(t.x, t.y);
+    contacts += t.x.size();
+    CHECK(t.det.last_pairs_tested() * 100 < t.ref.last_pairs_tested());
   }
   CHECK(contacts > 0);
 }
@@ -549,12 +578,7 @@ TEST_CASE("the BVH finds what all pairs find for a big model against a small one
   const cf::Polyhedron sphere = tm::faceted_sphere(30, 20, 30, Vec3(5, -3, 2));
   const cf::Polyhedron a = which == 0 ? sphere : which == 1 ? tm::cube() : tm::l_block();
   const cf::Polyhedron b = which == 0 ? tm::l_block() : sphere;
-  cf::DetectionParams prm;
-  prm.epsilon = prm.max_penetration = eps;
-  cf::DetectionParams all = prm;
-  all.use_bvh = false;
-  cf::ContactDetector fast(a, b, prm), slow(a, b, all);
-  cf::ContactSet x, y;
+  Twin t(a, b, band(eps), all_pairs(band(eps)));
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> U(-1, 1);
   int contacts = 0;
@@ -569,12 +593,11 @@ TEST_CASE("the BVH finds what all pairs find for a big model against a small one
     for (const cf::Vertex& v : a.vertices())
       if (dir.dot(R * v.p) < dir.dot(low)) low = R * v.p;
     const cf::Pose p = pose(R, top + 1.1 * eps * U(rng) * dir - low);
-    fast.detect(p, x);
-    slow.detect(p, y);
+    t.detect(p);
     INFO("epsilon " << eps << ", pair " << which << ", pose " << k);
-    check_same_contacts(x, y);
-    contacts += x.size();
-    CHECK(fast.last_pairs_tested() * 10 < slow.last_pairs_tested());
+    check_same_contacts(t.x, t.y);
+    contacts += t.x.size();
+    CHECK(t.det.last_pairs_tested() * 10 < t.ref.last_pairs_tested());
   }
   CHECK(contacts > 24);
 }
@@ -603,12 +626,7 @@ TEST_CASE("the BVH finds what all pairs find in a torus's hole", "[detector]") {
   // side (reflex edges, non-convex surroundings) on one side and then another.
   const double eps = GENERATE(1.0, 0.1);
   const cf::Polyhedron a = tm::faceted_sphere(18, 16, 24), b = faceted_torus(30, 10, 24, 16);
-  cf::DetectionParams prm;
-  prm.epsilon = prm.max_penetration = eps;
-  cf::DetectionParams all = prm;
-  all.use_bvh = false;
-  cf::ContactDetector fast(a, b, prm), slow(a, b, all);
-  cf::ContactSet x, y;
+  Twin t(a, b, band(eps), all_pairs(band(eps)));
   std::mt19937 rng(23);
   std::uniform_real_distribution<double> U(-1, 1);
   int contacts = 0, reflex = 0;
@@ -618,16 +636,15 @@ TEST_CASE("the BVH finds what all pairs find in a torus's hole", "[detector]") {
     const double az = M_PI * U(rng);
     const Vec3 off = (1.8 + 0.2 * U(rng)) * Vec3(std::cos(az), std::sin(az), 0) + Vec3(0, 0, 2 * U(rng));
     const cf::Pose p = pose(rot(3 * U(rng), Vec3(U(rng), U(rng), U(rng))), off);
-    fast.detect(p, x);
-    slow.detect(p, y);
+    t.detect(p);
     INFO("epsilon " << eps << ", pose " << k);
     // Within ContactSet's capacity: past it, which contacts are kept depends on the order
     // they are found in.
-    REQUIRE(!y.overflow());
-    check_same_contacts(x, y);
-    for (const cf::ContactPc& c : x)
+    REQUIRE(!t.y.overflow());
+    check_same_contacts(t.x, t.y);
+    for (const cf::ContactPc& c : t.x)
       if (c.pc.type == PcType::kFE && !b.edges()[static_cast<std::size_t>(c.pc.b)].convex) ++reflex;
-    contacts += x.size();
+    contacts += t.x.size();
   }
   CHECK(contacts > 8);
   CHECK(reflex == 0);  // a face never touches a reflex edge as f-e
@@ -641,13 +658,8 @@ TEST_CASE("pairs kept between nearby poses give what the hierarchy gives", "[det
   const double eps = GENERATE(1.0, 0.1);
   const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30);
   const cf::Polyhedron b = tm::faceted_sphere(50, 21, 32);
-  cf::DetectionParams prm;
-  prm.epsilon = prm.max_penetration = eps;
-  cf::DetectionParams cold = prm;
-  cold.reuse_margin = 0;
-  REQUIRE(prm.reuse_margin > 0);
-  cf::ContactDetector warm_det(a, b, prm), cold_det(a, b, cold);
-  cf::ContactSet x, y;
+  REQUIRE(band(eps).reuse_margin > 0);
+  Twin t(a, b, band(eps), not_kept(band(eps)));
   int reused = 0, contacts = 0;
   const int n = 400;
   for (int k = 0; k < n; ++k) {
@@ -658,19 +670,12 @@ TEST_CASE("pairs kept between nearby poses give what the hierarchy gives", "[det
     // swinging by an epsilon around 0.15 mm deep keep the meshes in or near the band.
     const double gap = (k % 100 == 50) ? 5.0 : eps * 0.5 * std::sin(20 * s) - 0.15;
     const cf::Pose p = pose(R, dir * (80 + gap));
-    warm_det.detect(p, x);
-    cold_det.detect(p, y);
+    t.detect(p);
     INFO("epsilon " << eps << ", tick " << k);
-    REQUIRE(x.size() == y.size());
-    for (int i = 0; i < x.size(); ++i) {
-      CHECK(x[i].pc == y[i].pc);
-      CHECK(x[i].distance == y[i].distance);
-      CHECK(x[i].dominated == y[i].dominated);
-      CHECK(x[i].plane == y[i].plane);
-    }
-    CHECK_FALSE(cold_det.last_reused_pairs());
-    reused += warm_det.last_reused_pairs() ? 1 : 0;
-    contacts += x.size();
+    check_same_readings(t.x, t.y);
+    CHECK_FALSE(t.ref.last_reused_pairs());
+    reused += t.det.last_reused_pairs() ? 1 : 0;
+    contacts += t.x.size();
   }
   CAPTURE(contacts, reused);
   CHECK(contacts > 50);  // contacts on a good share of the ticks (over 100 at either epsilon)
@@ -680,11 +685,10 @@ TEST_CASE("pairs kept between nearby poses give what the hierarchy gives", "[det
   std::uniform_real_distribution<double> U(-1, 1);
   for (int k = 0; k < 20; ++k) {
     const cf::Pose p = pose(rot(3 * U(rng), Vec3(U(rng), U(rng), U(rng))), Vec3(U(rng), U(rng), U(rng)).normalized() * 80);
-    warm_det.detect(p, x);
-    cold_det.detect(p, y);
-    CHECK_FALSE(warm_det.last_reused_pairs());
-    REQUIRE(x.size() == y.size());
-    for (int i = 0; i < x.size(); ++i) CHECK(x[i].pc == y[i].pc);
+    t.detect(p);
+    CHECK_FALSE(t.det.last_reused_pairs());
+    REQUIRE(t.x.size() == t.y.size());
+    for (int i = 0; i < t.x.size(); ++i) CHECK(t.x[i].pc == t.y[i].pc);
   }
 }
 
@@ -698,32 +702,21 @@ struct WarmCold {
 };
 WarmCold compare_warm_cold(const cf::Polyhedron& a, const cf::Polyhedron& b, double eps,
                            const std::vector<cf::Pose>& poses, double reuse_margin = cf::DetectionParams{}.reuse_margin) {
-  cf::DetectionParams prm;
-  prm.epsilon = prm.max_penetration = eps;
+  cf::DetectionParams prm = band(eps);
   prm.reuse_margin = reuse_margin;
-  cf::DetectionParams cold = prm;
-  cold.reuse_margin = 0;
-  cf::ContactDetector warm_det(a, b, prm), cold_det(a, b, cold);
-  cf::ContactSet x, y;
+  Twin t(a, b, prm, not_kept(prm));
   WarmCold r;
   for (std::size_t k = 0; k < poses.size(); ++k) {
-    warm_det.detect(poses[k], x);
-    cold_det.detect(poses[k], y);
+    t.detect(poses[k]);
     INFO("epsilon " << eps << ", tick " << k);
-    REQUIRE(!y.overflow());
-    REQUIRE(x.size() == y.size());
-    for (int i = 0; i < x.size(); ++i) {
-      CHECK(x[i].pc == y[i].pc);
-      CHECK(x[i].distance == y[i].distance);
-      CHECK(x[i].dominated == y[i].dominated);
-      CHECK(x[i].plane == y[i].plane);
-    }
-    if (warm_det.last_reused_pairs()) {
+    REQUIRE(!t.y.overflow());
+    check_same_readings(t.x, t.y);
+    if (t.det.last_reused_pairs()) {
       ++r.reused;
-      r.warm_pairs += warm_det.last_pairs_tested();
-      r.cold_pairs += cold_det.last_pairs_tested();
+      r.warm_pairs += t.det.last_pairs_tested();
+      r.cold_pairs += t.ref.last_pairs_tested();
     }
-    r.contacts += x.size();
+    r.contacts += t.x.size();
   }
   return r;
 }
