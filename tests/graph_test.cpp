@@ -7,6 +7,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -320,7 +323,7 @@ TEST_CASE("save writes JSON or CBOR whole and load reads it back", "[graph]") {
   CHECK(entries == 2);
   CHECK_THROWS_WITH(g.save((dir / "no" / "such" / "dir.json").string()),
                     Catch::Contains("writing graph '" + (dir / "no" / "such" / "dir.json").string() +
-                                    "': cannot create a temporary file in '" + (dir / "no" / "such").string()));
+                                    "': the directory '" + (dir / "no" / "such").string() + "' does not exist"));
   std::filesystem::remove_all(dir);
 }
 
@@ -526,11 +529,42 @@ TEST_CASE("from_parts rejects metadata that is not an object or that overrides t
 
 TEST_CASE("load: a missing file", "[graph][bad]") {
   CHECK_THROWS_WITH(CfGraph::load(bad("no_such_file.json")),
-                    Catch::Contains("reading '" + bad("no_such_file.json") + "': cannot open: No such file or directory"));
+                    Catch::Contains("reading '" + bad("no_such_file.json") + "': cannot open: no such file"));
 }
 
 TEST_CASE("load: a directory", "[graph][bad]") {
-  CHECK_THROWS_WITH(CfGraph::load(kGraphDir), Catch::Contains("reading '" + kGraphDir + "': is a directory, not a graph file"));
+  CHECK_THROWS_WITH(CfGraph::load(kGraphDir),
+                    Catch::Contains("reading '" + kGraphDir + "': cannot open: is a directory, not a regular file"));
+}
+
+TEST_CASE("load: a FIFO is refused at once, never read (no writer: reading would block)", "[graph][bad]") {
+  const std::string fifo = (std::filesystem::temp_directory_path() / ("cf_graph_fifo_" + std::to_string(::getpid()) + ".json")).string();
+  std::remove(fifo.c_str());
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  CHECK_THROWS_WITH(CfGraph::load(fifo), Catch::Contains("reading '" + fifo + "': cannot open: is a FIFO (named pipe), not a regular file"));
+  std::remove(fifo.c_str());
+}
+
+TEST_CASE("load: CBOR and JSON nesting is capped at 256 levels (100,000 used to overflow the stack)", "[graph][bad]") {
+  // {"x": [[[...null...]]]}: a free-form member, 100,000 arrays deep.
+  std::string cbor = "\xa1\x61x";
+  cbor.append(100000, '\x81');
+  cbor += '\xf6';
+  CHECK_THROWS_WITH(CfGraph::from_bytes(cbor, "deep.cbor", true),
+                    Catch::Contains("reading 'deep.cbor': not valid CBOR: nesting deeper than 256 levels"));
+  // 256 levels are fine as far as nesting goes (the file then fails for what it lacks).
+  std::string ok = "\xa1\x61x";
+  ok.append(255, '\x81');
+  ok += '\xf6';
+  CHECK_THROWS_WITH(CfGraph::from_bytes(ok, "ok.cbor", true), !Catch::Contains("nesting"));
+  const std::string json = "{\"x\":" + std::string(100000, '[') + std::string(100000, ']') + "}";
+  CHECK_THROWS_WITH(CfGraph::from_bytes(json, "deep.json", false), Catch::Contains("nesting deeper than 256 levels"));
+}
+
+TEST_CASE("load: invalid UTF-8 in a CBOR graph's strings is reported, not an internal error", "[graph][bad]") {
+  // {"format": "\xff"}: nlohmann's dump() throws on invalid UTF-8 unless told to replace it.
+  const std::string cbor = "\xa1\x66" "format" "\x61\xff";
+  CHECK_THROWS_WITH(CfGraph::from_bytes(cbor, "utf8.cbor", true), Catch::Contains("reading 'utf8.cbor' at /format: format is"));
 }
 
 TEST_CASE("load: truncated JSON gives the line and column", "[graph][bad]") {

@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
@@ -172,7 +174,7 @@ TEST_CASE("files that cannot be read are rejected, naming the file", "[mesh_io]"
                     Catch::Contains("loading '" + missing + "': cannot open file: no such file"));
   fs::create_directories(scratch() / "dir.off");
   CHECK_THROWS_WITH(load_model((scratch() / "dir.off").string()),
-                    Catch::Contains("dir.off': cannot open file: not a regular file"));
+                    Catch::Contains("dir.off': cannot open file: is a directory, not a regular file"));
   const std::string empty = write_file("empty.off", "");
   CHECK_THROWS_WITH(load_model(empty), Catch::Contains("loading '" + empty + "': the file is empty"));
   const std::string xyz = write_file("cube.xyz", off_text(kCubeV, kCubeF));
@@ -183,24 +185,92 @@ TEST_CASE("files that cannot be read are rejected, naming the file", "[mesh_io]"
 }
 
 TEST_CASE("malformed files are parse errors", "[mesh_io]") {
-  CHECK_THROWS_WITH(load_model(write_file("bad.off", "OFF\n8 6 0\n0 0 zero\n")),
-                    Catch::Contains("bad.off': parse error: not a readable OFF file"));
+  CHECK_THROWS_WITH(load_model(write_file("bad.off", "OFF\n3 1 0\n0 0 zero\n1 0 0\n0 1 0\n3 0 1 2\n")),
+                    Catch::Contains("bad.off': parse error: line 3: vertex 0: 'zero' is not a finite number"));
   CHECK_THROWS_WITH(load_model(write_file("bad.obj", "v 0 0 0\nbogus line\n")),
-                    Catch::Contains("bad.obj': parse error: not a readable OBJ file"));
+                    Catch::Contains("bad.obj': parse error: line 2: unknown OBJ record 'bogus'"));
   CHECK_THROWS_WITH(load_model(write_file("bad.stl", "solid x\n  facet normal 0 0 1\n    outer loop\n"
                                                     "      vertex 0 0 nope\n")),
-                    Catch::Contains("bad.stl': parse error: not a readable STL file"));
+                    Catch::Contains("bad.stl': parse error: line 4: expected a finite number in a vertex, found 'nope'"));
   CHECK_THROWS_WITH(load_model(write_file("bad.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
                                                     "property float x\nend_header\n1\n")),
-                    Catch::Contains("bad.ply': parse error: not a readable PLY file"));
-  // A facet index beyond the vertex list: CGAL's OFF reader rejects it; its OBJ reader lets
-  // index n (one past the end) through, which the loader catches.
+                    Catch::Contains("bad.ply': parse error: the header's element counts need at least 6 bytes of data, but the file has 2 after the header"));
+  // A facet index beyond the vertex list, in OFF and in OBJ (where it may point forward).
   auto f = kCubeF;
   f[0] = {0, 3, 2, 9};
   CHECK_THROWS_WITH(load_model(write_file("index.off", off_text(kCubeV, f))),
-                    Catch::Contains("index.off': parse error: not a readable OFF file"));
+                    Catch::Contains("index.off': parse error: line 11: facet 0 refers to vertex 9 but the file has 8 vertices (0 to 7)"));
   CHECK_THROWS_WITH(load_model(write_file("index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n")),
                     Catch::Contains("index.obj': parse error: facet 0 refers to vertex 3 but the file has 3 vertices"));
+}
+
+TEST_CASE("header counts are checked against the file's size before anything is allocated", "[mesh_io][hostile]") {
+  // Each of these used to allocate gigabytes (CGAL reserves what the header says).
+  CHECK_THROWS_WITH(load_model(write_file("count.off", "OFF\n3 999999999 0\n0 0 0\n1 0 0\n0 1 0\n")),
+                    Catch::Contains("count.off': parse error: the header says 3 vertices and 999999999 facets, more than the "
+                                    "remaining 18 bytes of the file can hold"));
+  CHECK_THROWS_WITH(load_model(write_file("facet.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n1000000000 0 1 2\n")),
+                    Catch::Contains("facet.off': parse error: line 6: facet 0 says it has 1000000000 vertices but its line "
+                                    "lists 3 numbers"));
+  CHECK_THROWS_WITH(load_model(write_file("count.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\n"
+                                                      "property float x\nproperty float y\nproperty float z\nend_header\n")),
+                    Catch::Contains("count.ply': parse error: the header's element counts need at least 48000000000 bytes"));
+  CHECK_THROWS_WITH(load_model(write_file("list.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 0\n"
+                                                     "property float x\nproperty float y\nproperty float z\nelement face 1\n"
+                                                     "property list uint int vertex_indices\nend_header\n\xff\xff\xff\x7f")),
+                    Catch::Contains("list.ply': parse error: item 0 of element 'face' has a list of 2147483647 values, more than "
+                                    "the rest of the file holds"));
+  std::string stl(80, ' ');
+  stl += std::string("\xff\xff\xff\x7f", 4);
+  CHECK_THROWS_WITH(load_model(write_file("count.stl", stl)),
+                    Catch::Contains("count.stl': parse error: not an ascii STL (no 'solid'), and as binary STL its header says "
+                                    "2147483647 triangles"));
+}
+
+TEST_CASE("indices and coordinates out of range get precise messages", "[mesh_io][hostile]") {
+  auto f = kCubeF;
+  std::string text = off_text(kCubeV, f);
+  text.replace(text.find("\n4 0 3 2 1\n"), 11, "\n4 99999999999999999999 3 2 1\n");
+  CHECK_THROWS_WITH(load_model(write_file("index20.off", text)),
+                    Catch::Contains("index20.off': parse error: line 11: facet 0 refers to vertex 99999999999999999999 but the "
+                                    "file has 8 vertices (0 to 7)"));
+  CHECK_THROWS_WITH(load_model(write_file("index20.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n")),
+                    Catch::Contains("index20.obj': parse error: line 4: facet 0 refers to vertex 99999999999999999999, which "
+                                    "does not exist"));
+  std::vector<cf::Vec3> v = kCubeV;
+  for (auto& p : v) p *= 1e300;
+  CHECK_THROWS_WITH(load_model(write_file("huge.off", off_text(v, kCubeF))),
+                    Catch::Contains("huge.off': vertex 1 has the coordinate 1e+301 mm, beyond the largest accepted (|x| <= 1e+09 mm)"));
+  CHECK_THROWS_WITH(load_model(write_file("inf.off", "OFF\n3 1 0\n0 0 0\n1e999 0 0\n0 1 0\n3 0 1 2\n")),
+                    Catch::Contains("inf.off': parse error: line 4: vertex 1: '1e999' is not a finite number"));
+  // Binary garbage is quoted printable.
+  CHECK_THROWS_WITH(load_model(write_file("garbage.obj", "v 0 0 0\n\x01\x1b[2J\xff x\n")),
+                    Catch::Contains("garbage.obj': parse error: line 2: unknown OBJ record '\\x01\\x1B[2J\\xFF'"));
+}
+
+TEST_CASE("a FIFO is refused without blocking", "[mesh_io][hostile]") {
+  const std::string fifo = (scratch() / "fifo.off").string();
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  CHECK_THROWS_WITH(load_model(fifo), Catch::Contains("fifo.off': cannot open file: is a FIFO (named pipe), not a regular file"));
+}
+
+TEST_CASE("units: the points are converted to mm", "[mesh_io][units]") {
+  std::vector<cf::Vec3> v = kCubeV;
+  for (auto& p : v) p /= 1000;  // the 10 mm cube in metres
+  const std::string path = write_file("cube_m.off", off_text(v, kCubeF));
+  cf::tools::LoadOptions opt;
+  opt.units = "m";
+  check_cube(load_model(path, opt));
+  const cf::Polyhedron raw = load_model(path);
+  CHECK(raw.size() == Approx(0.01 * std::sqrt(3.0)));
+  CHECK_THAT(cf::tools::size_warning(raw, "A", "--units-a"),
+             Catch::StartsWith("model A 'cube_m' is 0.01732 mm across (bounding-box diagonal), small against the contact "
+                               "threshold epsilon = 1 mm") && Catch::EndsWith("give its unit with --units-a (mm, cm, m or in)"));
+  CHECK(cf::tools::size_warning(load_model(path, opt), "A", "--units-a").empty());
+  opt.units = "in";
+  CHECK(load_model(path, opt).size() == Approx(0.01 * 25.4 * std::sqrt(3.0)));
+  opt.units = "furlong";
+  CHECK_THROWS_WITH(load_model(path, opt), Catch::Contains("unknown unit 'furlong' (expected mm, cm, m or in)"));
 }
 
 TEST_CASE("a file without facets is rejected", "[mesh_io]") {

@@ -1,24 +1,18 @@
 // The CF graph file (SPEC section 5): writing (deterministic, whole-or-nothing) and reading
 // (JSON or CBOR, schema-validated, every fault named by file and JSON pointer).
 
+#include "file_io.hpp"
 #include "graph_impl.hpp"
 #include "graph_schema.hpp"
 #include "json_util.hpp"
 #include "polyhedron_json.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <iterator>
 #include <sstream>
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 namespace cf {
 
@@ -303,8 +297,6 @@ void print(const ojson& v, int indent, int level, bool items_inline, std::string
   out += "\n" + std::string(static_cast<std::size_t>(indent * level), ' ') + (v.is_object() ? "}" : "]");
 }
 
-std::string errno_text() { return std::strerror(errno); }
-
 }  // namespace
 
 std::string CfGraph::to_json(int indent) const {
@@ -361,20 +353,11 @@ void CfGraph::save(const std::string& path) const {
 CfGraph CfGraph::load(const std::string& path) { return load(path, GraphLoadOptions()); }
 
 CfGraph CfGraph::load(const std::string& path, const GraphLoadOptions& options) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("reading '" + path + "': cannot open: " + errno_text());
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw Error("reading '" + path + "': is a directory, not a graph file");
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  in.seekg(0, std::ios::beg);
-  if (size < 0) throw Error("reading '" + path + "': cannot determine its size");
-  // Uninitialised buffer: zero-filling 50 MB first would be wasted work.
-  const auto n = static_cast<std::size_t>(size);
-  std::unique_ptr<char[]> bytes(new char[n > 0 ? n : 1]);
-  if (n > 0 && !in.read(bytes.get(), size)) throw Error("reading '" + path + "': read failed: " + errno_text());
+  // Never blocks on a FIFO; a directory, a device or a FIFO is refused before reading.
+  std::string bytes, why;
+  if (!detail::read_input_file(path, bytes, why)) throw Error("reading '" + path + "': cannot open: " + why);
   CfGraph g;
-  g.impl_ = detail::read_graph(bytes.get(), n, path, is_cbor_path(path), options);
+  g.impl_ = detail::read_graph(bytes.data(), bytes.size(), path, is_cbor_path(path), options);
   return g;
 }
 
@@ -388,39 +371,7 @@ CfGraph CfGraph::from_bytes(const std::string& bytes, const std::string& source,
 namespace detail {
 
 void write_file_atomically(const std::string& path, const std::string& bytes, const char* what) {
-  const std::size_t slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash == 0 ? 1 : slash);
-  std::string tmp = path + ".tmp-XXXXXX";
-  const int fd = ::mkstemp(tmp.data());
-  if (fd < 0)
-    throw Error(std::string(what) + " '" + path + "': cannot create a temporary file in '" + dir +
-                "': " + errno_text());
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const std::string why = errno_text();
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      throw Error(std::string(what) + " '" + path + "': write failed: " + why);
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    const std::string why = errno_text();
-    ::unlink(tmp.c_str());
-    throw Error(std::string(what) + " '" + path + "': write failed: " + why);
-  }
-  // mkstemp creates the file 0600; a graph is an ordinary document.
-  const mode_t mask = ::umask(0);
-  ::umask(mask);
-  ::chmod(tmp.c_str(), 0666 & ~mask);
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string why = errno_text();
-    ::unlink(tmp.c_str());
-    throw Error(std::string(what) + " '" + path + "': cannot rename the temporary file into place: " + why);
-  }
+  write_outputs({OutputFile{path, bytes}}, {}, what);
 }
 
 }  // namespace detail

@@ -26,6 +26,8 @@ namespace cf::detail {
 namespace {
 
 constexpr std::size_t kNoFault = static_cast<std::size_t>(-1);
+/// Deepest nesting of arrays and objects accepted, in JSON and in CBOR.
+constexpr std::size_t kMaxNesting = 256;
 
 /// A CF's PCs as the file gives them (order kept for error pointers), checked against the
 /// models once those are read.
@@ -365,6 +367,11 @@ bool GraphSax::scalar(const Scalar& s) {
 }
 
 bool GraphSax::start(bool object) {
+  // nlohmann's CBOR reader recurses once per level: without a cap, a few hundred thousand
+  // nested arrays overflow the stack. JSON is capped by FastJsonParser at the same depth.
+  if (cbor_ && stack_.size() > kMaxNesting)
+    throw Error("reading '" + source_ + "': not valid CBOR: nesting deeper than " + std::to_string(kMaxNesting) +
+                " levels");
   const Ctx c = stack_.back();
   if (c == Ctx::kDocument) {
     if (!object) {
@@ -588,7 +595,7 @@ class FastJsonParser {
   }
 
  private:
-  static constexpr int kMaxDepth = 256;
+  static constexpr int kMaxDepth = static_cast<int>(kMaxNesting);
 
   [[noreturn]] void fail(const std::string& what) const {
     std::size_t line = 1, col = 1;
@@ -966,7 +973,7 @@ std::unique_ptr<CfGraph::Impl> read_graph(const char* data, std::size_t size, co
   json meta = json::object();
   for (auto it = j.begin(); it != j.end(); ++it)
     if (!is_reserved(it.key())) meta[it.key()] = it.value();
-  impl->metadata = meta.dump();
+  impl->metadata = meta.dump(-1, ' ', false, json::error_handler_t::replace);
   impl->transitions = std::move(sax.transitions);
   impl->build(where);
   return impl;

@@ -25,7 +25,7 @@ struct JsonWhere {
 }
 
 inline std::string json_short(const json& j) {
-  std::string s = j.dump();
+  std::string s = j.dump(-1, ' ', false, json::error_handler_t::replace);
   if (s.size() > 40) s = s.substr(0, 37) + "...";
   return s;
 }

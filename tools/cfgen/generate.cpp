@@ -3,6 +3,8 @@
 #include "cfgen/enumerate.hpp"
 #include "mesh/model_loader.hpp"
 
+#include "file_io.hpp"  // libcf private: output path checks
+
 #include <cf/graph.hpp>
 
 #include <nlohmann/json.hpp>
@@ -10,13 +12,20 @@
 #include <chrono>
 #include <iostream>
 #include <thread>
+#include <tuple>
 
 namespace cf::tools {
 
 int run_generate(const GenerateArgs& args) {
   const auto t0 = std::chrono::steady_clock::now();
-  const Polyhedron A = load_model(args.a_path);
-  const Polyhedron B = load_model(args.b_path);
+  // The output path is checked before the work: not a device, FIFO or directory, not one of
+  // the models (SPEC section 5b).
+  const std::vector<std::string> inputs{args.a_path, args.b_path};
+  detail::check_output_path(args.out_path, inputs, "writing graph");
+  const Polyhedron A = load_model(args.a_path, args.load_a);
+  const Polyhedron B = load_model(args.b_path, args.load_b);
+  for (const auto& [m, which, option] : {std::tuple{&A, "A", "--units-a"}, std::tuple{&B, "B", "--units-b"}})
+    if (const std::string w = size_warning(*m, which, option); !w.empty()) std::cerr << "cfgen: warning: " << w << '\n';
   const gen::ModelInfo ai = gen::analyse_model(A);
   const gen::ModelInfo bi = gen::analyse_model(B);
 
@@ -66,10 +75,16 @@ int run_generate(const GenerateArgs& args) {
                         {"max_rotations", s.max_rotations},
                         {"max_pcs", opt.max_pcs}};
   meta["generator"] = {{"name", "cfgen"}, {"a_model", args.a_path}, {"b_model", args.b_path}};
+  // Coordinates are stored in mm; the unit each model file was read in (SPEC section 2).
+  meta["source_units"] = {{"A", args.load_a.units}, {"B", args.load_b.units}};
 
   const std::size_t n_cfs = e.cfs.size(), n_tr = e.transitions.size();
   const CfGraph graph = CfGraph::from_parts(A, B, e.cfs, e.transitions, meta.dump());
+  detail::check_output_path(args.out_path, inputs, "writing graph");
   graph.save(args.out_path);
+  if (n_cfs == 0)
+    std::cerr << "cfgen: warning: the graph has no CF: A (" << A.size() << " mm across) and B (" << B.size()
+              << " mm across) never touch in a valid contact formation; are the models' units right (--units)?\n";
   if (!args.quiet)
     std::cerr << "cfgen: " << n_cfs << " CFs (" << e.levels[0].valid << " + " << e.levels[1].valid
               << " + " << e.levels[2].valid << "), " << n_tr << " transitions, " << seconds

@@ -5,6 +5,7 @@
 /// present, which defines CF_HAVE_GENERATOR).
 
 #include "cfgen/witness.hpp"
+#include "mesh/model_loader.hpp"
 
 #include <string>
 
@@ -19,6 +20,7 @@ struct GenerateArgs {
   bool quiet = false;    ///< no progress on stderr
   int max_pcs = 3;       ///< largest CFs to enumerate (1..3)
   gen::SearchParams search;  ///< tolerances and search limits of the witness search
+  LoadOptions load_a, load_b;  ///< units and coplanarity tolerance of each model
 };
 
 /// Generates the CF graph of A against B and writes it to args.out_path.

@@ -4,6 +4,7 @@
 
 #include "cfgen/generate.hpp"
 #include "mesh/model_loader.hpp"
+#include "cli_checks.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -13,10 +14,10 @@
 
 namespace {
 
-int print_features(const std::string& path, double coplanar_tol) {
-  cf::tools::LoadOptions opt;
-  opt.coplanar_rel_tol = coplanar_tol;
+int print_features(const std::string& path, const cf::tools::LoadOptions& opt) {
   const cf::Polyhedron model = cf::tools::load_model(path, opt);
+  if (const std::string w = cf::tools::size_warning(model, "", "--units"); !w.empty())
+    std::cerr << "cfgen: warning: " << w << '\n';
   std::cout << cf::to_json(model) << '\n';
   std::cout.flush();
   if (!std::cout) throw cf::Error("writing the features to stdout failed");
@@ -36,6 +37,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> models;
   cf::tools::GenerateArgs gen;
   double coplanar_tol = cf::tools::LoadOptions{}.coplanar_rel_tol;
+  std::string units = "mm", units_a, units_b;
 
   auto* features = app.add_option("--features", features_path,
                                   "print the features (vertices, edges, faces) of MODEL as JSON")
@@ -45,7 +47,7 @@ int main(int argc, char** argv) {
                   ->type_name("MODEL");
   auto* out = app.add_option("-o,--output", gen.out_path, "graph file to write")->type_name("GRAPH.json");
   auto* threads = app.add_option("-j,--threads", gen.threads, "worker threads (0: all cores)")
-                      ->check(CLI::NonNegativeNumber);
+                      ->check(CLI::Range(0, 1024));
   auto* quiet = app.add_flag("-q,--quiet", gen.quiet, "no progress messages");
   // Witness-search tolerances and limits (docs/generator.md explains each).
   auto& sp = gen.search;
@@ -55,23 +57,23 @@ int main(int argc, char** argv) {
                          ->capture_default_str());
   gen_opts.push_back(app.add_option("--touch-tol", sp.touch_tol,
                                     "mm: element pairs closer than this touch")
-                         ->check(CLI::Range(1e-12, 1e-3))
+                         ->check(cf::cli::finite_range(1e-12, 1e-3))
                          ->capture_default_str());
   gen_opts.push_back(app.add_option("--min-clearance", sp.min_clearance,
                                     "mm: at a witness, every pair not part of a PC is at least this far apart")
-                         ->check(CLI::Range(1e-9, 100.0))
+                         ->check(cf::cli::finite_range(1e-9, 100.0))
                          ->capture_default_str());
   gen_opts.push_back(app.add_option("--good-clearance", sp.good_clearance,
                                     "mm: stop searching a CF's witness once it is this clear")
-                         ->check(CLI::Range(1e-9, 1000.0))
+                         ->check(cf::cli::finite_range(1e-9, 1000.0))
                          ->capture_default_str());
   gen_opts.push_back(app.add_option("--min-margin", sp.min_margin,
                                     "mm: contact point at least this far inside its elements")
-                         ->check(CLI::Range(1e-9, 100.0))
+                         ->check(cf::cli::finite_range(1e-9, 100.0))
                          ->capture_default_str());
   gen_opts.push_back(app.add_option("--angle-margin", sp.angle_margin,
                                     "rad: local non-penetration slack at each PC")
-                         ->check(CLI::Range(1e-9, 0.5))
+                         ->check(cf::cli::finite_range(1e-9, 0.5))
                          ->capture_default_str());
   gen_opts.push_back(app.add_option("--theta-samples", sp.theta_samples,
                                     "samples of a one-parameter rotation family")
@@ -83,7 +85,14 @@ int main(int argc, char** argv) {
                          ->capture_default_str());
   app.add_option("--coplanar-tol", coplanar_tol,
                  "coplanarity tolerance relative to the model's bounding-box diagonal")
-      ->check(CLI::Range(1e-12, 0.1));
+      ->check(cf::cli::finite_range(cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol));
+  // Model units (SPEC section 2): files carry none; mm unless said otherwise.
+  const auto unit_names = CLI::IsMember({"mm", "cm", "m", "in"});
+  app.add_option("--units", units, "length unit of every model file: mm, cm, m or in (the graph stores mm)")
+      ->check(unit_names)
+      ->capture_default_str();
+  gen_opts.push_back(app.add_option("--units-a", units_a, "length unit of A_MODEL (overrides --units)")->check(unit_names));
+  gen_opts.push_back(app.add_option("--units-b", units_b, "length unit of B_MODEL (overrides --units)")->check(unit_names));
   features->excludes(pos)->excludes(out);
   for (CLI::Option* o : gen_opts) features->excludes(o);
 
@@ -97,7 +106,10 @@ int main(int argc, char** argv) {
   }
 
   try {
-    if (!features_path.empty()) return print_features(features_path, coplanar_tol);
+    cf::tools::LoadOptions load;
+    load.coplanar_rel_tol = coplanar_tol;
+    load.units = units;
+    if (!features_path.empty()) return print_features(features_path, load);
     if (models.size() != 2) {
       std::cerr << "cfgen: expected A_MODEL B_MODEL -o GRAPH.json or --features MODEL (see cfgen --help)\n";
       return 2;
@@ -108,6 +120,9 @@ int main(int argc, char** argv) {
     }
     gen.a_path = models[0];
     gen.b_path = models[1];
+    gen.load_a = gen.load_b = load;
+    if (!units_a.empty()) gen.load_a.units = units_a;
+    if (!units_b.empty()) gen.load_b.units = units_b;
 #ifdef CF_HAVE_GENERATOR
     return cf::tools::run_generate(gen);
 #else

@@ -5,7 +5,9 @@
 #include <cf/graph.hpp>
 #include <cf/identifier.hpp>
 
-#include "graph_impl.hpp"    // Boost.Graph view, atomic file writing (libcf private)
+#include "cli_checks.hpp"     // finite_range
+#include "file_io.hpp"        // output paths, printable messages (libcf private)
+#include "graph_impl.hpp"    // Boost.Graph view (libcf private)
 #include "graph_schema.hpp"  // the embedded schema text
 
 #include <CLI/CLI.hpp>
@@ -131,7 +133,7 @@ ojson summary_json(const std::string& path, const cf::CfGraph& g, const Summary&
 void print_summary(std::ostream& out, const std::string& path, const cf::CfGraph& g, const Summary& s,
                    bool full_check) {
   auto model_line = [&](const char* which, const cf::Polyhedron& m) {
-    out << "model " << which << " '" << m.name() << "': " << m.num_vertices() << " vertices, " << m.num_edges()
+    out << "model " << which << " '" << cf::detail::printable(m.name()) << "': " << m.num_vertices() << " vertices, " << m.num_edges()
         << " edges (" << reflex_edges(m) << " reflex), " << m.num_faces() << " faces\n";
   };
   out << path << ": valid cf-graph v1 (" << (full_check ? "full schema check" : "schema check of the skeleton")
@@ -251,15 +253,14 @@ cf::Pose parse_pose(const std::string& text) {
     }
     while (used < item.size() && item[used] == ' ') ++used;
     if (item.empty() || used != item.size())
-      throw Failure{"--pose '" + text + "': '" + item + "' is not a number"};
+      throw Failure{"--pose '" + cf::detail::printable(text) + "': '" + cf::detail::printable(item) + "' is not a number"};
     v.push_back(x);
   }
-  if (v.size() != 7) throw Failure{"--pose '" + text + "': expected 7 numbers tx,ty,tz,qw,qx,qy,qz, got " + std::to_string(v.size())};
+  if (v.size() != 7) throw Failure{"--pose '" + cf::detail::printable(text) + "': expected 7 numbers tx,ty,tz,qw,qx,qy,qz, got " + std::to_string(v.size())};
   Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
-  // Same tolerance as a hand-typed quaternion needs: 4 significant digits.
-  constexpr double kUnitTol = 1e-3;
-  if (std::abs(q.norm() - 1) > kUnitTol)
-    throw Failure{"--pose '" + text + "': the quaternion's norm is " + std::to_string(q.norm()) + ", not 1"};
+  // The one tolerance of every tool (cfreplay's POSES.csv too): 4 significant digits.
+  if (std::string why = cf::detail::quaternion_problem(v[3], v[4], v[5], v[6]); !why.empty())
+    throw Failure{"--pose '" + text + "': " + why};
   cf::Pose p;
   p.R_BA = q.normalized().toRotationMatrix();
   p.t_BA = cf::Vec3(v[0], v[1], v[2]);
@@ -280,7 +281,8 @@ int run(int argc, char** argv) {
   app.add_option("--dot", dot_path, "write the graph as Graphviz DOT (labels: PC lists; edges: kinds)");
   app.add_option("--pose", pose_text,
                  "identify the CF at the pose tx,ty,tz,qw,qx,qy,qz of A (mm, unit quaternion; as in POSES.csv)");
-  app.add_option("--epsilon", epsilon, "contact threshold for --pose, mm (default 1.0, the paper's)")->check(CLI::PositiveNumber);
+  app.add_option("--epsilon", epsilon, "contact threshold for --pose, mm (default 1.0, the paper's)")
+      ->check(cf::cli::finite_range(1e-6, 1e3));
   app.add_flag("--json", as_json, "machine-readable output (the summary or the query's answer)");
   app.add_flag("--fast", fast, "check the items of cfs/transitions with the reader's rules instead of the full schema");
   app.add_flag("--print-schema", print_schema, "print the JSON Schema of graph files (schemas/cf-graph.schema.json) and exit");
@@ -311,10 +313,20 @@ int run(int argc, char** argv) {
   std::optional<cf::Pose> pose;
   if (!pose_text.empty()) pose = parse_pose(pose_text);
 
-  if (std::filesystem::is_directory(path)) throw Failure{"reading '" + path + "': is a directory, not a graph file"};
+  // An output path is checked before the load: never the graph itself, a device, a FIFO
+  // or a directory (SPEC section 5b).
+  if (!dot_path.empty()) cf::detail::check_output_path(dot_path, {path}, "writing DOT");
   cf::GraphLoadOptions options;
   options.full_schema_check = !fast;
   const cf::CfGraph g = cf::CfGraph::load(path, options);
+  // Warnings (stderr, exit status 0): nothing to identify, or models whose size suggests a
+  // unit mistake.
+  if (g.num_cfs() == 0)
+    std::cerr << "cfinspect: warning: the graph has no CF (A " << g.model_a().size() << " mm across, B "
+              << g.model_b().size() << " mm across): nothing can be identified; were the models' units right?\n";
+  for (const auto& [m, which] : {std::pair{&g.model_a(), "A"}, std::pair{&g.model_b(), "B"}})
+    if (const std::string w = cf::detail::size_warning(*m, which, epsilon); !w.empty())
+      std::cerr << "cfinspect: warning: " << w << "\n";
 
   bool queried = false;
   ojson answer = ojson::object();
@@ -371,7 +383,7 @@ int run(int argc, char** argv) {
     }
   }
   if (!dot_path.empty()) {
-    cf::detail::write_file_atomically(dot_path, dot_text(g), "writing DOT");
+    cf::detail::write_outputs({{dot_path, dot_text(g)}}, {path}, "writing DOT");
     if (!as_json) std::cout << "wrote " << dot_path << " (" << g.num_cfs() << " nodes, " << g.num_transitions() << " edges)\n";
     else answer["dot"] = dot_path;
   }
@@ -385,7 +397,7 @@ int run(int argc, char** argv) {
       print_summary(std::cout, path, g, s, !fast);
     }
   }
-  if (as_json) std::cout << answer.dump(2) << "\n";
+  if (as_json) std::cout << answer.dump(2, ' ', false, ojson::error_handler_t::replace) << "\n";
   return 0;
 }
 

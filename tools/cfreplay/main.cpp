@@ -8,6 +8,9 @@
 #include <cf/graph.hpp>
 #include <cf/params.hpp>
 
+#include "cli_checks.hpp"
+#include "file_io.hpp"  // libcf private: output paths, size warnings
+
 #include <CLI/CLI.hpp>
 
 #include <exception>
@@ -17,6 +20,7 @@
 #include <vector>
 
 int main(int argc, char** argv) {
+  using cf::cli::finite_range;
   CLI::App app{
       "cfreplay: replays a trajectory of A against the CF graph and writes the haptic force and\n"
       "moment of every servo tick.\n"
@@ -42,24 +46,25 @@ int main(int argc, char** argv) {
                  "(the paper's literal one-tick displacement)")
       ->check(CLI::IsMember({"anchor", "per-tick"}));
   app.add_option("--hold", P.hold_fcy_threshold_N, "hold F_cy while it changes by less than this (N); 0: off")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_range(0, 1e6));
   app.add_option("--tau", P.interpolation_time_constant_s,
                  "low-pass time constant of the total contact force and moment (s); 0: off")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_range(0, 1e3));
   app.add_option("--moment-ref", moment_ref,
                  "moment about A's 'origin' (paper eq. (9)), its 'centroid', or the 'point' given by --moment-point")
       ->check(CLI::IsMember({"origin", "centroid", "point"}));
   std::vector<double> moment_point;
   app.add_option("--moment-point", moment_point, "X Y Z: the moment's reference point, mm in A's frame (implies --moment-ref point)")
-      ->expected(3);
+      ->expected(3)
+      ->check(finite_range(-1e9, 1e9));
   app.add_option("--centroid", centroid, "mass centre: 'vertex' mean (paper) or 'volume' centroid")
       ->check(CLI::IsMember({"vertex", "volume"}));
-  app.add_option("--mass", P.mass_kg, "m, kg")->check(CLI::NonNegativeNumber);
-  app.add_option("--stiffness", P.stiffness_N_per_mm, "K, N/mm")->check(CLI::PositiveNumber);
-  app.add_option("--kp", P.kp_N_per_mm, "K_p, N/mm")->check(CLI::PositiveNumber);
-  app.add_option("--mu", P.mu_static, "static friction coefficient")->check(CLI::NonNegativeNumber);
-  app.add_option("--mu-d", P.mu_kinetic, "kinetic friction coefficient")->check(CLI::NonNegativeNumber);
-  app.add_option("--epsilon", P.epsilon_mm, "contact threshold, mm")->check(CLI::PositiveNumber);
+  app.add_option("--mass", P.mass_kg, "m, kg")->check(finite_range(0, 1e6));
+  app.add_option("--stiffness", P.stiffness_N_per_mm, "K, N/mm")->check(finite_range(1e-9, 1e9));
+  app.add_option("--kp", P.kp_N_per_mm, "K_p, N/mm")->check(finite_range(1e-9, 1e9));
+  app.add_option("--mu", P.mu_static, "static friction coefficient")->check(finite_range(0, 100));
+  app.add_option("--mu-d", P.mu_kinetic, "kinetic friction coefficient")->check(finite_range(0, 100));
+  app.add_option("--epsilon", P.epsilon_mm, "contact threshold, mm")->check(finite_range(1e-6, 1e3));
 
   try {
     app.parse(argc, argv);
@@ -82,7 +87,14 @@ int main(int argc, char** argv) {
   P.centroid = centroid == "volume" ? cf::CentroidChoice::kVolume : cf::CentroidChoice::kVertexMean;
 
   try {
+    // Output paths first, so that a bad one fails before the work (SPEC section 5b).
+    const std::vector<std::string> inputs{graph_path, traj_path};
+    cf::detail::check_output_path(out_path, inputs, "writing");
+    if (!plot_path.empty()) cf::detail::check_output_path(plot_path, inputs, "writing");
     const cf::CfGraph graph = cf::CfGraph::load(graph_path);
+    for (const auto& [m, which] : {std::pair{&graph.model_a(), "A"}, std::pair{&graph.model_b(), "B"}})
+      if (const std::string w = cf::detail::size_warning(*m, which, P.epsilon_mm); !w.empty())
+        std::cerr << "cfreplay: warning: " << w << "\n";
     const std::vector<cf::replay::Sample> samples = cf::replay::read_trajectory(traj_path);
     const std::vector<cf::replay::Row> rows = cf::replay::run(graph, samples, P);
 
@@ -94,9 +106,11 @@ int main(int argc, char** argv) {
       text += '\n';
       ++statuses[r.status];
     }
-    cf::replay::write_file_atomic(out_path, text);
+    // Both files or neither: a plot that cannot be written leaves no CSV behind.
+    std::vector<cf::detail::OutputFile> files{{out_path, std::move(text)}};
     if (!plot_path.empty())
-      cf::replay::write_file_atomic(plot_path, cf::replay::svg_plot(rows, traj_path + " against " + graph_path));
+      files.push_back({plot_path, cf::replay::svg_plot(rows, traj_path + " against " + graph_path)});
+    cf::detail::write_outputs(files, inputs, "writing");
     std::cerr << "cfreplay: " << rows.size() << " ticks ->" << ' ' << out_path << " (";
     bool first = true;
     for (const auto& [s, n] : statuses) {

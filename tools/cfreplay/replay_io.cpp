@@ -1,5 +1,7 @@
 #include "replay_io.hpp"
 
+#include "file_io.hpp"  // libcf private: reading and writing files
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -46,7 +48,7 @@ double number(const std::string& field, const char* column, const std::string& s
   char* end = nullptr;
   const double v = std::strtod(field.c_str(), &end);
   if (end != field.c_str() + field.size() || errno == ERANGE || !std::isfinite(v))
-    fail(source, line, std::string("column '") + column + "' is not a finite number: '" + field + "'");
+    fail(source, line, std::string("column '") + column + "' is not a finite number: '" + detail::printable(field) + "'");
   return v;
 }
 
@@ -68,7 +70,8 @@ std::vector<Sample> parse_trajectory(const std::string& text, const std::string&
       std::string joined;
       for (std::size_t i = 0; i < f.size(); ++i) joined += (i ? "," : "") + f[i];
       if (joined != kInputHeader)
-        fail(source, line, std::string("expected the header '") + kInputHeader + "', found '" + s + "'");
+        fail(source, line, std::string("expected the header '") + kInputHeader + "', found '" +
+                               detail::printable(s) + "'");
       header = true;
       continue;
     }
@@ -77,13 +80,7 @@ std::vector<Sample> parse_trajectory(const std::string& text, const std::string&
     double v[8];
     for (int i = 0; i < 8; ++i) v[i] = number(f[static_cast<std::size_t>(i)], kColumns[i], source, line);
     Eigen::Quaterniond q(v[4], v[5], v[6], v[7]);
-    const double norm = q.norm();
-    if (std::abs(norm - 1.0) > kQuaternionTolerance) {
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "the quaternion (qw,qx,qy,qz) has norm %.9g, not 1 within %g", norm,
-                    kQuaternionTolerance);
-      fail(source, line, buf);
-    }
+    if (std::string why = detail::quaternion_problem(v[4], v[5], v[6], v[7]); !why.empty()) fail(source, line, why);
     q.normalize();
     Sample smp;
     smp.t = v[0];
@@ -104,11 +101,10 @@ std::vector<Sample> parse_trajectory(const std::string& text, const std::string&
 }
 
 std::vector<Sample> read_trajectory(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open the trajectory: " + std::strerror(errno));
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_trajectory(ss.str(), path);
+  // Never blocks on a FIFO; a directory or a device is refused before reading.
+  std::string text, why;
+  if (!detail::read_input_file(path, text, why)) throw Error(path + ": cannot open the trajectory: " + why);
+  return parse_trajectory(text, path);
 }
 
 const char* output_header() {
@@ -125,23 +121,8 @@ std::string format_row(const Row& r) {
   return buf;
 }
 
-void write_file_atomic(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(path + ": cannot write the output: " + std::strerror(errno));
-    out << text;
-    out.flush();
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw Error(path + ": writing the output failed");
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string why = std::strerror(errno);
-    std::remove(tmp.c_str());
-    throw Error(path + ": cannot rename the temporary file into place: " + why);
-  }
+void write_file_atomic(const std::string& path, const std::string& text, const std::vector<std::string>& inputs) {
+  detail::write_outputs({detail::OutputFile{path, text}}, inputs, "writing");
 }
 
 namespace {

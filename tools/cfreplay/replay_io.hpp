@@ -17,8 +17,9 @@ struct Sample {
 };
 
 /// Largest | |q| - 1 | accepted; such quaternions are normalised. Beyond it a row is not a
-/// pose (a typo, or Euler angles written by mistake).
-constexpr double kQuaternionTolerance = 1e-6;
+/// pose (a typo, or Euler angles written by mistake). The same for every tool
+/// (cf::detail::kUnitQuaternionTolerance): four significant digits.
+constexpr double kQuaternionTolerance = 1e-3;
 
 /// Reads POSES.csv: header `t,tx,ty,tz,qw,qx,qy,qz`, then one pose per line; blank lines
 /// and lines starting with '#' are skipped.
@@ -46,8 +47,10 @@ const char* output_header();
 std::string format_row(const Row& row);
 
 /// Writes `text` to `path` through a temporary file in the same directory and a rename, so
-/// the file is whole or absent. @throws cf::Error naming the file.
-void write_file_atomic(const std::string& path, const std::string& text);
+/// the file is whole or absent; refuses a device, FIFO or directory and any of `inputs`.
+/// @throws cf::Error naming the file.
+void write_file_atomic(const std::string& path, const std::string& text,
+                       const std::vector<std::string>& inputs = {});
 
 /// An SVG of force and moment components against time, with background bands labelled
 /// with the CF id and the motion type of each run of equal (cf, motion).

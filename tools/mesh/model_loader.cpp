@@ -3,11 +3,9 @@
 
 #include "mesh_detail.hpp"
 
+#include "file_io.hpp"  // libcf private: size_warning
+
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/IO/OBJ.h>
-#include <CGAL/IO/OFF.h>
-#include <CGAL/IO/PLY.h>
-#include <CGAL/IO/STL.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
@@ -15,10 +13,9 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <map>
 
 namespace cf::tools {
 namespace {
@@ -73,92 +70,27 @@ void check_self_intersection(const PolygonSoup& s, const std::string& src) {
                 " intersect (" + std::to_string(pairs.size()) + " intersecting triangle pairs)");
 }
 
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
-
 }  // namespace
-
-PolygonSoup read_polygon_soup(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) fail(path, "cannot open file: no such file");
-  if (!fs::is_regular_file(path, ec)) fail(path, "cannot open file: not a regular file");
-  const std::string ext = lower(fs::path(path).extension().string());
-  if (ext != ".off" && ext != ".obj" && ext != ".stl" && ext != ".ply")
-    fail(path, "unknown file extension '" + fs::path(path).extension().string() +
-                   "' (expected .off, .obj, .stl or .ply)");
-  {
-    std::ifstream probe(path, std::ios::binary);
-    if (!probe) fail(path, "cannot open file: not readable");
-    if (probe.peek() == std::ifstream::traits_type::eof()) fail(path, "the file is empty");
-  }
-
-  std::vector<Point> points;
-  std::vector<std::vector<std::size_t>> polygons;
-  const auto np = CGAL::parameters::verbose(false);
-  bool ok = false;
-  std::string format;
-  if (ext == ".off") {
-    format = "OFF";
-    ok = CGAL::IO::read_OFF(path, points, polygons, np);
-  } else if (ext == ".obj") {
-    format = "OBJ";
-    ok = CGAL::IO::read_OBJ(path, points, polygons, np);
-  } else if (ext == ".stl") {
-    format = "STL";
-    std::vector<std::array<std::size_t, 3>> triangles;
-    ok = CGAL::IO::read_STL(path, points, triangles, np);
-    for (const auto& t : triangles) polygons.emplace_back(t.begin(), t.end());
-  } else {
-    format = "PLY";
-    ok = CGAL::IO::read_PLY(path, points, polygons, np);
-  }
-  if (!ok) fail(path, "parse error: not a readable " + format + " file");
-  if (points.empty() || polygons.empty()) {
-    // CGAL's STL reader gives up silently (no facets) on text that is neither ascii nor
-    // binary STL; only a blank file is truly without facets.
-    std::ifstream in(path, std::ios::binary);
-    char c;
-    bool blank = true;
-    while (blank && in.get(c)) blank = std::isspace(static_cast<unsigned char>(c)) != 0;
-    if (format == "STL" && !blank) fail(path, "parse error: not a readable STL file");
-    fail(path, "the file contains no facets");
-  }
-
-  // Merge points with identical coordinates into the first occurrence. Every point keeps its
-  // input index (duplicates are left unused), so messages and index rules use file order.
-  PolygonSoup soup;
-  soup.points.reserve(points.size());
-  std::vector<int> remap(points.size());
-  std::map<std::array<double, 3>, int> first;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const std::array<double, 3> c{points[i].x(), points[i].y(), points[i].z()};
-    soup.points.emplace_back(c[0], c[1], c[2]);
-    remap[i] = first.emplace(c, static_cast<int>(i)).first->second;
-  }
-  soup.polygons.reserve(polygons.size());
-  for (std::size_t f = 0; f < polygons.size(); ++f) {
-    std::vector<int> poly;
-    poly.reserve(polygons[f].size());
-    for (std::size_t i : polygons[f]) {
-      if (i >= points.size())
-        fail(path, "parse error: facet " + std::to_string(f) + " refers to vertex " +
-                       std::to_string(i) + " but the file has " + std::to_string(points.size()) +
-                       " vertices");
-      poly.push_back(remap[i]);
-    }
-    soup.polygons.push_back(std::move(poly));
-  }
-  return soup;
-}
 
 cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& source,
                                const LoadOptions& options) {
-  if (!(options.coplanar_rel_tol > 0 && options.coplanar_rel_tol < 0.1))
-    fail(source, "coplanarity tolerance " + std::to_string(options.coplanar_rel_tol) +
-                     " is outside (0, 0.1)");
+  if (!(options.coplanar_rel_tol >= kMinCoplanarTol && options.coplanar_rel_tol <= kMaxCoplanarTol)) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "coplanarity tolerance %g is outside [%g, %g]", options.coplanar_rel_tol,
+                  kMinCoplanarTol, kMaxCoplanarTol);
+    fail(source, buf);
+  }
+  for (std::size_t i = 0; i < soup.points.size(); ++i) {
+    const Vec3& p = soup.points[i];
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(p[k]) || std::abs(p[k]) > kMaxCoordinateMm) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "vertex %zu has the coordinate %g mm, beyond the largest accepted (|x| <= %g mm)", i, p[k],
+                      kMaxCoordinateMm);
+        fail(source, buf);
+      }
+  }
   detail::check_soup(soup, source, options);
   if (options.check_self_intersection) check_self_intersection(soup, source);
   const std::string name =
@@ -166,8 +98,28 @@ cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& sourc
   return detail::extract_features(soup, source, name, options);
 }
 
+std::string size_warning(const cf::Polyhedron& model, const std::string& which, const std::string& unit_option,
+                         double epsilon_mm) {
+  std::string w = cf::detail::size_warning(model, which, epsilon_mm);
+  if (!w.empty()) w += "; if the file is not in mm, give its unit with " + unit_option + " (mm, cm, m or in)";
+  return w;
+}
+
+double mm_per_unit(const std::string& unit) {
+  if (unit == "mm") return 1;
+  if (unit == "cm") return 10;
+  if (unit == "m") return 1000;
+  if (unit == "in") return 25.4;
+  return 0;
+}
+
 cf::Polyhedron load_model(const std::string& path, const LoadOptions& options) {
-  return model_from_soup(read_polygon_soup(path), path, options);
+  const double scale = mm_per_unit(options.units);
+  if (!(scale > 0)) fail(path, "unknown unit '" + options.units + "' (expected mm, cm, m or in)");
+  PolygonSoup soup = read_polygon_soup(path);
+  if (scale != 1)
+    for (Vec3& p : soup.points) p *= scale;
+  return model_from_soup(soup, path, options);
 }
 
 }  // namespace cf::tools

@@ -7,9 +7,21 @@
 #include <cf/polyhedron.hpp>
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace cf::tools {
+
+/// Coplanarity tolerances accepted (LoadOptions::coplanar_rel_tol, cfgen --coplanar-tol).
+constexpr double kMinCoplanarTol = 1e-12;
+constexpr double kMaxCoplanarTol = 0.1;
+/// Largest |coordinate| of a model, in mm after the unit conversion (1000 km): beyond it
+/// areas and volumes lose all precision, and no haptic scene is that large.
+constexpr double kMaxCoordinateMm = 1e9;
+
+/// Millimetres per unit of a model file's unit name (SPEC section 2: mm, cm, m, in);
+/// 0 for an unknown name.
+double mm_per_unit(const std::string& unit);
 
 /// Options for load_model and model_from_soup.
 struct LoadOptions {
@@ -23,6 +35,9 @@ struct LoadOptions {
   double coplanar_rel_tol = 1e-5;
   /// Run the (slowest) self-intersection check.
   bool check_self_intersection = true;
+  /// The length unit of the file's coordinates: "mm" (the default), "cm", "m" or "in".
+  /// load_model converts the points to mm.
+  std::string units = "mm";
 };
 
 /// A polygon soup as read from a file: points (mm) and facets as indices into them.
@@ -31,11 +46,24 @@ struct PolygonSoup {
   std::vector<std::vector<int>> polygons;
 };
 
-/// Reads the raw polygon soup of a mesh file; the format comes from the extension (.off, .obj,
-/// .stl, .ply, any case). Points with identical coordinates are merged into the first one
-/// (STL stores every corner separately), and facet indices are rewritten accordingly.
-/// @throws cf::Error naming the file: missing or unreadable, empty, unknown extension,
-///   parse error.
+/// The mesh file formats.
+enum class MeshFormat { kOff, kObj, kStl, kPly };
+
+/// The format of a file from its extension (.off, .obj, .stl, .ply, any case).
+/// @throws cf::Error "loading '<path>': unknown file extension ..."
+MeshFormat mesh_format_of(const std::string& path);
+
+/// Parses a mesh file's bytes (mesh_read.cpp; no CGAL). Points with identical coordinates
+/// are merged into the first one (STL stores every corner separately), and facet indices
+/// are rewritten accordingly. Counts in headers are checked against the bytes that follow
+/// before anything is allocated; indices against their range; numbers must be finite.
+/// @throws cf::Error "loading '<source>': ..." (empty, parse error with the line, no facets).
+PolygonSoup parse_polygon_soup(std::string_view bytes, MeshFormat format, const std::string& source);
+
+/// Reads the raw polygon soup of a mesh file (the format from the extension), without
+/// blocking on a FIFO or reading anything that is not a regular file.
+/// @throws cf::Error naming the file: missing or unreadable, not a regular file, empty,
+///   unknown extension, parse error.
 PolygonSoup read_polygon_soup(const std::string& path);
 
 /// Validates a soup as a closed, outward-oriented, 2-manifold, non-self-intersecting single
@@ -47,7 +75,13 @@ PolygonSoup read_polygon_soup(const std::string& path);
 cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& source,
                                const LoadOptions& options = {});
 
-/// read_polygon_soup then model_from_soup.
+/// Empty when `model` is a reasonable size against the contact threshold `epsilon_mm` (the
+/// paper's 1 mm by default), else a warning naming the sizes and `unit_option`, the option
+/// that gives the file's unit (SPEC section 2).
+std::string size_warning(const cf::Polyhedron& model, const std::string& which, const std::string& unit_option,
+                         double epsilon_mm = 1.0);
+
+/// read_polygon_soup, the points converted from options.units to mm, then model_from_soup.
 /// @throws cf::Error with a one-line message that names the file and the problem.
 cf::Polyhedron load_model(const std::string& path, const LoadOptions& options = {});
 

@@ -1,0 +1,74 @@
+#pragma once
+/// @file
+/// Private to libcf and the tools of this repository: reading input files and writing
+/// output files the way SPEC section 5b requires.
+///
+/// - Reading never blocks: the file is opened non-blocking and anything that is not a
+///   regular file (a FIFO, a device, a directory, a socket) is refused before a byte is read.
+/// - Output files are written whole or not at all (a temporary file in the target's
+///   directory, fsync, rename), never over one of the run's inputs; an output path that is a
+///   device, a FIFO, a socket or a directory is refused; a symlink is followed and its
+///   target replaced (the link stays a link).
+/// - Text from a file that goes into a message is made printable first.
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace cf {
+class Polyhedron;
+}
+
+namespace cf::detail {
+
+/// Reads the whole of `path`. On failure returns false with `why` set to a short reason
+/// ("no such file", "is a directory, not a regular file", "is a FIFO (named pipe), not a
+/// regular file", "permission denied", "larger than 2 GiB"), without the file name.
+bool read_input_file(const std::string& path, std::string& bytes, std::string& why,
+                     std::size_t max_bytes = std::size_t{1} << 31);
+
+/// One file to write.
+struct OutputFile {
+  std::string path;
+  std::string bytes;
+};
+
+/// Checks that `path` can be an output of a run that reads `inputs`: not empty, not naming a
+/// directory, not a device, FIFO, socket or directory (after following symlinks), not the
+/// same file as an input. Call it before the work, so that a bad path fails fast; the
+/// writers below check again.
+/// @throws cf::Error "<what> '<path>': <reason>".
+void check_output_path(const std::string& path, const std::vector<std::string>& inputs,
+                       const char* what);
+
+/// Writes every file whole, or none of them: all the temporary files are written and synced
+/// first, then renamed into place (symlinks followed). Two outputs naming the same file are
+/// refused. An existing target keeps its permission bits.
+/// @throws cf::Error "<what> '<path>': <reason>"; no temporary file is left behind.
+void write_outputs(const std::vector<OutputFile>& files, const std::vector<std::string>& inputs,
+                   const char* what);
+
+/// `text` with every byte that is not printable ASCII written as \xHH, cut to `max` bytes
+/// of input (then "..."), for quoting file content in a one-line message.
+std::string printable(const std::string& text, std::size_t max = 60);
+
+/// One tolerance for a quaternion typed or read by any tool (SPEC section 5b): within 1e-3 of
+/// norm 1 (four significant digits) it is accepted and normalised, beyond it refused.
+constexpr double kUnitQuaternionTolerance = 1e-3;
+
+/// Empty when | |q| - 1 | <= kUnitQuaternionTolerance (and q finite), else the reason with
+/// the norm: "the quaternion (qw,qx,qy,qz) has norm 1.00498756, not 1 within 0.001".
+std::string quaternion_problem(double w, double x, double y, double z);
+
+/// Below this many epsilon across (bounding-box diagonal) a model is small against the
+/// contact threshold, above kLargeModel epsilon it is large (SPEC section 2: a model whose
+/// unit was not given may be in metres, or in micrometres).
+constexpr double kSmallModel = 10;
+constexpr double kLargeModel = 1e5;
+
+/// Empty when `model` is a reasonable size against `epsilon_mm`, else a warning naming the
+/// sizes: "model A 'cube' is 0.0173 mm across (bounding-box diagonal), small against the
+/// contact threshold epsilon = 1 mm". The caller adds what the user can do about it.
+std::string size_warning(const Polyhedron& model, const std::string& which, double epsilon_mm);
+
+}  // namespace cf::detail

@@ -1,0 +1,39 @@
+#pragma once
+/// @file
+/// CLI11 validators shared by the tools (SPEC section 5b: an option value must be a finite
+/// number in range). CLI::Range lets NaN through (every comparison with NaN is false) and
+/// says nothing about infinity; these do not. The range shows in --help.
+
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+namespace cf::cli {
+
+/// "%g" of a bound, for --help and messages.
+inline std::string bound_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+/// A finite number in [lo, hi].
+inline CLI::Validator finite_range(double lo, double hi) {
+  const std::string range = "[" + bound_text(lo) + ", " + bound_text(hi) + "]";
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        const char* b = text.c_str();
+        char* end = nullptr;
+        const double v = std::strtod(b, &end);
+        if (text.empty() || end == b || *end != '\0') return "'" + text + "' is not a number";
+        if (!std::isfinite(v)) return "'" + text + "' is not a finite number";
+        if (v < lo || v > hi) return "'" + text + "' is outside " + range;
+        return {};
+      },
+      range);
+}
+
+}  // namespace cf::cli
