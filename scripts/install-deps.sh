@@ -23,6 +23,9 @@ CF_APT_PACKAGES=(
   libglpk-dev
   # tests/ and bench/
   catch2 libbenchmark-dev libfcl-dev
+  # the sanitizer and fuzz build (scripts/sanitize.sh, scripts/fuzz.sh): clang, its
+  # ASan/UBSan runtimes and libFuzzer (clang is only a recommendation of clang-14)
+  clang clang-14 libclang-rt-14-dev libfuzzer-14-dev
 )
 
 missing_packages() {

@@ -11,7 +11,7 @@
 namespace {
 
 using cf::Vec3;
-namespace tm = cf::testmodels;
+namespace tmod = cf::testmodels;
 
 // A single-precision box holds its points up to float rounding of coordinates of a few
 // hundred mm (about 3e-5 mm); the boxes are inflated by 1e-6 of their reach (>= 1 mm) on top,
@@ -80,7 +80,7 @@ cf::detail::NodeBox random_box(std::mt19937& rng, const Vec3& c, double aabb_gro
 TEST_CASE("every element is in one leaf, and every node's boxes hold it", "[bvh]") {
   // Off its frame's origin, with the boxes' centres relative to the sphere's centre.
   const Vec3 centre(100, -20, 5);
-  const cf::Polyhedron m = tm::faceted_sphere(30, 40, 50, centre, "sphere2000");
+  const cf::Polyhedron m = tmod::faceted_sphere(30, 40, 50, centre, "sphere2000");
   const auto leaves = GENERATE(cf::detail::Leaves::kElements, cf::detail::Leaves::kFaceGroups);
   for (int leaf : {1, 2, 4}) {
     for (double inflate : {0.0, 0.25}) {
@@ -156,7 +156,7 @@ TEST_CASE("every element is in one leaf, and every node's boxes hold it", "[bvh]
 TEST_CASE("oriented boxes of a curved surface's patches are thin along the normal", "[bvh]") {
   // A leaf pair's patch of a 50 mm sphere with 4 mm facets bulges by about 0.1 mm: the
   // oriented box's thinnest half extent is far below its axis-aligned box's.
-  const cf::Polyhedron m = tm::faceted_sphere(50, 42, 48, Vec3::Zero(), "sphere2016");
+  const cf::Polyhedron m = tmod::faceted_sphere(50, 42, 48, Vec3::Zero(), "sphere2016");
   const cf::detail::Bvh t(m, 0.0, 2);
   double thin_sum = 0, aabb_sum = 0;
   std::size_t n = 0;
@@ -216,7 +216,7 @@ TEST_CASE("the 4-lane box test agrees with a double-precision separating-axis te
 }
 
 TEST_CASE("face-group leaves hold their element boxes on lanes, tested like one box each", "[bvh]") {
-  const cf::Polyhedron m = tm::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000");
+  const cf::Polyhedron m = tmod::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000");
   const cf::detail::Bvh t(m, 0.5, 1, Vec3::Zero(), cf::detail::Leaves::kFaceGroups);
   // Only face-group trees with one group per leaf carry lanes.
   CHECK(cf::detail::Bvh(m, 0.5, 1, Vec3::Zero(), cf::detail::Leaves::kElements).leaf_boxes().empty());
@@ -260,7 +260,7 @@ TEST_CASE("face-group leaves hold their element boxes on lanes, tested like one 
 }
 
 TEST_CASE("the 4-wide tree holds every node once, each inner lane opening into its subtree", "[bvh]") {
-  const cf::Polyhedron m = tm::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000");
+  const cf::Polyhedron m = tmod::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000");
   const auto leaves = GENERATE(cf::detail::Leaves::kElements, cf::detail::Leaves::kFaceGroups);
   const cf::detail::Bvh t(m, 0.25, 1, Vec3::Zero(), leaves);
   const auto& nodes = t.nodes();

@@ -15,7 +15,7 @@ namespace {
 
 using cf::PcType;
 using cf::Vec3;
-namespace tm = cf::testmodels;
+namespace tmod = cf::testmodels;
 
 // Poses are built from round numbers; results follow through a few rotations: 1e-9 mm.
 constexpr double kTol = 1e-9;
@@ -53,7 +53,7 @@ void check_frame(const cf::ContactPc& c) {
 }  // namespace
 
 TEST_CASE("cube resting flat on the slab: one plane, f-f undominated", "[detector]") {
-  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
   // Cube face 2 (y = -15) 0.3 mm above the slab top (B face 4, y = 20).
@@ -79,7 +79,7 @@ TEST_CASE("cube resting flat on the slab: one plane, f-f undominated", "[detecto
 }
 
 TEST_CASE("cube half over the slab's edge: overlap centroid of the shared part", "[detector]") {
-  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
   // Cube x in [110, 140]: overlap with the slab top x in [110, 120], z in [25, 55].
@@ -99,7 +99,7 @@ TEST_CASE("cube half over the slab's edge: overlap centroid of the shared part",
 }
 
 TEST_CASE("cube in the corner of the L: two contact planes", "[detector]") {
-  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
   det.detect(pose(Eigen::Matrix3d::Identity(), {35.2, 35.4, 40}), cs);
@@ -115,7 +115,7 @@ TEST_CASE("cube in the corner of the L: two contact planes", "[detector]") {
 }
 
 TEST_CASE("cube on an edge: e-f with the task frame along the edge", "[detector]") {
-  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
   // Rotated 45 degrees about z: the edge through A's vertices 0 and 4 (x = y = -15, along z)
@@ -137,7 +137,7 @@ TEST_CASE("cube on an edge: e-f with the task frame along the edge", "[detector]
 }
 
 TEST_CASE("a slightly tilted edge gives e-f and the v-f of its lower end (paper Fig. 3)", "[detector]") {
-  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
   const double h = 15 * std::sqrt(2.0);
@@ -169,7 +169,7 @@ TEST_CASE("a slightly tilted edge gives e-f and the v-f of its lower end (paper 
 }
 
 TEST_CASE("the f-f tolerance follows the overlap's extent along the tilt, whatever the yaw", "[detector]") {
-  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
   // The cube's bottom face (2) over the slab's top (4), tilted about one of its edges'
@@ -200,7 +200,7 @@ TEST_CASE("the f-f tolerance follows the overlap's extent along the tilt, whatev
 }
 
 TEST_CASE("the e-f tolerance follows the part of the edge over the face", "[detector]") {
-  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
   // The cube on its edge x = y = -15 (vertices 0-4, along z), turned 45 degrees about z, the
@@ -229,7 +229,7 @@ TEST_CASE("the e-f tolerance follows the part of the edge over the face", "[dete
 }
 
 TEST_CASE("cube on a corner: a single v-f", "[detector]") {
-  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
   // Turn the diagonal to vertex 0 (-15,-15,-15) straight down.
@@ -246,7 +246,7 @@ TEST_CASE("cube on a corner: a single v-f", "[detector]") {
 }
 
 TEST_CASE("a face of A on a vertex of B: f-v", "[detector]") {
-  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
   // A's bottom face (2, normal -y in A) tilted so that it slopes away beyond the wall's
@@ -265,7 +265,7 @@ TEST_CASE("a face of A on a vertex of B: f-v", "[detector]") {
 }
 
 TEST_CASE("an edge of A crossing the slab's edge: e-e", "[detector]") {
-  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
   // After Rx(45) the edge from (-15,-15,15) to (15,-15,15) is lowest; Rz(-30) tilts it down
@@ -284,7 +284,7 @@ TEST_CASE("an edge of A crossing the slab's edge: e-e", "[detector]") {
 }
 
 TEST_CASE("no contact far away; a deep penetration is not a contact", "[detector]") {
-  const cf::Polyhedron a = tm::cube(), b = tm::l_block();
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
   det.detect(pose(Eigen::Matrix3d::Identity(), {70, 60, 40}), cs);
@@ -299,7 +299,7 @@ TEST_CASE("no contact far away; a deep penetration is not a contact", "[detector
 TEST_CASE("bad parameters are rejected with their name", "[detector]") {
   cf::DetectionParams p;
   p.epsilon = -1;
-  CHECK_THROWS_WITH(cf::ContactDetector(tm::cube(), tm::l_block(), p),
+  CHECK_THROWS_WITH(cf::ContactDetector(tmod::cube(), tmod::l_block(), p),
                     Catch::Contains("parameter epsilon must be positive"));
 }
 
@@ -549,8 +549,8 @@ TEST_CASE("the BVH finds what all pairs find on faceted spheres", "[detector]") 
   // not lose contacts there).
   const bool far = GENERATE(false, true);
   const Vec3 ca = far ? Vec3(4000, -3000, 2500) : Vec3::Zero(), cb = far ? Vec3(-2500, 1500, 3000) : Vec3::Zero();
-  const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30, ca);
-  const cf::Polyhedron b = tm::faceted_sphere(50, 21, 32, cb);
+  const cf::Polyhedron a = tmod::faceted_sphere(30, 20, 30, ca);
+  const cf::Polyhedron b = tmod::faceted_sphere(50, 21, 32, cb);
   Twin t(a, b, band(eps), all_pairs(band(eps)));
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> U(-1, 1);
@@ -575,9 +575,9 @@ TEST_CASE("the BVH finds what all pairs find for a big model against a small one
   // (one element per leaf): the culling mixes both kinds of tree.
   const double eps = GENERATE(1.0, 0.1);
   const int which = GENERATE(0, 1, 2);
-  const cf::Polyhedron sphere = tm::faceted_sphere(30, 20, 30, Vec3(5, -3, 2));
-  const cf::Polyhedron a = which == 0 ? sphere : which == 1 ? tm::cube() : tm::l_block();
-  const cf::Polyhedron b = which == 0 ? tm::l_block() : sphere;
+  const cf::Polyhedron sphere = tmod::faceted_sphere(30, 20, 30, Vec3(5, -3, 2));
+  const cf::Polyhedron a = which == 0 ? sphere : which == 1 ? tmod::cube() : tmod::l_block();
+  const cf::Polyhedron b = which == 0 ? tmod::l_block() : sphere;
   Twin t(a, b, band(eps), all_pairs(band(eps)));
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> U(-1, 1);
@@ -616,7 +616,7 @@ cf::Polyhedron faceted_torus(double R, double r, int around, int across) {
   std::vector<std::vector<int>> f;
   for (int i = 0; i < around; ++i)
     for (int j = 0; j < across; ++j) f.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
-  return tm::from_loops("torus", v, f);
+  return tmod::from_loops("torus", v, f);
 }
 
 }  // namespace
@@ -625,7 +625,7 @@ TEST_CASE("the BVH finds what all pairs find in a torus's hole", "[detector]") {
   // A 384-face sphere in the hole of a 384-face torus, touching its inner, saddle-shaped
   // side (reflex edges, non-convex surroundings) on one side and then another.
   const double eps = GENERATE(1.0, 0.1);
-  const cf::Polyhedron a = tm::faceted_sphere(18, 16, 24), b = faceted_torus(30, 10, 24, 16);
+  const cf::Polyhedron a = tmod::faceted_sphere(18, 16, 24), b = faceted_torus(30, 10, 24, 16);
   Twin t(a, b, band(eps), all_pairs(band(eps)));
   std::mt19937 rng(23);
   std::uniform_real_distribution<double> U(-1, 1);
@@ -656,8 +656,8 @@ TEST_CASE("pairs kept between nearby poses give what the hierarchy gives", "[det
   // jumps of 5 mm now and then: every result must equal the one without kept pairs, and most
   // ticks must reuse.
   const double eps = GENERATE(1.0, 0.1);
-  const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30);
-  const cf::Polyhedron b = tm::faceted_sphere(50, 21, 32);
+  const cf::Polyhedron a = tmod::faceted_sphere(30, 20, 30);
+  const cf::Polyhedron b = tmod::faceted_sphere(50, 21, 32);
   REQUIRE(band(eps).reuse_margin > 0);
   Twin t(a, b, band(eps), not_kept(band(eps)));
   int reused = 0, contacts = 0;
@@ -733,7 +733,7 @@ TEST_CASE("kept pairs' certificates never hide a contact", "[detector]") {
     // 1.5 mrad per tick about a slowly turning axis (0.045 mm of its facets' travel per tick,
     // about the most for which pairs are still kept), the centre drifting 0.02 mm per tick,
     // the gap swinging through the band (the facets lie up to 0.4 mm inside the spheres).
-    const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30), b = tm::faceted_sphere(50, 21, 32);
+    const cf::Polyhedron a = tmod::faceted_sphere(30, 20, 30), b = tmod::faceted_sphere(50, 21, 32);
     std::vector<cf::Pose> poses;
     Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
     for (int k = 0; k < n; ++k) {
@@ -757,7 +757,7 @@ TEST_CASE("kept pairs' certificates never hide a contact", "[detector]") {
     // = 55.82, less 0.7 mm for the facets. The contact is on the inner,
     // saddle-shaped side of the tube (reflex edges) over about a quarter of the ring. The
     // torus spins 1 mrad per tick about its axis and rocks by up to 0.03 rad.
-    const cf::Polyhedron a = faceted_torus(30, 10, 24, 16), b = tm::faceted_sphere(50, 21, 32);
+    const cf::Polyhedron a = faceted_torus(30, 10, 24, 16), b = tmod::faceted_sphere(50, 21, 32);
     std::vector<cf::Pose> poses;
     for (int k = 0; k < n; ++k) {
       const double s = static_cast<double>(k) / n;
@@ -778,7 +778,7 @@ TEST_CASE("kept pairs' certificates never hide a contact", "[detector]") {
     // (a pair moved or turned away there) must not be read as if from the first when A is
     // back at the first. 30 poses in contact at random, 6 ticks each: first, first (pairs
     // kept), second, first, second, first.
-    const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30), b = tm::faceted_sphere(50, 21, 32);
+    const cf::Polyhedron a = tmod::faceted_sphere(30, 20, 30), b = tmod::faceted_sphere(50, 21, 32);
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> U(-1, 1);
     std::vector<cf::Pose> poses;
@@ -802,7 +802,7 @@ TEST_CASE("kept pairs' certificates never hide a contact", "[detector]") {
     // change as fast as the motion bound allows, and a margin of 1 mm (beyond B's boxes'
     // growth past the band, 0.41 epsilon) lets pairs kept apart by the boxes come into
     // the band while their certificates are in use.
-    const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30), b = tm::faceted_sphere(50, 21, 32);
+    const cf::Polyhedron a = tmod::faceted_sphere(30, 20, 30), b = tmod::faceted_sphere(50, 21, 32);
     const Vec3 dir = Vec3(0.2, -0.3, 1).normalized();
     std::vector<cf::Pose> poses;
     double gap = 1.5 * eps;
@@ -829,7 +829,7 @@ TEST_CASE("kept pairs serve rotations, and rotations rounded to float", "[detect
   // unchanged; rotations 1e-4 off orthonormal are detected from scratch, results unchanged.
   const double eps = GENERATE(1.0, 0.1);
   const Vec3 centre(300, -400, 0);
-  const cf::Polyhedron a = tm::faceted_sphere(30, 20, 30, centre), b = tm::faceted_sphere(50, 21, 32);
+  const cf::Polyhedron a = tmod::faceted_sphere(30, 20, 30, centre), b = tmod::faceted_sphere(50, 21, 32);
   const int n = 200;
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> U(-1, 1);
@@ -862,6 +862,6 @@ TEST_CASE("kept pairs serve rotations, and rotations rounded to float", "[detect
 TEST_CASE("a negative reuse margin is refused", "[detector]") {
   cf::DetectionParams p;
   p.reuse_margin = -0.1;
-  CHECK_THROWS_WITH(cf::ContactDetector(tm::cube(), tm::l_block(), p),
+  CHECK_THROWS_WITH(cf::ContactDetector(tmod::cube(), tmod::l_block(), p),
                     Catch::Contains("parameter reuse_margin must be non-negative"));
 }

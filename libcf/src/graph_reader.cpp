@@ -8,6 +8,7 @@
 // members, types, ranges, no unknown members in PCs and witnesses); GraphLoadOptions::
 // full_schema_check runs valijson over the whole document as well.
 
+#include "file_io.hpp"
 #include "graph_impl.hpp"
 #include "graph_schema.hpp"
 #include "json_util.hpp"
@@ -211,12 +212,12 @@ bool GraphSax::key(std::string& k) {
       break;
     case Ctx::kPc:
       field_ = k == "type" ? Field::kPcType : k == "a" ? Field::kPcA : k == "b" ? Field::kPcB : Field::kPcOther;
-      if (field_ == Field::kPcOther) fault(pc_ptr(), "unexpected member \"" + k + "\" (a PC has type, a and b)");
+      if (field_ == Field::kPcOther) fault(pc_ptr(), "unexpected member \"" + printable(k) + "\" (a PC has type, a and b)");
       break;
     case Ctx::kWitness:
       field_ = k == "R" ? Field::kWR : k == "t" ? Field::kWT : Field::kWOther;
       if (field_ == Field::kWOther)
-        fault(cf_ptr() + "/witness", "unexpected member \"" + k + "\" (a witness has R and t)");
+        fault(cf_ptr() + "/witness", "unexpected member \"" + printable(k) + "\" (a witness has R and t)");
       break;
     case Ctx::kTransition:
       field_ = k == "from" ? Field::kTrFrom : k == "to" ? Field::kTrTo : k == "kind" ? Field::kTrKind : Field::kTrOther;

@@ -157,7 +157,7 @@ void print_summary(std::ostream& out, const std::string& path, const cf::CfGraph
   const auto meta = nlohmann::json::parse(g.metadata_json());
   out << "metadata:";
   if (meta.empty()) out << " none";
-  for (auto it = meta.begin(); it != meta.end(); ++it) out << " " << it.key();
+  for (auto it = meta.begin(); it != meta.end(); ++it) out << " " << cf::detail::printable(it.key());
   out << "\n";
 }
 
