@@ -1,5 +1,7 @@
 #include "enumerate.hpp"
 
+#include "explore.hpp"
+
 #include <cf/geometry.hpp>
 
 #include <algorithm>
@@ -10,6 +12,7 @@
 #include <sstream>
 #include <thread>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace cf::gen {
 namespace {
@@ -163,6 +166,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
                                       : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   Enumeration out;
   std::vector<std::pair<PcSet, Witness>> valid[3];
+  std::vector<PcSet> failed;  // candidates the search found no witness for
 
   auto run_level = [&](int level, const std::vector<PcSet>& cands,
                        const std::function<std::vector<Mat3>(const PcSet&)>& seeds_of) {
@@ -180,6 +184,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
                  tick);
     for (std::size_t i = 0; i < cands.size(); ++i)
       if (res[i].found) valid[level].push_back({cands[i], res[i]});
+      else failed.push_back(cands[i]);
     out.levels[level] = {cands.size(), valid[level].size(),
                          std::chrono::duration<double>(Clock::now() - t0).count()};
   };
@@ -244,7 +249,85 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     run_level(2, c3, seeds_from_subsets);
   }
 
+  // Closure by motion (explore.hpp): from every witness, translations and rotations that keep
+  // some PCs and break the others, to the first contact. Sets met that are not in the graph yet are
+  // searched (seeded with the rotation they were met at), and their own witnesses explored
+  // in the next round, until a round adds nothing.
+  {
+    std::unordered_set<PcSet, PcSetHash> known;
+    std::vector<std::pair<PcSet, Pose>> frontier;
+    for (int l = 0; l < 3; ++l)
+      for (const auto& [s, w] : valid[l]) {
+        known.insert(s);
+        frontier.push_back({s, w.pose});
+      }
+    for (int round = 0; !frontier.empty(); ++round) {
+      const auto t0 = Clock::now();
+      std::vector<std::vector<Discovery>> met(frontier.size());
+      std::function<void(std::size_t)> tick;
+      if (opt.progress)
+        tick = [&](std::size_t done) {
+          std::ostringstream os;
+          os << "motion round " << round + 1 << ": " << done << "/" << frontier.size() << " CFs explored, "
+             << std::chrono::duration<double>(Clock::now() - t0).count() << " s";
+          opt.progress(os.str());
+        };
+      parallel_for(frontier.size(), threads,
+                   [&](std::size_t i) {
+                     met[i] = explore_translations(search, frontier[i].first, frontier[i].second);
+                     std::vector<Discovery> r = explore_rotations(search, frontier[i].first, frontier[i].second);
+                     met[i].insert(met[i].end(), r.begin(), r.end());
+                   },
+                   tick);
+      // The first discovery of each new set, in frontier order: independent of thread count.
+      std::vector<Discovery> fresh;
+      std::unordered_set<PcSet, PcSetHash> pending;
+      for (const auto& list : met)
+        for (const Discovery& d : list)
+          if (d.pcs.size() <= opt.max_pcs && !known.count(d.pcs) && pending.insert(d.pcs).second)
+            fresh.push_back(d);
+      std::vector<Witness> res(fresh.size());
+      parallel_for(fresh.size(), threads,
+                   [&](std::size_t i) {
+                     Witness w = search.find(fresh[i].pcs, {fresh[i].pose.R_BA});
+                     if (!w.found) w = search.refine(fresh[i].pcs, fresh[i].pose);
+                     res[i] = w;
+                   },
+                   {});
+      frontier.clear();
+      for (std::size_t i = 0; i < fresh.size(); ++i) {
+        if (!res[i].found) continue;
+        const int level = fresh[i].pcs.size() - 1;
+        valid[level].push_back({fresh[i].pcs, res[i]});
+        ++out.levels[level].by_motion;
+        ++out.levels[level].valid;
+        known.insert(fresh[i].pcs);
+        frontier.push_back({fresh[i].pcs, res[i].pose});
+      }
+    }
+  }
+
+  // What the search could not decide: failed candidates that motion did not find either and
+  // that no proof rules out (WitnessSearch::refuted).
+  {
+    std::unordered_set<PcSet, PcSetHash> known;
+    for (int l = 0; l < 3; ++l)
+      for (const auto& [s, w] : valid[l]) known.insert(s);
+    std::vector<char> open(failed.size(), 0);
+    parallel_for(failed.size(), threads,
+                 [&](std::size_t i) { open[i] = !known.count(failed[i]) && !search.refuted(failed[i]); }, {});
+    for (std::size_t i = 0; i < failed.size(); ++i)
+      if (open[i]) out.undecided.push_back(failed[i]);
+    std::sort(out.undecided.begin(), out.undecided.end(), [](const PcSet& x, const PcSet& y) {
+      if (x.size() != y.size()) return x.size() < y.size();
+      for (int k = 0; k < x.size(); ++k)
+        if (x[k] != y[k]) return x[k] < y[k];
+      return false;
+    });
+  }
+
   out.min_clearance = std::numeric_limits<double>::infinity();
+  out.min_margin = std::numeric_limits<double>::infinity();
   for (int l = 0; l < 3; ++l) {
     std::sort(valid[l].begin(), valid[l].end(), [](const auto& x, const auto& y) {
       for (int k = 0; k < x.first.size(); ++k)
@@ -263,6 +346,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
       r.num_planes = s.size();
       out.cfs.push_back(r);
       out.min_clearance = std::min(out.min_clearance, w.clearance);
+      out.min_margin = std::min(out.min_margin, search.contact_margin(s, w.pose));
     }
   }
   out.transitions = transitions_between(out.cfs, A, B);

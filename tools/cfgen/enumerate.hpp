@@ -24,6 +24,7 @@ struct LevelStats {
   std::size_t candidates = 0;  // sets that reached the witness search
   std::size_t valid = 0;
   double seconds = 0;
+  std::size_t by_motion = 0;   // of the valid ones, found by the closure by motion
 };
 
 struct Enumeration {
@@ -31,6 +32,8 @@ struct Enumeration {
   std::vector<Transition> transitions;
   LevelStats levels[3];
   double min_clearance = 0;           // mm, smallest witness clearance in the graph
+  double min_margin = 0;              // mm, smallest LP margin of a witness's contacts
+  std::vector<PcSet> undecided;       // failed candidates with no proof of invalidity
 };
 
 Enumeration enumerate(const ModelInfo& A, const ModelInfo& B, const EnumerateOptions& options);

@@ -32,6 +32,12 @@ int run_generate(const GenerateArgs& args) {
   gen::EnumerateOptions opt;
   opt.threads = args.threads;
   opt.search = args.search;
+  // Lengths scale with the smaller model (RelativeLengths).
+  const double diag = std::min((A.bbox_max() - A.bbox_min()).norm(), (B.bbox_max() - B.bbox_min()).norm());
+  opt.search.touch_tol = args.rel.touch_tol * diag;
+  opt.search.min_clearance = args.rel.min_clearance * diag;
+  opt.search.good_clearance = args.rel.good_clearance * diag;
+  opt.search.min_margin = args.rel.min_margin * diag;
   opt.max_pcs = args.max_pcs;
   bool progress_shown = false;
   if (!args.quiet)
@@ -56,17 +62,31 @@ int run_generate(const GenerateArgs& args) {
     by_kind[to_string(t.kind)] = by_kind.value(to_string(t.kind), 0) + 1;
   nlohmann::json levels = nlohmann::json::array();
   for (const auto& l : e.levels)
-    levels.push_back({{"candidates", l.candidates}, {"valid", l.valid}});
+    levels.push_back({{"candidates", l.candidates}, {"valid", l.valid}, {"found_by_motion", l.by_motion}});
+  // The undecided sets, in canonical order; only the first kUndecidedListed are listed, so
+  // that a pair with many keeps a file of reasonable size (the count is always exact).
+  constexpr std::size_t kUndecidedListed = 100;
+  nlohmann::json undecided = nlohmann::json::array();
+  for (std::size_t i = 0; i < e.undecided.size() && i < kUndecidedListed; ++i)
+    undecided.push_back(to_string(e.undecided[i]));
   meta["stats"] = {{"cfs", e.cfs.size()},
                    {"cfs_by_pc_count", by_count},
                    {"pcs_by_type", by_type},
                    {"transitions", e.transitions.size()},
                    {"transitions_by_kind", by_kind},
                    {"levels", levels},
-                   {"min_witness_clearance_mm", e.cfs.empty() ? 0.0 : e.min_clearance}};
+                   {"min_witness_clearance_mm", e.cfs.empty() ? 0.0 : e.min_clearance},
+                   {"min_witness_margin_mm", e.cfs.empty() ? 0.0 : e.min_margin},
+                   {"undecided", e.undecided.size()},
+                   {"undecided_sets", undecided}};
   // Timing goes to stderr, not into the file, so that the same input gives the same bytes.
   const auto& s = opt.search;
-  meta["parameters"] = {{"touch_tol_mm", s.touch_tol},
+  meta["parameters"] = {{"length_scale_mm", diag},
+                        {"touch_tol_rel", args.rel.touch_tol},
+                        {"min_clearance_rel", args.rel.min_clearance},
+                        {"good_clearance_rel", args.rel.good_clearance},
+                        {"min_margin_rel", args.rel.min_margin},
+                        {"touch_tol_mm", s.touch_tol},
                         {"min_clearance_mm", s.min_clearance},
                         {"good_clearance_mm", s.good_clearance},
                         {"min_margin_mm", s.min_margin},

@@ -11,6 +11,16 @@
 
 namespace cf::tools {
 
+/// The search's lengths as fractions of D, the smaller model's bounding-box diagonal: the
+/// graph of a pair scaled by any factor is the same up to that scale. Defaults give about
+/// the SearchParams defaults (in mm) for a 30 mm cube (D = 52 mm).
+struct RelativeLengths {
+  double touch_tol = 2e-11;      ///< element pairs closer than this touch
+  double min_clearance = 2e-4;   ///< every pair not part of a PC at least this far apart at a witness
+  double good_clearance = 2e-2;  ///< a witness this clear ends the search
+  double min_margin = 2e-4;      ///< contact points at least this far inside their elements
+};
+
 /// Parsed arguments of `cfgen A_MODEL B_MODEL -o GRAPH.json [options]`.
 struct GenerateArgs {
   std::string a_path;    ///< model of A, the moving object
@@ -19,7 +29,8 @@ struct GenerateArgs {
   int threads = 0;       ///< worker threads; 0 = hardware concurrency
   bool quiet = false;    ///< no progress on stderr
   int max_pcs = 3;       ///< largest CFs to enumerate (1..3)
-  gen::SearchParams search;  ///< tolerances and search limits of the witness search
+  gen::SearchParams search;  ///< angular tolerances and search limits (lengths: `rel`)
+  RelativeLengths rel;       ///< lengths of the search, relative to the models' size
   LoadOptions load_a, load_b;  ///< units and coplanarity tolerance of each model
 };
 

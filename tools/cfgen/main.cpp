@@ -10,6 +10,7 @@
 
 #include <exception>
 #include <iostream>
+#include <new>
 #include <string>
 
 namespace {
@@ -55,21 +56,23 @@ int main(int argc, char** argv) {
   gen_opts.push_back(app.add_option("--max-pcs", gen.max_pcs, "largest CFs to enumerate")
                          ->check(CLI::Range(1, 3))
                          ->capture_default_str());
-  gen_opts.push_back(app.add_option("--touch-tol", sp.touch_tol,
-                                    "mm: element pairs closer than this touch")
-                         ->check(cf::cli::finite_range(1e-12, 1e-3))
+  // Lengths of the search are relative to the smaller model's bounding-box diagonal D, so
+  // that a pair scaled by any factor gives the same graph up to scale.
+  gen_opts.push_back(app.add_option("--touch-tol", gen.rel.touch_tol,
+                                    "x D: element pairs closer than this touch (D: the smaller model's bounding-box diagonal)")
+                         ->check(cf::cli::finite_range(1e-15, 1e-5))
                          ->capture_default_str());
-  gen_opts.push_back(app.add_option("--min-clearance", sp.min_clearance,
-                                    "mm: at a witness, every pair not part of a PC is at least this far apart")
-                         ->check(cf::cli::finite_range(1e-9, 100.0))
+  gen_opts.push_back(app.add_option("--min-clearance", gen.rel.min_clearance,
+                                    "x D: at a witness, every pair not part of a PC is at least this far apart")
+                         ->check(cf::cli::finite_range(1e-9, 0.1))
                          ->capture_default_str());
-  gen_opts.push_back(app.add_option("--good-clearance", sp.good_clearance,
-                                    "mm: stop searching a CF's witness once it is this clear")
-                         ->check(cf::cli::finite_range(1e-9, 1000.0))
+  gen_opts.push_back(app.add_option("--good-clearance", gen.rel.good_clearance,
+                                    "x D: stop searching a CF's witness once it is this clear")
+                         ->check(cf::cli::finite_range(1e-9, 1.0))
                          ->capture_default_str());
-  gen_opts.push_back(app.add_option("--min-margin", sp.min_margin,
-                                    "mm: contact point at least this far inside its elements")
-                         ->check(cf::cli::finite_range(1e-9, 100.0))
+  gen_opts.push_back(app.add_option("--min-margin", gen.rel.min_margin,
+                                    "x D: contact point at least this far inside its elements")
+                         ->check(cf::cli::finite_range(1e-9, 0.1))
                          ->capture_default_str());
   gen_opts.push_back(app.add_option("--angle-margin", sp.angle_margin,
                                     "rad: local non-penetration slack at each PC")
@@ -131,6 +134,12 @@ int main(int argc, char** argv) {
 #endif
   } catch (const cf::Error& e) {
     std::cerr << "cfgen: " << e.what() << '\n';
+    return 1;
+  } catch (const std::bad_alloc&) {
+    // Named, not "internal error: std::bad_alloc": which input asked for the memory.
+    std::string what = features_path;
+    for (const std::string& m : models) what += (what.empty() ? "" : "' and '") + m;
+    std::cerr << "cfgen: out of memory while processing '" << what << "'\n";
     return 1;
   } catch (const std::exception& e) {
     std::cerr << "cfgen: internal error: " << e.what() << '\n';

@@ -52,6 +52,30 @@ Poly face_polygon(const std::vector<std::vector<Eigen::Vector2d>>& loops) {
 
 }  // namespace
 
+std::optional<Vec3> face_overlap_centroid(const Polyhedron& A, const Pose& pose, int a, const Polyhedron& B, int b) {
+  const Face& fa = A.face(FaceId(a));
+  const Face& fb = B.face(FaceId(b));
+  std::vector<std::vector<Eigen::Vector2d>> loops_a;
+  for (const auto& loop : fa.loops) {
+    loops_a.emplace_back();
+    for (VertexId v : loop) loops_a.back().push_back(B.face_coords(FaceId(b), pose.apply(A.vertex(v).p)));
+  }
+  const Poly pa = face_polygon(loops_a), pb = face_polygon(fb.loops_2d);
+  std::vector<Poly> inter;
+  bg::intersection(pa, pb, inter);
+  double best = 0;
+  std::optional<Vec3> out;
+  for (const auto& p : inter) {
+    const double area = std::abs(bg::area(p));
+    if (area <= best) continue;
+    P2 c;
+    bg::centroid(p, c);
+    best = area;
+    out = fb.offset * fb.normal + c.x() * fb.u + c.y() * fb.v;
+  }
+  return out;
+}
+
 bool open_touch(const Polyhedron& A, const Pose& pose, ElementKind ka, int a, const Polyhedron& B,
                 ElementKind kb, int b, double tol) {
   using K = ElementKind;

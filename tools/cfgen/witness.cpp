@@ -68,7 +68,7 @@ double closest_theta(const Vec3& axis, const Mat3& R0, const Mat3& S) {
 
 // Rotations R = Rot(axis, theta) * R0 satisfying all constraints; finitely many or samples.
 std::vector<Mat3> align_family(const RotConstraints& c, const std::vector<Mat3>& seeds,
-                               int samples) {
+                               int samples, bool* finite_out = nullptr) {
   const Vec3 a1 = c.align[0].first, axis = c.align[0].second;
   const Mat3 R0 = align(a1, axis);
   std::vector<double> thetas;
@@ -93,6 +93,7 @@ std::vector<Mat3> align_family(const RotConstraints& c, const std::vector<Mat3>&
     if (!consider(c.align[i].first, c.align[i].second, 1.0)) return {};
   for (const auto& [u, w] : c.perp)
     if (!consider(u, w, 0.0)) return {};
+  if (finite_out) *finite_out = finite;
   if (!finite) {
     for (const Mat3& S : seeds) thetas.push_back(closest_theta(axis, R0, S));
     for (int k = 0; k < samples; ++k) thetas.push_back(0.1 + 2 * M_PI * k / samples);
@@ -129,6 +130,17 @@ bool project_perp(const RotConstraints& c, Mat3& R) {
 }
 
 }  // namespace
+
+bool in_closure(const Polyhedron& m, ElementKind kx, int x, ElementKind ky, int y) {
+  if (kx == ky) return x == y;
+  if (ky == ElementKind::kFace) {
+    if (kx == ElementKind::kEdge) return m.edge_bounds_face(EdgeId(x), FaceId(y));
+    return m.vertex_on_face(VertexId(x), FaceId(y));
+  }
+  if (ky == ElementKind::kEdge && kx == ElementKind::kVertex)
+    return m.vertex_ends_edge(VertexId(x), EdgeId(y));
+  return false;
+}
 
 WitnessSearch::WitnessSearch(const ModelInfo& a, const ModelInfo& b, const SearchParams& p)
     : A_(a), B_(b), p_(p), scale_(std::max(a.model->size(), b.model->size())),
@@ -502,18 +514,6 @@ std::pair<Vec3, double> WitnessSearch::contact_plane(const Pc& pc, const Pose& p
 
 namespace {
 
-// Is element (kx, x) of a model in the closure of element (ky, y)?
-bool in_closure(const Polyhedron& m, ElementKind kx, int x, ElementKind ky, int y) {
-  if (kx == ky) return x == y;
-  if (ky == ElementKind::kFace) {
-    if (kx == ElementKind::kEdge) return m.edge_bounds_face(EdgeId(x), FaceId(y));
-    return m.vertex_on_face(VertexId(x), FaceId(y));
-  }
-  if (ky == ElementKind::kEdge && kx == ElementKind::kVertex)
-    return m.vertex_ends_edge(VertexId(x), EdgeId(y));
-  return false;
-}
-
 int count(const Polyhedron& m, ElementKind k) {
   return static_cast<int>(k == ElementKind::kVertex ? m.num_vertices()
                           : k == ElementKind::kEdge ? m.num_edges()
@@ -534,6 +534,105 @@ constexpr ElementKind kKinds[] = {ElementKind::kVertex, ElementKind::kEdge, Elem
 
 }  // namespace
 
+bool WitnessSearch::cones_disjoint(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b) const {
+  using K = ElementKind;
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  const double tol = 1e-9;  // on unit directions
+  const Mat3& R = pose.R_BA;
+  // A point on the open touching set, and a short probe length that stays near it.
+  const ClosestPoints cp = element_distance(A, pose, ka, a, B, kb, b);
+  const Vec3 x = cp.p_b;
+  double h = scale_;
+  auto shorten = [&](const Polyhedron& m, ElementKind k, int i) {
+    if (k == K::kVertex)
+      for (EdgeId e : m.vertices()[i].edges) h = std::min(h, m.edge(e).length);
+    else if (k == K::kEdge) h = std::min(h, m.edges()[i].length);
+  };
+  shorten(A, ka, a);
+  shorten(B, kb, b);
+  h *= 1e-4;
+  auto inside_a = [&](const Vec3& p_B) { return point_inside(A, pose.inverse_apply(p_B), 1e-3 * h); };
+  auto inside_b = [&](const Vec3& p_B) { return point_inside(B, p_B, 1e-3 * h); };
+  // B's wedge at a convex edge lies in A's closed outer half-space {y : n . y >= 0}.
+  auto wedge_b_outside = [&](int e, const Vec3& n) {
+    return B.edges()[e].convex && B_.wedges[e].into_left.dot(n) >= -tol && B_.wedges[e].into_right.dot(n) >= -tol;
+  };
+  auto wedge_a_outside = [&](int e, const Vec3& n) {  // n in B's frame, outward of B
+    return A.edges()[e].convex && (R * A_.wedges[e].into_left).dot(n) >= -tol &&
+           (R * A_.wedges[e].into_right).dot(n) >= -tol;
+  };
+  if (ka == K::kFace && kb == K::kFace) return (R * A.faces()[a].normal).dot(B.faces()[b].normal) < -1 + tol;
+  if (ka == K::kFace && kb == K::kEdge) return wedge_b_outside(b, R * A.faces()[a].normal);
+  if (ka == K::kEdge && kb == K::kFace) return wedge_a_outside(a, B.faces()[b].normal);
+  if (ka == K::kVertex && kb == K::kFace) {
+    const Vec3& n = B.faces()[b].normal;
+    for (const Vec3& r : A_.cones[a].rays)
+      if ((R * r).dot(n) < -tol) return false;
+    return A_.cones[a].pointed || !inside_a(x - h * n);
+  }
+  if (ka == K::kFace && kb == K::kVertex) {
+    const Vec3 n = R * A.faces()[a].normal;
+    for (const Vec3& r : B_.cones[b].rays)
+      if (r.dot(n) < -tol) return false;
+    return B_.cones[b].pointed || !inside_b(x - h * n);
+  }
+  if (ka == K::kEdge && kb == K::kEdge) {
+    const Vec3 da = R * A.edges()[a].dir;
+    const Vec3& db = B.edges()[b].dir;
+    Vec3 N = da.cross(db);
+    if (N.norm() > 1e-9) {
+      // Crossing edges: the only plane that can separate the wedges holds both edges.
+      if (!A.edges()[a].convex || !B.edges()[b].convex) return false;
+      N.normalize();
+      auto side = [&](const Vec3& n) {
+        return std::min({B_.wedges[b].into_left.dot(n), B_.wedges[b].into_right.dot(n),
+                         -(R * A_.wedges[a].into_left).dot(n), -(R * A_.wedges[a].into_right).dot(n)});
+      };
+      return std::max(side(N), side(-N)) >= -tol;
+    }
+    // Collinear edges: the two wedges' angular sectors about the common line must not overlap.
+    const Vec3 u = B_.wedges[b].into_left, w = db.cross(u);
+    auto angle = [&](const Vec3& v) {
+      const double t = std::atan2(v.dot(w), v.dot(u));
+      return t < 0 ? t + 2 * M_PI : t;
+    };
+    // Each sector as [start, start + width] going round +db from into_right to into_left
+    // (or the reverse), the width being the interior dihedral angle.
+    auto sector = [&](const Vec3& from, const Vec3& to, double width) {
+      double s0 = angle(from), s1 = angle(to);
+      double ccw = s1 - s0;
+      if (ccw < 0) ccw += 2 * M_PI;
+      // The sector runs ccw from `from` when that sweep equals the width, else ccw from `to`.
+      if (std::abs(ccw - width) < 1e-6) return std::pair{s0, width};
+      return std::pair{s1, width};
+    };
+    const auto sb = sector(B_.wedges[b].into_right, B_.wedges[b].into_left, B.edges()[b].dihedral);
+    const auto sa = sector(R * A_.wedges[a].into_right, R * A_.wedges[a].into_left, A.edges()[a].dihedral);
+    auto overlap = [&](std::pair<double, double> p, std::pair<double, double> q) {
+      double off = q.first - p.first;
+      off = std::fmod(off + 4 * M_PI, 2 * M_PI);  // q starts this far ccw from p
+      if (off < p.second - 1e-6) return true;     // q starts inside p
+      return off + q.second > 2 * M_PI + 1e-6;    // q wraps round into p's start
+    };
+    return !overlap(sa, sb) && !overlap(sb, sa);
+  }
+  // A vertex against an edge or a vertex: probe into each solid's cone along its inward
+  // axis and check that the point is outside the other solid.
+  auto inward_b = [&]() -> Vec3 {
+    if (kb == K::kEdge) return -B_.wedges[b].bisector;
+    return B_.cones[b].pointed ? Vec3(B_.cones[b].center) : Vec3::Zero();
+  };
+  auto inward_a = [&]() -> Vec3 {
+    if (ka == K::kEdge) return -(R * A_.wedges[a].bisector);
+    return A_.cones[a].pointed ? Vec3(R * A_.cones[a].center) : Vec3::Zero();
+  };
+  const Vec3 ib = inward_b(), ia = inward_a();
+  if (ib.norm() > 0.5 && inside_a(x + h * ib)) return false;
+  if (ia.norm() > 0.5 && inside_b(x + h * ia)) return false;
+  return true;
+}
+
 double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* why) const {
   auto reject = [&](const std::string& reason) {
     if (why) *why = reason;
@@ -543,6 +642,12 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
   const Polyhedron& B = *B_.model;
   if (local_margin(pcs, pose.R_BA) < std::sin(p_.angle_margin) * 0.5)
     return reject("locally penetrating");
+  // Line and plane PCs need their rotational conditions (a rotation found by a motion may
+  // only nearly satisfy them).
+  {
+    const RotConstraints c = rotation_constraints(pcs, A, B);
+    if (!satisfies(c, pose.R_BA)) return reject("a line or plane PC is not parallel to its face");
+  }
   // Pairwise distinct contact planes.
   for (int i = 0; i < pcs.size(); ++i)
     for (int j = i + 1; j < pcs.size(); ++j) {
@@ -580,8 +685,21 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
           }
           if (is_pc) {
             if (d > p_.touch_tol) return reject("PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " apart by " + std::to_string(d));
+            // The open elements must touch: a face meeting an edge only at its own boundary
+            // realises an edge-edge PC, not face-edge.
+            if (!open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol))
+              return reject("PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " touches only on its boundary");
             ++touching_pcs;
-          } else if (!covered) {
+          }
+          // Where two elements share open points, A's and B's tangent cones there must have
+          // disjoint interiors; pairs that touch only through their boundaries are judged
+          // as those boundary pairs. This catches a face of A running through a reflex edge
+          // of B, which no pair reports as crossing.
+          if ((is_pc || covered) && d <= p_.touch_tol && open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol) &&
+              !cones_disjoint(pose, ka, a, kb, b))
+            return reject("A and B overlap where " + kind_name(ka) + std::to_string(a) + " touches " +
+                          kind_name(kb) + std::to_string(b));
+          if (!is_pc && !covered) {
             // Closed elements that meet only on their boundaries do not touch: their boundary
             // elements do, and those pairs are judged on their own.
             if (d <= p_.touch_tol && !open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
@@ -604,6 +722,56 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
   return clearance;
 }
 
+bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  struct Touch {
+    ElementKind ka, kb;
+    int a, b;
+  };
+  std::vector<Touch> touching;
+  for (ElementKind ka : kKinds)
+    for (ElementKind kb : kKinds) {
+      const int na = count(A, ka), nb = count(B, kb);
+      for (int a = 0; a < na; ++a)
+        for (int b = 0; b < nb; ++b) {
+          const auto& sa = A_.spheres[static_cast<int>(ka)][a];
+          const auto& sb = B_.spheres[static_cast<int>(kb)][b];
+          if ((pose.apply(sa.first) - sb.first).norm() - sa.second - sb.second > p_.touch_tol) continue;
+          if (element_distance(A, pose, ka, a, B, kb, b).distance > p_.touch_tol) continue;
+          if (!open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
+          touching.push_back({ka, kb, a, b});
+        }
+    }
+  out = PcSet();
+  for (std::size_t i = 0; i < touching.size(); ++i) {
+    const Touch& x = touching[i];
+    bool dominated = false;
+    for (std::size_t j = 0; j < touching.size() && !dominated; ++j) {
+      const Touch& y = touching[j];
+      dominated = j != i && in_closure(A, x.ka, x.a, y.ka, y.a) && in_closure(B, x.kb, x.b, y.kb, y.b);
+    }
+    if (dominated) continue;
+    auto fail = [&](const std::string& reason) {
+      if (why) *why = reason;
+      return false;
+    };
+    using K = ElementKind;
+    const std::string name = kind_name(x.ka) + std::to_string(x.a) + "-" + kind_name(x.kb) + std::to_string(x.b);
+    if (x.ka == K::kVertex && x.kb != K::kFace) return fail("degenerate touch " + name);
+    if (x.kb == K::kVertex && x.ka != K::kFace) return fail("degenerate touch " + name);
+    if (x.ka == K::kEdge && x.kb == K::kEdge &&
+        (pose.R_BA * A.edges()[x.a].dir).cross(B.edges()[x.b].dir).norm() < 1e-9)
+      return fail("degenerate touch " + name + " (parallel edges)");
+    PcType t = PcType::kFF;
+    if (x.ka == K::kFace) t = x.kb == K::kFace ? PcType::kFF : x.kb == K::kEdge ? PcType::kFE : PcType::kFV;
+    else if (x.ka == K::kEdge) t = x.kb == K::kFace ? PcType::kEF : PcType::kEE;
+    else t = PcType::kVF;
+    if (!out.insert(Pc{t, x.a, x.b})) return fail("more than three PCs");
+  }
+  return true;
+}
+
 bool WitnessSearch::plausible(const PcSet& pcs) const {
   // A point lies in at most one open element: one vertex cannot make two PCs.
   for (int i = 0; i < pcs.size(); ++i)
@@ -622,6 +790,141 @@ bool WitnessSearch::plausible(const PcSet& pcs) const {
       const bool xa = a_kind(x.type) == ElementKind::kFace, ya = a_kind(y.type) == ElementKind::kFace;
       if (xa && ya && A_.face_plane[x.a] == A_.face_plane[y.a]) return false;
     }
+  return true;
+}
+
+double WitnessSearch::contact_margin(const PcSet& pcs, const Pose& pose) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  double m = std::numeric_limits<double>::infinity();
+  // How far a point of an edge lies inside the open edge and inside the face (B's frame).
+  auto edge_in_face = [&](const Vec3& p0, const Vec3& p1, const Polyhedron& fm, FaceId f, bool face_on_a) {
+    double best = 0;
+    const double len = (p1 - p0).norm();
+    for (int k = 1; k < 64; ++k) {
+      const double s = k / 64.0;
+      const Vec3 x = p0 + s * (p1 - p0);
+      const double in_face = fm.face_inset(f, face_on_a ? pose.inverse_apply(x) : x);
+      best = std::max(best, std::min({in_face, s * len, (1 - s) * len}));
+    }
+    return best;
+  };
+  for (const Pc& pc : pcs) {
+    switch (pc.type) {
+      case PcType::kVF:
+        m = std::min(m, B.face_inset(FaceId(pc.b), pose.apply(A.vertices()[pc.a].p)));
+        break;
+      case PcType::kFV:
+        m = std::min(m, A.face_inset(FaceId(pc.a), pose.inverse_apply(B.vertices()[pc.b].p)));
+        break;
+      case PcType::kEF:
+        m = std::min(m, edge_in_face(pose.apply(A.edge_point(EdgeId(pc.a), 0)), pose.apply(A.edge_point(EdgeId(pc.a), 1)),
+                                     B, FaceId(pc.b), false));
+        break;
+      case PcType::kFE:
+        m = std::min(m, edge_in_face(B.edge_point(EdgeId(pc.b), 0), B.edge_point(EdgeId(pc.b), 1), A, FaceId(pc.a), true));
+        break;
+      case PcType::kEE: {
+        const Vec3 p0 = pose.apply(A.edge_point(EdgeId(pc.a), 0)), p1 = pose.apply(A.edge_point(EdgeId(pc.a), 1));
+        const Vec3& q0 = B.edge_point(EdgeId(pc.b), 0);
+        const Vec3& q1 = B.edge_point(EdgeId(pc.b), 1);
+        const ClosestPoints cp = segment_segment(p0, p1, q0, q1);
+        m = std::min({m, (cp.p_a - p0).norm(), (cp.p_a - p1).norm(), (cp.p_b - q0).norm(), (cp.p_b - q1).norm()});
+        break;
+      }
+      case PcType::kFF: {
+        // At the centroid of the largest piece of the overlap region.
+        const std::optional<Vec3> x = face_overlap_centroid(A, pose, pc.a, B, pc.b);
+        m = std::min(m, x ? std::max(0.0, std::min(B.face_inset(FaceId(pc.b), *x),
+                                                   A.face_inset(FaceId(pc.a), pose.inverse_apply(*x))))
+                          : 0.0);
+        break;
+      }
+    }
+  }
+  return m;
+}
+
+Witness WitnessSearch::refine(const PcSet& pcs, const Pose& pose) const {
+  Witness out;
+  std::vector<int> slot_sizes;
+  for (const Pc& pc : pcs) {
+    switch (pc.type) {
+      case PcType::kVF: case PcType::kEF: slot_sizes.push_back(int(B_.pieces[pc.b].size())); break;
+      case PcType::kFV: case PcType::kFE: slot_sizes.push_back(int(A_.pieces[pc.a].size())); break;
+      case PcType::kFF:
+        slot_sizes.push_back(int(B_.pieces[pc.b].size()));
+        slot_sizes.push_back(int(A_.pieces[pc.a].size()));
+        break;
+      case PcType::kEE: break;
+    }
+  }
+  auto accept = [&](const Pose& q) {
+    const double c = verify(pcs, q);
+    if (c < p_.min_clearance || contact_margin(pcs, q) < p_.min_margin) return false;
+    out.found = true;
+    out.pose = q;
+    out.clearance = c;
+    return true;
+  };
+  // The translations that keep the contacts inside their elements form a convex set that
+  // holds the given pose: move from it towards that set's centre, most central first.
+  std::vector<int> choice(slot_sizes.size(), 0);
+  for (int combo = 0; combo < p_.max_piece_combinations; ++combo) {
+    double margin = 0;
+    const std::vector<Vec3> ts = translations(pcs, pose.R_BA, choice, margin, false);
+    if (!ts.empty())
+      for (double lambda : {0.5, 0.25, 0.1, 0.03}) {
+        Pose q = pose;
+        q.t_BA = pose.t_BA + lambda * (ts.front() - pose.t_BA);
+        if (accept(q)) return out;
+      }
+    std::size_t i = 0;
+    while (i < choice.size() && ++choice[i] == slot_sizes[i]) choice[i++] = 0;
+    if (i == choice.size()) break;
+  }
+  accept(pose);
+  return out;
+}
+
+bool WitnessSearch::refuted(const PcSet& pcs) const {
+  if (!plausible(pcs)) return true;
+  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
+  if (c.align.empty()) return false;  // a continuous family of rotations: not decided here
+  bool finite = false;
+  const std::vector<Mat3> rots = align_family(c, {}, 0, &finite);
+  if (!finite && !rots.empty()) return false;
+  if (!finite) {
+    // No other condition fixed the spin: the family is continuous unless a condition failed,
+    // and align_family returns nothing either way. Tell them apart with one sample.
+    if (!align_family(c, {}, 1).empty()) return false;
+  }
+  std::size_t combos = 1;
+  std::vector<int> slot_sizes;
+  for (const Pc& pc : pcs) {
+    switch (pc.type) {
+      case PcType::kVF: case PcType::kEF: slot_sizes.push_back(int(B_.pieces[pc.b].size())); break;
+      case PcType::kFV: case PcType::kFE: slot_sizes.push_back(int(A_.pieces[pc.a].size())); break;
+      case PcType::kFF:
+        slot_sizes.push_back(int(B_.pieces[pc.b].size()));
+        slot_sizes.push_back(int(A_.pieces[pc.a].size()));
+        break;
+      case PcType::kEE: break;
+    }
+  }
+  for (int n : slot_sizes) combos *= static_cast<std::size_t>(n);
+  if (combos > 4096) return false;
+  // Finitely many rotations: each must be locally penetrating or leave no room to place the
+  // contacts inside their elements (the LP over every combination of convex pieces).
+  for (const Mat3& R : rots) {
+    if (local_margin(pcs, R) < std::sin(p_.angle_margin) * 0.5) continue;
+    std::vector<int> choice(slot_sizes.size(), 0);
+    for (std::size_t k = 0; k < combos; ++k) {
+      const LpResult r = solve(build_lp(pcs, R, choice));
+      if (r.status == LpResult::Status::kOptimal && r.x[3] >= p_.min_margin) return false;
+      for (std::size_t i = 0; i < choice.size() && ++choice[i] == slot_sizes[i]; ++i) choice[i] = 0;
+    }
+  }
   return true;
 }
 

@@ -31,6 +31,9 @@ struct Witness {
   double margin = 0;     // mm, the LP margin of the contacts inside their elements
 };
 
+/// Is element (kx, x) of a model in the closure of element (ky, y)?
+bool in_closure(const Polyhedron& m, ElementKind kx, int x, ElementKind ky, int y);
+
 class WitnessSearch {
  public:
   WitnessSearch(const ModelInfo& a, const ModelInfo& b, const SearchParams& p);
@@ -44,6 +47,28 @@ class WitnessSearch {
   /// Returns the clearance, or a negative number when the pose is not a witness.
   double verify(const PcSet& pcs, const Pose& pose, std::string* why = nullptr) const;
 
+  /// The PCs that hold at a pose: every touching pair of open elements (distance within
+  /// touch_tol) that no other touching pair dominates. Returns false, with the reason, when
+  /// a non-dominated touch is degenerate (v-v, v-e, e-v, parallel e-e) or more than three
+  /// PCs hold; `out` is then meaningless. An empty `out` means no contact.
+  bool contacts_at(const Pose& pose, PcSet& out, std::string* why = nullptr) const;
+
+  /// A witness for `pcs` near `pose`, a pose where they hold (found by a motion): moved
+  /// towards the centre of the translations that keep the contacts, or `pose` itself, when
+  /// verified with the contacts at least min_margin inside their elements.
+  Witness refine(const PcSet& pcs, const Pose& pose) const;
+
+  /// How far inside their open elements the contacts of `pcs` lie at `pose` (mm): for each
+  /// PC the depth of its contact point, of the best of 63 points along its contact edge, or of
+  /// the centroid of its contact region, inside both elements; the smallest over the PCs.
+  double contact_margin(const PcSet& pcs, const Pose& pose) const;
+
+  /// For a set `find` found no witness for: true when it is proven invalid within the
+  /// search's tolerances (a necessary condition fails, or its rotational conditions leave
+  /// finitely many rotations and at each the PCs are locally penetrating or cannot be placed
+  /// inside their elements). False means undecided: the search gave up without a proof.
+  bool refuted(const PcSet& pcs) const;
+
   /// Cheap necessary conditions on a candidate set (no geometry search).
   bool plausible(const PcSet& pcs) const;
 
@@ -53,11 +78,20 @@ class WitnessSearch {
   /// Contact plane of a PC at a pose (unit normal pointing into A, offset along it).
   std::pair<Vec3, double> contact_plane(const Pc& pc, const Pose& pose) const;
 
+  const ModelInfo& a() const { return A_; }
+  const ModelInfo& b() const { return B_; }
+  const SearchParams& params() const { return p_; }
+  double scale() const { return scale_; }
+
  private:
   // generic_seeds: add each PC's preferred family and a spread of rotations to `seeds`.
   std::vector<Mat3> rotation_candidates(const PcSet& pcs, const std::vector<Mat3>& seeds,
                                         bool generic_seeds = true) const;
   double local_margin(const PcSet& pcs, const Mat3& R) const;
+  // Whether A's and B's tangent cones where element a of A touches element b of B have
+  // disjoint interiors (exact for pairs with a face or two edges; vertex-edge and
+  // vertex-vertex probe along each cone's inward axis).
+  bool cones_disjoint(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b) const;
   LinearProgram build_lp(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces) const;
   // Candidate translations for rotation R, best first; empty when the contacts cannot hold
   // with min_margin. `margin` receives the largest margin.
