@@ -19,16 +19,17 @@ args=(-S "$CF_ROOT" -B "$SAN_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_
       -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCF_SANITIZE=ON -DCF_BUILD_FUZZ=ON -DCF_WITH_CGAL=OFF
       -DCF_BUILD_TOOLS=ON -DCF_BUILD_TESTS=ON -DCF_BUILD_BENCH=OFF)
 if [[ ! -f "$SAN_DIR/CMakeCache.txt" ]]; then args+=(-G Ninja); fi
+# alloc_dealloc_mismatch=0: renderer_test and identifier_test replace the global operator
+# new/delete (malloc/free) to count allocations but not the nothrow form std::stable_sort
+# uses; that pairing is the test harness's, not a bug of the library. Set before the build:
+# catch_discover_tests runs the test programs to list their cases.
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:alloc_dealloc_mismatch=0"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 cf_log "configure $SAN_DIR (clang, ASan + UBSan, fuzz targets)"
 cmake "${args[@]}" >/dev/null
 cf_log "build $SAN_DIR (-j$CF_JOBS)"
 cmake --build "$SAN_DIR" -j "$CF_JOBS"
 cf_log "test $SAN_DIR (ASan + UBSan)"
-# alloc_dealloc_mismatch=0: renderer_test and identifier_test replace the global operator
-# new/delete (malloc/free) to count allocations but not the nothrow form std::stable_sort
-# uses; that pairing is the test harness's, not a bug of the library.
-export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:alloc_dealloc_mismatch=0"
-export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 # Left out here (they run in the main build): the install/find_package proof (a sanitized
 # libcf.a cannot link into the plain consumer), and the brute-force comparisons of the BVH
 # with all pairs on 2,000-face models (10 minutes and more under ASan).

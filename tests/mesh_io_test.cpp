@@ -243,6 +243,20 @@ TEST_CASE("indices and coordinates out of range get precise messages", "[mesh_io
                     Catch::Contains("huge.off': vertex 1 has the coordinate 1e+301 mm, beyond the largest accepted (|x| <= 1e+09 mm)"));
   CHECK_THROWS_WITH(load_model(write_file("inf.off", "OFF\n3 1 0\n0 0 0\n1e999 0 0\n0 1 0\n3 0 1 2\n")),
                     Catch::Contains("inf.off': parse error: line 4: vertex 1: '1e999' is not a finite number"));
+  // Found by fuzz_ply: an index beyond the range of long long (the message's cast was
+  // undefined behaviour), and a NaN in binary PLY (it broke the ordering of the point index).
+  const std::string ply_head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                               "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                               "0 0 0\n1 0 0\n0 1 0\n";
+  CHECK_THROWS_WITH(load_model(write_file("index_huge.ply", ply_head + "3 0 1 1" + std::string(40, '1') + "\n")),
+                    Catch::Contains("index_huge.ply': parse error: facet 0 refers to vertex 1.111111111111111e+40, which does "
+                                    "not exist"));
+  std::string nan_ply = "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                        "property float z\nend_header\n";
+  const float nan_xyz[3] = {std::nanf(""), 0, 0};
+  nan_ply.append(reinterpret_cast<const char*>(nan_xyz), sizeof nan_xyz);
+  CHECK_THROWS_WITH(load_model(write_file("nan.ply", nan_ply)),
+                    Catch::Contains("nan.ply': parse error: a property value in the binary data is not a finite number"));
   // Binary garbage is quoted printable.
   CHECK_THROWS_WITH(load_model(write_file("garbage.obj", "v 0 0 0\n\x01\x1b[2J\xff x\n")),
                     Catch::Contains("garbage.obj': parse error: line 2: unknown OBJ record '\\x01\\x1B[2J\\xFF'"));

@@ -14,6 +14,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -27,6 +28,15 @@ using detail::fail;
 using cf::detail::printable;
 
 std::string quoted(std::string_view t) { return "'" + printable(std::string(t), 40) + "'"; }
+
+/// A number from a file for a message: integers exactly (any size), others with %.17g.
+/// (A cast of a double beyond the range of long long is undefined: fuzz_ply found one.)
+std::string number_text(double v) {
+  char buf[40];
+  if (std::abs(v) < 9e18 && v == std::floor(v)) std::snprintf(buf, sizeof buf, "%lld", static_cast<long long>(v));
+  else std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v'; }
 
@@ -476,9 +486,15 @@ class PlyData {
       case PlyType::kU16: { std::uint16_t v; std::memcpy(&v, b, 2); return v; }
       case PlyType::kI32: { std::int32_t v; std::memcpy(&v, b, 4); return v; }
       case PlyType::kU32: { std::uint32_t v; std::memcpy(&v, b, 4); return v; }
-      case PlyType::kF32: { float v; std::memcpy(&v, b, 4); return v; }
-      default: { double v; std::memcpy(&v, b, 8); return v; }
+      case PlyType::kF32: { float v; std::memcpy(&v, b, 4); return finite(v, what); }
+      default: { double v; std::memcpy(&v, b, 8); return finite(v, what); }
     }
+  }
+  /// Binary floats may be NaN or infinite: refused like the text "nan" (and a NaN would
+  /// break the ordering of the point index).
+  double finite(double v, const char* what) const {
+    if (!std::isfinite(v)) fail(src_, std::string("parse error: ") + what + " in the binary data is not a finite number");
+    return v;
   }
   /// Bytes left; in ascii a value takes at least 2 (a digit and a separator).
   std::size_t remaining() const { return d_.size() - p_; }
@@ -616,7 +632,7 @@ RawSoup read_ply(std::string_view bytes, const std::string& src) {
         const double nd = data.value(p.count_type, "a list count");
         if (nd < 0 || nd * static_cast<double>(data.min_bytes(p.type)) > static_cast<double>(data.remaining()) + 1)
           fail(src, "parse error: item " + std::to_string(i) + " of element '" + printable(e.name, 40) +
-                        "' has a list of " + std::to_string(static_cast<long long>(nd)) +
+                        "' has a list of " + number_text(nd) +
                         " values, more than the rest of the file holds");
         const auto n = static_cast<std::size_t>(nd);
         const bool keep = static_cast<int>(k) == ilist;
@@ -625,11 +641,11 @@ RawSoup read_ply(std::string_view bytes, const std::string& src) {
           const double v = data.value(p.type, "a list value");
           if (!keep) continue;
           if (!ply_integer(p.type) && v != std::floor(v))
-            fail(src, "parse error: facet " + std::to_string(i) + ": vertex index " + std::to_string(v) +
+            fail(src, "parse error: facet " + std::to_string(i) + ": vertex index " + number_text(v) +
                           " is not an integer");
           if (v < 0 || v > static_cast<double>(std::numeric_limits<int>::max()))
             fail(src, "parse error: facet " + std::to_string(i) + " refers to vertex " +
-                          std::to_string(static_cast<long long>(v)) + ", which does not exist");
+                          number_text(v) + ", which does not exist");
           poly.push_back(static_cast<std::size_t>(v));
         }
       }
