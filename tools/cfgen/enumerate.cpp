@@ -277,6 +277,10 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
                      met[i] = explore_translations(search, frontier[i].first, frontier[i].second);
                      std::vector<Discovery> r = explore_rotations(search, frontier[i].first, frontier[i].second);
                      met[i].insert(met[i].end(), r.begin(), r.end());
+                     for (const Pose& q : turned_witnesses(search, frontier[i].first, frontier[i].second)) {
+                       r = explore_translations(search, frontier[i].first, q);
+                       met[i].insert(met[i].end(), r.begin(), r.end());
+                     }
                    },
                    tick);
       // The first discovery of each new set, in frontier order: independent of thread count.

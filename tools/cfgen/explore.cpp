@@ -136,6 +136,46 @@ double first_contact_translation(const Polyhedron& A, const Polyhedron& B, const
   return hit ? best : kInf;
 }
 
+std::vector<Pose> turned_witnesses(const WitnessSearch& search, const PcSet& pcs, const Pose& witness) {
+  const Polyhedron& A = *search.a().model;
+  const Polyhedron& B = *search.b().model;
+  std::vector<Vec3> points;
+  for (const Pc& pc : pcs) {
+    switch (pc.type) {
+      case PcType::kVF: points.push_back(witness.apply(A.vertices()[pc.a].p)); break;
+      case PcType::kFV: points.push_back(B.vertices()[pc.b].p); break;
+      case PcType::kEE:
+        points.push_back(element_distance(A, witness, ElementKind::kEdge, pc.a, B, ElementKind::kEdge, pc.b).p_b);
+        break;
+      default:
+        return {};  // line and plane PCs leave no rotation about a point free
+    }
+  }
+  // Turns that keep the contact points fixed: about any axis through a single point, about
+  // the line through two.
+  std::vector<std::pair<Vec3, double>> turns;
+  if (points.size() == 1) {
+    static const Vec3 kAxes[] = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1),
+                                 Vec3(1, 1, 0).normalized(), Vec3(0, 1, -1).normalized(), Vec3(-1, 0, 1).normalized()};
+    for (const Vec3& ax : kAxes)
+      for (double ang : {0.25, -0.25, 0.6, -0.6}) turns.push_back({ax, ang});
+  } else if (points.size() == 2 && (points[1] - points[0]).norm() > 1e-6 * search.scale()) {
+    const Vec3 ax = (points[1] - points[0]).normalized();
+    for (double ang : {0.15, -0.15, 0.4, -0.4}) turns.push_back({ax, ang});
+  }
+  std::vector<Pose> out;
+  for (const auto& [ax, ang] : turns) {
+    const Mat3 Q = Eigen::AngleAxisd(ang, ax).toRotationMatrix();
+    Pose q;
+    q.R_BA = Q * witness.R_BA;
+    q.t_BA = Q * (witness.t_BA - points[0]) + points[0];
+    PcSet now;
+    if (search.contacts_at(q, now) && now == pcs && search.verify(pcs, q) >= search.params().min_clearance)
+      out.push_back(q);
+  }
+  return out;
+}
+
 std::vector<Discovery> explore_translations(const WitnessSearch& search, const PcSet& pcs,
                                             const Pose& witness) {
   const Polyhedron& A = *search.a().model;
@@ -428,7 +468,6 @@ std::vector<Discovery> explore_rotations(const WitnessSearch& search, const PcSe
     PcSet found;
     if (search.contacts_at(pose, found) && !found.empty() && found != pcs) out.push_back({found, pose});
   };
-  const double reach = A.size() + B.size();
   for (int mask = 0; mask + 1 < (1 << n); ++mask) {  // mask: the PCs to break
     PcSet kept;
     std::vector<int> K, L;
@@ -477,8 +516,54 @@ std::vector<Discovery> explore_rotations(const WitnessSearch& search, const PcSe
           record(rotated(witness, p, w, phi));
         }
         if (std::isfinite(phi_hit)) record(rotated(witness, p, w, phi_hit));
-        (void)reach;
       }
+  }
+  // Tipping: a line or plane PC turned about one of its boundary elements becomes the
+  // neighbouring PC that element makes (f-f about an edge of either face: e-f or f-e; e-f or
+  // f-e about an end of the edge: v-f or f-v), while the other PCs are kept.
+  auto tip = [&](int j, const Vec3& p, const Vec3& u0, const Pc& neighbour) {
+    const Vec3 u = u0.normalized();
+    PcSet kept;
+    kept.insert(neighbour);
+    for (int k = 0; k < n; ++k)
+      if (k != j) {
+        if (!keeps(k, p, u)) return;
+        kept.insert(pcs[k]);
+      }
+    for (double sign : {1.0, -1.0}) {
+      const Vec3 w = sign * u;
+      const double rate = normal[j].dot(w.cross(anchor[j] - p));  // the PC's anchor lifts
+      if (!(rate > 1e-6 * search.scale())) continue;
+      const double phi_hit = first_contact_rotation(A, B, witness, p, w, 1e-9, M_PI, tol, kept);
+      const double phi = std::min(0.5 * std::min(phi_hit, M_PI), std::max(10 * prm.min_clearance, prm.good_clearance) / rate);
+      record(rotated(witness, p, w, phi));
+      if (std::isfinite(phi_hit)) record(rotated(witness, p, w, phi_hit));
+    }
+  };
+  for (int j = 0; j < n; ++j) {
+    const Pc& pc = pcs[j];
+    switch (pc.type) {
+      case PcType::kFF:
+        for (cf::EdgeId e : A.faces()[pc.a].edges)
+          tip(j, witness.apply(A.edge_point(e, 0)), witness.R_BA * A.edge(e).dir, Pc{PcType::kEF, e.value(), pc.b});
+        for (cf::EdgeId e : B.faces()[pc.b].edges)
+          tip(j, B.edge_point(e, 0), B.edge(e).dir, Pc{PcType::kFE, pc.a, e.value()});
+        break;
+      case PcType::kEF:
+        for (int end = 0; end < 2; ++end) {
+          const cf::VertexId v = end == 0 ? A.edges()[pc.a].v0 : A.edges()[pc.a].v1;
+          tip(j, witness.apply(A.vertex(v).p), normal[j].cross(line[j]), Pc{PcType::kVF, v.value(), pc.b});
+        }
+        break;
+      case PcType::kFE:
+        for (int end = 0; end < 2; ++end) {
+          const cf::VertexId v = end == 0 ? B.edges()[pc.b].v0 : B.edges()[pc.b].v1;
+          tip(j, B.vertex(v).p, normal[j].cross(line[j]), Pc{PcType::kFV, pc.a, v.value()});
+        }
+        break;
+      default:
+        break;
+    }
   }
   return out;
 }
