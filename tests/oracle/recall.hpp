@@ -1,0 +1,69 @@
+#pragma once
+// Independent test oracle: one recall run on a model pair. Writes the pair (generated from a
+// seed, or given files), runs cfgen on it, rebuilds the featured models from the graph, checks
+// the models against the meshes, re-verifies every witness, samples valid CFs independently
+// and reports the sampled CFs the graph lacks.
+
+#include "graph.hpp"
+#include "sampler.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace oracle {
+
+struct RecallOptions {
+  std::string cfgen;         // path of the cfgen binary
+  double budget_s = 3.0;     // sampler time per pair
+  int threads = 2;           // cfgen -j
+  double cfgen_timeout_s = 0;  // >0: kill cfgen after this long and report the run as failed
+  std::string keep_dir;      // keep the models and the graph here ("" = temporary, removed)
+  std::uint64_t sampler_seed = 0;  // 0: derived from the pair's seed
+  int max_printed_misses = 30;
+  long sampler_rounds = 0;         // >0: stop the sampler after this many rounds (deterministic)
+  std::vector<Pose> check_poses;   // classify these poses of A and say whether the graph holds the CF
+};
+
+struct Miss {
+  CfKey key;
+  Sample sample;
+};
+
+struct RecallResult {
+  bool ok = false;            // the run itself worked (cfgen ran, graph read)
+  std::string error;
+  std::uint64_t seed = 0;
+  bool from_seed = false;
+  std::string desc;
+  std::string a_path, b_path, graph_path;
+  int graph_cfs = 0;
+  int sampled = 0;
+  int found = 0;  // sampled and in the graph
+  std::vector<Miss> misses;
+  int unstable = 0;               // sampled CFs whose PCs change between tol/10 and tol*10 (dropped)
+  int suspect = 0;                // misses the Monte-Carlo check contradicts (dropped, printed)
+  std::vector<Miss> suspects;
+  std::vector<std::string> pose_reports;  // for RecallOptions::check_poses
+  CheckReport check;
+  std::vector<std::string> model_problems;  // graph models vs the meshes
+  double cfgen_s = 0, sampler_s = 0, check_s = 0;
+  SamplerStats sampler_stats;
+
+  double recall() const { return sampled ? 100.0 * found / sampled : 100.0; }
+  std::string line() const;     // one line: seed, description, counts, recall, unsound
+  std::string details() const;  // misses (PC lists, poses), unsound witnesses, model problems
+};
+
+/// A pose as 12 comma-separated numbers (R row by row, then t), and back (false when malformed
+/// or not a rotation).
+std::string pose_arg(const Pose& X);
+bool parse_pose_arg(const std::string& a, Pose* X);
+
+/// Signature of a CF for grouping: "2:e-f+v-f".
+std::string signature(const CfKey& k);
+
+RecallResult run_recall_seed(std::uint64_t seed, const RecallOptions& o);
+RecallResult run_recall_files(const std::string& a_off, const std::string& b_off, const RecallOptions& o);
+
+}  // namespace oracle

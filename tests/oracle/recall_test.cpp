@@ -1,0 +1,70 @@
+// Recall of cfgen against the independent oracle on fixed seeds (tests/oracle/README.md).
+// For each seed: generate the pair, run cfgen, re-verify every witness (all must be sound),
+// sample valid CFs independently and require every sampled CF to be in the graph. Misses are
+// printed with the seed, the pair, the PC list and the pose where the oracle realised them;
+// reproduce one with `oracle_recall --seed N --keep DIR`.
+//
+// Environment: ORACLE_ROUNDS (sampler rounds per pair, default 8000, about 3 s),
+// ORACLE_BUDGET (cap on the sampler's seconds, default 15), ORACLE_THREADS (cfgen -j, default 2).
+
+#include "recall.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cstdlib>
+#include <iostream>
+#include <string>
+
+#ifndef CF_CFGEN
+#error "CF_CFGEN must name the cfgen binary"
+#endif
+
+namespace {
+
+// The floor every fixed seed meets today (98.2% on the box on stairs, seed 171, is the
+// lowest); the completeness issue's acceptance level is 99.5% and its aim 100%. Raise it as
+// the generator improves; it guards against regressions meanwhile.
+constexpr double kMinRecallPercent = 98.0;
+
+void run_seed(std::uint64_t seed) {
+  oracle::RecallOptions o;
+  o.cfgen = CF_CFGEN;
+  o.budget_s = 15.0;         // a cap only: the sampler stops after sampler_rounds rounds,
+  o.sampler_rounds = 8000;   // which takes about 3 s and makes the run deterministic
+  o.threads = 2;
+  if (const char* b = std::getenv("ORACLE_BUDGET")) o.budget_s = std::atof(b);
+  if (const char* k = std::getenv("ORACLE_ROUNDS")) o.sampler_rounds = std::atol(k);
+  if (const char* j = std::getenv("ORACLE_THREADS")) o.threads = std::atoi(j);
+  oracle::RecallResult r = oracle::run_recall_seed(seed, o);
+  std::cout << r.line() << "\n  sampler: " << r.sampler_stats.str() << "\n" << r.details() << std::flush;
+  INFO(r.line());
+  REQUIRE(r.ok);
+  CHECK(r.model_problems.empty());
+  CHECK(r.check.unsound == 0);
+  // Every witness must be sound, exactly. Recall, the share of the CFs the sampler realises
+  // that are in the graph, must reach kMinRecallPercent; every miss is printed above with its
+  // pose so that it can be chased.
+  CHECK(r.recall() >= kMinRecallPercent);
+}
+
+}  // namespace
+
+// Fixed seeds: small pairs, one per pairing whose cfgen run is short (pairing = seed % 12):
+// 127 wedge against L-section, 44 tiny wedge against stairs, 11 box against L-section,
+// 171 box on stairs, 144 triangular peg in triangular hole, 126 box against T-section,
+// 1 box in corner block, 14 triangular prism in U-channel. The other pairings (cube in square
+// hole, L-part against U-channel, A wider than the pocket, L-part against corner/stairs) make
+// cfgen run for minutes; scripts/recall-soak.sh covers them.
+#define ORACLE_SEED(N)                                  \
+  TEST_CASE("recall on seed " #N, "[oracle][recall]") { \
+    run_seed(N);                                        \
+  }
+
+ORACLE_SEED(127)
+ORACLE_SEED(44)
+ORACLE_SEED(11)
+ORACLE_SEED(171)
+ORACLE_SEED(144)
+ORACLE_SEED(126)
+ORACLE_SEED(1)
+ORACLE_SEED(14)
