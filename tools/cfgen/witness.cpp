@@ -847,18 +847,7 @@ double WitnessSearch::contact_margin(const PcSet& pcs, const Pose& pose) const {
 
 Witness WitnessSearch::refine(const PcSet& pcs, const Pose& pose) const {
   Witness out;
-  std::vector<int> slot_sizes;
-  for (const Pc& pc : pcs) {
-    switch (pc.type) {
-      case PcType::kVF: case PcType::kEF: slot_sizes.push_back(int(B_.pieces[pc.b].size())); break;
-      case PcType::kFV: case PcType::kFE: slot_sizes.push_back(int(A_.pieces[pc.a].size())); break;
-      case PcType::kFF:
-        slot_sizes.push_back(int(B_.pieces[pc.b].size()));
-        slot_sizes.push_back(int(A_.pieces[pc.a].size()));
-        break;
-      case PcType::kEE: break;
-    }
-  }
+  const std::vector<int> slot_sizes = piece_slots(pcs);
   auto accept = [&](const Pose& q) {
     const double c = verify(pcs, q);
     if (c < p_.min_clearance || contact_margin(pcs, q) < p_.min_margin) return false;
@@ -887,6 +876,22 @@ Witness WitnessSearch::refine(const PcSet& pcs, const Pose& pose) const {
   return out;
 }
 
+std::vector<int> WitnessSearch::piece_slots(const PcSet& pcs) const {
+  std::vector<int> slot_sizes;
+  for (const Pc& pc : pcs) {
+    switch (pc.type) {
+      case PcType::kVF: case PcType::kEF: slot_sizes.push_back(int(B_.pieces[pc.b].size())); break;
+      case PcType::kFV: case PcType::kFE: slot_sizes.push_back(int(A_.pieces[pc.a].size())); break;
+      case PcType::kFF:
+        slot_sizes.push_back(int(B_.pieces[pc.b].size()));
+        slot_sizes.push_back(int(A_.pieces[pc.a].size()));
+        break;
+      case PcType::kEE: break;
+    }
+  }
+  return slot_sizes;
+}
+
 bool WitnessSearch::refuted(const PcSet& pcs) const {
   if (!plausible(pcs)) return true;
   const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
@@ -900,18 +905,7 @@ bool WitnessSearch::refuted(const PcSet& pcs) const {
     if (!align_family(c, {}, 1).empty()) return false;
   }
   std::size_t combos = 1;
-  std::vector<int> slot_sizes;
-  for (const Pc& pc : pcs) {
-    switch (pc.type) {
-      case PcType::kVF: case PcType::kEF: slot_sizes.push_back(int(B_.pieces[pc.b].size())); break;
-      case PcType::kFV: case PcType::kFE: slot_sizes.push_back(int(A_.pieces[pc.a].size())); break;
-      case PcType::kFF:
-        slot_sizes.push_back(int(B_.pieces[pc.b].size()));
-        slot_sizes.push_back(int(A_.pieces[pc.a].size()));
-        break;
-      case PcType::kEE: break;
-    }
-  }
+  const std::vector<int> slot_sizes = piece_slots(pcs);
   for (int n : slot_sizes) combos *= static_cast<std::size_t>(n);
   if (combos > 4096) return false;
   // Finitely many rotations: each must be locally penetrating or leave no room to place the
@@ -934,18 +928,7 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
   const std::vector<Mat3> rots = rotation_candidates(pcs, seeds);
   if (debug_) std::cerr << "find " << to_string(pcs[0]) << (pcs.size() > 1 ? " +" : "") << ": " << rots.size() << " rotations\n";
   // Face-piece slots, in the order solve_translation consumes them.
-  std::vector<int> slot_sizes;
-  for (const Pc& pc : pcs) {
-    switch (pc.type) {
-      case PcType::kVF: case PcType::kEF: slot_sizes.push_back(int(B_.pieces[pc.b].size())); break;
-      case PcType::kFV: case PcType::kFE: slot_sizes.push_back(int(A_.pieces[pc.a].size())); break;
-      case PcType::kFF:
-        slot_sizes.push_back(int(B_.pieces[pc.b].size()));
-        slot_sizes.push_back(int(A_.pieces[pc.a].size()));
-        break;
-      case PcType::kEE: break;
-    }
-  }
+  const std::vector<int> slot_sizes = piece_slots(pcs);
   std::vector<Mat3> near;  // rotations where the contacts held but the pose failed
   auto try_rotation = [&](const Mat3& R) {
     std::vector<int> choice(slot_sizes.size(), 0);

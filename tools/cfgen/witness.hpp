@@ -88,6 +88,8 @@ class WitnessSearch {
   std::vector<Mat3> rotation_candidates(const PcSet& pcs, const std::vector<Mat3>& seeds,
                                         bool generic_seeds = true) const;
   double local_margin(const PcSet& pcs, const Mat3& R) const;
+  // Number of convex pieces of each face slot of the LP (build_lp's `pieces`), in its order.
+  std::vector<int> piece_slots(const PcSet& pcs) const;
   // Whether A's and B's tangent cones where element a of A touches element b of B have
   // disjoint interiors (exact for pairs with a face or two edges; vertex-edge and
   // vertex-vertex probe along each cone's inward axis).
