@@ -9,6 +9,7 @@
 #include "file_io.hpp"        // output paths, printable messages (libcf private)
 #include "graph_impl.hpp"    // Boost.Graph view (libcf private)
 #include "graph_schema.hpp"  // the embedded schema text
+#include "html.hpp"          // --html: the browser viewer
 
 #include <CLI/CLI.hpp>
 #include <boost/graph/connected_components.hpp>
@@ -270,7 +271,7 @@ cf::Pose parse_pose(const std::string& text) {
 int run(int argc, char** argv) {
   CLI::App app{"cfinspect: validate a CF graph file against the schema, summarise it, answer queries, export DOT"};
   app.set_version_flag("--version", "cfinspect 0.1 (cf-graph format version 1)");
-  std::string path, holding_text, dot_path, pose_text;
+  std::string path, holding_text, dot_path, pose_text, html_path, replay_path, trajectory_path;
   long long neighbours_id = -1, cf_id = -1;
   bool as_json = false, fast = false, print_schema = false;
   double epsilon = 1.0;
@@ -283,6 +284,9 @@ int run(int argc, char** argv) {
                  "identify the CF at the pose tx,ty,tz,qw,qx,qy,qz of A (mm, unit quaternion; as in POSES.csv)");
   app.add_option("--epsilon", epsilon, "contact threshold for --pose, mm (default 1.0, the paper's)")
       ->check(cf::cli::finite_range(1e-6, 1e3));
+  app.add_option("--html", html_path, "write the browser viewer of the graph: one self-contained HTML file");
+  app.add_option("--replay", replay_path, "with --html: a cfreplay output CSV for the page to animate");
+  app.add_option("--trajectory", trajectory_path, "with --replay: the POSES.csv it was replayed from (moves A)");
   app.add_flag("--json", as_json, "machine-readable output (the summary or the query's answer)");
   app.add_flag("--fast", fast, "check the items of cfs/transitions with the reader's rules instead of the full schema");
   app.add_flag("--print-schema", print_schema, "print the JSON Schema of graph files (schemas/cf-graph.schema.json) and exit");
@@ -316,6 +320,18 @@ int run(int argc, char** argv) {
   // An output path is checked before the load: never the graph itself, a device, a FIFO
   // or a directory (SPEC section 5b).
   if (!dot_path.empty()) cf::detail::check_output_path(dot_path, {path}, "writing DOT");
+  if (html_path.empty() && !(replay_path.empty() && trajectory_path.empty())) {
+    std::cerr << "cfinspect: --replay and --trajectory go with --html (see --help)\n";
+    return 2;
+  }
+  if (!trajectory_path.empty() && replay_path.empty()) {
+    std::cerr << "cfinspect: --trajectory goes with --replay (see --help)\n";
+    return 2;
+  }
+  std::vector<std::string> html_inputs{path};  // never written over
+  for (const std::string* p : {&replay_path, &trajectory_path})
+    if (!p->empty()) html_inputs.push_back(*p);
+  if (!html_path.empty()) cf::detail::check_output_path(html_path, html_inputs, "writing HTML");
   cf::GraphLoadOptions options;
   options.full_schema_check = !fast;
   const cf::CfGraph g = cf::CfGraph::load(path, options);
@@ -387,7 +403,17 @@ int run(int argc, char** argv) {
     if (!as_json) std::cout << "wrote " << dot_path << " (" << g.num_cfs() << " nodes, " << g.num_transitions() << " edges)\n";
     else answer["dot"] = dot_path;
   }
-  if (!queried) {  // no query: the summary (also after --dot)
+  if (!html_path.empty()) {
+    // The graph file's own text when it is JSON (with cfgen's contact planes, which the
+    // loaded graph does not keep); the re-serialised graph for CBOR.
+    const bool cbor = path.size() >= 5 && path.compare(path.size() - 5, 5, ".cbor") == 0;
+    cf::inspect::ViewerInputs in{path, cbor ? g.to_json(-1) : cf::inspect::read_text_file(path, "reading"),
+                                 g.num_cfs(), replay_path, trajectory_path, cf_id};
+    cf::detail::write_outputs({{html_path, cf::inspect::viewer_html(in)}}, html_inputs, "writing HTML");
+    if (!as_json) std::cout << "wrote " << html_path << " (viewer of " << g.num_cfs() << " CFs" << (replay_path.empty() ? "" : ", with the replay") << ")\n";
+    else answer["html"] = html_path;
+  }
+  if (!queried) {  // no query: the summary (also after --dot, --html)
     const Summary s = summarise(g);
     if (as_json) {
       ojson summary = summary_json(path, g, s, !fast);
