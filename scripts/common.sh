@@ -19,6 +19,7 @@ cf_log() { printf '== %s\n' "$*"; }
 cf_install_deps() {
   if [[ "${CF_SKIP_DEPS:-0}" == 1 ]]; then return 0; fi
   bash "$CF_ROOT/scripts/install-deps.sh"
+  bash "$CF_ROOT/scripts/install-npm.sh"
 }
 
 cf_configure() {

@@ -26,7 +26,14 @@ CF_APT_PACKAGES=(
   # the sanitizer and fuzz build (scripts/sanitize.sh, scripts/fuzz.sh): clang, its
   # ASan/UBSan runtimes and libFuzzer (clang is only a recommendation of clang-14)
   clang clang-14 libclang-rt-14-dev libfuzzer-14-dev
+  # cfinspect --html: the browser test of the viewer (tools/cfinspect/viewer, headless)
+  chromium
 )
+# The viewer's bundler and browser driver run on Node.js; Debian's nodejs and npm only when
+# the machine has no node or npm (Debian's npm would conflict with another vendor's nodejs).
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  CF_APT_PACKAGES+=(nodejs npm)
+fi
 
 missing_packages() {
   local pkg status
