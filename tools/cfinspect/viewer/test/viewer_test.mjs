@@ -49,9 +49,9 @@ const graph = JSON.parse(readFileSync(args.graph, 'utf8'));
 const replayRows = readFileSync(replayCsv, 'utf8').trim().split('\n').slice(1).map((l) => l.split(','));
 const KIND = { v: 'vertex', e: 'edge', f: 'face' };
 const pcText = (pc) => `${pc.type}:${pc.a}:${pc.b}`;
-// A CF with two PCs of different element kinds and some neighbours of each kind, if any.
+// A CF with two PCs of different element kinds and neighbours of two kinds or more, if any.
 const kinds = (id) => new Set(graph.transitions.filter((t) => t.from === id).map((t) => t.kind));
-const cf = graph.cfs.find((c) => c.pcs.length === 2 && c.pcs[0].type !== c.pcs[1].type && kinds(c.id).size === 3) ||
+const cf = graph.cfs.find((c) => c.pcs.length === 2 && c.pcs[0].type[0] !== c.pcs[1].type[0] && c.pcs[0].type[2] !== c.pcs[1].type[2] && kinds(c.id).size >= 2) ||
   graph.cfs.find((c) => c.pcs.length === 2) || graph.cfs[0];
 
 // --- the browser -----------------------------------------------------------------------
