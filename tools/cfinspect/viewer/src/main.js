@@ -141,7 +141,16 @@ function aim() {
   for (const h of state.highlighted) { c.add(v3(h.plane.point)); n.add(v3(h.plane.normal)); }
   c.divideScalar(state.highlighted.length);
   if (n.lengthSq() < 1e-6) n.set(0, 0, 1);
-  const dir = n.normalize().add(new THREE.Vector3(0.55, -0.75, 0.45)).normalize();
+  n.normalize();
+  // Of a few directions around the mean normal, the one that sees every contact plane most
+  // squarely from A's side (the smallest cosine with a plane's normal is largest).
+  let dir = n.clone(), best = -Infinity;
+  for (const g of [[1, -1, 1], [1, 1, 1], [-1, 1, 1], [-1, -1, 1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, -1]]) {
+    const d = n.clone().add(new THREE.Vector3(...g).normalize().multiplyScalar(0.8)).normalize();
+    // Capped: beyond 0.75 an oblique view (the first in the list) beats a head-on one.
+    const score = Math.min(0.75, ...state.highlighted.map((h) => d.dot(v3(h.plane.normal))));
+    if (score > best + 1e-9) { best = score; dir = d; }
+  }
   controls.target.copy(c);
   camera.position.copy(c).addScaledVector(dir, 1.7 * size);
   controls.update();
@@ -231,14 +240,14 @@ function highlightMesh(model, k, index, colour) {
     return new THREE.Mesh(g, m);
   }
   if (k === 'v') {
-    const s = new THREE.Mesh(new THREE.SphereGeometry(size * 0.012, 16, 12), m);
+    const s = new THREE.Mesh(new THREE.SphereGeometry(size * 0.015, 16, 12), m);
     s.position.copy(v3(model.vertices[index]));
     s.renderOrder = 2;
     return s;
   }
   const [i, j] = model.edges[index];
   const p = v3(model.vertices[i]), q = v3(model.vertices[j]);
-  const tube = new THREE.Mesh(new THREE.CylinderGeometry(size * 0.006, size * 0.006, p.distanceTo(q), 8), m);
+  const tube = new THREE.Mesh(new THREE.CylinderGeometry(size * 0.009, size * 0.009, p.distanceTo(q), 8), m);
   tube.position.copy(p).add(q).multiplyScalar(0.5);
   tube.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), q.clone().sub(p).normalize());
   tube.renderOrder = 2;
