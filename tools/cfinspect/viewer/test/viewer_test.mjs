@@ -28,7 +28,7 @@ function skip(why) {
 const chromium = process.env.CF_CHROMIUM || '/usr/bin/chromium';
 if (!existsSync(chromium)) skip(`no Chromium at ${chromium} (Debian package chromium; bash scripts/install-deps.sh installs it)`);
 let playwright;
-try { playwright = await import('playwright-core'); } catch { skip('no playwright-core (npm ci in tools/cfinspect/viewer; bash scripts/install-deps.sh runs it)'); }
+try { playwright = await import('playwright-core'); } catch { skip('no playwright-core (bash scripts/install-npm.sh runs npm ci in tools/cfinspect/viewer)'); }
 
 let passed = 0, failed = 0;
 function check(ok, what, detail = '') {
