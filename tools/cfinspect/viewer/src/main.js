@@ -463,7 +463,7 @@ function loadReplay(csvText, trajText, name) {
     return m.length ? m[Math.floor(0.9 * (m.length - 1))] : 1;
   };
   const maxF = scale('F'), maxM = scale('M');
-  state.replay = { rows, poses, tick: 0, playing: false, maxF, maxM, name, ticksShown: 0 };
+  state.replay = { rows, poses, tick: 0, playing: false, maxF, maxM, name };
   $('time').max = rows.length - 1;
   $('time').disabled = false;
   $('play').disabled = false;
@@ -479,7 +479,6 @@ function setTick(i) {
   const r = state.replay;
   if (!r) return;
   r.tick = Math.max(0, Math.min(r.rows.length - 1, i));
-  r.ticksShown++;
   const row = r.rows[r.tick];
   const pose = r.poses ? r.poses[r.tick] : row.cf >= 0 ? graph.cfs[row.cf].witness : null;
   showCf(row.cf, pose, true);

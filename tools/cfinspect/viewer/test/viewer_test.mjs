@@ -2,8 +2,8 @@
 // with cfreplay's replay of a trajectory, opens it from file:// in headless Chromium
 // (playwright-core, Debian's /usr/bin/chromium, SwiftShader WebGL) and checks what a person
 // would: the PCs listed and highlighted for a selected CF, the filters, the neighbours, a
-// canvas that is not blank, a replay that animates (embedded and opened in the page), and
-// no console errors.
+// canvas that is not blank, a replay that animates (embedded and opened in the page), no
+// console errors, and no request for anything but the page itself.
 //
 //   node viewer_test.mjs --cfinspect BIN --cfreplay BIN --graph G.json --trajectory P.csv
 //                        --out DIR [--screenshots DIR]
@@ -62,6 +62,8 @@ async function open(file) {
   const page = await browser.newPage({ viewport: { width: 1400, height: 820 } });
   page.on('console', (m) => { if (m.type() === 'error') errors.push(`${file}: console: ${m.text()}`); });
   page.on('pageerror', (e) => errors.push(`${file}: page error: ${e.message}`));
+  // Offline: the page may load nothing but itself (and data: or blob: URLs).
+  page.on('request', (r) => { if (!/^(data|blob):/.test(r.url()) && r.url() !== pathToFileURL(file).href) errors.push(`${file}: fetched ${r.url()}`); });
   await page.goto(pathToFileURL(file).href);
   try {
     await page.waitForFunction(() => window.cfViewer && window.cfViewer.state.ready, null, { timeout: 20000 });
@@ -169,6 +171,6 @@ try {
 } finally {
   await browser.close();
 }
-check(errors.length === 0, 'no console errors', errors.join('\n'));
+check(errors.length === 0, 'no console errors and nothing fetched', errors.join('\n'));
 console.log(`${passed} passed, ${failed} failed`);
 process.exit(failed ? 1 : 0);
