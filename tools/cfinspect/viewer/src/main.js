@@ -309,8 +309,12 @@ function showCf(id, pose, fromReplay = false) {
   cf.pcs.forEach((pc, k) => {
     const colour = PC_COLOURS[k % PC_COLOURS.length];
     const [ka, kb] = [pc.type[0], pc.type[2]];
-    overlayA.add(highlightMesh(modelA, ka, pc.a, colour));
-    overlay.add(highlightMesh(modelB, kb, pc.b, colour));
+    const meshA = highlightMesh(modelA, ka, pc.a, colour), meshB = highlightMesh(modelB, kb, pc.b, colour);
+    overlayA.add(meshA);
+    overlay.add(meshB);
+    overlay.updateMatrixWorld(true);
+    // Where the highlights are drawn (world frame, bounding-box centres), for the test hook.
+    const centre = (mesh) => new THREE.Box3().setFromObject(mesh).getCenter(new THREE.Vector3()).toArray();
     const ea = element(modelA, ka, pc.a, mA), eb = element(modelB, kb, pc.b, mB);
     const frame = contactFrame(pc, ea, eb, mA, pose ? null : cf.planes && cf.planes[k]);
     if ($('show-planes').checked) {
@@ -324,7 +328,8 @@ function showCf(id, pose, fromReplay = false) {
         overlay.add(new THREE.ArrowHelper(dir, frame.point, len, c, len * 0.25, len * 0.12));
     }
     state.highlighted.push({ pc: pcText(pc), colour,
-      a: { model: 'A', kind: KIND_NAME[ka], index: pc.a }, b: { model: 'B', kind: KIND_NAME[kb], index: pc.b },
+      a: { model: 'A', kind: KIND_NAME[ka], index: pc.a, drawnAt: centre(meshA) },
+      b: { model: 'B', kind: KIND_NAME[kb], index: pc.b, drawnAt: centre(meshB) },
       plane: { normal: frame.normal.toArray(), point: frame.point.toArray() } });
     const li = document.createElement('li');
     li.className = 'pc';

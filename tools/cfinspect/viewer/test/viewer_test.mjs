@@ -105,7 +105,24 @@ try {
   check(JSON.stringify(listed) === JSON.stringify(cf.pcs.map(pcText)), `CF ${cf.id}'s PCs are listed`, `${listed} vs ${cf.pcs.map(pcText)}`);
   const hl = await page.evaluate(() => window.cfViewer.state.highlighted);
   const want = cf.pcs.map((pc) => ({ pc: pcText(pc), a: { model: 'A', kind: KIND[pc.type[0]], index: pc.a }, b: { model: 'B', kind: KIND[pc.type[2]], index: pc.b } }));
-  check(JSON.stringify(hl.map(({ pc, a, b }) => ({ pc, a, b }))) === JSON.stringify(want), 'the contacting elements of A and B are highlighted', JSON.stringify(hl));
+  const strip = ({ model, kind, index }) => ({ model, kind, index });
+  check(JSON.stringify(hl.map(({ pc, a, b }) => ({ pc, a: strip(a), b: strip(b) }))) === JSON.stringify(want),
+    'the contacting elements of A and B are highlighted', JSON.stringify(hl));
+  // And drawn where those elements are: A's at the witness pose (x_B = R x_A + t).
+  const { R, t } = cf.witness;
+  const atWitness = (p) => R.map((row, i) => row[0] * p[0] + row[1] * p[1] + row[2] * p[2] + t[i]);
+  const centre = (model, kind, index, pose) => {
+    const ids = kind === 'v' ? [index] : kind === 'e' ? model.edges[index] : model.faces[index].loops.flat();
+    const ps = ids.map((i) => pose(model.vertices[i]));
+    return [0, 1, 2].map((k) => (Math.min(...ps.map((p) => p[k])) + Math.max(...ps.map((p) => p[k]))) / 2);
+  };
+  const far = (p, q) => Math.hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+  const off = cf.pcs.map((pc, k) => Math.max(far(hl[k].a.drawnAt, centre(graph.models.A, pc.type[0], pc.a, atWitness)),
+    far(hl[k].b.drawnAt, centre(graph.models.B, pc.type[2], pc.b, (p) => p))));
+  check(off.every((d) => d < 1e-3), 'the highlights are drawn at the elements, A\'s at the witness pose', `off by ${off} mm`);
+  const m = await page.evaluate(() => window.cfViewer.poseA());  // column-major 4x4
+  check([0, 1, 2].every((i) => [0, 1, 2].every((j) => Math.abs(m[4 * j + i] - R[i][j]) < 1e-12) && Math.abs(m[12 + i] - t[i]) < 1e-12),
+    'A is drawn at the witness pose');
   check(new Set(hl.map((h) => h.colour)).size === cf.pcs.length, 'one colour per PC');
   const px = await pixels(page, hl.map((h) => h.colour));
   check(px.ink > px.total * 0.02 && px.colours > 20, 'the canvas is not blank', JSON.stringify(px));
