@@ -427,6 +427,18 @@ function search() {
 }
 $('go').onclick = search;
 $('search').addEventListener('keydown', (e) => { if (e.key === 'Enter') search(); });
+// Keys, outside the inputs: up/down step through the listed CFs, space plays or pauses.
+document.addEventListener('keydown', (e) => {
+  if (e.target.closest('input, select, button')) return;
+  if (e.key === 'ArrowDown' || e.key === 'ArrowUp') {
+    const at = state.listed.indexOf(state.selected);
+    const next = state.listed[Math.max(0, Math.min(state.listed.length - 1, at + (e.key === 'ArrowDown' ? 1 : -1)))];
+    if (next !== undefined) { select(next); e.preventDefault(); }
+  } else if (e.key === ' ' && state.replay) {
+    state.replay.playing ? pause() : play();
+    e.preventDefault();
+  }
+});
 $('show-planes').onchange = () => redraw();
 $('see-through').onchange = () => {
   for (const g of [groupA, groupB]) {

@@ -136,6 +136,12 @@ try {
     const n = graph.transitions.filter((t) => t.from === cf.id && t.kind === kind).length;
     check(await page.locator(`#neighbours button[data-kind="${kind}"]`).count() === n, `${n} ${kind} neighbours listed`);
   }
+  await page.locator('#cf-list div[data-id]').first().click();  // a click on a row selects it
+  await page.keyboard.press('ArrowDown');
+  const second = await page.evaluate(() => [window.cfViewer.state.selected, window.cfViewer.state.listed[1]]);
+  check(second[0] === second[1], 'the down arrow selects the next listed CF', JSON.stringify(second));
+  await page.fill('#search', String(cf.id));
+  await page.press('#search', 'Enter');
   const nb = page.locator('#neighbours button.nb').first();
   const to = Number(await nb.getAttribute('data-to'));
   await nb.click();
