@@ -259,7 +259,11 @@ overlayA.matrixAutoUpdate = false;
 
 function clearOverlay() {
   for (const g of [overlay, overlayA]) {
-    g.traverse((o) => { if (o.geometry) o.geometry.dispose(); });
+    // ArrowHelpers share one geometry among all of them (the replay's arrows too): keep it.
+    g.traverse((o) => {
+      if (o.geometry && !(o.parent instanceof THREE.ArrowHelper)) o.geometry.dispose();
+      if (o.material) o.material.dispose();
+    });
     g.clear();
   }
   overlay.add(overlayA);
@@ -272,7 +276,7 @@ function clearOverlay() {
 const state = {
   ready: false,
   selected: -1,
-  highlighted: [],  // [{pc, colour, a: {model, kind, index}, b: {...}}] of the CF shown
+  highlighted: [],  // [{pc, colour, a: {model, kind, index, drawnAt}, b: {...}, plane}] of the CF shown
   listed: [],       // ids in the CF list after the filters
   pose: null,       // A's pose drawn
   replay: null,     // {rows, poses, tick, playing}
