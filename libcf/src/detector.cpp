@@ -12,18 +12,6 @@
 
 namespace cf {
 
-PcExtent extent(PcType type) {
-  switch (type) {
-    case PcType::kFF:
-      return PcExtent::kPlane;
-    case PcType::kEF:
-    case PcType::kFE:
-      return PcExtent::kLine;
-    default:
-      return PcExtent::kPoint;
-  }
-}
-
 namespace {
 
 using detail::Vec2;
@@ -1022,16 +1010,6 @@ struct ContactDetector::Impl {
     }
   }
 
-  // Is element (ki, i) the element (kj, j) or on its boundary, in model m?
-  static bool within(const Polyhedron& m, ElementKind ki, int i, ElementKind kj, int j) {
-    using K = ElementKind;
-    if (ki == kj) return i == j;
-    if (ki == K::kVertex && kj == K::kEdge) return m.vertex_ends_edge(VertexId(i), EdgeId(j));
-    if (ki == K::kVertex && kj == K::kFace) return m.vertex_on_face(VertexId(i), FaceId(j));
-    if (ki == K::kEdge && kj == K::kFace) return m.edge_bounds_face(EdgeId(i), FaceId(j));
-    return false;
-  }
-
   // Sorts the contacts by PC. On packed keys (type, a, b, position) and then one gather:
   // an insertion sort moving 160-byte contacts cost half of finish() on 70 contacts. A few
   // contacts (the paper's blocks) sort faster as they are.
@@ -1084,7 +1062,8 @@ struct ContactDetector::Impl {
       const ElementKind ai = a_kind(ci.pc.type), bi = b_kind(ci.pc.type), aj = a_kind(type), bj = b_kind(type);
       for (int k = 0; k < num_dom[t]; ++k) {
         const ContactPc& cj = cs[dominators[t][static_cast<std::size_t>(k)]];
-        if (within(a, ai, ci.pc.a, aj, cj.pc.a) && within(b, bi, ci.pc.b, bj, cj.pc.b)) return true;
+        if (in_closure(a, ai, ci.pc.a, aj, cj.pc.a) && in_closure(b, bi, ci.pc.b, bj, cj.pc.b))
+          return true;
       }
       return false;
     };

@@ -4,6 +4,7 @@
 /// adjacency, planes and mass properties. CGAL-free; built by the tools from a mesh or read
 /// from the `models.A` / `models.B` objects of a graph file.
 
+#include <cf/pc.hpp>
 #include <cf/types.hpp>
 
 #include <array>
@@ -46,9 +47,6 @@ struct Face {
   Vec3 centroid;                    ///< mm, area centroid of the region
   double area = 0;                  ///< mm^2, holes excluded
 };
-
-/// Kinds of elements. A PC type names the A element kind then the B element kind.
-enum class ElementKind : std::uint8_t { kVertex, kEdge, kFace };
 
 /// An immutable featured polyhedron.
 class Polyhedron {
