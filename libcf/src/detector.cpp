@@ -1,11 +1,11 @@
 #include <cf/detector.hpp>
 
 #include "bvh.hpp"
+#include "check.hpp"
 #include "detector_poly.hpp"
 
 #include <algorithm>
 #include <array>
-#include <cassert>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -1179,17 +1179,17 @@ struct ContactDetector::Impl {
     }
     // The stack is sized for the trees' depths, so the descents cannot overflow it.
     const auto leaves = [this](const detail::BvhNode& A, const detail::BvhNode& B) { leaf_pair(A, B); };
-    [[maybe_unused]] const bool complete =
+    const bool complete =
         big ? detail::descend_wide(
-                  bvh_a, bvh_b, [this](std::int32_t w) -> const detail::Box4& { return posed_wide(w); },
+                  bvh_a, bvh_b,
+                  [this](std::int32_t w) -> const detail::Box4& { return posed_wide(w); },
                   stack.data(), stack.size(), leaves)
             : detail::descend(
                   bvh_a, bvh_b,
-                  [this](std::int32_t ia, std::int32_t, const detail::BvhNode& A, const detail::BvhNode& B) {
-                    return overlap(ia, A, B);
-                  },
+                  [this](std::int32_t ia, std::int32_t, const detail::BvhNode& A,
+                         const detail::BvhNode& B) { return overlap(ia, A, B); },
                   stack.data(), stack.size(), leaves);
-    assert(complete);
+    CF_DEMAND(complete);
     if (recording && !kept_overflow) {
       kept_valid = true;
       kept_pose = pose;

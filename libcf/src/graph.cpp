@@ -1,12 +1,12 @@
-// PCs, PC sets and the in-memory CF graph: construction, consistency checks and queries.
+// The in-memory CF graph: construction, consistency checks and queries.
 // Reading and writing the file is in graph_json.cpp.
 
+#include "check.hpp"
 #include "graph_impl.hpp"
 #include "json_util.hpp"
 
 #include <algorithm>
 #include <array>
-#include <cassert>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -19,22 +19,6 @@ namespace cf {
 namespace {
 
 constexpr const char* kTransitionKindNames[] = {"gain", "lose", "change"};
-
-const char* kind_plural(ElementKind k) {
-  switch (k) {
-    case ElementKind::kVertex: return "vertices";
-    case ElementKind::kEdge: return "edges";
-    default: return "faces";
-  }
-}
-
-std::size_t count_of(const Polyhedron& m, ElementKind k) {
-  switch (k) {
-    case ElementKind::kVertex: return m.num_vertices();
-    case ElementKind::kEdge: return m.num_edges();
-    default: return m.num_faces();
-  }
-}
 
 }  // namespace
 
@@ -53,23 +37,6 @@ std::optional<TransitionKind> transition_kind_from_string(std::string_view name)
 // Checks and construction
 
 namespace detail {
-
-std::string check_pc(const Pc& pc, const Polyhedron& a, const Polyhedron& b, const char** field) {
-  const auto check = [&](std::int32_t index, const Polyhedron& m, ElementKind kind, const char* side,
-                         const char* name) -> std::string {
-    const std::size_t n = count_of(m, kind);
-    if (index < 0 || static_cast<std::size_t>(index) >= n) {
-      *field = name;
-      return std::string(to_string(pc.type)) + " PC: " + name + " = " + std::to_string(index) +
-             " is not an index into the " + kind_plural(kind) + " of model " + side + " '" + m.name() +
-             "' (" + std::to_string(n) + " " + kind_plural(kind) + ")";
-    }
-    return {};
-  };
-  std::string r = check(pc.a, a, a_kind(pc.type), "A", "a");
-  if (r.empty()) r = check(pc.b, b, b_kind(pc.type), "B", "b");
-  return r;
-}
 
 std::string check_witness(const Pose& pose, const char** field) {
   // Witnesses are written with full double precision; 1e-6 leaves room for hand-written
@@ -90,8 +57,6 @@ std::string check_witness(const Pose& pose, const char** field) {
   }
   return {};
 }
-
-const BoostCfGraph& boost_graph(const CfGraph& graph) { return graph.impl().bgraph; }
 
 }  // namespace detail
 
@@ -214,11 +179,6 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
                                             " is listed twice");
       }
   }
-
-  bgraph = detail::BoostCfGraph(n);
-  for (std::size_t t = 0; t < transitions.size(); ++t)
-    boost::add_edge(transitions[t].from.index(), transitions[t].to.index(),
-                    detail::GraphEdge{t, transitions[t].kind}, bgraph);
 }
 
 namespace {
@@ -268,7 +228,7 @@ CfGraph CfGraph::from_parts(Polyhedron a, Polyhedron b, std::vector<CfRecord> cf
     const CfRecord& r = cfs[i];
     for (int p = 0; p < r.pcs.size(); ++p) {
       const char* field = "";
-      if (std::string why = detail::check_pc(r.pcs[p], a, b, &field); !why.empty())
+      if (std::string why = check_pc(r.pcs[p], a, b, &field); !why.empty())
         where.pc_fault(i, static_cast<std::size_t>(p), field, why);
     }
     {
@@ -305,13 +265,22 @@ const CfGraph::Impl& CfGraph::impl() const { return impl_ ? *impl_ : empty_impl(
 const Polyhedron& CfGraph::model_a() const { return impl().a; }
 const Polyhedron& CfGraph::model_b() const { return impl().b; }
 std::size_t CfGraph::num_cfs() const { return impl().cfs.size(); }
+namespace {
+std::string not_a_cf(const char* operation, CfId id, std::size_t num_cfs) {
+  return std::string("CfGraph::") + operation + ": CF id " + std::to_string(id.value()) +
+         " is not in the graph (" + std::to_string(num_cfs) + " CFs)";
+}
+}  // namespace
+
 const CfRecord& CfGraph::cf(CfId id) const {
-  assert(id.valid() && id.index() < num_cfs());
+  CF_REQUIRE(id.valid() && id.index() < num_cfs(), not_a_cf("cf", id, num_cfs()));
   return impl().cfs[id.index()];
 }
 std::size_t CfGraph::num_transitions() const { return impl().transitions.size(); }
 const Transition& CfGraph::transition(std::size_t i) const {
-  assert(i < num_transitions());
+  CF_REQUIRE(i < num_transitions(), "CfGraph::transition: index " + std::to_string(i) +
+                                        " is not in the graph (" +
+                                        std::to_string(num_transitions()) + " transitions)");
   return impl().transitions[i];
 }
 
@@ -328,7 +297,7 @@ bool CfGraph::holds(const Pc& pc) const {
 }
 
 const std::vector<Transition>& CfGraph::out_transitions(CfId id) const {
-  assert(id.valid() && id.index() < num_cfs());
+  CF_REQUIRE(id.valid() && id.index() < num_cfs(), not_a_cf("out_transitions", id, num_cfs()));
   return impl().out[id.index()];
 }
 

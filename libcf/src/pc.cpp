@@ -165,6 +165,26 @@ std::string to_string(const PcSet& pcs) {
 // ---------------------------------------------------------------------------------------
 // Relations
 
+std::string check_pc(const Pc& pc, const Polyhedron& A, const Polyhedron& B, const char** field) {
+  const auto check = [&](std::int32_t index, const Polyhedron& m, ElementKind kind,
+                         const char* side, const char* name) -> std::string {
+    const std::size_t n = m.num_elements(kind);
+    if (index < 0 || static_cast<std::size_t>(index) >= n) {
+      if (field) *field = name;
+      const char* plural = kind == ElementKind::kVertex ? "vertices"
+                           : kind == ElementKind::kEdge ? "edges"
+                                                        : "faces";
+      return std::string(to_string(pc.type)) + " PC: " + name + " = " + std::to_string(index) +
+             " is not an index into the " + plural + " of model " + side + " '" + m.name() + "' (" +
+             std::to_string(n) + " " + plural + ")";
+    }
+    return {};
+  };
+  std::string r = check(pc.a, A, a_kind(pc.type), "A", "a");
+  if (r.empty()) r = check(pc.b, B, b_kind(pc.type), "B", "b");
+  return r;
+}
+
 bool in_closure(const Polyhedron& m, ElementKind kx, int x, ElementKind ky, int y) {
   if (kx == ky) return x == y;
   if (kx == ElementKind::kVertex && ky == ElementKind::kEdge)

@@ -50,6 +50,10 @@ struct Transition {
   TransitionKind kind = TransitionKind::kGain;
 };
 
+/// The JSON Schema of the graph file (schemas/cf-graph.schema.json) as it was when the
+/// library was built; it refers to the model schema by its `$id`.
+const char* graph_schema_text();
+
 /// Options of CfGraph::load.
 struct GraphLoadOptions {
   /// Check the file against schemas/cf-graph.schema.json (embedded in the library) with
@@ -106,17 +110,18 @@ class CfGraph {
   const Polyhedron& model_a() const;
   const Polyhedron& model_b() const;
   std::size_t num_cfs() const;
-  /// @pre id.index() < num_cfs()
+  /// @throws cf::Error when id is not a CF of the graph.
   const CfRecord& cf(CfId id) const;
   std::size_t num_transitions() const;
-  /// In file order. @pre i < num_transitions()
+  /// In file order. @throws cf::Error when i >= num_transitions().
   const Transition& transition(std::size_t i) const;
 
   /// The CF with exactly this PC set, in constant time.
   std::optional<CfId> find(const PcSet& pcs) const;
   /// True when some CF of the graph holds this PC, in constant time.
   bool holds(const Pc& pc) const;
-  /// Transitions leaving `id` (to, kind), sorted by target id. @pre id.index() < num_cfs()
+  /// Transitions leaving `id` (to, kind), sorted by target id.
+  /// @throws cf::Error when id is not a CF of the graph.
   const std::vector<Transition>& out_transitions(CfId id) const;
   /// True when the graph has a transition from `from` to `to` (false for invalid ids);
   /// O(log out-degree).
@@ -124,12 +129,11 @@ class CfGraph {
   /// The extra top-level members of the file (statistics, parameters) as JSON text.
   const std::string& metadata_json() const;
 
-  /// The representation; complete only inside libcf (and tools that include its private
-  /// headers). An empty graph when default-constructed or moved from.
-  struct Impl;
-  const Impl& impl() const;
+  struct Impl;  ///< the representation, complete only inside libcf
 
  private:
+  /// An empty graph when default-constructed or moved from.
+  const Impl& impl() const;
   std::unique_ptr<const Impl> impl_;
 };
 

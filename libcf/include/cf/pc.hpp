@@ -122,6 +122,12 @@ class PcSet {
 /// "" for the empty set.
 std::string to_string(const PcSet& pcs);
 
+/// Empty when pc's indices are in range for the element kinds its type names in A and B,
+/// else the reason ("v-f PC: a = 9 is not an index into the vertices of model A 'cube' (8
+/// vertices)"); `field`, when given, is then set to "a" or "b".
+std::string check_pc(const Pc& pc, const Polyhedron& A, const Polyhedron& B,
+                     const char** field = nullptr);
+
 /// True when element (kx, x) of m is element (ky, y) or lies on its boundary: a vertex
 /// ending an edge or on a face's boundary, an edge bounding a face.
 /// @pre the indices are in range for their kinds in m.

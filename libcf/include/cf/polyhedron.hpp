@@ -77,6 +77,12 @@ class Polyhedron {
   std::size_t num_vertices() const { return vertices_.size(); }
   std::size_t num_edges() const { return edges_.size(); }
   std::size_t num_faces() const { return faces_.size(); }
+  /// The number of elements of a kind: num_vertices(), num_edges() or num_faces().
+  std::size_t num_elements(ElementKind kind) const {
+    return kind == ElementKind::kVertex ? vertices_.size()
+           : kind == ElementKind::kEdge ? edges_.size()
+                                        : faces_.size();
+  }
 
   /// mm, the end point of an edge.
   const Vec3& edge_point(EdgeId e, int end) const {
