@@ -289,10 +289,7 @@ void BM_ServoStepIntrinsic(benchmark::State& state) {
       auto b = std::chrono::steady_clock::now();
       t.ident_ns = std::min(t.ident_ns, elapsed_ns(a, b));
       a = std::chrono::steady_clock::now();
-      const cf::HapticResult& r = split.step_identified(k.pose, k.t, id.cf, id.cf_pcs.data(),
-                                                        id.has_cf() ? id.num_cf_pcs : 0, id.contacts.begin(),
-                                                        id.contacts.size(), cf::to_string(id.status),
-                                                        id.approaching.data(), id.has_cf() ? id.num_approaching : 0);
+      const cf::HapticResult& r = split.step_identified(k.pose, k.t, id);
       b = std::chrono::steady_clock::now();
       t.force_ns = std::min(t.force_ns, elapsed_ns(a, b));
       nondet += !(t.F_W == r.F_W);

@@ -2,8 +2,6 @@
 
 #include <cf/renderer.hpp>
 
-#include "renderer_ident.hpp"
-
 #include <algorithm>
 #include <array>
 
@@ -19,13 +17,26 @@ const char* to_string(RenderStatus status) {
   return "ok";
 }
 
+namespace {
+// The renderer's one epsilon also sets the detector's.
+IdentificationParams identification_params(const Params& p) {
+  IdentificationParams ip;
+  ip.detection.epsilon = p.epsilon_mm;
+  return ip;
+}
+}  // namespace
+
 struct HapticRenderer::Impl {
-  Impl(const CfGraph& g, const Params& p) : graph(&g), params(p), force(g.model_a(), g.model_b(), p), ident(g, p) {}
+  Impl(const CfGraph& g, const Params& p)
+      : graph(&g),
+        params(p),
+        force(g.model_a(), g.model_b(), p),
+        ident(g, identification_params(p)) {}
 
   const CfGraph* graph;
   Params params;
   ForceModel force;
-  detail::IdentAdapter ident;
+  CfIdentifier ident;
   CfId prev_cf;
   PcSet prev_pcs;
   std::array<ContactPc, PcSet::kMaxPcs> ordered{};
@@ -51,10 +62,14 @@ void HapticRenderer::reset() {
 }
 
 const HapticResult& HapticRenderer::step(const Pose& pose, double t_s) {
-  Impl& m = *impl_;
-  const detail::IdentView v = m.ident.step(pose);
-  return step_identified(pose, t_s, v.cf, v.cf_pcs, v.n_cf, v.detected, v.n_detected, v.status, v.approaching,
-                         v.n_approaching);
+  return step_identified(pose, t_s, impl_->ident.step(pose));
+}
+
+const HapticResult& HapticRenderer::step_identified(const Pose& pose, double t_s,
+                                                    const Identification& id) {
+  return step_identified(pose, t_s, id.cf, id.cf_pcs.data(), id.has_cf() ? id.num_cf_pcs : 0,
+                         id.contacts.begin(), id.contacts.size(), to_string(id.status),
+                         id.approaching.data(), id.has_cf() ? id.num_approaching : 0);
 }
 
 const HapticResult& HapticRenderer::step_identified(const Pose& pose, double t_s, CfId cf,

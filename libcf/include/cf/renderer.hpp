@@ -7,6 +7,7 @@
 #include <cf/contact.hpp>
 #include <cf/force.hpp>
 #include <cf/graph.hpp>
+#include <cf/identifier.hpp>
 #include <cf/motion.hpp>
 #include <cf/params.hpp>
 
@@ -66,6 +67,9 @@ class HapticRenderer {
                                       int n_cf, const ContactPc* detected, int n_detected,
                                       const char* identification = "", const ContactPc* approaching = nullptr,
                                       int n_approaching = 0);
+
+  /// The same with a CfIdentifier's result (what step() does after identifying).
+  const HapticResult& step_identified(const Pose& pose, double t_s, const Identification& id);
 
   /// Forgets the history (previous CF, anchors, filters).
   void reset();
