@@ -4,7 +4,7 @@
 
 #include "common.hpp"
 
-#include "replay_io.hpp"  // cfreplay_core: kQuaternionTolerance
+#include <cf/file_io.hpp>  // quaternion_problem: the tools' check of a quaternion
 
 #include <cmath>
 #include <cstdio>
@@ -16,13 +16,8 @@ namespace cfpy {
 cf::Pose pose_from(const double* p, const double* q, const std::string& where) {
   for (int i = 0; i < 3; ++i)
     if (!std::isfinite(p[i])) fail(where + ": the translation is not finite");
-  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  if (!(std::isfinite(norm) && std::abs(norm - 1) <= cf::replay::kQuaternionTolerance)) {
-    char buf[200];
-    std::snprintf(buf, sizeof buf, ": the quaternion (qw,qx,qy,qz) has norm %.9g, not 1 within %g", norm,
-                  cf::replay::kQuaternionTolerance);
-    fail(where + buf);
-  }
+  // The check and message every tool applies to a quaternion it reads (cf/file_io.hpp).
+  if (const std::string why = cf::quaternion_problem(q[0], q[1], q[2], q[3]); !why.empty()) fail(where + ": " + why);
   // As cfreplay reads a row: normalised, then the rotation matrix.
   Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
   quat.normalize();
