@@ -3,7 +3,7 @@
 // full-precision witnesses. Measures load() of JSON and CBOR, with and without the schema
 // check, and find(). Figures go to docs/performance.md, "Graph loading".
 
-#include "../tests/fixtures.hpp"
+#include "fixtures.hpp"
 #include <cf/graph.hpp>
 
 #include <benchmark/benchmark.h>

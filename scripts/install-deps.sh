@@ -28,6 +28,9 @@ CF_APT_PACKAGES=(
   clang clang-14 libclang-rt-14-dev libfuzzer-14-dev
   # cfinspect --html: the browser test of the viewer (tools/cfinspect/viewer, headless)
   chromium
+  # libcf/python: the Python package cf (pybind11 against Debian's /usr/bin/python3), its
+  # pytest suite, the example's plots, graph.to_networkx()
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-networkx
 )
 # The viewer's bundler and browser driver run on Node.js; Debian's nodejs and npm only when
 # the machine has no node or npm (Debian's npm would conflict with another vendor's nodejs).

@@ -34,6 +34,11 @@ main_job() {
   cf_log "main job: cfreplay --graph $replay_graph --trajectory $traj"
   "$cfreplay" --graph "$replay_graph" --trajectory "$traj" -o "$out/replay.csv" --plot "$out/replay.svg"
   cf_log "main job: wrote $out/replay.csv ($(($(wc -l <"$out/replay.csv") - 1)) ticks) and $out/replay.svg"
+  # The browser viewer of that graph with the replay (docs/viewer.md); open it from disk.
+  if "$CF_BUILD_DIR/tools/cfinspect/cfinspect" "$replay_graph" --fast --html "$out/viewer.html" \
+       --replay "$out/replay.csv" --trajectory "$traj" >/dev/null; then
+    cf_log "main job: wrote $out/viewer.html (open it in a browser)"
+  fi
 }
 
 cf_install_deps

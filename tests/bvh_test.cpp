@@ -1,7 +1,7 @@
 // The bounding volume tree's boxes (libcf/src/bvh.*): every node's axis-aligned and oriented
 // boxes hold the points of the elements below it, the 4-wide tree holds every node once,
 // and the SIMD box tests agree with plain double-precision ones.
-#include "../bench/runtime_models.hpp"
+#include "runtime_models.hpp"
 #include "bvh.hpp"
 
 #include <catch2/catch.hpp>

@@ -516,7 +516,7 @@ TouchResult open_touch(const Placed& A, K ka, int a, const Placed& B, K kb, int 
 }
 
 // Element (k, i) is (k2, j) or lies on its boundary (SPEC section 4's domination).
-bool in_closure(const Polyhedron& m, K k, int i, K k2, int j) {
+bool within_closure(const Polyhedron& m, K k, int i, K k2, int j) {
   if (k == k2) return i == j;
   if (k == K::kVertex && k2 == K::kEdge) {
     const cf::Edge& e = m.edges()[static_cast<std::size_t>(j)];
@@ -691,8 +691,8 @@ Analysis analyse(const ModelGeom& ga, const ModelGeom& gb, const Pose& pose, dou
   for (const Contact& c : out.touching) {
     bool dominated = false;
     for (const Contact& o : out.touching)
-      if (&o != &c && in_closure(*ga.m, c.ka, c.a, o.ka, o.a) &&
-          in_closure(*gb.m, c.kb, c.b, o.kb, o.b))
+      if (&o != &c && within_closure(*ga.m, c.ka, c.a, o.ka, o.a) &&
+          within_closure(*gb.m, c.kb, c.b, o.kb, o.b))
         dominated = true;
     if (!dominated) out.undominated.push_back(c);
   }
@@ -1237,10 +1237,10 @@ void check_recall(const Generated& g, const std::string& label, int trials, std:
 // boundary relations". `x` is the PC with the larger element(s).
 bool neighbour_dir(const Pc& x, const Pc& y, const Polyhedron& A, const Polyhedron& B) {
   auto edge_bounds = [](const Polyhedron& m, int e, int f) {
-    return in_closure(m, K::kEdge, e, K::kFace, f);
+    return within_closure(m, K::kEdge, e, K::kFace, f);
   };
   auto vertex_ends = [](const Polyhedron& m, int v, int e) {
-    return in_closure(m, K::kVertex, v, K::kEdge, e);
+    return within_closure(m, K::kVertex, v, K::kEdge, e);
   };
   using T = PcType;
   if (x.type == T::kFF && y.type == T::kEF) return x.b == y.b && edge_bounds(A, y.a, x.a);

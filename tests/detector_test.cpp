@@ -1,7 +1,7 @@
 #include <cf/detector.hpp>
 #include <cf/geometry.hpp>
 
-#include "../bench/runtime_models.hpp"
+#include "runtime_models.hpp"
 #include "fixtures.hpp"
 #include "detector_poly.hpp"
 

@@ -137,6 +137,12 @@ TEST_CASE("face-face and element distances between posed boxes", "[geometry]") {
 
   // Element pairs through the convenience function: A's bottom corner vertex 0 at (5,0,32).
   pose = translation(5, 0, 32);
+  CHECK_THROWS_WITH(
+      cf::element_distance(a, pose, ElementKind::kVertex, 8, b, ElementKind::kFace, 1),
+      Catch::Contains("element_distance: element index 8 is out of range for its model's A"));
+  CHECK_THROWS_WITH(
+      cf::element_distance(a, pose, ElementKind::kVertex, 0, b, ElementKind::kFace, -1),
+      Catch::Contains("element index -1 is out of range for its model's B"));
   CHECK(cf::element_distance(a, pose, ElementKind::kVertex, 0, b, ElementKind::kFace, 1).distance ==
         Approx(2).margin(kTol));
   // B's vertex 5 = (20, 0, 30) against A's bottom face [5,15] x [0,10] at z = 32: 5 in-plane, 2 up.

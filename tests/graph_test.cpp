@@ -229,6 +229,20 @@ TEST_CASE("transitions are listed per CF by target and answer adjacency", "[grap
   CHECK(g.transition(1).from == CfId(2));
 }
 
+// Release builds keep these checks (libcf/src/check.hpp): an id from the caller is input.
+TEST_CASE("ids out of range throw instead of reading past the graph", "[graph][bad]") {
+  const CfGraph g = cf_test::box_l_graph();
+  CHECK_THROWS_WITH(g.cf(CfId(static_cast<int>(g.num_cfs()))),
+                    Catch::Contains("CfGraph::cf: CF id 5 is not in the graph (5 CFs)"));
+  CHECK_THROWS_WITH(g.cf(CfId()), Catch::Contains("CF id -1 is not in the graph"));
+  CHECK_THROWS_WITH(g.out_transitions(CfId(7)),
+                    Catch::Contains("CfGraph::out_transitions: CF id 7"));
+  CHECK_THROWS_WITH(
+      g.transition(8),
+      Catch::Contains("CfGraph::transition: index 8 is not in the graph (8 transitions)"));
+  CHECK_THROWS_WITH(CfGraph().cf(CfId(0)), Catch::Contains("(0 CFs)"));
+}
+
 TEST_CASE("an empty graph answers queries", "[graph]") {
   const CfGraph g;
   CHECK(g.num_cfs() == 0);

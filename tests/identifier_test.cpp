@@ -1,6 +1,6 @@
 #include <cf/identifier.hpp>
 
-#include "../bench/runtime_models.hpp"
+#include "runtime_models.hpp"
 #include "fixtures.hpp"
 
 #include <catch2/catch.hpp>

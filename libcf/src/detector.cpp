@@ -1,28 +1,16 @@
 #include <cf/detector.hpp>
 
 #include "bvh.hpp"
+#include "check.hpp"
 #include "detector_poly.hpp"
 
 #include <algorithm>
 #include <array>
-#include <cassert>
 #include <cmath>
 #include <string>
 #include <vector>
 
 namespace cf {
-
-PcExtent extent(PcType type) {
-  switch (type) {
-    case PcType::kFF:
-      return PcExtent::kPlane;
-    case PcType::kEF:
-    case PcType::kFE:
-      return PcExtent::kLine;
-    default:
-      return PcExtent::kPoint;
-  }
-}
 
 namespace {
 
@@ -1022,16 +1010,6 @@ struct ContactDetector::Impl {
     }
   }
 
-  // Is element (ki, i) the element (kj, j) or on its boundary, in model m?
-  static bool within(const Polyhedron& m, ElementKind ki, int i, ElementKind kj, int j) {
-    using K = ElementKind;
-    if (ki == kj) return i == j;
-    if (ki == K::kVertex && kj == K::kEdge) return m.vertex_ends_edge(VertexId(i), EdgeId(j));
-    if (ki == K::kVertex && kj == K::kFace) return m.vertex_on_face(VertexId(i), FaceId(j));
-    if (ki == K::kEdge && kj == K::kFace) return m.edge_bounds_face(EdgeId(i), FaceId(j));
-    return false;
-  }
-
   // Sorts the contacts by PC. On packed keys (type, a, b, position) and then one gather:
   // an insertion sort moving 160-byte contacts cost half of finish() on 70 contacts. A few
   // contacts (the paper's blocks) sort faster as they are.
@@ -1084,7 +1062,8 @@ struct ContactDetector::Impl {
       const ElementKind ai = a_kind(ci.pc.type), bi = b_kind(ci.pc.type), aj = a_kind(type), bj = b_kind(type);
       for (int k = 0; k < num_dom[t]; ++k) {
         const ContactPc& cj = cs[dominators[t][static_cast<std::size_t>(k)]];
-        if (within(a, ai, ci.pc.a, aj, cj.pc.a) && within(b, bi, ci.pc.b, bj, cj.pc.b)) return true;
+        if (in_closure(a, ai, ci.pc.a, aj, cj.pc.a) && in_closure(b, bi, ci.pc.b, bj, cj.pc.b))
+          return true;
       }
       return false;
     };
@@ -1200,17 +1179,17 @@ struct ContactDetector::Impl {
     }
     // The stack is sized for the trees' depths, so the descents cannot overflow it.
     const auto leaves = [this](const detail::BvhNode& A, const detail::BvhNode& B) { leaf_pair(A, B); };
-    [[maybe_unused]] const bool complete =
+    const bool complete =
         big ? detail::descend_wide(
-                  bvh_a, bvh_b, [this](std::int32_t w) -> const detail::Box4& { return posed_wide(w); },
+                  bvh_a, bvh_b,
+                  [this](std::int32_t w) -> const detail::Box4& { return posed_wide(w); },
                   stack.data(), stack.size(), leaves)
             : detail::descend(
                   bvh_a, bvh_b,
-                  [this](std::int32_t ia, std::int32_t, const detail::BvhNode& A, const detail::BvhNode& B) {
-                    return overlap(ia, A, B);
-                  },
+                  [this](std::int32_t ia, std::int32_t, const detail::BvhNode& A,
+                         const detail::BvhNode& B) { return overlap(ia, A, B); },
                   stack.data(), stack.size(), leaves);
-    assert(complete);
+    CF_DEMAND(complete);
     if (recording && !kept_overflow) {
       kept_valid = true;
       kept_pose = pose;

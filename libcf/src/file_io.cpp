@@ -1,7 +1,6 @@
-// Reading inputs without blocking and writing outputs whole or not at all (file_io.hpp).
+// Reading inputs without blocking and writing outputs whole or not at all (cf/file_io.hpp).
 
-#include "file_io.hpp"
-
+#include <cf/file_io.hpp>
 #include <cf/polyhedron.hpp>
 #include <cf/types.hpp>
 
@@ -15,7 +14,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-namespace cf::detail {
+namespace cf {
 
 namespace {
 
@@ -263,4 +262,4 @@ std::string size_warning(const Polyhedron& model, const std::string& which, doub
   return "model " + (which.empty() ? "" : which + " ") + "'" + printable(model.name(), 40) + "'" + buf;
 }
 
-}  // namespace cf::detail
+}  // namespace cf

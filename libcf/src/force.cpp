@@ -26,38 +26,6 @@ namespace {
 // mm: tangential motions below this have no direction (round-off of poses in mm).
 constexpr double kTinyMm = 1e-12;
 
-ElementKind kind_a(PcType t) {
-  switch (t) {
-    case PcType::kFF:
-    case PcType::kFE:
-    case PcType::kFV: return ElementKind::kFace;
-    case PcType::kEF:
-    case PcType::kEE: return ElementKind::kEdge;
-    case PcType::kVF: return ElementKind::kVertex;
-  }
-  return ElementKind::kFace;
-}
-ElementKind kind_b(PcType t) {
-  switch (t) {
-    case PcType::kFF:
-    case PcType::kEF:
-    case PcType::kVF: return ElementKind::kFace;
-    case PcType::kFE:
-    case PcType::kEE: return ElementKind::kEdge;
-    case PcType::kFV: return ElementKind::kVertex;
-  }
-  return ElementKind::kFace;
-}
-
-// True when element (kx, x) of m is element (ky, y) or lies on its boundary.
-bool on_closure(const Polyhedron& m, ElementKind kx, int x, ElementKind ky, int y) {
-  if (kx == ky) return x == y;
-  if (kx == ElementKind::kVertex && ky == ElementKind::kEdge) return m.vertex_ends_edge(VertexId(x), EdgeId(y));
-  if (kx == ElementKind::kVertex && ky == ElementKind::kFace) return m.vertex_on_face(VertexId(x), FaceId(y));
-  if (kx == ElementKind::kEdge && ky == ElementKind::kFace) return m.edge_bounds_face(EdgeId(x), FaceId(y));
-  return false;
-}
-
 Vec3 tangential(const Vec3& v, const Vec3& n) { return v - n * n.dot(v); }
 
 Vec3 unit_or_zero(const Vec3& v) {
@@ -109,7 +77,7 @@ namespace {
 PcForce with_geometry(const ContactPc& c) {
   PcForce f;
   f.pc = c.pc;
-  f.extent = pc_extent(c.pc.type);
+  f.extent = extent(c.pc.type);
   f.R_WT = c.R_WT;
   f.origin_W = c.origin_W;
   f.p_W = c.p_W;
@@ -117,12 +85,6 @@ PcForce with_geometry(const ContactPc& c) {
   return f;
 }
 }  // namespace
-
-bool ForceModel::dominated(const ContactPc& x, const ContactPc& y) const {
-  if (x.pc == y.pc) return false;
-  return on_closure(*A_, kind_a(x.pc.type), x.pc.a, kind_a(y.pc.type), y.pc.a) &&
-         on_closure(*B_, kind_b(x.pc.type), x.pc.b, kind_b(y.pc.type), y.pc.b);
-}
 
 const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactPc* pcs, int n,
                                     const PriorMotion& prior, bool conservative,
@@ -147,7 +109,7 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
       // Several interpretations of one physical contact (paper Fig. 3) must not add up:
       // keep the contacts no other detected contact dominates (SPEC section 4's PC rule).
       bool dom = false;
-      for (int j = 0; j < n && !dom; ++j) dom = j != i && dominated(pcs[i], pcs[j]);
+      for (int j = 0; j < n && !dom; ++j) dom = j != i && dominates(*A_, *B_, pcs[j].pc, pcs[i].pc);
       if (dom) continue;
     }
     if (m == ForceResult::kMaxPcs) {

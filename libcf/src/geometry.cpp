@@ -1,8 +1,10 @@
 #include <cf/geometry.hpp>
 
+#include "check.hpp"
+
 #include <algorithm>
-#include <cassert>
 #include <cmath>
+#include <string>
 
 namespace cf {
 namespace {
@@ -158,10 +160,19 @@ ClosestPoints face_face(const Polyhedron& A, const Pose& pose, FaceId fa, const 
   return best;
 }
 
+namespace {
+bool in_range(const Polyhedron& m, ElementKind k, int i) {
+  return i >= 0 && static_cast<std::size_t>(i) < m.num_elements(k);
+}
+}  // namespace
+
 ClosestPoints element_distance(const Polyhedron& A, const Pose& pose, ElementKind ka, int a,
                                const Polyhedron& B, ElementKind kb, int b) {
   using K = ElementKind;
-  assert(a >= 0 && b >= 0);
+  CF_REQUIRE(in_range(A, ka, a) && in_range(B, kb, b),
+             "element_distance: element index " + std::to_string(in_range(A, ka, a) ? b : a) +
+                 " is out of range for its model's " + (in_range(A, ka, a) ? "B" : "A") +
+                 " elements of that kind");
   if (ka == K::kFace && kb == K::kFace) return face_face(A, pose, FaceId(a), B, FaceId(b));
   if (ka == K::kFace) {
     // Work in A's frame against A's face; the B element is mapped there.

@@ -1,12 +1,12 @@
-// PCs, PC sets and the in-memory CF graph: construction, consistency checks and queries.
+// The in-memory CF graph: construction, consistency checks and queries.
 // Reading and writing the file is in graph_json.cpp.
 
+#include "check.hpp"
 #include "graph_impl.hpp"
 #include "json_util.hpp"
 
 #include <algorithm>
 #include <array>
-#include <cassert>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -18,186 +18,12 @@ namespace cf {
 
 namespace {
 
-constexpr const char* kPcTypeNames[] = {"f-f", "e-f", "f-e", "v-f", "f-v", "e-e"};
 constexpr const char* kTransitionKindNames[] = {"gain", "lose", "change"};
-
-ElementKind kind_of_letter(char c) {
-  switch (c) {
-    case 'v': return ElementKind::kVertex;
-    case 'e': return ElementKind::kEdge;
-    default: return ElementKind::kFace;
-  }
-}
-
-const char* kind_plural(ElementKind k) {
-  switch (k) {
-    case ElementKind::kVertex: return "vertices";
-    case ElementKind::kEdge: return "edges";
-    default: return "faces";
-  }
-}
-
-std::size_t count_of(const Polyhedron& m, ElementKind k) {
-  switch (k) {
-    case ElementKind::kVertex: return m.num_vertices();
-    case ElementKind::kEdge: return m.num_edges();
-    default: return m.num_faces();
-  }
-}
-
-std::uint64_t mix64(std::uint64_t x) {  // splitmix64 finaliser
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ULL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebULL;
-  x ^= x >> 31;
-  return x;
-}
 
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
-// PC types and PCs
-
-const char* to_string(PcType type) { return kPcTypeNames[static_cast<int>(type)]; }
-
-std::optional<PcType> pc_type_from_string(std::string_view name) {
-  for (int i = 0; i < 6; ++i)
-    if (name == kPcTypeNames[i]) return static_cast<PcType>(i);
-  return std::nullopt;
-}
-
-ElementKind a_kind(PcType type) { return kind_of_letter(kPcTypeNames[static_cast<int>(type)][0]); }
-ElementKind b_kind(PcType type) { return kind_of_letter(kPcTypeNames[static_cast<int>(type)][2]); }
-
-std::string to_string(const Pc& pc) {
-  return std::string(to_string(pc.type)) + ":" + std::to_string(pc.a) + ":" + std::to_string(pc.b);
-}
-
-std::optional<Pc> pc_from_string(std::string_view text) {
-  const std::size_t c1 = text.find(':');
-  if (c1 == std::string_view::npos) return std::nullopt;
-  const std::size_t c2 = text.find(':', c1 + 1);
-  if (c2 == std::string_view::npos) return std::nullopt;
-  const auto type = pc_type_from_string(text.substr(0, c1));
-  if (!type) return std::nullopt;
-  auto parse_index = [](std::string_view s, std::int32_t& out) {
-    if (s.empty()) return false;
-    const auto r = std::from_chars(s.data(), s.data() + s.size(), out);
-    return r.ec == std::errc() && r.ptr == s.data() + s.size() && out >= 0;
-  };
-  Pc pc;
-  pc.type = *type;
-  if (!parse_index(text.substr(c1 + 1, c2 - c1 - 1), pc.a)) return std::nullopt;
-  if (!parse_index(text.substr(c2 + 1), pc.b)) return std::nullopt;
-  return pc;
-}
-
-std::vector<Pc> neighbouring_pcs(const Pc& pc, const Polyhedron& A, const Polyhedron& B) {
-  std::vector<Pc> out;
-  auto add = [&](PcType t, int a, int b) { out.push_back({t, a, b}); };
-  auto edges_of_face = [](const Polyhedron& m, int f) { return m.faces()[f].edges; };
-  auto faces_of_edge = [](const Polyhedron& m, int e) {
-    return std::vector<int>{m.edges()[e].left.value(), m.edges()[e].right.value()};
-  };
-  auto ends_of_edge = [](const Polyhedron& m, int e) {
-    return std::vector<int>{m.edges()[e].v0.value(), m.edges()[e].v1.value()};
-  };
-  switch (pc.type) {
-    case PcType::kFF:
-      for (EdgeId e : edges_of_face(A, pc.a)) add(PcType::kEF, e.value(), pc.b);
-      for (EdgeId e : edges_of_face(B, pc.b)) add(PcType::kFE, pc.a, e.value());
-      break;
-    case PcType::kEF:
-      for (int f : faces_of_edge(A, pc.a)) add(PcType::kFF, f, pc.b);
-      for (int v : ends_of_edge(A, pc.a)) add(PcType::kVF, v, pc.b);
-      for (EdgeId e : edges_of_face(B, pc.b)) add(PcType::kEE, pc.a, e.value());
-      break;
-    case PcType::kFE:
-      for (int f : faces_of_edge(B, pc.b)) add(PcType::kFF, pc.a, f);
-      for (int v : ends_of_edge(B, pc.b)) add(PcType::kFV, pc.a, v);
-      for (EdgeId e : edges_of_face(A, pc.a)) add(PcType::kEE, e.value(), pc.b);
-      break;
-    case PcType::kVF:
-      for (EdgeId ea : A.vertices()[pc.a].edges) {
-        add(PcType::kEF, ea.value(), pc.b);
-        for (EdgeId eb : edges_of_face(B, pc.b)) add(PcType::kEE, ea.value(), eb.value());
-      }
-      break;
-    case PcType::kFV:
-      for (EdgeId eb : B.vertices()[pc.b].edges) {
-        add(PcType::kFE, pc.a, eb.value());
-        for (EdgeId ea : edges_of_face(A, pc.a)) add(PcType::kEE, ea.value(), eb.value());
-      }
-      break;
-    case PcType::kEE:
-      for (int f : faces_of_edge(B, pc.b)) add(PcType::kEF, pc.a, f);
-      for (int f : faces_of_edge(A, pc.a)) add(PcType::kFE, f, pc.b);
-      for (int v : ends_of_edge(A, pc.a))
-        for (int f : faces_of_edge(B, pc.b)) add(PcType::kVF, v, f);
-      for (int v : ends_of_edge(B, pc.b))
-        for (int f : faces_of_edge(A, pc.a)) add(PcType::kFV, f, v);
-      break;
-  }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
-}
-
-// ---------------------------------------------------------------------------------------
-// PcSet
-
-PcSet::PcSet(const std::vector<Pc>& pcs) {
-  if (pcs.size() > static_cast<std::size_t>(kMaxPcs))
-    throw Error("PcSet: " + std::to_string(pcs.size()) + " PCs given, a CF has at most 3");
-  for (const Pc& pc : pcs)
-    if (!insert(pc)) throw Error("PcSet: PC " + to_string(pc) + " is repeated");
-}
-
-bool PcSet::insert(const Pc& pc) {
-  if (size_ == kMaxPcs || contains(pc)) return false;
-  int i = size_;
-  while (i > 0 && pc < pcs_[static_cast<std::size_t>(i - 1)]) {
-    pcs_[static_cast<std::size_t>(i)] = pcs_[static_cast<std::size_t>(i - 1)];
-    --i;
-  }
-  pcs_[static_cast<std::size_t>(i)] = pc;
-  ++size_;
-  return true;
-}
-
-bool PcSet::contains(const Pc& pc) const {
-  for (int i = 0; i < size_; ++i)
-    if (pcs_[static_cast<std::size_t>(i)] == pc) return true;
-  return false;
-}
-
-std::size_t PcSet::hash() const {
-  std::uint64_t h = static_cast<std::uint64_t>(size_);
-  for (int i = 0; i < size_; ++i) {
-    const Pc& pc = pcs_[static_cast<std::size_t>(i)];
-    const std::uint64_t key = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(pc.a)) << 32) |
-                              static_cast<std::uint32_t>(pc.b);
-    h = mix64(h ^ key ^ (static_cast<std::uint64_t>(pc.type) << 61));
-  }
-  return static_cast<std::size_t>(h);
-}
-
-bool operator==(const PcSet& x, const PcSet& y) {
-  if (x.size_ != y.size_) return false;
-  for (int i = 0; i < x.size_; ++i)
-    if (x.pcs_[static_cast<std::size_t>(i)] != y.pcs_[static_cast<std::size_t>(i)]) return false;
-  return true;
-}
-
-std::string to_string(const PcSet& pcs) {
-  std::string s;
-  for (const Pc& pc : pcs) {
-    if (!s.empty()) s += ';';
-    s += to_string(pc);
-  }
-  return s;
-}
+// Transition kinds
 
 const char* to_string(TransitionKind kind) { return kTransitionKindNames[static_cast<int>(kind)]; }
 
@@ -211,23 +37,6 @@ std::optional<TransitionKind> transition_kind_from_string(std::string_view name)
 // Checks and construction
 
 namespace detail {
-
-std::string check_pc(const Pc& pc, const Polyhedron& a, const Polyhedron& b, const char** field) {
-  const auto check = [&](std::int32_t index, const Polyhedron& m, ElementKind kind, const char* side,
-                         const char* name) -> std::string {
-    const std::size_t n = count_of(m, kind);
-    if (index < 0 || static_cast<std::size_t>(index) >= n) {
-      *field = name;
-      return std::string(to_string(pc.type)) + " PC: " + name + " = " + std::to_string(index) +
-             " is not an index into the " + kind_plural(kind) + " of model " + side + " '" + m.name() +
-             "' (" + std::to_string(n) + " " + kind_plural(kind) + ")";
-    }
-    return {};
-  };
-  std::string r = check(pc.a, a, a_kind(pc.type), "A", "a");
-  if (r.empty()) r = check(pc.b, b, b_kind(pc.type), "B", "b");
-  return r;
-}
 
 std::string check_witness(const Pose& pose, const char** field) {
   // Witnesses are written with full double precision; 1e-6 leaves room for hand-written
@@ -248,8 +57,6 @@ std::string check_witness(const Pose& pose, const char** field) {
   }
   return {};
 }
-
-const BoostCfGraph& boost_graph(const CfGraph& graph) { return graph.impl().bgraph; }
 
 }  // namespace detail
 
@@ -372,11 +179,6 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
                                             " is listed twice");
       }
   }
-
-  bgraph = detail::BoostCfGraph(n);
-  for (std::size_t t = 0; t < transitions.size(); ++t)
-    boost::add_edge(transitions[t].from.index(), transitions[t].to.index(),
-                    detail::GraphEdge{t, transitions[t].kind}, bgraph);
 }
 
 namespace {
@@ -426,7 +228,7 @@ CfGraph CfGraph::from_parts(Polyhedron a, Polyhedron b, std::vector<CfRecord> cf
     const CfRecord& r = cfs[i];
     for (int p = 0; p < r.pcs.size(); ++p) {
       const char* field = "";
-      if (std::string why = detail::check_pc(r.pcs[p], a, b, &field); !why.empty())
+      if (std::string why = check_pc(r.pcs[p], a, b, &field); !why.empty())
         where.pc_fault(i, static_cast<std::size_t>(p), field, why);
     }
     {
@@ -463,13 +265,22 @@ const CfGraph::Impl& CfGraph::impl() const { return impl_ ? *impl_ : empty_impl(
 const Polyhedron& CfGraph::model_a() const { return impl().a; }
 const Polyhedron& CfGraph::model_b() const { return impl().b; }
 std::size_t CfGraph::num_cfs() const { return impl().cfs.size(); }
+namespace {
+std::string not_a_cf(const char* operation, CfId id, std::size_t num_cfs) {
+  return std::string("CfGraph::") + operation + ": CF id " + std::to_string(id.value()) +
+         " is not in the graph (" + std::to_string(num_cfs) + " CFs)";
+}
+}  // namespace
+
 const CfRecord& CfGraph::cf(CfId id) const {
-  assert(id.valid() && id.index() < num_cfs());
+  CF_REQUIRE(id.valid() && id.index() < num_cfs(), not_a_cf("cf", id, num_cfs()));
   return impl().cfs[id.index()];
 }
 std::size_t CfGraph::num_transitions() const { return impl().transitions.size(); }
 const Transition& CfGraph::transition(std::size_t i) const {
-  assert(i < num_transitions());
+  CF_REQUIRE(i < num_transitions(), "CfGraph::transition: index " + std::to_string(i) +
+                                        " is not in the graph (" +
+                                        std::to_string(num_transitions()) + " transitions)");
   return impl().transitions[i];
 }
 
@@ -486,7 +297,7 @@ bool CfGraph::holds(const Pc& pc) const {
 }
 
 const std::vector<Transition>& CfGraph::out_transitions(CfId id) const {
-  assert(id.valid() && id.index() < num_cfs());
+  CF_REQUIRE(id.valid() && id.index() < num_cfs(), not_a_cf("out_transitions", id, num_cfs()));
   return impl().out[id.index()];
 }
 

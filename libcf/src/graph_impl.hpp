@@ -1,10 +1,8 @@
 #pragma once
-// Private: the representation behind cf::CfGraph. Tools in this repository (cfinspect) may
-// include it to reach the Boost.Graph view; nothing public depends on it.
+// Private: the representation behind cf::CfGraph and the checks its readers share.
 
 #include <cf/graph.hpp>
 
-#include <boost/graph/adjacency_list.hpp>
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
@@ -24,19 +22,6 @@ struct PcHash {
   }
 };
 
-/// Bundled edge property of the Boost.Graph view: which transition this edge is.
-struct GraphEdge {
-  std::size_t transition = 0;  ///< index into CfGraph::transition()
-  TransitionKind kind = TransitionKind::kGain;
-};
-
-/// Vertex i is CF i; one directed edge per transition, in file order.
-using BoostCfGraph = boost::adjacency_list<boost::vecS, boost::vecS, boost::bidirectionalS,
-                                           boost::no_property, GraphEdge>;
-
-/// The Boost.Graph view of a graph (for algorithms: components, Graphviz export).
-const BoostCfGraph& boost_graph(const CfGraph& graph);
-
 /// Says where a fault is, in the caller's terms: "CF 3" for from_parts, "'g.json' at
 /// /cfs/3" for load. The checks below use it to build their messages.
 class FaultLocator {
@@ -55,10 +40,6 @@ class FaultLocator {
 /// else the reason. `field` is set to "R" or "t".
 std::string check_witness(const Pose& pose, const char** field);
 
-/// Checks one PC against the models: the indices are in range for the kinds its type names.
-/// Returns an empty string when fine, else the reason; `field` is set to "a" or "b".
-std::string check_pc(const Pc& pc, const Polyhedron& a, const Polyhedron& b, const char** field);
-
 }  // namespace cf::detail
 
 namespace cf {
@@ -70,13 +51,11 @@ struct CfGraph::Impl {
   std::unordered_map<PcSet, CfId> index;          ///< PC set -> CF, for constant-time find
   std::unordered_set<Pc, detail::PcHash> held;    ///< every PC some CF holds
   std::vector<std::vector<Transition>> out;       ///< per CF, sorted by target id
-  detail::BoostCfGraph bgraph;
   std::string metadata;                           ///< JSON object text, canonical dump
 
   /// Checks everything that does not need the original PC order (repeated PC sets, PCs
-  /// sharing a contact plane, transitions) and builds the index, the out lists and the
-  /// Boost view. PC index ranges are the caller's job (check_pc), so that it can point at
-  /// the PC as given.
+  /// sharing a contact plane, transitions) and builds the index and the out lists. PC index ranges
+  /// are the caller's job (check_pc), so that it can point at the PC as given.
   void build(const detail::FaultLocator& where);
 };
 

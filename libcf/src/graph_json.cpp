@@ -1,11 +1,12 @@
 // The CF graph file (SPEC section 5): writing (deterministic, whole-or-nothing) and reading
 // (JSON or CBOR, schema-validated, every fault named by file and JSON pointer).
 
-#include "file_io.hpp"
 #include "graph_impl.hpp"
 #include "graph_schema.hpp"
 #include "json_util.hpp"
 #include "polyhedron_json.hpp"
+
+#include <cf/file_io.hpp>
 
 #include <algorithm>
 #include <charconv>
@@ -355,7 +356,7 @@ CfGraph CfGraph::load(const std::string& path) { return load(path, GraphLoadOpti
 CfGraph CfGraph::load(const std::string& path, const GraphLoadOptions& options) {
   // Never blocks on a FIFO; a directory, a device or a FIFO is refused before reading.
   std::string bytes, why;
-  if (!detail::read_input_file(path, bytes, why)) throw Error("reading '" + path + "': cannot open: " + why);
+  if (!read_input_file(path, bytes, why)) throw Error("reading '" + path + "': cannot open: " + why);
   CfGraph g;
   g.impl_ = detail::read_graph(bytes.data(), bytes.size(), path, is_cbor_path(path), options);
   return g;

@@ -8,11 +8,12 @@
 // members, types, ranges, no unknown members in PCs and witnesses); GraphLoadOptions::
 // full_schema_check runs valijson over the whole document as well.
 
-#include "file_io.hpp"
 #include "graph_impl.hpp"
 #include "graph_schema.hpp"
 #include "json_util.hpp"
 #include "polyhedron_json.hpp"
+
+#include <cf/file_io.hpp>
 
 #include <array>
 #include <cctype>

@@ -2,14 +2,14 @@
 // Private: the graph file's JSON Schema (schemas/cf-graph.schema.json, embedded at build
 // time) and validation against it with valijson.
 
+#include <cf/graph.hpp>  // graph_schema_text()
+
 #include <nlohmann/json.hpp>
 
 #include <string>
 
 namespace cf::detail {
 
-/// The text of schemas/cf-graph.schema.json as it was when the library was built.
-const char* graph_schema_text();
 /// The text of schemas/model.schema.json, which the graph schema refers to for models.A/B.
 const char* model_schema_text();
 

@@ -25,18 +25,6 @@ const char* to_string(MotionType type) {
   return "none";
 }
 
-PcExtent pc_extent(PcType type) {
-  switch (type) {
-    case PcType::kFF: return PcExtent::kPlane;
-    case PcType::kEF:
-    case PcType::kFE: return PcExtent::kLine;
-    case PcType::kVF:
-    case PcType::kFV:
-    case PcType::kEE: return PcExtent::kPoint;
-  }
-  return PcExtent::kPoint;
-}
-
 namespace {
 
 using Mat6 = Eigen::Matrix<double, 6, 6>;
@@ -70,7 +58,7 @@ Freedoms compute_freedoms(const ContactPc* pcs, int n, const Polyhedron& A, cons
     const ContactPc& c = pcs[i];
     const Vec3 nrm = c.R_WT.col(1);
     add(c.p_W, nrm);
-    switch (pc_extent(c.pc.type)) {
+    switch (extent(c.pc.type)) {
       case PcExtent::kPoint: break;
       case PcExtent::kLine: add(c.p_W + L * line_direction(c, A, B, pose), nrm); break;
       case PcExtent::kPlane:

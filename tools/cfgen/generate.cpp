@@ -3,7 +3,7 @@
 #include "cfgen/enumerate.hpp"
 #include "mesh/model_loader.hpp"
 
-#include "file_io.hpp"  // libcf private: output path checks
+#include <cf/file_io.hpp>
 
 #include <cf/graph.hpp>
 
@@ -21,7 +21,7 @@ int run_generate(const GenerateArgs& args) {
   // The output path is checked before the work: not a device, FIFO or directory, not one of
   // the models (SPEC section 5b).
   const std::vector<std::string> inputs{args.a_path, args.b_path};
-  detail::check_output_path(args.out_path, inputs, "writing graph");
+  check_output_path(args.out_path, inputs, "writing graph");
   const Polyhedron A = load_model(args.a_path, args.load_a);
   const Polyhedron B = load_model(args.b_path, args.load_b);
   for (const auto& [m, which, option] : {std::tuple{&A, "A", "--units-a"}, std::tuple{&B, "B", "--units-b"}})
@@ -100,7 +100,7 @@ int run_generate(const GenerateArgs& args) {
 
   const std::size_t n_cfs = e.cfs.size(), n_tr = e.transitions.size();
   const CfGraph graph = CfGraph::from_parts(A, B, e.cfs, e.transitions, meta.dump());
-  detail::check_output_path(args.out_path, inputs, "writing graph");
+  check_output_path(args.out_path, inputs, "writing graph");
   graph.save(args.out_path);
   if (n_cfs == 0)
     std::cerr << "cfgen: warning: the graph has no CF: A (" << A.size() << " mm across) and B (" << B.size()

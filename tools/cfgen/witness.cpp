@@ -146,17 +146,6 @@ bool project_perp(const RotConstraints& c, Mat3& R) {
 
 }  // namespace
 
-bool in_closure(const Polyhedron& m, ElementKind kx, int x, ElementKind ky, int y) {
-  if (kx == ky) return x == y;
-  if (ky == ElementKind::kFace) {
-    if (kx == ElementKind::kEdge) return m.edge_bounds_face(EdgeId(x), FaceId(y));
-    return m.vertex_on_face(VertexId(x), FaceId(y));
-  }
-  if (ky == ElementKind::kEdge && kx == ElementKind::kVertex)
-    return m.vertex_ends_edge(VertexId(x), EdgeId(y));
-  return false;
-}
-
 WitnessSearch::WitnessSearch(const ModelInfo& a, const ModelInfo& b, const SearchParams& p)
     : A_(a), B_(b), p_(p), scale_(std::max(a.model->size(), b.model->size())),
       debug_(std::getenv("CFGEN_DEBUG") != nullptr) {}

@@ -31,9 +31,6 @@ struct Witness {
   double margin = 0;     // mm, the LP margin of the contacts inside their elements
 };
 
-/// Is element (kx, x) of a model in the closure of element (ky, y)?
-bool in_closure(const Polyhedron& m, ElementKind kx, int x, ElementKind ky, int y);
-
 class WitnessSearch {
  public:
   WitnessSearch(const ModelInfo& a, const ModelInfo& b, const SearchParams& p);

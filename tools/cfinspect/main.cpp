@@ -2,16 +2,15 @@
 // queries (CFs holding a PC, a CF's transitions, one CF, the CF at a pose) and exports
 // Graphviz DOT (SPEC section 5b). One translation unit, no CGAL.
 
+#include <cf/file_io.hpp>
 #include <cf/graph.hpp>
 #include <cf/identifier.hpp>
 
-#include "cli_checks.hpp"     // finite_range
-#include "file_io.hpp"        // output paths, printable messages (libcf private)
-#include "graph_impl.hpp"    // Boost.Graph view (libcf private)
-#include "graph_schema.hpp"  // the embedded schema text
-#include "html.hpp"          // --html: the browser viewer
+#include "cli_checks.hpp"  // finite_range
+#include "html.hpp"        // --html: the browser viewer
 
 #include <CLI/CLI.hpp>
+#include <boost/graph/adjacency_list.hpp>
 #include <boost/graph/connected_components.hpp>
 #include <boost/graph/graphviz.hpp>
 #include <nlohmann/json.hpp>
@@ -134,8 +133,9 @@ ojson summary_json(const std::string& path, const cf::CfGraph& g, const Summary&
 void print_summary(std::ostream& out, const std::string& path, const cf::CfGraph& g, const Summary& s,
                    bool full_check) {
   auto model_line = [&](const char* which, const cf::Polyhedron& m) {
-    out << "model " << which << " '" << cf::detail::printable(m.name()) << "': " << m.num_vertices() << " vertices, " << m.num_edges()
-        << " edges (" << reflex_edges(m) << " reflex), " << m.num_faces() << " faces\n";
+    out << "model " << which << " '" << cf::printable(m.name()) << "': " << m.num_vertices()
+        << " vertices, " << m.num_edges() << " edges (" << reflex_edges(m) << " reflex), "
+        << m.num_faces() << " faces\n";
   };
   out << path << ": valid cf-graph v1 (" << (full_check ? "full schema check" : "schema check of the skeleton")
       << ")\n";
@@ -158,7 +158,7 @@ void print_summary(std::ostream& out, const std::string& path, const cf::CfGraph
   const auto meta = nlohmann::json::parse(g.metadata_json());
   out << "metadata:";
   if (meta.empty()) out << " none";
-  for (auto it = meta.begin(); it != meta.end(); ++it) out << " " << cf::detail::printable(it.key());
+  for (auto it = meta.begin(); it != meta.end(); ++it) out << " " << cf::printable(it.key());
   out << "\n";
 }
 
@@ -223,14 +223,23 @@ std::vector<cf::CfId> holding(const cf::CfGraph& g, const cf::Pc& pc) {
   return ids;
 }
 
+// Vertex i is CF i; one directed edge per transition, in file order (write_graphviz lists
+// them per source CF in that order).
+using DotGraph = boost::adjacency_list<boost::vecS, boost::vecS, boost::directedS,
+                                       boost::no_property, cf::TransitionKind>;
+
 std::string dot_text(const cf::CfGraph& g) {
-  const auto& bg = cf::detail::boost_graph(g);
+  DotGraph bg(g.num_cfs());
+  for (std::size_t i = 0; i < g.num_transitions(); ++i) {
+    const cf::Transition& t = g.transition(i);
+    boost::add_edge(t.from.index(), t.to.index(), t.kind, bg);
+  }
   std::ostringstream dot;
   auto vertex_label = [&g](std::ostream& os, std::size_t v) {
     os << "[label=\"" << v << ": " << cf::to_string(g.cf(cf::CfId(static_cast<int>(v))).pcs) << "\"]";
   };
-  auto edge_label = [&bg](std::ostream& os, const cf::detail::BoostCfGraph::edge_descriptor& e) {
-    const cf::TransitionKind k = bg[e].kind;
+  auto edge_label = [&bg](std::ostream& os, const DotGraph::edge_descriptor& e) {
+    const cf::TransitionKind k = bg[e];
     const char* style = k == cf::TransitionKind::kGain ? "solid" : k == cf::TransitionKind::kLose ? "dashed" : "dotted";
     os << "[label=\"" << cf::to_string(k) << "\", style=" << style << "]";
   };
@@ -254,13 +263,16 @@ cf::Pose parse_pose(const std::string& text) {
     }
     while (used < item.size() && item[used] == ' ') ++used;
     if (item.empty() || used != item.size())
-      throw Failure{"--pose '" + cf::detail::printable(text) + "': '" + cf::detail::printable(item) + "' is not a number"};
+      throw Failure{"--pose '" + cf::printable(text) + "': '" + cf::printable(item) +
+                    "' is not a number"};
     v.push_back(x);
   }
-  if (v.size() != 7) throw Failure{"--pose '" + cf::detail::printable(text) + "': expected 7 numbers tx,ty,tz,qw,qx,qy,qz, got " + std::to_string(v.size())};
+  if (v.size() != 7)
+    throw Failure{"--pose '" + cf::printable(text) +
+                  "': expected 7 numbers tx,ty,tz,qw,qx,qy,qz, got " + std::to_string(v.size())};
   Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
   // The one tolerance of every tool (cfreplay's POSES.csv too): 4 significant digits.
-  if (std::string why = cf::detail::quaternion_problem(v[3], v[4], v[5], v[6]); !why.empty())
+  if (std::string why = cf::quaternion_problem(v[3], v[4], v[5], v[6]); !why.empty())
     throw Failure{"--pose '" + text + "': " + why};
   cf::Pose p;
   p.R_BA = q.normalized().toRotationMatrix();
@@ -301,7 +313,7 @@ int run(int argc, char** argv) {
     return 2;
   }
   if (print_schema) {
-    std::cout << cf::detail::graph_schema_text();
+    std::cout << cf::graph_schema_text();
     return 0;
   }
   if (path.empty()) {
@@ -319,7 +331,7 @@ int run(int argc, char** argv) {
 
   // An output path is checked before the load: never the graph itself, a device, a FIFO
   // or a directory (SPEC section 5b).
-  if (!dot_path.empty()) cf::detail::check_output_path(dot_path, {path}, "writing DOT");
+  if (!dot_path.empty()) cf::check_output_path(dot_path, {path}, "writing DOT");
   if (html_path.empty() && !(replay_path.empty() && trajectory_path.empty())) {
     std::cerr << "cfinspect: --replay and --trajectory go with --html (see --help)\n";
     return 2;
@@ -331,7 +343,7 @@ int run(int argc, char** argv) {
   std::vector<std::string> html_inputs{path};  // never written over
   for (const std::string* p : {&replay_path, &trajectory_path})
     if (!p->empty()) html_inputs.push_back(*p);
-  if (!html_path.empty()) cf::detail::check_output_path(html_path, html_inputs, "writing HTML");
+  if (!html_path.empty()) cf::check_output_path(html_path, html_inputs, "writing HTML");
   cf::GraphLoadOptions options;
   options.full_schema_check = !fast;
   const cf::CfGraph g = cf::CfGraph::load(path, options);
@@ -341,7 +353,7 @@ int run(int argc, char** argv) {
     std::cerr << "cfinspect: warning: the graph has no CF (A " << g.model_a().size() << " mm across, B "
               << g.model_b().size() << " mm across): nothing can be identified; were the models' units right?\n";
   for (const auto& [m, which] : {std::pair{&g.model_a(), "A"}, std::pair{&g.model_b(), "B"}})
-    if (const std::string w = cf::detail::size_warning(*m, which, epsilon); !w.empty())
+    if (const std::string w = cf::size_warning(*m, which, epsilon); !w.empty())
       std::cerr << "cfinspect: warning: " << w << "\n";
 
   bool queried = false;
@@ -350,7 +362,7 @@ int run(int argc, char** argv) {
     queried = true;
     const cf::Pc& pc = *holding_pc;
     const char* field = "";
-    if (std::string why = cf::detail::check_pc(pc, g.model_a(), g.model_b(), &field); !why.empty())
+    if (std::string why = cf::check_pc(pc, g.model_a(), g.model_b(), &field); !why.empty())
       throw Failure{"--holding '" + holding_text + "': " + why};
     const auto ids = holding(g, pc);
     if (as_json) {
@@ -399,7 +411,7 @@ int run(int argc, char** argv) {
     }
   }
   if (!dot_path.empty()) {
-    cf::detail::write_outputs({{dot_path, dot_text(g)}}, {path}, "writing DOT");
+    cf::write_outputs({{dot_path, dot_text(g)}}, {path}, "writing DOT");
     if (!as_json) std::cout << "wrote " << dot_path << " (" << g.num_cfs() << " nodes, " << g.num_transitions() << " edges)\n";
     else answer["dot"] = dot_path;
   }
@@ -409,7 +421,7 @@ int run(int argc, char** argv) {
     const bool cbor = path.size() >= 5 && path.compare(path.size() - 5, 5, ".cbor") == 0;
     cf::inspect::ViewerInputs in{path, cbor ? g.to_json(-1) : cf::inspect::read_text_file(path, "reading"),
                                  g.num_cfs(), replay_path, trajectory_path, cf_id};
-    cf::detail::write_outputs({{html_path, cf::inspect::viewer_html(in)}}, html_inputs, "writing HTML");
+    cf::write_outputs({{html_path, cf::inspect::viewer_html(in)}}, html_inputs, "writing HTML");
     if (!as_json) std::cout << "wrote " << html_path << " (viewer of " << g.num_cfs() << " CFs" << (replay_path.empty() ? "" : ", with the replay") << ")\n";
     else answer["html"] = html_path;
   }

@@ -9,7 +9,7 @@
 #include <cf/params.hpp>
 
 #include "cli_checks.hpp"
-#include "file_io.hpp"  // libcf private: output paths, size warnings
+#include <cf/file_io.hpp>
 
 #include <CLI/CLI.hpp>
 
@@ -89,11 +89,11 @@ int main(int argc, char** argv) {
   try {
     // Output paths first, so that a bad one fails before the work (SPEC section 5b).
     const std::vector<std::string> inputs{graph_path, traj_path};
-    cf::detail::check_output_path(out_path, inputs, "writing");
-    if (!plot_path.empty()) cf::detail::check_output_path(plot_path, inputs, "writing");
+    cf::check_output_path(out_path, inputs, "writing");
+    if (!plot_path.empty()) cf::check_output_path(plot_path, inputs, "writing");
     const cf::CfGraph graph = cf::CfGraph::load(graph_path);
     for (const auto& [m, which] : {std::pair{&graph.model_a(), "A"}, std::pair{&graph.model_b(), "B"}})
-      if (const std::string w = cf::detail::size_warning(*m, which, P.epsilon_mm); !w.empty())
+      if (const std::string w = cf::size_warning(*m, which, P.epsilon_mm); !w.empty())
         std::cerr << "cfreplay: warning: " << w << "\n";
     const std::vector<cf::replay::Sample> samples = cf::replay::read_trajectory(traj_path);
     const std::vector<cf::replay::Row> rows = cf::replay::run(graph, samples, P);
@@ -107,10 +107,10 @@ int main(int argc, char** argv) {
       ++statuses[r.status];
     }
     // Both files or neither: a plot that cannot be written leaves no CSV behind.
-    std::vector<cf::detail::OutputFile> files{{out_path, std::move(text)}};
+    std::vector<cf::OutputFile> files{{out_path, std::move(text)}};
     if (!plot_path.empty())
       files.push_back({plot_path, cf::replay::svg_plot(rows, traj_path + " against " + graph_path)});
-    cf::detail::write_outputs(files, inputs, "writing");
+    cf::write_outputs(files, inputs, "writing");
     std::cerr << "cfreplay: " << rows.size() << " ticks ->" << ' ' << out_path << " (";
     bool first = true;
     for (const auto& [s, n] : statuses) {

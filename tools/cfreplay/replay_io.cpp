@@ -1,6 +1,6 @@
 #include "replay_io.hpp"
 
-#include "file_io.hpp"  // libcf private: reading and writing files
+#include <cf/file_io.hpp>
 
 #include <algorithm>
 #include <cerrno>
@@ -48,7 +48,7 @@ double number(const std::string& field, const char* column, const std::string& s
   char* end = nullptr;
   const double v = std::strtod(field.c_str(), &end);
   if (end != field.c_str() + field.size() || errno == ERANGE || !std::isfinite(v))
-    fail(source, line, std::string("column '") + column + "' is not a finite number: '" + detail::printable(field) + "'");
+    fail(source, line, std::string("column '") + column + "' is not a finite number: '" + printable(field) + "'");
   return v;
 }
 
@@ -71,7 +71,7 @@ std::vector<Sample> parse_trajectory(const std::string& text, const std::string&
       for (std::size_t i = 0; i < f.size(); ++i) joined += (i ? "," : "") + f[i];
       if (joined != kInputHeader)
         fail(source, line, std::string("expected the header '") + kInputHeader + "', found '" +
-                               detail::printable(s) + "'");
+                               printable(s) + "'");
       header = true;
       continue;
     }
@@ -80,7 +80,7 @@ std::vector<Sample> parse_trajectory(const std::string& text, const std::string&
     double v[8];
     for (int i = 0; i < 8; ++i) v[i] = number(f[static_cast<std::size_t>(i)], kColumns[i], source, line);
     Eigen::Quaterniond q(v[4], v[5], v[6], v[7]);
-    if (std::string why = detail::quaternion_problem(v[4], v[5], v[6], v[7]); !why.empty()) fail(source, line, why);
+    if (std::string why = quaternion_problem(v[4], v[5], v[6], v[7]); !why.empty()) fail(source, line, why);
     q.normalize();
     Sample smp;
     smp.t = v[0];
@@ -103,7 +103,7 @@ std::vector<Sample> parse_trajectory(const std::string& text, const std::string&
 std::vector<Sample> read_trajectory(const std::string& path) {
   // Never blocks on a FIFO; a directory or a device is refused before reading.
   std::string text, why;
-  if (!detail::read_input_file(path, text, why)) throw Error(path + ": cannot open the trajectory: " + why);
+  if (!read_input_file(path, text, why)) throw Error(path + ": cannot open the trajectory: " + why);
   return parse_trajectory(text, path);
 }
 
@@ -122,7 +122,7 @@ std::string format_row(const Row& r) {
 }
 
 void write_file_atomic(const std::string& path, const std::string& text, const std::vector<std::string>& inputs) {
-  detail::write_outputs({detail::OutputFile{path, text}}, inputs, "writing");
+  write_outputs({OutputFile{path, text}}, inputs, "writing");
 }
 
 namespace {

@@ -18,7 +18,7 @@ struct Sample {
 
 /// Largest | |q| - 1 | accepted; such quaternions are normalised. Beyond it a row is not a
 /// pose (a typo, or Euler angles written by mistake). The same for every tool
-/// (cf::detail::kUnitQuaternionTolerance): four significant digits.
+/// (cf::kUnitQuaternionTolerance): four significant digits.
 constexpr double kQuaternionTolerance = 1e-3;
 
 /// Reads POSES.csv: header `t,tx,ty,tz,qw,qx,qy,qz`, then one pose per line; blank lines

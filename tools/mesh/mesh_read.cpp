@@ -7,7 +7,7 @@
 
 #include "mesh_detail.hpp"
 
-#include "file_io.hpp"  // libcf private: non-blocking reading, printable()
+#include <cf/file_io.hpp>
 
 #include <algorithm>
 #include <array>
@@ -25,7 +25,7 @@ namespace cf::tools {
 namespace {
 
 using detail::fail;
-using cf::detail::printable;
+using cf::printable;
 
 std::string quoted(std::string_view t) { return "'" + printable(std::string(t), 40) + "'"; }
 
@@ -711,7 +711,7 @@ PolygonSoup parse_polygon_soup(std::string_view bytes, MeshFormat format, const 
 PolygonSoup read_polygon_soup(const std::string& path) {
   const MeshFormat format = mesh_format_of(path);
   std::string bytes, why;
-  if (!cf::detail::read_input_file(path, bytes, why)) fail(path, "cannot open file: " + why);
+  if (!cf::read_input_file(path, bytes, why)) fail(path, "cannot open file: " + why);
   return parse_polygon_soup(bytes, format, path);
 }
 

@@ -3,7 +3,7 @@
 
 #include "mesh_detail.hpp"
 
-#include "file_io.hpp"  // libcf private: size_warning
+#include <cf/file_io.hpp>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
@@ -100,7 +100,7 @@ cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& sourc
 
 std::string size_warning(const cf::Polyhedron& model, const std::string& which, const std::string& unit_option,
                          double epsilon_mm) {
-  std::string w = cf::detail::size_warning(model, which, epsilon_mm);
+  std::string w = cf::size_warning(model, which, epsilon_mm);
   if (!w.empty()) w += "; if the file is not in mm, give its unit with " + unit_option + " (mm, cm, m or in)";
   return w;
 }

@@ -3,17 +3,13 @@
 /// Contacts detected at a pose: the candidate principal contacts of SPEC section 6, each
 /// with its distance, point of action and task frame, and a fixed-capacity set of them.
 
-#include <cf/graph.hpp>
+#include <cf/pc.hpp>
 #include <cf/types.hpp>
 
 #include <array>
 #include <cstdint>
 
 namespace cf {
-
-/// Geometric category of a PC (paper section 2).
-enum class PcExtent : std::uint8_t { kPoint, kLine, kPlane };
-PcExtent extent(PcType type);
 
 /// One contact between an element of A and an element of B at the current pose.
 struct ContactPc {

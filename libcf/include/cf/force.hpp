@@ -113,7 +113,6 @@ class ForceModel {
   };
   Slot* find_slot(const Pc& pc);
   Slot* new_slot(const Pc& pc);
-  bool dominated(const ContactPc& x, const ContactPc& y) const;
 
   const Polyhedron* A_;
   const Polyhedron* B_;

@@ -60,6 +60,7 @@ ClosestPoints face_face(const Polyhedron& A, const Pose& pose, FaceId fa, const 
 /// Distance between element `a` of kind `ka` of A posed by `pose` and element `b` of kind
 /// `kb` of B, in the world frame (any of the nine kind pairs). p_a lies on A's element, p_b on
 /// B's.
+/// @throws cf::Error when an index is out of range for its kind in its model.
 ClosestPoints element_distance(const Polyhedron& A, const Pose& pose, ElementKind ka, int a,
                                const Polyhedron& B, ElementKind kb, int b);
 

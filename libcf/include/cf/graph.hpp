@@ -1,8 +1,9 @@
 #pragma once
 /// @file
-/// Principal contacts, contact formations and the CF graph of SPEC sections 4-5.
+/// Contact formations and the CF graph of SPEC section 5 (the PC vocabulary is cf/pc.hpp).
 /// The graph is immutable once built or loaded; Boost.Graph and nlohmann live behind it.
 
+#include <cf/pc.hpp>
 #include <cf/polyhedron.hpp>
 #include <cf/types.hpp>
 
@@ -15,76 +16,6 @@
 #include <vector>
 
 namespace cf {
-
-/// Non-degenerate PC types, named A-element then B-element (paper Fig. 1). The enumerator
-/// order is the canonical order used to sort PCs.
-enum class PcType : std::uint8_t { kFF = 0, kEF, kFE, kVF, kFV, kEE };
-
-/// "f-f", "e-f", ... as in the graph file.
-const char* to_string(PcType type);
-/// Parses "f-f", "e-f", ...; std::nullopt for anything else.
-std::optional<PcType> pc_type_from_string(std::string_view name);
-/// Kind of the A element (first letter) and of the B element (last letter).
-ElementKind a_kind(PcType type);
-ElementKind b_kind(PcType type);
-
-/// A principal contact: a pair of elements, by index into A's and B's arrays of the kinds
-/// that `type` names.
-struct Pc {
-  PcType type = PcType::kFF;
-  std::int32_t a = -1;  ///< index of A's element (vertex, edge or face per type)
-  std::int32_t b = -1;  ///< index of B's element
-  friend bool operator==(const Pc& x, const Pc& y) {
-    return x.type == y.type && x.a == y.a && x.b == y.b;
-  }
-  friend bool operator!=(const Pc& x, const Pc& y) { return !(x == y); }
-  friend bool operator<(const Pc& x, const Pc& y) {
-    if (x.type != y.type) return x.type < y.type;
-    if (x.a != y.a) return x.a < y.a;
-    return x.b < y.b;
-  }
-};
-
-/// "type:a:b", as in the `pcs` column of cfreplay's output.
-std::string to_string(const Pc& pc);
-/// Parses "type:a:b" (e.g. "v-f:3:5"); std::nullopt when malformed. Ranges are not checked.
-std::optional<Pc> pc_from_string(std::string_view text);
-
-/// The PCs neighbouring `pc` (SPEC section 4): one step through a degenerate touch, under the
-/// boundary relations of A and B (edge bounds face, vertex ends edge; the table is in
-/// docs/generator.md). Sorted, without repeats; the relation is symmetric. This is the rule
-/// behind `change` transitions, for cfgen and for the graph reader's checks.
-/// @pre pc's indices are in range for the element kinds its type names in A and B.
-std::vector<Pc> neighbouring_pcs(const Pc& pc, const Polyhedron& A, const Polyhedron& B);
-
-/// Up to three PCs in canonical (sorted) order: the key of a CF. Fixed capacity, no heap.
-class PcSet {
- public:
-  static constexpr int kMaxPcs = 3;
-  PcSet() = default;
-  /// Builds the canonical set.
-  /// @throws cf::Error when pcs has more than 3 PCs or repeats one.
-  explicit PcSet(const std::vector<Pc>& pcs);
-  /// Inserts keeping the order; returns false when full or already present.
-  bool insert(const Pc& pc);
-  int size() const { return size_; }
-  bool empty() const { return size_ == 0; }
-  const Pc& operator[](int i) const { return pcs_[static_cast<std::size_t>(i)]; }
-  const Pc* begin() const { return pcs_.data(); }
-  const Pc* end() const { return pcs_.data() + size_; }
-  bool contains(const Pc& pc) const;
-  std::size_t hash() const;
-  friend bool operator==(const PcSet& x, const PcSet& y);
-  friend bool operator!=(const PcSet& x, const PcSet& y) { return !(x == y); }
-
- private:
-  std::array<Pc, kMaxPcs> pcs_{};
-  int size_ = 0;
-};
-
-/// The PCs as "type:a:b" joined by ';' in canonical order (cfreplay's `pcs` column);
-/// "" for the empty set.
-std::string to_string(const PcSet& pcs);
 
 using CfId = Id<struct CfTag>;
 
@@ -118,6 +49,10 @@ struct Transition {
   CfId to;
   TransitionKind kind = TransitionKind::kGain;
 };
+
+/// The JSON Schema of the graph file (schemas/cf-graph.schema.json) as it was when the
+/// library was built; it refers to the model schema by its `$id`.
+const char* graph_schema_text();
 
 /// Options of CfGraph::load.
 struct GraphLoadOptions {
@@ -175,17 +110,18 @@ class CfGraph {
   const Polyhedron& model_a() const;
   const Polyhedron& model_b() const;
   std::size_t num_cfs() const;
-  /// @pre id.index() < num_cfs()
+  /// @throws cf::Error when id is not a CF of the graph.
   const CfRecord& cf(CfId id) const;
   std::size_t num_transitions() const;
-  /// In file order. @pre i < num_transitions()
+  /// In file order. @throws cf::Error when i >= num_transitions().
   const Transition& transition(std::size_t i) const;
 
   /// The CF with exactly this PC set, in constant time.
   std::optional<CfId> find(const PcSet& pcs) const;
   /// True when some CF of the graph holds this PC, in constant time.
   bool holds(const Pc& pc) const;
-  /// Transitions leaving `id` (to, kind), sorted by target id. @pre id.index() < num_cfs()
+  /// Transitions leaving `id` (to, kind), sorted by target id.
+  /// @throws cf::Error when id is not a CF of the graph.
   const std::vector<Transition>& out_transitions(CfId id) const;
   /// True when the graph has a transition from `from` to `to` (false for invalid ids);
   /// O(log out-degree).
@@ -193,18 +129,12 @@ class CfGraph {
   /// The extra top-level members of the file (statistics, parameters) as JSON text.
   const std::string& metadata_json() const;
 
-  /// The representation; complete only inside libcf (and tools that include its private
-  /// headers). An empty graph when default-constructed or moved from.
-  struct Impl;
-  const Impl& impl() const;
+  struct Impl;  ///< the representation, complete only inside libcf
 
  private:
+  /// An empty graph when default-constructed or moved from.
+  const Impl& impl() const;
   std::unique_ptr<const Impl> impl_;
 };
 
 }  // namespace cf
-
-template <>
-struct std::hash<cf::PcSet> {
-  std::size_t operator()(const cf::PcSet& s) const noexcept { return s.hash(); }
-};

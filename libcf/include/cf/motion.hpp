@@ -32,9 +32,6 @@ enum class MotionType : std::uint8_t {
 /// "none", "MT1", "MT2.a", "MT2.b", "MT2.c", "MT3", "MT4", "MT5" (cfreplay's `motion`).
 const char* to_string(MotionType type);
 
-/// Geometric category of a PC type (paper section 2); same as `cf::extent` of contact.hpp.
-PcExtent pc_extent(PcType type);
-
 /// The instantaneous freedoms of A that keep every PC of a CF (bilateral contact
 /// constraints: each contact point keeps zero normal velocity).
 struct Freedoms {

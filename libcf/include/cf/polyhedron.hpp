@@ -4,6 +4,7 @@
 /// adjacency, planes and mass properties. CGAL-free; built by the tools from a mesh or read
 /// from the `models.A` / `models.B` objects of a graph file.
 
+#include <cf/pc.hpp>
 #include <cf/types.hpp>
 
 #include <array>
@@ -47,9 +48,6 @@ struct Face {
   double area = 0;                  ///< mm^2, holes excluded
 };
 
-/// Kinds of elements. A PC type names the A element kind then the B element kind.
-enum class ElementKind : std::uint8_t { kVertex, kEdge, kFace };
-
 /// An immutable featured polyhedron.
 class Polyhedron {
  public:
@@ -79,6 +77,12 @@ class Polyhedron {
   std::size_t num_vertices() const { return vertices_.size(); }
   std::size_t num_edges() const { return edges_.size(); }
   std::size_t num_faces() const { return faces_.size(); }
+  /// The number of elements of a kind: num_vertices(), num_edges() or num_faces().
+  std::size_t num_elements(ElementKind kind) const {
+    return kind == ElementKind::kVertex ? vertices_.size()
+           : kind == ElementKind::kEdge ? edges_.size()
+                                        : faces_.size();
+  }
 
   /// mm, the end point of an edge.
   const Vec3& edge_point(EdgeId e, int end) const {

@@ -1,6 +1,6 @@
 # The browser viewer (cfinspect --html): viewer/build.mjs bundles src/ with three.js (esbuild,
 # both from npm, pinned in package-lock.json and installed by `npm ci`, which
-# scripts/install-deps.sh runs) into one page and writes it as a C++ source. Without Node.js
+# scripts/install-npm.sh runs) into one page and writes it as a C++ source. Without Node.js
 # or node_modules, cfinspect is built with viewer_none.cpp and --html says what is missing.
 # Sets CF_VIEWER_SOURCE.
 set(_viewer ${CMAKE_CURRENT_SOURCE_DIR}/viewer)
@@ -14,7 +14,7 @@ if(CF_NODE AND EXISTS ${_viewer}/node_modules/esbuild/package.json AND EXISTS ${
     COMMENT "Bundling the cfinspect viewer (esbuild, three.js)" VERBATIM)
   set(CF_HAVE_VIEWER ON CACHE INTERNAL "cfinspect --html is built in")
 else()
-  message(STATUS "cfinspect: no browser viewer (needs node and `npm ci` in ${_viewer}; scripts/install-deps.sh runs it)")
+  message(STATUS "cfinspect: no browser viewer (needs node and `npm ci` in ${_viewer}: bash scripts/install-npm.sh, then configure again)")
   set(CF_VIEWER_SOURCE ${CMAKE_CURRENT_SOURCE_DIR}/viewer_none.cpp)
   set(CF_HAVE_VIEWER OFF CACHE INTERNAL "cfinspect --html is built in")
 endif()

@@ -141,7 +141,16 @@ function aim() {
   for (const h of state.highlighted) { c.add(v3(h.plane.point)); n.add(v3(h.plane.normal)); }
   c.divideScalar(state.highlighted.length);
   if (n.lengthSq() < 1e-6) n.set(0, 0, 1);
-  const dir = n.normalize().add(new THREE.Vector3(0.55, -0.75, 0.45)).normalize();
+  n.normalize();
+  // Of a few directions around the mean normal, the one that sees every contact plane most
+  // squarely from A's side (the smallest cosine with a plane's normal is largest).
+  let dir = n.clone(), best = -Infinity;
+  for (const g of [[1, -1, 1], [1, 1, 1], [-1, 1, 1], [-1, -1, 1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, -1]]) {
+    const d = n.clone().add(new THREE.Vector3(...g).normalize().multiplyScalar(0.8)).normalize();
+    // Capped: beyond 0.75 an oblique view (the first in the list) beats a head-on one.
+    const score = Math.min(0.75, ...state.highlighted.map((h) => d.dot(v3(h.plane.normal))));
+    if (score > best + 1e-9) { best = score; dir = d; }
+  }
   controls.target.copy(c);
   camera.position.copy(c).addScaledVector(dir, 1.7 * size);
   controls.update();
@@ -231,14 +240,14 @@ function highlightMesh(model, k, index, colour) {
     return new THREE.Mesh(g, m);
   }
   if (k === 'v') {
-    const s = new THREE.Mesh(new THREE.SphereGeometry(size * 0.012, 16, 12), m);
+    const s = new THREE.Mesh(new THREE.SphereGeometry(size * 0.015, 16, 12), m);
     s.position.copy(v3(model.vertices[index]));
     s.renderOrder = 2;
     return s;
   }
   const [i, j] = model.edges[index];
   const p = v3(model.vertices[i]), q = v3(model.vertices[j]);
-  const tube = new THREE.Mesh(new THREE.CylinderGeometry(size * 0.006, size * 0.006, p.distanceTo(q), 8), m);
+  const tube = new THREE.Mesh(new THREE.CylinderGeometry(size * 0.009, size * 0.009, p.distanceTo(q), 8), m);
   tube.position.copy(p).add(q).multiplyScalar(0.5);
   tube.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), q.clone().sub(p).normalize());
   tube.renderOrder = 2;
@@ -250,7 +259,11 @@ overlayA.matrixAutoUpdate = false;
 
 function clearOverlay() {
   for (const g of [overlay, overlayA]) {
-    g.traverse((o) => { if (o.geometry) o.geometry.dispose(); });
+    // ArrowHelpers share one geometry among all of them (the replay's arrows too): keep it.
+    g.traverse((o) => {
+      if (o.geometry && !(o.parent instanceof THREE.ArrowHelper)) o.geometry.dispose();
+      if (o.material) o.material.dispose();
+    });
     g.clear();
   }
   overlay.add(overlayA);
@@ -263,7 +276,7 @@ function clearOverlay() {
 const state = {
   ready: false,
   selected: -1,
-  highlighted: [],  // [{pc, colour, a: {model, kind, index}, b: {...}}] of the CF shown
+  highlighted: [],  // [{pc, colour, a: {model, kind, index, drawnAt}, b: {...}, plane}] of the CF shown
   listed: [],       // ids in the CF list after the filters
   pose: null,       // A's pose drawn
   replay: null,     // {rows, poses, tick, playing}
@@ -300,8 +313,12 @@ function showCf(id, pose, fromReplay = false) {
   cf.pcs.forEach((pc, k) => {
     const colour = PC_COLOURS[k % PC_COLOURS.length];
     const [ka, kb] = [pc.type[0], pc.type[2]];
-    overlayA.add(highlightMesh(modelA, ka, pc.a, colour));
-    overlay.add(highlightMesh(modelB, kb, pc.b, colour));
+    const meshA = highlightMesh(modelA, ka, pc.a, colour), meshB = highlightMesh(modelB, kb, pc.b, colour);
+    overlayA.add(meshA);
+    overlay.add(meshB);
+    overlay.updateMatrixWorld(true);
+    // Where the highlights are drawn (world frame, bounding-box centres), for the test hook.
+    const centre = (mesh) => new THREE.Box3().setFromObject(mesh).getCenter(new THREE.Vector3()).toArray();
     const ea = element(modelA, ka, pc.a, mA), eb = element(modelB, kb, pc.b, mB);
     const frame = contactFrame(pc, ea, eb, mA, pose ? null : cf.planes && cf.planes[k]);
     if ($('show-planes').checked) {
@@ -315,7 +332,8 @@ function showCf(id, pose, fromReplay = false) {
         overlay.add(new THREE.ArrowHelper(dir, frame.point, len, c, len * 0.25, len * 0.12));
     }
     state.highlighted.push({ pc: pcText(pc), colour,
-      a: { model: 'A', kind: KIND_NAME[ka], index: pc.a }, b: { model: 'B', kind: KIND_NAME[kb], index: pc.b },
+      a: { model: 'A', kind: KIND_NAME[ka], index: pc.a, drawnAt: centre(meshA) },
+      b: { model: 'B', kind: KIND_NAME[kb], index: pc.b, drawnAt: centre(meshB) },
       plane: { normal: frame.normal.toArray(), point: frame.point.toArray() } });
     const li = document.createElement('li');
     li.className = 'pc';
@@ -413,6 +431,18 @@ function search() {
 }
 $('go').onclick = search;
 $('search').addEventListener('keydown', (e) => { if (e.key === 'Enter') search(); });
+// Keys, outside the inputs: up/down step through the listed CFs, space plays or pauses.
+document.addEventListener('keydown', (e) => {
+  if (e.target.closest('input, select, button')) return;
+  if (e.key === 'ArrowDown' || e.key === 'ArrowUp') {
+    const at = state.listed.indexOf(state.selected);
+    const next = state.listed[Math.max(0, Math.min(state.listed.length - 1, at + (e.key === 'ArrowDown' ? 1 : -1)))];
+    if (next !== undefined) { select(next); e.preventDefault(); }
+  } else if (e.key === ' ' && state.replay) {
+    state.replay.playing ? pause() : play();
+    e.preventDefault();
+  }
+});
 $('show-planes').onchange = () => redraw();
 $('see-through').onchange = () => {
   for (const g of [groupA, groupB]) {
@@ -454,7 +484,7 @@ function loadReplay(csvText, trajText, name) {
     return m.length ? m[Math.floor(0.9 * (m.length - 1))] : 1;
   };
   const maxF = scale('F'), maxM = scale('M');
-  state.replay = { rows, poses, tick: 0, playing: false, maxF, maxM, name, ticksShown: 0 };
+  state.replay = { rows, poses, tick: 0, playing: false, maxF, maxM, name };
   $('time').max = rows.length - 1;
   $('time').disabled = false;
   $('play').disabled = false;
@@ -470,7 +500,6 @@ function setTick(i) {
   const r = state.replay;
   if (!r) return;
   r.tick = Math.max(0, Math.min(r.rows.length - 1, i));
-  r.ticksShown++;
   const row = r.rows[r.tick];
   const pose = r.poses ? r.poses[r.tick] : row.cf >= 0 ? graph.cfs[row.cf].witness : null;
   showCf(row.cf, pose, true);

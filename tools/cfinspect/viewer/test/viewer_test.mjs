@@ -2,8 +2,8 @@
 // with cfreplay's replay of a trajectory, opens it from file:// in headless Chromium
 // (playwright-core, Debian's /usr/bin/chromium, SwiftShader WebGL) and checks what a person
 // would: the PCs listed and highlighted for a selected CF, the filters, the neighbours, a
-// canvas that is not blank, a replay that animates (embedded and opened in the page), and
-// no console errors.
+// canvas that is not blank, a replay that animates (embedded and opened in the page), no
+// console errors, and no request for anything but the page itself.
 //
 //   node viewer_test.mjs --cfinspect BIN --cfreplay BIN --graph G.json --trajectory P.csv
 //                        --out DIR [--screenshots DIR]
@@ -28,7 +28,7 @@ function skip(why) {
 const chromium = process.env.CF_CHROMIUM || '/usr/bin/chromium';
 if (!existsSync(chromium)) skip(`no Chromium at ${chromium} (Debian package chromium; bash scripts/install-deps.sh installs it)`);
 let playwright;
-try { playwright = await import('playwright-core'); } catch { skip('no playwright-core (npm ci in tools/cfinspect/viewer; bash scripts/install-deps.sh runs it)'); }
+try { playwright = await import('playwright-core'); } catch { skip('no playwright-core (bash scripts/install-npm.sh runs npm ci in tools/cfinspect/viewer)'); }
 
 let passed = 0, failed = 0;
 function check(ok, what, detail = '') {
@@ -62,6 +62,8 @@ async function open(file) {
   const page = await browser.newPage({ viewport: { width: 1400, height: 820 } });
   page.on('console', (m) => { if (m.type() === 'error') errors.push(`${file}: console: ${m.text()}`); });
   page.on('pageerror', (e) => errors.push(`${file}: page error: ${e.message}`));
+  // Offline: the page may load nothing but itself (and data: or blob: URLs).
+  page.on('request', (r) => { if (!/^(data|blob):/.test(r.url()) && r.url() !== pathToFileURL(file).href) errors.push(`${file}: fetched ${r.url()}`); });
   await page.goto(pathToFileURL(file).href);
   try {
     await page.waitForFunction(() => window.cfViewer && window.cfViewer.state.ready, null, { timeout: 20000 });
@@ -103,7 +105,24 @@ try {
   check(JSON.stringify(listed) === JSON.stringify(cf.pcs.map(pcText)), `CF ${cf.id}'s PCs are listed`, `${listed} vs ${cf.pcs.map(pcText)}`);
   const hl = await page.evaluate(() => window.cfViewer.state.highlighted);
   const want = cf.pcs.map((pc) => ({ pc: pcText(pc), a: { model: 'A', kind: KIND[pc.type[0]], index: pc.a }, b: { model: 'B', kind: KIND[pc.type[2]], index: pc.b } }));
-  check(JSON.stringify(hl.map(({ pc, a, b }) => ({ pc, a, b }))) === JSON.stringify(want), 'the contacting elements of A and B are highlighted', JSON.stringify(hl));
+  const strip = ({ model, kind, index }) => ({ model, kind, index });
+  check(JSON.stringify(hl.map(({ pc, a, b }) => ({ pc, a: strip(a), b: strip(b) }))) === JSON.stringify(want),
+    'the contacting elements of A and B are highlighted', JSON.stringify(hl));
+  // And drawn where those elements are: A's at the witness pose (x_B = R x_A + t).
+  const { R, t } = cf.witness;
+  const atWitness = (p) => R.map((row, i) => row[0] * p[0] + row[1] * p[1] + row[2] * p[2] + t[i]);
+  const centre = (model, kind, index, pose) => {
+    const ids = kind === 'v' ? [index] : kind === 'e' ? model.edges[index] : model.faces[index].loops.flat();
+    const ps = ids.map((i) => pose(model.vertices[i]));
+    return [0, 1, 2].map((k) => (Math.min(...ps.map((p) => p[k])) + Math.max(...ps.map((p) => p[k]))) / 2);
+  };
+  const far = (p, q) => Math.hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+  const off = cf.pcs.map((pc, k) => Math.max(far(hl[k].a.drawnAt, centre(graph.models.A, pc.type[0], pc.a, atWitness)),
+    far(hl[k].b.drawnAt, centre(graph.models.B, pc.type[2], pc.b, (p) => p))));
+  check(off.every((d) => d < 1e-3), 'the highlights are drawn at the elements, A\'s at the witness pose', `off by ${off} mm`);
+  const m = await page.evaluate(() => window.cfViewer.poseA());  // column-major 4x4
+  check([0, 1, 2].every((i) => [0, 1, 2].every((j) => Math.abs(m[4 * j + i] - R[i][j]) < 1e-12) && Math.abs(m[12 + i] - t[i]) < 1e-12),
+    'A is drawn at the witness pose');
   check(new Set(hl.map((h) => h.colour)).size === cf.pcs.length, 'one colour per PC');
   const px = await pixels(page, hl.map((h) => h.colour));
   check(px.ink > px.total * 0.02 && px.colours > 20, 'the canvas is not blank', JSON.stringify(px));
@@ -117,6 +136,12 @@ try {
     const n = graph.transitions.filter((t) => t.from === cf.id && t.kind === kind).length;
     check(await page.locator(`#neighbours button[data-kind="${kind}"]`).count() === n, `${n} ${kind} neighbours listed`);
   }
+  await page.locator('#cf-list div[data-id]').first().click();  // a click on a row selects it
+  await page.keyboard.press('ArrowDown');
+  const second = await page.evaluate(() => [window.cfViewer.state.selected, window.cfViewer.state.listed[1]]);
+  check(second[0] === second[1], 'the down arrow selects the next listed CF', JSON.stringify(second));
+  await page.fill('#search', String(cf.id));
+  await page.press('#search', 'Enter');
   const nb = page.locator('#neighbours button.nb').first();
   const to = Number(await nb.getAttribute('data-to'));
   await nb.click();
@@ -169,6 +194,6 @@ try {
 } finally {
   await browser.close();
 }
-check(errors.length === 0, 'no console errors', errors.join('\n'));
+check(errors.length === 0, 'no console errors and nothing fetched', errors.join('\n'));
 console.log(`${passed} passed, ${failed} failed`);
 process.exit(failed ? 1 : 0);

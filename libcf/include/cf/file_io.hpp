@@ -1,7 +1,8 @@
 #pragma once
 /// @file
-/// Private to libcf and the tools of this repository: reading input files and writing
-/// output files the way SPEC section 5b requires.
+/// Reading input files and writing output files the way SPEC section 5b requires, and the
+/// checks every cf tool applies to what it reads (quaternions, model sizes). libcf's graph
+/// reading and writing use it; so do the tools, through this public header.
 ///
 /// - Reading never blocks: the file is opened non-blocking and anything that is not a
 ///   regular file (a FIFO, a device, a directory, a socket) is refused before a byte is read.
@@ -16,10 +17,8 @@
 #include <vector>
 
 namespace cf {
-class Polyhedron;
-}
 
-namespace cf::detail {
+class Polyhedron;
 
 /// Reads the whole of `path`. On failure returns false with `why` set to a short reason
 /// ("no such file", "is a directory, not a regular file", "is a FIFO (named pipe), not a
@@ -71,4 +70,4 @@ constexpr double kLargeModel = 1e5;
 /// contact threshold epsilon = 1 mm". The caller adds what the user can do about it.
 std::string size_warning(const Polyhedron& model, const std::string& which, double epsilon_mm);
 
-}  // namespace cf::detail
+}  // namespace cf

@@ -1,7 +1,7 @@
 #pragma once
 // Models built in code for the run-time tests and benchmarks: the paper's cube and L-block
 // (as data/models/cube.off and l_block.off) and faceted spheres of about 2,000 faces.
-// Header-only; shared by tests/{detector,identifier}_test.cpp and bench/detect_bench.cpp.
+// Part of tests/support, shared by the tests and the benchmarks.
 
 #include <cf/polyhedron.hpp>
 

@@ -1,0 +1,73 @@
+"""The result of cf.replay, and reading cfreplay's trajectory files into arrays."""
+
+import numpy as _np
+
+
+class ReplayResult:
+    """One row per servo tick of cf.replay, as numpy arrays named like cf::HapticResult.
+
+    t_s (N,)                seconds
+    cf (N,) int32           the CF's id, -1 for none
+    pcs (N,) str            its PCs 'type:a:b;...' (when no CF fits: the contacts rendered)
+    motion (N,) str         'MT1' .. 'MT5', 'MT2.a/b/c', 'none'
+    status (N,) str         'no_contact', 'ok', 'no_fitting_cf', 'unlisted_transition'
+    identification (N,) str the identifier's status ('matched-previous', ...)
+    num_detected (N,) int32 candidate PCs detected
+    F_W, M_W (N, 3)         haptic force (N) and moment (N mm) in the world frame
+    F_A, M_A (N, 3)         the same in A's frame
+    F_contact_W, F_gravity_W (N, 3)  the contact and gravity parts of F_W
+    conservative (N,) bool  rendered with the conservative laws
+    dof (N,) int32          freedoms the force model computed (6 when it did not)
+    regimes (N,) str        per-PC friction regimes, as cfreplay's regimes column
+
+    ``t`` is ``t_s``; ``to_csv()`` gives cfreplay's output text, byte for byte.
+    """
+
+    _FIELDS = ("t_s", "cf", "pcs", "motion", "status", "identification", "num_detected", "F_W", "M_W",
+               "F_A", "M_A", "F_contact_W", "F_gravity_W", "conservative", "dof", "regimes")
+
+    def __init__(self, d):
+        self._rows = d.pop("_rows")
+        for name in self._FIELDS:
+            v = d[name]
+            setattr(self, name, _np.array(v, dtype=str) if isinstance(v, list) else v)
+
+    @property
+    def t(self):
+        return self.t_s
+
+    def __len__(self):
+        return len(self.t_s)
+
+    def __repr__(self):
+        n = len(self)
+        contact = int((self.status != "no_contact").sum())
+        return f"<cf.ReplayResult: {n} ticks, {contact} in contact, {len(set(self.cf[self.cf >= 0]))} CFs>"
+
+    def to_csv(self, path=None):
+        """cfreplay's CSV (header t,cf,pcs,motion,Fx,...,status,regimes); written to path when given."""
+        text = self._rows.csv()
+        if path is not None:
+            with open(path, "w", encoding="utf-8") as f:
+                f.write(text)
+        return text
+
+
+def read_trajectory(path):
+    """Reads a cfreplay trajectory CSV (header t,tx,ty,tz,qw,qx,qy,qz; '#' lines and blank lines
+    skipped) into (t (N,), p (N, 3), q (N, 4)) float64 arrays, ready for cf.replay."""
+    rows = []
+    header = None
+    with open(path, encoding="utf-8") as f:
+        for line in f:
+            s = line.strip()
+            if not s or s.startswith("#"):
+                continue
+            if header is None:
+                header = [c.strip() for c in s.split(",")]
+                if header != ["t", "tx", "ty", "tz", "qw", "qx", "qy", "qz"]:
+                    raise ValueError(f"{path}: expected the header 't,tx,ty,tz,qw,qx,qy,qz', found '{s}'")
+                continue
+            rows.append([float(x) for x in s.split(",")])
+    a = _np.array(rows, dtype=float).reshape(-1, 8)
+    return a[:, 0].copy(), a[:, 1:4].copy(), a[:, 4:8].copy()

@@ -1,0 +1,265 @@
+// cf.Renderer (one servo tick at a pose) and cf._cf.replay (cfreplay's loop, cf::replay::run,
+// over numpy arrays of poses).
+
+#include "common.hpp"
+
+#include "replay_io.hpp"   // cfreplay_core: Sample, Row, format_row, output_header
+#include "replay_run.hpp"  // cfreplay_core: run
+
+#include <cf/renderer.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+namespace cfpy {
+
+namespace {
+
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+py::array_t<double> vec(const cf::Vec3& v) { return py::array_t<double>(3, v.data()); }
+
+Array as_array(const py::handle& h, const char* name, const std::string& where) {
+  Array a = Array::ensure(h);
+  if (!a) fail(where + ": " + name + " must be an array of numbers, got " + std::string(py::repr(h)));
+  return a;
+}
+
+std::string shape_of(const Array& a) {
+  std::string s = "(";
+  for (py::ssize_t i = 0; i < a.ndim(); ++i) s += (i ? ", " : "") + std::to_string(a.shape(i));
+  return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+/// The per-tick record of one renderer result: the C++ result's fields and cfreplay's row.
+py::dict step_dict(const cf::HapticResult& r) {
+  py::dict d;
+  const cf::replay::Row row = cf::replay::make_row(r);
+  d["t_s"] = r.t_s;
+  d["cf"] = r.cf.valid() ? r.cf.value() : -1;
+  d["pcs"] = pcs_to_py(r.pcs);
+  d["pcs_string"] = row.pcs;
+  d["motion"] = row.motion;
+  d["status"] = row.status;
+  d["identification"] = std::string(r.identification);
+  d["num_detected"] = r.num_detected;
+  d["F_W"] = vec(r.F_W);
+  d["M_W"] = vec(r.M_W);
+  d["F_A"] = vec(r.F_A);
+  d["M_A"] = vec(r.M_A);
+  d["regimes"] = row.regimes;
+  if (r.force != nullptr) {
+    const cf::ForceResult& f = *r.force;
+    d["F_contact_W"] = vec(f.F_contact_W);
+    d["F_gravity_W"] = vec(f.F_gravity_W);
+    d["reference_W"] = vec(f.reference_W);
+    d["centroid_W"] = vec(f.centroid_W);
+    d["conservative"] = f.conservative;
+    d["dof"] = f.freedoms.dof;
+    d["translation_dof"] = f.freedoms.translation_dof;
+    d["pure_rotation"] = f.freedoms.pure_rotation;
+    py::list pcf;
+    for (int k = 0; k < f.num_pcs + f.num_approaching; ++k) {
+      const cf::PcForce& p = f.pcs[static_cast<std::size_t>(k)];
+      py::dict e;
+      e["pc"] = p.pc;
+      e["regime"] = std::string(cf::to_string(p.regime));
+      e["R_WT"] = cf::Mat3(p.R_WT);
+      e["origin_W"] = vec(p.origin_W);
+      e["p_W"] = vec(p.p_W);
+      e["distance"] = p.distance;
+      e["F_cy"] = p.F_cy;
+      e["s_mm"] = p.s_mm;
+      e["s_bound_mm"] = p.s_bound_mm;
+      e["F_T"] = vec(p.F_T);
+      e["F_W"] = vec(p.F_W);
+      e["gained"] = p.gained;
+      pcf.append(e);
+    }
+    d["pc_forces"] = pcf;
+  }
+  return d;
+}
+
+/// The rows of a replay, kept for to_csv (cfreplay's format, cf::replay::format_row).
+struct ReplayRows {
+  std::vector<cf::replay::Row> rows;
+};
+
+/// One renderer bound to its graph (kept alive by the Python object).
+struct Renderer {
+  Renderer(const cf::CfGraph& g, const cf::Params& p) : r(g, p) {}
+  cf::HapticRenderer r;
+  bool stepped = false;  ///< since construction or reset
+  double last_t = 0;
+};
+
+cf::Params params_arg(const py::object& params, const py::kwargs& kw, const std::string& where) {
+  cf::Params base;
+  if (!params.is_none()) {
+    if (!py::isinstance<cf::Params>(params)) fail(where + ": params must be a cf.Params or None");
+    base = params.cast<cf::Params>();
+  }
+  return params_from_kwargs(base, kw, where);
+}
+
+}  // namespace
+
+void bind_render(py::module_& m) {
+  py::class_<Renderer>(m, "Renderer",
+                       "The haptic renderer (cf::HapticRenderer) of one graph: Renderer(graph, params=None, "
+                       "**params). step() runs one servo tick: detect, identify the CF, classify the prior "
+                       "motion, compute the force and moment.")
+      .def(py::init([](const cf::CfGraph& g, const py::object& params, const py::kwargs& kw) {
+             return std::make_unique<Renderer>(g, params_arg(params, kw, "Renderer"));
+           }),
+           py::arg("graph"), py::arg("params") = py::none(), py::keep_alive<1, 2>())
+      .def(
+          "step",
+          [](Renderer& self, double t_s, const py::object& p, const py::object& q) {
+            const Array pa = as_array(p, "p", "step"), qa = as_array(q, "q", "step");
+            if (pa.ndim() != 1 || pa.shape(0) != 3) fail("step: p must have shape (3,), got " + shape_of(pa));
+            if (qa.ndim() != 1 || qa.shape(0) != 4) fail("step: q must have shape (4,) (w, x, y, z), got " + shape_of(qa));
+            if (!std::isfinite(t_s)) fail("step: t is not finite");
+            if (self.stepped && !(t_s > self.last_t)) {
+              char buf[160];
+              std::snprintf(buf, sizeof buf, "step: time %.9g s does not increase (previous step: %.9g s)", t_s,
+                            self.last_t);
+              fail(buf);
+            }
+            const cf::Pose pose = pose_from(pa.data(), qa.data(), "step");
+            self.stepped = true;
+            self.last_t = t_s;
+            return step_dict(self.r.step(pose, t_s));
+          },
+          py::arg("t"), py::arg("p"), py::arg("q"),
+          "One servo tick at time t (s, increasing), A's translation p (3, mm) and rotation q (4, unit "
+          "quaternion w, x, y, z; x_B = R x_A + p). Returns a dict named like cf::HapticResult's fields: "
+          "t_s, cf (-1 for none), pcs, motion, status, identification, num_detected, F_W, M_W, F_A, "
+          "M_A, and the force model's F_contact_W, F_gravity_W, dof, pc_forces (per PC: regime, "
+          "distance, F_cy, task frame R_WT, ...).")
+      .def("reset", [](Renderer& self) { self.r.reset(); self.stepped = false; }, "Forgets the history (previous CF, anchors, filters).")
+      .def_property_readonly("params", [](const Renderer& self) { return self.r.params(); });
+
+  py::class_<ReplayRows>(m, "_ReplayRows")
+      .def("__len__", [](const ReplayRows& r) { return r.rows.size(); })
+      .def("csv",
+           [](const ReplayRows& r) {
+             std::string text = cf::replay::output_header();
+             text += '\n';
+             for (const cf::replay::Row& row : r.rows) {
+               text += cf::replay::format_row(row);
+               text += '\n';
+             }
+             return text;
+           },
+           "The rows as cfreplay writes them (header first).");
+
+  m.def(
+      "replay",
+      [](const cf::CfGraph& g, const py::object& t, const py::object& p, const py::object& q, const py::object& params,
+         const py::kwargs& kw) {
+        const std::string where = "replay";
+        const cf::Params P = params_arg(params, kw, where);
+        const Array ta = as_array(t, "t", where), pa = as_array(p, "p", where), qa = as_array(q, "q", where);
+        if (ta.ndim() != 1) fail(where + ": t must have shape (N,), got " + shape_of(ta));
+        const py::ssize_t n = ta.shape(0);
+        if (n == 0) fail(where + ": no poses (t is empty)");
+        if (pa.ndim() != 2 || pa.shape(0) != n || pa.shape(1) != 3)
+          fail(where + ": p must have shape (N, 3) with N = len(t) = " + std::to_string(n) + ", got " + shape_of(pa));
+        if (qa.ndim() != 2 || qa.shape(0) != n || qa.shape(1) != 4)
+          fail(where + ": q must have shape (N, 4) (w, x, y, z) with N = len(t) = " + std::to_string(n) + ", got " +
+               shape_of(qa));
+        std::vector<cf::replay::Sample> samples(static_cast<std::size_t>(n));
+        const double* T = ta.data();
+        for (py::ssize_t i = 0; i < n; ++i) {
+          const std::string row = where + ": row " + std::to_string(i);
+          if (!std::isfinite(T[i])) fail(row + ": time is not finite");
+          if (i > 0 && !(T[i] > T[i - 1])) {
+            char buf[160];
+            std::snprintf(buf, sizeof buf, ": time %.9g s does not increase (previous row: %.9g s)", T[i], T[i - 1]);
+            fail(row + buf);
+          }
+          cf::replay::Sample& s = samples[static_cast<std::size_t>(i)];
+          s.t = T[i];
+          s.pose = pose_from(pa.data() + 3 * i, qa.data() + 4 * i, row);
+          s.line = static_cast<int>(i);
+        }
+
+        const auto N = static_cast<std::size_t>(n);
+        auto rows = std::make_unique<ReplayRows>();
+        std::vector<std::int32_t> num_detected(N);
+        std::vector<std::string> identification(N);
+        std::vector<double> Fc(3 * N, 0.0), Fg(3 * N, 0.0);
+        std::vector<std::uint8_t> conservative(N, 0);
+        std::vector<std::int32_t> dof(N, 6);
+        {
+          py::gil_scoped_release release;
+          std::size_t i = 0;
+          rows->rows = cf::replay::run(g, samples, P, [&](const cf::replay::Sample&, const cf::HapticResult& r) {
+            num_detected[i] = r.num_detected;
+            identification[i] = r.identification;
+            if (r.force != nullptr) {
+              for (int k = 0; k < 3; ++k) {
+                Fc[3 * i + static_cast<std::size_t>(k)] = r.force->F_contact_W[k];
+                Fg[3 * i + static_cast<std::size_t>(k)] = r.force->F_gravity_W[k];
+              }
+              conservative[i] = r.force->conservative;
+              dof[i] = r.force->freedoms.dof;
+            }
+            ++i;
+          });
+        }
+
+        py::dict d;
+        const std::vector<py::ssize_t> shape3{n, 3};
+        py::array_t<double> tt(n), FW(shape3), MW(shape3), FA(shape3), MA(shape3), FC(shape3), FG(shape3);
+        py::array_t<std::int32_t> cfa(n), nd(n), dofa(n);
+        py::array_t<bool> cons(n);
+        py::list pcs, motion, status, regimes, ident;
+        for (py::ssize_t i = 0; i < n; ++i) {
+          const cf::replay::Row& r = rows->rows[static_cast<std::size_t>(i)];
+          tt.mutable_at(i) = r.t;
+          cfa.mutable_at(i) = r.cf;
+          nd.mutable_at(i) = num_detected[static_cast<std::size_t>(i)];
+          dofa.mutable_at(i) = dof[static_cast<std::size_t>(i)];
+          cons.mutable_at(i) = conservative[static_cast<std::size_t>(i)] != 0;
+          for (int k = 0; k < 3; ++k) {
+            FW.mutable_at(i, k) = r.F_W[k];
+            MW.mutable_at(i, k) = r.M_W[k];
+            FA.mutable_at(i, k) = r.F_A[k];
+            MA.mutable_at(i, k) = r.M_A[k];
+            FC.mutable_at(i, k) = Fc[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(k)];
+            FG.mutable_at(i, k) = Fg[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(k)];
+          }
+          pcs.append(r.pcs);
+          motion.append(r.motion);
+          status.append(r.status);
+          regimes.append(r.regimes);
+          ident.append(identification[static_cast<std::size_t>(i)]);
+        }
+        d["t_s"] = tt;
+        d["cf"] = cfa;
+        d["pcs"] = pcs;
+        d["motion"] = motion;
+        d["status"] = status;
+        d["identification"] = ident;
+        d["num_detected"] = nd;
+        d["F_W"] = FW;
+        d["M_W"] = MW;
+        d["F_A"] = FA;
+        d["M_A"] = MA;
+        d["F_contact_W"] = FC;
+        d["F_gravity_W"] = FG;
+        d["conservative"] = cons;
+        d["dof"] = dofa;
+        d["regimes"] = regimes;
+        d["_rows"] = py::cast(std::move(rows));
+        return d;
+      },
+      py::arg("graph"), py::arg("t"), py::arg("p"), py::arg("q"), py::arg("params") = py::none(),
+      "cfreplay's loop (cf::replay::run) over arrays; the package's cf.replay wraps the result.");
+}
+
+}  // namespace cfpy

@@ -1,0 +1,127 @@
+// cf.load_model (tools/mesh's loader) and cf._cf.generate (cfgen's run_generate), built when
+// the CGAL tools are (CF_WITH_CGAL).
+
+#include "common.hpp"
+
+#ifdef CF_PYTHON_HAVE_TOOLS
+#include "cfgen/generate.hpp"
+#include "mesh/model_loader.hpp"
+#endif
+
+#include <cmath>
+#include <cstdio>
+
+namespace cfpy {
+
+#ifdef CF_PYTHON_HAVE_TOOLS
+namespace {
+
+void check_units(const std::string& units, const char* name, const std::string& where) {
+  if (cf::tools::mm_per_unit(units) == 0)
+    fail(where + ": " + name + " must be 'mm', 'cm', 'm' or 'in', got '" + units + "'");
+}
+
+void check_range(double v, double lo, double hi, const char* name, const std::string& where) {
+  if (!std::isfinite(v) || v < lo || v > hi) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, ": %s must be a finite number in [%g, %g], got %.17g", name, lo, hi, v);
+    fail(where + buf);
+  }
+}
+
+void check_int(int v, int lo, int hi, const char* name, const std::string& where) {
+  if (v < lo || v > hi)
+    fail(where + ": " + name + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+         "], got " + std::to_string(v));
+}
+
+}  // namespace
+#endif
+
+void bind_tools(py::module_& m) {
+#ifdef CF_PYTHON_HAVE_TOOLS
+  m.attr("HAVE_TOOLS") = true;
+  m.def(
+      "load_model",
+      [](const std::string& path, const std::string& units, double coplanar_rel_tol, bool check_self_intersection,
+         const std::string& name) {
+        check_units(units, "units", "load_model");
+        check_range(coplanar_rel_tol, cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol, "coplanar_rel_tol",
+                    "load_model");
+        cf::tools::LoadOptions o;
+        o.units = units;
+        o.coplanar_rel_tol = coplanar_rel_tol;
+        o.check_self_intersection = check_self_intersection;
+        o.name = name;
+        py::gil_scoped_release release;
+        return cf::tools::load_model(path, o);
+      },
+      py::arg("path"), py::arg("units") = "mm", py::arg("coplanar_rel_tol") = cf::tools::LoadOptions{}.coplanar_rel_tol,
+      py::arg("check_self_intersection") = true, py::arg("name") = "",
+      "Reads a closed, outward-oriented polyhedral model (OFF, OBJ, STL or PLY), validates it and "
+      "extracts its features (cf::tools::load_model, as cfgen --features). units: the file's length "
+      "unit ('mm', 'cm', 'm', 'in'); the model is in mm. Raises cf.Error naming the file and the problem.");
+
+  m.def(
+      "generate",
+      [](const std::string& a_path, const std::string& b_path, const std::string& out_path, int threads, bool quiet,
+         int max_pcs, double touch_tol, double min_clearance, double good_clearance, double min_margin,
+         double angle_margin, int theta_samples, int max_rotations, const std::string& units, const std::string& units_a,
+         const std::string& units_b, double coplanar_rel_tol) {
+        const std::string where = "generate";
+        // The ranges cfgen's options accept.
+        check_int(threads, 0, 1024, "threads", where);
+        check_int(max_pcs, 1, 3, "max_pcs", where);
+        check_range(touch_tol, 1e-15, 1e-5, "touch_tol", where);
+        check_range(min_clearance, 1e-9, 0.1, "min_clearance", where);
+        check_range(good_clearance, 1e-9, 1.0, "good_clearance", where);
+        check_range(min_margin, 1e-9, 0.1, "min_margin", where);
+        check_range(angle_margin, 1e-9, 0.5, "angle_margin", where);
+        check_int(theta_samples, 1, 1000, "theta_samples", where);
+        check_int(max_rotations, 1, 10000, "max_rotations", where);
+        check_range(coplanar_rel_tol, cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol, "coplanar_rel_tol", where);
+        check_units(units, "units", where);
+        cf::tools::GenerateArgs g;
+        g.a_path = a_path;
+        g.b_path = b_path;
+        g.out_path = out_path;
+        g.threads = threads;
+        g.quiet = quiet;
+        g.max_pcs = max_pcs;
+        g.rel.touch_tol = touch_tol;
+        g.rel.min_clearance = min_clearance;
+        g.rel.good_clearance = good_clearance;
+        g.rel.min_margin = min_margin;
+        g.search.angle_margin = angle_margin;
+        g.search.theta_samples = theta_samples;
+        g.search.max_rotations = max_rotations;
+        g.load_a.units = units_a.empty() ? units : units_a;
+        g.load_b.units = units_b.empty() ? units : units_b;
+        check_units(g.load_a.units, "units_a", where);
+        check_units(g.load_b.units, "units_b", where);
+        g.load_a.coplanar_rel_tol = g.load_b.coplanar_rel_tol = coplanar_rel_tol;
+        int status;
+        {
+          py::gil_scoped_release release;
+          status = cf::tools::run_generate(g);
+        }
+        if (status != 0) fail(where + ": cfgen's generator failed with status " + std::to_string(status));
+      },
+      py::arg("a_path"), py::arg("b_path"), py::arg("output"), py::arg("threads") = 0, py::arg("quiet") = true,
+      py::arg("max_pcs") = 3, py::arg("touch_tol") = cf::tools::RelativeLengths{}.touch_tol,
+      py::arg("min_clearance") = cf::tools::RelativeLengths{}.min_clearance,
+      py::arg("good_clearance") = cf::tools::RelativeLengths{}.good_clearance,
+      py::arg("min_margin") = cf::tools::RelativeLengths{}.min_margin,
+      py::arg("angle_margin") = cf::gen::SearchParams{}.angle_margin,
+      py::arg("theta_samples") = cf::gen::SearchParams{}.theta_samples,
+      py::arg("max_rotations") = cf::gen::SearchParams{}.max_rotations, py::arg("units") = "mm",
+      py::arg("units_a") = "", py::arg("units_b") = "",
+      py::arg("coplanar_rel_tol") = cf::tools::LoadOptions{}.coplanar_rel_tol,
+      "cfgen's generation (cf::tools::run_generate) into the graph file `output`; the package's "
+      "cf.generate wraps it.");
+#else
+  m.attr("HAVE_TOOLS") = false;
+#endif
+}
+
+}  // namespace cfpy

@@ -1,0 +1,44 @@
+#pragma once
+// Shared by the binding units of the Python package cf (libcf/python): conversions between
+// numpy arrays and libcf's types, and the checks that turn bad arguments into cf.Error.
+
+#include <cf/graph.hpp>
+#include <cf/params.hpp>
+#include <cf/pc.hpp>
+#include <cf/polyhedron.hpp>
+#include <cf/types.hpp>
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <string>
+
+namespace cfpy {
+
+namespace py = pybind11;
+
+/// Raises cf.Error (a ValueError) with the message.
+[[noreturn]] inline void fail(const std::string& message) { throw cf::Error(message); }
+
+/// A pose from a translation (3, mm) and a unit quaternion (4, w x y z), normalised as
+/// cfreplay does. `where` prefixes messages ("step", "replay: row 3").
+cf::Pose pose_from(const double* p, const double* q, const std::string& where);
+
+/// Params from keyword arguments (names and units of cf::Params' fields), starting from
+/// `base`. Unknown names and values out of range raise cf.Error naming the function.
+cf::Params params_from_kwargs(const cf::Params& base, const py::kwargs& kwargs, const std::string& where);
+
+/// A PC from "type:a:b", a (type, a, b) tuple or a cf.Pc.
+cf::Pc pc_from_py(const py::handle& h);
+/// A PC set from "type:a:b;..." or a sequence of PCs.
+cf::PcSet pcset_from_py(const py::handle& h);
+/// The PCs as a list of cf.Pc.
+py::list pcs_to_py(const cf::PcSet& pcs);
+
+void bind_graph(py::module_& m);
+void bind_render(py::module_& m);
+void bind_tools(py::module_& m);
+
+}  // namespace cfpy

@@ -1,0 +1,293 @@
+// The extension module cf._cf: errors, PCs, parameters. The graph and models are bound in
+// bind_graph.cpp, the renderer and the replay in bind_render.cpp, the model loader and the
+// generator in bind_tools.cpp. docs/python.md describes the Python API.
+
+#include "common.hpp"
+
+#include "replay_io.hpp"  // cfreplay_core: kQuaternionTolerance
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <vector>
+
+namespace cfpy {
+
+cf::Pose pose_from(const double* p, const double* q, const std::string& where) {
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(p[i])) fail(where + ": the translation is not finite");
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!(std::isfinite(norm) && std::abs(norm - 1) <= cf::replay::kQuaternionTolerance)) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, ": the quaternion (qw,qx,qy,qz) has norm %.9g, not 1 within %g", norm,
+                  cf::replay::kQuaternionTolerance);
+    fail(where + buf);
+  }
+  // As cfreplay reads a row: normalised, then the rotation matrix.
+  Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
+  quat.normalize();
+  cf::Pose pose;
+  pose.R_BA = quat.toRotationMatrix();
+  pose.t_BA = cf::Vec3(p[0], p[1], p[2]);
+  return pose;
+}
+
+namespace {
+
+struct DoubleField {
+  const char* name;
+  double cf::Params::*member;
+  double lo, hi;
+  const char* doc;
+};
+
+// Every double of cf::Params, with the ranges cfreplay's options accept where it has one.
+const std::vector<DoubleField>& double_fields() {
+  static const std::vector<DoubleField> f{
+      {"mass_kg", &cf::Params::mass_kg, 0, 1e6, "m, mass of A (kg)"},
+      {"gravity_N_per_kg", &cf::Params::gravity_N_per_kg, -1e6, 1e6, "g along -y of the world (N/kg)"},
+      {"stiffness_N_per_mm", &cf::Params::stiffness_N_per_mm, 1e-9, 1e9, "K of eq. (1) (N/mm)"},
+      {"kp_N_per_mm", &cf::Params::kp_N_per_mm, 1e-9, 1e9, "K_p of eqs. (3)-(4) (N/mm)"},
+      {"mu_static", &cf::Params::mu_static, 0, 100, "mu of eqs. (2), (3), (6)"},
+      {"mu_kinetic", &cf::Params::mu_kinetic, 0, 100, "mu_D of eq. (5)"},
+      {"epsilon_mm", &cf::Params::epsilon_mm, 1e-6, 1e3, "contact threshold of eq. (1) (mm)"},
+      {"freedom_rank_tolerance", &cf::Params::freedom_rank_tolerance, 0, 1,
+       "relative singular-value tolerance of the freedoms' null space"},
+      {"motion_angle_tolerance_rad", &cf::Params::motion_angle_tolerance_rad, 0, M_PI,
+       "'approximately along' angle of paper Fig. 10 (rad)"},
+      {"motion_noise_mm", &cf::Params::motion_noise_mm, 0, 1e3, "pose changes below this are no motion (mm)"},
+      {"hold_fcy_threshold_N", &cf::Params::hold_fcy_threshold_N, 0, 1e6,
+       "hold F_cy while it changes by less than this (N); 0: off"},
+      {"interpolation_time_constant_s", &cf::Params::interpolation_time_constant_s, 0, 1e3,
+       "low-pass time constant of the contact force and moment (s); 0: off"},
+  };
+  return f;
+}
+
+template <class E>
+struct EnumField {
+  const char* name;
+  std::vector<std::pair<const char*, E>> values;
+};
+
+const EnumField<cf::FrictionDisplacement> kFriction{
+    "friction_displacement",
+    {{"stick_anchor", cf::FrictionDisplacement::kStickAnchor}, {"per_tick", cf::FrictionDisplacement::kPerTick}}};
+const EnumField<cf::CentroidChoice> kCentroid{
+    "centroid", {{"vertex_mean", cf::CentroidChoice::kVertexMean}, {"volume", cf::CentroidChoice::kVolume}}};
+const EnumField<cf::MomentReference> kMomentRef{"moment_reference",
+                                                {{"a_origin", cf::MomentReference::kAOrigin},
+                                                 {"a_centroid", cf::MomentReference::kACentroid},
+                                                 {"a_point", cf::MomentReference::kAPoint}}};
+
+template <class E>
+std::string enum_name(const EnumField<E>& f, E v) {
+  for (const auto& [n, e] : f.values)
+    if (e == v) return n;
+  return "?";
+}
+
+template <class E>
+E enum_value(const EnumField<E>& f, const py::handle& h, const std::string& where) {
+  std::string allowed;
+  for (const auto& [n, e] : f.values) allowed += std::string(allowed.empty() ? "" : ", ") + "'" + n + "'";
+  if (!py::isinstance<py::str>(h))
+    fail(where + ": " + f.name + " must be one of " + allowed + ", got " + std::string(py::repr(h)));
+  const std::string s = h.cast<std::string>();
+  for (const auto& [n, e] : f.values)
+    if (s == n) return e;
+  fail(where + ": " + f.name + " must be one of " + allowed + ", got '" + s + "'");
+}
+
+double double_value(const DoubleField& f, const py::handle& h, const std::string& where) {
+  double v;
+  try {
+    if (py::isinstance<py::bool_>(h) || py::isinstance<py::str>(h)) throw py::cast_error();
+    v = py::float_(py::reinterpret_borrow<py::object>(h)).cast<double>();
+  } catch (const py::error_already_set&) {
+    fail(where + ": " + f.name + " must be a number, got " + std::string(py::repr(h)));
+  } catch (const py::cast_error&) {
+    fail(where + ": " + f.name + " must be a number, got " + std::string(py::repr(h)));
+  }
+  if (!std::isfinite(v) || v < f.lo || v > f.hi) {
+    char buf[120];
+    std::snprintf(buf, sizeof buf, " must be a finite number in [%g, %g], got %.17g", f.lo, f.hi, v);
+    fail(where + ": " + f.name + buf);
+  }
+  return v;
+}
+
+cf::Vec3 vec3_value(const char* name, const py::handle& h, const std::string& where) {
+  py::array_t<double, py::array::c_style | py::array::forcecast> a;
+  try {
+    a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(h);
+  } catch (const py::error_already_set&) {
+  }
+  if (!a || a.ndim() != 1 || a.shape(0) != 3)
+    fail(where + ": " + name + " must be 3 numbers (x, y, z), got " + std::string(py::repr(h)));
+  const cf::Vec3 v(a.at(0), a.at(1), a.at(2));
+  if (!v.allFinite()) fail(where + ": " + std::string(name) + " must be finite");
+  return v;
+}
+
+void set_param(cf::Params& P, const std::string& key, const py::handle& value, const std::string& where) {
+  for (const DoubleField& f : double_fields())
+    if (key == f.name) {
+      P.*(f.member) = double_value(f, value, where);
+      return;
+    }
+  if (key == kFriction.name) {
+    P.friction_displacement = enum_value(kFriction, value, where);
+  } else if (key == kCentroid.name) {
+    P.centroid = enum_value(kCentroid, value, where);
+  } else if (key == kMomentRef.name) {
+    P.moment_reference = enum_value(kMomentRef, value, where);
+  } else if (key == "moment_point_A") {
+    P.moment_point_A = vec3_value("moment_point_A", value, where);
+  } else if (key == "render_approaching") {
+    if (!py::isinstance<py::bool_>(value))
+      fail(where + ": render_approaching must be True or False, got " + std::string(py::repr(value)));
+    P.render_approaching = value.cast<bool>();
+  } else {
+    std::string names;
+    for (const DoubleField& f : double_fields()) names += std::string(names.empty() ? "" : ", ") + f.name;
+    names += std::string(", ") + kFriction.name + ", " + kCentroid.name + ", " + kMomentRef.name +
+             ", moment_point_A, render_approaching";
+    fail(where + ": unknown parameter '" + key + "' (parameters: " + names + ")");
+  }
+}
+
+py::dict params_to_dict(const cf::Params& P) {
+  py::dict d;
+  for (const DoubleField& f : double_fields()) d[f.name] = P.*(f.member);
+  d[kFriction.name] = enum_name(kFriction, P.friction_displacement);
+  d[kCentroid.name] = enum_name(kCentroid, P.centroid);
+  d[kMomentRef.name] = enum_name(kMomentRef, P.moment_reference);
+  d["moment_point_A"] = py::array_t<double>(3, P.moment_point_A.data());
+  d["render_approaching"] = P.render_approaching;
+  return d;
+}
+
+}  // namespace
+
+cf::Params params_from_kwargs(const cf::Params& base, const py::kwargs& kwargs, const std::string& where) {
+  cf::Params P = base;
+  for (const auto& [k, v] : kwargs) set_param(P, k.cast<std::string>(), v, where);
+  return P;
+}
+
+cf::Pc pc_from_py(const py::handle& h) {
+  if (py::isinstance<cf::Pc>(h)) return h.cast<cf::Pc>();
+  if (py::isinstance<py::str>(h)) {
+    const std::string s = h.cast<std::string>();
+    const std::optional<cf::Pc> pc = cf::pc_from_string(s);
+    if (!pc) fail("not a PC: '" + s + "' (expected 'type:a:b' with type f-f, e-f, f-e, v-f, f-v or e-e)");
+    return *pc;
+  }
+  if (py::isinstance<py::tuple>(h) && py::len(h) == 3) {
+    const py::tuple t = py::reinterpret_borrow<py::tuple>(h);
+    if (py::isinstance<py::str>(t[0])) {
+      const std::optional<cf::PcType> type = cf::pc_type_from_string(t[0].cast<std::string>());
+      if (!type) fail("not a PC type: '" + t[0].cast<std::string>() + "' (f-f, e-f, f-e, v-f, f-v or e-e)");
+      try {
+        return cf::Pc{*type, t[1].cast<std::int32_t>(), t[2].cast<std::int32_t>()};
+      } catch (const py::cast_error&) {
+      }
+    }
+  }
+  fail("not a PC: " + std::string(py::repr(h)) + " (expected 'type:a:b', a (type, a, b) tuple or a cf.Pc)");
+}
+
+cf::PcSet pcset_from_py(const py::handle& h) {
+  std::vector<cf::Pc> pcs;
+  if (py::isinstance<py::str>(h)) {
+    const std::string s = h.cast<std::string>();
+    std::size_t start = 0;
+    while (start <= s.size() && !s.empty()) {
+      const std::size_t semi = s.find(';', start);
+      pcs.push_back(pc_from_py(py::str(s.substr(start, semi == std::string::npos ? std::string::npos : semi - start))));
+      if (semi == std::string::npos) break;
+      start = semi + 1;
+    }
+  } else if (py::isinstance<cf::Pc>(h) || py::isinstance<py::tuple>(h)) {
+    // A single PC given alone, or a (type, a, b) tuple.
+    if (py::isinstance<py::tuple>(h) && py::len(h) == 3 && py::isinstance<py::str>(py::reinterpret_borrow<py::tuple>(h)[0]))
+      pcs.push_back(pc_from_py(h));
+    else if (py::isinstance<cf::Pc>(h))
+      pcs.push_back(pc_from_py(h));
+    else
+      for (const py::handle& x : h) pcs.push_back(pc_from_py(x));
+  } else if (py::isinstance<py::sequence>(h)) {
+    for (const py::handle& x : h) pcs.push_back(pc_from_py(x));
+  } else {
+    fail("not a set of PCs: " + std::string(py::repr(h)) + " (expected 'type:a:b;...' or a list of PCs)");
+  }
+  if (pcs.empty()) fail("a set of PCs needs 1 to 3 PCs, got none");
+  return cf::PcSet(pcs);  // throws cf::Error for more than 3 or a repeat
+}
+
+py::list pcs_to_py(const cf::PcSet& pcs) {
+  py::list out;
+  for (const cf::Pc& pc : pcs) out.append(pc);
+  return out;
+}
+
+}  // namespace cfpy
+
+PYBIND11_MODULE(_cf, m) {
+  namespace py = pybind11;
+  using namespace cfpy;
+  m.doc() = "cf: contact formations of two rigid polyhedra (libcf), the C++ extension of the package cf.";
+
+  py::register_exception<cf::Error>(m, "Error", PyExc_ValueError).doc() =
+      "Bad input (a file, a model, a graph, a trajectory, a parameter): a ValueError whose message is libcf's.";
+
+  py::class_<cf::Pc>(m, "Pc", "A principal contact: a PC type and the indices of A's and B's elements.")
+      .def(py::init([](const py::object& spec) { return pc_from_py(spec); }), py::arg("spec"),
+           "From 'type:a:b' (e.g. 'e-f:4:4') or a (type, a, b) tuple.")
+      .def(py::init([](const std::string& type, int a, int b) { return pc_from_py(py::make_tuple(type, a, b)); }),
+           py::arg("type"), py::arg("a"), py::arg("b"))
+      .def_property_readonly("type", [](const cf::Pc& pc) { return std::string(cf::to_string(pc.type)); },
+                             "'f-f', 'e-f', 'f-e', 'v-f', 'f-v' or 'e-e' (A's element kind, then B's)")
+      .def_readonly("a", &cf::Pc::a, "index of A's element (of the kind the type names)")
+      .def_readonly("b", &cf::Pc::b, "index of B's element")
+      .def("__str__", [](const cf::Pc& pc) { return cf::to_string(pc); })
+      .def("__repr__", [](const cf::Pc& pc) { return "cf.Pc('" + cf::to_string(pc) + "')"; })
+      .def("__eq__", [](const cf::Pc& x, const py::object& y) {
+        try {
+          return x == pc_from_py(y);
+        } catch (const cf::Error&) {
+          return false;
+        }
+      })
+      .def("__lt__", [](const cf::Pc& x, const cf::Pc& y) { return x < y; })
+      .def("__hash__", [](const cf::Pc& pc) { return py::hash(py::str(cf::to_string(pc))); })
+      .def(py::pickle([](const cf::Pc& pc) { return cf::to_string(pc); },
+                      [](const std::string& s) { return pc_from_py(py::str(s)); }));
+
+  py::class_<cf::Params>(m, "Params",
+                         "Parameters of the renderer (cf::Params): the same names and units as in C++. "
+                         "Params(**kwargs) starts from the defaults (the paper's values).")
+      .def(py::init([](const py::kwargs& kw) { return params_from_kwargs(cf::Params(), kw, "Params"); }))
+      .def("replace", [](const cf::Params& P, const py::kwargs& kw) { return params_from_kwargs(P, kw, "Params.replace"); },
+           "A copy with the given fields changed.")
+      .def("to_dict", &params_to_dict, "Every field by name (enums as strings, moment_point_A as an array).")
+      .def("__getattr__", [](const cf::Params& P, const std::string& name) -> py::object {
+        py::dict d = params_to_dict(P);
+        if (d.contains(name)) return d[py::str(name)];
+        throw py::attribute_error("cf.Params has no field '" + name + "'");
+      })
+      .def("__repr__", [](const cf::Params& P) {
+        std::string s = "cf.Params(";
+        bool first = true;
+        for (const auto& [k, v] : params_to_dict(P)) {
+          s += (first ? "" : ", ") + k.cast<std::string>() + "=" + std::string(py::repr(v));
+          first = false;
+        }
+        return s + ")";
+      });
+
+  bind_graph(m);
+  bind_render(m);
+  bind_tools(m);
+}

@@ -1,0 +1,42 @@
+"""cf.generate: cfgen's generator from Python, the same graph as the cfgen command."""
+
+import subprocess
+
+import pytest
+
+import cf
+from conftest import DATA, tool
+
+pytestmark = pytest.mark.skipif(not cf.HAVE_TOOLS, reason="built without the CGAL tools")
+
+
+def test_generate_equals_cfgen(tmp_path):
+    # The cube against itself, single PCs only: about 5 s per run on 2 threads.
+    a = b = DATA / "models" / "cube.off"
+    out = tmp_path / "py.json"
+    g = cf.generate(a, b, out, max_pcs=1, threads=2)
+    ref = tmp_path / "cfgen.json"
+    subprocess.run([tool("CF_CFGEN"), "--quiet", "--max-pcs", "1", "-j", "2", str(a), str(b), "-o", str(ref)],
+                   check=True, capture_output=True)
+    assert out.read_bytes() == ref.read_bytes()
+    # Every face, edge and vertex pair of the cube that can touch alone: f-f 6 x 6, e-f and
+    # f-e 12 x 6 each, v-f and f-v 8 x 6 each, e-e between the 12 x 12 edges (non-parallel).
+    types = {}
+    for c in g.cfs:
+        assert len(c.pcs) == 1 and c.dof is not None
+        types[c.pcs[0].type] = types.get(c.pcs[0].type, 0) + 1
+    assert types["f-f"] == 36 and types["e-f"] == types["f-e"] == 72 and types["v-f"] == types["f-v"] == 48
+    # Without an output file: the same graph.
+    assert cf.generate(a, b, max_pcs=1, threads=2).to_json() == g.to_json()
+
+
+def test_generate_errors(tmp_path):
+    a = DATA / "models" / "cube.off"
+    with pytest.raises(cf.Error, match=r"^generate: max_pcs must be an integer in \[1, 3\], got 4$"):
+        cf.generate(a, a, max_pcs=4)
+    with pytest.raises(cf.Error, match=r"^generate: min_clearance must be a finite number in \[1e-09, 0\.1\], got 1$"):
+        cf.generate(a, a, min_clearance=1.0)
+    with pytest.raises(cf.Error, match=r"missing\.off"):
+        cf.generate(a, tmp_path / "missing.off")
+    with pytest.raises(TypeError):
+        cf.generate(a, a, bogus=1)

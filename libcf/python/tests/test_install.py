@@ -1,0 +1,27 @@
+"""cmake --install puts a working package cf under PREFIX/lib/python3.X/site-packages."""
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from conftest import DATA
+
+
+def test_installed_package_imports_and_replays(tmp_path):
+    cmake, binary = os.environ.get("CF_CMAKE"), os.environ.get("CF_PYTHON_BINARY_DIR")
+    if not cmake or not binary:
+        pytest.skip("CF_CMAKE and CF_PYTHON_BINARY_DIR are set by ctest")
+    prefix = tmp_path / "prefix"
+    subprocess.run([cmake, "--install", binary, "--prefix", str(prefix)], check=True, capture_output=True)
+    site = prefix / "lib" / f"python{sys.version_info.major}.{sys.version_info.minor}" / "site-packages"
+    assert (site / "cf" / "__init__.py").exists()
+    code = ("import cf, numpy as np; g = cf.load_graph(%r); t, p, q = cf.read_trajectory(%r); "
+            "r = cf.replay(g, t, p, q); print(cf.__file__); print(int((r.cf >= 0).sum()))"
+            % (str(DATA / "graphs" / "cube_l_block.json"), str(DATA / "trajectories" / "cube_lblock_guarded.csv")))
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["PYTHONPATH"] = str(site)
+    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True, env=env,
+                         cwd=tmp_path).stdout.split()
+    assert out[0].startswith(str(site)) and int(out[1]) > 100

@@ -1,0 +1,162 @@
+"""cf.replay and cf.Renderer against the C++ renderer (cf::replay::run, printed with 17 digits
+by cf_python_replay_ref) to 1e-12, and against cfreplay's CSV to the 9 digits it prints."""
+
+import csv
+import io
+import subprocess
+
+import numpy as np
+import pytest
+
+import cf
+from conftest import DATA, TRAJECTORIES, tool
+
+VEC = ("F_W", "M_W", "F_A", "M_A")
+
+
+def read_csv(text):
+    return list(csv.DictReader(io.StringIO(text)))
+
+
+def columns(rows, names):
+    return np.array([[float(r[n]) for n in names] for r in rows])
+
+
+CSV_COLS = {"F_W": ("Fx", "Fy", "Fz"), "M_W": ("Mx", "My", "Mz"), "F_A": ("FAx", "FAy", "FAz"),
+            "M_A": ("MAx", "MAy", "MAz")}
+
+
+@pytest.fixture(scope="module", params=sorted(TRAJECTORIES))
+def case(request, graphs):
+    name = request.param
+    path = DATA / "trajectories" / f"{name}.csv"
+    graph = graphs[TRAJECTORIES[name]]
+    t, p, q = cf.read_trajectory(path)
+    return name, path, graph, t, p, q, cf.replay(graph, t, p, q)
+
+
+def test_same_cfs_and_forces_as_the_cpp_renderer(case):
+    name, path, graph, t, p, q, r = case
+    graph_path = DATA / "graphs" / f"{TRAJECTORIES[name]}.json"
+    out = subprocess.run([tool("CF_REPLAY_REF"), str(graph_path), str(path)], check=True, capture_output=True,
+                         text=True).stdout
+    ref = read_csv(out)
+    assert len(r) == len(ref) == len(t) > 100
+    np.testing.assert_array_equal(r.t_s, [float(x["t"]) for x in ref])
+    np.testing.assert_array_equal(r.cf, [int(x["cf"]) for x in ref])
+    assert r.pcs.tolist() == [x["pcs"] for x in ref]
+    assert r.motion.tolist() == [x["motion"] for x in ref]
+    assert r.status.tolist() == [x["status"] for x in ref]
+    for v in VEC:
+        np.testing.assert_allclose(getattr(r, v), columns(ref, CSV_COLS[v]), rtol=1e-12, atol=1e-12, err_msg=v)
+    # The trajectory does touch: some ticks have a CF and a contact force.
+    assert (r.cf >= 0).sum() > 100 and np.abs(r.F_contact_W).max() > 0.1
+    np.testing.assert_allclose(r.F_contact_W + r.F_gravity_W, r.F_W, rtol=0, atol=1e-12)
+
+
+def test_same_as_cfreplay_csv(case, tmp_path):
+    name, path, graph, t, p, q, r = case
+    graph_path = DATA / "graphs" / f"{TRAJECTORIES[name]}.json"
+    out = tmp_path / "out.csv"
+    subprocess.run([tool("CF_CFREPLAY"), "--graph", str(graph_path), "--trajectory", str(path), "-o", str(out)],
+                   check=True, capture_output=True)
+    text = out.read_text()
+    rows = read_csv(text)
+    assert len(rows) == len(r)
+    np.testing.assert_array_equal(r.cf, [int(x["cf"]) for x in rows])
+    assert r.pcs.tolist() == [x["pcs"] for x in rows]
+    assert r.motion.tolist() == [x["motion"] for x in rows]
+    assert r.status.tolist() == [x["status"] for x in rows]
+    assert r.regimes.tolist() == [x["regimes"] for x in rows]
+    np.testing.assert_allclose(r.t_s, [float(x["t"]) for x in rows], rtol=0, atol=5e-7)  # %.6f
+    for v in VEC:
+        # %.9g: 9 significant digits, so within half a unit of the 9th.
+        ref = columns(rows, CSV_COLS[v])
+        np.testing.assert_array_less(np.abs(getattr(r, v) - ref), 5e-9 * np.abs(ref) + 1e-300, err_msg=v)
+    # And the result's own CSV is cfreplay's, byte for byte.
+    assert r.to_csv() == text
+
+
+def test_renderer_step_by_step_equals_replay(case):
+    name, path, graph, t, p, q, r = case
+    renderer = cf.Renderer(graph)
+    for i in range(len(t)):
+        s = renderer.step(t[i], p[i], q[i])
+        assert s["cf"] == r.cf[i] and s["motion"] == r.motion[i] and s["status"] == r.status[i]
+        assert s["pcs_string"] == r.pcs[i] and s["regimes"] == r.regimes[i]
+        for v in VEC:
+            np.testing.assert_array_equal(s[v], getattr(r, v)[i])
+    if name == "cube_lblock_corner":
+        # Per-PC diagnostics of the last tick: the CF's PCs, the force's parts.
+        assert [str(e["pc"]) for e in s["pc_forces"]][: len(s["pcs"])] == [str(pc) for pc in s["pcs"]]
+        total = sum(e["F_W"] for e in s["pc_forces"])
+        assert np.allclose(total, s["F_contact_W"], atol=1e-9)
+    renderer.reset()
+    s = renderer.step(t[0], p[0], q[0])
+    assert s["cf"] == r.cf[0]
+
+
+def test_parameters_are_cfreplays_options(l_graph, tmp_path):
+    path = DATA / "trajectories" / "cube_lblock_slide.csv"
+    t, p, q = cf.read_trajectory(path)
+    kw = dict(mu_static=0.3, mu_kinetic=0.2, stiffness_N_per_mm=1.5, kp_N_per_mm=0.9, mass_kg=0.25,
+              epsilon_mm=0.5, friction_displacement="per_tick", centroid="volume", moment_reference="a_point",
+              moment_point_A=[1.0, 2.0, 3.0], hold_fcy_threshold_N=0.01, interpolation_time_constant_s=0.002)
+    r = cf.replay(l_graph, t, p, q, **kw)
+    assert not np.array_equal(r.F_W, cf.replay(l_graph, t, p, q).F_W)
+    # A cf.Params, or a Params plus keywords, are the same run.
+    params = cf.Params(**kw)
+    assert cf.replay(l_graph, t, p, q, params=params).to_csv() == r.to_csv()
+    assert cf.replay(l_graph, t, p, q, params=cf.Params(mu_static=0.3), **{k: v for k, v in kw.items()
+                                                                           if k != "mu_static"}).to_csv() == r.to_csv()
+    out = tmp_path / "out.csv"
+    subprocess.run([tool("CF_CFREPLAY"), "--graph", str(DATA / "graphs" / "cube_l_block.json"), "--trajectory",
+                    str(path), "-o", str(out), "--mu", "0.3", "--mu-d", "0.2", "--stiffness", "1.5", "--kp", "0.9",
+                    "--mass", "0.25", "--epsilon", "0.5", "--friction", "per-tick", "--centroid", "volume",
+                    "--moment-point", "1", "2", "3", "--hold", "0.01", "--tau", "0.002"],
+                   check=True, capture_output=True)
+    assert r.to_csv() == out.read_text()
+    assert params.mu_static == 0.3 and params.friction_displacement == "per_tick"
+    np.testing.assert_array_equal(params.moment_point_A, [1, 2, 3])
+
+
+def test_replay_errors_carry_messages(l_graph):
+    t, p, q = cf.read_trajectory(DATA / "trajectories" / "cube_lblock_guarded.csv")
+    with pytest.raises(cf.Error, match=r"^replay: p must have shape \(N, 3\) with N = len\(t\) = \d+, got \(\d+, 2\)$"):
+        cf.replay(l_graph, t, p[:, :2], q)
+    with pytest.raises(cf.Error, match=r"^replay: q must have shape \(N, 4\) \(w, x, y, z\)"):
+        cf.replay(l_graph, t, p, q[:-1])
+    with pytest.raises(cf.Error, match=r"^replay: no poses \(t is empty\)$"):
+        cf.replay(l_graph, t[:0], p[:0], q[:0])
+    t2 = t.copy()
+    t2[5] = t2[4]
+    with pytest.raises(cf.Error, match=r"^replay: row 5: time 0\.004 s does not increase \(previous row: 0\.004 s\)$"):
+        cf.replay(l_graph, t2, p, q)
+    q2 = q.copy()
+    q2[7] = [1, 0.1, 0, 0]
+    with pytest.raises(cf.Error, match=r"^replay: row 7: the quaternion \(qw,qx,qy,qz\) has norm 1\.00498756, "
+                                       r"not 1 within 0\.001$"):
+        cf.replay(l_graph, t, p, q2)
+    p2 = p.copy()
+    p2[3, 1] = np.nan
+    with pytest.raises(cf.Error, match=r"^replay: row 3: the translation is not finite$"):
+        cf.replay(l_graph, t, p2, q)
+    with pytest.raises(cf.Error, match=r"^replay: unknown parameter 'mu' \(parameters: mass_kg, "):
+        cf.replay(l_graph, t, p, q, mu=0.3)
+    with pytest.raises(cf.Error, match=r"^replay: epsilon_mm must be a finite number in \[1e-06, 1000\], got -1$"):
+        cf.replay(l_graph, t, p, q, epsilon_mm=-1)
+    with pytest.raises(cf.Error, match=r"^replay: friction_displacement must be one of 'stick_anchor', 'per_tick', "
+                                       r"got 'anchor'$"):
+        cf.replay(l_graph, t, p, q, friction_displacement="anchor")
+    with pytest.raises(cf.Error, match=r"^replay: mass_kg must be a number, got 'heavy'$"):
+        cf.replay(l_graph, t, p, q, mass_kg="heavy")
+    with pytest.raises(cf.Error, match=r"^replay: t must be an array of numbers, got"):
+        cf.replay(l_graph, ["a"], p[:1], q[:1])
+    r = cf.Renderer(l_graph)
+    r.step(0.0, p[0], q[0])
+    with pytest.raises(cf.Error, match=r"^step: time 0 s does not increase \(previous step: 0 s\)$"):
+        r.step(0.0, p[0], q[0])
+    with pytest.raises(cf.Error, match=r"^step: q must have shape \(4,\) \(w, x, y, z\), got \(3,\)$"):
+        r.step(1.0, p[0], q[0][:3])
+    with pytest.raises(cf.Error, match=r"^Renderer: unknown parameter 'K'"):
+        cf.Renderer(l_graph, K=2)
