@@ -256,3 +256,87 @@ TEST_CASE("exploring rotations from a vertex on the slab lands an edge", "[explo
   }
   CHECK(edges_landed >= 2);
 }
+
+namespace {
+
+// The search's lengths as cfgen sets them from the smaller model's bounding-box diagonal D
+// (tools/cfgen/generate.hpp, RelativeLengths defaults).
+cf::gen::SearchParams params_for(const Polyhedron& A, const Polyhedron& B) {
+  const double D = std::min((A.bbox_max() - A.bbox_min()).norm(), (B.bbox_max() - B.bbox_min()).norm());
+  cf::gen::SearchParams p;
+  p.touch_tol = 2e-11 * D;
+  p.min_clearance = 2e-4 * D;
+  p.good_clearance = 2e-2 * D;
+  p.min_margin = 2e-4 * D;
+  return p;
+}
+
+PcSet parse_set(const std::string& text) {
+  PcSet s;
+  std::istringstream is(text);
+  for (std::string w; is >> w;) s.insert(*cf::pc_from_string(w));
+  return s;
+}
+
+}  // namespace
+
+// Pairs drawn by the independent oracle (tests/oracle, seeds 171 and 1002: a box on two
+// stairs, a box against a T-slot block, both placed by random rigid motions) and CFs it
+// sampled that the search used to miss: two face alignments solved as a double root (a
+// rounding error e in the models' angles moved the rotation by sqrt(e)); a contact set whose
+// rotations place the contacts only in a narrow region (climbing the LP margin); a centred
+// translation running into another part of B (separating cuts).
+TEST_CASE("find: CFs of randomly placed pairs that need exact alignments, climbing and cuts", "[explore]") {
+  struct Case {
+    const char* a;
+    const char* b;
+    std::vector<const char*> sets;
+  };
+  const std::vector<Case> cases = {
+      {"stairs_box_A.off", "stairs_B.off",
+       {"f-f:0:4 f-f:2:7", "f-f:0:4 f-f:3:7", "e-f:1:4 v-f:5:7", "e-f:4:7 v-f:6:4", "e-f:5:7 v-f:5:4",
+        "e-f:6:7 v-f:7:4", "v-f:0:7 v-f:4:4", "v-f:1:4 e-e:11:16", "f-v:4:5 e-e:6:7",
+        "e-e:1:10 e-e:7:16", "e-e:3:10 e-e:6:16"}},
+      {"tslot_box_A.off", "tslot_B.off", {"f-e:5:21"}},
+  };
+  for (const Case& c : cases) {
+    const std::string dir = std::string(CF_SOURCE_DIR) + "/tests/data/models/";
+    const Pair p(cf::tools::load_model(dir + c.a), cf::tools::load_model(dir + c.b));
+    const cf::gen::SearchParams params = params_for(p.A, p.B);
+    const cf::gen::WitnessSearch search(p.ai, p.bi, params);
+    for (const char* text : c.sets) {
+      INFO(c.b << ": " << text);
+      const PcSet s = parse_set(text);
+      const cf::gen::Witness w = search.find(s, {});
+      REQUIRE(w.found);
+      CHECK(search.verify(s, w.pose) >= params.min_clearance);
+      PcSet at;
+      REQUIRE(search.contacts_at(w.pose, at));
+      CHECK(at == s);
+    }
+  }
+}
+
+TEST_CASE("plausible: a dominated PC, and heights over a face-face contact that cannot meet", "[explore]") {
+  // A 10 mm cube on the L-block's slab (top y = 20).
+  const Pair p(load_text("cube10h.off", off_box(0, 0, 0, 10, 10, 10)), l_block());
+  const cf::gen::WitnessSearch search(p.ai, p.bi, cf::gen::SearchParams{});
+  const int bottom = face_of(p.A, Vec3(0, -1, 0), 0), top = face_of(p.A, Vec3(0, 1, 0), 10);
+  const int slab = face_of(p.B, Vec3(0, 1, 0), 20), wall = face_of(p.B, Vec3(1, 0, 0), 20);
+  const int slab_under = face_of(p.B, Vec3(0, -1, 0), 0);
+  const PcSet on_slab({Pc{PcType::kFF, bottom, slab}});
+  CHECK(search.plausible(on_slab));
+  // The cube's side face against the wall: heights 0..10 over the slab meet the wall's 0..60.
+  const int side = face_of(p.A, Vec3(-1, 0, 0), 0);
+  CHECK(search.plausible(PcSet({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kFF, side, wall}})));
+  // An edge of the bottom face on the slab is dominated by the face-face PC.
+  const int bottom_edge = edge_of(p.A, Vec3(0, 0, 0), Vec3(10, 0, 0));
+  CHECK_FALSE(search.plausible(PcSet({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kEF, bottom_edge, slab}})));
+  // The cube's top (10 mm over the slab) cannot touch the slab's underside (20 mm below it).
+  const int top_edge = edge_of(p.A, Vec3(0, 10, 0), Vec3(10, 10, 0));
+  (void)top;
+  CHECK_FALSE(search.plausible(PcSet({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kEF, top_edge, slab_under}})));
+  // A vertical edge of the cube spans heights 0..10; the wall face spans 0..60 over the slab.
+  const int vertical_edge = edge_of(p.A, Vec3(0, 0, 0), Vec3(0, 10, 0));
+  CHECK(search.plausible(PcSet({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kEF, vertical_edge, wall}})));
+}

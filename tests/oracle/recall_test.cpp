@@ -21,10 +21,9 @@
 
 namespace {
 
-// The floor every fixed seed meets today (98.2% on the box on stairs, seed 171, is the
-// lowest); the completeness issue's acceptance level is 99.5% and its aim 100%. Raise it as
-// the generator improves; it guards against regressions meanwhile.
-constexpr double kMinRecallPercent = 98.0;
+// The completeness issue's acceptance level (its aim is 100%). Every fixed seed meets it
+// today: 99.7% (seed 14, two misses) is the lowest, four seeds have no miss.
+constexpr double kMinRecallPercent = 99.5;
 
 void run_seed(std::uint64_t seed) {
   oracle::RecallOptions o;

@@ -174,4 +174,23 @@ ModelInfo analyse_model(const Polyhedron& m) {
   return info;
 }
 
+std::vector<Vec3> closure_points(const Polyhedron& m, ElementKind k, int i) {
+  std::vector<Vec3> out;
+  if (k == ElementKind::kVertex) out.push_back(m.vertices()[i].p);
+  else if (k == ElementKind::kEdge) {
+    out.push_back(m.edge_point(EdgeId(i), 0));
+    out.push_back(m.edge_point(EdgeId(i), 1));
+  } else
+    for (VertexId v : m.faces()[i].vertices) out.push_back(m.vertex(v).p);
+  return out;
+}
+
+std::vector<Vec3> closure_directions(const Polyhedron& m, ElementKind k, int i) {
+  std::vector<Vec3> out;
+  if (k == ElementKind::kEdge) out.push_back(m.edges()[i].dir);
+  else if (k == ElementKind::kFace)
+    for (EdgeId e : m.faces()[i].edges) out.push_back(m.edge(e).dir);
+  return out;
+}
+
 }  // namespace cf::gen

@@ -41,6 +41,11 @@ ModelInfo analyse_model(const Polyhedron& m);
 /// vertex are retried). Points within `boundary_tol` of the boundary count as outside.
 bool point_inside(const Polyhedron& m, const Vec3& p, double boundary_tol);
 
+/// Vertices of an element's closure (model frame, mm).
+std::vector<Vec3> closure_points(const Polyhedron& m, ElementKind k, int i);
+/// Unit directions of the edges in an element's closure (none for a vertex).
+std::vector<Vec3> closure_directions(const Polyhedron& m, ElementKind k, int i);
+
 /// Minimal rotation taking unit vector x to unit vector y.
 Mat3 align(const Vec3& x, const Vec3& y);
 /// Rotation by angle (rad) about a unit axis.

@@ -29,18 +29,6 @@ int element_count(const Polyhedron& m, ElementKind k) {
                                                     : m.num_faces());
 }
 
-// Vertices of an element's closure.
-std::vector<Vec3> closure_points(const Polyhedron& m, ElementKind k, int i) {
-  std::vector<Vec3> out;
-  if (k == ElementKind::kVertex) out.push_back(m.vertices()[i].p);
-  else if (k == ElementKind::kEdge) {
-    out.push_back(m.edge_point(EdgeId(i), 0));
-    out.push_back(m.edge_point(EdgeId(i), 1));
-  } else
-    for (VertexId v : m.faces()[i].vertices) out.push_back(m.vertex(v).p);
-  return out;
-}
-
 // Rigid-body necessary condition for two PCs: the distance between the two touching points
 // is the same measured in A and in B, so the [min, max] distance ranges of the A elements and
 // of the B elements must meet.

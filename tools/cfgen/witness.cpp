@@ -69,6 +69,21 @@ double closest_theta(const Vec3& axis, const Mat3& R0, const Mat3& S) {
 // Rotations R = Rot(axis, theta) * R0 satisfying all constraints; finitely many or samples.
 std::vector<Mat3> align_family(const RotConstraints& c, const std::vector<Mat3>& seeds,
                                int samples, bool* finite_out = nullptr) {
+  if (c.align.size() >= 2) {
+    // Two alignments fix the rotation. Solving the second as a condition on the spin about
+    // the first meets it at a double root (its dot product is at its maximum, 1), where a
+    // rounding error e in the models' angles moves the answer by sqrt(e): 3e-8 rad for
+    // e = 1e-15, above kRotTol. The least-squares rotation (Kabsch) errs by e itself.
+    if (finite_out) *finite_out = true;
+    Mat3 H = Mat3::Zero();
+    for (const auto& [a, b] : c.align) H += b * a.transpose();
+    Eigen::JacobiSVD<Mat3> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Mat3 D = Mat3::Identity();
+    D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
+    const Mat3 R = svd.matrixU() * D * svd.matrixV().transpose();
+    if (satisfies(c, R)) return {R};
+    return {};
+  }
   const Vec3 a1 = c.align[0].first, axis = c.align[0].second;
   const Mat3 R0 = align(a1, axis);
   std::vector<double> thetas;
@@ -159,16 +174,28 @@ RotConstraints rotation_constraints(const PcSet& pcs, const Polyhedron& A, const
 
 }  // namespace
 
-std::vector<Mat3> WitnessSearch::rotation_candidates(const PcSet& pcs,
-                                                     const std::vector<Mat3>& seeds,
-                                                     bool generic_seeds) const {
+std::vector<Mat3> WitnessSearch::family_samples(const PcSet& pcs, const std::vector<Mat3>& seeds,
+                                               int samples) const {
+  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
+  std::vector<Mat3> rots;
+  if (!c.align.empty()) {
+    rots = align_family(c, seeds, samples);
+  } else if (!c.perp.empty()) {
+    for (Mat3 R : seeds)
+      if (project_perp(c, R)) add_unique(rots, R);
+  } else {
+    for (const Mat3& R : seeds) add_unique(rots, R);
+  }
+  return rots;
+}
+
+std::vector<Mat3> WitnessSearch::spread_rotations(const PcSet& pcs, const std::vector<Mat3>& seeds) const {
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
   // Each PC's preferred one-parameter family: its local conditions hold with most slack.
   std::vector<Mat3> prefs;
   const int n = std::max(4, p_.theta_samples / std::max(1, pcs.size()));
   for (const Pc& pc : pcs) {
-    if (!generic_seeds) break;
     Vec3 x, y;  // align A-frame x to world y, then spin about y
     switch (pc.type) {
       case PcType::kFF: x = A.faces()[pc.a].normal; y = -B.faces()[pc.b].normal; break;
@@ -201,18 +228,15 @@ std::vector<Mat3> WitnessSearch::rotation_candidates(const PcSet& pcs,
         }
     return out;
   }();
-  if (generic_seeds) all_seeds.insert(all_seeds.end(), kSpread.begin(), kSpread.end());
+  all_seeds.insert(all_seeds.end(), kSpread.begin(), kSpread.end());
+  return all_seeds;
+}
 
-  const RotConstraints c = rotation_constraints(pcs, A, B);
-  std::vector<Mat3> rots;
-  if (!c.align.empty()) {
-    rots = align_family(c, all_seeds, generic_seeds ? p_.theta_samples : 0);
-  } else if (!c.perp.empty()) {
-    for (Mat3 R : all_seeds)
-      if (project_perp(c, R)) add_unique(rots, R);
-  } else {
-    for (const Mat3& R : all_seeds) add_unique(rots, R);
-  }
+std::vector<Mat3> WitnessSearch::rotation_candidates(const PcSet& pcs,
+                                                     const std::vector<Mat3>& seeds,
+                                                     bool generic_seeds) const {
+  const std::vector<Mat3> rots = family_samples(pcs, generic_seeds ? spread_rotations(pcs, seeds) : seeds,
+                                                generic_seeds ? p_.theta_samples : 0);
   // Drop rotations that are locally penetrating; try the sub-sets' witnesses first, then the
   // rest by decreasing local slack, skipping near-duplicates so that the budget of
   // max_rotations covers different orientations rather than one well-liked family.
@@ -422,10 +446,37 @@ LinearProgram WitnessSearch::build_lp(const PcSet& pcs, const Mat3& R,
   return lp;
 }
 
+double WitnessSearch::signed_margin(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces) const {
+  LinearProgram lp = build_lp(pcs, R, pieces);
+  lp.lower[3] = {true, -scale_};
+  const LpResult r = solve(lp);
+  return r.status == LpResult::Status::kOptimal ? r.x[3] : -std::numeric_limits<double>::infinity();
+}
+
+std::vector<Mat3> WitnessSearch::rotation_steps(const PcSet& pcs, const Mat3& R, double h) const {
+  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
+  std::vector<Mat3> out;
+  if (c.align.size() >= 2) return out;  // the rotation is fixed
+  if (c.align.size() == 1) {
+    // The spin about the aligned normal is free; perp conditions, if any, fix it.
+    if (!c.perp.empty()) return out;
+    for (double sg : {1.0, -1.0}) out.push_back(axis_angle(c.align[0].second, sg * h) * R);
+    return out;
+  }
+  for (int ax = 0; ax < 3; ++ax)
+    for (double sg : {1.0, -1.0}) {
+      Mat3 Q = axis_angle(sg * Vec3::Unit(ax), h) * R;
+      if (c.perp.empty() || project_perp(c, Q)) out.push_back(Q);
+    }
+  return out;
+}
+
 std::vector<Vec3> WitnessSearch::translations(const PcSet& pcs, const Mat3& R,
                                               const std::vector<int>& pieces, double& margin,
-                                              bool near_boundary) const {
+                                              bool near_boundary,
+                                              const std::vector<LinearProgram::Row>& cuts) const {
   LinearProgram lp = build_lp(pcs, R, pieces);
+  lp.rows.insert(lp.rows.end(), cuts.begin(), cuts.end());
   const LpResult best = solve(lp);
   margin = best.status == LpResult::Status::kOptimal ? best.x[3] : 0.0;
   if (best.status != LpResult::Status::kOptimal || margin < p_.min_margin) return {};
@@ -472,6 +523,49 @@ std::vector<Vec3> WitnessSearch::translations(const PcSet& pcs, const Mat3& R,
   for (const auto& x : extremes) out.push_back((0.5 * (center + x)).head<3>());
   out.push_back(best.x.head<3>());
   return out;
+}
+
+bool WitnessSearch::separating_cut(const Mat3& R, const Vec3& t, const Obstacle& o,
+                                  LinearProgram::Row& cut) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  std::vector<Vec3> pa = closure_points(A, o.ka, o.a), pb = closure_points(B, o.kb, o.b);
+  for (Vec3& p : pa) p = R * p;
+  std::vector<Vec3> da = closure_directions(A, o.ka, o.a), db = closure_directions(B, o.kb, o.b);
+  for (Vec3& d : da) d = R * d;
+  // Separating axes of two convex hulls: face normals, edge cross products, and for the
+  // lower-dimensional pairs the directions between an edge or a point and a point.
+  std::vector<Vec3> axes;
+  if (o.ka == ElementKind::kFace) axes.push_back(R * A.faces()[o.a].normal);
+  if (o.kb == ElementKind::kFace) axes.push_back(B.faces()[o.b].normal);
+  for (const Vec3& x : da)
+    for (const Vec3& y : db) axes.push_back(x.cross(y));
+  for (const Vec3& p : pa)
+    for (const Vec3& q : pb) {
+      const Vec3 w = q - (p + t);
+      axes.push_back(w);
+      for (const Vec3& x : da) axes.push_back(w - w.dot(x) * x);
+      for (const Vec3& y : db) axes.push_back(w - w.dot(y) * y);
+    }
+  double best_move = std::numeric_limits<double>::infinity();
+  for (Vec3 n : axes) {
+    const double len = n.norm();
+    if (len < 1e-9 * scale_) continue;
+    n /= len;
+    for (double sign : {1.0, -1.0}) {
+      const Vec3 m = sign * n;  // A on m's side: min over A of m.(p + t) >= max over B of m.q + c
+      double a_min = std::numeric_limits<double>::infinity(), b_max = -a_min;
+      for (const Vec3& p : pa) a_min = std::min(a_min, m.dot(p));
+      for (const Vec3& q : pb) b_max = std::max(b_max, m.dot(q));
+      const double rhs = b_max - a_min + 2 * p_.min_clearance;
+      const double move = rhs - m.dot(t);
+      if (move < best_move) {
+        best_move = move;
+        cut = {{{0, m.x()}, {1, m.y()}, {2, m.z()}}, LinearProgram::Rel::kGreaterEq, rhs};
+      }
+    }
+  }
+  return best_move < std::numeric_limits<double>::infinity();
 }
 
 std::pair<Vec3, double> WitnessSearch::contact_plane(const Pc& pc, const Pose& pose) const {
@@ -623,6 +717,10 @@ bool WitnessSearch::cones_disjoint(const Pose& pose, ElementKind ka, int a, Elem
 }
 
 double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* why) const {
+  return verify(pcs, pose, why, nullptr);
+}
+
+double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* why, Obstacle* obstacle) const {
   auto reject = [&](const std::string& reason) {
     if (why) *why = reason;
     return -1.0;
@@ -692,8 +790,10 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
             // Closed elements that meet only on their boundaries do not touch: their boundary
             // elements do, and those pairs are judged on their own.
             if (d <= p_.touch_tol && !open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
-            if (d < p_.min_clearance)
+            if (d < p_.min_clearance) {
+              if (obstacle) *obstacle = Obstacle{true, ka, kb, a, b};
               return reject("extra contact " + kind_name(ka) + std::to_string(a) + "-" + kind_name(kb) + std::to_string(b) + " at " + std::to_string(d));
+            }
             clearance = std::min(clearance, d);
           }
         }
@@ -773,12 +873,55 @@ bool WitnessSearch::plausible(const PcSet& pcs) const {
       if (b_kind(x.type) == ElementKind::kVertex && b_kind(y.type) == ElementKind::kVertex &&
           x.b == y.b)
         return false;
+      // A PC whose two elements lie in the closures of another's is dominated by it, not
+      // principal.
+      const Polyhedron& A = *A_.model;
+      const Polyhedron& B = *B_.model;
+      if ((in_closure(A, a_kind(x.type), x.a, a_kind(y.type), y.a) &&
+           in_closure(B, b_kind(x.type), x.b, b_kind(y.type), y.b)) ||
+          (in_closure(A, a_kind(y.type), y.a, a_kind(x.type), x.a) &&
+           in_closure(B, b_kind(y.type), y.b, b_kind(x.type), x.b)))
+        return false;
       // Two PCs on one plane of B, or one plane of A, share their contact plane.
       const bool xb = b_kind(x.type) == ElementKind::kFace, yb = b_kind(y.type) == ElementKind::kFace;
       if (xb && yb && B_.face_plane[x.b] == B_.face_plane[y.b]) return false;
       const bool xa = a_kind(x.type) == ElementKind::kFace, ya = a_kind(y.type) == ElementKind::kFace;
       if (xa && ya && A_.face_plane[x.a] == A_.face_plane[y.a]) return false;
     }
+  // Heights over a face-face contact: while faces a and b lie against each other, a point's
+  // depth below A's face plane (along A's normal, into A) is its height over B's face plane
+  // (along B's normal), whatever the spin and the slide in the plane. So every other PC's
+  // contact point, a common point of its two elements, needs the two elements' height
+  // ranges over that plane to meet.
+  const double tol = 1e-9 * scale_ + p_.touch_tol;
+  for (const Pc& ff : pcs) {
+    if (ff.type != PcType::kFF) continue;
+    const Face& fa = A_.model->faces()[ff.a];
+    const Face& fb = B_.model->faces()[ff.b];
+    for (const Pc& pc : pcs) {
+      if (pc == ff) continue;
+      double a_lo = std::numeric_limits<double>::infinity(), a_hi = -a_lo, b_lo = a_lo, b_hi = -a_lo;
+      for (const Vec3& p : closure_points(*A_.model, a_kind(pc.type), pc.a)) {
+        const double h = fa.offset - fa.normal.dot(p);
+        a_lo = std::min(a_lo, h);
+        a_hi = std::max(a_hi, h);
+      }
+      for (const Vec3& q : closure_points(*B_.model, b_kind(pc.type), pc.b)) {
+        const double h = fb.normal.dot(q) - fb.offset;
+        b_lo = std::min(b_lo, h);
+        b_hi = std::max(b_hi, h);
+      }
+      // An element's open points span the open interval (lo, hi), or the one height of an
+      // element parallel to the plane.
+      const bool a_flat = a_hi - a_lo <= tol, b_flat = b_hi - b_lo <= tol;
+      bool meet;
+      if (a_flat && b_flat) meet = std::abs(a_lo - b_lo) <= 2 * tol;
+      else if (a_flat) meet = a_lo > b_lo + tol && a_lo < b_hi - tol;
+      else if (b_flat) meet = b_lo > a_lo + tol && b_lo < a_hi - tol;
+      else meet = std::max(a_lo, b_lo) < std::min(a_hi, b_hi) - tol;
+      if (!meet) return false;
+    }
+  }
   return true;
 }
 
@@ -919,6 +1062,40 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
   // Face-piece slots, in the order solve_translation consumes them.
   const std::vector<int> slot_sizes = piece_slots(pcs);
   std::vector<Mat3> near;  // rotations where the contacts held but the pose failed
+  // Returns true when a good witness was found.
+  auto cut_obstacles = [&](const Mat3& R, const std::vector<int>& choice, Vec3 t, Obstacle obstacle) {
+    constexpr int kMaxCuts = 4;  // obstacles avoided in turn before giving up on a rotation
+    std::vector<LinearProgram::Row> cuts;
+    for (int k = 0; k < kMaxCuts && obstacle.set; ++k) {
+      LinearProgram::Row cut;
+      if (!separating_cut(R, t, obstacle, cut)) return false;
+      cuts.push_back(cut);
+      double margin = 0;
+      const std::vector<Vec3> ts = translations(pcs, R, choice, margin, false, cuts);
+      if (debug_) std::cerr << "  cut " << k + 1 << ": " << ts.size() << " translations, margin " << margin << "\n";
+      if (ts.empty()) return false;
+      obstacle = Obstacle();
+      for (const Vec3& tt : ts) {
+        Pose pose;
+        pose.R_BA = R;
+        pose.t_BA = tt;
+        Obstacle o;
+        const double clearance = verify(pcs, pose, nullptr, &o);
+        if (&tt == &ts.front()) {
+          obstacle = o;
+          t = tt;
+        }
+        if (clearance >= p_.min_clearance && clearance > best.clearance) {
+          best.found = true;
+          best.pose = pose;
+          best.clearance = clearance;
+          best.margin = margin;
+          return clearance >= p_.good_clearance;
+        }
+      }
+    }
+    return false;
+  };
   auto try_rotation = [&](const Mat3& R) {
     std::vector<int> choice(slot_sizes.size(), 0);
     for (int combo = 0; combo < p_.max_piece_combinations; ++combo) {
@@ -929,12 +1106,15 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
         const std::vector<Vec3> ts = translations(pcs, R, choice, margin, pass == 1);
         if (pass == 0 && !ts.empty() && near.size() < 4) near.push_back(R);
         if (debug_) std::cerr << "  rotation, pass " << pass << ": " << ts.size() << " translations, margin " << margin << "\n";
+        Obstacle first_obstacle;
         for (const Vec3& t : ts) {
           Pose pose;
           pose.R_BA = R;
           pose.t_BA = t;
           std::string why;
-          const double clearance = verify(pcs, pose, debug_ ? &why : nullptr);
+          Obstacle obstacle;
+          const double clearance = verify(pcs, pose, debug_ ? &why : nullptr, &obstacle);
+          if (&t == &ts.front()) first_obstacle = obstacle;
           if (debug_) std::cerr << "    t " << t.transpose() << " clearance " << clearance << " " << why << "\n";
           if (clearance >= p_.min_clearance && clearance > best.clearance) {
             best.found = true;
@@ -946,6 +1126,11 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
           if (clearance >= p_.min_clearance) break;  // a witness for this rotation; try others
         }
         if (ts.empty() || best.found) break;
+        // The contacts were placed but the centred translation ran into another pair of
+        // elements: move away from it (a half-space of translations where the pair is apart)
+        // and place the contacts again, a few obstacles deep.
+        if (pass == 0 && first_obstacle.set && cut_obstacles(R, choice, ts.front(), first_obstacle)) return true;
+        if (best.found) break;
       }
       // Next combination of pieces (odometer); stop when all tried.
       std::size_t i = 0;
@@ -956,6 +1141,67 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
   };
   for (const Mat3& R : rots)
     if (try_rotation(R)) return best;
+  if (best.found) return best;
+  // Where no rotation tried could place the contacts, climb the margin: from the rotations
+  // that came closest, step along the rotations the conditions leave free while the
+  // (possibly negative) margin grows, and try each rotation that reaches min_margin.
+  // Narrow CFs, e.g. a vertex of A reaching a riser of B while an edge of A lies on the
+  // tread, live in a small region of such rotations that a fixed sample misses.
+  if (near.empty()) {
+    constexpr int kStarts = 2;            // closest rotations climbed from
+    constexpr int kMaxSteps = 32;         // evaluations per climb
+    constexpr double kFirstStep = 0.2;    // rad
+    constexpr double kLastStep = 1e-2;    // rad
+    const std::vector<int> first_pieces(slot_sizes.size(), 0);
+    const double min_local = std::sin(p_.angle_margin);
+    // Lexicographic: first the local non-penetration slack (a cosine) until it is positive,
+    // then the contacts' margin inside their elements (mm).
+    auto score = [&](const Mat3& R) {
+      const double local = local_margin(pcs, R);
+      if (local <= min_local) return std::make_pair(0, local);
+      return std::make_pair(1, signed_margin(pcs, R, first_pieces));
+    };
+    std::vector<std::pair<std::pair<int, double>, Mat3>> starts;
+    auto by_score = [](const auto& x, const auto& y) { return x.first > y.first; };
+    for (const Mat3& R : rots) starts.push_back({score(R), R});
+    std::stable_sort(starts.begin(), starts.end(), by_score);
+    if (starts.size() > kStarts) starts.resize(kStarts);
+    if (starts.size() < kStarts) {
+      // Too few rotations hold locally: climb also from the locally penetrating ones that
+      // come closest.
+      std::vector<std::pair<std::pair<int, double>, Mat3>> more;
+      for (const Mat3& R : family_samples(pcs, spread_rotations(pcs, seeds), p_.theta_samples)) {
+        const double local = local_margin(pcs, R);
+        if (local <= min_local) more.push_back({{0, local}, R});
+      }
+      std::stable_sort(more.begin(), more.end(), by_score);
+      for (std::size_t i = 0; i < more.size() && starts.size() < kStarts; ++i) starts.push_back(more[i]);
+    }
+    for (auto [m, R] : starts) {
+      if (!std::isfinite(m.second)) continue;
+      if (debug_) std::cerr << "  climb from " << m.first << " / " << m.second << "\n";
+      double h = kFirstStep;
+      const auto done = [&] { return m.first == 1 && m.second >= p_.min_margin; };
+      int evals = 0;
+      for (; evals < kMaxSteps && h >= kLastStep && !done();) {
+        bool moved = false;
+        for (const Mat3& Q : rotation_steps(pcs, R, h)) {
+          const auto mq = score(Q);
+          ++evals;
+          if (mq > m) {
+            m = mq;
+            R = Q;
+            moved = true;
+            break;
+          }
+        }
+        if (!moved) h *= 0.5;
+      }
+      if (debug_) std::cerr << "  climbed to " << m.first << " / " << m.second << " in " << evals << " evaluations\n";
+      if (done() && try_rotation(R)) return best;
+      if (best.found) return best;
+    }
+  }
   if (best.found || near.empty()) return best;
   // The contacts could be placed but the pose touched something else: look closer around
   // those rotations, where valid sets with a narrow range of orientations live.

@@ -44,6 +44,16 @@ class WitnessSearch {
   /// Returns the clearance, or a negative number when the pose is not a witness.
   double verify(const PcSet& pcs, const Pose& pose, std::string* why = nullptr) const;
 
+  /// A pair of elements, not part of the contacts, that came too close at a pose verify
+  /// refused (set: whether there was one).
+  struct Obstacle {
+    bool set = false;
+    ElementKind ka = ElementKind::kVertex, kb = ElementKind::kVertex;
+    int a = -1, b = -1;
+  };
+  /// verify, also naming the obstacle when the pose failed on one.
+  double verify(const PcSet& pcs, const Pose& pose, std::string* why, Obstacle* obstacle) const;
+
   /// The PCs that hold at a pose: every touching pair of open elements (distance within
   /// touch_tol) that no other touching pair dominates. Returns false, with the reason, when
   /// a non-dominated touch is degenerate (v-v, v-e, e-v, parallel e-e) or more than three
@@ -85,6 +95,11 @@ class WitnessSearch {
   std::vector<Mat3> rotation_candidates(const PcSet& pcs, const std::vector<Mat3>& seeds,
                                         bool generic_seeds = true) const;
   double local_margin(const PcSet& pcs, const Mat3& R) const;
+  // Rotations satisfying the PCs' rotational conditions: the seeds projected onto them, and
+  // `samples` spins when one face alignment leaves the spin free.
+  std::vector<Mat3> family_samples(const PcSet& pcs, const std::vector<Mat3>& seeds, int samples) const;
+  // The seeds, each PC's preferred rotations and a fixed spread over SO(3).
+  std::vector<Mat3> spread_rotations(const PcSet& pcs, const std::vector<Mat3>& seeds) const;
   // Number of convex pieces of each face slot of the LP (build_lp's `pieces`), in its order.
   std::vector<int> piece_slots(const PcSet& pcs) const;
   // Whether A's and B's tangent cones where element a of A touches element b of B have
@@ -92,12 +107,26 @@ class WitnessSearch {
   // vertex-vertex probe along each cone's inward axis).
   bool cones_disjoint(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b) const;
   LinearProgram build_lp(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces) const;
+  // The largest margin of the contacts inside their elements at rotation R, negative (down
+  // to -scale) when they cannot be placed: how far R is from placing them. -inf when even
+  // that fails (e.g. parallel contact planes).
+  double signed_margin(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces) const;
+  // Rotations near R that satisfy the PCs' rotational conditions: R turned by +-h about
+  // each axis the conditions leave free, projected back onto them.
+  std::vector<Mat3> rotation_steps(const PcSet& pcs, const Mat3& R, double h) const;
   // Candidate translations for rotation R, best first; empty when the contacts cannot hold
   // with min_margin. `margin` receives the largest margin.
   // near_boundary: instead, extremes that keep only 5% of the margin (a contact that must sit
   // close to its element's boundary, e.g. A in a slot barely wider than itself).
+  // cuts: extra rows on the translation (variables 0..2), e.g. from separating_cut.
   std::vector<Vec3> translations(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces,
-                                 double& margin, bool near_boundary) const;
+                                 double& margin, bool near_boundary,
+                                 const std::vector<LinearProgram::Row>& cuts = {}) const;
+  // A half-space of translations t (a row n.t >= h) in which the obstacle's two elements, A
+  // rotated by R, are separated by at least min_clearance: the separating axis (face normals,
+  // edge cross products, edge-vertex and vertex-vertex directions of their closures) that
+  // needs the smallest move from t. False when no axis separates them.
+  bool separating_cut(const Mat3& R, const Vec3& t, const Obstacle& o, LinearProgram::Row& cut) const;
 
   const ModelInfo& A_;
   const ModelInfo& B_;
