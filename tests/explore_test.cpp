@@ -280,12 +280,13 @@ PcSet parse_set(const std::string& text) {
 
 }  // namespace
 
-// Pairs drawn by the independent oracle (tests/oracle, seeds 171 and 1002: a box on two
-// stairs, a box against a T-slot block, both placed by random rigid motions) and CFs it
-// sampled that the search used to miss: two face alignments solved as a double root (a
-// rounding error e in the models' angles moved the rotation by sqrt(e)); a contact set whose
-// rotations place the contacts only in a narrow region (climbing the LP margin); a centred
-// translation running into another part of B (separating cuts).
+// Pairs drawn by the independent oracle (tests/oracle, seeds 171, 1011 and 1002: a box on
+// two stairs, a slab on steep stairs, a box against a T-slot block, all placed by random
+// rigid motions) and CFs it sampled that the search used to miss: two face alignments solved
+// as a double root (a rounding error e in the models' angles moved the rotation by sqrt(e));
+// a contact set whose rotations place the contacts only in a narrow region (climbing the LP
+// margin); two e-e crossings that no spread rotation holds locally (anchored rotations); a
+// centred translation running into another part of B (separating cuts).
 TEST_CASE("find: CFs of randomly placed pairs that need exact alignments, climbing and cuts", "[explore]") {
   struct Case {
     const char* a;
@@ -296,7 +297,9 @@ TEST_CASE("find: CFs of randomly placed pairs that need exact alignments, climbi
       {"stairs_box_A.off", "stairs_B.off",
        {"f-f:0:4 f-f:2:7", "f-f:0:4 f-f:3:7", "e-f:1:4 v-f:5:7", "e-f:4:7 v-f:6:4", "e-f:5:7 v-f:5:4",
         "e-f:6:7 v-f:7:4", "v-f:0:7 v-f:4:4", "v-f:1:4 e-e:11:16", "f-v:4:5 e-e:6:7",
-        "e-e:1:10 e-e:7:16", "e-e:3:10 e-e:6:16"}},
+        "e-e:1:10 e-e:7:16", "e-e:3:10 e-e:6:16", "e-e:7:16 e-e:8:10"}},
+      {"stairs_slab_A.off", "stairs_steep_B.off",
+       {"e-e:5:6 e-e:6:16", "e-e:5:16 e-e:7:6", "e-e:0:16 e-e:3:8", "e-e:2:16 e-e:8:6", "v-f:0:7 v-f:1:4"}},
       {"tslot_box_A.off", "tslot_B.off", {"f-e:5:21"}},
   };
   for (const Case& c : cases) {

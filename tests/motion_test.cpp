@@ -162,3 +162,33 @@ TEST_CASE("prior motion from the previous and current PC sets (paper section 4.2
   CHECK(std::string(cf::to_string(cf::MotionType::kMT2c)) == "MT2.c");
   CHECK(std::string(cf::to_string(cf::MotionType::kNone)) == "none");
 }
+
+TEST_CASE("freedoms from constraint points: the relation the generator and the run time share", "[motion]") {
+  const cf::Params P;
+  // Three points of a floor (normal +y): translations in the floor and the spin about y.
+  const cf::ConstraintPoint floor[] = {{{0, 0, 0}, Y}, {{20, 0, 0}, Y}, {{0, 0, 20}, Y}};
+  const cf::Freedoms f = cf::freedoms_from_points(floor, 3, {10, 10, 10}, 20.0, P);
+  CHECK(f.dof == 3);
+  CHECK(f.translation_dof == 2);
+  CHECK(f.pure_rotation);
+  CHECK(std::abs(f.rotation_axis_W.dot(Y)) == Approx(1.0).margin(kTol));
+  // Two crossing contacts (a vertex on the floor, another on a wall, normal +x): 4 freedoms,
+  // the translation along z among them.
+  const cf::ConstraintPoint two[] = {{{0, 0, 0}, Y}, {{-10, 5, 0}, X}};
+  const cf::Freedoms g = cf::freedoms_from_points(two, 2, {0, 10, 0}, 20.0, P);
+  CHECK(g.dof == 4);
+  CHECK(g.translation_dof == 1);
+  // No constraint: every twist.
+  const cf::Freedoms free = cf::freedoms_from_points(nullptr, 0, {0, 0, 0}, 20.0, P);
+  CHECK(free.dof == 6);
+  CHECK(free.translation_dof == 3);
+}
+
+TEST_CASE("freedoms from constraint points: bad arguments are refused with the reason", "[motion]") {
+  const cf::Params P;
+  cf::ConstraintPoint many[cf::Freedoms::kMaxRows + 1];
+  CHECK_THROWS_WITH(cf::freedoms_from_points(many, cf::Freedoms::kMaxRows + 1, {0, 0, 0}, 20.0, P),
+                    "computing freedoms: at most 9 constraint points, got 10");
+  CHECK_THROWS_WITH(cf::freedoms_from_points(many, 1, {0, 0, 0}, 0.0, P),
+                    Catch::Matchers::StartsWith("computing freedoms: the length scale must be positive"));
+}

@@ -3,11 +3,14 @@
 
 #include <cf/motion.hpp>
 
+#include "check.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace cf {
 
@@ -40,19 +43,11 @@ Vec3 line_direction(const ContactPc& c, const Polyhedron& A, const Polyhedron& B
 
 Freedoms compute_freedoms(const ContactPc* pcs, int n, const Polyhedron& A, const Polyhedron& B,
                           const Pose& pose, const Params& params) {
-  Freedoms f;
   const double L = std::max(A.size(), 1e-9);
-  f.length_scale = L;
-  f.reference_W = pose.t_BA;
-
-  // Rows n . v + ((q - ref) x n / L) . (L w) = 0, one per constraint point q.
-  Eigen::Matrix<double, Freedoms::kMaxRows, 6> J = Eigen::Matrix<double, Freedoms::kMaxRows, 6>::Zero();
+  ConstraintPoint pts[Freedoms::kMaxRows];
   int rows = 0;
   auto add = [&](const Vec3& q, const Vec3& nrm) {
-    if (rows >= Freedoms::kMaxRows) return;
-    J.row(rows).head<3>() = nrm.transpose();
-    J.row(rows).tail<3>() = ((q - f.reference_W).cross(nrm) / L).transpose();
-    ++rows;
+    if (rows < Freedoms::kMaxRows) pts[rows++] = {q, nrm};
   };
   for (int i = 0; i < n; ++i) {
     const ContactPc& c = pcs[i];
@@ -68,6 +63,27 @@ Freedoms compute_freedoms(const ContactPc* pcs, int n, const Polyhedron& A, cons
         add(c.p_W + L * c.R_WT.col(2), nrm);
         break;
     }
+  }
+  return freedoms_from_points(pts, rows, pose.t_BA, L, params);
+}
+
+Freedoms freedoms_from_points(const ConstraintPoint* pts, int n, const Vec3& reference_W,
+                              double length_scale, const Params& params) {
+  CF_REQUIRE(n >= 0 && n <= Freedoms::kMaxRows,
+             "computing freedoms: at most " + std::to_string(Freedoms::kMaxRows) + " constraint points, got " +
+                 std::to_string(n));
+  CF_REQUIRE(length_scale > 0, "computing freedoms: the length scale must be positive, got " + std::to_string(length_scale));
+  Freedoms f;
+  const double L = length_scale;
+  f.length_scale = L;
+  f.reference_W = reference_W;
+
+  // Rows n . v + ((q - ref) x n / L) . (L w) = 0, one per constraint point q.
+  Eigen::Matrix<double, Freedoms::kMaxRows, 6> J = Eigen::Matrix<double, Freedoms::kMaxRows, 6>::Zero();
+  int rows = 0;
+  for (int i = 0; i < n; ++i, ++rows) {
+    J.row(rows).head<3>() = pts[i].n_W.transpose();
+    J.row(rows).tail<3>() = ((pts[i].p_W - f.reference_W).cross(pts[i].n_W) / L).transpose();
   }
   f.num_constraints = rows;
 

@@ -9,7 +9,6 @@
 #include <chrono>
 #include <map>
 #include <mutex>
-#include <sstream>
 #include <thread>
 #include <unordered_map>
 #include <unordered_set>
@@ -156,25 +155,52 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   std::vector<std::pair<PcSet, Witness>> valid[3];
   std::vector<PcSet> failed;  // candidates the search found no witness for
 
+  // Every set that reached the witness search or was found valid: nothing is searched twice.
+  std::unordered_set<PcSet, PcSetHash> seen;
+  std::unordered_map<PcSet, Mat3, PcSetHash> witness_rot;  // seeds for the sets above them
+  std::vector<std::pair<PcSet, Pose>> frontier;             // valid sets not explored by motion yet
+  auto accept = [&](int level, const PcSet& s, const Witness& w) {
+    valid[level].push_back({s, w});
+    witness_rot.emplace(s, w.pose.R_BA);
+    frontier.push_back({s, w.pose});
+  };
+
+  // Progress: ticks while a stage runs, one event when it ends.
+  auto ticker = [&](ProgressEvent& ev, Clock::time_point t0) -> std::function<void(std::size_t)> {
+    if (!opt.progress) return {};
+    return [&ev, t0, &opt](std::size_t done) {
+      ev.done = done;
+      ev.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+      opt.progress(ev);
+    };
+  };
+  auto finished = [&](ProgressEvent& ev, Clock::time_point t0, const std::string& result) {
+    if (!opt.progress) return;
+    ev.done = ev.total;
+    ev.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    ev.finished = true;
+    ev.result = result;
+    opt.progress(ev);
+  };
+  int motion_rounds = 0;
+
   auto run_level = [&](int level, const std::vector<PcSet>& cands,
                        const std::function<std::vector<Mat3>(const PcSet&)>& seeds_of) {
     const auto t0 = Clock::now();
     std::vector<Witness> res(cands.size());
-    std::function<void(std::size_t)> tick;
-    if (opt.progress)
-      tick = [&](std::size_t done) {
-        std::ostringstream os;
-        os << "level " << level + 1 << ": " << done << "/" << cands.size() << " candidate sets, "
-           << std::chrono::duration<double>(Clock::now() - t0).count() << " s";
-        opt.progress(os.str());
-      };
+    ProgressEvent ev{"level " + std::to_string(level + 1), "candidate sets", 0, cands.size(), 0, false, {}};
     parallel_for(cands.size(), threads, [&](std::size_t i) { res[i] = search.find(cands[i], seeds_of(cands[i])); },
-                 tick);
-    for (std::size_t i = 0; i < cands.size(); ++i)
-      if (res[i].found) valid[level].push_back({cands[i], res[i]});
+                 ticker(ev, t0));
+    std::size_t found = 0;
+    for (std::size_t i = 0; i < cands.size(); ++i) {
+      seen.insert(cands[i]);
+      if (res[i].found) accept(level, cands[i], res[i]), ++found;
       else failed.push_back(cands[i]);
-    out.levels[level] = {cands.size(), valid[level].size(),
-                         std::chrono::duration<double>(Clock::now() - t0).count()};
+    }
+    LevelStats& st = out.levels[level];
+    st.candidates += cands.size();
+    st.seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+    finished(ev, t0, std::to_string(found) + " valid");
   };
 
   // Level 1: every element pair that local convexity allows.
@@ -193,9 +219,6 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   }
   run_level(0, c1, [](const PcSet&) { return std::vector<Mat3>{}; });
 
-  std::unordered_map<PcSet, Mat3, PcSetHash> witness_rot;
-  for (int l = 0; l < 1; ++l)
-    for (const auto& [s, w] : valid[l]) witness_rot.emplace(s, w.pose.R_BA);
   auto seeds_from_subsets = [&](const PcSet& s) {
     std::vector<Mat3> seeds;
     for (int k = 0; k < s.size(); ++k) {
@@ -208,23 +231,28 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     return seeds;
   };
 
-  if (opt.max_pcs >= 2) {
-    const DistanceFilter dist(A, B);
+  const DistanceFilter dist(A, B);
+  std::size_t singles_paired = 0;  // valid[0][0, singles_paired) have been paired with each other
+  // Level 2 over the valid single PCs not paired yet (with every valid single PC).
+  auto pairs_level = [&] {
     std::vector<PcSet> c2;
-    for (std::size_t i = 0; i < valid[0].size(); ++i)
-      for (std::size_t j = i + 1; j < valid[0].size(); ++j) {
+    const std::size_t n = valid[0].size();
+    for (std::size_t j = singles_paired; j < n; ++j)
+      for (std::size_t i = 0; i < j; ++i) {
         const Pc& x = valid[0][i].first[0];
         const Pc& y = valid[0][j].first[0];
         PcSet s({x, y});
-        if (!search.plausible(s) || !dist.compatible(x, y)) continue;
+        if (seen.count(s) || !dist.compatible(x, y) || !search.plausible(s)) continue;
         c2.push_back(s);
       }
+    singles_paired = n;
     run_level(1, c2, seeds_from_subsets);
-    for (const auto& [s, w] : valid[1]) witness_rot.emplace(s, w.pose.R_BA);
-  }
-  if (opt.max_pcs >= 3) {
-    std::unordered_map<PcSet, int, PcSetHash> pairs;
-    for (const auto& [s, w] : valid[1]) pairs.emplace(s, 0);
+  };
+  std::size_t pairs_tripled = 0;  // valid pairs when the triples were last built
+  // Level 3 over every set whose three pairs are valid and that was not searched yet.
+  auto triples_level = [&] {
+    std::unordered_set<PcSet, PcSetHash> pairs;
+    for (const auto& [s, w] : valid[1]) pairs.insert(s);
     std::vector<PcSet> c3;
     for (const auto& [s, w] : valid[1])
       for (const auto& [s1, w1] : valid[0]) {
@@ -232,34 +260,21 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
         if (!(s[1] < z)) continue;  // z beyond both, so each triple is built once
         if (!pairs.count(PcSet({s[0], z})) || !pairs.count(PcSet({s[1], z}))) continue;
         PcSet t({s[0], s[1], z});
-        if (search.plausible(t)) c3.push_back(t);
+        if (!seen.count(t) && search.plausible(t)) c3.push_back(t);
       }
+    pairs_tripled = valid[1].size();
     run_level(2, c3, seeds_from_subsets);
-  }
+  };
 
   // Closure by motion (explore.hpp): from every witness, translations and rotations that keep
   // some PCs and break the others, to the first contact. Sets met that are not in the graph yet are
   // searched (seeded with the rotation they were met at), and their own witnesses explored
   // in the next round, until a round adds nothing.
-  {
-    std::unordered_set<PcSet, PcSetHash> known;
-    std::vector<std::pair<PcSet, Pose>> frontier;
-    for (int l = 0; l < 3; ++l)
-      for (const auto& [s, w] : valid[l]) {
-        known.insert(s);
-        frontier.push_back({s, w.pose});
-      }
-    for (int round = 0; !frontier.empty(); ++round) {
+  auto motion_closure = [&] {
+    while (!frontier.empty()) {
       const auto t0 = Clock::now();
       std::vector<std::vector<Discovery>> met(frontier.size());
-      std::function<void(std::size_t)> tick;
-      if (opt.progress)
-        tick = [&](std::size_t done) {
-          std::ostringstream os;
-          os << "motion round " << round + 1 << ": " << done << "/" << frontier.size() << " CFs explored, "
-             << std::chrono::duration<double>(Clock::now() - t0).count() << " s";
-          opt.progress(os.str());
-        };
+      ProgressEvent ev{"motion round " + std::to_string(++motion_rounds), "CFs explored", 0, frontier.size(), 0, false, {}};
       parallel_for(frontier.size(), threads,
                    [&](std::size_t i) {
                      met[i] = explore_translations(search, frontier[i].first, frontier[i].second);
@@ -270,13 +285,13 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
                        met[i].insert(met[i].end(), r.begin(), r.end());
                      }
                    },
-                   tick);
+                   ticker(ev, t0));
       // The first discovery of each new set, in frontier order: independent of thread count.
       std::vector<Discovery> fresh;
       std::unordered_set<PcSet, PcSetHash> pending;
       for (const auto& list : met)
         for (const Discovery& d : list)
-          if (d.pcs.size() <= opt.max_pcs && !known.count(d.pcs) && pending.insert(d.pcs).second)
+          if (d.pcs.size() <= opt.max_pcs && !witness_rot.count(d.pcs) && pending.insert(d.pcs).second)
             fresh.push_back(d);
       std::vector<Witness> res(fresh.size());
       parallel_for(fresh.size(), threads,
@@ -287,17 +302,33 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
                    },
                    {});
       frontier.clear();
+      std::size_t found = 0;
       for (std::size_t i = 0; i < fresh.size(); ++i) {
         if (!res[i].found) continue;
         const int level = fresh[i].pcs.size() - 1;
-        valid[level].push_back({fresh[i].pcs, res[i]});
+        seen.insert(fresh[i].pcs);
+        accept(level, fresh[i].pcs, res[i]);
+        // Explore from where motion met the set too: another pose in its region, which
+        // reaches what the witness's orientation does not.
+        frontier.push_back({fresh[i].pcs, fresh[i].pose});
         ++out.levels[level].by_motion;
-        ++out.levels[level].valid;
-        known.insert(fresh[i].pcs);
-        frontier.push_back({fresh[i].pcs, res[i].pose});
+        ++found;
       }
+      finished(ev, t0, std::to_string(found) + " new CFs");
     }
+  };
+
+  // Levels and motion to a fixed point: a single PC or a pair that only motion found takes
+  // part in the levels above it like any other (a CF's subsets need not be found first).
+  for (;;) {
+    if (opt.max_pcs >= 2) pairs_level();
+    if (opt.max_pcs >= 3) triples_level();
+    motion_closure();
+    const bool grew = (opt.max_pcs >= 2 && valid[0].size() > singles_paired) ||
+                      (opt.max_pcs >= 3 && valid[1].size() > pairs_tripled);
+    if (!grew) break;
   }
+  for (int l = 0; l < 3; ++l) out.levels[l].valid = valid[l].size();
 
   // What the search could not decide: failed candidates that motion did not find either and
   // that no proof rules out (WitnessSearch::refuted).
@@ -306,10 +337,14 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     for (int l = 0; l < 3; ++l)
       for (const auto& [s, w] : valid[l]) known.insert(s);
     std::vector<char> open(failed.size(), 0);
+    const auto t0 = Clock::now();
+    ProgressEvent ev{"proofs of invalidity", "failed candidate sets", 0, failed.size(), 0, false, {}};
     parallel_for(failed.size(), threads,
-                 [&](std::size_t i) { open[i] = !known.count(failed[i]) && !search.refuted(failed[i]); }, {});
+                 [&](std::size_t i) { open[i] = !known.count(failed[i]) && !search.refuted(failed[i]); },
+                 ticker(ev, t0));
     for (std::size_t i = 0; i < failed.size(); ++i)
       if (open[i]) out.undecided.push_back(failed[i]);
+    finished(ev, t0, std::to_string(out.undecided.size()) + " undecided");
     std::sort(out.undecided.begin(), out.undecided.end(), [](const PcSet& x, const PcSet& y) {
       if (x.size() != y.size()) return x.size() < y.size();
       for (int k = 0; k < x.size(); ++k)

@@ -2,6 +2,7 @@
 // Level-by-level enumeration of the valid contact formations of a model pair, and the
 // transitions between them (SPEC section 4).
 
+#include "progress.hpp"
 #include "witness.hpp"
 
 #include <cf/graph.hpp>
@@ -16,8 +17,9 @@ struct EnumerateOptions {
   SearchParams search;
   int threads = 0;       // 0: all hardware threads
   int max_pcs = 3;       // 1..3
-  /// Called now and then with a one-line status; empty to stay quiet.
-  std::function<void(const std::string&)> progress;
+  /// Called now and then while a stage runs, and once when it ends (ProgressEvent::finished);
+  /// from one thread at a time. Empty to stay quiet.
+  std::function<void(const ProgressEvent&)> progress;
 };
 
 struct LevelStats {

@@ -1,6 +1,7 @@
 #include "cfgen/generate.hpp"
 
 #include "cfgen/enumerate.hpp"
+#include "cfgen/progress.hpp"
 #include "mesh/model_loader.hpp"
 
 #include <cf/file_io.hpp>
@@ -13,6 +14,8 @@
 #include <iostream>
 #include <thread>
 #include <tuple>
+
+#include <unistd.h>
 
 namespace cf::tools {
 
@@ -39,16 +42,16 @@ int run_generate(const GenerateArgs& args) {
   opt.search.good_clearance = args.rel.good_clearance * diag;
   opt.search.min_margin = args.rel.min_margin * diag;
   opt.max_pcs = args.max_pcs;
-  bool progress_shown = false;
+  const bool terminal = isatty(STDERR_FILENO) != 0;
+  gen::ProgressPrinter printer(std::cerr, terminal);
   if (!args.quiet)
-    opt.progress = [&](const std::string& line) {
-      // Only runs over a couple of seconds get a progress display.
-      if (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(2)) return;
-      std::cerr << "\rcfgen: " << line << "    " << std::flush;
-      progress_shown = true;
+    opt.progress = [&](const gen::ProgressEvent& ev) {
+      // On a terminal, only runs over a couple of seconds get the updating line.
+      if (terminal && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(2)) return;
+      printer(ev);
     };
   const gen::Enumeration e = gen::enumerate(ai, bi, opt);
-  if (progress_shown) std::cerr << '\n';
+  printer.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   nlohmann::json meta;

@@ -3,9 +3,10 @@
 #include "touch.hpp"
 
 #include <cf/geometry.hpp>
+#include <cf/motion.hpp>
+#include <cf/params.hpp>
 
 #include <Eigen/SVD>
-#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
@@ -230,6 +231,179 @@ std::vector<Mat3> WitnessSearch::spread_rotations(const PcSet& pcs, const std::v
   }();
   all_seeds.insert(all_seeds.end(), kSpread.begin(), kSpread.end());
   return all_seeds;
+}
+
+namespace {
+
+bool point_pc(PcType t) { return t == PcType::kVF || t == PcType::kFV || t == PcType::kEE; }
+
+// Sample points of an element's interior: a vertex itself; an edge at its eighths; a face at its
+// centroid and toward the corners and sides of its outer loop (kept when inside).
+std::vector<Vec3> interior_samples(const Polyhedron& m, ElementKind k, int i) {
+  std::vector<Vec3> out;
+  if (k == ElementKind::kVertex) {
+    out.push_back(m.vertices()[i].p);
+  } else if (k == ElementKind::kEdge) {
+    const Vec3 &a = m.edge_point(EdgeId(i), 0), &b = m.edge_point(EdgeId(i), 1);
+    for (double f : {0.5, 0.25, 0.75, 0.125, 0.375, 0.625, 0.875}) out.push_back(a + f * (b - a));
+  } else {
+    // Toward each corner and each side's midpoint, halfway and nine tenths of the way:
+    // contacts near a face's boundary matter (a peg's corner just inside a hole's rim).
+    const Face& F = m.faces()[i];
+    std::vector<Vec3> targets;
+    for (std::size_t j = 0; j < F.loops.front().size(); ++j) {
+      const Vec3& a = m.vertices()[F.loops.front()[j].index()].p;
+      const Vec3& b = m.vertices()[F.loops.front()[(j + 1) % F.loops.front().size()].index()].p;
+      targets.push_back(a);
+      targets.push_back(0.5 * (a + b));
+    }
+    if (m.face_inset(FaceId(i), F.centroid) > 0) out.push_back(F.centroid);
+    for (double f : {0.5, 0.9})
+      for (const Vec3& c : targets) {
+        const Vec3 q = F.centroid + f * (c - F.centroid);
+        if (m.face_inset(FaceId(i), q) > 0) out.push_back(q);
+      }
+  }
+  return out;
+}
+
+// Points x inside element i (an edge or a face) with |x - c| = L.
+std::vector<Vec3> at_distance(const Polyhedron& m, ElementKind k, int i, const Vec3& c, double L) {
+  std::vector<Vec3> out;
+  if (k == ElementKind::kEdge) {
+    const Vec3 a = m.edge_point(EdgeId(i), 0), d = m.edge_point(EdgeId(i), 1) - a;
+    // |a + u d - c|^2 = L^2: quadratic in u.
+    const double qa = d.squaredNorm(), qb = 2 * d.dot(a - c), qc = (a - c).squaredNorm() - L * L;
+    const double disc = qb * qb - 4 * qa * qc;
+    if (qa <= 0 || disc < 0) return out;
+    for (double sg : {-1.0, 1.0}) {
+      const double u = (-qb + sg * std::sqrt(disc)) / (2 * qa);
+      if (u > 0.02 && u < 0.98) out.push_back(a + u * d);
+    }
+  } else if (k == ElementKind::kFace) {
+    const Face& F = m.faces()[i];
+    const double h = F.normal.dot(c) - F.offset;
+    const double r2 = L * L - h * h;
+    if (r2 <= 0) return out;
+    const Vec3 c0 = c - h * F.normal;
+    constexpr int kAngles = 8;  // points on the circle where the sphere meets the face plane
+    for (int j = 0; j < kAngles; ++j) {
+      const double th = 2 * M_PI * (j + 0.5) / kAngles;
+      const Vec3 x = c0 + std::sqrt(r2) * (std::cos(th) * F.u + std::sin(th) * F.v);
+      if (m.face_inset(FaceId(i), x) > 0) out.push_back(x);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  std::vector<Pc> pts;
+  for (const Pc& pc : pcs)
+    if (point_pc(pc.type)) pts.push_back(pc);
+  std::vector<Mat3> cands;
+  std::vector<std::size_t> exact;  // indices into cands where all three point contacts hold
+  if (pts.size() < 2) return cands;
+  const Pc& x = pts[0];
+  const Pc& y = pts[1];
+  const Pc* third = pts.size() >= 3 ? &pts[2] : nullptr;
+  // Signed distance between the third PC's elements (their lines or planes) at pose (R, t).
+  auto third_residual = [&](const Pc& z, const Mat3& R, const Vec3& t) {
+    switch (z.type) {
+      case PcType::kVF: {
+        const Face& F = B.faces()[z.b];
+        return F.normal.dot(R * A.vertices()[z.a].p + t) - F.offset;
+      }
+      case PcType::kFV: {
+        const Face& F = A.faces()[z.a];
+        return (R * F.normal).dot(B.vertices()[z.b].p - t) - F.offset;
+      }
+      default: {  // e-e
+        const Vec3 a0 = R * A.edge_point(EdgeId(z.a), 0) + t;
+        const Vec3 da = R * (A.edge_point(EdgeId(z.a), 1) - A.edge_point(EdgeId(z.a), 0));
+        const Vec3 b0 = B.edge_point(EdgeId(z.b), 0);
+        const Vec3 n = da.cross(B.edge_point(EdgeId(z.b), 1) - b0);
+        const double len = n.norm();
+        if (len < 1e-12 * scale_ * scale_) return std::numeric_limits<double>::quiet_NaN();
+        return (a0 - b0).dot(n) / len;
+      }
+    }
+  };
+  // Solve for the free point on the side where y's element is not a vertex.
+  const bool solve_on_b = b_kind(y.type) != ElementKind::kVertex;
+  for (const Vec3& pa : interior_samples(A, a_kind(x.type), x.a))
+    for (const Vec3& qb : interior_samples(B, b_kind(x.type), x.b)) {
+      const std::vector<Vec3> fixed = solve_on_b ? interior_samples(A, a_kind(y.type), y.a)
+                                                 : interior_samples(B, b_kind(y.type), y.b);
+      for (const Vec3& f : fixed) {
+        const double L = (f - (solve_on_b ? pa : qb)).norm();
+        if (L < 1e-9 * scale_) continue;
+        for (const Vec3& g : solve_on_b ? at_distance(B, b_kind(y.type), y.b, qb, L)
+                                        : at_distance(A, a_kind(y.type), y.a, pa, L)) {
+          const Vec3 dA = ((solve_on_b ? f : g) - pa).normalized();
+          const Vec3 dB = ((solve_on_b ? g : f) - qb).normalized();
+          const Mat3 R0 = align(dA, dB);
+          auto spun = [&](double phi) { return Mat3(axis_angle(dB, phi) * R0); };
+          for (int k = 0; k < p_.theta_samples; ++k) cands.push_back(spun(2 * M_PI * k / p_.theta_samples));
+          if (!third) continue;
+          // A third point PC: also the spins where its contact holds, the first contact held
+          // at (pa, qb); tried first.
+          auto residual = [&](double phi) {
+            const Mat3 R = spun(phi);
+            return third_residual(*third, R, qb - R * pa);
+          };
+          constexpr int kSpinSamples = 96;
+          double f0 = residual(0);
+          for (int k = 1; k <= kSpinSamples; ++k) {
+            double lo = 2 * M_PI * (k - 1) / kSpinSamples, hi = 2 * M_PI * k / kSpinSamples;
+            const double f1 = residual(hi);
+            if (std::isfinite(f0) && std::isfinite(f1) && (f0 < 0) != (f1 < 0)) {
+              double flo = f0;
+              for (int it = 0; it < 40; ++it) {
+                const double mid = 0.5 * (lo + hi), fm = residual(mid);
+                if (!std::isfinite(fm)) break;
+                if ((fm < 0) == (flo < 0)) lo = mid, flo = fm;
+                else hi = mid;
+              }
+              // A sign change across the e-e residual's jump (lines turning parallel) is no root.
+              if (std::abs(residual(0.5 * (lo + hi))) < 1e-6 * scale_) {
+                cands.push_back(spun(0.5 * (lo + hi)));
+                exact.push_back(cands.size() - 1);
+              }
+            }
+            f0 = f1;
+          }
+        }
+      }
+    }
+  // Locally admissible ones, most slack first, spread apart, at most max_rotations.
+  std::vector<std::pair<double, std::size_t>> order;
+  const double min_local = std::sin(p_.angle_margin);
+  std::vector<char> is_exact(cands.size(), 0);
+  for (std::size_t i : exact) is_exact[i] = 1;
+  for (std::size_t i = 0; i < cands.size(); ++i) {
+    const double m = local_margin(pcs, cands[i]);
+    if (m > min_local) order.push_back({is_exact[i] ? -2.0 - m : -m, i});
+  }
+  std::stable_sort(order.begin(), order.end());
+  if (debug_) std::cerr << "  anchored: " << cands.size() << " rotations, " << order.size() << " locally admissible\n";
+  constexpr double kMinSeparation = 0.15;  // rad between two rotations tried
+  const double min_trace = 1 + 2 * std::cos(kMinSeparation);
+  std::vector<Mat3> out;
+  for (std::size_t i = 0; i < order.size() && static_cast<int>(out.size()) < p_.max_rotations; ++i) {
+    const Mat3& R = cands[order[i].second];
+    bool distinct = true;
+    for (const Mat3& Q : out)
+      if ((Q.transpose() * R).trace() > min_trace) {
+        distinct = false;
+        break;
+      }
+    if (distinct) out.push_back(R);
+  }
+  return out;
 }
 
 std::vector<Mat3> WitnessSearch::rotation_candidates(const PcSet& pcs,
@@ -1142,6 +1316,12 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
   for (const Mat3& R : rots)
     if (try_rotation(R)) return best;
   if (best.found) return best;
+  // Two point PCs: rotations built to place both contacts inside their elements, where the
+  // spread above left too few locally admissible ones (two e-e crossings) or none that
+  // fits (a peg's corner just inside a hole's rim).
+  for (const Mat3& R : anchored_rotations(pcs))
+    if (try_rotation(R)) return best;
+  if (best.found) return best;
   // Where no rotation tried could place the contacts, climb the margin: from the rotations
   // that came closest, step along the rotations the conditions leave free while the
   // (possibly negative) margin grows, and try each rotation that reaches min_margin.
@@ -1218,74 +1398,43 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
 void WitnessSearch::freedoms(const PcSet& pcs, const Pose& pose, CfRecord& out) const {
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
-  std::vector<std::pair<Vec3, Vec3>> pts;  // (point, normal), world frame
+  // The run time's constraint points (cf::compute_freedoms): the contact point of a point
+  // PC, two points of a contact line, three of a contact plane, all with the contact normal.
+  const double L = std::max(A.size(), 1e-9);
+  ConstraintPoint pts[Freedoms::kMaxRows];
+  int n = 0;
+  auto add = [&](const Vec3& p, const Vec3& nrm) {
+    if (n < Freedoms::kMaxRows) pts[n++] = {p, nrm};
+  };
   for (const Pc& pc : pcs) {
-    const Vec3 n = contact_plane(pc, pose).first;
+    const Vec3 nrm = contact_plane(pc, pose).first;
     switch (pc.type) {
-      case PcType::kVF: pts.push_back({pose.apply(A.vertices()[pc.a].p), n}); break;
-      case PcType::kFV: pts.push_back({B.vertices()[pc.b].p, n}); break;
+      case PcType::kVF: add(pose.apply(A.vertices()[pc.a].p), nrm); break;
+      case PcType::kFV: add(B.vertices()[pc.b].p, nrm); break;
       case PcType::kEF:
-        pts.push_back({pose.apply(A.edge_point(EdgeId(pc.a), 0)), n});
-        pts.push_back({pose.apply(A.edge_point(EdgeId(pc.a), 1)), n});
+        add(pose.apply(A.edge_point(EdgeId(pc.a), 0)), nrm);
+        add(pose.apply(A.edge_point(EdgeId(pc.a), 1)), nrm);
         break;
       case PcType::kFE:
-        pts.push_back({B.edge_point(EdgeId(pc.b), 0), n});
-        pts.push_back({B.edge_point(EdgeId(pc.b), 1), n});
+        add(B.edge_point(EdgeId(pc.b), 0), nrm);
+        add(B.edge_point(EdgeId(pc.b), 1), nrm);
         break;
       case PcType::kFF: {
         const Face& fa = A.faces()[pc.a];
-        const Vec3 c = fa.centroid;
-        pts.push_back({pose.apply(c), n});
-        pts.push_back({pose.apply(c + fa.u * 10.0), n});
-        pts.push_back({pose.apply(c + fa.v * 10.0), n});
+        add(pose.apply(fa.centroid), nrm);
+        add(pose.apply(fa.centroid + L * fa.u), nrm);
+        add(pose.apply(fa.centroid + L * fa.v), nrm);
         break;
       }
-      case PcType::kEE: {
-        const auto cp = element_distance(A, pose, ElementKind::kEdge, pc.a, B, ElementKind::kEdge, pc.b);
-        pts.push_back({cp.p_b, n});
+      case PcType::kEE:
+        add(element_distance(A, pose, ElementKind::kEdge, pc.a, B, ElementKind::kEdge, pc.b).p_b, nrm);
         break;
-      }
     }
   }
-  Vec3 ref = Vec3::Zero();
-  for (const auto& pn : pts) ref += pn.first;
-  ref /= static_cast<double>(pts.size());
-  // Rows n . (v + w x (p - ref)); rotational columns scaled by the model size to balance units.
-  Eigen::MatrixXd J(pts.size(), 6);
-  Eigen::MatrixXd N(pts.size(), 3);
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const Vec3 r = (pts[i].first - ref) / scale_;
-    J.row(i) << pts[i].second.transpose(), r.cross(pts[i].second).transpose();
-    N.row(i) = pts[i].second.transpose();
-  }
-  constexpr double kRankTol = 1e-9;
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
-  int rank = 0;
-  for (int i = 0; i < svd.singularValues().size(); ++i)
-    if (svd.singularValues()[i] > kRankTol) ++rank;
-  Eigen::JacobiSVD<Eigen::MatrixXd> svdn(N);
-  int rank_n = 0;
-  for (int i = 0; i < svdn.singularValues().size(); ++i)
-    if (svdn.singularValues()[i] > kRankTol) ++rank_n;
-  out.dof = 6 - rank;
-  out.translation_dof = 3 - rank_n;
-  out.pure_rotation = false;
-  const int k = 6 - rank;
-  if (k == 0) return;
-  const Eigen::MatrixXd Z = svd.matrixV().rightCols(k);
-  const Eigen::MatrixXd Zv = Z.topRows(3), Zw = Z.bottomRows(3);
-  if (Zw.norm() < kRankTol) return;
-  // Zero-pitch twists: c with (Zv c).(Zw c) == 0 and Zw c != 0 (twists about `ref` scaled).
-  const Eigen::MatrixXd Q = 0.5 * (Zv.transpose() * Zw + Zw.transpose() * Zv);
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Q);
-  const auto& ev = es.eigenvalues();
-  if (ev.minCoeff() < -kRankTol && ev.maxCoeff() > kRankTol) {
-    out.pure_rotation = true;
-    return;
-  }
-  for (int i = 0; i < k; ++i)
-    if (std::abs(ev[i]) <= kRankTol && (Zw * es.eigenvectors().col(i)).norm() > 1e-6)
-      out.pure_rotation = true;
+  const Freedoms f = freedoms_from_points(pts, n, pose.t_BA, L, Params{});
+  out.dof = f.dof;
+  out.translation_dof = f.translation_dof;
+  out.pure_rotation = f.pure_rotation;
 }
 
 }  // namespace cf::gen

@@ -100,6 +100,11 @@ class WitnessSearch {
   std::vector<Mat3> family_samples(const PcSet& pcs, const std::vector<Mat3>& seeds, int samples) const;
   // The seeds, each PC's preferred rotations and a fixed spread over SO(3).
   std::vector<Mat3> spread_rotations(const PcSet& pcs, const std::vector<Mat3>& seeds) const;
+  // For a set with two point PCs (v-f, f-v, e-e): rotations that place both contacts at
+  // sampled points inside their elements, i.e. take the segment between the two points on A
+  // onto a segment of the same length between the two points on B, spun about it. Locally
+  // penetrating ones dropped, at most max_rotations, spread apart.
+  std::vector<Mat3> anchored_rotations(const PcSet& pcs) const;
   // Number of convex pieces of each face slot of the LP (build_lp's `pieces`), in its order.
   std::vector<int> piece_slots(const PcSet& pcs) const;
   // Whether A's and B's tangent cones where element a of A touches element b of B have

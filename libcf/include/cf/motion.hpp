@@ -51,6 +51,23 @@ struct Freedoms {
   Vec3 reference_W = Vec3::Zero();  ///< A's origin at this pose: the twists' reference point
 };
 
+/// A point of A whose velocity along a contact normal must stay zero while a CF holds.
+struct ConstraintPoint {
+  Vec3 p_W = Vec3::Zero();  ///< mm, world frame
+  Vec3 n_W = Vec3::UnitY(); ///< unit contact normal, world frame
+};
+
+/// The freedoms left by constraint points: the null space of the rows
+/// n . v + ((p - reference_W) x n) . w, with rank decided at Params::freedom_rank_tolerance
+/// on rows scaled by length_scale. The one place where a CF's freedoms are computed: the run
+/// time (compute_freedoms) and the generator (the `dof` written into a graph) both call it.
+/// @param pts  at most Freedoms::kMaxRows points.
+/// @param reference_W  mm, the twists' reference point (A's origin).
+/// @param length_scale  mm, > 0, balances rotations against translations (A's size).
+/// @throws cf::Error when n is out of [0, Freedoms::kMaxRows] or length_scale <= 0.
+Freedoms freedoms_from_points(const ConstraintPoint* pts, int n, const Vec3& reference_W,
+                              double length_scale, const Params& params);
+
 /// Constraint points of one PC: the contact point (point PCs), two points on the contact
 /// line (line PCs), three non-collinear points of the contact plane (plane PCs), each with
 /// the contact normal (task frame y, into A). Line directions come from the models.

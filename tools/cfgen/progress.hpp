@@ -1,0 +1,47 @@
+#pragma once
+// Progress of a long cfgen run, for a person: an updating line on a terminal, one plain line
+// per finished stage otherwise (a log file, a batch job's output).
+
+#include <cstddef>
+#include <ostream>
+#include <string>
+
+namespace cf::gen {
+
+/// One report from the enumeration: a stage under way (finished = false, sent now and then)
+/// or a stage that has just ended (finished = true, sent once).
+struct ProgressEvent {
+  std::string stage;         // "level 2", "motion round 1", ...
+  std::string unit;          // what `done` and `total` count: "candidate sets", "CFs"
+  std::size_t done = 0;
+  std::size_t total = 0;
+  double seconds = 0;        // s since the stage began
+  bool finished = false;
+  std::string result;        // when finished: what the stage found, e.g. "816 valid"
+};
+
+/// Writes ProgressEvents to a stream. On a terminal: one line, rewritten in place, with the
+/// rate and the estimated time left of the stage under way. Otherwise: one line per finished
+/// stage, no carriage returns.
+class ProgressPrinter {
+ public:
+  ProgressPrinter(std::ostream& os, bool terminal, std::string prefix = "cfgen: ")
+      : os_(os), terminal_(terminal), prefix_(std::move(prefix)) {}
+  void operator()(const ProgressEvent& e);
+  /// Ends the updating line (terminal only); call once the run is over.
+  void finish();
+
+ private:
+  std::ostream& os_;
+  bool terminal_;
+  std::string prefix_;
+  std::size_t shown_ = 0;  // length of the line on screen (terminal)
+};
+
+/// "4.2 s", "3 min 05 s", "2 h 10 min": a duration for people.
+std::string human_duration(double seconds);
+
+/// The line printed for an event: stage, counts, rate and time left (or the result).
+std::string progress_line(const ProgressEvent& e);
+
+}  // namespace cf::gen
