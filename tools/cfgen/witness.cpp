@@ -296,6 +296,28 @@ std::vector<Vec3> at_distance(const Polyhedron& m, ElementKind k, int i, const V
   return out;
 }
 
+// The rotations rots[order[i].second] in that order, at most `limit`; with `spread`, each at
+// least kMinSeparation from those taken, so that the budget covers different orientations
+// rather than one well-liked family.
+std::vector<Mat3> take_spread(const std::vector<Mat3>& rots,
+                              const std::vector<std::pair<double, std::size_t>>& order, int limit,
+                              bool spread) {
+  constexpr double kMinSeparation = 0.15;  // rad between two rotations tried
+  const double min_trace = 1 + 2 * std::cos(kMinSeparation);
+  std::vector<Mat3> out;
+  for (std::size_t i = 0; i < order.size() && static_cast<int>(out.size()) < limit; ++i) {
+    const Mat3& R = rots[order[i].second];
+    bool distinct = true;
+    for (const Mat3& Q : out)
+      if (spread && (Q.transpose() * R).trace() > min_trace) {
+        distinct = false;
+        break;
+      }
+    if (distinct) out.push_back(R);
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs) const {
@@ -390,20 +412,7 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs) const {
   }
   std::stable_sort(order.begin(), order.end());
   if (debug_) std::cerr << "  anchored: " << cands.size() << " rotations, " << order.size() << " locally admissible\n";
-  constexpr double kMinSeparation = 0.15;  // rad between two rotations tried
-  const double min_trace = 1 + 2 * std::cos(kMinSeparation);
-  std::vector<Mat3> out;
-  for (std::size_t i = 0; i < order.size() && static_cast<int>(out.size()) < p_.max_rotations; ++i) {
-    const Mat3& R = cands[order[i].second];
-    bool distinct = true;
-    for (const Mat3& Q : out)
-      if ((Q.transpose() * R).trace() > min_trace) {
-        distinct = false;
-        break;
-      }
-    if (distinct) out.push_back(R);
-  }
-  return out;
+  return take_spread(cands, order, p_.max_rotations, true);
 }
 
 std::vector<Mat3> WitnessSearch::rotation_candidates(const PcSet& pcs,
@@ -421,20 +430,7 @@ std::vector<Mat3> WitnessSearch::rotation_candidates(const PcSet& pcs,
     if (m > std::sin(p_.angle_margin)) order.push_back({i < n_subset && generic_seeds ? -2.0 : -m, i});
   }
   std::stable_sort(order.begin(), order.end());
-  constexpr double kMinSeparation = 0.15;  // rad between two rotations tried
-  const double min_trace = 1 + 2 * std::cos(kMinSeparation);
-  std::vector<Mat3> out;
-  for (std::size_t i = 0; i < order.size() && static_cast<int>(out.size()) < p_.max_rotations; ++i) {
-    const Mat3& R = rots[order[i].second];
-    bool distinct = true;
-    for (const Mat3& Q : out)
-      if ((Q.transpose() * R).trace() > min_trace) {
-        distinct = false;
-        break;
-      }
-    if (distinct || !generic_seeds) out.push_back(R);
-  }
-  return out;
+  return take_spread(rots, order, p_.max_rotations, generic_seeds);
 }
 
 double WitnessSearch::local_margin(const PcSet& pcs, const Mat3& R) const {
