@@ -184,13 +184,23 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   };
   int motion_rounds = 0;
 
+  // given: results computed elsewhere (the shards of the first level-2 round), one per candidate.
   auto run_level = [&](int level, const std::vector<PcSet>& cands,
-                       const std::function<std::vector<Mat3>(const PcSet&)>& seeds_of) {
+                       const std::function<std::vector<Mat3>(const PcSet&)>& seeds_of,
+                       const std::vector<Witness>* given = nullptr) {
     const auto t0 = Clock::now();
     std::vector<Witness> res(cands.size());
     ProgressEvent ev{"level " + std::to_string(level + 1), "candidate sets", 0, cands.size(), 0, false, {}};
-    parallel_for(cands.size(), threads, [&](std::size_t i) { res[i] = search.find(cands[i], seeds_of(cands[i])); },
-                 ticker(ev, t0));
+    if (given) {
+      if (given->size() != cands.size())
+        throw Error("merging shards: the parts hold " + std::to_string(given->size()) +
+                    " results of the first level-2 round, but these models and options give " +
+                    std::to_string(cands.size()) + " candidates");
+      res = *given;
+    } else {
+      parallel_for(cands.size(), threads, [&](std::size_t i) { res[i] = search.find(cands[i], seeds_of(cands[i])); },
+                   ticker(ev, t0));
+    }
     std::size_t found = 0;
     for (std::size_t i = 0; i < cands.size(); ++i) {
       seen.insert(cands[i]);
@@ -234,7 +244,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   const DistanceFilter dist(A, B);
   std::size_t singles_paired = 0;  // valid[0][0, singles_paired) have been paired with each other
   // Level 2 over the valid single PCs not paired yet (with every valid single PC).
-  auto pairs_level = [&] {
+  auto build_pairs = [&] {
     std::vector<PcSet> c2;
     const std::size_t n = valid[0].size();
     for (std::size_t j = singles_paired; j < n; ++j)
@@ -246,7 +256,13 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
         c2.push_back(s);
       }
     singles_paired = n;
-    run_level(1, c2, seeds_from_subsets);
+    return c2;
+  };
+  bool first_pairs = true;
+  auto pairs_level = [&] {
+    const std::vector<PcSet> c2 = build_pairs();
+    run_level(1, c2, seeds_from_subsets, first_pairs ? opt.first_pairs : nullptr);
+    first_pairs = false;
   };
   std::size_t pairs_tripled = 0;  // valid pairs when the triples were last built
   // Level 3 over every set whose three pairs are valid and that was not searched yet.
@@ -320,6 +336,28 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
 
   // Levels and motion to a fixed point: a single PC or a pair that only motion found takes
   // part in the levels above it like any other (a CF's subsets need not be found first).
+  if (opt.shard.count > 0) {
+    // One shard of the first level-2 round: its candidates only, results by index.
+    const std::vector<PcSet> c2 = opt.max_pcs >= 2 ? build_pairs() : std::vector<PcSet>{};
+    std::vector<std::size_t> mine;
+    for (std::size_t i = static_cast<std::size_t>(opt.shard.index); i < c2.size(); i += static_cast<std::size_t>(opt.shard.count))
+      mine.push_back(i);
+    std::vector<Witness> res(mine.size());
+    const auto t0 = Clock::now();
+    ProgressEvent ev{"level 2, shard " + std::to_string(opt.shard.index) + "/" + std::to_string(opt.shard.count),
+                     "candidate sets", 0, mine.size(), 0, false, {}};
+    parallel_for(mine.size(), threads,
+                 [&](std::size_t k) { res[k] = search.find(c2[mine[k]], seeds_from_subsets(c2[mine[k]])); },
+                 ticker(ev, t0));
+    std::size_t found = 0;
+    for (std::size_t k = 0; k < mine.size(); ++k) {
+      found += res[k].found ? 1 : 0;
+      out.shard_results.push_back({mine[k], res[k]});
+    }
+    finished(ev, t0, std::to_string(found) + " valid");
+    out.first_pair_candidates = c2.size();
+    return out;
+  }
   for (;;) {
     if (opt.max_pcs >= 2) pairs_level();
     if (opt.max_pcs >= 3) triples_level();

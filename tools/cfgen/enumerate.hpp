@@ -13,10 +13,24 @@
 
 namespace cf::gen {
 
+/// A slice of the first level-2 search, the bulk of a run: candidate i belongs to shard
+/// i % count. count == 0: no sharding.
+struct ShardSpec {
+  int index = 0;
+  int count = 0;
+};
+
 struct EnumerateOptions {
   SearchParams search;
   int threads = 0;       // 0: all hardware threads
   int max_pcs = 3;       // 1..3
+  /// With shard.count > 0, enumerate() searches only this shard's candidates of the first
+  /// level-2 round and returns them in Enumeration::shard_results; nothing else is built.
+  ShardSpec shard;
+  /// The first level-2 round's results gathered from every shard, one per candidate in
+  /// candidate order: used instead of searching (cfgen merge). The rest of the run is the
+  /// same, so the graph equals an unsharded run's.
+  const std::vector<Witness>* first_pairs = nullptr;
   /// Called now and then while a stage runs, and once when it ends (ProgressEvent::finished);
   /// from one thread at a time. Empty to stay quiet.
   std::function<void(const ProgressEvent&)> progress;
@@ -36,6 +50,10 @@ struct Enumeration {
   double min_clearance = 0;           // mm, smallest witness clearance in the graph
   double min_margin = 0;              // mm, smallest LP margin of a witness's contacts
   std::vector<PcSet> undecided;       // failed candidates with no proof of invalidity
+  // Sharded runs only (EnumerateOptions::shard): the number of candidates of the first
+  // level-2 round, and this shard's results by candidate index.
+  std::size_t first_pair_candidates = 0;
+  std::vector<std::pair<std::size_t, Witness>> shard_results;
 };
 
 Enumeration enumerate(const ModelInfo& A, const ModelInfo& B, const EnumerateOptions& options);

@@ -2,6 +2,7 @@
 
 #include "cfgen/enumerate.hpp"
 #include "cfgen/progress.hpp"
+#include "cfgen/shard.hpp"
 #include "mesh/model_loader.hpp"
 
 #include <cf/file_io.hpp>
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <filesystem>
 #include <iostream>
 #include <thread>
 #include <tuple>
@@ -24,7 +26,9 @@ int run_generate(const GenerateArgs& args) {
   // The output path is checked before the work: not a device, FIFO or directory, not one of
   // the models (SPEC section 5b).
   const std::vector<std::string> inputs{args.a_path, args.b_path};
-  check_output_path(args.out_path, inputs, "writing graph");
+  const bool sharded = args.shard.count > 0;
+  check_output_path(args.out_path, inputs, sharded ? "writing shard part" : "writing graph");
+  const std::string fingerprint = sharded ? run_fingerprint(args) : std::string();
   const Polyhedron A = load_model(args.a_path, args.load_a);
   const Polyhedron B = load_model(args.b_path, args.load_b);
   for (const auto& [m, which, option] : {std::tuple{&A, "A", "--units-a"}, std::tuple{&B, "B", "--units-b"}})
@@ -42,6 +46,8 @@ int run_generate(const GenerateArgs& args) {
   opt.search.good_clearance = args.rel.good_clearance * diag;
   opt.search.min_margin = args.rel.min_margin * diag;
   opt.max_pcs = args.max_pcs;
+  opt.shard = args.shard;
+  opt.first_pairs = args.first_pairs;
   const bool terminal = isatty(STDERR_FILENO) != 0;
   gen::ProgressPrinter printer(std::cerr, terminal);
   if (!args.quiet)
@@ -53,6 +59,24 @@ int run_generate(const GenerateArgs& args) {
   const gen::Enumeration e = gen::enumerate(ai, bi, opt);
   printer.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (sharded) {
+    ShardPart part;
+    part.args = args;
+    part.args.a_path = std::filesystem::absolute(args.a_path).lexically_normal().string();
+    part.args.b_path = std::filesystem::absolute(args.b_path).lexically_normal().string();
+    part.a_given = args.a_path;
+    part.b_given = args.b_path;
+    part.fingerprint = fingerprint;
+    part.index = args.shard.index;
+    part.count = args.shard.count;
+    part.candidates = e.first_pair_candidates;
+    part.results = e.shard_results;
+    write_part(args.out_path, part);
+    if (!args.quiet)
+      std::cerr << "cfgen: shard " << part.index << "/" << part.count << ": " << part.results.size() << " of "
+                << part.candidates << " level-2 candidates, " << seconds << " s -> " << args.out_path << '\n';
+    return 0;
+  }
 
   nlohmann::json meta;
   nlohmann::json by_count = nlohmann::json::object(), by_type = nlohmann::json::object();
@@ -97,7 +121,9 @@ int run_generate(const GenerateArgs& args) {
                         {"theta_samples", s.theta_samples},
                         {"max_rotations", s.max_rotations},
                         {"max_pcs", opt.max_pcs}};
-  meta["generator"] = {{"name", "cfgen"}, {"a_model", args.a_path}, {"b_model", args.b_path}};
+  meta["generator"] = {{"name", "cfgen"},
+                       {"a_model", args.a_label.empty() ? args.a_path : args.a_label},
+                       {"b_model", args.b_label.empty() ? args.b_path : args.b_label}};
   // Coordinates are stored in mm; the unit each model file was read in (SPEC section 2).
   meta["source_units"] = {{"A", args.load_a.units}, {"B", args.load_b.units}};
 

@@ -4,6 +4,7 @@
 /// main.cpp parses the command line; run_generate does the work (generate.cpp, built when
 /// present, which defines CF_HAVE_GENERATOR).
 
+#include "cfgen/enumerate.hpp"
 #include "cfgen/witness.hpp"
 #include "mesh/model_loader.hpp"
 
@@ -32,6 +33,13 @@ struct GenerateArgs {
   gen::SearchParams search;  ///< angular tolerances and search limits (lengths: `rel`)
   RelativeLengths rel;       ///< lengths of the search, relative to the models' size
   LoadOptions load_a, load_b;  ///< units and coplanarity tolerance of each model
+  /// With shard.count > 0: search one shard of the first level-2 round and write a part file
+  /// to out_path instead of the graph (cfgen/shard.hpp).
+  gen::ShardSpec shard;
+  /// cfgen merge: the first level-2 round's results gathered from the parts.
+  const std::vector<gen::Witness>* first_pairs = nullptr;
+  /// The model names written into the graph's generator record; empty: a_path, b_path.
+  std::string a_label, b_label;
 };
 
 /// Generates the CF graph of A against B and writes it to args.out_path.

@@ -1,8 +1,10 @@
 // cfgen: builds CF graphs (SPEC section 5b) and prints the features of a model.
 //   cfgen --features MODEL                 the model object (SPEC section 5) as JSON on stdout
 //   cfgen A_MODEL B_MODEL -o GRAPH.json    the CF graph of A against B
+//   cfgen A_MODEL B_MODEL --shard i/K -o PART, then cfgen merge PART... -o GRAPH.json
 
 #include "cfgen/generate.hpp"
+#include "cfgen/shard.hpp"
 #include "mesh/model_loader.hpp"
 #include "cli_checks.hpp"
 
@@ -25,13 +27,52 @@ int print_features(const std::string& path, const cf::tools::LoadOptions& opt) {
   return 0;
 }
 
+// cfgen merge PART... -o GRAPH.json [-j N] [-q]
+int merge_main(int argc, char** argv) {
+  CLI::App app{
+      "cfgen merge: joins the part files of a sharded run (cfgen A B --shard i/K -o PART) and\n"
+      "finishes it; the graph equals the one `cfgen A B -o GRAPH.json` writes.",
+      "cfgen merge"};
+  std::vector<std::string> parts;
+  std::string out_path;
+  int threads = 0;
+  bool quiet = false;
+  app.add_option("parts", parts, "the part files, one per shard, in any order")->required()->type_name("PART");
+  app.add_option("-o,--output", out_path, "graph file to write")->required()->type_name("GRAPH.json");
+  app.add_option("-j,--threads", threads, "worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+  app.add_flag("-q,--quiet", quiet, "no progress messages");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "cfgen merge: " << e.what() << " (see cfgen merge --help)\n";
+    return 2;
+  }
+  try {
+    return cf::tools::run_merge(parts, out_path, threads, quiet);
+  } catch (const cf::Error& e) {
+    std::cerr << "cfgen merge: " << e.what() << '\n';
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "cfgen merge: out of memory\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "cfgen merge: internal error: " << e.what() << '\n';
+    return 3;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "merge") return merge_main(argc - 1, argv + 1);
   CLI::App app{
       "cfgen: contact-formation graph generator.\n"
       "  cfgen A_MODEL B_MODEL -o GRAPH.json   write the CF graph of A (moving) against B (fixed)\n"
       "  cfgen --features MODEL                print the model's features as JSON\n"
+      "  cfgen A_MODEL B_MODEL --shard i/K -o PART, then cfgen merge PART... -o GRAPH.json\n"
+      "                                        the same graph, its bulk split over K runs\n"
       "Models: closed, outward-oriented polyhedra in OFF, OBJ, STL or PLY (mm).",
       "cfgen"};
   std::string features_path;
@@ -50,9 +91,14 @@ int main(int argc, char** argv) {
   auto* threads = app.add_option("-j,--threads", gen.threads, "worker threads (0: all cores)")
                       ->check(CLI::Range(0, 1024));
   auto* quiet = app.add_flag("-q,--quiet", gen.quiet, "no progress messages");
+  std::string shard_text;
+  auto* shard = app.add_option("--shard", shard_text,
+                               "search shard i of K of the first level-2 round and write a part file "
+                               "for `cfgen merge` instead of the graph")
+                    ->type_name("i/K");
   // Witness-search tolerances and limits (docs/generator.md explains each).
   auto& sp = gen.search;
-  std::vector<CLI::Option*> gen_opts{threads, quiet};
+  std::vector<CLI::Option*> gen_opts{threads, quiet, shard};
   gen_opts.push_back(app.add_option("--max-pcs", gen.max_pcs, "largest CFs to enumerate")
                          ->check(CLI::Range(1, 3))
                          ->capture_default_str());
@@ -120,6 +166,14 @@ int main(int argc, char** argv) {
     if (gen.out_path.empty()) {
       std::cerr << "cfgen: missing -o GRAPH.json\n";
       return 2;
+    }
+    if (!shard_text.empty()) {
+      try {
+        gen.shard = cf::tools::parse_shard(shard_text);
+      } catch (const cf::Error& e) {
+        std::cerr << "cfgen: " << e.what() << " (see cfgen --help)\n";
+        return 2;
+      }
     }
     gen.a_path = models[0];
     gen.b_path = models[1];

@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# Sharded cfgen runs end to end (docs/generator.md, "Shards"): two shards of the cube against
+# the L-block, merged in reverse order from another directory, must give the bundled graph
+# byte for byte; parts that do not make one whole run are refused with a message that names
+# the problem, and nothing is written.
+#
+#   cfgen_shard_test.sh CFGEN SOURCE_DIR WORK_DIR
+set -uo pipefail
+cfgen="$1"
+src="$2"
+work="$3/cfgen_shard"
+rm -rf "$work"
+mkdir -p "$work/elsewhere"
+cd "$work" || exit 1
+A="$src/data/models/cube.off"
+B="$src/data/models/l_block.off"
+fail=0
+check() {  # name, expected status, stderr regex, command...
+  local name="$1" want="$2" re="$3"
+  shift 3
+  "$@" >out.txt 2>err.txt
+  local rc=$?
+  if [[ $rc -ne $want ]] || { [[ -n $re ]] && ! grep -Eq -- "$re" err.txt; }; then
+    echo "FAIL $name: status $rc (want $want), stderr:"
+    cat err.txt
+    fail=1
+  else
+    echo "ok   $name"
+  fi
+}
+
+# The shards run where the golden graph was made (the model paths, as typed, go into the
+# graph); the merge runs elsewhere.
+check "shard 0/2" 0 "shard 0/2: [0-9]+ of [0-9]+ level-2 candidates" \
+  env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off --shard 0/2 -o "$work/p0.part" -j 2
+check "shard 1/2" 0 "" env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off --shard 1/2 \
+  -o "$work/p1.part" -q -j 2
+(cd elsewhere && "$cfgen" merge ../p1.part ../p0.part -o merged.json -q -j 2) || fail=1
+if cmp -s elsewhere/merged.json "$src/data/graphs/cube_l_block.json"; then
+  echo "ok   merged graph equals data/graphs/cube_l_block.json"
+else
+  echo "FAIL merged graph differs from data/graphs/cube_l_block.json"
+  fail=1
+fi
+
+check "missing shard" 1 "1 of 2 shards are missing \(shard 1\)" "$cfgen" merge p0.part -o g.json
+check "shard given twice" 1 "shard 0/2 is given twice" "$cfgen" merge p0.part p0.part p1.part -o g.json
+# A part of another run: other options (a one-level run, which is quick).
+check "part of another run" 0 "" "$cfgen" "$A" "$B" --max-pcs 1 --shard 1/2 -o other.part -q
+check "parts of two runs" 1 "comes from another run than" "$cfgen" merge p0.part other.part -o g.json
+printf '{"format": "cfgen shard part", "version": 1, "shard": 0' >cut.part
+check "truncated part" 1 "reading shard part 'cut.part': not JSON" "$cfgen" merge cut.part p1.part -o g.json
+check "not a part" 1 "reading shard part '.*cube.off': not JSON" "$cfgen" merge "$A" -o g.json
+check "bad --shard" 2 "--shard '3/2': i must be in 0..1" "$cfgen" "$A" "$B" --shard 3/2 -o g.json
+check "--shard not i/K" 2 "--shard 'two': expected i/K" "$cfgen" "$A" "$B" --shard two -o g.json
+check "merge without -o" 2 "output is required|--output is required" "$cfgen" merge p0.part p1.part
+if [[ -e g.json ]]; then
+  echo "FAIL a refused merge wrote g.json"
+  fail=1
+fi
+# A model changed after the shards ran: its bytes no longer match the parts' fingerprint.
+cp "$A" a_copy.off
+check "shard of a copy" 0 "" "$cfgen" a_copy.off "$B" --max-pcs 1 --shard 0/1 -o copy.part -q
+echo "# touched" >>a_copy.off
+check "model changed" 1 "are not the files the shards read" "$cfgen" merge copy.part -o g.json
+exit $fail

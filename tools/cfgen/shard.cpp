@@ -1,0 +1,247 @@
+#include "cfgen/shard.hpp"
+
+#include <cf/file_io.hpp>
+#include <cf/types.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <cinttypes>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <set>
+
+namespace cf::tools {
+namespace {
+
+constexpr const char* kFormat = "cfgen shard part";
+constexpr int kVersion = 1;
+constexpr int kMaxShards = 4096;
+
+// The options that shape the graph, in a fixed order (not the thread count, the output or
+// --quiet, which do not change a byte of it).
+nlohmann::json options_json(const GenerateArgs& a) {
+  return {{"max_pcs", a.max_pcs},
+          {"touch_tol_rel", a.rel.touch_tol},
+          {"min_clearance_rel", a.rel.min_clearance},
+          {"good_clearance_rel", a.rel.good_clearance},
+          {"min_margin_rel", a.rel.min_margin},
+          {"angle_margin_rad", a.search.angle_margin},
+          {"theta_samples", a.search.theta_samples},
+          {"max_rotations", a.search.max_rotations},
+          {"max_piece_combinations", a.search.max_piece_combinations},
+          {"units_a", a.load_a.units},
+          {"units_b", a.load_b.units},
+          {"coplanar_tol_a", a.load_a.coplanar_rel_tol},
+          {"coplanar_tol_b", a.load_b.coplanar_rel_tol}};
+}
+
+[[noreturn]] void bad_part(const std::string& path, const std::string& problem) {
+  throw Error("reading shard part '" + path + "': " + problem);
+}
+
+template <class T>
+T field(const nlohmann::json& j, const char* key, const std::string& path) {
+  if (!j.is_object() || !j.contains(key)) bad_part(path, std::string("missing \"") + key + "\"");
+  try {
+    return j.at(key).get<T>();
+  } catch (const nlohmann::json::exception&) {
+    bad_part(path, std::string("\"") + key + "\" has the wrong type");
+  }
+}
+
+std::uint64_t fnv1a(std::uint64_t h, const std::string& bytes) {
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  }
+  // Length too, so that concatenations cannot collide by shifting bytes between fields.
+  const std::string len = std::to_string(bytes.size()) + ";";
+  for (unsigned char c : len) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+}  // namespace
+
+gen::ShardSpec parse_shard(const std::string& text) {
+  int i = -1, k = -1;
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%d/%d%c", &i, &k, &tail) != 2)
+    throw Error("--shard '" + printable(text) + "': expected i/K, e.g. 0/4");
+  if (k < 1 || k > kMaxShards)
+    throw Error("--shard '" + printable(text) + "': K must be in 1.." + std::to_string(kMaxShards));
+  if (i < 0 || i >= k) throw Error("--shard '" + printable(text) + "': i must be in 0.." + std::to_string(k - 1));
+  return {i, k};
+}
+
+std::string run_fingerprint(const GenerateArgs& args) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  h = fnv1a(h, "cfgen shard v" + std::to_string(kVersion));
+  for (const std::string* p : {&args.a_path, &args.b_path}) {
+    std::string bytes, why;
+    if (!read_input_file(*p, bytes, why)) throw Error("reading model '" + *p + "': " + why);
+    h = fnv1a(h, bytes);
+  }
+  h = fnv1a(h, options_json(args).dump());
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016" PRIx64, h);
+  return buf;
+}
+
+void write_part(const std::string& path, const ShardPart& part) {
+  nlohmann::json results = nlohmann::json::array();
+  for (const auto& [i, w] : part.results) {
+    if (!w.found) {
+      results.push_back({i, false});
+      continue;
+    }
+    nlohmann::json R = nlohmann::json::array(), t = nlohmann::json::array();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) R.push_back(w.pose.R_BA(r, c));
+    for (int r = 0; r < 3; ++r) t.push_back(w.pose.t_BA(r));
+    results.push_back({i, true, R, t, w.clearance, w.margin});
+  }
+  const nlohmann::json j = {{"format", kFormat},
+                            {"version", kVersion},
+                            {"shard", part.index},
+                            {"shards", part.count},
+                            {"fingerprint", part.fingerprint},
+                            {"models",
+                             {{"a", part.a_given}, {"b", part.b_given}, {"a_path", part.args.a_path},
+                              {"b_path", part.args.b_path}}},
+                            {"options", options_json(part.args)},
+                            {"candidates", part.candidates},
+                            {"results", results}};
+  write_outputs({{path, j.dump() + "\n"}}, {part.args.a_path, part.args.b_path}, "writing shard part");
+}
+
+ShardPart read_part(const std::string& path) {
+  std::string bytes, why;
+  if (!read_input_file(path, bytes, why)) bad_part(path, why);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(bytes);
+  } catch (const nlohmann::json::parse_error& e) {
+    bad_part(path, std::string("not JSON (") + e.what() + ")");
+  }
+  if (!j.is_object() || j.value("format", std::string()) != kFormat)
+    bad_part(path, "not a cfgen shard part (no \"format\": \"cfgen shard part\")");
+  const int version = field<int>(j, "version", path);
+  if (version != kVersion)
+    bad_part(path, "version " + std::to_string(version) + ", this cfgen reads version " + std::to_string(kVersion));
+  ShardPart p;
+  p.path = path;
+  p.index = field<int>(j, "shard", path);
+  p.count = field<int>(j, "shards", path);
+  if (p.count < 1 || p.count > kMaxShards || p.index < 0 || p.index >= p.count)
+    bad_part(path, "shard " + std::to_string(p.index) + "/" + std::to_string(p.count) + " is out of range");
+  p.fingerprint = field<std::string>(j, "fingerprint", path);
+  const nlohmann::json& m = j.contains("models") ? j.at("models") : nlohmann::json();
+  p.a_given = field<std::string>(m, "a", path);
+  p.b_given = field<std::string>(m, "b", path);
+  p.args.a_path = field<std::string>(m, "a_path", path);
+  p.args.b_path = field<std::string>(m, "b_path", path);
+  const nlohmann::json& o = j.contains("options") ? j.at("options") : nlohmann::json();
+  p.args.max_pcs = field<int>(o, "max_pcs", path);
+  p.args.rel.touch_tol = field<double>(o, "touch_tol_rel", path);
+  p.args.rel.min_clearance = field<double>(o, "min_clearance_rel", path);
+  p.args.rel.good_clearance = field<double>(o, "good_clearance_rel", path);
+  p.args.rel.min_margin = field<double>(o, "min_margin_rel", path);
+  p.args.search.angle_margin = field<double>(o, "angle_margin_rad", path);
+  p.args.search.theta_samples = field<int>(o, "theta_samples", path);
+  p.args.search.max_rotations = field<int>(o, "max_rotations", path);
+  p.args.search.max_piece_combinations = field<int>(o, "max_piece_combinations", path);
+  p.args.load_a.units = field<std::string>(o, "units_a", path);
+  p.args.load_b.units = field<std::string>(o, "units_b", path);
+  p.args.load_a.coplanar_rel_tol = field<double>(o, "coplanar_tol_a", path);
+  p.args.load_b.coplanar_rel_tol = field<double>(o, "coplanar_tol_b", path);
+  p.candidates = field<std::size_t>(j, "candidates", path);
+  if (!j.contains("results") || !j.at("results").is_array()) bad_part(path, "missing \"results\" array");
+  for (const nlohmann::json& r : j.at("results")) {
+    const std::string where = "result " + std::to_string(p.results.size());
+    if (!r.is_array() || r.size() < 2 || !r[0].is_number_unsigned() || !r[1].is_boolean())
+      bad_part(path, where + ": expected [index, found, ...]");
+    const std::size_t i = r[0].get<std::size_t>();
+    if (i >= p.candidates || i % static_cast<std::size_t>(p.count) != static_cast<std::size_t>(p.index))
+      bad_part(path, where + ": candidate " + std::to_string(i) + " is not one of this shard's");
+    gen::Witness w;
+    w.found = r[1].get<bool>();
+    if (w.found) {
+      if (r.size() != 6 || !r[2].is_array() || r[2].size() != 9 || !r[3].is_array() || r[3].size() != 3 ||
+          !r[4].is_number() || !r[5].is_number())
+        bad_part(path, where + ": expected [index, true, R (9 numbers), t (3 numbers), clearance, margin]");
+      for (int k = 0; k < 9; ++k) {
+        if (!r[2][k].is_number()) bad_part(path, where + ": R holds a non-number");
+        w.pose.R_BA(k / 3, k % 3) = r[2][k].get<double>();
+      }
+      for (int k = 0; k < 3; ++k) {
+        if (!r[3][k].is_number()) bad_part(path, where + ": t holds a non-number");
+        w.pose.t_BA(k) = r[3][k].get<double>();
+      }
+      w.clearance = r[4].get<double>();
+      w.margin = r[5].get<double>();
+    }
+    p.results.push_back({i, w});
+  }
+  return p;
+}
+
+std::vector<gen::Witness> gather_parts(const std::vector<ShardPart>& parts) {
+  if (parts.empty()) throw Error("merging shards: no part given");
+  const ShardPart& first = parts.front();
+  std::set<int> seen;
+  for (const ShardPart& p : parts) {
+    if (p.fingerprint != first.fingerprint || p.count != first.count || p.candidates != first.candidates)
+      throw Error("merging shards: '" + p.path + "' comes from another run than '" + first.path +
+                  "' (other models, options or shard count)");
+    if (!seen.insert(p.index).second)
+      throw Error("merging shards: shard " + std::to_string(p.index) + "/" + std::to_string(p.count) +
+                  " is given twice ('" + p.path + "')");
+  }
+  if (static_cast<int>(seen.size()) != first.count) {
+    std::string missing;
+    for (int i = 0, n = 0; i < first.count && n < 8; ++i)
+      if (!seen.count(i)) missing += (n++ ? ", " : "") + std::to_string(i);
+    throw Error("merging shards: " + std::to_string(first.count - static_cast<int>(seen.size())) + " of " +
+                std::to_string(first.count) + " shards are missing (shard " + missing +
+                (first.count - static_cast<int>(seen.size()) > 8 ? ", ..." : "") + ")");
+  }
+  std::vector<gen::Witness> all(first.candidates);
+  std::vector<char> have(first.candidates, 0);
+  for (const ShardPart& p : parts)
+    for (const auto& [i, w] : p.results) {
+      if (have[i]) throw Error("merging shards: '" + p.path + "' repeats candidate " + std::to_string(i));
+      have[i] = 1;
+      all[i] = w;
+    }
+  for (std::size_t i = 0; i < have.size(); ++i)
+    if (!have[i])
+      throw Error("merging shards: no part holds candidate " + std::to_string(i) + " (shard " +
+                  std::to_string(i % static_cast<std::size_t>(first.count)) + " is incomplete)");
+  return all;
+}
+
+int run_merge(const std::vector<std::string>& part_paths, const std::string& out_path, int threads,
+              bool quiet) {
+  std::vector<ShardPart> parts;
+  for (const std::string& p : part_paths) parts.push_back(read_part(p));
+  const std::vector<gen::Witness> first_pairs = gather_parts(parts);
+  GenerateArgs args = parts.front().args;
+  args.out_path = out_path;
+  args.threads = threads;
+  args.quiet = quiet;
+  if (run_fingerprint(args) != parts.front().fingerprint)
+    throw Error("merging shards: the models '" + args.a_path + "' and '" + args.b_path +
+                "' are not the files the shards read (they changed since)");
+  args.a_label = parts.front().a_given;
+  args.b_label = parts.front().b_given;
+  args.first_pairs = &first_pairs;
+  std::vector<std::string> inputs = part_paths;
+  check_output_path(out_path, inputs, "writing graph");
+  return run_generate(args);
+}
+
+}  // namespace cf::tools

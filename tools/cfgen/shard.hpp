@@ -1,0 +1,52 @@
+#pragma once
+/// @file
+/// Sharded runs of cfgen (docs/generator.md, "Shards"): `cfgen A B --shard i/K -o PART`
+/// searches one slice of the first level-2 round, the bulk of a run, and writes a part file;
+/// `cfgen merge PART... -o GRAPH.json` checks the parts, finishes the run and writes the
+/// graph, byte for byte the graph of `cfgen A B -o GRAPH.json`.
+
+#include "cfgen/generate.hpp"
+#include "cfgen/witness.hpp"
+
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace cf::tools {
+
+/// What a part file holds.
+struct ShardPart {
+  std::string path;              ///< where it was read from (for messages)
+  GenerateArgs args;             ///< the run's models and options (models as absolute paths)
+  std::string a_given, b_given;  ///< the model paths as typed, written into the graph
+  std::string fingerprint;       ///< of the models' bytes and every option that shapes the graph
+  int index = 0, count = 0;      ///< shard index / count
+  std::size_t candidates = 0;    ///< candidates of the first level-2 round, all shards
+  std::vector<std::pair<std::size_t, gen::Witness>> results;  ///< by candidate index
+};
+
+/// "i/K" with 0 <= i < K <= 4096.
+/// @throws cf::Error naming the text and what is wrong.
+gen::ShardSpec parse_shard(const std::string& text);
+
+/// A hex digest of the models' bytes and the options that shape the graph (not the thread
+/// count, the output path or --quiet).
+/// @throws cf::Error when a model cannot be read.
+std::string run_fingerprint(const GenerateArgs& args);
+
+/// Writes a part file whole or not at all.
+void write_part(const std::string& path, const ShardPart& part);
+/// @throws cf::Error "reading shard part '<path>': <problem>".
+ShardPart read_part(const std::string& path);
+
+/// The first level-2 round's results, one per candidate, from parts that must come from one
+/// run (same fingerprint and shard count) and cover every shard exactly once.
+/// @throws cf::Error naming the parts and the problem.
+std::vector<gen::Witness> gather_parts(const std::vector<ShardPart>& parts);
+
+/// `cfgen merge PART... -o GRAPH.json`: 0 on success.
+int run_merge(const std::vector<std::string>& part_paths, const std::string& out_path, int threads,
+              bool quiet);
+
+}  // namespace cf::tools
