@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Sharded cfgen runs end to end (docs/generator.md, "Shards"): two shards of the cube against
-# the L-block, merged in reverse order from another directory, must give the bundled graph
-# byte for byte; parts that do not make one whole run are refused with a message that names
-# the problem, and nothing is written.
+# Sharded and resumable cfgen runs end to end (docs/generator.md, "Shards", "Checkpoints"):
+# two shards of the cube against the L-block, merged in reverse order from another directory,
+# must give the bundled graph byte for byte, and so must a run resumed from a checkpoint that
+# lost some of its chunks; parts that do not make one whole run and checkpoints of other runs
+# are refused with a message that names the problem, and nothing is written.
 #
 #   cfgen_shard_test.sh CFGEN SOURCE_DIR WORK_DIR
 set -uo pipefail
@@ -63,4 +64,38 @@ cp "$A" a_copy.off
 check "shard of a copy" 0 "" "$cfgen" a_copy.off "$B" --max-pcs 1 --shard 0/1 -o copy.part -q
 echo "# touched" >>a_copy.off
 check "model changed" 1 "are not the files the shards read" "$cfgen" merge copy.part -o g.json
+
+# Checkpoints: a whole run keeps every chunk; with chunks 3 and later removed (as if killed),
+# the rerun resumes the first three and writes the same graph.
+check "checkpointed run" 0 "" env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off \
+  --checkpoint "$work/ck" -o "$work/ck1.json" -q -j 2
+nchunks=$(ls ck/level2_chunk_*.json 2>/dev/null | wc -l)
+if [[ $nchunks -lt 4 ]]; then
+  echo "FAIL the checkpoint holds $nchunks chunks, expected at least 4"
+  fail=1
+fi
+find ck -name 'level2_chunk_*.json' ! -name 'level2_chunk_00000[012].json' -delete
+check "resumed run" 0 "resumed 3 finished chunks of the first level-2 round" \
+  env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off --checkpoint "$work/ck" -o "$work/ck2.json" -j 2
+for g in ck1.json ck2.json; do
+  if cmp -s "$g" "$src/data/graphs/cube_l_block.json"; then
+    echo "ok   $g equals data/graphs/cube_l_block.json"
+  else
+    echo "FAIL $g differs from data/graphs/cube_l_block.json"
+    fail=1
+  fi
+done
+check "checkpoint of other options" 1 "was made from other models or options" \
+  "$cfgen" "$A" "$B" --max-pcs 2 --checkpoint ck -o g.json
+echo "garbage" >ck/level2_chunk_000001.json
+check "damaged chunk" 1 "reading checkpoint chunk '.*level2_chunk_000001.json': not JSON" \
+  env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off --checkpoint "$work/ck" -o "$work/g.json"
+touch not_a_dir
+check "checkpoint is a file" 1 "checkpoint 'not_a_dir': exists and is not a directory" \
+  "$cfgen" "$A" "$B" --checkpoint not_a_dir -o g.json
+check "--checkpoint with --shard" 2 "excludes" "$cfgen" "$A" "$B" --checkpoint ck --shard 0/2 -o g.json
+if [[ -e g.json ]]; then
+  echo "FAIL a refused run wrote g.json"
+  fail=1
+fi
 exit $fail

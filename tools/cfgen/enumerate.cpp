@@ -183,6 +183,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     opt.progress(ev);
   };
   int motion_rounds = 0;
+  bool first_pair_round = true;  // the first level-2 round (sharded, checkpointed)
 
   // given: results computed elsewhere (the shards of the first level-2 round), one per candidate.
   auto run_level = [&](int level, const std::vector<PcSet>& cands,
@@ -197,6 +198,30 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
                     " results of the first level-2 round, but these models and options give " +
                     std::to_string(cands.size()) + " candidates");
       res = *given;
+    } else if (level == 1 && first_pair_round && opt.checkpoint.load) {
+      // In chunks, each kept as soon as it is done: a killed run loses the chunk in flight.
+      const std::size_t n = cands.size(), size = std::max<std::size_t>(1, opt.checkpoint.chunk_size);
+      for (std::size_t begin = 0, chunk = 0; begin < n; begin += size, ++chunk) {
+        const std::size_t end = std::min(n, begin + size);
+        std::vector<Witness> kept;
+        if (opt.checkpoint.load(chunk, begin, end, kept)) {
+          std::copy(kept.begin(), kept.end(), res.begin() + static_cast<std::ptrdiff_t>(begin));
+          continue;
+        }
+        std::function<void(std::size_t)> tick;
+        if (opt.progress)
+          tick = [&, begin](std::size_t done) {
+            ev.done = begin + done;
+            ev.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+            opt.progress(ev);
+          };
+        parallel_for(end - begin, threads,
+                     [&](std::size_t k) { res[begin + k] = search.find(cands[begin + k], seeds_of(cands[begin + k])); },
+                     tick);
+        opt.checkpoint.save(chunk, begin, end,
+                            std::vector<Witness>(res.begin() + static_cast<std::ptrdiff_t>(begin),
+                                                 res.begin() + static_cast<std::ptrdiff_t>(end)));
+      }
     } else {
       parallel_for(cands.size(), threads, [&](std::size_t i) { res[i] = search.find(cands[i], seeds_of(cands[i])); },
                    ticker(ev, t0));
@@ -258,11 +283,10 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     singles_paired = n;
     return c2;
   };
-  bool first_pairs = true;
   auto pairs_level = [&] {
     const std::vector<PcSet> c2 = build_pairs();
-    run_level(1, c2, seeds_from_subsets, first_pairs ? opt.first_pairs : nullptr);
-    first_pairs = false;
+    run_level(1, c2, seeds_from_subsets, first_pair_round ? opt.first_pairs : nullptr);
+    first_pair_round = false;
   };
   std::size_t pairs_tripled = 0;  // valid pairs when the triples were last built
   // Level 3 over every set whose three pairs are valid and that was not searched yet.

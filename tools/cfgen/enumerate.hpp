@@ -20,6 +20,15 @@ struct ShardSpec {
   int count = 0;
 };
 
+/// Keeps the first level-2 round's results in chunks as they are finished, so that a killed
+/// run resumes (cfgen --checkpoint). load: true and `out` filled when chunk [begin, end) was
+/// kept; save: keeps a finished chunk. Chunks do not depend on the thread count.
+struct ChunkStore {
+  std::size_t chunk_size = 2048;
+  std::function<bool(std::size_t chunk, std::size_t begin, std::size_t end, std::vector<Witness>& out)> load;
+  std::function<void(std::size_t chunk, std::size_t begin, std::size_t end, const std::vector<Witness>& results)> save;
+};
+
 struct EnumerateOptions {
   SearchParams search;
   int threads = 0;       // 0: all hardware threads
@@ -31,6 +40,8 @@ struct EnumerateOptions {
   /// candidate order: used instead of searching (cfgen merge). The rest of the run is the
   /// same, so the graph equals an unsharded run's.
   const std::vector<Witness>* first_pairs = nullptr;
+  /// Empty, or where the first level-2 round's finished chunks are kept and found again.
+  ChunkStore checkpoint;
   /// Called now and then while a stage runs, and once when it ends (ProgressEvent::finished);
   /// from one thread at a time. Empty to stay quiet.
   std::function<void(const ProgressEvent&)> progress;

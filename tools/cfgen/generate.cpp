@@ -47,6 +47,16 @@ int run_generate(const GenerateArgs& args) {
   opt.search.min_margin = args.rel.min_margin * diag;
   opt.max_pcs = args.max_pcs;
   opt.shard = args.shard;
+  std::size_t resumed_chunks = 0;
+  if (!args.checkpoint_dir.empty()) {
+    opt.checkpoint = open_checkpoint(args.checkpoint_dir, run_fingerprint(args), inputs);
+    auto load = opt.checkpoint.load;
+    opt.checkpoint.load = [load, &resumed_chunks](std::size_t c, std::size_t b, std::size_t e, std::vector<gen::Witness>& out) {
+      const bool kept = load(c, b, e, out);
+      resumed_chunks += kept ? 1 : 0;
+      return kept;
+    };
+  }
   opt.first_pairs = args.first_pairs;
   const bool terminal = isatty(STDERR_FILENO) != 0;
   gen::ProgressPrinter printer(std::cerr, terminal);
@@ -58,6 +68,9 @@ int run_generate(const GenerateArgs& args) {
     };
   const gen::Enumeration e = gen::enumerate(ai, bi, opt);
   printer.finish();
+  if (resumed_chunks > 0 && !args.quiet)
+    std::cerr << "cfgen: checkpoint '" << args.checkpoint_dir << "': resumed " << resumed_chunks
+              << " finished chunks of the first level-2 round\n";
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (sharded) {
     ShardPart part;

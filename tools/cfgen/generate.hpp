@@ -38,6 +38,8 @@ struct GenerateArgs {
   gen::ShardSpec shard;
   /// cfgen merge: the first level-2 round's results gathered from the parts.
   const std::vector<gen::Witness>* first_pairs = nullptr;
+  /// Non-empty: keep the first level-2 round's finished chunks there and resume from them.
+  std::string checkpoint_dir;
   /// The model names written into the graph's generator record; empty: a_path, b_path.
   std::string a_label, b_label;
 };

@@ -96,9 +96,14 @@ int main(int argc, char** argv) {
                                "search shard i of K of the first level-2 round and write a part file "
                                "for `cfgen merge` instead of the graph")
                     ->type_name("i/K");
+  auto* checkpoint = app.add_option("--checkpoint", gen.checkpoint_dir,
+                                    "keep finished work in DIR; a rerun with the same models and options "
+                                    "resumes from it")
+                         ->type_name("DIR");
+  shard->excludes(checkpoint);
   // Witness-search tolerances and limits (docs/generator.md explains each).
   auto& sp = gen.search;
-  std::vector<CLI::Option*> gen_opts{threads, quiet, shard};
+  std::vector<CLI::Option*> gen_opts{threads, quiet, shard, checkpoint};
   gen_opts.push_back(app.add_option("--max-pcs", gen.max_pcs, "largest CFs to enumerate")
                          ->check(CLI::Range(1, 3))
                          ->capture_default_str());

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <functional>
 #include <set>
 
 namespace cf::tools {
@@ -64,6 +65,58 @@ std::uint64_t fnv1a(std::uint64_t h, const std::string& bytes) {
   return h;
 }
 
+// [index, false] or [index, true, R (9), t (3), clearance, margin]: doubles round-trip exactly.
+nlohmann::json results_json(const std::vector<std::pair<std::size_t, gen::Witness>>& results) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& [i, w] : results) {
+    if (!w.found) {
+      out.push_back({i, false});
+      continue;
+    }
+    nlohmann::json R = nlohmann::json::array(), t = nlohmann::json::array();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) R.push_back(w.pose.R_BA(r, c));
+    for (int r = 0; r < 3; ++r) t.push_back(w.pose.t_BA(r));
+    out.push_back({i, true, R, t, w.clearance, w.margin});
+  }
+  return out;
+}
+
+// The "results" array of `j`; `mine(i)` says whether candidate i may appear in this file.
+std::vector<std::pair<std::size_t, gen::Witness>> parse_results(const nlohmann::json& j, const std::string& path,
+                                                                 const std::string& what,
+                                                                 const std::function<bool(std::size_t)>& mine) {
+  auto bad = [&](const std::string& problem) { throw Error("reading " + what + " '" + path + "': " + problem); };
+  if (!j.contains("results") || !j.at("results").is_array()) bad("missing \"results\" array");
+  std::vector<std::pair<std::size_t, gen::Witness>> out;
+  for (const nlohmann::json& r : j.at("results")) {
+    const std::string where = "result " + std::to_string(out.size());
+    if (!r.is_array() || r.size() < 2 || !r[0].is_number_unsigned() || !r[1].is_boolean())
+      bad(where + ": expected [index, found, ...]");
+    const std::size_t i = r[0].get<std::size_t>();
+    if (!mine(i)) bad(where + ": candidate " + std::to_string(i) + " does not belong in this file");
+    gen::Witness w;
+    w.found = r[1].get<bool>();
+    if (w.found) {
+      if (r.size() != 6 || !r[2].is_array() || r[2].size() != 9 || !r[3].is_array() || r[3].size() != 3 ||
+          !r[4].is_number() || !r[5].is_number())
+        bad(where + ": expected [index, true, R (9 numbers), t (3 numbers), clearance, margin]");
+      for (int k = 0; k < 9; ++k) {
+        if (!r[2][k].is_number()) bad(where + ": R holds a non-number");
+        w.pose.R_BA(k / 3, k % 3) = r[2][k].get<double>();
+      }
+      for (int k = 0; k < 3; ++k) {
+        if (!r[3][k].is_number()) bad(where + ": t holds a non-number");
+        w.pose.t_BA(k) = r[3][k].get<double>();
+      }
+      w.clearance = r[4].get<double>();
+      w.margin = r[5].get<double>();
+    }
+    out.push_back({i, w});
+  }
+  return out;
+}
+
 }  // namespace
 
 gen::ShardSpec parse_shard(const std::string& text) {
@@ -92,18 +145,7 @@ std::string run_fingerprint(const GenerateArgs& args) {
 }
 
 void write_part(const std::string& path, const ShardPart& part) {
-  nlohmann::json results = nlohmann::json::array();
-  for (const auto& [i, w] : part.results) {
-    if (!w.found) {
-      results.push_back({i, false});
-      continue;
-    }
-    nlohmann::json R = nlohmann::json::array(), t = nlohmann::json::array();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) R.push_back(w.pose.R_BA(r, c));
-    for (int r = 0; r < 3; ++r) t.push_back(w.pose.t_BA(r));
-    results.push_back({i, true, R, t, w.clearance, w.margin});
-  }
+  const nlohmann::json results = results_json(part.results);
   const nlohmann::json j = {{"format", kFormat},
                             {"version", kVersion},
                             {"shard", part.index},
@@ -159,33 +201,9 @@ ShardPart read_part(const std::string& path) {
   p.args.load_a.coplanar_rel_tol = field<double>(o, "coplanar_tol_a", path);
   p.args.load_b.coplanar_rel_tol = field<double>(o, "coplanar_tol_b", path);
   p.candidates = field<std::size_t>(j, "candidates", path);
-  if (!j.contains("results") || !j.at("results").is_array()) bad_part(path, "missing \"results\" array");
-  for (const nlohmann::json& r : j.at("results")) {
-    const std::string where = "result " + std::to_string(p.results.size());
-    if (!r.is_array() || r.size() < 2 || !r[0].is_number_unsigned() || !r[1].is_boolean())
-      bad_part(path, where + ": expected [index, found, ...]");
-    const std::size_t i = r[0].get<std::size_t>();
-    if (i >= p.candidates || i % static_cast<std::size_t>(p.count) != static_cast<std::size_t>(p.index))
-      bad_part(path, where + ": candidate " + std::to_string(i) + " is not one of this shard's");
-    gen::Witness w;
-    w.found = r[1].get<bool>();
-    if (w.found) {
-      if (r.size() != 6 || !r[2].is_array() || r[2].size() != 9 || !r[3].is_array() || r[3].size() != 3 ||
-          !r[4].is_number() || !r[5].is_number())
-        bad_part(path, where + ": expected [index, true, R (9 numbers), t (3 numbers), clearance, margin]");
-      for (int k = 0; k < 9; ++k) {
-        if (!r[2][k].is_number()) bad_part(path, where + ": R holds a non-number");
-        w.pose.R_BA(k / 3, k % 3) = r[2][k].get<double>();
-      }
-      for (int k = 0; k < 3; ++k) {
-        if (!r[3][k].is_number()) bad_part(path, where + ": t holds a non-number");
-        w.pose.t_BA(k) = r[3][k].get<double>();
-      }
-      w.clearance = r[4].get<double>();
-      w.margin = r[5].get<double>();
-    }
-    p.results.push_back({i, w});
-  }
+  p.results = parse_results(j, path, "shard part", [&](std::size_t i) {
+    return i < p.candidates && i % static_cast<std::size_t>(p.count) == static_cast<std::size_t>(p.index);
+  });
   return p;
 }
 
@@ -222,6 +240,70 @@ std::vector<gen::Witness> gather_parts(const std::vector<ShardPart>& parts) {
       throw Error("merging shards: no part holds candidate " + std::to_string(i) + " (shard " +
                   std::to_string(i % static_cast<std::size_t>(first.count)) + " is incomplete)");
   return all;
+}
+
+gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& fingerprint,
+                               const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw Error("checkpoint '" + dir + "': exists and is not a directory");
+  fs::create_directories(dir, ec);
+  if (ec) throw Error("checkpoint '" + dir + "': cannot create the directory (" + ec.message() + ")");
+  const std::string manifest = (fs::path(dir) / "checkpoint.json").string();
+  std::string bytes, why;
+  if (fs::exists(manifest, ec)) {
+    if (!read_input_file(manifest, bytes, why)) throw Error("checkpoint '" + manifest + "': " + why);
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(bytes);
+    } catch (const nlohmann::json::parse_error&) {
+      throw Error("checkpoint '" + manifest + "': not JSON; not a cfgen checkpoint");
+    }
+    if (!j.is_object() || j.value("format", std::string()) != "cfgen checkpoint")
+      throw Error("checkpoint '" + manifest + "': not a cfgen checkpoint");
+    if (j.value("fingerprint", std::string()) != fingerprint)
+      throw Error("checkpoint '" + dir +
+                  "' was made from other models or options; use another directory, or remove it to start over");
+  } else {
+    const nlohmann::json j = {{"format", "cfgen checkpoint"}, {"version", kVersion}, {"fingerprint", fingerprint}};
+    write_outputs({{manifest, j.dump() + "\n"}}, inputs, "writing checkpoint");
+  }
+  gen::ChunkStore store;
+  auto chunk_path = [dir](std::size_t chunk) {
+    char name[48];
+    std::snprintf(name, sizeof name, "level2_chunk_%06zu.json", chunk);
+    return (fs::path(dir) / name).string();
+  };
+  store.load = [=](std::size_t chunk, std::size_t begin, std::size_t end, std::vector<gen::Witness>& out) {
+    const std::string path = chunk_path(chunk);
+    std::error_code e;
+    if (!fs::exists(path, e)) return false;
+    std::string text, reason;
+    if (!read_input_file(path, text, reason)) throw Error("reading checkpoint chunk '" + path + "': " + reason);
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(text);
+    } catch (const nlohmann::json::parse_error&) {
+      throw Error("reading checkpoint chunk '" + path + "': not JSON (remove it to search the chunk again)");
+    }
+    if (!j.is_object() || j.value("fingerprint", std::string()) != fingerprint ||
+        j.value("begin", std::size_t{0}) != begin || j.value("end", std::size_t{0}) != end)
+      throw Error("reading checkpoint chunk '" + path + "': made by another run (remove it to search the chunk again)");
+    const auto results = parse_results(j, path, "checkpoint chunk", [&](std::size_t i) { return i >= begin && i < end; });
+    if (results.size() != end - begin) throw Error("reading checkpoint chunk '" + path + "': incomplete");
+    out.assign(end - begin, gen::Witness());
+    for (const auto& [i, w] : results) out[i - begin] = w;
+    return true;
+  };
+  store.save = [=](std::size_t chunk, std::size_t begin, std::size_t end, const std::vector<gen::Witness>& res) {
+    std::vector<std::pair<std::size_t, gen::Witness>> indexed;
+    for (std::size_t k = 0; k < res.size(); ++k) indexed.push_back({begin + k, res[k]});
+    const nlohmann::json j = {{"fingerprint", fingerprint}, {"chunk", chunk}, {"begin", begin}, {"end", end},
+                              {"results", results_json(indexed)}};
+    write_outputs({{chunk_path(chunk), j.dump() + "\n"}}, inputs, "writing checkpoint");
+  };
+  return store;
 }
 
 int run_merge(const std::vector<std::string>& part_paths, const std::string& out_path, int threads,

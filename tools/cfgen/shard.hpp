@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Sharded runs of cfgen (docs/generator.md, "Shards"): `cfgen A B --shard i/K -o PART`
+/// Sharded and resumable runs of cfgen (docs/generator.md, "Shards"): `cfgen A B --shard i/K -o PART`
 /// searches one slice of the first level-2 round, the bulk of a run, and writes a part file;
 /// `cfgen merge PART... -o GRAPH.json` checks the parts, finishes the run and writes the
 /// graph, byte for byte the graph of `cfgen A B -o GRAPH.json`.
@@ -44,6 +44,14 @@ ShardPart read_part(const std::string& path);
 /// run (same fingerprint and shard count) and cover every shard exactly once.
 /// @throws cf::Error naming the parts and the problem.
 std::vector<gen::Witness> gather_parts(const std::vector<ShardPart>& parts);
+
+/// cfgen --checkpoint DIR: creates DIR and its manifest (checkpoint.json, the run's
+/// fingerprint), or reopens it; the store keeps the first level-2 round's finished chunks
+/// there (level2_chunk_NNNNNN.json), each written whole.
+/// @throws cf::Error when DIR is not a directory, holds another run's checkpoint, or a kept
+/// chunk is damaged.
+gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& fingerprint,
+                               const std::vector<std::string>& inputs);
 
 /// `cfgen merge PART... -o GRAPH.json`: 0 on success.
 int run_merge(const std::vector<std::string>& part_paths, const std::string& out_path, int threads,
