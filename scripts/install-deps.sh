@@ -19,8 +19,8 @@ CF_APT_PACKAGES=(
   libboost-dev libboost-graph-dev nlohmann-json3-dev libeigen3-dev
   # tools/: command lines, JSON Schema checks
   libcli11-dev libvalijson-dev
-  # tools/cfgen: linear programs of the witness search
-  libglpk-dev
+  # tools/cfgen: linear programs of the witness search; `mpirun -n K cfgen` (Open MPI)
+  libglpk-dev libopenmpi-dev openmpi-bin
   # tests/ and bench/
   catch2 libbenchmark-dev libfcl-dev
   # the sanitizer and fuzz build (scripts/sanitize.sh, scripts/fuzz.sh): clang, its

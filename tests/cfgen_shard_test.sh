@@ -5,11 +5,13 @@
 # lost some of its chunks; parts that do not make one whole run and checkpoints of other runs
 # are refused with a message that names the problem, and nothing is written.
 #
-#   cfgen_shard_test.sh CFGEN SOURCE_DIR WORK_DIR
+#   cfgen_shard_test.sh CFGEN SOURCE_DIR WORK_DIR [MPIEXEC]
+# With MPIEXEC (cfgen built with MPI): `mpirun -n 2 cfgen` must write the same graph.
 set -uo pipefail
 cfgen="$1"
 src="$2"
 work="$3/cfgen_shard"
+mpiexec="${4:-}"
 rm -rf "$work"
 mkdir -p "$work/elsewhere"
 cd "$work" || exit 1
@@ -64,6 +66,19 @@ cp "$A" a_copy.off
 check "shard of a copy" 0 "" "$cfgen" a_copy.off "$B" --max-pcs 1 --shard 0/1 -o copy.part -q
 echo "# touched" >>a_copy.off
 check "model changed" 1 "are not the files the shards read" "$cfgen" merge copy.part -o g.json
+
+if [[ -n $mpiexec ]]; then
+  check "mpirun -n 2" 0 "" env -C "$src" "$mpiexec" -n 2 --oversubscribe --allow-run-as-root "$cfgen" \
+    data/models/cube.off data/models/l_block.off -o "$work/mpi.json" -q -j 1
+  if cmp -s mpi.json "$src/data/graphs/cube_l_block.json"; then
+    echo "ok   mpirun -n 2: the graph equals data/graphs/cube_l_block.json"
+  else
+    echo "FAIL mpirun -n 2: the graph differs from data/graphs/cube_l_block.json"
+    fail=1
+  fi
+else
+  echo "skip mpirun (cfgen built without MPI)"
+fi
 
 # Checkpoints: a whole run keeps every chunk; with chunks 3 and later removed (as if killed),
 # the rerun resumes the first three and writes the same graph.

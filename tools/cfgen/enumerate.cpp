@@ -361,25 +361,33 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   // Levels and motion to a fixed point: a single PC or a pair that only motion found takes
   // part in the levels above it like any other (a CF's subsets need not be found first).
   if (opt.shard.count > 0) {
-    // One shard of the first level-2 round: its candidates only, results by index.
+    // Shards of the first level-2 round: their candidates only, results by index. One shard,
+    // or (opt.shard.next) as many as the provider hands out, level 1 done once.
     const std::vector<PcSet> c2 = opt.max_pcs >= 2 ? build_pairs() : std::vector<PcSet>{};
-    std::vector<std::size_t> mine;
-    for (std::size_t i = static_cast<std::size_t>(opt.shard.index); i < c2.size(); i += static_cast<std::size_t>(opt.shard.count))
-      mine.push_back(i);
-    std::vector<Witness> res(mine.size());
-    const auto t0 = Clock::now();
-    ProgressEvent ev{"level 2, shard " + std::to_string(opt.shard.index) + "/" + std::to_string(opt.shard.count),
-                     "candidate sets", 0, mine.size(), 0, false, {}};
-    parallel_for(mine.size(), threads,
-                 [&](std::size_t k) { res[k] = search.find(c2[mine[k]], seeds_from_subsets(c2[mine[k]])); },
-                 ticker(ev, t0));
-    std::size_t found = 0;
-    for (std::size_t k = 0; k < mine.size(); ++k) {
-      found += res[k].found ? 1 : 0;
-      out.shard_results.push_back({mine[k], res[k]});
-    }
-    finished(ev, t0, std::to_string(found) + " valid");
     out.first_pair_candidates = c2.size();
+    bool single_done = false;
+    for (;;) {
+      int index = -1;
+      if (opt.shard.next) index = opt.shard.next();
+      else if (!single_done) index = opt.shard.index, single_done = true;
+      if (index < 0) break;
+      std::vector<std::size_t> mine;
+      for (std::size_t i = static_cast<std::size_t>(index); i < c2.size(); i += static_cast<std::size_t>(opt.shard.count))
+        mine.push_back(i);
+      std::vector<Witness> res(mine.size());
+      const auto t0 = Clock::now();
+      ProgressEvent ev{"level 2, shard " + std::to_string(index) + "/" + std::to_string(opt.shard.count),
+                       "candidate sets", 0, mine.size(), 0, false, {}};
+      parallel_for(mine.size(), threads,
+                   [&](std::size_t k) { res[k] = search.find(c2[mine[k]], seeds_from_subsets(c2[mine[k]])); },
+                   ticker(ev, t0));
+      std::size_t found = 0;
+      for (std::size_t k = 0; k < mine.size(); ++k) {
+        found += res[k].found ? 1 : 0;
+        out.shard_results.push_back({mine[k], res[k]});
+      }
+      finished(ev, t0, std::to_string(found) + " valid");
+    }
     return out;
   }
   for (;;) {

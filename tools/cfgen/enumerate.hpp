@@ -18,6 +18,9 @@ namespace cf::gen {
 struct ShardSpec {
   int index = 0;
   int count = 0;
+  /// When set, the shards to search are handed out one at a time (-1: no more) instead of
+  /// `index` alone: the processes of an MPI run share them dynamically.
+  std::function<int()> next;
 };
 
 /// Keeps the first level-2 round's results in chunks as they are finished, so that a killed

@@ -27,8 +27,8 @@ int run_generate(const GenerateArgs& args) {
   // the models (SPEC section 5b).
   const std::vector<std::string> inputs{args.a_path, args.b_path};
   const bool sharded = args.shard.count > 0;
-  check_output_path(args.out_path, inputs, sharded ? "writing shard part" : "writing graph");
-  const std::string fingerprint = sharded ? run_fingerprint(args) : std::string();
+  if (!args.shard_sink) check_output_path(args.out_path, inputs, sharded ? "writing shard part" : "writing graph");
+  const std::string fingerprint = sharded && !args.shard_sink ? run_fingerprint(args) : std::string();
   const Polyhedron A = load_model(args.a_path, args.load_a);
   const Polyhedron B = load_model(args.b_path, args.load_b);
   for (const auto& [m, which, option] : {std::tuple{&A, "A", "--units-a"}, std::tuple{&B, "B", "--units-b"}})
@@ -72,6 +72,10 @@ int run_generate(const GenerateArgs& args) {
     std::cerr << "cfgen: checkpoint '" << args.checkpoint_dir << "': resumed " << resumed_chunks
               << " finished chunks of the first level-2 round\n";
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (sharded && args.shard_sink) {
+    args.shard_sink(e.first_pair_candidates, e.shard_results);
+    return 0;
+  }
   if (sharded) {
     ShardPart part;
     part.args = args;

@@ -8,7 +8,10 @@
 #include "cfgen/witness.hpp"
 #include "mesh/model_loader.hpp"
 
+#include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace cf::tools {
 
@@ -36,6 +39,9 @@ struct GenerateArgs {
   /// With shard.count > 0: search one shard of the first level-2 round and write a part file
   /// to out_path instead of the graph (cfgen/shard.hpp).
   gen::ShardSpec shard;
+  /// With shard.count > 0 and this set, the shard results go here instead of a part file
+  /// (an MPI run gathers them in memory): (candidates of the first round, results by index).
+  std::function<void(std::size_t, const std::vector<std::pair<std::size_t, gen::Witness>>&)> shard_sink;
   /// cfgen merge: the first level-2 round's results gathered from the parts.
   const std::vector<gen::Witness>* first_pairs = nullptr;
   /// Non-empty: keep the first level-2 round's finished chunks there and resume from them.

@@ -5,6 +5,9 @@
 
 #include "cfgen/generate.hpp"
 #include "cfgen/shard.hpp"
+#ifdef CF_HAVE_MPI
+#include "cfgen/mpi_run.hpp"
+#endif
 #include "mesh/model_loader.hpp"
 #include "cli_checks.hpp"
 
@@ -186,6 +189,15 @@ int main(int argc, char** argv) {
     if (!units_a.empty()) gen.load_a.units = units_a;
     if (!units_b.empty()) gen.load_b.units = units_b;
 #ifdef CF_HAVE_GENERATOR
+#ifdef CF_HAVE_MPI
+    if (cf::tools::launched_by_mpi()) {
+      if (gen.shard.count > 0 || !gen.checkpoint_dir.empty()) {
+        std::cerr << "cfgen: --shard and --checkpoint are for runs outside mpirun\n";
+        return 2;
+      }
+      return cf::tools::run_generate_mpi(gen);
+    }
+#endif
     return cf::tools::run_generate(gen);
 #else
     std::cerr << "cfgen: graph generation is not built yet\n";

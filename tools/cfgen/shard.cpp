@@ -127,7 +127,10 @@ gen::ShardSpec parse_shard(const std::string& text) {
   if (k < 1 || k > kMaxShards)
     throw Error("--shard '" + printable(text) + "': K must be in 1.." + std::to_string(kMaxShards));
   if (i < 0 || i >= k) throw Error("--shard '" + printable(text) + "': i must be in 0.." + std::to_string(k - 1));
-  return {i, k};
+  gen::ShardSpec spec;
+  spec.index = i;
+  spec.count = k;
+  return spec;
 }
 
 std::string run_fingerprint(const GenerateArgs& args) {
@@ -240,6 +243,21 @@ std::vector<gen::Witness> gather_parts(const std::vector<ShardPart>& parts) {
       throw Error("merging shards: no part holds candidate " + std::to_string(i) + " (shard " +
                   std::to_string(i % static_cast<std::size_t>(first.count)) + " is incomplete)");
   return all;
+}
+
+std::string results_text(const std::vector<std::pair<std::size_t, gen::Witness>>& results) {
+  return nlohmann::json{{"results", results_json(results)}}.dump();
+}
+
+std::vector<std::pair<std::size_t, gen::Witness>> results_from_text(const std::string& text, const std::string& what,
+                                                                    std::size_t candidates) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw Error("reading " + what + ": not JSON (" + e.what() + ")");
+  }
+  return parse_results(j, what, "shard results", [&](std::size_t i) { return i < candidates; });
 }
 
 gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& fingerprint,

@@ -53,6 +53,14 @@ std::vector<gen::Witness> gather_parts(const std::vector<ShardPart>& parts);
 gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& fingerprint,
                                const std::vector<std::string>& inputs);
 
+/// Shard results as text and back (an MPI run sends them to rank 0 this way); doubles
+/// round-trip exactly.
+/// @throws cf::Error "reading <what>: <problem>" when the text is not such results or names a
+/// candidate >= candidates.
+std::string results_text(const std::vector<std::pair<std::size_t, gen::Witness>>& results);
+std::vector<std::pair<std::size_t, gen::Witness>> results_from_text(const std::string& text, const std::string& what,
+                                                                    std::size_t candidates);
+
 /// `cfgen merge PART... -o GRAPH.json`: 0 on success.
 int run_merge(const std::vector<std::string>& part_paths, const std::string& out_path, int threads,
               bool quiet);
