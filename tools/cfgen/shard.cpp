@@ -37,6 +37,17 @@ nlohmann::json options_json(const GenerateArgs& a) {
           {"coplanar_tol_b", a.load_b.coplanar_rel_tol}};
 }
 
+// The JSON document in file `path`; errors read "<what> '<path>': <reason><hint>".
+nlohmann::json read_json_file(const std::string& path, const std::string& what, const std::string& hint = "") {
+  std::string bytes, why;
+  if (!read_input_file(path, bytes, why)) throw Error(what + " '" + path + "': " + why);
+  try {
+    return nlohmann::json::parse(bytes);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw Error(what + " '" + path + "': not JSON (" + e.what() + ")" + hint);
+  }
+}
+
 [[noreturn]] void bad_part(const std::string& path, const std::string& problem) {
   throw Error("reading shard part '" + path + "': " + problem);
 }
@@ -164,14 +175,7 @@ void write_part(const std::string& path, const ShardPart& part) {
 }
 
 ShardPart read_part(const std::string& path) {
-  std::string bytes, why;
-  if (!read_input_file(path, bytes, why)) bad_part(path, why);
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(bytes);
-  } catch (const nlohmann::json::parse_error& e) {
-    bad_part(path, std::string("not JSON (") + e.what() + ")");
-  }
+  const nlohmann::json j = read_json_file(path, "reading shard part");
   if (!j.is_object() || j.value("format", std::string()) != kFormat)
     bad_part(path, "not a cfgen shard part (no \"format\": \"cfgen shard part\")");
   const int version = field<int>(j, "version", path);
@@ -269,15 +273,8 @@ gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& finge
   fs::create_directories(dir, ec);
   if (ec) throw Error("checkpoint '" + dir + "': cannot create the directory (" + ec.message() + ")");
   const std::string manifest = (fs::path(dir) / "checkpoint.json").string();
-  std::string bytes, why;
   if (fs::exists(manifest, ec)) {
-    if (!read_input_file(manifest, bytes, why)) throw Error("checkpoint '" + manifest + "': " + why);
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(bytes);
-    } catch (const nlohmann::json::parse_error&) {
-      throw Error("checkpoint '" + manifest + "': not JSON; not a cfgen checkpoint");
-    }
+    const nlohmann::json j = read_json_file(manifest, "checkpoint", "; not a cfgen checkpoint");
     if (!j.is_object() || j.value("format", std::string()) != "cfgen checkpoint")
       throw Error("checkpoint '" + manifest + "': not a cfgen checkpoint");
     if (j.value("fingerprint", std::string()) != fingerprint)
@@ -297,14 +294,8 @@ gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& finge
     const std::string path = chunk_path(chunk);
     std::error_code e;
     if (!fs::exists(path, e)) return false;
-    std::string text, reason;
-    if (!read_input_file(path, text, reason)) throw Error("reading checkpoint chunk '" + path + "': " + reason);
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(text);
-    } catch (const nlohmann::json::parse_error&) {
-      throw Error("reading checkpoint chunk '" + path + "': not JSON (remove it to search the chunk again)");
-    }
+    const nlohmann::json j =
+        read_json_file(path, "reading checkpoint chunk", "; remove it to search the chunk again");
     if (!j.is_object() || j.value("fingerprint", std::string()) != fingerprint ||
         j.value("begin", std::size_t{0}) != begin || j.value("end", std::size_t{0}) != end)
       throw Error("reading checkpoint chunk '" + path + "': made by another run (remove it to search the chunk again)");
