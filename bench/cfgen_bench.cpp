@@ -9,6 +9,7 @@
 // Figures go to docs/performance.md, "Graph generation".
 
 #include "cfgen/enumerate.hpp"
+#include "cfgen/generate.hpp"
 #include "mesh/model_loader.hpp"
 
 #include <benchmark/benchmark.h>
@@ -89,12 +90,7 @@ void BM_NgonPegInHole(benchmark::State& state) {
   const cf::gen::ModelInfo ai = cf::gen::analyse_model(A), bi = cf::gen::analyse_model(B);
   cf::gen::EnumerateOptions opt;
   opt.threads = threads;
-  // cfgen's defaults: lengths relative to the smaller model's bounding-box diagonal.
-  const double diag = std::min((A.bbox_max() - A.bbox_min()).norm(), (B.bbox_max() - B.bbox_min()).norm());
-  opt.search.touch_tol = 2e-11 * diag;
-  opt.search.min_clearance = 2e-4 * diag;
-  opt.search.good_clearance = 2e-2 * diag;
-  opt.search.min_margin = 2e-4 * diag;
+  opt.search = cf::tools::scaled_search(A, B, cf::tools::RelativeLengths{});  // cfgen's defaults
   std::size_t cfs = 0, candidates = 0;
   double seconds = 0;
   for (auto _ : state) {

@@ -5,6 +5,7 @@
 
 #include "cfgen/enumerate.hpp"
 #include "cfgen/explore.hpp"
+#include "cfgen/generate.hpp"
 #include "mesh/model_loader.hpp"
 #include "scratch.hpp"
 
@@ -259,16 +260,9 @@ TEST_CASE("exploring rotations from a vertex on the slab lands an edge", "[explo
 
 namespace {
 
-// The search's lengths as cfgen sets them from the smaller model's bounding-box diagonal D
-// (tools/cfgen/generate.hpp, RelativeLengths defaults).
+// The search's lengths as cfgen sets them from the smaller model's bounding-box diagonal.
 cf::gen::SearchParams params_for(const Polyhedron& A, const Polyhedron& B) {
-  const double D = std::min((A.bbox_max() - A.bbox_min()).norm(), (B.bbox_max() - B.bbox_min()).norm());
-  cf::gen::SearchParams p;
-  p.touch_tol = 2e-11 * D;
-  p.min_clearance = 2e-4 * D;
-  p.good_clearance = 2e-2 * D;
-  p.min_margin = 2e-4 * D;
-  return p;
+  return cf::tools::scaled_search(A, B, cf::tools::RelativeLengths{});
 }
 
 PcSet parse_set(const std::string& text) {

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -20,6 +21,20 @@
 #include <unistd.h>
 
 namespace cf::tools {
+
+double length_scale(const Polyhedron& A, const Polyhedron& B) {
+  return std::min((A.bbox_max() - A.bbox_min()).norm(), (B.bbox_max() - B.bbox_min()).norm());
+}
+
+gen::SearchParams scaled_search(const Polyhedron& A, const Polyhedron& B, const RelativeLengths& rel,
+                                gen::SearchParams base) {
+  const double D = length_scale(A, B);
+  base.touch_tol = rel.touch_tol * D;
+  base.min_clearance = rel.min_clearance * D;
+  base.good_clearance = rel.good_clearance * D;
+  base.min_margin = rel.min_margin * D;
+  return base;
+}
 
 int run_generate(const GenerateArgs& args) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -38,13 +53,9 @@ int run_generate(const GenerateArgs& args) {
 
   gen::EnumerateOptions opt;
   opt.threads = args.threads;
-  opt.search = args.search;
   // Lengths scale with the smaller model (RelativeLengths).
-  const double diag = std::min((A.bbox_max() - A.bbox_min()).norm(), (B.bbox_max() - B.bbox_min()).norm());
-  opt.search.touch_tol = args.rel.touch_tol * diag;
-  opt.search.min_clearance = args.rel.min_clearance * diag;
-  opt.search.good_clearance = args.rel.good_clearance * diag;
-  opt.search.min_margin = args.rel.min_margin * diag;
+  const double diag = length_scale(A, B);
+  opt.search = scaled_search(A, B, args.rel, args.search);
   opt.max_pcs = args.max_pcs;
   opt.shard = args.shard;
   std::size_t resumed_chunks = 0;

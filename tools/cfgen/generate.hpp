@@ -25,6 +25,13 @@ struct RelativeLengths {
   double min_margin = 2e-4;      ///< contact points at least this far inside their elements
 };
 
+/// D in mm: the smaller model's bounding-box diagonal, the unit of RelativeLengths.
+double length_scale(const Polyhedron& A, const Polyhedron& B);
+
+/// `base` with its lengths set to `rel` times length_scale(A, B): the search cfgen runs.
+gen::SearchParams scaled_search(const Polyhedron& A, const Polyhedron& B, const RelativeLengths& rel,
+                                gen::SearchParams base = {});
+
 /// Parsed arguments of `cfgen A_MODEL B_MODEL -o GRAPH.json [options]`.
 struct GenerateArgs {
   std::string a_path;    ///< model of A, the moving object
