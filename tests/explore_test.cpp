@@ -7,6 +7,7 @@
 #include "cfgen/explore.hpp"
 #include "cfgen/generate.hpp"
 #include "mesh/model_loader.hpp"
+#include "fixtures.hpp"
 #include "scratch.hpp"
 
 #include <catch2/catch.hpp>
@@ -69,11 +70,9 @@ Polyhedron l_block() { return cf::tools::load_model(std::string(CF_SOURCE_DIR) +
 
 // The index of the face of m with this outward normal and plane offset.
 int face_of(const Polyhedron& m, const Vec3& n, double offset) {
-  for (std::size_t f = 0; f < m.num_faces(); ++f)
-    if (m.faces()[f].normal.dot(n) > 1 - 1e-12 && std::abs(m.faces()[f].offset - offset) < 1e-9)
-      return static_cast<int>(f);
-  FAIL("no face with that plane");
-  return -1;
+  const int f = cf::test::face_with_plane(m, n, offset);
+  if (f < 0) FAIL("no face with that plane");
+  return f;
 }
 
 int edge_of(const Polyhedron& m, const Vec3& a, const Vec3& b) {
@@ -87,10 +86,9 @@ int edge_of(const Polyhedron& m, const Vec3& a, const Vec3& b) {
 }
 
 int vertex_of(const Polyhedron& m, const Vec3& x) {
-  for (std::size_t v = 0; v < m.num_vertices(); ++v)
-    if ((m.vertices()[v].p - x).norm() < 1e-9) return static_cast<int>(v);
-  FAIL("no such vertex");
-  return -1;
+  const int v = cf::test::vertex_at(m, x);
+  if (v < 0) FAIL("no such vertex");
+  return v;
 }
 
 struct Pair {

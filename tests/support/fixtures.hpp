@@ -4,6 +4,7 @@
 #include <cf/polyhedron.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <set>
 #include <string>
@@ -75,6 +76,21 @@ inline int edge_between(const Polyhedron& m, int v0, int v1) {
     if ((E.v0.value() == v0 && E.v1.value() == v1) || (E.v0.value() == v1 && E.v1.value() == v0))
       return static_cast<int>(e);
   }
+  return -1;
+}
+
+/// Index of the face of m with this outward unit normal and plane offset (mm), or -1.
+inline int face_with_plane(const Polyhedron& m, const Vec3& n, double offset) {
+  for (std::size_t f = 0; f < m.num_faces(); ++f)
+    if (m.faces()[f].normal.dot(n) > 1 - 1e-12 && std::abs(m.faces()[f].offset - offset) < 1e-9)
+      return static_cast<int>(f);
+  return -1;
+}
+
+/// Index of the vertex of m at x (within 1e-9 mm), or -1.
+inline int vertex_at(const Polyhedron& m, const Vec3& x) {
+  for (std::size_t v = 0; v < m.num_vertices(); ++v)
+    if ((m.vertices()[v].p - x).norm() < 1e-9) return static_cast<int>(v);
   return -1;
 }
 

@@ -1,12 +1,14 @@
 #include "enumerate.hpp"
 
 #include "explore.hpp"
+#include "pair_conditions.hpp"
 
 #include <cf/geometry.hpp>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -27,32 +29,6 @@ int element_count(const Polyhedron& m, ElementKind k) {
                           : k == ElementKind::kEdge ? m.num_edges()
                                                     : m.num_faces());
 }
-
-// Rigid-body necessary condition for two PCs: the distance between the two touching points
-// is the same measured in A and in B, so the [min, max] distance ranges of the A elements and
-// of the B elements must meet.
-class DistanceFilter {
- public:
-  DistanceFilter(const Polyhedron& A, const Polyhedron& B) : A_(A), B_(B) {}
-  bool compatible(const Pc& x, const Pc& y) const {
-    const auto [amin, amax] = range(A_, a_kind(x.type), x.a, a_kind(y.type), y.a);
-    const auto [bmin, bmax] = range(B_, b_kind(x.type), x.b, b_kind(y.type), y.b);
-    const double tol = 1e-9 * std::max(A_.size(), B_.size());
-    return amin <= bmax + tol && bmin <= amax + tol;
-  }
-
- private:
-  static std::pair<double, double> range(const Polyhedron& m, ElementKind k1, int i1,
-                                         ElementKind k2, int i2) {
-    const double dmin = element_distance(m, Pose(), k1, i1, m, k2, i2).distance;
-    double dmax = 0;
-    for (const Vec3& p : closure_points(m, k1, i1))
-      for (const Vec3& q : closure_points(m, k2, i2)) dmax = std::max(dmax, (p - q).norm());
-    return {dmin, dmax};
-  }
-  const Polyhedron& A_;
-  const Polyhedron& B_;
-};
 
 // Runs fn(i) for i in [0, n) on `threads` threads; results are written by index, so the
 // output does not depend on the thread count.
@@ -266,20 +242,31 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     return seeds;
   };
 
-  const DistanceFilter dist(A, B);
+  // Rejects only pairs that no pose verify accepts can make hold (pair_conditions.hpp):
+  // ranges widened by more than rounding; normal cones shrunk by verify's local slack.
+  const PairConditions pair_ok(Ai, Bi, 1e-9 * search.scale() + opt.search.touch_tol, 1e-6,
+                               std::asin(search.verified_local_slack()) - 1e-6);
   std::size_t singles_paired = 0;  // valid[0][0, singles_paired) have been paired with each other
   // Level 2 over the valid single PCs not paired yet (with every valid single PC).
   auto build_pairs = [&] {
-    std::vector<PcSet> c2;
     const std::size_t n = valid[0].size();
-    for (std::size_t j = singles_paired; j < n; ++j)
-      for (std::size_t i = 0; i < j; ++i) {
-        const Pc& x = valid[0][i].first[0];
-        const Pc& y = valid[0][j].first[0];
-        PcSet s({x, y});
-        if (seen.count(s) || !dist.compatible(x, y) || !search.plausible(s)) continue;
-        c2.push_back(s);
-      }
+    // Each new single PC against the ones before it, on all cores (the conditions cost
+    // microseconds a pair, and big models have millions of pairs); joined in order.
+    std::vector<std::vector<PcSet>> by_j(n - singles_paired);
+    parallel_for(by_j.size(), threads,
+                 [&](std::size_t k) {
+                   const std::size_t j = singles_paired + k;
+                   const Pc& y = valid[0][j].first[0];
+                   for (std::size_t i = 0; i < j; ++i) {
+                     const Pc& x = valid[0][i].first[0];
+                     PcSet s({x, y});
+                     if (seen.count(s) || !pair_ok.compatible(x, y) || !search.plausible(s)) continue;
+                     by_j[k].push_back(s);
+                   }
+                 },
+                 {});
+    std::vector<PcSet> c2;
+    for (auto& v : by_j) c2.insert(c2.end(), v.begin(), v.end());
     singles_paired = n;
     return c2;
   };

@@ -433,6 +433,8 @@ std::vector<Mat3> WitnessSearch::rotation_candidates(const PcSet& pcs,
   return take_spread(rots, order, p_.max_rotations, generic_seeds);
 }
 
+double WitnessSearch::verified_local_slack() const { return 0.5 * std::sin(p_.angle_margin); }
+
 double WitnessSearch::local_margin(const PcSet& pcs, const Mat3& R) const {
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
@@ -897,7 +899,7 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
   };
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
-  if (local_margin(pcs, pose.R_BA) < std::sin(p_.angle_margin) * 0.5)
+  if (local_margin(pcs, pose.R_BA) < verified_local_slack())
     return reject("locally penetrating");
   // Line and plane PCs need their rotational conditions (a rotation found by a motion may
   // only nearly satisfy them).
@@ -1213,7 +1215,7 @@ bool WitnessSearch::refuted(const PcSet& pcs) const {
   // Finitely many rotations: each must be locally penetrating or leave no room to place the
   // contacts inside their elements (the LP over every combination of convex pieces).
   for (const Mat3& R : rots) {
-    if (local_margin(pcs, R) < std::sin(p_.angle_margin) * 0.5) continue;
+    if (local_margin(pcs, R) < verified_local_slack()) continue;
     std::vector<int> choice(slot_sizes.size(), 0);
     for (std::size_t k = 0; k < combos; ++k) {
       const LpResult r = solve(build_lp(pcs, R, choice));

@@ -85,6 +85,10 @@ class WitnessSearch {
   /// Contact plane of a PC at a pose (unit normal pointing into A, offset along it).
   std::pair<Vec3, double> contact_plane(const Pc& pc, const Pose& pose) const;
 
+  /// The local non-penetration slack (a sine) a verified pose needs at every contact: half
+  /// of sin(angle_margin), the slack the search asks of the rotations it tries.
+  double verified_local_slack() const;
+
   const ModelInfo& a() const { return A_; }
   const ModelInfo& b() const { return B_; }
   const SearchParams& params() const { return p_; }

@@ -1,0 +1,185 @@
+// Tests of the generator's necessary conditions on two PCs (tools/cfgen/pair_conditions.cpp):
+// spherical distances worked out by hand on a cube's normal cones, rejections on the cube
+// against the L-block that follow from one measurement each, and soundness on every CF of the
+// bundled graphs (their witnesses were verified apart from these conditions).
+
+#include "cfgen/pair_conditions.hpp"
+#include "fixtures.hpp"
+#include "mesh/model_loader.hpp"
+
+#include <cf/graph.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+
+using cf::ElementKind;
+using cf::Pc;
+using cf::PcType;
+using cf::Polyhedron;
+using cf::Vec3;
+using cf::gen::NormalCone;
+
+namespace {
+
+// Closed-form angles evaluated with atan2 on unit vectors: rounding only.
+constexpr double kAngle = 1e-12;
+// Widening used by the generator (enumerate.cpp): far above rounding, far below its margins.
+constexpr double kLengthTol = 1e-9;
+constexpr double kAngleTol = 1e-6;
+
+std::string model(const std::string& name) { return std::string(CF_SOURCE_DIR) + "/data/models/" + name; }
+
+struct Pair {
+  Polyhedron A, B;
+  cf::gen::ModelInfo ai, bi;
+  Pair(Polyhedron a, Polyhedron b) : A(std::move(a)), B(std::move(b)) {
+    ai = cf::gen::analyse_model(A);
+    bi = cf::gen::analyse_model(B);
+  }
+  Pair(const Pair&) = delete;
+  cf::gen::PairConditions conditions() const { return {ai, bi, kLengthTol, kAngleTol}; }
+};
+
+}  // namespace
+
+TEST_CASE("the normal cones of a cube: a face's normal, an edge's arc, a corner's octant") {
+  // Cube [-15, 15]^3 (data/models/cube.off).
+  const Pair p(cf::tools::load_model(model("cube.off")), cf::tools::load_model(model("l_block.off")));
+  const auto pc = p.conditions();
+  const int corner = cf::test::vertex_at(p.A, Vec3(15, 15, 15));
+  REQUIRE(corner >= 0);
+  const NormalCone& octant = pc.cone(true, ElementKind::kVertex, corner);
+  REQUIRE(octant.gens.size() == 3);
+  for (const Vec3& g : octant.gens) {
+    CHECK(g.minCoeff() == Approx(0).margin(kAngle));
+    CHECK(g.maxCoeff() == Approx(1).margin(kAngle));
+  }
+  const Vec3 diag = Vec3(1, 1, 1).normalized();
+  CHECK(cf::gen::cone_distance(diag, octant, kAngleTol) == 0);
+  CHECK(cf::gen::cone_distance(Vec3(-1, 0, 0), octant, kAngleTol) == Approx(M_PI / 2).margin(kAngle));
+  // (1, 1, -1) is nearest to (1, 1, 0) on the octant's boundary: acos(sqrt(2/3)).
+  CHECK(cf::gen::cone_distance(Vec3(1, 1, -1).normalized(), octant, kAngleTol) ==
+        Approx(std::acos(std::sqrt(2.0 / 3.0))).margin(kAngle));
+
+  // The edge from (15, 15, -15) to (15, 15, 15): the quarter arc from +x to +y.
+  int edge = -1;
+  for (std::size_t e = 0; e < p.A.num_edges(); ++e) {
+    const Vec3 a = p.A.edge_point(cf::EdgeId(int(e)), 0), b = p.A.edge_point(cf::EdgeId(int(e)), 1);
+    if (a.x() > 14 && a.y() > 14 && b.x() > 14 && b.y() > 14) edge = static_cast<int>(e);
+  }
+  REQUIRE(edge >= 0);
+  const NormalCone& arc = pc.cone(true, ElementKind::kEdge, edge);
+  REQUIRE(arc.gens.size() == 2);
+  CHECK(cf::gen::cone_distance(Vec3(0, 0, 1), arc, kAngleTol) == Approx(M_PI / 2).margin(kAngle));
+  CHECK(cf::gen::cone_distance(diag, arc, kAngleTol) == Approx(std::asin(1 / std::sqrt(3.0))).margin(kAngle));
+  CHECK(cf::gen::cone_distance(Vec3(-1, 0, 0), arc, kAngleTol) == Approx(M_PI / 2).margin(kAngle));
+  CHECK(cf::gen::cone_distance(Vec3(-1, -1, 0).normalized(), arc, kAngleTol) ==
+        Approx(3 * M_PI / 4).margin(kAngle));
+
+  // Two opposite corners' octants: u >= 0 and v <= 0 componentwise give u . v <= 0.
+  const int opposite = cf::test::vertex_at(p.A, Vec3(-15, -15, -15));
+  REQUIRE(opposite >= 0);
+  CHECK(cf::gen::cone_cone_distance(octant, pc.cone(true, ElementKind::kVertex, opposite), kAngleTol) ==
+        Approx(M_PI / 2).margin(kAngle));
+  // An octant and its own edge's arc meet.
+  CHECK(cf::gen::cone_cone_distance(octant, arc, kAngleTol) == 0);
+}
+
+TEST_CASE("two PCs are rejected when a distance, an angle or a height has no common value") {
+  // A: cube [-15, 15]^3. B: the L-block, slab 0 <= y <= 20 over x in [0, 120], wall
+  // 0 <= x <= 20 up to y = 80, both 80 deep along z.
+  const Pair p(cf::tools::load_model(model("cube.off")), cf::tools::load_model(model("l_block.off")));
+  const auto pc = p.conditions();
+  const int a_bottom = cf::test::face_with_plane(p.A, Vec3(0, -1, 0), 15);
+  const int a_top = cf::test::face_with_plane(p.A, Vec3(0, 1, 0), 15);
+  const int a_left = cf::test::face_with_plane(p.A, Vec3(-1, 0, 0), 15);
+  const int slab_top = cf::test::face_with_plane(p.B, Vec3(0, 1, 0), 20);
+  const int wall_side = cf::test::face_with_plane(p.B, Vec3(1, 0, 0), 20);
+  const int wall_top = cf::test::face_with_plane(p.B, Vec3(0, 1, 0), 80);
+  const int slab_end = cf::test::face_with_plane(p.B, Vec3(1, 0, 0), 120);
+  REQUIRE(std::min({a_bottom, a_top, a_left, slab_top, wall_side, wall_top, slab_end}) >= 0);
+
+  // The cube in the inner corner: bottom on the slab, left face on the wall. Valid.
+  CHECK(pc.compatible(Pc{PcType::kFF, a_bottom, slab_top}, Pc{PcType::kFF, a_left, wall_side}));
+  // Angle: A's bottom and top are antiparallel (pi), the slab's top and the wall's side are
+  // at pi/2.
+  CHECK_FALSE(pc.compatible(Pc{PcType::kFF, a_bottom, slab_top}, Pc{PcType::kFF, a_top, wall_side}));
+  // Distance: the wall's side (x = 20, y >= 20) and the slab's far end (x = 120, y <= 20)
+  // are 100 mm apart, more than the cube's diagonal (52 mm); a corner of A's left face
+  // cannot reach the end. (A height over either plane is at most that distance, so the
+  // heights reject it too.)
+  const int left_corner = cf::test::vertex_at(p.A, Vec3(-15, 15, 15));
+  REQUIRE(left_corner >= 0);
+  CHECK_FALSE(pc.compatible(Pc{PcType::kFF, a_left, wall_side}, Pc{PcType::kVF, left_corner, slab_end}));
+  CHECK(pc.compatible(Pc{PcType::kFF, a_left, wall_side}, Pc{PcType::kVF, left_corner, slab_top}));
+  // Height: with the cube's bottom on the slab (y = 20), its top vertices are at y = 50, but
+  // the wall's top is at y = 80 (its distance from the slab's top, 60 mm, is within the
+  // cube's diagonal, so only the height tells).
+  const int top_corner = cf::test::vertex_at(p.A, Vec3(15, 15, 15));
+  REQUIRE(top_corner >= 0);
+  CHECK_FALSE(pc.compatible(Pc{PcType::kFF, a_bottom, slab_top}, Pc{PcType::kVF, top_corner, wall_top}));
+  CHECK_FALSE(pc.compatible(Pc{PcType::kVF, top_corner, wall_top}, Pc{PcType::kFF, a_bottom, slab_top}));
+  // The same corner against the wall's side: heights 0 to 60 over the slab hold 30.
+  CHECK(pc.compatible(Pc{PcType::kFF, a_bottom, slab_top}, Pc{PcType::kVF, top_corner, wall_side}));
+}
+
+TEST_CASE("the cones shrunk by the verified slack exclude normals at a cone's boundary") {
+  const Pair p(cf::tools::load_model(model("cube.off")), cf::tools::load_model(model("l_block.off")));
+  constexpr double kMargin = 5e-4;  // rad, about the generator's default (half of 1e-3)
+  const cf::gen::PairConditions shrunk(p.ai, p.bi, kLengthTol, kAngleTol, kMargin);
+  const double s = std::sin(kMargin);
+  // The corner (15, 15, 15): the octant u >= sin(margin) componentwise, corners (s, s, c).
+  const NormalCone& octant = shrunk.cone(true, ElementKind::kVertex, cf::test::vertex_at(p.A, Vec3(15, 15, 15)));
+  REQUIRE(octant.gens.size() == 3);
+  for (const Vec3& g : octant.gens) {
+    CHECK(g.minCoeff() == Approx(s).margin(kAngle));
+    CHECK(g.maxCoeff() == Approx(std::sqrt(1 - 2 * s * s)).margin(kAngle));
+  }
+  CHECK(cf::gen::cone_distance(Vec3(1, 1, 0).normalized(), octant, 0) > 0.99 * kMargin);
+
+  const int a_bottom = cf::test::face_with_plane(p.A, Vec3(0, -1, 0), 15);
+  const int slab_top = cf::test::face_with_plane(p.B, Vec3(0, 1, 0), 20);
+  const int wall_side = cf::test::face_with_plane(p.B, Vec3(1, 0, 0), 20);
+  int bottom_left = -1;  // the edge from (-15, -15, -15) to (-15, -15, 15)
+  for (std::size_t e = 0; e < p.A.num_edges(); ++e) {
+    const Vec3 a = p.A.edge_point(cf::EdgeId(int(e)), 0), b = p.A.edge_point(cf::EdgeId(int(e)), 1);
+    if (a.x() < -14 && a.y() < -14 && b.x() < -14 && b.y() < -14) bottom_left = static_cast<int>(e);
+  }
+  REQUIRE(bottom_left >= 0);
+  // The cube's bottom on the slab and its bottom-left edge on the wall's side: the edge's
+  // normal must be -x, the end of its arc, i.e. the left face lies on the wall and the edge
+  // is no principal contact. The exact cones allow it (the angle ranges touch at pi/2); the
+  // shrunk ones do not.
+  const Pc ff{PcType::kFF, a_bottom, slab_top}, ef{PcType::kEF, bottom_left, wall_side};
+  CHECK(p.conditions().compatible(ff, ef));
+  CHECK_FALSE(shrunk.compatible(ff, ef));
+}
+
+TEST_CASE("every pair of PCs of every CF of the bundled graphs passes") {
+  // The graphs' CFs have verified witnesses (contact normals at least the generator's slack,
+  // about 5e-4 rad, inside their cones): a rejected pair among them would be a set the conditions
+  // throw away although the generator can verify it.
+  for (const char* name : {"cube_l_block.json", "cube_corner_block.json", "peg_hole_block.json"}) {
+    INFO(name);
+    const cf::CfGraph g = cf::CfGraph::load(std::string(CF_SOURCE_DIR) + "/data/graphs/" + name);
+    const Pair p(g.model_a(), g.model_b());
+    // As enumerate.cpp builds them for the default --angle-margin (1e-3 rad).
+    const cf::gen::PairConditions pc(p.ai, p.bi, kLengthTol, kAngleTol, std::asin(0.5 * std::sin(1e-3)) - kAngleTol);
+    std::size_t pairs = 0, rejected = 0;
+    for (std::size_t i = 0; i < g.num_cfs(); ++i) {
+      const cf::PcSet& s = g.cf(cf::CfId(static_cast<int>(i))).pcs;
+      for (int x = 0; x < s.size(); ++x)
+        for (int y = x + 1; y < s.size(); ++y) {
+          ++pairs;
+          if (!pc.compatible(s[x], s[y]) || !pc.compatible(s[y], s[x])) {
+            ++rejected;
+            UNSCOPED_INFO("rejected " << cf::to_string(s[x]) << " with " << cf::to_string(s[y]));
+          }
+        }
+    }
+    CHECK(pairs > 500);
+    CHECK(rejected == 0);
+  }
+}
