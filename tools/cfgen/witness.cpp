@@ -787,6 +787,45 @@ Pc pc_of(const PcSet& pcs, ElementKind ka, int a, ElementKind kb, int b) {
 
 constexpr ElementKind kKinds[] = {ElementKind::kVertex, ElementKind::kEdge, ElementKind::kFace};
 
+// Lower bounds on the distance between an element of A and an element of B at one pose, from
+// a face's plane: when every vertex of the other element's closure lies on one side of it,
+// the two are at least the nearest vertex's height apart. Computed before the exact distance,
+// which locates points in faces (the bulk of verify's and contacts_at's time on big faces).
+class PlaneBound {
+ public:
+  PlaneBound(const Polyhedron& A, const Polyhedron& B, const Pose& pose) : A_(A), B_(B) {
+    a_in_b_.reserve(A.num_vertices());
+    for (const Vertex& v : A.vertices()) a_in_b_.push_back(pose.apply(v.p));
+    b_in_a_.reserve(B.num_vertices());
+    for (const Vertex& v : B.vertices()) b_in_a_.push_back(pose.inverse_apply(v.p));
+  }
+  double lower(ElementKind ka, int a, ElementKind kb, int b) const {
+    double lb = 0;
+    if (kb == ElementKind::kFace) lb = std::max(lb, side(B_.faces()[b], A_, ka, a, a_in_b_));
+    if (ka == ElementKind::kFace) lb = std::max(lb, side(A_.faces()[a], B_, kb, b, b_in_a_));
+    return lb;
+  }
+
+ private:
+  // Smallest height of element (k, i) of m (vertices given in f's frame) over f's plane when
+  // all of them are on one side, else 0.
+  static double side(const Face& f, const Polyhedron& m, ElementKind k, int i, const std::vector<Vec3>& pts) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    auto add = [&](VertexId v) {
+      const double h = f.normal.dot(pts[v.index()]) - f.offset;
+      lo = std::min(lo, h);
+      hi = std::max(hi, h);
+    };
+    if (k == ElementKind::kVertex) add(VertexId(i));
+    else if (k == ElementKind::kEdge) add(m.edges()[i].v0), add(m.edges()[i].v1);
+    else for (VertexId v : m.faces()[i].vertices) add(v);
+    return lo > 0 ? lo : hi < 0 ? -hi : 0.0;
+  }
+  const Polyhedron& A_;
+  const Polyhedron& B_;
+  std::vector<Vec3> a_in_b_, b_in_a_;
+};
+
 }  // namespace
 
 bool WitnessSearch::cones_disjoint(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b) const {
@@ -920,17 +959,19 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
   std::vector<double> a_vertex_gap(A.num_vertices(), clearance);
   std::vector<double> b_vertex_gap(B.num_vertices(), clearance);
   int touching_pcs = 0;
+  const PlaneBound planes(A, B, pose);
   for (ElementKind ka : kKinds)
     for (ElementKind kb : kKinds) {
       const int na = count(A, ka), nb = count(B, kb);
       for (int a = 0; a < na; ++a)
         for (int b = 0; b < nb; ++b) {
-          // Pairs whose bounding spheres are farther apart than good_clearance can neither
-          // touch nor lower the clearance below what counts as good: skip the exact test.
+          // Pairs whose bounding spheres, or a face's plane, keep them farther apart than
+          // good_clearance can neither touch nor lower the clearance below what counts as
+          // good: skip the exact test.
           const auto& sa = A_.spheres[static_cast<int>(ka)][a];
           const auto& sb = B_.spheres[static_cast<int>(kb)][b];
           const double lower = (pose.apply(sa.first) - sb.first).norm() - sa.second - sb.second;
-          if (lower > p_.good_clearance) continue;
+          if (lower > p_.good_clearance || planes.lower(ka, a, kb, b) > p_.good_clearance) continue;
           const double d = element_distance(A, pose, ka, a, B, kb, b).distance;
           if (ka == ElementKind::kVertex) a_vertex_gap[a] = std::min(a_vertex_gap[a], d);
           if (kb == ElementKind::kVertex) b_vertex_gap[b] = std::min(b_vertex_gap[b], d);
@@ -991,6 +1032,7 @@ bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) 
     int a, b;
   };
   std::vector<Touch> touching;
+  const PlaneBound planes(A, B, pose);
   for (ElementKind ka : kKinds)
     for (ElementKind kb : kKinds) {
       const int na = count(A, ka), nb = count(B, kb);
@@ -999,6 +1041,7 @@ bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) 
           const auto& sa = A_.spheres[static_cast<int>(ka)][a];
           const auto& sb = B_.spheres[static_cast<int>(kb)][b];
           if ((pose.apply(sa.first) - sb.first).norm() - sa.second - sb.second > p_.touch_tol) continue;
+          if (planes.lower(ka, a, kb, b) > p_.touch_tol) continue;
           if (element_distance(A, pose, ka, a, B, kb, b).distance > p_.touch_tol) continue;
           if (!open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
           touching.push_back({ka, kb, a, b});
