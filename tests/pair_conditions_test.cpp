@@ -27,7 +27,7 @@ namespace {
 constexpr double kAngle = 1e-12;
 // Widening used by the generator (enumerate.cpp): far above rounding, far below its margins.
 constexpr double kLengthTol = 1e-9;
-constexpr double kAngleTol = 1e-6;
+constexpr double kAngleTol = 1e-9;
 
 std::string model(const std::string& name) { return std::string(CF_SOURCE_DIR) + "/data/models/" + name; }
 

@@ -157,6 +157,12 @@ ModelInfo analyse_model(const Polyhedron& m) {
     for (VertexId v : F.vertices) r = std::max(r, (m.vertex(v).p - c).norm());
     info.spheres[2].push_back({c, r});
   }
+  {
+    Vec3 lo = m.vertices()[0].p, hi = lo;
+    for (const Vertex& V : m.vertices()) lo = lo.cwiseMin(V.p), hi = hi.cwiseMax(V.p);
+    info.bound.first = 0.5 * (lo + hi);
+    for (const Vertex& V : m.vertices()) info.bound.second = std::max(info.bound.second, (V.p - info.bound.first).norm());
+  }
   info.face_plane.assign(m.num_faces(), -1);
   int next = 0;
   const double ptol = 1e-7 * m.size();

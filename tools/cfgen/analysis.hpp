@@ -32,6 +32,7 @@ struct ModelInfo {
   // Bounding spheres (center in the model frame, radius, mm) of every element, indexed by
   // kind (vertex, edge, face) then element, for cheap distance lower bounds.
   std::vector<std::pair<Vec3, double>> spheres[3];
+  std::pair<Vec3, double> bound{Vec3::Zero(), 0.0};  // bounding sphere of the whole model
 };
 
 /// @throws cf::Error when the model has a face that cannot be partitioned.

@@ -243,9 +243,12 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   };
 
   // Rejects only pairs that no pose verify accepts can make hold (pair_conditions.hpp):
-  // ranges widened by more than rounding; normal cones shrunk by verify's local slack.
-  const PairConditions pair_ok(Ai, Bi, 1e-9 * search.scale() + opt.search.touch_tol, 1e-6,
-                               std::asin(search.verified_local_slack()) - 1e-6);
+  // ranges widened by far more than rounding (1e-9 rad: the slack's effect on the angle
+  // between two edges' normals is second order, 2.5e-7 rad for the default angle margin);
+  // normal cones shrunk by verify's local slack.
+  constexpr double kAngleTol = 1e-9;
+  const PairConditions pair_ok(Ai, Bi, 1e-9 * search.scale() + opt.search.touch_tol, kAngleTol,
+                               std::asin(search.verified_local_slack()) - kAngleTol);
   std::size_t singles_paired = 0;  // valid[0][0, singles_paired) have been paired with each other
   // Level 2 over the valid single PCs not paired yet (with every valid single PC).
   auto build_pairs = [&] {

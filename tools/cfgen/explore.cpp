@@ -361,12 +361,35 @@ double first_contact_rotation(const Polyhedron& A, const Polyhedron& B, const Po
     C = r - r_par;
     S = u.cross(C);
   };
+  // A turning keeps each point's height along the axis and its distance from it: an edge of
+  // A can meet an edge of B only where their [height] and [distance] ranges overlap.
+  struct AxisBox {
+    double z_lo, z_hi, r_lo, r_hi;
+  };
+  auto axis_box = [&](const Vec3& a, const Vec3& b) {
+    const double za = (a - p).dot(u), zb = (b - p).dot(u);
+    const Vec3 ra = (a - p) - za * u, rb = (b - p) - zb * u;
+    const Vec3 dr = rb - ra;
+    const double s = dr.squaredNorm() > 0 ? std::clamp(-ra.dot(dr) / dr.squaredNorm(), 0.0, 1.0) : 0.0;
+    return AxisBox{std::min(za, zb), std::max(za, zb), (ra + s * dr).norm(), std::max(ra.norm(), rb.norm())};
+  };
+  std::vector<AxisBox> b_boxes(B.num_edges());
+  for (std::size_t eb = 0; eb < B.num_edges(); ++eb)
+    b_boxes[eb] = axis_box(B.edge_point(EdgeId(int(eb)), 0), B.edge_point(EdgeId(int(eb)), 1));
+  const double reach = 1e3 * tol;  // as the segment check below
   for (std::size_t ea = 0; ea < A.num_edges(); ++ea) {
     Vec3 P0, C0, S0, P1, C1, S1;
-    circle(pa[A.edges()[ea].v0.index()], P0, C0, S0);
-    circle(pa[A.edges()[ea].v1.index()], P1, C1, S1);
+    const Vec3& a0 = pa[A.edges()[ea].v0.index()];
+    const Vec3& a1 = pa[A.edges()[ea].v1.index()];
+    const AxisBox box = axis_box(a0, a1);
+    circle(a0, P0, C0, S0);
+    circle(a1, P1, C1, S1);
     const Vec3 D[3] = {P1 - P0, C1 - C0, S1 - S0};
     for (std::size_t eb = 0; eb < B.num_edges(); ++eb) {
+      const AxisBox& bb = b_boxes[eb];
+      if (bb.z_lo > box.z_hi + reach || box.z_lo > bb.z_hi + reach || bb.r_lo > box.r_hi + reach ||
+          box.r_lo > bb.r_hi + reach)
+        continue;
       if (dominated(ElementKind::kEdge, int(ea), ElementKind::kEdge, int(eb))) continue;
       const Vec3& q0 = B.edge_point(EdgeId(int(eb)), 0);
       const Vec3& q1 = B.edge_point(EdgeId(int(eb)), 1);

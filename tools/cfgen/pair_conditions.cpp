@@ -191,81 +191,79 @@ double cone_cone_distance(const NormalCone& p, const NormalCone& q, double tol) 
   return d;
 }
 
-PairConditions::PairConditions(const ModelInfo& A, const ModelInfo& B, double length_tol, double angle_tol,
-                               double cone_margin)
-    : a_cones_(cones_of(A, cone_margin)), b_cones_(cones_of(B, cone_margin)), A_(A), B_(B),
-      length_tol_(length_tol), angle_tol_(angle_tol) {
+PairConditions::Side PairConditions::build(const ModelInfo& info, double cone_margin, double angle_tol) {
+  const Polyhedron& m = *info.model;
+  Side side;
+  side.cones = cones_of(info, cone_margin);
+  std::vector<std::pair<ElementKind, int>> elems;
+  std::vector<std::vector<Vec3>> points;
   for (int k = 0; k < 3; ++k) {
-    const auto kind = static_cast<ElementKind>(k);
-    for (std::size_t i = 0; i < a_cones_[k].size(); ++i)
-      a_points_[k].push_back(closure_points(*A.model, kind, static_cast<int>(i)));
-    for (std::size_t i = 0; i < b_cones_[k].size(); ++i)
-      b_points_[k].push_back(closure_points(*B.model, kind, static_cast<int>(i)));
+    side.offset[static_cast<std::size_t>(k)] = static_cast<int>(elems.size());
+    for (std::size_t i = 0; i < side.cones[static_cast<std::size_t>(k)].size(); ++i) {
+      elems.push_back({static_cast<ElementKind>(k), static_cast<int>(i)});
+      points.push_back(closure_points(m, static_cast<ElementKind>(k), static_cast<int>(i)));
+    }
   }
+  side.n = static_cast<int>(elems.size());
+  side.table.resize(static_cast<std::size_t>(side.n) * static_cast<std::size_t>(side.n));
+  auto cone_of = [&](std::size_t e) -> const NormalCone& {
+    return side.cones[static_cast<int>(elems[e].first)][static_cast<std::size_t>(elems[e].second)];
+  };
+  for (std::size_t x = 0; x < elems.size(); ++x)
+    for (std::size_t y = 0; y < elems.size(); ++y) {
+      Allowed& al = side.table[x * elems.size() + y];
+      const NormalCone &cx = cone_of(x), &cy = cone_of(y);
+      al.usable = !cx.gens.empty() && !cy.gens.empty();
+      if (!al.usable) continue;
+      if (y < x) {
+        // Distances and angles are symmetric: copied from (y, x), computed first.
+        const Allowed& yx = side.table[y * elems.size() + x];
+        al.dist_lo = yx.dist_lo, al.dist_hi = yx.dist_hi, al.angle_lo = yx.angle_lo, al.angle_hi = yx.angle_hi;
+      } else {
+        al.dist_lo = element_distance(m, Pose(), elems[x].first, elems[x].second, m, elems[y].first,
+                                      elems[y].second).distance;
+        for (const Vec3& p : points[x])
+          for (const Vec3& q : points[y]) al.dist_hi = std::max(al.dist_hi, (p - q).norm());
+        NormalCone neg_y = cy;
+        for (Vec3& g : neg_y.gens) g = -g;
+        for (Vec3& h : neg_y.facets) h = -h;
+        al.angle_lo = cone_cone_distance(cx, cy, angle_tol);
+        al.angle_hi = M_PI - cone_cone_distance(cx, neg_y, angle_tol);
+      }
+      const Range h = height_range(points[x], points[y], cx, angle_tol);
+      al.height_lo = h.lo, al.height_hi = h.hi;
+    }
+  return side;
 }
 
+PairConditions::PairConditions(const ModelInfo& A, const ModelInfo& B, double length_tol, double angle_tol,
+                               double cone_margin)
+    : a_(build(A, cone_margin, angle_tol)), b_(build(B, cone_margin, angle_tol)), length_tol_(length_tol),
+      angle_tol_(angle_tol) {}
+
 const NormalCone& PairConditions::cone(bool of_a, ElementKind k, int i) const {
-  return (of_a ? a_cones_ : b_cones_)[static_cast<int>(k)][static_cast<std::size_t>(i)];
+  return (of_a ? a_ : b_).cones[static_cast<int>(k)][static_cast<std::size_t>(i)];
 }
 
 bool PairConditions::compatible(const Pc& x, const Pc& y) const {
-  const Polyhedron& A = *A_.model;
-  const Polyhedron& B = *B_.model;
   const ElementKind kax = a_kind(x.type), kay = a_kind(y.type), kbx = b_kind(x.type), kby = b_kind(y.type);
-  const auto& pax = a_points_[static_cast<int>(kax)][static_cast<std::size_t>(x.a)];
-  const auto& pay = a_points_[static_cast<int>(kay)][static_cast<std::size_t>(y.a)];
-  const auto& pbx = b_points_[static_cast<int>(kbx)][static_cast<std::size_t>(x.b)];
-  const auto& pby = b_points_[static_cast<int>(kby)][static_cast<std::size_t>(y.b)];
-
-  // Distance between the two contact points, the same measured in A and in B.
-  {
-    auto range = [](const Polyhedron& m, ElementKind k1, int i1, ElementKind k2, int i2,
-                    const std::vector<Vec3>& p1, const std::vector<Vec3>& p2) {
-      Range r;
-      double dmax = 0;
-      for (const Vec3& p : p1)
-        for (const Vec3& q : p2) dmax = std::max(dmax, (p - q).norm());
-      r.add(element_distance(m, Pose(), k1, i1, m, k2, i2).distance, dmax);
-      return r;
-    };
-    const Range ra = range(A, kax, x.a, kay, y.a, pax, pay), rb = range(B, kbx, x.b, kby, y.b, pbx, pby);
-    if (ra.lo > rb.hi + length_tol_ || rb.lo > ra.hi + length_tol_) return false;
-  }
-
-  const NormalCone& ax = cone(true, kax, x.a);
-  const NormalCone& ay = cone(true, kay, y.a);
-  const NormalCone& bx = cone(false, kbx, x.b);
-  const NormalCone& by = cone(false, kby, y.b);
+  const Allowed& a = a_.at(kax, x.a, kay, y.a);
+  const Allowed& b = b_.at(kbx, x.b, kby, y.b);
   // An element with no direction inside its cone cannot take part in a verified contact.
-  if (ax.gens.empty() || ay.gens.empty() || bx.gens.empty() || by.gens.empty()) return false;
-
+  if (!a.usable || !b.usable) return false;
+  // Distance between the two contact points, the same measured in A and in B.
+  if (a.dist_lo > b.dist_hi + length_tol_ || b.dist_lo > a.dist_hi + length_tol_) return false;
   // Angle between the contact normals: R maps A's outward normal u at each contact onto
   // -m, m B's outward normal there, so the angle between u_x and u_y equals that between m_x
-  // and m_y. Each side's angles form the interval [smallest, pi - smallest to the opposite].
-  {
-    auto neg = [](const NormalCone& c) {
-      NormalCone n = c;
-      for (Vec3& g : n.gens) g = -g;
-      for (Vec3& h : n.facets) h = -h;
-      return n;
-    };
-    const double a_lo = cone_cone_distance(ax, ay, angle_tol_);
-    const double a_hi = M_PI - cone_cone_distance(ax, neg(ay), angle_tol_);
-    const double b_lo = cone_cone_distance(bx, by, angle_tol_);
-    const double b_hi = M_PI - cone_cone_distance(bx, neg(by), angle_tol_);
-    if (a_lo > b_hi + 2 * angle_tol_ || b_lo > a_hi + 2 * angle_tol_) return false;
-  }
-
+  // and m_y.
+  if (a.angle_lo > b.angle_hi + 2 * angle_tol_ || b.angle_lo > a.angle_hi + 2 * angle_tol_) return false;
   // Height of one contact point over the other's contact plane: with q = R p + t on both
-  // contacts, (q_y - q_x) . m_x = -(p_y - p_x) . u_x.
-  auto heights_meet = [&](const std::vector<Vec3>& pa1, const std::vector<Vec3>& pa2, const NormalCone& ca,
-                          const std::vector<Vec3>& pb1, const std::vector<Vec3>& pb2, const NormalCone& cb) {
-    const Range ra = height_range(pa1, pa2, ca, angle_tol_);  // (p_2 - p_1) . u
-    const Range rb = height_range(pb1, pb2, cb, angle_tol_);  // (q_2 - q_1) . m
-    // rb must meet -ra.
-    return !(rb.lo > -ra.lo + length_tol_ || -ra.hi > rb.hi + length_tol_);
+  // contacts, (q_y - q_x) . m_x = -(p_y - p_x) . u_x, so B's range must meet minus A's; and
+  // the same over y's plane.
+  auto heights_meet = [&](const Allowed& ha, const Allowed& hb) {
+    return !(hb.height_lo > -ha.height_lo + length_tol_ || -ha.height_hi > hb.height_hi + length_tol_);
   };
-  return heights_meet(pax, pay, ax, pbx, pby, bx) && heights_meet(pay, pax, ay, pby, pbx, by);
+  return heights_meet(a, b) && heights_meet(a_.at(kay, y.a, kax, x.a), b_.at(kby, y.b, kbx, x.b));
 }
 
 }  // namespace cf::gen

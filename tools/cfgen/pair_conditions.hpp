@@ -32,6 +32,8 @@ class PairConditions {
   /// vertices: the generator verifies a witness only when every contact normal is at least
   /// that far inside them (WitnessSearch::verify's local non-penetration slack), so a pair
   /// that needs a normal closer to a cone's boundary cannot be in the graph.
+  /// Precomputes what each model allows for every ordered pair of its elements (memory and
+  /// time quadratic in the number of elements), so `compatible` is a few comparisons.
   PairConditions(const ModelInfo& A, const ModelInfo& B, double length_tol, double angle_tol,
                  double cone_margin = 0);
 
@@ -45,11 +47,28 @@ class PairConditions {
   /// not pointed, cones narrower than twice the margin).
   const NormalCone& cone(bool of_a, ElementKind k, int i) const;
 
+  /// What one model allows for two of its elements x and y touched by two PCs (mm, rad).
+  struct Allowed {
+    double dist_lo = 0, dist_hi = 0;    // distance between a point of x and a point of y
+    double angle_lo = 0, angle_hi = 0;  // angle between a normal of x's cone and one of y's
+    double height_lo = 0, height_hi = 0;  // (point of y - point of x) . (normal of x's cone)
+    bool usable = false;                // both cones have directions
+  };
+
  private:
-  std::array<std::vector<NormalCone>, 3> a_cones_, b_cones_;  // by element kind
-  std::array<std::vector<std::vector<Vec3>>, 3> a_points_, b_points_;  // closure vertices, by kind
-  const ModelInfo& A_;
-  const ModelInfo& B_;
+  struct Side {
+    std::array<std::vector<NormalCone>, 3> cones;  // by element kind
+    std::array<int, 3> offset{};                   // first index of each kind in the table
+    int n = 0;                                     // elements of all kinds
+    std::vector<Allowed> table;                    // n x n, ordered pairs
+    const Allowed& at(ElementKind kx, int x, ElementKind ky, int y) const {
+      return table[static_cast<std::size_t>(offset[static_cast<int>(kx)] + x) * static_cast<std::size_t>(n) +
+                   static_cast<std::size_t>(offset[static_cast<int>(ky)] + y)];
+    }
+  };
+  static Side build(const ModelInfo& m, double cone_margin, double angle_tol);
+
+  Side a_, b_;
   double length_tol_, angle_tol_;
 };
 

@@ -9,6 +9,7 @@
 #include <Eigen/SVD>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
@@ -787,6 +788,29 @@ Pc pc_of(const PcSet& pcs, ElementKind ka, int a, ElementKind kb, int b) {
 
 constexpr ElementKind kKinds[] = {ElementKind::kVertex, ElementKind::kEdge, ElementKind::kFace};
 
+// The elements of A and of B that can come within `reach` of the other solid at `pose` (each
+// element's bounding sphere against the other model's), ascending by kind: the pairs worth
+// measuring, found in time linear in the models' size. Every pair left out is farther apart
+// than `reach`.
+struct NearElements {
+  std::array<std::vector<int>, 3> a, b;
+};
+
+NearElements near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& pose, double reach) {
+  NearElements out;
+  const Vec3 b_in_a = pose.inverse_apply(B.bound.first);
+  const Vec3 a_in_b = pose.apply(A.bound.first);
+  for (int k = 0; k < 3; ++k) {
+    for (std::size_t i = 0; i < A.spheres[k].size(); ++i)
+      if ((A.spheres[k][i].first - b_in_a).norm() - A.spheres[k][i].second - B.bound.second <= reach)
+        out.a[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
+    for (std::size_t i = 0; i < B.spheres[k].size(); ++i)
+      if ((B.spheres[k][i].first - a_in_b).norm() - B.spheres[k][i].second - A.bound.second <= reach)
+        out.b[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
+  }
+  return out;
+}
+
 // Lower bounds on the distance between an element of A and an element of B at one pose, from
 // a face's plane: when every vertex of the other element's closure lies on one side of it,
 // the two are at least the nearest vertex's height apart. Computed before the exact distance,
@@ -960,11 +984,11 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
   std::vector<double> b_vertex_gap(B.num_vertices(), clearance);
   int touching_pcs = 0;
   const PlaneBound planes(A, B, pose);
+  const NearElements near = near_elements(A_, B_, pose, p_.good_clearance);
   for (ElementKind ka : kKinds)
     for (ElementKind kb : kKinds) {
-      const int na = count(A, ka), nb = count(B, kb);
-      for (int a = 0; a < na; ++a)
-        for (int b = 0; b < nb; ++b) {
+      for (int a : near.a[static_cast<std::size_t>(ka)])
+        for (int b : near.b[static_cast<std::size_t>(kb)]) {
           // Pairs whose bounding spheres, or a face's plane, keep them farther apart than
           // good_clearance can neither touch nor lower the clearance below what counts as
           // good: skip the exact test.
@@ -1033,11 +1057,11 @@ bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) 
   };
   std::vector<Touch> touching;
   const PlaneBound planes(A, B, pose);
+  const NearElements near = near_elements(A_, B_, pose, p_.touch_tol);
   for (ElementKind ka : kKinds)
     for (ElementKind kb : kKinds) {
-      const int na = count(A, ka), nb = count(B, kb);
-      for (int a = 0; a < na; ++a)
-        for (int b = 0; b < nb; ++b) {
+      for (int a : near.a[static_cast<std::size_t>(ka)])
+        for (int b : near.b[static_cast<std::size_t>(kb)]) {
           const auto& sa = A_.spheres[static_cast<int>(ka)][a];
           const auto& sb = B_.spheres[static_cast<int>(kb)][b];
           if ((pose.apply(sa.first) - sb.first).norm() - sa.second - sb.second > p_.touch_tol) continue;
