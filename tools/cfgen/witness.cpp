@@ -794,6 +794,7 @@ constexpr ElementKind kKinds[] = {ElementKind::kVertex, ElementKind::kEdge, Elem
 // than `reach`.
 struct NearElements {
   std::array<std::vector<int>, 3> a, b;
+  std::array<std::vector<Vec3>, 3> a_centers;  // A's element sphere centres in B's frame
 };
 
 NearElements near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& pose, double reach) {
@@ -801,9 +802,12 @@ NearElements near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& p
   const Vec3 b_in_a = pose.inverse_apply(B.bound.first);
   const Vec3 a_in_b = pose.apply(A.bound.first);
   for (int k = 0; k < 3; ++k) {
+    out.a_centers[static_cast<std::size_t>(k)].resize(A.spheres[k].size());
     for (std::size_t i = 0; i < A.spheres[k].size(); ++i)
-      if ((A.spheres[k][i].first - b_in_a).norm() - A.spheres[k][i].second - B.bound.second <= reach)
+      if ((A.spheres[k][i].first - b_in_a).norm() - A.spheres[k][i].second - B.bound.second <= reach) {
         out.a[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
+        out.a_centers[static_cast<std::size_t>(k)][i] = pose.apply(A.spheres[k][i].first);
+      }
     for (std::size_t i = 0; i < B.spheres[k].size(); ++i)
       if ((B.spheres[k][i].first - a_in_b).norm() - B.spheres[k][i].second - A.bound.second <= reach)
         out.b[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
@@ -994,7 +998,8 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
           // good: skip the exact test.
           const auto& sa = A_.spheres[static_cast<int>(ka)][a];
           const auto& sb = B_.spheres[static_cast<int>(kb)][b];
-          const double lower = (pose.apply(sa.first) - sb.first).norm() - sa.second - sb.second;
+          const Vec3& ca = near.a_centers[static_cast<std::size_t>(ka)][static_cast<std::size_t>(a)];
+          const double lower = (ca - sb.first).norm() - sa.second - sb.second;
           if (lower > p_.good_clearance || planes.lower(ka, a, kb, b) > p_.good_clearance) continue;
           const double d = element_distance(A, pose, ka, a, B, kb, b).distance;
           if (ka == ElementKind::kVertex) a_vertex_gap[a] = std::min(a_vertex_gap[a], d);
@@ -1064,7 +1069,8 @@ bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) 
         for (int b : near.b[static_cast<std::size_t>(kb)]) {
           const auto& sa = A_.spheres[static_cast<int>(ka)][a];
           const auto& sb = B_.spheres[static_cast<int>(kb)][b];
-          if ((pose.apply(sa.first) - sb.first).norm() - sa.second - sb.second > p_.touch_tol) continue;
+          const Vec3& ca = near.a_centers[static_cast<std::size_t>(ka)][static_cast<std::size_t>(a)];
+          if ((ca - sb.first).norm() - sa.second - sb.second > p_.touch_tol) continue;
           if (planes.lower(ka, a, kb, b) > p_.touch_tol) continue;
           if (element_distance(A, pose, ka, a, B, kb, b).distance > p_.touch_tol) continue;
           if (!open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
