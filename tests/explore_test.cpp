@@ -7,6 +7,7 @@
 #include "cfgen/explore.hpp"
 #include "cfgen/generate.hpp"
 #include "mesh/model_loader.hpp"
+#include "analysed_pair.hpp"
 #include "fixtures.hpp"
 #include "scratch.hpp"
 
@@ -91,15 +92,7 @@ int vertex_of(const Polyhedron& m, const Vec3& x) {
   return v;
 }
 
-struct Pair {
-  Polyhedron A, B;
-  cf::gen::ModelInfo ai, bi;
-  Pair(Polyhedron a, Polyhedron b) : A(std::move(a)), B(std::move(b)) {
-    ai = cf::gen::analyse_model(A);
-    bi = cf::gen::analyse_model(B);
-  }
-  Pair(const Pair&) = delete;
-};
+using Pair = cf::test::AnalysedPair;
 
 bool has(const std::vector<cf::gen::Discovery>& ds, const PcSet& s) {
   for (const auto& d : ds)

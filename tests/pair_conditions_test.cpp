@@ -4,6 +4,7 @@
 // bundled graphs (their witnesses were verified apart from these conditions).
 
 #include "cfgen/pair_conditions.hpp"
+#include "analysed_pair.hpp"
 #include "fixtures.hpp"
 #include "mesh/model_loader.hpp"
 
@@ -31,23 +32,16 @@ constexpr double kAngleTol = 1e-9;
 
 std::string model(const std::string& name) { return std::string(CF_SOURCE_DIR) + "/data/models/" + name; }
 
-struct Pair {
-  Polyhedron A, B;
-  cf::gen::ModelInfo ai, bi;
-  Pair(Polyhedron a, Polyhedron b) : A(std::move(a)), B(std::move(b)) {
-    ai = cf::gen::analyse_model(A);
-    bi = cf::gen::analyse_model(B);
-  }
-  Pair(const Pair&) = delete;
-  cf::gen::PairConditions conditions() const { return {ai, bi, kLengthTol, kAngleTol}; }
-};
+using Pair = cf::test::AnalysedPair;
+
+cf::gen::PairConditions exact_conditions(const Pair& p) { return {p.ai, p.bi, kLengthTol, kAngleTol}; }
 
 }  // namespace
 
 TEST_CASE("the normal cones of a cube: a face's normal, an edge's arc, a corner's octant") {
   // Cube [-15, 15]^3 (data/models/cube.off).
   const Pair p(cf::tools::load_model(model("cube.off")), cf::tools::load_model(model("l_block.off")));
-  const auto pc = p.conditions();
+  const auto pc = exact_conditions(p);
   const int corner = cf::test::vertex_at(p.A, Vec3(15, 15, 15));
   REQUIRE(corner >= 0);
   const NormalCone& octant = pc.cone(true, ElementKind::kVertex, corner);
@@ -91,7 +85,7 @@ TEST_CASE("two PCs are rejected when a distance, an angle or a height has no com
   // A: cube [-15, 15]^3. B: the L-block, slab 0 <= y <= 20 over x in [0, 120], wall
   // 0 <= x <= 20 up to y = 80, both 80 deep along z.
   const Pair p(cf::tools::load_model(model("cube.off")), cf::tools::load_model(model("l_block.off")));
-  const auto pc = p.conditions();
+  const auto pc = exact_conditions(p);
   const int a_bottom = cf::test::face_with_plane(p.A, Vec3(0, -1, 0), 15);
   const int a_top = cf::test::face_with_plane(p.A, Vec3(0, 1, 0), 15);
   const int a_left = cf::test::face_with_plane(p.A, Vec3(-1, 0, 0), 15);
@@ -153,7 +147,7 @@ TEST_CASE("the cones shrunk by the verified slack exclude normals at a cone's bo
   // is no principal contact. The exact cones allow it (the angle ranges touch at pi/2); the
   // shrunk ones do not.
   const Pc ff{PcType::kFF, a_bottom, slab_top}, ef{PcType::kEF, bottom_left, wall_side};
-  CHECK(p.conditions().compatible(ff, ef));
+  CHECK(exact_conditions(p).compatible(ff, ef));
   CHECK_FALSE(shrunk.compatible(ff, ef));
 }
 
