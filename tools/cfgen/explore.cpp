@@ -108,12 +108,37 @@ double first_contact_translation(const Polyhedron& A, const Polyhedron& B, const
       if (A.face_inset(FaceId(int(f)), q + s * dA) >= -tol) take(s);
     }
   }
-  // Edges against edges: p0 + u ua + s d = q0 + w ub.
+  // Edges against edges: p0 + u ua + s d = q0 + w ub. A translation along d keeps the
+  // coordinates across d: two edges can meet only where their ranges along two axes across d
+  // overlap, and where B's edge lies ahead of A's by a shift in (s_min, best].
+  const Vec3 e1 = d.unitOrthogonal(), e2 = d.cross(e1);
+  struct Box {
+    double lo[3], hi[3];  // along e1, e2, d
+  };
+  auto box_of = [&](const Vec3& a, const Vec3& b) {
+    Box x;
+    const Vec3 axes[3] = {e1, e2, d};
+    for (int k = 0; k < 3; ++k) {
+      const double u = axes[k].dot(a), w = axes[k].dot(b);
+      x.lo[k] = std::min(u, w);
+      x.hi[k] = std::max(u, w);
+    }
+    return x;
+  };
+  std::vector<Box> b_boxes(B.num_edges());
+  for (std::size_t eb = 0; eb < B.num_edges(); ++eb)
+    b_boxes[eb] = box_of(B.edge_point(EdgeId(int(eb)), 0), B.edge_point(EdgeId(int(eb)), 1));
+  const double slack = 2 * tol;
   for (std::size_t ea = 0; ea < A.num_edges(); ++ea) {
     const Vec3& p0 = pa[A.edges()[ea].v0.index()];
     const Vec3& p1 = pa[A.edges()[ea].v1.index()];
     const Vec3 ua = p1 - p0;
+    const Box ba = box_of(p0, p1);
     for (std::size_t eb = 0; eb < B.num_edges(); ++eb) {
+      const Box& bb = b_boxes[eb];
+      if (bb.lo[0] > ba.hi[0] + slack || ba.lo[0] > bb.hi[0] + slack || bb.lo[1] > ba.hi[1] + slack ||
+          ba.lo[1] > bb.hi[1] + slack || bb.hi[2] - ba.lo[2] < s_min - slack || bb.lo[2] - ba.hi[2] > best + slack)
+        continue;
       if (dominated(ElementKind::kEdge, int(ea), ElementKind::kEdge, int(eb))) continue;
       const Vec3& q0 = B.edge_point(EdgeId(int(eb)), 0);
       const Vec3& q1 = B.edge_point(EdgeId(int(eb)), 1);
