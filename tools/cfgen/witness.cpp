@@ -770,12 +770,6 @@ std::pair<Vec3, double> WitnessSearch::contact_plane(const Pc& pc, const Pose& p
 
 namespace {
 
-int count(const Polyhedron& m, ElementKind k) {
-  return static_cast<int>(k == ElementKind::kVertex ? m.num_vertices()
-                          : k == ElementKind::kEdge ? m.num_edges()
-                                                    : m.num_faces());
-}
-
 std::string kind_name(ElementKind k) {
   return k == ElementKind::kVertex ? "v" : k == ElementKind::kEdge ? "e" : "f";
 }
