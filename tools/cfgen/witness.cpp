@@ -782,33 +782,6 @@ Pc pc_of(const PcSet& pcs, ElementKind ka, int a, ElementKind kb, int b) {
 
 constexpr ElementKind kKinds[] = {ElementKind::kVertex, ElementKind::kEdge, ElementKind::kFace};
 
-// The elements of A and of B that can come within `reach` of the other solid at `pose` (each
-// element's bounding sphere against the other model's), ascending by kind: the pairs worth
-// measuring, found in time linear in the models' size. Every pair left out is farther apart
-// than `reach`.
-struct NearElements {
-  std::array<std::vector<int>, 3> a, b;
-  std::array<std::vector<Vec3>, 3> a_centers;  // A's element sphere centres in B's frame
-};
-
-NearElements near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& pose, double reach) {
-  NearElements out;
-  const Vec3 b_in_a = pose.inverse_apply(B.bound.first);
-  const Vec3 a_in_b = pose.apply(A.bound.first);
-  for (int k = 0; k < 3; ++k) {
-    out.a_centers[static_cast<std::size_t>(k)].resize(A.spheres[k].size());
-    for (std::size_t i = 0; i < A.spheres[k].size(); ++i)
-      if ((A.spheres[k][i].first - b_in_a).norm() - A.spheres[k][i].second - B.bound.second <= reach) {
-        out.a[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
-        out.a_centers[static_cast<std::size_t>(k)][i] = pose.apply(A.spheres[k][i].first);
-      }
-    for (std::size_t i = 0; i < B.spheres[k].size(); ++i)
-      if ((B.spheres[k][i].first - a_in_b).norm() - B.spheres[k][i].second - A.bound.second <= reach)
-        out.b[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
-  }
-  return out;
-}
-
 // Lower bounds on the distance between an element of A and an element of B at one pose, from
 // a face's plane: when every vertex of the other element's closure lies on one side of it,
 // the two are at least the nearest vertex's height apart. Computed before the exact distance,
@@ -847,6 +820,61 @@ class PlaneBound {
   const Polyhedron& B_;
   std::vector<Vec3> a_in_b_, b_in_a_;
 };
+
+// The elements of A and of B that can come within `reach` of the other solid at `pose` (each
+// element's bounding sphere against the other model's), ascending by kind: the pairs worth
+// measuring, found in time linear in the models' size. Every pair left out is farther apart
+// than `reach`.
+struct NearElements {
+  std::array<std::vector<int>, 3> a, b;
+  std::array<std::vector<Vec3>, 3> a_centers;  // A's element sphere centres in B's frame
+};
+
+NearElements near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& pose, double reach) {
+  NearElements out;
+  const Vec3 b_in_a = pose.inverse_apply(B.bound.first);
+  const Vec3 a_in_b = pose.apply(A.bound.first);
+  for (int k = 0; k < 3; ++k) {
+    out.a_centers[static_cast<std::size_t>(k)].resize(A.spheres[k].size());
+    for (std::size_t i = 0; i < A.spheres[k].size(); ++i)
+      if ((A.spheres[k][i].first - b_in_a).norm() - A.spheres[k][i].second - B.bound.second <= reach) {
+        out.a[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
+        out.a_centers[static_cast<std::size_t>(k)][i] = pose.apply(A.spheres[k][i].first);
+      }
+    for (std::size_t i = 0; i < B.spheres[k].size(); ++i)
+      if ((B.spheres[k][i].first - a_in_b).norm() - B.spheres[k][i].second - A.bound.second <= reach)
+        out.b[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
+  }
+  return out;
+}
+
+// The element pairs (A's kind, B's kind, A's element, B's element, in that nesting order)
+// not proven farther apart than `reach` at `pose`: near the other model, then by bounding
+// spheres, then by a face's plane. verify and contacts_at measure only these.
+struct ElementPair {
+  ElementKind ka, kb;
+  int a, b;
+};
+
+std::vector<ElementPair> near_pairs(const ModelInfo& A, const ModelInfo& B, const Pose& pose, double reach) {
+  const NearElements near = near_elements(A, B, pose, reach);
+  const PlaneBound planes(*A.model, *B.model, pose);
+  std::vector<ElementPair> out;
+  for (ElementKind ka : kKinds)
+    for (ElementKind kb : kKinds) {
+      const auto ia = static_cast<std::size_t>(ka), ib = static_cast<std::size_t>(kb);
+      for (int a : near.a[ia])
+        for (int b : near.b[ib]) {
+          const auto& sa = A.spheres[ia][static_cast<std::size_t>(a)];
+          const auto& sb = B.spheres[ib][static_cast<std::size_t>(b)];
+          const Vec3& ca = near.a_centers[ia][static_cast<std::size_t>(a)];
+          if ((ca - sb.first).norm() - sa.second - sb.second > reach) continue;
+          if (planes.lower(ka, a, kb, b) > reach) continue;
+          out.push_back({ka, kb, a, b});
+        }
+    }
+  return out;
+}
 
 }  // namespace
 
@@ -981,59 +1009,49 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
   std::vector<double> a_vertex_gap(A.num_vertices(), clearance);
   std::vector<double> b_vertex_gap(B.num_vertices(), clearance);
   int touching_pcs = 0;
-  const PlaneBound planes(A, B, pose);
-  const NearElements near = near_elements(A_, B_, pose, p_.good_clearance);
-  for (ElementKind ka : kKinds)
-    for (ElementKind kb : kKinds) {
-      for (int a : near.a[static_cast<std::size_t>(ka)])
-        for (int b : near.b[static_cast<std::size_t>(kb)]) {
-          // Pairs whose bounding spheres, or a face's plane, keep them farther apart than
-          // good_clearance can neither touch nor lower the clearance below what counts as
-          // good: skip the exact test.
-          const auto& sa = A_.spheres[static_cast<int>(ka)][a];
-          const auto& sb = B_.spheres[static_cast<int>(kb)][b];
-          const Vec3& ca = near.a_centers[static_cast<std::size_t>(ka)][static_cast<std::size_t>(a)];
-          const double lower = (ca - sb.first).norm() - sa.second - sb.second;
-          if (lower > p_.good_clearance || planes.lower(ka, a, kb, b) > p_.good_clearance) continue;
-          const double d = element_distance(A, pose, ka, a, B, kb, b).distance;
-          if (ka == ElementKind::kVertex) a_vertex_gap[a] = std::min(a_vertex_gap[a], d);
-          if (kb == ElementKind::kVertex) b_vertex_gap[b] = std::min(b_vertex_gap[b], d);
-          bool covered = false, is_pc = false;
-          for (const Pc& pc : pcs) {
-            if (a_kind(pc.type) == ka && b_kind(pc.type) == kb && pc.a == a && pc.b == b)
-              is_pc = true;
-            if (in_closure(A, ka, a, a_kind(pc.type), pc.a) &&
-                in_closure(B, kb, b, b_kind(pc.type), pc.b))
-              covered = true;
-          }
-          if (is_pc) {
-            if (d > p_.touch_tol) return reject("PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " apart by " + std::to_string(d));
-            // The open elements must touch: a face meeting an edge only at its own boundary
-            // realises an edge-edge PC, not face-edge.
-            if (!open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol))
-              return reject("PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " touches only on its boundary");
-            ++touching_pcs;
-          }
-          // Where two elements share open points, A's and B's tangent cones there must have
-          // disjoint interiors; pairs that touch only through their boundaries are judged
-          // as those boundary pairs. This catches a face of A running through a reflex edge
-          // of B, which no pair reports as crossing.
-          if ((is_pc || covered) && d <= p_.touch_tol && open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol) &&
-              !cones_disjoint(pose, ka, a, kb, b))
-            return reject("A and B overlap where " + kind_name(ka) + std::to_string(a) + " touches " +
-                          kind_name(kb) + std::to_string(b));
-          if (!is_pc && !covered) {
-            // Closed elements that meet only on their boundaries do not touch: their boundary
-            // elements do, and those pairs are judged on their own.
-            if (d <= p_.touch_tol && !open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
-            if (d < p_.min_clearance) {
-              if (obstacle) *obstacle = Obstacle{true, ka, kb, a, b};
-              return reject("extra contact " + kind_name(ka) + std::to_string(a) + "-" + kind_name(kb) + std::to_string(b) + " at " + std::to_string(d));
-            }
-            clearance = std::min(clearance, d);
-          }
-        }
+  // Pairs proven farther apart than good_clearance can neither touch nor lower the clearance
+  // below what counts as good: not measured.
+  for (const ElementPair& e : near_pairs(A_, B_, pose, p_.good_clearance)) {
+    const ElementKind ka = e.ka, kb = e.kb;
+    const int a = e.a, b = e.b;
+    const double d = element_distance(A, pose, ka, a, B, kb, b).distance;
+    if (ka == ElementKind::kVertex) a_vertex_gap[a] = std::min(a_vertex_gap[a], d);
+    if (kb == ElementKind::kVertex) b_vertex_gap[b] = std::min(b_vertex_gap[b], d);
+    bool covered = false, is_pc = false;
+    for (const Pc& pc : pcs) {
+      if (a_kind(pc.type) == ka && b_kind(pc.type) == kb && pc.a == a && pc.b == b)
+        is_pc = true;
+      if (in_closure(A, ka, a, a_kind(pc.type), pc.a) &&
+          in_closure(B, kb, b, b_kind(pc.type), pc.b))
+        covered = true;
     }
+    if (is_pc) {
+      if (d > p_.touch_tol) return reject("PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " apart by " + std::to_string(d));
+      // The open elements must touch: a face meeting an edge only at its own boundary
+      // realises an edge-edge PC, not face-edge.
+      if (!open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol))
+        return reject("PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " touches only on its boundary");
+      ++touching_pcs;
+    }
+    // Where two elements share open points, A's and B's tangent cones there must have
+    // disjoint interiors; pairs that touch only through their boundaries are judged
+    // as those boundary pairs. This catches a face of A running through a reflex edge
+    // of B, which no pair reports as crossing.
+    if ((is_pc || covered) && d <= p_.touch_tol && open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol) &&
+        !cones_disjoint(pose, ka, a, kb, b))
+      return reject("A and B overlap where " + kind_name(ka) + std::to_string(a) + " touches " +
+                    kind_name(kb) + std::to_string(b));
+    if (!is_pc && !covered) {
+      // Closed elements that meet only on their boundaries do not touch: their boundary
+      // elements do, and those pairs are judged on their own.
+      if (d <= p_.touch_tol && !open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
+      if (d < p_.min_clearance) {
+        if (obstacle) *obstacle = Obstacle{true, ka, kb, a, b};
+        return reject("extra contact " + kind_name(ka) + std::to_string(a) + "-" + kind_name(kb) + std::to_string(b) + " at " + std::to_string(d));
+      }
+      clearance = std::min(clearance, d);
+    }
+  }
   if (touching_pcs != pcs.size()) return reject("a PC is not touching");
   // Neither solid inside the other: test the vertex of each farthest from the other solid.
   const auto ia = std::max_element(a_vertex_gap.begin(), a_vertex_gap.end()) - a_vertex_gap.begin();
@@ -1050,33 +1068,18 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
 bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) const {
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
-  struct Touch {
-    ElementKind ka, kb;
-    int a, b;
-  };
-  std::vector<Touch> touching;
-  const PlaneBound planes(A, B, pose);
-  const NearElements near = near_elements(A_, B_, pose, p_.touch_tol);
-  for (ElementKind ka : kKinds)
-    for (ElementKind kb : kKinds) {
-      for (int a : near.a[static_cast<std::size_t>(ka)])
-        for (int b : near.b[static_cast<std::size_t>(kb)]) {
-          const auto& sa = A_.spheres[static_cast<int>(ka)][a];
-          const auto& sb = B_.spheres[static_cast<int>(kb)][b];
-          const Vec3& ca = near.a_centers[static_cast<std::size_t>(ka)][static_cast<std::size_t>(a)];
-          if ((ca - sb.first).norm() - sa.second - sb.second > p_.touch_tol) continue;
-          if (planes.lower(ka, a, kb, b) > p_.touch_tol) continue;
-          if (element_distance(A, pose, ka, a, B, kb, b).distance > p_.touch_tol) continue;
-          if (!open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
-          touching.push_back({ka, kb, a, b});
-        }
-    }
+  std::vector<ElementPair> touching;
+  for (const ElementPair& e : near_pairs(A_, B_, pose, p_.touch_tol)) {
+    if (element_distance(A, pose, e.ka, e.a, B, e.kb, e.b).distance > p_.touch_tol) continue;
+    if (!open_touch(A, pose, e.ka, e.a, B, e.kb, e.b, p_.touch_tol)) continue;
+    touching.push_back(e);
+  }
   out = PcSet();
   for (std::size_t i = 0; i < touching.size(); ++i) {
-    const Touch& x = touching[i];
+    const ElementPair& x = touching[i];
     bool dominated = false;
     for (std::size_t j = 0; j < touching.size() && !dominated; ++j) {
-      const Touch& y = touching[j];
+      const ElementPair& y = touching[j];
       dominated = j != i && in_closure(A, x.ka, x.a, y.ka, y.a) && in_closure(B, x.kb, x.b, y.kb, y.b);
     }
     if (dominated) continue;
