@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -43,18 +44,27 @@ void parallel_for(std::size_t n, int threads, const std::function<void(std::size
   };
   std::vector<std::thread> pool;
   for (int k = 1; k < threads; ++k) pool.emplace_back(work);
+  // The reporter ticks every 250 ms and is woken at the end, so a short loop costs no wait.
   std::thread reporter;
-  std::atomic<bool> stop{false};
+  std::mutex m;
+  std::condition_variable cv;
+  bool stop = false;
   if (tick)
     reporter = std::thread([&] {
-      while (!stop) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(250));
+      std::unique_lock<std::mutex> lock(m);
+      while (!cv.wait_for(lock, std::chrono::milliseconds(250), [&] { return stop; })) {
+        lock.unlock();
         tick(done.load());
+        lock.lock();
       }
     });
   work();
   for (auto& t : pool) t.join();
-  stop = true;
+  {
+    std::lock_guard<std::mutex> lock(m);
+    stop = true;
+  }
+  cv.notify_one();
   if (reporter.joinable()) reporter.join();
 }
 

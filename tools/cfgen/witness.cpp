@@ -327,9 +327,18 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs) const {
   std::vector<Pc> pts;
   for (const Pc& pc : pcs)
     if (point_pc(pc.type)) pts.push_back(pc);
+  // Only the locally admissible candidates are kept (most are not, and there are thousands),
+  // each with its rank: most slack first, those where all three point contacts hold before all.
   std::vector<Mat3> cands;
-  std::vector<std::size_t> exact;  // indices into cands where all three point contacts hold
+  std::vector<std::pair<double, std::size_t>> order;
   if (pts.size() < 2) return cands;
+  const double min_local = std::sin(p_.angle_margin);
+  auto consider = [&](const Mat3& R, bool exact) {
+    const double m = local_margin(pcs, R);
+    if (m <= min_local) return;
+    order.push_back({exact ? -2.0 - m : -m, cands.size()});
+    cands.push_back(R);
+  };
   const Pc& x = pts[0];
   const Pc& y = pts[1];
   const Pc* third = pts.size() >= 3 ? &pts[2] : nullptr;
@@ -370,7 +379,7 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs) const {
           const Vec3 dB = ((solve_on_b ? g : f) - qb).normalized();
           const Mat3 R0 = align(dA, dB);
           auto spun = [&](double phi) { return Mat3(axis_angle(dB, phi) * R0); };
-          for (int k = 0; k < p_.theta_samples; ++k) cands.push_back(spun(2 * M_PI * k / p_.theta_samples));
+          for (int k = 0; k < p_.theta_samples; ++k) consider(spun(2 * M_PI * k / p_.theta_samples), false);
           if (!third) continue;
           // A third point PC: also the spins where its contact holds, the first contact held
           // at (pa, qb); tried first.
@@ -392,27 +401,16 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs) const {
                 else hi = mid;
               }
               // A sign change across the e-e residual's jump (lines turning parallel) is no root.
-              if (std::abs(residual(0.5 * (lo + hi))) < 1e-6 * scale_) {
-                cands.push_back(spun(0.5 * (lo + hi)));
-                exact.push_back(cands.size() - 1);
-              }
+              if (std::abs(residual(0.5 * (lo + hi))) < 1e-6 * scale_) consider(spun(0.5 * (lo + hi)), true);
             }
             f0 = f1;
           }
         }
       }
     }
-  // Locally admissible ones, most slack first, spread apart, at most max_rotations.
-  std::vector<std::pair<double, std::size_t>> order;
-  const double min_local = std::sin(p_.angle_margin);
-  std::vector<char> is_exact(cands.size(), 0);
-  for (std::size_t i : exact) is_exact[i] = 1;
-  for (std::size_t i = 0; i < cands.size(); ++i) {
-    const double m = local_margin(pcs, cands[i]);
-    if (m > min_local) order.push_back({is_exact[i] ? -2.0 - m : -m, i});
-  }
+  // Spread apart, at most max_rotations.
   std::stable_sort(order.begin(), order.end());
-  if (debug_) std::cerr << "  anchored: " << cands.size() << " rotations, " << order.size() << " locally admissible\n";
+  if (debug_) std::cerr << "  anchored: " << order.size() << " locally admissible rotations\n";
   return take_spread(cands, order, p_.max_rotations, true);
 }
 
