@@ -33,8 +33,16 @@ struct LpResult {
   Eigen::VectorXd x;  // the optimum, rounded to double from the exact solution
 };
 
-/// Solves with GLPK's primal simplex in double precision. Exactness is not needed here: every
-/// pose built from a solution is verified on its own before it is accepted.
+/// Solves in double precision: a small dense simplex first, GLPK's primal simplex for what it
+/// leaves (lp.cpp says why). Exactness is not needed here: every pose built from a solution
+/// is verified on its own before it is accepted, and every solution meets each row within
+/// 1e-7 (1 + |b|).
 LpResult solve(const LinearProgram& lp);
+
+namespace internal {
+/// The dense solver alone (for its tests): kOptimal with a solution, or kInfeasible meaning
+/// "not solved here", whatever the program's true status.
+LpResult dense_solve(const LinearProgram& lp);
+}  // namespace internal
 
 }  // namespace cf::gen

@@ -1,0 +1,242 @@
+// The witness search's small LP solver (tools/cfgen/lp.cpp: a dense simplex, GLPK for what it
+// leaves) against GLPK's simplex, a solver written apart from the dense one, on random
+// programs of the witness search's shapes: up to ten variables, equality rows, bounds, and
+// degenerate vertices where many rows meet.
+#include <catch2/catch.hpp>
+
+#include <glpk.h>
+
+#include <random>
+
+#include "cfgen/lp.hpp"
+
+using cf::gen::LinearProgram;
+using cf::gen::LpResult;
+using Rel = LinearProgram::Rel;
+using Status = LpResult::Status;
+
+namespace {
+
+struct Reference {
+  Status status;
+  double objective;
+};
+
+Reference glpk_solve(const LinearProgram& lp) {
+  glp_term_out(GLP_OFF);
+  glp_prob* P = glp_create_prob();
+  glp_set_obj_dir(P, GLP_MIN);
+  const int m = static_cast<int>(lp.rows.size());
+  if (m > 0) glp_add_rows(P, m);
+  glp_add_cols(P, lp.num_vars);
+  for (int j = 0; j < lp.num_vars; ++j) {
+    const auto [lf, lv] = lp.lower[j];
+    const auto [uf, uv] = lp.upper[j];
+    const int type = lf && uf ? (lv == uv ? GLP_FX : GLP_DB) : lf ? GLP_LO : uf ? GLP_UP : GLP_FR;
+    glp_set_col_bnds(P, j + 1, type, lf ? lv : 0.0, uf ? uv : 0.0);
+    glp_set_obj_coef(P, j + 1, lp.c[j]);
+  }
+  std::vector<int> ia{0}, ja{0};
+  std::vector<double> ar{0.0};
+  for (int i = 0; i < m; ++i) {
+    const auto& r = lp.rows[i];
+    glp_set_row_bnds(P, i + 1,
+                     r.rel == Rel::kEq ? GLP_FX : r.rel == Rel::kLessEq ? GLP_UP : GLP_LO, r.b,
+                     r.b);
+    for (const auto& [j, v] : r.a) {
+      ia.push_back(i + 1);
+      ja.push_back(j + 1);
+      ar.push_back(v);
+    }
+  }
+  glp_load_matrix(P, static_cast<int>(ar.size()) - 1, ia.data(), ja.data(), ar.data());
+  glp_smcp parm;
+  glp_init_smcp(&parm);
+  parm.msg_lev = GLP_MSG_OFF;
+  parm.presolve = GLP_ON;  // reports infeasible and unbounded programs as such
+  Reference ref{Status::kInfeasible, 0.0};
+  if (glp_simplex(P, &parm) == 0 && glp_get_status(P) == GLP_OPT) {
+    ref = {Status::kOptimal, glp_get_obj_val(P)};
+  } else {
+    glp_init_smcp(&parm);
+    parm.msg_lev = GLP_MSG_OFF;
+    if (glp_simplex(P, &parm) == 0 && glp_get_status(P) == GLP_UNBND)
+      ref.status = Status::kUnbounded;
+  }
+  glp_delete_prob(P);
+  return ref;
+}
+
+double objective(const LinearProgram& lp, const LpResult& r) {
+  double v = 0;
+  for (int j = 0; j < lp.num_vars; ++j) v += lp.c[j] * r.x[j];
+  return v;
+}
+
+// A program whose feasible set contains x_feas (so it is feasible) unless `infeasible`; rows
+// are random through or near x_feas, several of them through one point (degenerate).
+LinearProgram random_program(std::mt19937& rng, bool& bounded_box) {
+  std::uniform_int_distribution<int> nvars(2, 10);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int n = nvars(rng);
+  LinearProgram lp(n);
+  Eigen::VectorXd x(n);
+  for (int j = 0; j < n; ++j) x[j] = 20 * u(rng);
+  const int neq = std::uniform_int_distribution<int>(0, std::min(3, n - 1))(rng);
+  for (int k = 0; k < neq; ++k) {
+    std::vector<std::pair<int, double>> a;
+    double b = 0;
+    for (int j = 0; j < n; ++j)
+      if (u(rng) > -0.2) {
+        const double v = u(rng);
+        a.push_back({j, v});
+        b += v * x[j];
+      }
+    if (!a.empty()) lp.add(a, Rel::kEq, b);
+  }
+  if (!lp.rows.empty() && u(rng) > 0.5) {
+    const LinearProgram::Row repeated = lp.rows.front();
+    lp.rows.push_back(repeated);
+  }
+  // A degenerate vertex: several rows through one point v, and slack rows around x.
+  Eigen::VectorXd v = x;
+  for (int j = 0; j < n; ++j) v[j] += 5 * u(rng);
+  const int nin = std::uniform_int_distribution<int>(n, 3 * n + 6)(rng);
+  for (int k = 0; k < nin; ++k) {
+    std::vector<std::pair<int, double>> a;
+    double at_x = 0, at_v = 0;
+    for (int j = 0; j < n; ++j) {
+      const double c = u(rng);
+      a.push_back({j, c});
+      at_x += c * x[j];
+      at_v += c * v[j];
+    }
+    const bool through_v = k % 3 == 0 && at_v >= at_x;  // keeps x feasible
+    lp.add(a, Rel::kLessEq, through_v ? at_v : at_x + 10 * (u(rng) + 1.0));
+  }
+  bounded_box = u(rng) > -0.5;
+  for (int j = 0; j < n; ++j) {
+    if (bounded_box || u(rng) > 0) lp.lower[j] = {true, x[j] - 30};
+    if (bounded_box || u(rng) > 0) lp.upper[j] = {true, x[j] + 30};
+    lp.c[j] = u(rng) > 0.3 ? u(rng) : 0.0;  // zero costs: faces of optima
+  }
+  return lp;
+}
+
+}  // namespace
+
+TEST_CASE("lp: matches GLPK's optimum on random programs with degenerate vertices",
+          "[lp]") {
+  std::mt19937 rng(20261202);
+  int optimal = 0, unbounded = 0, dense_answered = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    bool box = false;
+    const LinearProgram lp = random_program(rng, box);
+    const Reference ref = glpk_solve(lp);
+    const LpResult got = cf::gen::solve(lp);
+    const LpResult dense = cf::gen::internal::dense_solve(lp);
+    INFO("trial " << trial << ", " << lp.num_vars << " variables, " << lp.rows.size()
+                  << " rows");
+    REQUIRE(ref.status != Status::kInfeasible);  // x is feasible by construction
+    REQUIRE(got.status == ref.status);
+    // The dense solver answers only with an optimum, never with an unbounded program's.
+    if (ref.status == Status::kUnbounded) CHECK(dense.status != Status::kOptimal);
+    if (got.status == Status::kOptimal) {
+      ++optimal;
+      // Objective agreement: both solvers work in double precision on rows of unit size
+      // and right sides up to ~100; 1e-6 relative is far above their rounding.
+      const double tol = 1e-6 * (1 + std::abs(ref.objective));
+      CHECK(objective(lp, got) == Approx(ref.objective).margin(tol));
+      if (dense.status == Status::kOptimal) {
+        ++dense_answered;
+        CHECK(objective(lp, dense) == Approx(ref.objective).margin(tol));
+      }
+    } else {
+      ++unbounded;
+    }
+  }
+  CHECK(optimal > 2000);
+  CHECK(unbounded > 10);  // 19 with this seed
+  // GLPK is the fallback for marginal programs only; random ones are not marginal.
+  CHECK(dense_answered == optimal);
+}
+
+TEST_CASE("lp: infeasible programs are reported infeasible", "[lp]") {
+  SECTION("contradicting rows") {
+    LinearProgram lp(2);
+    lp.add({{0, 1.0}, {1, 1.0}}, Rel::kLessEq, 1.0);
+    lp.add({{0, 1.0}, {1, 1.0}}, Rel::kGreaterEq, 2.0);
+    CHECK(cf::gen::solve(lp).status == Status::kInfeasible);
+    CHECK(cf::gen::internal::dense_solve(lp).status == Status::kInfeasible);
+  }
+  SECTION("inconsistent equalities") {
+    LinearProgram lp(3);
+    lp.add({{0, 1.0}, {1, 2.0}}, Rel::kEq, 1.0);
+    lp.add({{0, 2.0}, {1, 4.0}}, Rel::kEq, 3.0);
+    CHECK(cf::gen::solve(lp).status == Status::kInfeasible);
+    CHECK(cf::gen::internal::dense_solve(lp).status == Status::kInfeasible);
+  }
+  SECTION("an equality outside a bound") {
+    LinearProgram lp(2);
+    lp.upper[0] = {true, 1.0};
+    lp.add({{0, 1.0}}, Rel::kEq, 2.0);
+    CHECK(cf::gen::solve(lp).status == Status::kInfeasible);
+    CHECK(cf::gen::internal::dense_solve(lp).status == Status::kInfeasible);
+  }
+}
+
+TEST_CASE("lp: a vertex where many rows meet, and fixed variables", "[lp]") {
+  // max s subject to s <= x_i for the 3 coordinates and sum x = 3, s in [0, 10]: the optimum
+  // x = (1, 1, 1), s = 1 lies on four rows at once.
+  LinearProgram lp(4);
+  for (int i = 0; i < 3; ++i) lp.add({{i, 1.0}, {3, -1.0}}, Rel::kGreaterEq, 0.0);
+  lp.add({{0, 1.0}, {1, 1.0}, {2, 1.0}}, Rel::kEq, 3.0);
+  lp.add({{0, 1.0}, {1, 1.0}, {2, 1.0}}, Rel::kEq, 3.0);  // repeated
+  lp.lower[3] = {true, 0.0};
+  lp.upper[3] = {true, 10.0};
+  lp.c[3] = -1.0;
+  const LpResult r = cf::gen::internal::dense_solve(lp);
+  REQUIRE(r.status == Status::kOptimal);
+  CHECK(r.x[3] == Approx(1.0).margin(1e-12));
+  for (int i = 0; i < 3; ++i) CHECK(r.x[i] == Approx(1.0).margin(1e-12));
+
+  lp.lower[0] = lp.upper[0] = {true, 0.5};  // fixed: now s <= 0.5
+  const LpResult f = cf::gen::internal::dense_solve(lp);
+  REQUIRE(f.status == Status::kOptimal);
+  CHECK(f.x[0] == Approx(0.5).margin(1e-12));
+  CHECK(f.x[3] == Approx(0.5).margin(1e-12));
+}
+
+TEST_CASE("lp: a touching pose's program, feasible only within tolerance, is solved", "[lp]") {
+  // Written by the witness search for a peg touching a hole's wall (the largest margin of two
+  // contacts at one rotation): the rows meet only at margin 0, and only up to rounding of
+  // 1e-6 on right sides of 35. GLPK's relative tolerance accepts it, and so must solve().
+  LinearProgram lp(8);
+  lp.c[3] = -1;
+  lp.lower[3] = {true, 0};
+  lp.upper[3] = {true, 164.92422502470643};
+  lp.add({{2, -1}, {4, 7.2164496600635175e-16}}, Rel::kEq, 15.000000612127661);
+  lp.add({{0, -0.70710678118654746}, {1, 0.70710678118654746}, {4, -0.70710681004252163}}, Rel::kGreaterEq, -21.213203002756799);
+  lp.add({{0, 1}, {4, 0.99999999999999956}, {3, -1}}, Rel::kGreaterEq, 14.999999387872354);
+  lp.add({{1, -1}, {4, 4.0808510459733327e-08}, {3, -1}}, Rel::kGreaterEq, -65.000000000000028);
+  lp.add({{0, -1}, {4, -0.99999999999999956}, {3, -1}}, Rel::kGreaterEq, -34.99999938787235);
+  lp.add({{4, 1}, {3, -1}}, Rel::kGreaterEq, 0);
+  lp.add({{4, 1}, {3, 1}}, Rel::kLessEq, 30);
+  lp.add({{0, 1.1379786002407855e-15}, {1, 4.0808510431977751e-08}, {2, -0.99999999999999956}, {5, 1.1379786002407855e-15}}, Rel::kEq, 15.000000816170346);
+  lp.add({{0, -0.99999999999999956}, {1, 4.0808510459733327e-08}, {2, 7.2164496600635175e-16}, {5, -0.99999999999999956}, {3, -1}}, Rel::kGreaterEq, -134.99999918382974);
+  lp.add({{0, -4.0808510459733327e-08}, {1, -0.99999999999999845}, {2, -4.0808510459733327e-08}, {5, -4.0808510459733327e-08}, {3, -1}}, Rel::kGreaterEq, -35.000004897021228);
+  lp.add({{0, 0.99999999999999956}, {1, -4.0808510459733327e-08}, {2, -7.2164496600635175e-16}, {5, 0.99999999999999956}, {3, -1}}, Rel::kGreaterEq, 104.99999918382973);
+  lp.add({{0, 4.0808510459733327e-08}, {1, 0.99999999999999845}, {2, 4.0808510459733327e-08}, {5, 4.0808510459733327e-08}, {3, -1}}, Rel::kGreaterEq, 5.0000048970212241);
+  lp.add({{5, 1}, {3, -1}}, Rel::kGreaterEq, 0);
+  lp.add({{5, 1}, {3, 1}}, Rel::kLessEq, 100);
+  lp.add({{0, 1}, {6, -4.0808510459733327e-08}}, Rel::kEq, 34.99999938787235);
+  lp.add({{1, 1}, {6, -0.99999999999999845}, {7, -1}}, Rel::kEq, 5.0000000000000231);
+  lp.add({{2, 1}, {6, -4.0808510459733327e-08}}, Rel::kEq, -15.000000612127661);
+  lp.add({{6, 1}, {3, -1}}, Rel::kGreaterEq, 0);
+  lp.add({{6, 1}, {3, 1}}, Rel::kLessEq, 30);
+  lp.add({{7, 1}, {3, -1}}, Rel::kGreaterEq, 0);
+  lp.add({{7, 1}, {3, 1}}, Rel::kLessEq, 60);
+  const LpResult r = cf::gen::solve(lp);
+  REQUIRE(r.status == Status::kOptimal);
+  CHECK(r.x[3] == Approx(0.0).margin(1e-5));  // margin 0, up to the rows' tolerance
+}
