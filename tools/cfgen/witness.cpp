@@ -1066,9 +1066,43 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
 bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) const {
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
-  std::vector<ElementPair> touching;
+  using K = ElementKind;
+  // Pairs within touch_tol (closed elements), and those touching in their open interiors.
+  std::vector<ElementPair> close, touching;
+  // An edge and a face, or two faces, can only be within touch_tol where a pair of their
+  // boundary elements is, or where the edge crosses the face's plane: the distance between
+  // two planar regions, or a segment and a region that it does not cross, is reached on a
+  // boundary. near_pairs lists pairs in ascending kinds, so those boundary pairs come first,
+  // and the costly edge-face and face-face distances are measured only where they can be small.
+  auto bounded_by_close = [&](const ElementPair& e) {
+    for (const ElementPair& c : close)
+      if (in_closure(A, c.ka, c.a, e.ka, e.a) && in_closure(B, c.kb, c.b, e.kb, e.b)) return true;
+    return false;
+  };
+  auto crosses_plane = [&](const ElementPair& e) {
+    Vec3 p0, p1, n;
+    double offset;
+    if (e.ka == K::kEdge) {  // A's edge, B's face, in B's frame
+      p0 = pose.apply(A.edge_point(EdgeId(e.a), 0));
+      p1 = pose.apply(A.edge_point(EdgeId(e.a), 1));
+      n = B.faces()[e.b].normal;
+      offset = B.faces()[e.b].offset;
+    } else {  // A's face, B's edge, in A's frame
+      p0 = pose.inverse_apply(B.edge_point(EdgeId(e.b), 0));
+      p1 = pose.inverse_apply(B.edge_point(EdgeId(e.b), 1));
+      n = A.faces()[e.a].normal;
+      offset = A.faces()[e.a].offset;
+    }
+    const double h0 = n.dot(p0) - offset, h1 = n.dot(p1) - offset;
+    return !((h0 > p_.touch_tol && h1 > p_.touch_tol) || (h0 < -p_.touch_tol && h1 < -p_.touch_tol));
+  };
   for (const ElementPair& e : near_pairs(A_, B_, pose, p_.touch_tol)) {
+    const bool edge_face = (e.ka == K::kEdge && e.kb == K::kFace) || (e.ka == K::kFace && e.kb == K::kEdge);
+    const bool face_face = e.ka == K::kFace && e.kb == K::kFace;
+    if ((edge_face && !crosses_plane(e) && !bounded_by_close(e)) || (face_face && !bounded_by_close(e)))
+      continue;
     if (element_distance(A, pose, e.ka, e.a, B, e.kb, e.b).distance > p_.touch_tol) continue;
+    close.push_back(e);
     if (!open_touch(A, pose, e.ka, e.a, B, e.kb, e.b, p_.touch_tol)) continue;
     touching.push_back(e);
   }
@@ -1085,7 +1119,6 @@ bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) 
       if (why) *why = reason;
       return false;
     };
-    using K = ElementKind;
     const std::string name = kind_name(x.ka) + std::to_string(x.a) + "-" + kind_name(x.kb) + std::to_string(x.b);
     if (x.ka == K::kVertex && x.kb != K::kFace) return fail("degenerate touch " + name);
     if (x.kb == K::kVertex && x.ka != K::kFace) return fail("degenerate touch " + name);
