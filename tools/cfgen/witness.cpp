@@ -1069,11 +1069,12 @@ bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) 
   using K = ElementKind;
   // Pairs within touch_tol (closed elements), and those touching in their open interiors.
   std::vector<ElementPair> close, touching;
-  // An edge and a face, or two faces, can only be within touch_tol where a pair of their
-  // boundary elements is, or where the edge crosses the face's plane: the distance between
-  // two planar regions, or a segment and a region that it does not cross, is reached on a
-  // boundary. near_pairs lists pairs in ascending kinds, so those boundary pairs come first,
-  // and the costly edge-face and face-face distances are measured only where they can be small.
+  // near_pairs lists pairs in ascending kinds, so the pairs of an element pair's boundary
+  // elements come before it. Where one of those is within touch_tol, so is the pair (closed
+  // elements). Otherwise an edge and a face, or two faces, are farther apart unless the edge
+  // crosses the face's plane: the distance between two planar regions, or between a segment
+  // and a region it does not cross, is reached on a boundary. So the costly edge-face and
+  // face-face distances are measured only for an edge crossing a face's plane.
   auto bounded_by_close = [&](const ElementPair& e) {
     for (const ElementPair& c : close)
       if (in_closure(A, c.ka, c.a, e.ka, e.a) && in_closure(B, c.kb, c.b, e.kb, e.b)) return true;
@@ -1097,11 +1098,12 @@ bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) 
     return !((h0 > p_.touch_tol && h1 > p_.touch_tol) || (h0 < -p_.touch_tol && h1 < -p_.touch_tol));
   };
   for (const ElementPair& e : near_pairs(A_, B_, pose, p_.touch_tol)) {
-    const bool edge_face = (e.ka == K::kEdge && e.kb == K::kFace) || (e.ka == K::kFace && e.kb == K::kEdge);
-    const bool face_face = e.ka == K::kFace && e.kb == K::kFace;
-    if ((edge_face && !crosses_plane(e) && !bounded_by_close(e)) || (face_face && !bounded_by_close(e)))
-      continue;
-    if (element_distance(A, pose, e.ka, e.a, B, e.kb, e.b).distance > p_.touch_tol) continue;
+    if (!bounded_by_close(e)) {
+      const bool edge_face = (e.ka == K::kEdge && e.kb == K::kFace) || (e.ka == K::kFace && e.kb == K::kEdge);
+      const bool face_face = e.ka == K::kFace && e.kb == K::kFace;
+      if (face_face || (edge_face && !crosses_plane(e))) continue;
+      if (element_distance(A, pose, e.ka, e.a, B, e.kb, e.b).distance > p_.touch_tol) continue;
+    }
     close.push_back(e);
     if (!open_touch(A, pose, e.ka, e.a, B, e.kb, e.b, p_.touch_tol)) continue;
     touching.push_back(e);
