@@ -146,6 +146,58 @@ bool project_perp(const RotConstraints& c, Mat3& R) {
   return satisfies(c, R);
 }
 
+// Walks a one-parameter family of rotations (one alignment with its spin free, or two
+// perpendicularity conditions) away from R by steps of about h rad, at most n steps along
+// each branch: the rotations along each branch, R excluded. Where the two conditions'
+// gradients coincide (an axis-aligned pose, where branches of the family cross), each branch
+// is entered by a small turn about a coordinate axis projected back onto the conditions.
+// Empty for other families.
+std::vector<std::vector<Mat3>> walk_family(const RotConstraints& c, const Mat3& R, double h, int n) {
+  std::vector<std::vector<Mat3>> paths;
+  const bool spin = c.align.size() == 1 && c.perp.empty();
+  if (!spin && !(c.align.empty() && c.perp.size() == 2)) return paths;
+  // The axis keeping the conditions to first order (zero where it is not unique).
+  auto tangent = [&](const Mat3& Q) -> Vec3 {
+    if (spin) return c.align[0].second;
+    const Vec3 w = (Q * c.perp[0].first).cross(c.perp[0].second).cross((Q * c.perp[1].first).cross(c.perp[1].second));
+    return w.norm() < 1e-6 ? Vec3::Zero() : Vec3(w.normalized());
+  };
+  auto step = [&](const Mat3& Q, const Vec3& axis, Mat3& out) {
+    out = axis_angle(axis, h) * Q;
+    return spin || project_perp(c, out);
+  };
+  std::vector<Mat3> starts;
+  const Vec3 w0 = tangent(R);
+  std::vector<Vec3> kicks;
+  if (w0.norm() > 0) kicks = {w0, -w0};
+  else
+    for (int ax = 0; ax < 3; ++ax) kicks.push_back(Vec3::Unit(ax)), kicks.push_back(-Vec3::Unit(ax));
+  const double min_trace = 1 + 2 * std::cos(0.5 * h);  // a start at least h/2 from R and the others
+  for (const Vec3& k : kicks) {
+    Mat3 Q;
+    if (!step(R, k, Q) || (R.transpose() * Q).trace() > min_trace) continue;
+    bool distinct = true;
+    for (const Mat3& S : starts) distinct = distinct && (S.transpose() * Q).trace() <= min_trace;
+    if (distinct) starts.push_back(Q);
+  }
+  for (const Mat3& first : starts) {
+    std::vector<Mat3> path{first};
+    Mat3 prev = R;
+    for (int k = 1; k < n; ++k) {
+      // Keep turning the way the last step turned, then back onto the conditions: this
+      // follows a branch through points where gradients coincide.
+      const Mat3 cur = path.back();
+      const Eigen::AngleAxisd moved(Mat3(cur * prev.transpose()));
+      Mat3 next;
+      if (!step(cur, moved.angle() >= 0 ? moved.axis() : Vec3(-moved.axis()), next)) break;
+      prev = cur;
+      path.push_back(next);
+    }
+    paths.push_back(std::move(path));
+  }
+  return paths;
+}
+
 }  // namespace
 
 WitnessSearch::WitnessSearch(const ModelInfo& a, const ModelInfo& b, const SearchParams& p)
@@ -1492,6 +1544,30 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
       for (int ax = 0; ax < 3; ++ax)
         for (double sg : {1.0, -1.0}) around.push_back(axis_angle(sg * Vec3::Unit(ax), ang) * R);
   for (const Mat3& R : rotation_candidates(pcs, around, false))
+    if (try_rotation(R)) return best;
+  if (best.found) return best;
+  // A one-parameter family: a part leaning in a gap (a peg tilted in a hole, an edge resting
+  // on one wall and the rim on its face) holds in a narrow range of the parameter, a few
+  // hundredths of a radian wide, just inside the end of the range where its contacts are
+  // locally admissible. Walk the family from the rotations above to each such end and try the
+  // rotations just inside it. (Where the two conditions are one, e.g. an edge on a face and a
+  // face parallel to that edge on an edge parallel to that face, the rotations form a
+  // surface and the walk follows curves on it; it still finds such ends, not all of them.)
+  constexpr double kWalkStep = 0.03;  // rad
+  constexpr int kWalkSteps = 60;      // up to 1.8 rad each way
+  constexpr int kInside = 4;          // rotations tried inside each end, kWalkStep apart
+  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
+  const double min_local = std::sin(p_.angle_margin);
+  std::vector<Mat3> ends;
+  for (const Mat3& R : near)
+    for (const std::vector<Mat3>& path : walk_family(c, R, kWalkStep, kWalkSteps)) {
+      std::size_t k = 0;
+      while (k < path.size() && local_margin(pcs, path[k]) > min_local) ++k;
+      if (debug_) std::cerr << "  walk: " << path.size() << " steps, end at " << k << "\n";
+      if (k == path.size()) continue;  // no end within reach
+      for (int i = 1; i <= kInside && static_cast<int>(k) - i >= 0; ++i) add_unique(ends, path[k - i]);
+    }
+  for (const Mat3& R : ends)
     if (try_rotation(R)) return best;
   return best;
 }
