@@ -1031,6 +1031,18 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
   return verify(pcs, pose, why, nullptr);
 }
 
+bool WitnessSearch::still_blocked(const PcSet& pcs, const Pose& pose, const Obstacle& o) const {
+  if (!o.set) return false;
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  for (const Pc& pc : pcs)
+    if (in_closure(A, o.ka, o.a, a_kind(pc.type), pc.a) && in_closure(B, o.kb, o.b, b_kind(pc.type), pc.b))
+      return false;  // a PC's pair or covered by one: verify judges it otherwise
+  const double d = element_distance(A, pose, o.ka, o.a, B, o.kb, o.b).distance;
+  if (d >= p_.min_clearance) return false;
+  return d > p_.touch_tol || open_touch(A, pose, o.ka, o.a, B, o.kb, o.b, p_.touch_tol);
+}
+
 double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* why, Obstacle* obstacle) const {
   auto reject = [&](const std::string& reason) {
     if (why) *why = reason;
@@ -1406,6 +1418,7 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
         Pose pose;
         pose.R_BA = R;
         pose.t_BA = tt;
+        if (&tt != &ts.front() && still_blocked(pcs, pose, obstacle)) continue;
         Obstacle o;
         const double clearance = verify(pcs, pose, nullptr, &o);
         if (&tt == &ts.front()) {
@@ -1438,6 +1451,8 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
           Pose pose;
           pose.R_BA = R;
           pose.t_BA = t;
+          // Nearby translations are often blocked by the same pair: one distance decides.
+          if (&t != &ts.front() && still_blocked(pcs, pose, first_obstacle)) continue;
           std::string why;
           Obstacle obstacle;
           const double clearance = verify(pcs, pose, debug_ ? &why : nullptr, &obstacle);

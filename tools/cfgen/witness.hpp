@@ -54,6 +54,11 @@ class WitnessSearch {
   /// verify, also naming the obstacle when the pose failed on one.
   double verify(const PcSet& pcs, const Pose& pose, std::string* why, Obstacle* obstacle) const;
 
+  /// True when the obstacle's pair, neither a PC nor covered by one, is still closer than
+  /// min_clearance at `pose` (and touching in open points if within touch_tol): then verify
+  /// refuses `pose` too. False proves nothing.
+  bool still_blocked(const PcSet& pcs, const Pose& pose, const Obstacle& o) const;
+
   /// The PCs that hold at a pose: every touching pair of open elements (distance within
   /// touch_tol) that no other touching pair dominates. Returns false, with the reason, when
   /// a non-dominated touch is degenerate (v-v, v-e, e-v, parallel e-e) or more than three
