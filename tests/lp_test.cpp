@@ -1,10 +1,8 @@
 // The witness search's small LP solver (tools/cfgen/lp.cpp: a dense simplex, GLPK for what it
-// leaves) against GLPK's simplex, a solver written apart from the dense one, on random
-// programs of the witness search's shapes: up to ten variables, equality rows, bounds, and
-// degenerate vertices where many rows meet.
+// leaves) against GLPK's primal simplex alone, a solver written apart from the dense one, on
+// random programs of the witness search's shapes: up to ten variables, equality rows, bounds,
+// and degenerate vertices where many rows meet.
 #include <catch2/catch.hpp>
-
-#include <glpk.h>
 
 #include <random>
 
@@ -17,55 +15,11 @@ using Status = LpResult::Status;
 
 namespace {
 
+// GLPK's answer, the reference: its status, and its objective when optimal.
 struct Reference {
   Status status;
   double objective;
 };
-
-Reference glpk_solve(const LinearProgram& lp) {
-  glp_term_out(GLP_OFF);
-  glp_prob* P = glp_create_prob();
-  glp_set_obj_dir(P, GLP_MIN);
-  const int m = static_cast<int>(lp.rows.size());
-  if (m > 0) glp_add_rows(P, m);
-  glp_add_cols(P, lp.num_vars);
-  for (int j = 0; j < lp.num_vars; ++j) {
-    const auto [lf, lv] = lp.lower[j];
-    const auto [uf, uv] = lp.upper[j];
-    const int type = lf && uf ? (lv == uv ? GLP_FX : GLP_DB) : lf ? GLP_LO : uf ? GLP_UP : GLP_FR;
-    glp_set_col_bnds(P, j + 1, type, lf ? lv : 0.0, uf ? uv : 0.0);
-    glp_set_obj_coef(P, j + 1, lp.c[j]);
-  }
-  std::vector<int> ia{0}, ja{0};
-  std::vector<double> ar{0.0};
-  for (int i = 0; i < m; ++i) {
-    const auto& r = lp.rows[i];
-    glp_set_row_bnds(P, i + 1,
-                     r.rel == Rel::kEq ? GLP_FX : r.rel == Rel::kLessEq ? GLP_UP : GLP_LO, r.b,
-                     r.b);
-    for (const auto& [j, v] : r.a) {
-      ia.push_back(i + 1);
-      ja.push_back(j + 1);
-      ar.push_back(v);
-    }
-  }
-  glp_load_matrix(P, static_cast<int>(ar.size()) - 1, ia.data(), ja.data(), ar.data());
-  glp_smcp parm;
-  glp_init_smcp(&parm);
-  parm.msg_lev = GLP_MSG_OFF;
-  parm.presolve = GLP_ON;  // reports infeasible and unbounded programs as such
-  Reference ref{Status::kInfeasible, 0.0};
-  if (glp_simplex(P, &parm) == 0 && glp_get_status(P) == GLP_OPT) {
-    ref = {Status::kOptimal, glp_get_obj_val(P)};
-  } else {
-    glp_init_smcp(&parm);
-    parm.msg_lev = GLP_MSG_OFF;
-    if (glp_simplex(P, &parm) == 0 && glp_get_status(P) == GLP_UNBND)
-      ref.status = Status::kUnbounded;
-  }
-  glp_delete_prob(P);
-  return ref;
-}
 
 double objective(const LinearProgram& lp, const LpResult& r) {
   double v = 0;
@@ -73,8 +27,14 @@ double objective(const LinearProgram& lp, const LpResult& r) {
   return v;
 }
 
-// A program whose feasible set contains x_feas (so it is feasible) unless `infeasible`; rows
-// are random through or near x_feas, several of them through one point (degenerate).
+Reference glpk_solve(const LinearProgram& lp) {
+  const LpResult r = cf::gen::internal::glpk_solve(lp);
+  return {r.status, r.status == Status::kOptimal ? objective(lp, r) : 0.0};
+}
+
+// A feasible program: its rows pass through or near a random point x, every third one through
+// one vertex v beside it (a degenerate vertex); bounded in a box around x, or only partly
+// (then sometimes unbounded).
 LinearProgram random_program(std::mt19937& rng, bool& bounded_box) {
   std::uniform_int_distribution<int> nvars(2, 10);
   std::uniform_real_distribution<double> u(-1.0, 1.0);

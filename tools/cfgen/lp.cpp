@@ -258,9 +258,7 @@ LpResult internal::dense_solve(const LinearProgram& lp) {
   return out;
 }
 
-namespace {
-
-LpResult glpk_solve(const LinearProgram& lp) {
+LpResult internal::glpk_solve(const LinearProgram& lp) {
   glp_term_out(GLP_OFF);  // per thread; GLPK prints scaling reports otherwise
   glp_prob* P = glp_create_prob();
   glp_set_obj_dir(P, GLP_MIN);
@@ -311,11 +309,9 @@ LpResult glpk_solve(const LinearProgram& lp) {
   return out;
 }
 
-}  // namespace
-
 LpResult solve(const LinearProgram& lp) {
   LpResult r = internal::dense_solve(lp);
-  return r.status == LpResult::Status::kOptimal ? r : glpk_solve(lp);
+  return r.status == LpResult::Status::kOptimal ? r : internal::glpk_solve(lp);
 }
 
 }  // namespace cf::gen

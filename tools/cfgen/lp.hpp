@@ -43,6 +43,9 @@ namespace internal {
 /// The dense solver alone (for its tests): kOptimal with a solution, or kInfeasible meaning
 /// "not solved here", whatever the program's true status.
 LpResult dense_solve(const LinearProgram& lp);
+/// GLPK's primal simplex alone (for the tests' reference): its status and solution, the
+/// solution checked against every row.
+LpResult glpk_solve(const LinearProgram& lp);
 }  // namespace internal
 
 }  // namespace cf::gen
