@@ -43,14 +43,6 @@ double point_segment_hit(const Vec3& p, const Vec3& d, const Vec3& q0, const Vec
   return x[0];
 }
 
-// Whether a PC of `pcs` dominates the pair (element a of A, element b of B).
-bool dominated_by(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs, ElementKind ka, int a,
-                  ElementKind kb, int b) {
-  for (const Pc& pc : pcs)
-    if (in_closure(A, ka, a, a_kind(pc.type), pc.a) && in_closure(B, kb, b, b_kind(pc.type), pc.b)) return true;
-  return false;
-}
-
 // Null space of the rows of N (unit vectors), as an orthonormal basis.
 std::vector<Vec3> null_space(const std::vector<Vec3>& rows) {
   if (rows.empty()) return {Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
@@ -71,7 +63,7 @@ double first_contact_translation(const Polyhedron& A, const Polyhedron& B, const
                                  const Vec3& d, double s_min, double s_max, double tol,
                                  const PcSet& kept) {
   // Events between elements that the kept PCs dominate do not change the contact set.
-  auto dominated = [&](ElementKind ka, int a, ElementKind kb, int b) { return dominated_by(A, B, kept, ka, a, kb, b); };
+  auto dominated = [&](ElementKind ka, int a, ElementKind kb, int b) { return covered_by(A, B, kept, ka, a, kb, b); };
   double best = s_max;
   bool hit = false;
   auto take = [&](double s) {
@@ -318,7 +310,7 @@ void trig_roots(double a, double b, double c, double lo, double hi, std::vector<
 
 double first_contact_rotation(const Polyhedron& A, const Polyhedron& B, const Pose& pose, const Vec3& p,
                               const Vec3& u, double phi_min, double phi_max, double tol, const PcSet& kept) {
-  auto dominated = [&](ElementKind ka, int a, ElementKind kb, int b) { return dominated_by(A, B, kept, ka, a, kb, b); };
+  auto dominated = [&](ElementKind ka, int a, ElementKind kb, int b) { return covered_by(A, B, kept, ka, a, kb, b); };
   double best = phi_max;
   bool hit = false;
   std::vector<double> roots;

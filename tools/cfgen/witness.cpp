@@ -187,9 +187,9 @@ std::vector<std::vector<Mat3>> walk_family(const RotConstraints& c, const Mat3& 
       // Keep turning the way the last step turned, then back onto the conditions: this
       // follows a branch through points where gradients coincide.
       const Mat3 cur = path.back();
-      const Eigen::AngleAxisd moved(Mat3(cur * prev.transpose()));
+      const Eigen::AngleAxisd moved(Mat3(cur * prev.transpose()));  // angle in [0, pi]
       Mat3 next;
-      if (!step(cur, moved.angle() >= 0 ? moved.axis() : Vec3(-moved.axis()), next)) break;
+      if (!step(cur, moved.axis(), next)) break;
       prev = cur;
       path.push_back(next);
     }
@@ -1031,13 +1031,18 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
   return verify(pcs, pose, why, nullptr);
 }
 
+bool covered_by(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs, ElementKind ka, int a,
+                ElementKind kb, int b) {
+  for (const Pc& pc : pcs)
+    if (in_closure(A, ka, a, a_kind(pc.type), pc.a) && in_closure(B, kb, b, b_kind(pc.type), pc.b)) return true;
+  return false;
+}
+
 bool WitnessSearch::still_blocked(const PcSet& pcs, const Pose& pose, const Obstacle& o) const {
   if (!o.set) return false;
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
-  for (const Pc& pc : pcs)
-    if (in_closure(A, o.ka, o.a, a_kind(pc.type), pc.a) && in_closure(B, o.kb, o.b, b_kind(pc.type), pc.b))
-      return false;  // a PC's pair or covered by one: verify judges it otherwise
+  if (covered_by(A, B, pcs, o.ka, o.a, o.kb, o.b)) return false;  // verify judges those otherwise
   const double d = element_distance(A, pose, o.ka, o.a, B, o.kb, o.b).distance;
   if (d >= p_.min_clearance) return false;
   return d > p_.touch_tol || open_touch(A, pose, o.ka, o.a, B, o.kb, o.b, p_.touch_tol);
@@ -1079,14 +1084,10 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
     const double d = element_distance(A, pose, ka, a, B, kb, b).distance;
     if (ka == ElementKind::kVertex) a_vertex_gap[a] = std::min(a_vertex_gap[a], d);
     if (kb == ElementKind::kVertex) b_vertex_gap[b] = std::min(b_vertex_gap[b], d);
-    bool covered = false, is_pc = false;
-    for (const Pc& pc : pcs) {
-      if (a_kind(pc.type) == ka && b_kind(pc.type) == kb && pc.a == a && pc.b == b)
-        is_pc = true;
-      if (in_closure(A, ka, a, a_kind(pc.type), pc.a) &&
-          in_closure(B, kb, b, b_kind(pc.type), pc.b))
-        covered = true;
-    }
+    bool is_pc = false;
+    for (const Pc& pc : pcs)
+      if (a_kind(pc.type) == ka && b_kind(pc.type) == kb && pc.a == a && pc.b == b) is_pc = true;
+    const bool covered = covered_by(A, B, pcs, ka, a, kb, b);
     if (is_pc) {
       if (d > p_.touch_tol) return reject("PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " apart by " + std::to_string(d));
       // The open elements must touch: a face meeting an edge only at its own boundary

@@ -31,6 +31,12 @@ struct Witness {
   double margin = 0;     // mm, the LP margin of the contacts inside their elements
 };
 
+/// Whether a PC of `pcs` covers the pair (element a of A, element b of B): each element lies
+/// in the closure of that PC's element on its side (a PC covers its own pair). Touching such
+/// a pair does not change the contact set.
+bool covered_by(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs, ElementKind ka, int a,
+                ElementKind kb, int b);
+
 class WitnessSearch {
  public:
   WitnessSearch(const ModelInfo& a, const ModelInfo& b, const SearchParams& p);
