@@ -1138,35 +1138,17 @@ bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) 
   // elements come before it. Where one of those is within touch_tol, so is the pair (closed
   // elements). Otherwise an edge and a face, or two faces, are farther apart unless the edge
   // crosses the face's plane: the distance between two planar regions, or between a segment
-  // and a region it does not cross, is reached on a boundary. So the costly edge-face and
-  // face-face distances are measured only for an edge crossing a face's plane.
+  // and a region it does not cross, is reached on a boundary. near_pairs' plane bound has
+  // already dropped the edges that do not cross, so the costly face-face distance is never
+  // measured here, and the edge-face one only for an edge crossing the face's plane.
   auto bounded_by_close = [&](const ElementPair& e) {
     for (const ElementPair& c : close)
       if (in_closure(A, c.ka, c.a, e.ka, e.a) && in_closure(B, c.kb, c.b, e.kb, e.b)) return true;
     return false;
   };
-  auto crosses_plane = [&](const ElementPair& e) {
-    Vec3 p0, p1, n;
-    double offset;
-    if (e.ka == K::kEdge) {  // A's edge, B's face, in B's frame
-      p0 = pose.apply(A.edge_point(EdgeId(e.a), 0));
-      p1 = pose.apply(A.edge_point(EdgeId(e.a), 1));
-      n = B.faces()[e.b].normal;
-      offset = B.faces()[e.b].offset;
-    } else {  // A's face, B's edge, in A's frame
-      p0 = pose.inverse_apply(B.edge_point(EdgeId(e.b), 0));
-      p1 = pose.inverse_apply(B.edge_point(EdgeId(e.b), 1));
-      n = A.faces()[e.a].normal;
-      offset = A.faces()[e.a].offset;
-    }
-    const double h0 = n.dot(p0) - offset, h1 = n.dot(p1) - offset;
-    return !((h0 > p_.touch_tol && h1 > p_.touch_tol) || (h0 < -p_.touch_tol && h1 < -p_.touch_tol));
-  };
   for (const ElementPair& e : near_pairs(A_, B_, pose, p_.touch_tol)) {
     if (!bounded_by_close(e)) {
-      const bool edge_face = (e.ka == K::kEdge && e.kb == K::kFace) || (e.ka == K::kFace && e.kb == K::kEdge);
-      const bool face_face = e.ka == K::kFace && e.kb == K::kFace;
-      if (face_face || (edge_face && !crosses_plane(e))) continue;
+      if (e.ka == K::kFace && e.kb == K::kFace) continue;
       if (element_distance(A, pose, e.ka, e.a, B, e.kb, e.b).distance > p_.touch_tol) continue;
     }
     close.push_back(e);
