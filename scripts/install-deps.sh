@@ -16,7 +16,7 @@ CF_APT_PACKAGES=(
   # tools/ only: exact geometry and mesh IO (CGAL and its number types)
   libcgal-dev libgmp-dev libmpfr-dev
   # libcf (private): CF graph, graph and model files; public: small linear algebra
-  libboost-dev libboost-graph-dev nlohmann-json3-dev libeigen3-dev
+  libboost-dev libboost-graph-dev nlohmann-json3-dev libsimdjson-dev libeigen3-dev
   # tools/: command lines, JSON Schema checks
   libcli11-dev libvalijson-dev
   # tools/cfgen: linear programs of the witness search; `mpirun -n K cfgen` (Open MPI)

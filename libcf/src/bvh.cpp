@@ -60,15 +60,15 @@ void obb_of(const std::vector<Vec3>& pts, double inflate, const Vec3& origin, No
   }
   const Eigen::Matrix3f axes_f = axes.cast<float>();
   for (int k = 0; k < 3; ++k) {
-    o.ax[k] << axes_f.col(k), 0.0f;
+    o.ax[k] = lanes4(axes_f.col(k));
   }
   // The float axes are off by about 1e-7 rad: widen by that much of the box's reach.
   const Vec3 centre_local = 0.5 * (lo + hi);
   const double reach = (0.5 * (hi - lo)).norm() + 1.0;
   Eigen::Vector3f c, h;
   round_out(axes * centre_local - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate + 1e-6 * reach), c, h);
-  o.oc << c, 0.0f;
-  o.oh << h, 0.0f;
+  o.oc = lanes4(c);
+  o.oh = lanes4(h);
 }
 
 }  // namespace
@@ -170,8 +170,8 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin,
     obb_of(pts, inflate, origin, box);
     Eigen::Vector3f c, h;
     round_out(0.5 * (lo + hi) - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate), c, h);
-    box.c << c, 0.0f;
-    box.h << h, 0.0f;
+    box.c = lanes4(c);
+    box.h = lanes4(h);
     n.touchable = touchable_by_a(n.kinds);
     if (t.end - t.begin <= leaf_size) {
       n.child = ~t.begin;  // items for now; elements below
@@ -215,8 +215,8 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin,
       Eigen::Vector3f c, h;
       round_out(0.5 * (lo + hi) - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate), c, h);
       ElemBox& b = elem_boxes_.emplace_back();
-      b.c << c, 0.0f;
-      b.h << h, 0.0f;
+      b.c = lanes4(c);
+      b.h = lanes4(h);
     }
   }
   offset[items.size()] = static_cast<std::int32_t>(elements_.size());

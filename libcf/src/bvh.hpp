@@ -24,6 +24,10 @@ namespace cf::detail {
 // Unrolls the next loop of 3 (GCC and Clang): -O2 does not.
 #define CF_UNROLL3 _Pragma("GCC unroll 3")
 
+/// A 3-vector in the first three of four float lanes, the fourth 0. Written out because
+/// Eigen's comma initialiser from a Vector3f made GCC 12 -O3 warn of a 16-byte load from it.
+inline Eigen::Array4f lanes4(const Eigen::Ref<const Eigen::Vector3f>& v) { return {v.x(), v.y(), v.z(), 0.0f}; }
+
 struct BvhElement {
   ElementKind kind;
   std::int32_t index;
@@ -173,8 +177,8 @@ struct WideNode {
 /// face axes). Unused lanes of q give any answer: the caller masks them.
 __attribute__((always_inline)) inline unsigned overlapping_lanes(const Box4& p, int s, const Box4& q) {
 #if defined(CF_SSE)
-  // Written on SSE registers and unrolled (the project builds at -O2, which keeps loops of 3
-  // and spilled Eigen's 4-float temporaries to memory here).
+  // Written on SSE registers and unrolled: GCC at -O2, which an embedding application may
+  // use, keeps loops of 3 and spills Eigen's 4-float temporaries to memory here.
   const __m128 sign = _mm_set1_ps(-0.0f);
   const auto ld = [](const Eigen::Array4f& v) { return _mm_load_ps(v.data()); };
   const auto abs = [&](__m128 x) { return _mm_andnot_ps(sign, x); };

@@ -1,9 +1,9 @@
 // The in-memory CF graph: construction, consistency checks and queries.
-// Reading and writing the file is in graph_json.cpp.
+// Reading and writing the file is in io/graph_reader.cpp and io/graph_json.cpp.
 
 #include "check.hpp"
 #include "graph_impl.hpp"
-#include "json_util.hpp"
+#include "io/json_util.hpp"
 
 #include <algorithm>
 #include <array>

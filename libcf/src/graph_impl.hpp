@@ -71,8 +71,10 @@ void write_file_atomically(const std::string& path, const std::string& bytes, co
 }  // namespace cf::detail
 
 namespace cf::detail {
-/// Reads a graph file's bytes (graph_reader.cpp): one streaming pass, then the checks.
+/// Reads a graph file's bytes (io/graph_reader.cpp): one streaming pass, then the checks. JSON
+/// is read in place when `bytes` has kReadSlack bytes of capacity past its end (as
+/// read_input_file leaves), else from a padded copy.
 /// @throws cf::Error naming `source`, the JSON pointer and the problem.
-std::unique_ptr<CfGraph::Impl> read_graph(const char* data, std::size_t size, const std::string& source,
-                                          bool cbor, const GraphLoadOptions& options);
+std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::string& source, bool cbor,
+                                          const GraphLoadOptions& options);
 }  // namespace cf::detail

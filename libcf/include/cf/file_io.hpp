@@ -20,9 +20,13 @@ namespace cf {
 
 class Polyhedron;
 
+/// Bytes of capacity read_input_file leaves past the end of what it read.
+inline constexpr std::size_t kReadSlack = 64;
+
 /// Reads the whole of `path`. On failure returns false with `why` set to a short reason
 /// ("no such file", "is a directory, not a regular file", "is a FIFO (named pipe), not a
-/// regular file", "permission denied", "larger than 2 GiB"), without the file name.
+/// regular file", "permission denied", "larger than 2 GiB"), without the file name. On
+/// success `bytes.capacity()` exceeds `bytes.size()` by at least kReadSlack.
 bool read_input_file(const std::string& path, std::string& bytes, std::string& why,
                      std::size_t max_bytes = std::size_t{1} << 31);
 

@@ -137,6 +137,8 @@ bool read_input_file(const std::string& path, std::string& bytes, std::string& w
   }
   const int flags = ::fcntl(fd, F_GETFL);
   if (flags >= 0) ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+  // The slack past the end lets a parser that reads ahead (simdjson) take the bytes in place.
+  bytes.reserve(static_cast<std::size_t>(st.st_size) + kReadSlack);
   bytes.resize(static_cast<std::size_t>(st.st_size));
   std::size_t done = 0;
   while (true) {

@@ -100,7 +100,7 @@ ojson graph_json(const CfGraph::Impl& g, bool with_items = true) {
   return root;
 }
 
-// --- direct writing of the items, byte for byte what nlohmann's dump() writes -----------
+// --- direct writing of the items, in the layout of nlohmann's dump() --------------------
 
 void append_int(std::string& out, long long v) {
   char buf[24];
@@ -110,6 +110,8 @@ void append_int(std::string& out, long long v) {
 
 /// Shortest round-trip digits (std::to_chars), laid out by nlohmann's rules
 /// (dtoa_impl::format_buffer): plain decimals for exponents -4 < n <= 15, else d.ddde+XX.
+/// nlohmann's own Grisu2 digits are not always the shortest (it writes -7.3743686707643326
+/// for -7.374368670764333); both read back to the same double.
 void append_double(std::string& out, double v) {
   if (!std::isfinite(v)) {
     out += "null";
@@ -358,14 +360,14 @@ CfGraph CfGraph::load(const std::string& path, const GraphLoadOptions& options) 
   std::string bytes, why;
   if (!read_input_file(path, bytes, why)) throw Error("reading '" + path + "': cannot open: " + why);
   CfGraph g;
-  g.impl_ = detail::read_graph(bytes.data(), bytes.size(), path, is_cbor_path(path), options);
+  g.impl_ = detail::read_graph(bytes, path, is_cbor_path(path), options);
   return g;
 }
 
 CfGraph CfGraph::from_bytes(const std::string& bytes, const std::string& source, bool cbor,
                             const GraphLoadOptions& options) {
   CfGraph g;
-  g.impl_ = detail::read_graph(bytes.data(), bytes.size(), source, cbor, options);
+  g.impl_ = detail::read_graph(bytes, source, cbor, options);
   return g;
 }
 

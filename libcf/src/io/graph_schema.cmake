@@ -6,5 +6,5 @@ set(_cf_model_schema ${PROJECT_SOURCE_DIR}/schemas/model.schema.json)
 set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${_cf_graph_schema} ${_cf_model_schema})
 file(READ ${_cf_graph_schema} CF_GRAPH_SCHEMA_TEXT)
 file(READ ${_cf_model_schema} CF_MODEL_SCHEMA_TEXT)
-configure_file(${CMAKE_CURRENT_SOURCE_DIR}/src/graph_schema_text.cpp.in
+configure_file(${CMAKE_CURRENT_SOURCE_DIR}/src/io/graph_schema_text.cpp.in
   ${CMAKE_CURRENT_BINARY_DIR}/graph_schema_text.cpp @ONLY)

@@ -21,6 +21,10 @@
 #include <cstdint>
 #include <cstring>
 #include <cmath>
+#include <string_view>
+#include <utility>
+
+#include <simdjson.h>
 #include <sstream>
 
 namespace cf::detail {
@@ -370,7 +374,7 @@ bool GraphSax::scalar(const Scalar& s) {
 
 bool GraphSax::start(bool object) {
   // nlohmann's CBOR reader recurses once per level: without a cap, a few hundred thousand
-  // nested arrays overflow the stack. JSON is capped by FastJsonParser at the same depth.
+  // nested arrays overflow the stack. JSON is capped by JsonWalker at the same depth.
   if (cbor_ && stack_.size() > kMaxNesting)
     throw Error("reading '" + source_ + "': not valid CBOR: nesting deeper than " + std::to_string(kMaxNesting) +
                 " levels");
@@ -579,29 +583,56 @@ bool GraphSax::end() {
   return true;
 }
 
-/// A strict JSON (RFC 8259) parser that drives a SAX handler, several times faster than
-/// nlohmann's lexer on number-heavy graph files (std::from_chars, no per-character token
-/// buffer). Syntax errors give the line and column. CBOR still goes through nlohmann.
-class FastJsonParser {
+/// Drives a SAX handler from simdjson's On-Demand parser: strict RFC 8259 with UTF-8
+/// checked, and every value visited, so the whole document is validated (On Demand checks
+/// what it is asked for). Errors give the line and column of where the parser stopped.
+/// CBOR goes through nlohmann's SAX parser.
+class JsonWalker {
  public:
-  FastJsonParser(const char* data, std::size_t size, const std::string& source)
-      : begin_(data), p_(data), end_(data + size), source_(source) {}
+  JsonWalker(const std::string& bytes, const std::string& source) : source_(source) {
+    static_assert(kReadSlack >= simdjson::SIMDJSON_PADDING, "read_input_file's slack must cover simdjson's padding");
+    if (bytes.capacity() - bytes.size() >= simdjson::SIMDJSON_PADDING) {
+      text_ = simdjson::padded_string_view(bytes);  // reads into the string's spare capacity
+    } else {
+      copy_ = simdjson::padded_string(bytes.data(), bytes.size());
+      text_ = copy_;
+    }
+  }
 
   template <class Sax>
   void parse(Sax& sax) {
-    skip_ws();
-    if (p_ == end_) fail("empty input, expected a JSON value");
-    value(sax, 0);
-    skip_ws();
-    if (p_ != end_) fail("unexpected content after the JSON value");
+    // An empty or blank document is refused before simdjson sees it, to say so plainly.
+    const char* first = text_.data();
+    const char* const end = first + text_.size();
+    while (first < end && (*first == ' ' || *first == '\n' || *first == '\r' || *first == '\t')) ++first;
+    if (first == end) fail_at(end, "empty input, expected a JSON value");
+    // Errors of simdjson's first pass (invalid UTF-8, an unclosed string, a raw control
+    // character) come before there is a document to ask for a position.
+    if (const auto e = parser_.iterate(text_).get(doc_); e != simdjson::SUCCESS)
+      throw Error("reading '" + source_ + "': not valid JSON: " + simdjson::error_message(e));
+    iterating_ = true;
+    simdjson::ondemand::json_type type{};
+    check(doc_.type().get(type), first);
+    if (type == simdjson::ondemand::json_type::object || type == simdjson::ondemand::json_type::array) {
+      simdjson::ondemand::value root;
+      check(doc_.get_value().get(root), first);
+      value(root, sax, 0);
+    } else {
+      scalar_document(type, sax, first);
+    }
+    // current_location() is OUT_OF_BOUNDS once every token has been read.
+    if (const char* rest = nullptr; doc_.current_location().get(rest) == simdjson::SUCCESS)
+      fail_at(rest, "unexpected content after the JSON value");
   }
 
  private:
-  static constexpr int kMaxDepth = static_cast<int>(kMaxNesting);
-
-  [[noreturn]] void fail(const std::string& what) const {
+  /// Line and column (1-based) of a position in the text, and what is there.
+  [[noreturn]] void fail_at(const char* at, const std::string& what) const {
+    const char* const begin = text_.data();
+    const char* const end = begin + text_.size();
+    if (at == nullptr || at < begin || at > end) at = end;
     std::size_t line = 1, col = 1;
-    for (const char* q = begin_; q < p_ && q < end_; ++q) {
+    for (const char* q = begin; q < at; ++q) {
       if (*q == '\n') {
         ++line;
         col = 1;
@@ -610,9 +641,9 @@ class FastJsonParser {
       }
     }
     std::string near;
-    if (p_ < end_) {
-      const unsigned char c = static_cast<unsigned char>(*p_);
-      near = c >= 0x20 && c < 0x7f ? std::string(" near '") + *p_ + "'" : " near byte " + std::to_string(c);
+    if (at < end) {
+      const unsigned char c = static_cast<unsigned char>(*at);
+      near = c >= 0x20 && c < 0x7f ? std::string(" near '") + *at + "'" : " near byte " + std::to_string(c);
     } else {
       near = " at the end of the input";
     }
@@ -620,271 +651,170 @@ class FastJsonParser {
                 ", column " + std::to_string(col) + near + ": " + what);
   }
 
-  void skip_ws() {
-    while (p_ < end_ && (*p_ == ' ' || *p_ == '\n' || *p_ == '\r' || *p_ == '\t')) ++p_;
+  /// Where the parser stopped; `fallback` when it cannot say.
+  const char* here(const char* fallback) {
+    const char* at = nullptr;
+    if (!iterating_ || doc_.current_location().get(at) != simdjson::SUCCESS) return fallback;
+    return at;
   }
 
-  void expect(char c, const char* what) {
-    skip_ws();
-    if (p_ == end_ || *p_ != c) fail(what);
-    ++p_;
+  /// An error reading the value that starts at `at`, reported there.
+  void check(simdjson::error_code e, const char* at) {
+    if (e != simdjson::SUCCESS) fail_at(at, what(e));
+  }
+  /// An error moving through a container, reported where the parser stopped.
+  void check_step(simdjson::error_code e, const char* fallback) {
+    if (e != simdjson::SUCCESS) fail_at(here(fallback), what(e));
+  }
+  static std::string what(simdjson::error_code e) {
+    switch (e) {
+      case simdjson::T_ATOM_ERROR:
+      case simdjson::F_ATOM_ERROR:
+      case simdjson::N_ATOM_ERROR: return "invalid literal";
+      case simdjson::STRING_ERROR: return "invalid string (an unknown escape or an unpaired UTF-16 surrogate)";
+      case simdjson::NUMBER_ERROR: return "invalid number";
+      default: return simdjson::error_message(e);
+    }
   }
 
   template <class Sax>
-  void value(Sax& sax, int depth) {
-    if (depth > kMaxDepth) fail("nesting deeper than " + std::to_string(kMaxDepth) + " levels");
-    skip_ws();
-    if (p_ == end_) fail("unexpected end of input, expected a value");
-    switch (*p_) {
-      case '{': {
-        ++p_;
+  void value(simdjson::ondemand::value v, Sax& sax, std::size_t depth) {
+    using simdjson::ondemand::json_type;
+    const char* at = v.raw_json_token().data();  // the value's first byte
+    json_type type{};
+    check(v.type().get(type), at);
+    switch (type) {
+      case json_type::object: {
+        if (depth >= kMaxNesting) fail_at(at, "nesting deeper than " + std::to_string(kMaxNesting) + " levels");
+        simdjson::ondemand::object object;
+        check(v.get_object().get(object), at);
         sax.start_object(static_cast<std::size_t>(-1));
-        skip_ws();
-        if (p_ < end_ && *p_ == '}') {
-          ++p_;
-          sax.end_object();
-          return;
+        for (auto item : object) {
+          simdjson::ondemand::field field;
+          check_step(std::move(item).get(field), at);
+          std::string_view key;
+          check(field.unescaped_key().get(key), field.key().raw());
+          key_.assign(key.data(), key.size());
+          sax.key(key_);
+          value(field.value(), sax, depth + 1);
         }
-        for (;;) {
-          skip_ws();
-          if (p_ == end_ || *p_ != '"') fail("expected a member name in double quotes");
-          string();
-          sax.key(buf_);
-          expect(':', "expected ':' after a member name");
-          value(sax, depth + 1);
-          skip_ws();
-          if (p_ < end_ && *p_ == ',') {
-            ++p_;
-            continue;
-          }
-          if (p_ < end_ && *p_ == '}') {
-            ++p_;
-            sax.end_object();
-            return;
-          }
-          fail("expected ',' or '}' in an object");
-        }
-      }
-      case '[': {
-        ++p_;
-        sax.start_array(static_cast<std::size_t>(-1));
-        skip_ws();
-        if (p_ < end_ && *p_ == ']') {
-          ++p_;
-          sax.end_array();
-          return;
-        }
-        for (;;) {
-          value(sax, depth + 1);
-          skip_ws();
-          if (p_ < end_ && *p_ == ',') {
-            ++p_;
-            continue;
-          }
-          if (p_ < end_ && *p_ == ']') {
-            ++p_;
-            sax.end_array();
-            return;
-          }
-          fail("expected ',' or ']' in an array");
-        }
-      }
-      case '"':
-        string();
-        sax.string(buf_);
+        sax.end_object();
         return;
-      case 't': literal("true"); sax.boolean(true); return;
-      case 'f': literal("false"); sax.boolean(false); return;
-      case 'n': literal("null"); sax.null(); return;
-      default: number(sax);
+      }
+      case json_type::array: {
+        if (depth >= kMaxNesting) fail_at(at, "nesting deeper than " + std::to_string(kMaxNesting) + " levels");
+        simdjson::ondemand::array array;
+        check(v.get_array().get(array), at);
+        sax.start_array(static_cast<std::size_t>(-1));
+        for (auto item : array) {
+          simdjson::ondemand::value element;
+          check_step(std::move(item).get(element), at);
+          value(element, sax, depth + 1);
+        }
+        sax.end_array();
+        return;
+      }
+      case json_type::number: {
+        simdjson::ondemand::number n;
+        if (v.get_number().get(n) != simdjson::SUCCESS) return number_fallback(v.raw_json_token(), sax, at);
+        emit_number(n, sax);
+        return;
+      }
+      case json_type::string: {
+        std::string_view s;
+        check(v.get_string().get(s), at);
+        string_.assign(s.data(), s.size());
+        sax.string(string_);
+        return;
+      }
+      case json_type::boolean: {
+        bool b = false;
+        if (v.get_bool().get(b) != simdjson::SUCCESS) fail_at(at, "invalid literal");
+        sax.boolean(b);
+        return;
+      }
+      case json_type::null: {
+        bool is_null = false;
+        if (v.is_null().get(is_null) != simdjson::SUCCESS || !is_null) fail_at(at, "invalid literal");
+        sax.null();
+        return;
+      }
     }
-  }
-
-  void literal(const char* word) {
-    const std::size_t n = std::strlen(word);
-    if (static_cast<std::size_t>(end_ - p_) < n || std::memcmp(p_, word, n) != 0) fail("invalid literal");
-    p_ += n;
   }
 
   template <class Sax>
-  void number(Sax& sax) {
-    const char* start = p_;
-    const char* q = p_;
-    if (q < end_ && *q == '-') ++q;
-    if (q == end_ || !std::isdigit(static_cast<unsigned char>(*q))) fail("expected a value");
-    if (*q == '0') {
-      ++q;
-    } else {
-      while (q < end_ && std::isdigit(static_cast<unsigned char>(*q))) ++q;
-    }
-    bool integer = true;
-    if (q < end_ && *q == '.') {
-      integer = false;
-      ++q;
-      if (q == end_ || !std::isdigit(static_cast<unsigned char>(*q))) {
-        p_ = q;
-        fail("expected a digit after the decimal point");
+  void scalar_document(simdjson::ondemand::json_type type, Sax& sax, const char* at) {
+    using simdjson::ondemand::json_type;
+    switch (type) {
+      case json_type::number: {
+        simdjson::ondemand::number n;
+        if (doc_.get_number().get(n) != simdjson::SUCCESS) return number_fallback(doc_.raw_json_token(), sax, at);
+        return emit_number(n, sax);
       }
-      while (q < end_ && std::isdigit(static_cast<unsigned char>(*q))) ++q;
-    }
-    if (q < end_ && (*q == 'e' || *q == 'E')) {
-      integer = false;
-      ++q;
-      if (q < end_ && (*q == '+' || *q == '-')) ++q;
-      if (q == end_ || !std::isdigit(static_cast<unsigned char>(*q))) {
-        p_ = q;
-        fail("expected a digit in the exponent");
-      }
-      while (q < end_ && std::isdigit(static_cast<unsigned char>(*q))) ++q;
-    }
-    p_ = q;
-    if (integer) {
-      if (*start != '-') {
-        std::uint64_t u = 0;
-        const auto r = std::from_chars(start, q, u);
-        if (r.ec == std::errc() && r.ptr == q) {
-          if (u <= static_cast<std::uint64_t>(INT64_MAX)) sax.number_integer(static_cast<std::int64_t>(u));
-          else sax.number_unsigned(u);
-          return;
-        }
-      } else {
-        std::int64_t i = 0;
-        const auto r = std::from_chars(start, q, i);
-        if (r.ec == std::errc() && r.ptr == q) {
-          sax.number_integer(i);
-          return;
-        }
-      }
-      // Too large for 64 bits: a floating-point number, as nlohmann reads it.
-    }
-    double d = 0;
-    const auto r = std::from_chars(start, q, d);
-    if (r.ec != std::errc() || r.ptr != q) {
-      p_ = start;
-      fail("number out of the range of a double");
-    }
-    sax.number_float(d, kEmpty);
-  }
-
-  static unsigned hex(char c) {
-    if (c >= '0' && c <= '9') return static_cast<unsigned>(c - '0');
-    if (c >= 'a' && c <= 'f') return static_cast<unsigned>(c - 'a' + 10);
-    if (c >= 'A' && c <= 'F') return static_cast<unsigned>(c - 'A' + 10);
-    return 16;
-  }
-
-  unsigned hex4() {
-    if (end_ - p_ < 4) fail("incomplete \\u escape");
-    unsigned v = 0;
-    for (int k = 0; k < 4; ++k) {
-      const unsigned h = hex(p_[k]);
-      if (h == 16) fail("invalid \\u escape");
-      v = v * 16 + h;
-    }
-    p_ += 4;
-    return v;
-  }
-
-  void put_utf8(unsigned cp) {
-    if (cp < 0x80) {
-      buf_ += static_cast<char>(cp);
-    } else if (cp < 0x800) {
-      buf_ += static_cast<char>(0xC0 | (cp >> 6));
-      buf_ += static_cast<char>(0x80 | (cp & 0x3F));
-    } else if (cp < 0x10000) {
-      buf_ += static_cast<char>(0xE0 | (cp >> 12));
-      buf_ += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-      buf_ += static_cast<char>(0x80 | (cp & 0x3F));
-    } else {
-      buf_ += static_cast<char>(0xF0 | (cp >> 18));
-      buf_ += static_cast<char>(0x80 | ((cp >> 12) & 0x3F));
-      buf_ += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-      buf_ += static_cast<char>(0x80 | (cp & 0x3F));
-    }
-  }
-
-  /// Length of the valid UTF-8 sequence at p_ (lead byte >= 0x80), or 0.
-  std::size_t utf8_length() const {
-    const auto* u = reinterpret_cast<const unsigned char*>(p_);
-    const std::size_t avail = static_cast<std::size_t>(end_ - p_);
-    auto cont = [&](std::size_t k) { return k < avail && (u[k] & 0xC0) == 0x80; };
-    if (u[0] >= 0xC2 && u[0] <= 0xDF) return cont(1) ? 2 : 0;
-    if (u[0] >= 0xE0 && u[0] <= 0xEF) {
-      if (!cont(1) || !cont(2)) return 0;
-      if (u[0] == 0xE0 && u[1] < 0xA0) return 0;  // overlong
-      if (u[0] == 0xED && u[1] > 0x9F) return 0;  // surrogate
-      return 3;
-    }
-    if (u[0] >= 0xF0 && u[0] <= 0xF4) {
-      if (!cont(1) || !cont(2) || !cont(3)) return 0;
-      if (u[0] == 0xF0 && u[1] < 0x90) return 0;
-      if (u[0] == 0xF4 && u[1] > 0x8F) return 0;
-      return 4;
-    }
-    return 0;
-  }
-
-  /// Reads the string at p_ (on its opening quote) into buf_.
-  void string() {
-    ++p_;
-    buf_.clear();
-    for (;;) {
-      const char* run = p_;
-      while (p_ < end_ && *p_ != '"' && *p_ != '\\' && static_cast<unsigned char>(*p_) >= 0x20 &&
-             static_cast<unsigned char>(*p_) < 0x80)
-        ++p_;
-      buf_.append(run, static_cast<std::size_t>(p_ - run));
-      if (p_ == end_) fail("unterminated string");
-      const unsigned char c = static_cast<unsigned char>(*p_);
-      if (c == '"') {
-        ++p_;
+      case json_type::string: {
+        std::string_view s;
+        check(doc_.get_string().get(s), at);
+        string_.assign(s.data(), s.size());
+        sax.string(string_);
         return;
       }
-      if (c < 0x20) fail("control character in a string (escape it)");
-      if (c >= 0x80) {
-        const std::size_t n = utf8_length();
-        if (n == 0) fail("invalid UTF-8 in a string");
-        buf_.append(p_, n);
-        p_ += n;
-        continue;
+      case json_type::boolean: {
+        bool b = false;
+        if (doc_.get_bool().get(b) != simdjson::SUCCESS) fail_at(at, "invalid literal");
+        sax.boolean(b);
+        return;
       }
-      ++p_;  // backslash
-      if (p_ == end_) fail("unterminated string");
-      const char e = *p_++;
-      switch (e) {
-        case '"': buf_ += '"'; break;
-        case '\\': buf_ += '\\'; break;
-        case '/': buf_ += '/'; break;
-        case 'b': buf_ += '\b'; break;
-        case 'f': buf_ += '\f'; break;
-        case 'n': buf_ += '\n'; break;
-        case 'r': buf_ += '\r'; break;
-        case 't': buf_ += '\t'; break;
-        case 'u': {
-          unsigned cp = hex4();
-          if (cp >= 0xD800 && cp <= 0xDBFF) {
-            if (end_ - p_ < 2 || p_[0] != '\\' || p_[1] != 'u') fail("unpaired UTF-16 surrogate in a \\u escape");
-            p_ += 2;
-            const unsigned lo = hex4();
-            if (lo < 0xDC00 || lo > 0xDFFF) fail("unpaired UTF-16 surrogate in a \\u escape");
-            cp = 0x10000 + ((cp - 0xD800) << 10) + (lo - 0xDC00);
-          } else if (cp >= 0xDC00 && cp <= 0xDFFF) {
-            fail("unpaired UTF-16 surrogate in a \\u escape");
-          }
-          put_utf8(cp);
-          break;
-        }
-        default: --p_; fail("invalid escape in a string");
+      case json_type::null: {
+        bool is_null = false;
+        if (doc_.is_null().get(is_null) != simdjson::SUCCESS || !is_null) fail_at(at, "invalid literal");
+        sax.null();
+        return;
       }
+      default: fail_at(at, "expected a value");
     }
+  }
+
+  template <class Sax>
+  void emit_number(simdjson::ondemand::number n, Sax& sax) {
+    switch (n.get_number_type()) {
+      case simdjson::ondemand::number_type::signed_integer: sax.number_integer(n.get_int64()); return;
+      case simdjson::ondemand::number_type::unsigned_integer: sax.number_unsigned(n.get_uint64()); return;
+      default: sax.number_float(n.get_double(), kEmpty); return;
+    }
+  }
+
+  /// simdjson refuses integers past 64 bits, which JSON allows and nlohmann reads as doubles;
+  /// any other number it refuses is reported with its position.
+  template <class Sax>
+  void number_fallback(simdjson::simdjson_result<std::string_view> token, Sax& sax, const char* at) {
+    std::string_view raw;
+    if (std::move(token).get(raw) != simdjson::SUCCESS) fail_at(at, "invalid number");
+    // The token runs to the next structural character; the number is its leading part.
+    std::size_t len = 0;
+    while (len < raw.size() && std::strchr("+-.0123456789eE", raw[len]) != nullptr) ++len;
+    raw = raw.substr(0, len);
+    const std::string_view digits = raw.substr(!raw.empty() && raw[0] == '-' ? 1 : 0);
+    const bool long_integer = digits.size() >= 20 && digits[0] != '0' &&
+                              digits.find_first_not_of("0123456789") == std::string_view::npos;
+    double d = 0;
+    const auto r = std::from_chars(raw.data(), raw.data() + raw.size(), d);
+    if (long_integer && r.ec == std::errc()) {
+      sax.number_float(d, kEmpty);
+      return;
+    }
+    if (r.ec == std::errc::result_out_of_range) fail_at(at, "number out of the range of a double");
+    fail_at(at, "invalid number (RFC 8259: an optional minus, digits without leading zeros, an optional "
+                "fraction and exponent)");
   }
 
   inline static const std::string kEmpty;
-  const char* begin_;
-  const char* p_;
-  const char* end_;
+  simdjson::padded_string copy_;     // when the caller's bytes have no padding
+  simdjson::padded_string_view text_;  // simdjson reads up to SIMDJSON_PADDING bytes past the end
   const std::string& source_;
-  std::string buf_;
+  simdjson::ondemand::parser parser_;
+  simdjson::ondemand::document doc_;
+  bool iterating_ = false;  // doc_ is valid
+  std::string key_, string_;
 };
 
 class JsonLocator final : public FaultLocator {
@@ -913,13 +843,15 @@ bool is_reserved(const std::string& key) {
 
 }  // namespace
 
-std::unique_ptr<CfGraph::Impl> read_graph(const char* data, std::size_t size, const std::string& source,
-                                          bool cbor, const GraphLoadOptions& options) {
+std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::string& source, bool cbor,
+                                          const GraphLoadOptions& options) {
+  const char* const data = bytes.data();
+  const std::size_t size = bytes.size();
   GraphSax sax(source, cbor);
   if (cbor)
     json::sax_parse(data, data + size, &sax, json::input_format_t::cbor);
   else
-    FastJsonParser(data, size, source).parse(sax);
+    JsonWalker(bytes, source).parse(sax);
 
   const JsonWhere root{source, ""};
   const json& j = sax.skeleton;
