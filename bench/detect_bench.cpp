@@ -170,12 +170,12 @@ void report(benchmark::State& state, std::vector<double>& ns) {
 struct Pair {
   cf::Polyhedron a, b;
   std::vector<cf::Pose> poses;
-  cf::DetectionParams detection;
+  cf::Params params;
 };
 
-cf::DetectionParams with_epsilon(double eps) {
-  cf::DetectionParams p;
-  p.epsilon = p.max_penetration = eps;
+cf::Params with_epsilon(double eps) {
+  cf::Params p;
+  p.epsilon_mm = p.detection.max_penetration_mm = eps;
   return p;
 }
 
@@ -184,7 +184,7 @@ Pair& cube_l() {
   return p;
 }
 // Spheres of 2,000 (r = 30) and 2,016 faces (r = 50), facets of 2.4 to 6.5 mm, at a contact
-// threshold eps (and max_penetration) with poses whose gaps scale with it.
+// threshold eps (and max_penetration_mm) with poses whose gaps scale with it.
 Pair sphere_pair(double eps) {
   return {tm::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000"),
           tm::faceted_sphere(50, 42, 48, Vec3::Zero(), "sphere2016"), sphere_poses(30, 50, eps), with_epsilon(eps)};
@@ -212,18 +212,16 @@ Pair& spheres_fine_servo() {
   return p;
 }
 
-// Without the pairs kept between nearby poses (DetectionParams::reuse_margin 0).
+// Without the pairs kept between nearby poses (DetectionParams::reuse_margin_mm 0).
 Pair cold(const Pair& pr) {
   Pair c = pr;
-  c.detection.reuse_margin = 0;
+  c.params.detection.reuse_margin_mm = 0;
   return c;
 }
 
 void run_cf(benchmark::State& state, const Pair& pr) {
   const cf::CfGraph g = timing_graph(pr.a, pr.b);
-  cf::IdentificationParams ip;
-  ip.detection = pr.detection;
-  cf::CfIdentifier id(g, ip);
+  cf::CfIdentifier id(g, pr.params);
   std::vector<double> ns;
   ns.reserve(1 << 22);
   std::size_t i = 0, contacts = 0;
@@ -241,7 +239,7 @@ void run_cf(benchmark::State& state, const Pair& pr) {
 }
 
 void run_detect(benchmark::State& state, const Pair& pr) {
-  cf::ContactDetector det(pr.a, pr.b, pr.detection);
+  cf::ContactDetector det(pr.a, pr.b, pr.params);
   cf::ContactSet cs;
   std::vector<double> ns;
   ns.reserve(1 << 22);

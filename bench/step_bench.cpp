@@ -245,10 +245,9 @@ void BM_ServoStepIntrinsic(benchmark::State& state) {
   const auto graph = load_graph(&which);
   const std::vector<Tick> ticks = load_ticks();
   cf::HapticRenderer full(*graph), split(*graph);
-  cf::IdentificationParams ip;
-  ip.detection.epsilon = cf::Params().epsilon_mm;  // as the renderer's identifier
+  const cf::Params ip;  // as the renderer's identifier
   cf::CfIdentifier ident(*graph, ip);
-  cf::ContactDetector det(graph->model_a(), graph->model_b(), ip.detection);
+  cf::ContactDetector det(graph->model_a(), graph->model_b(), ip);
   auto set = std::make_unique<cf::ContactSet>();
   std::vector<TickRecord> rec(ticks.size());
   long nondet = 0;

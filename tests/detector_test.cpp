@@ -297,10 +297,14 @@ TEST_CASE("no contact far away; a deep penetration is not a contact", "[detector
 }
 
 TEST_CASE("bad parameters are rejected with their name", "[detector]") {
-  cf::DetectionParams p;
-  p.epsilon = -1;
+  cf::Params p;
+  p.epsilon_mm = -1;
   CHECK_THROWS_WITH(cf::ContactDetector(tmod::cube(), tmod::l_block(), p),
-                    Catch::Contains("parameter epsilon must be positive"));
+                    Catch::Contains("parameter epsilon_mm must be positive"));
+  p = cf::Params();
+  p.detection.max_penetration_mm = std::nan("");
+  CHECK_THROWS_WITH(cf::ContactDetector(tmod::cube(), tmod::l_block(), p),
+                    Catch::Contains("parameter max_penetration_mm must be non-negative"));
 }
 
 TEST_CASE("overlap of polygons with holes matches Boost.Geometry", "[detector]") {
@@ -495,17 +499,17 @@ TEST_CASE("convexity: one loop, no reflex corner", "[detector]") {
 }
 
 namespace {
-cf::DetectionParams band(double eps) {
-  cf::DetectionParams p;
-  p.epsilon = p.max_penetration = eps;
+cf::Params band(double eps) {
+  cf::Params p;
+  p.epsilon_mm = p.detection.max_penetration_mm = eps;
   return p;
 }
-cf::DetectionParams all_pairs(cf::DetectionParams p) {
-  p.use_bvh = false;
+cf::Params all_pairs(cf::Params p) {
+  p.detection.use_bvh = false;
   return p;
 }
-cf::DetectionParams not_kept(cf::DetectionParams p) {
-  p.reuse_margin = 0;
+cf::Params not_kept(cf::Params p) {
+  p.detection.reuse_margin_mm = 0;
   return p;
 }
 // One model pair under a detector and a reference detector (all pairs, or no kept pairs),
@@ -513,7 +517,7 @@ cf::DetectionParams not_kept(cf::DetectionParams p) {
 struct Twin {
   cf::ContactDetector det, ref;
   cf::ContactSet x, y;
-  Twin(const cf::Polyhedron& a, const cf::Polyhedron& b, const cf::DetectionParams& p, const cf::DetectionParams& q)
+  Twin(const cf::Polyhedron& a, const cf::Polyhedron& b, const cf::Params& p, const cf::Params& q)
       : det(a, b, p), ref(a, b, q) {}
   void detect(const cf::Pose& pose) {
     det.detect(pose, x);
@@ -555,7 +559,7 @@ TEST_CASE("the BVH finds what all pairs find on faceted spheres", "[detector]") 
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> U(-1, 1);
   int contacts = 0;
-  // Gaps from 1.1 epsilon apart (nothing) to 1.1 epsilon deep (beyond max_penetration):
+  // Gaps from 1.1 epsilon apart (nothing) to 1.1 epsilon deep (beyond max_penetration_mm):
   // the band's edges on both sides.
   for (int k = 0; k < 32; ++k) {
     const Vec3 dir = Vec3(U(rng), U(rng), U(rng)).normalized();
@@ -658,7 +662,7 @@ TEST_CASE("pairs kept between nearby poses give what the hierarchy gives", "[det
   const double eps = GENERATE(1.0, 0.1);
   const cf::Polyhedron a = tmod::faceted_sphere(30, 20, 30);
   const cf::Polyhedron b = tmod::faceted_sphere(50, 21, 32);
-  REQUIRE(band(eps).reuse_margin > 0);
+  REQUIRE(band(eps).detection.reuse_margin_mm > 0);
   Twin t(a, b, band(eps), not_kept(band(eps)));
   int reused = 0, contacts = 0;
   const int n = 400;
@@ -701,9 +705,9 @@ struct WarmCold {
   std::size_t warm_pairs = 0, cold_pairs = 0;
 };
 WarmCold compare_warm_cold(const cf::Polyhedron& a, const cf::Polyhedron& b, double eps,
-                           const std::vector<cf::Pose>& poses, double reuse_margin = cf::DetectionParams{}.reuse_margin) {
-  cf::DetectionParams prm = band(eps);
-  prm.reuse_margin = reuse_margin;
+                           const std::vector<cf::Pose>& poses, double reuse_margin_mm = cf::DetectionParams{}.reuse_margin_mm) {
+  cf::Params prm = band(eps);
+  prm.detection.reuse_margin_mm = reuse_margin_mm;
   Twin t(a, b, prm, not_kept(prm));
   WarmCold r;
   for (std::size_t k = 0; k < poses.size(); ++k) {
@@ -860,8 +864,8 @@ TEST_CASE("kept pairs serve rotations, and rotations rounded to float", "[detect
 }
 
 TEST_CASE("a negative reuse margin is refused", "[detector]") {
-  cf::DetectionParams p;
-  p.reuse_margin = -0.1;
+  cf::Params p;
+  p.detection.reuse_margin_mm = -0.1;
   CHECK_THROWS_WITH(cf::ContactDetector(tmod::cube(), tmod::l_block(), p),
-                    Catch::Contains("parameter reuse_margin must be non-negative"));
+                    Catch::Contains("parameter reuse_margin_mm must be non-negative"));
 }

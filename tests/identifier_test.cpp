@@ -160,7 +160,7 @@ TEST_CASE("a contact farther than the CF's own is apart until it touches; the CF
   // Approaching: still apart at 0.01 mm (witnesses keep non-contacts at least that far).
   CHECK(id.step(at(-0.1, 0.01)).status == IdStatus::kMatchedPrevious);
   CHECK(id.last().num_approaching == 1);
-  // Touching (within touch_distance = 0.001 mm): gained, no longer approaching.
+  // Touching (within touch_distance_mm = 0.001 mm): gained, no longer approaching.
   CHECK(id.step(at(-0.1, 0.0005)).status == IdStatus::kMatchedNeighbour);
   CHECK(id.last().cf == CfId(3));
   CHECK_FALSE(id.last().partial_cover);
@@ -180,13 +180,13 @@ TEST_CASE("a contact farther than the CF's own is apart until it touches; the CF
   CHECK(id.step(at(0.4, 0.2)).cf == CfId(3));  // the floor alone would leave out the nearer wall
   id.reset();
   CHECK(id.step(at(0.3, 0.3)).cf == CfId(3));  // equally near: both
-  // touch_distance is a parameter.
-  cf::IdentificationParams p;
-  p.touch_distance = 0.5;
+  // touch_distance_mm is a parameter.
+  cf::Params p;
+  p.identification.touch_distance_mm = 0.5;
   cf::CfIdentifier wide(fx.graph, p);
   CHECK(wide.step(at(-0.1, 0.3)).cf == CfId(3));
-  p.touch_distance = -1;
-  CHECK_THROWS_WITH(cf::CfIdentifier(fx.graph, p), Catch::Contains("touch_distance must be finite and non-negative"));
+  p.identification.touch_distance_mm = -1;
+  CHECK_THROWS_WITH(cf::CfIdentifier(fx.graph, p), Catch::Contains("touch_distance_mm must be finite and non-negative"));
 }
 
 TEST_CASE("the ambiguity of paper Fig. 3: the undominated reading wins, else history", "[identifier]") {

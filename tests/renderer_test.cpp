@@ -193,6 +193,32 @@ TEST_CASE("full servo step: the cube lands on the L-block floor and slides into 
   CHECK(res->status == cf::RenderStatus::kOk);
 }
 
+TEST_CASE("one parameter tree: epsilon, detection and identification reach the renderer's stages", "[renderer]") {
+  const cf::CfGraph g = corner_graph();
+  cf::Params P;
+  P.epsilon_mm = 0.3;  // one epsilon: the detector's band and eq. (1)
+  cf::HapticRenderer r(g, P);
+  cf::Pose p = at(70, 35.5, 40);  // the cube's bottom face 0.5 mm above the floor
+  CHECK(r.step(p, 0.001).status == cf::RenderStatus::kNoContact);
+  p.t_BA.y() = 35.2;
+  const cf::HapticResult& res = r.step(p, 0.002);
+  REQUIRE(res.cf == cf::CfId(0));
+  CHECK(res.F_W.y() == Approx(P.stiffness_N_per_mm * (0.3 - 0.2) - 4.9).margin(1e-9));
+  // All pairs instead of the hierarchies: the same wrench.
+  cf::Params brute = P;
+  brute.detection.use_bvh = false;
+  cf::HapticRenderer rb(g, brute);
+  rb.step(at(70, 35.5, 40), 0.001);
+  CHECK(rb.step(p, 0.002).F_W == res.F_W);
+  // Out-of-range values of the subtrees are refused by the stage that reads them.
+  cf::Params bad = P;
+  bad.detection.reuse_margin_mm = -1;
+  CHECK_THROWS_WITH(cf::HapticRenderer(g, bad), Catch::Contains("parameter reuse_margin_mm must be non-negative"));
+  bad = P;
+  bad.identification.max_combinations = 0;
+  CHECK_THROWS_WITH(cf::HapticRenderer(g, bad), Catch::Contains("parameter max_combinations must be at least 1"));
+}
+
 TEST_CASE("a second plane's contact pushes from epsilon on, without a step at its gain", "[renderer]") {
   // The cube resting 0.5 mm into the floor's band slides towards the wall, 10 um per tick,
   // from 3 mm away to 0.2 mm into it. The wall's normal force (of its PC, or of its contact
@@ -230,7 +256,7 @@ TEST_CASE("a second plane's contact pushes from epsilon on, without a step at it
       CHECK(first_push_gap > 0.98);
       CHECK(max_step <= 2.3 * 0.01 + 1e-9);
     } else {
-      // Gained when as near as the floor's PC (0.5 mm, + touch_distance): K (1 - 0.501).
+      // Gained when as near as the floor's PC (0.5 mm, + touch_distance_mm): K (1 - 0.501).
       CHECK(max_step > 1.1);
     }
   }

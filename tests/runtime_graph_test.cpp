@@ -40,7 +40,7 @@ using cf::Vec3;
 // poses written as shortest round-trip doubles and of the detector's own arithmetic.
 constexpr double kExact = 1e-6;  // mm
 // Perturbed poses keep every PC of the witness's CF within this band of signed distances
-// (mm; inside the detector's [-max_penetration, epsilon] = [-1, 1]), and the heights over a
+// (mm; inside the detector's [-max_penetration_mm, epsilon] = [-1, 1]), and the heights over a
 // line or plane PC within kSpread of each other, so that its tilt is within the detector's
 // angular tolerance (the tilt at which the whole contact stays within epsilon = 1 mm).
 constexpr double kBandLo = -0.3, kBandHi = 0.8, kSpread = 0.9;
@@ -141,7 +141,7 @@ bool distance_consistent(const cf::CfGraph& g, const cf::ContactPc& c, const Pos
   const Span s = pc_span(g, c.pc, P);
   if (c.pc.type == PcType::kEE) {
     // Only comparable when the crossing lies inside both edges (else the detector measures
-    // from the nearer end, within in_plane_tolerance): then equal.
+    // from the nearer end, within in_plane_tolerance_mm): then equal.
     const cf::Edge& EA = g.model_a().edges()[static_cast<std::size_t>(c.pc.a)];
     const cf::Edge& EB = g.model_b().edges()[static_cast<std::size_t>(c.pc.b)];
     const Vec3 p0 = P.apply(g.model_a().vertex(EA.v0).p), uA = P.R_BA * EA.dir;

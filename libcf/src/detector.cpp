@@ -121,7 +121,8 @@ detail::Leaves leaves_for(const Polyhedron& m) {
 
 struct ContactDetector::Impl {
   Polyhedron a, b;
-  DetectionParams prm;
+  Params all;           // as given (params())
+  DetectionParams prm;  // all.detection
   double eps, depth, in_plane, geo_tol, area_tol;
   detail::Bvh bvh_a, bvh_b;
   FlatFaces flat_a, flat_b;
@@ -195,7 +196,7 @@ struct ContactDetector::Impl {
   ContactSet* out = nullptr;
   std::size_t pairs = 0;
   std::array<int, ContactSet::kCapacity> reps{};  // first member of each plane group
-  // Temporal coherence (big models, DetectionParams::reuse_margin): the element pairs whose
+  // Temporal coherence (big models, DetectionParams::reuse_margin_mm): the element pairs whose
   // boxes overlapped with A's boxes grown by the margin at kept_pose. Every pair that can
   // touch at a pose where no point of A is further than the margin from where it was at
   // kept_pose is among them, so such a pose tests only those. A kept pair turned away
@@ -242,25 +243,26 @@ struct ContactDetector::Impl {
   std::array<std::uint64_t, ContactSet::kCapacity> sort_keys{};
   std::array<ContactPc, ContactSet::kCapacity> sort_buf{};
 
-  Impl(const Polyhedron& ma, const Polyhedron& mb, const DetectionParams& p)
-      : a(ma), b(mb), prm(p), flat_a(ma), flat_b(mb), wings_a(wings_of(ma)), wings_b(wings_of(mb)) {
+  Impl(const Polyhedron& ma, const Polyhedron& mb, const Params& params_in)
+      : a(ma), b(mb), all(params_in), prm(params_in.detection), flat_a(ma), flat_b(mb), wings_a(wings_of(ma)), wings_b(wings_of(mb)) {
     auto check = [](double v, const char* name, bool positive) {
       if (!std::isfinite(v) || v < 0 || (positive && v == 0))
         throw Error(std::string("ContactDetector: parameter ") + name + " must be " +
                     (positive ? "positive" : "non-negative") + ", got " + std::to_string(v));
     };
-    check(p.epsilon, "epsilon", true);
-    check(p.max_penetration, "max_penetration", false);
-    check(p.min_angular_tolerance, "min_angular_tolerance", true);
-    check(p.max_angular_tolerance, "max_angular_tolerance", true);
+    const DetectionParams& p = prm;
+    check(all.epsilon_mm, "epsilon_mm", true);
+    check(p.max_penetration_mm, "max_penetration_mm", false);
+    check(p.min_angular_tolerance_rad, "min_angular_tolerance_rad", true);
+    check(p.max_angular_tolerance_rad, "max_angular_tolerance_rad", true);
     check(p.dominance_penalty, "dominance_penalty", false);
     check(p.dominance_fit, "dominance_fit", false);
-    check(p.reuse_margin, "reuse_margin", false);
-    if (!std::isfinite(p.in_plane_tolerance) || !std::isfinite(p.angular_tolerance))
-      throw Error("ContactDetector: in_plane_tolerance and angular_tolerance must be finite");
-    eps = p.epsilon;
-    depth = p.max_penetration;
-    in_plane = p.in_plane_tolerance > 0 ? p.in_plane_tolerance : eps;
+    check(p.reuse_margin_mm, "reuse_margin_mm", false);
+    if (!std::isfinite(p.in_plane_tolerance_mm) || !std::isfinite(p.angular_tolerance_rad))
+      throw Error("ContactDetector: in_plane_tolerance_mm and angular_tolerance_rad must be finite");
+    eps = all.epsilon_mm;
+    depth = p.max_penetration_mm;
+    in_plane = p.in_plane_tolerance_mm > 0 ? p.in_plane_tolerance_mm : eps;
     const double scale = std::max(ma.size(), mb.size());
     // Coincidence tolerance for boundaries in 2D: far below any feature, far above rounding.
     geo_tol = 1e-9 * std::max(scale, 1.0);
@@ -304,7 +306,7 @@ struct ContactDetector::Impl {
         r_a = std::max(r_a, (v.p - bvh_a.origin()).norm());
       }
       a_vert_posed.resize(ma.num_vertices());
-      if (prm.use_bvh && prm.reuse_margin > 0) {
+      if (prm.use_bvh && prm.reuse_margin_mm > 0) {
         kept.resize(kMaxKept);
         kept_lin.resize(kMaxKept + 3);
         kept_rot.resize(kMaxKept + 3);
@@ -428,12 +430,12 @@ struct ContactDetector::Impl {
 
   // The largest angular tolerance any pair can get: a cheap early out before the contact
   // region, and with it the pair's own tolerance, is known.
-  double max_tol() const { return prm.angular_tolerance > 0 ? prm.angular_tolerance : prm.max_angular_tolerance; }
+  double max_tol() const { return prm.angular_tolerance_rad > 0 ? prm.angular_tolerance_rad : prm.max_angular_tolerance_rad; }
 
   double tol_for(double extent) const {
-    if (prm.angular_tolerance > 0) return prm.angular_tolerance;
+    if (prm.angular_tolerance_rad > 0) return prm.angular_tolerance_rad;
     const double t = std::atan(eps / std::max(extent, 1e-12));
-    return std::clamp(t, prm.min_angular_tolerance, prm.max_angular_tolerance);
+    return std::clamp(t, prm.min_angular_tolerance_rad, prm.max_angular_tolerance_rad);
   }
 
   // Does the solid around edge E stay on the +n side of a contact plane (n in E's model
@@ -1091,8 +1093,8 @@ struct ContactDetector::Impl {
     for (ContactPc& c : cs)
       if (c.dominated) c.misfit += prm.dominance_penalty;
     // Contact planes: greedy clustering in canonical order.
-    const double cos_tol = std::cos(prm.angular_tolerance > 0 ? prm.angular_tolerance
-                                                              : prm.max_angular_tolerance);
+    const double cos_tol = std::cos(prm.angular_tolerance_rad > 0 ? prm.angular_tolerance_rad
+                                                              : prm.max_angular_tolerance_rad);
     int groups = 0;
     for (int i = 0; i < n; ++i) {
       ContactPc& ci = cs[i];
@@ -1155,7 +1157,7 @@ struct ContactDetector::Impl {
       have_last = true;
       const bool rotation = ((pose.R_BA.transpose() * pose.R_BA - Mat3::Identity()) * bvh_a.origin()).norm() <= orth_allow;
       moved_from_kept = kept_valid ? motion_bound(kept_pose, pose) : std::numeric_limits<double>::infinity();
-      if (rotation && moved_from_kept <= prm.reuse_margin) {
+      if (rotation && moved_from_kept <= prm.reuse_margin_mm) {
         reused = true;
         turned_from_kept = (pose.R_BA - kept_pose.R_BA).norm();
         certifying = true;
@@ -1168,9 +1170,9 @@ struct ContactDetector::Impl {
       // Keep pairs for the next poses only while A moves slowly enough for them to serve a
       // few; otherwise (poses far apart) the grown boxes would only cost.
       kept_valid = false;
-      recording = rotation && moved <= 0.5 * prm.reuse_margin;
+      recording = rotation && moved <= 0.5 * prm.reuse_margin_mm;
       if (recording) {
-        grow = static_cast<float>(prm.reuse_margin);
+        grow = static_cast<float>(prm.reuse_margin_mm);
         num_kept = 0;
         kept_overflow = false;
         moved_from_kept = turned_from_kept = 0;  // this pose is the new kept_pose
@@ -1202,14 +1204,14 @@ struct ContactDetector::Impl {
   }
 };
 
-ContactDetector::ContactDetector(const Polyhedron& a, const Polyhedron& b, const DetectionParams& params)
+ContactDetector::ContactDetector(const Polyhedron& a, const Polyhedron& b, const Params& params)
     : impl_(std::make_unique<Impl>(a, b, params)) {}
 ContactDetector::~ContactDetector() = default;
 ContactDetector::ContactDetector(ContactDetector&&) noexcept = default;
 ContactDetector& ContactDetector::operator=(ContactDetector&&) noexcept = default;
 
 void ContactDetector::detect(const Pose& pose, ContactSet& out) { impl_->detect(pose, out); }
-const DetectionParams& ContactDetector::params() const { return impl_->prm; }
+const Params& ContactDetector::params() const { return impl_->all; }
 const Polyhedron& ContactDetector::model_a() const { return impl_->a; }
 const Polyhedron& ContactDetector::model_b() const { return impl_->b; }
 std::size_t ContactDetector::last_pairs_tested() const { return impl_->pairs; }

@@ -94,8 +94,8 @@ struct CfIdentifier::Impl {
   static constexpr std::size_t kHeldMemo = 1024;
   std::array<HeldEntry, kHeldMemo> held_memo{};
 
-  Impl(const CfGraph& g, const IdentificationParams& p)
-      : graph(&g), prm(p), detector(g.model_a(), g.model_b(), p.detection) {}
+  Impl(const CfGraph& g, const Params& p)
+      : graph(&g), prm(p.identification), detector(g.model_a(), g.model_b(), p) {}
 
   bool holds(const Pc& pc) {
     const std::uint64_t k = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(pc.a)) << 34) ^
@@ -118,7 +118,7 @@ struct CfIdentifier::Impl {
 
   // Group g, from which nothing is chosen, is accounted for: each of its contacts is apart
   // (beyond apart_beyond: farther than touching and than every chosen PC, by more than
-  // touch_distance; the CF says those touch and this does not, which only a nearer contact
+  // touch_distance_mm; the CF says those touch and this does not, which only a nearer contact
   // can say) or related to a chosen contact (another reading of the same degenerate touch).
   // Returns 0 when every contact is apart, 1 when some need explaining, 2 when one is
   // neither.
@@ -160,7 +160,7 @@ struct CfIdentifier::Impl {
     r.partial = n < G;
     double farthest = 0;
     for (int i = 0; i < n; ++i) farthest = std::max(farthest, cs[chosen[i]].distance);
-    const double apart_beyond = farthest + prm.touch_distance;
+    const double apart_beyond = farthest + prm.touch_distance_mm;
     r.tier = 0;
     for (int g = 0; g < G && r.tier < 2 && r.partial; ++g)
       if (!taken[g]) r.tier = std::max(r.tier, accounted(g, chosen, n, apart_beyond));
@@ -219,7 +219,7 @@ struct CfIdentifier::Impl {
     }
     res.num_approaching = 0;
     for (int g = 0; g < cs.num_planes() && partial; ++g) {
-      if (held[static_cast<std::size_t>(g)] || accounted(g, chosen, n, farthest + prm.touch_distance) != 0) continue;
+      if (held[static_cast<std::size_t>(g)] || accounted(g, chosen, n, farthest + prm.touch_distance_mm) != 0) continue;
       int best = -1;
       for (int k = 0; k < count[static_cast<std::size_t>(g)]; ++k) {
         const int i = members[static_cast<std::size_t>(g)][static_cast<std::size_t>(k)];
@@ -355,14 +355,14 @@ struct CfIdentifier::Impl {
   }
 };
 
-CfIdentifier::CfIdentifier(const CfGraph& graph, const IdentificationParams& params)
+CfIdentifier::CfIdentifier(const CfGraph& graph, const Params& params)
     : impl_(std::make_unique<Impl>(graph, params)) {
-  if (params.max_combinations < 1)
+  if (params.identification.max_combinations < 1)
     throw Error("CfIdentifier: parameter max_combinations must be at least 1, got " +
-                std::to_string(params.max_combinations));
-  if (!std::isfinite(params.touch_distance) || params.touch_distance < 0)
-    throw Error("CfIdentifier: parameter touch_distance must be finite and non-negative, got " +
-                std::to_string(params.touch_distance));
+                std::to_string(params.identification.max_combinations));
+  if (!std::isfinite(params.identification.touch_distance_mm) || params.identification.touch_distance_mm < 0)
+    throw Error("CfIdentifier: parameter touch_distance_mm must be finite and non-negative, got " +
+                std::to_string(params.identification.touch_distance_mm));
 }
 CfIdentifier::~CfIdentifier() = default;
 CfIdentifier::CfIdentifier(CfIdentifier&&) noexcept = default;

@@ -17,21 +17,12 @@ const char* to_string(RenderStatus status) {
   return "ok";
 }
 
-namespace {
-// The renderer's one epsilon also sets the detector's.
-IdentificationParams identification_params(const Params& p) {
-  IdentificationParams ip;
-  ip.detection.epsilon = p.epsilon_mm;
-  return ip;
-}
-}  // namespace
-
 struct HapticRenderer::Impl {
   Impl(const CfGraph& g, const Params& p)
       : graph(&g),
         params(p),
         force(g.model_a(), g.model_b(), p),
-        ident(g, identification_params(p)) {}
+        ident(g, p) {}
 
   const CfGraph* graph;
   Params params;

@@ -388,8 +388,8 @@ int run(int argc, char** argv) {
   }
   if (pose) {
     queried = true;
-    cf::IdentificationParams params;
-    params.detection.epsilon = epsilon;
+    cf::Params params;
+    params.epsilon_mm = epsilon;
     cf::CfIdentifier identifier(g, params);
     const cf::Identification& r = identifier.step(*pose);
     if (as_json) {

@@ -8,28 +8,13 @@
 #include <cf/contact.hpp>
 #include <cf/detector.hpp>
 #include <cf/graph.hpp>
+#include <cf/params.hpp>
 
 #include <array>
 #include <cstdint>
 #include <memory>
 
 namespace cf {
-
-/// Parameters of identification.
-struct IdentificationParams {
-  DetectionParams detection;
-  /// Most interpretations (one candidate or none per contact plane) examined per step;
-  /// enumeration goes from the best-fitting candidates down, so a cap drops the worst.
-  int max_combinations = 4096;
-  /// mm. Which detected contacts a CF must hold: those within touch_distance of touching
-  /// (distance <= touch_distance) or of the CF's farthest PC (<= its distance +
-  /// touch_distance), unless they are another reading of one of its touches. Farther ones
-  /// (up to epsilon) may be left out as apart. So at a witness the exact CF wins over one
-  /// that also holds a pair 0.05 mm away (best fit), and a CF is kept while a new contact
-  /// approaches, which is gained once it touches. The default is far above rounding (1e-9 mm
-  /// at the generator's witnesses) and far below their clearance of non-contacts (0.01 mm).
-  double touch_distance = 0.001;
-};
 
 /// Outcome of one identification step.
 enum class IdStatus : std::uint8_t {
@@ -61,7 +46,7 @@ struct Identification {
   int combinations = 0;      ///< interpretations examined
   bool capped = false;       ///< the enumeration hit max_combinations
   /// True when the chosen CF does not cover every contact plane: the other planes' contacts
-  /// are apart (farther than every PC of the CF, and than touch_distance) or alternative
+  /// are apart (farther than every PC of the CF, and than touch_distance_mm) or alternative
   /// readings of the chosen PCs (degenerate touches).
   bool partial_cover = false;
   /// Contacts approaching within epsilon that the CF leaves apart: of each contact plane
@@ -77,7 +62,9 @@ struct Identification {
 /// read-only, and must outlive the identifier.
 class CfIdentifier {
  public:
-  explicit CfIdentifier(const CfGraph& graph, const IdentificationParams& params = {});
+  /// Uses `params.epsilon_mm`, `params.detection` and `params.identification`.
+  /// @throws cf::Error when a parameter is out of range (see ContactDetector).
+  explicit CfIdentifier(const CfGraph& graph, const Params& params = {});
   ~CfIdentifier();
   CfIdentifier(CfIdentifier&&) noexcept;
   CfIdentifier& operator=(CfIdentifier&&) noexcept;

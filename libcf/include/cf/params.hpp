@@ -1,8 +1,10 @@
 #pragma once
 /// @file
-/// Parameters of the haptic force model (SPEC section 2 and section 6, paper section 4).
-/// Defaults are the paper's values; every choice the paper leaves open is a named option
-/// here and described in docs/force-model.md.
+/// The run time's parameters, one tree (`cf::Params`): the contact threshold, the force
+/// model (SPEC section 2 and section 6, paper section 4), and under it detection
+/// (`Params::detection`) and identification (`Params::identification`). Defaults are the
+/// paper's values; every choice the paper leaves open is a named option here, described in
+/// docs/force-model.md and docs/runtime.md. Every field's name or comment gives its unit.
 
 #include <cf/types.hpp>
 
@@ -30,7 +32,65 @@ enum class MomentReference : std::uint8_t {
   kAPoint,     ///< Params::moment_point_A, a point fixed in A (e.g. where the device holds it)
 };
 
-/// All parameters of contact detection thresholds, friction, gravity and smoothing.
+/// Tolerances of contact detection (ContactDetector; docs/runtime.md). The contact threshold
+/// itself is Params::epsilon_mm.
+struct DetectionParams {
+  /// mm. Deepest interpenetration still reported as a contact (distance down to
+  /// -max_penetration_mm). Deeper pairs are taken as the far side of the other solid.
+  double max_penetration_mm = 1.0;
+  /// mm. How far outside a face (in its plane) or beyond an edge's end a contact may fall
+  /// and still count, so that degenerate touches (v-v, v-e, e-v, collinear e-e) yield their
+  /// neighbouring non-degenerate interpretations. <= 0 means epsilon_mm.
+  double in_plane_tolerance_mm = 0;
+  /// rad. Fixed angular tolerance for "near-parallel" (f-f, e-f, f-e) and "not
+  /// near-parallel" (e-e). <= 0 (the default) derives it per pair from the extent L of the
+  /// contact region: atan(epsilon / L), i.e. the tilt at which the whole region stays within
+  /// the threshold, clamped to [min_angular_tolerance_rad, max_angular_tolerance_rad].
+  double angular_tolerance_rad = 0;
+  double min_angular_tolerance_rad = 1e-3;  ///< rad (about 0.06 degrees)
+  double max_angular_tolerance_rad = 0.1;   ///< rad (about 5.7 degrees)
+  /// Misfit units (1 = a contact at the edge of its tolerances), added to the misfit of a
+  /// contact that another detected contact dominates.
+  double dominance_penalty = 1.0;
+  /// A detected contact dominates another (ContactPc::dominated) only when its shape fits
+  /// within this share of its tolerances: its misfit without the distance term (angle /
+  /// angular tolerance + in-plane gap / epsilon) is at most this. Between this and the
+  /// tolerance both readings stand (e.g. an edge touching exactly under a face tilted by
+  /// 0.7 of the face's tolerance: e-f and f-f), and the previous CF, else the fit, decides:
+  /// a hysteresis band rather than a flip at one angle.
+  double dominance_fit = 0.25;
+  /// Cull element pairs with bounding volume hierarchies and cheap necessary conditions
+  /// (the default). false runs the exact tests on all pairs: for checking the culling and
+  /// for comparison only.
+  bool use_bvh = true;
+  /// mm. Temporal coherence for models of 256 features or more in a servo loop: when A
+  /// has moved less than half this since the previous call, `detect` keeps the element
+  /// pairs that come within this margin of each other, and at the following poses, while no
+  /// point of A is further than the margin from where it was then (bounded from the
+  /// translation and the change of rotation), it tests only those, skipping the hierarchy.
+  /// The results are the same for any value; 0 turns it off. A larger margin keeps more
+  /// pairs for more ticks.
+  double reuse_margin_mm = 0.3;
+};
+
+/// Parameters of identification (CfIdentifier; docs/runtime.md).
+struct IdentificationParams {
+  /// Most interpretations (one candidate or none per contact plane) examined per step;
+  /// enumeration goes from the best-fitting candidates down, so a cap drops the worst.
+  int max_combinations = 4096;
+  /// mm. Which detected contacts a CF must hold: those within touch_distance_mm of touching
+  /// (distance <= touch_distance_mm) or of the CF's farthest PC (<= its distance +
+  /// touch_distance_mm), unless they are another reading of one of its touches. Farther ones
+  /// (up to epsilon) may be left out as apart. So at a witness the exact CF wins over one
+  /// that also holds a pair 0.05 mm away (best fit), and a CF is kept while a new contact
+  /// approaches, which is gained once it touches. The default is far above rounding (1e-9 mm
+  /// at the generator's witnesses) and far below their clearance of non-contacts (0.01 mm).
+  double touch_distance_mm = 0.001;
+};
+
+/// All parameters of the run time: the contact threshold, detection, identification,
+/// friction, gravity and smoothing. ContactDetector, CfIdentifier, ForceModel and
+/// HapticRenderer each read the parts they need from one Params.
 struct Params {
   // --- Paper's experimental values (paper section 6, SPEC section 2) ---
   double mass_kg = 0.5;             ///< m, mass of A
@@ -39,7 +99,9 @@ struct Params {
   double kp_N_per_mm = 1.6;         ///< K_p of eqs. (3)-(4)
   double mu_static = 0.7;           ///< mu of eqs. (2), (3), (6)
   double mu_kinetic = 0.08;         ///< mu_D of eq. (5) (SPEC reading)
-  double epsilon_mm = 1.0;          ///< contact threshold of eq. (1)
+  /// The contact threshold: of eq. (1), of detection (element pairs farther apart are not in
+  /// contact) and of identification. The only epsilon of the run time.
+  double epsilon_mm = 1.0;
 
   // --- Friction ---
   FrictionDisplacement friction_displacement = FrictionDisplacement::kStickAnchor;
@@ -64,7 +126,7 @@ struct Params {
 
   // --- Contacts approaching in a plane the CF leaves apart ---
   /// Identification gains a contact of a new plane when it touches (within
-  /// IdentificationParams::touch_distance), not when it comes within epsilon; true renders
+  /// IdentificationParams::touch_distance_mm), not when it comes within epsilon; true renders
   /// such approaching contacts with eq. (1) meanwhile (normal force only), so that the force
   /// rises from 0 at epsilon as eq. (1) intends instead of stepping by up to K epsilon at the
   /// gain. false: only the CF's PCs push (docs/force-model.md).
@@ -78,6 +140,10 @@ struct Params {
   /// s. When > 0 the total contact force and moment are low-pass filtered across ticks with
   /// this time constant: factor = 1 - exp(-dt / tau), so the filter is rate independent.
   double interpolation_time_constant_s = 0.0;
+
+  // --- Detection and identification ---
+  DetectionParams detection;
+  IdentificationParams identification;
 };
 
 }  // namespace cf

@@ -31,33 +31,57 @@ namespace {
 
 struct DoubleField {
   const char* name;
-  double cf::Params::*member;
+  double& (*ref)(cf::Params&);  // the field in the tree
   double lo, hi;
   const char* doc;
+  double get(const cf::Params& P) const { return ref(const_cast<cf::Params&>(P)); }
 };
+
+// A field of cf::Params, or of its detection or identification subtree (the Python names
+// are flat: every name in the tree is unique).
+#define CF_FIELD(path) [](cf::Params& P) -> double& { return P.path; }
 
 // Every double of cf::Params, with the ranges cfreplay's options accept where it has one.
 const std::vector<DoubleField>& double_fields() {
   static const std::vector<DoubleField> f{
-      {"mass_kg", &cf::Params::mass_kg, 0, 1e6, "m, mass of A (kg)"},
-      {"gravity_N_per_kg", &cf::Params::gravity_N_per_kg, -1e6, 1e6, "g along -y of the world (N/kg)"},
-      {"stiffness_N_per_mm", &cf::Params::stiffness_N_per_mm, 1e-9, 1e9, "K of eq. (1) (N/mm)"},
-      {"kp_N_per_mm", &cf::Params::kp_N_per_mm, 1e-9, 1e9, "K_p of eqs. (3)-(4) (N/mm)"},
-      {"mu_static", &cf::Params::mu_static, 0, 100, "mu of eqs. (2), (3), (6)"},
-      {"mu_kinetic", &cf::Params::mu_kinetic, 0, 100, "mu_D of eq. (5)"},
-      {"epsilon_mm", &cf::Params::epsilon_mm, 1e-6, 1e3, "contact threshold of eq. (1) (mm)"},
-      {"freedom_rank_tolerance", &cf::Params::freedom_rank_tolerance, 0, 1,
+      {"mass_kg", CF_FIELD(mass_kg), 0, 1e6, "m, mass of A (kg)"},
+      {"gravity_N_per_kg", CF_FIELD(gravity_N_per_kg), -1e6, 1e6, "g along -y of the world (N/kg)"},
+      {"stiffness_N_per_mm", CF_FIELD(stiffness_N_per_mm), 1e-9, 1e9, "K of eq. (1) (N/mm)"},
+      {"kp_N_per_mm", CF_FIELD(kp_N_per_mm), 1e-9, 1e9, "K_p of eqs. (3)-(4) (N/mm)"},
+      {"mu_static", CF_FIELD(mu_static), 0, 100, "mu of eqs. (2), (3), (6)"},
+      {"mu_kinetic", CF_FIELD(mu_kinetic), 0, 100, "mu_D of eq. (5)"},
+      {"epsilon_mm", CF_FIELD(epsilon_mm), 1e-6, 1e3, "contact threshold of eq. (1) (mm)"},
+      {"freedom_rank_tolerance", CF_FIELD(freedom_rank_tolerance), 0, 1,
        "relative singular-value tolerance of the freedoms' null space"},
-      {"motion_angle_tolerance_rad", &cf::Params::motion_angle_tolerance_rad, 0, M_PI,
+      {"motion_angle_tolerance_rad", CF_FIELD(motion_angle_tolerance_rad), 0, M_PI,
        "'approximately along' angle of paper Fig. 10 (rad)"},
-      {"motion_noise_mm", &cf::Params::motion_noise_mm, 0, 1e3, "pose changes below this are no motion (mm)"},
-      {"hold_fcy_threshold_N", &cf::Params::hold_fcy_threshold_N, 0, 1e6,
+      {"motion_noise_mm", CF_FIELD(motion_noise_mm), 0, 1e3, "pose changes below this are no motion (mm)"},
+      {"hold_fcy_threshold_N", CF_FIELD(hold_fcy_threshold_N), 0, 1e6,
        "hold F_cy while it changes by less than this (N); 0: off"},
-      {"interpolation_time_constant_s", &cf::Params::interpolation_time_constant_s, 0, 1e3,
+      {"interpolation_time_constant_s", CF_FIELD(interpolation_time_constant_s), 0, 1e3,
        "low-pass time constant of the contact force and moment (s); 0: off"},
+      {"max_penetration_mm", CF_FIELD(detection.max_penetration_mm), 0, 1e6,
+       "deepest interpenetration still a contact (mm)"},
+      {"in_plane_tolerance_mm", CF_FIELD(detection.in_plane_tolerance_mm), -1e6, 1e6,
+       "how far outside an element a contact may fall (mm); <= 0: epsilon_mm"},
+      {"angular_tolerance_rad", CF_FIELD(detection.angular_tolerance_rad), -M_PI, M_PI,
+       "fixed angular tolerance of near-parallel (rad); <= 0: from each contact region"},
+      {"min_angular_tolerance_rad", CF_FIELD(detection.min_angular_tolerance_rad), 1e-12, M_PI,
+       "least derived angular tolerance (rad)"},
+      {"max_angular_tolerance_rad", CF_FIELD(detection.max_angular_tolerance_rad), 1e-12, M_PI,
+       "largest derived angular tolerance (rad)"},
+      {"dominance_penalty", CF_FIELD(detection.dominance_penalty), 0, 1e6,
+       "misfit added to a dominated contact"},
+      {"dominance_fit", CF_FIELD(detection.dominance_fit), 0, 1e6,
+       "share of its tolerances within which a contact dominates"},
+      {"reuse_margin_mm", CF_FIELD(detection.reuse_margin_mm), 0, 1e6,
+       "margin of the element pairs kept between ticks (mm); 0: off"},
+      {"touch_distance_mm", CF_FIELD(identification.touch_distance_mm), 0, 1e6,
+       "contacts a CF must hold: those within this of touching (mm)"},
   };
   return f;
 }
+#undef CF_FIELD
 
 template <class E>
 struct EnumField {
@@ -128,7 +152,7 @@ cf::Vec3 vec3_value(const char* name, const py::handle& h, const std::string& wh
 void set_param(cf::Params& P, const std::string& key, const py::handle& value, const std::string& where) {
   for (const DoubleField& f : double_fields())
     if (key == f.name) {
-      P.*(f.member) = double_value(f, value, where);
+      f.ref(P) = double_value(f, value, where);
       return;
     }
   if (key == kFriction.name) {
@@ -139,27 +163,34 @@ void set_param(cf::Params& P, const std::string& key, const py::handle& value, c
     P.moment_reference = enum_value(kMomentRef, value, where);
   } else if (key == "moment_point_A") {
     P.moment_point_A = vec3_value("moment_point_A", value, where);
-  } else if (key == "render_approaching") {
+  } else if (key == "render_approaching" || key == "use_bvh") {
     if (!py::isinstance<py::bool_>(value))
-      fail(where + ": render_approaching must be True or False, got " + std::string(py::repr(value)));
-    P.render_approaching = value.cast<bool>();
+      fail(where + ": " + key + " must be True or False, got " + std::string(py::repr(value)));
+    (key == "use_bvh" ? P.detection.use_bvh : P.render_approaching) = value.cast<bool>();
+  } else if (key == "max_combinations") {
+    if (!py::isinstance<py::int_>(value) || py::isinstance<py::bool_>(value) || value.cast<long long>() < 1 ||
+        value.cast<long long>() > 1000000000)
+      fail(where + ": max_combinations must be an integer in [1, 1000000000], got " + std::string(py::repr(value)));
+    P.identification.max_combinations = value.cast<int>();
   } else {
     std::string names;
     for (const DoubleField& f : double_fields()) names += std::string(names.empty() ? "" : ", ") + f.name;
     names += std::string(", ") + kFriction.name + ", " + kCentroid.name + ", " + kMomentRef.name +
-             ", moment_point_A, render_approaching";
+             ", moment_point_A, render_approaching, use_bvh, max_combinations";
     fail(where + ": unknown parameter '" + key + "' (parameters: " + names + ")");
   }
 }
 
 py::dict params_to_dict(const cf::Params& P) {
   py::dict d;
-  for (const DoubleField& f : double_fields()) d[f.name] = P.*(f.member);
+  for (const DoubleField& f : double_fields()) d[f.name] = f.get(P);
   d[kFriction.name] = enum_name(kFriction, P.friction_displacement);
   d[kCentroid.name] = enum_name(kCentroid, P.centroid);
   d[kMomentRef.name] = enum_name(kMomentRef, P.moment_reference);
   d["moment_point_A"] = py::array_t<double>(3, P.moment_point_A.data());
   d["render_approaching"] = P.render_approaching;
+  d["use_bvh"] = P.detection.use_bvh;
+  d["max_combinations"] = P.identification.max_combinations;
   return d;
 }
 

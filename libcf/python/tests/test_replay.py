@@ -120,6 +120,20 @@ def test_parameters_are_cfreplays_options(l_graph, tmp_path):
     np.testing.assert_array_equal(params.moment_point_A, [1, 2, 3])
 
 
+def test_detection_and_identification_parameters_are_reachable(l_graph):
+    t, p, q = cf.read_trajectory(DATA / "trajectories" / "cube_lblock_corner.csv")
+    base = cf.replay(l_graph, t, p, q).to_csv()
+    # Culling and kept pairs never change a result; the fields are in the one tree.
+    assert cf.replay(l_graph, t, p, q, use_bvh=False, reuse_margin_mm=0.0).to_csv() == base
+    params = cf.Params(touch_distance_mm=0.002, max_penetration_mm=0.5, max_combinations=100)
+    assert params.touch_distance_mm == 0.002 and params.max_penetration_mm == 0.5 and params.max_combinations == 100
+    assert {"in_plane_tolerance_mm", "angular_tolerance_rad", "dominance_fit", "use_bvh"} <= set(params.to_dict())
+    with pytest.raises(cf.Error, match=r"^Params: max_combinations must be an integer in \[1, 1000000000\], got 0$"):
+        cf.Params(max_combinations=0)
+    with pytest.raises(cf.Error, match=r"^Params: use_bvh must be True or False, got 'yes'$"):
+        cf.Params(use_bvh="yes")
+
+
 def test_replay_errors_carry_messages(l_graph):
     t, p, q = cf.read_trajectory(DATA / "trajectories" / "cube_lblock_guarded.csv")
     with pytest.raises(cf.Error, match=r"^replay: p must have shape \(N, 3\) with N = len\(t\) = \d+, got \(\d+, 2\)$"):
