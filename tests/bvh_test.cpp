@@ -1,8 +1,8 @@
-// The bounding volume tree's boxes (libcf/src/bvh.*): every node's axis-aligned and oriented
+// The bounding volume tree's boxes (libcf/src/detect/bvh.*): every node's axis-aligned and oriented
 // boxes hold the points of the elements below it, the 4-wide tree holds every node once,
 // and the SIMD box tests agree with plain double-precision ones.
 #include "runtime_models.hpp"
-#include "bvh.hpp"
+#include "detect/bvh.hpp"
 
 #include <catch2/catch.hpp>
 

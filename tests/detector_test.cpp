@@ -3,7 +3,7 @@
 
 #include "runtime_models.hpp"
 #include "fixtures.hpp"
-#include "detector_poly.hpp"
+#include "detect/detector_poly.hpp"
 
 #include <boost/geometry.hpp>
 #include <catch2/catch.hpp>

@@ -1,7 +1,7 @@
 // The CF graph file (SPEC section 5): writing (deterministic, whole-or-nothing) and reading
 // (JSON or CBOR, schema-validated, every fault named by file and JSON pointer).
 
-#include "graph_impl.hpp"
+#include "model/graph_impl.hpp"
 #include "graph_schema.hpp"
 #include "json_util.hpp"
 #include "polyhedron_json.hpp"

@@ -8,7 +8,7 @@
 // members, types, ranges, no unknown members in PCs and witnesses); GraphLoadOptions::
 // full_schema_check runs valijson over the whole document as well.
 
-#include "graph_impl.hpp"
+#include "model/graph_impl.hpp"
 #include "graph_schema.hpp"
 #include "json_util.hpp"
 #include "polyhedron_json.hpp"

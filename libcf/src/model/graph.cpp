@@ -2,7 +2,7 @@
 // Reading and writing the file is in io/graph_reader.cpp and io/graph_json.cpp.
 
 #include "check.hpp"
-#include "graph_impl.hpp"
+#include "model/graph_impl.hpp"
 #include "io/json_util.hpp"
 
 #include <algorithm>

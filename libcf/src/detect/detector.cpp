@@ -1,0 +1,607 @@
+#include <cf/detector.hpp>
+
+#include "bvh.hpp"
+#include "check.hpp"
+#include "exact.hpp"
+#include "finish.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace cf {
+
+
+// BVH leaves of a model: one element for small models (with bigger leaves, leaf boxes of the
+// paper's cube and L-block overlap everything), posed like inner nodes (cheaper than exact
+// boxes there: 2.4 against 2.8 us per tick). Big models' nodes are also tested as oriented
+// boxes, four at a time (detail::descend_wide): a curved surface's patches are tilted, and
+// the axis-aligned box of a tilted patch is as thick as it is wide, so that two surfaces in
+// contact overlap over many patches; and their leaves hold one face with the edges and
+// vertices it owns, which tile the surface, each element with its own box tested in the
+// leaf (on 2,000-face spheres 7% fewer instructions than leaves of 2 elements of any kind,
+// 15% fewer at the paper's epsilon). docs/performance.md has the figures.
+constexpr std::size_t kBigModelElements = 256;
+bool is_big(const Polyhedron& m) { return m.num_vertices() + m.num_edges() + m.num_faces() >= kBigModelElements; }
+detail::Leaves leaves_for(const Polyhedron& m) {
+  return is_big(m) ? detail::Leaves::kFaceGroups : detail::Leaves::kElements;
+}
+
+struct ContactDetector::Impl {
+  Polyhedron a, b;
+  Params all;           // as given (params())
+  DetectionParams prm;  // all.detection
+  // The exact tests' tables (exact.hpp): the model pair and the tolerances, built once.
+  detail::PairTables tab;
+  detail::Bvh bvh_a, bvh_b;
+  // A's nodes' (and elements') boxes in B's frame at the current pose (computed on first
+  // use per call).
+  struct PosedBox {
+    Eigen::Vector3f c, h;  // mm, B's frame
+    std::uint64_t stamp = 0;
+  };
+  std::vector<PosedBox> a_box;
+  struct PosedWide {  // big models: a wide node's four boxes
+    detail::Box4 box;  // B's frame
+    std::uint64_t stamp = 0;
+  };
+  std::vector<PosedWide> a_wide;
+  // Big models: A's elements' boxes, from A's vertices posed in single precision.
+  struct PosedElem {
+    detail::ElemBox box;  // B's frame
+    std::uint64_t stamp = 0;
+  };
+  std::vector<PosedElem> a_elem;
+  std::vector<Eigen::Array4f> a_vert;  // mm, A's vertices relative to bvh_a.origin(), A's frame
+  struct PosedVertex {
+    Eigen::Array4f p;  // mm, B's frame
+    std::uint64_t stamp = 0;
+  };
+  std::vector<PosedVertex> a_vert_posed;
+  // A model of kBigModelElements or more: leaves of face groups, each element's own box
+  // tested in the leaf, and nodes tested as oriented boxes too.
+  bool big = false;
+  Mat3 absR = Mat3::Identity();
+  // Compact copies of what the cheap rejections read (most pairs the boxes pass are not
+  // contacts: on 2,000-face spheres about 1 in 80 is), so that a rejection touches a few
+  // contiguous bytes rather than the polyhedra's feature records. B's are fixed; A's are
+  // posed on first use per call.
+  struct Plane {
+    Vec3 n;             // unit outward normal, B's frame
+    double off = 0;     // mm: plane { x : n . x == off }
+    std::uint64_t stamp = 0;
+  };
+  struct Seg {
+    Vec3 p0, dir;       // mm, B's frame; dir unit
+    double len = 0;     // mm
+    std::uint64_t stamp = 0;
+  };
+  std::vector<Plane> plane_b, plane_a;
+  std::vector<Seg> seg_b, seg_a;
+  Eigen::Matrix3f Rf = Eigen::Matrix3f::Identity(), absRf = Eigen::Matrix3f::Identity();
+  Eigen::Array4f Rcol[3];  // R_BA's columns, lane 3 zero (A's vertices' posing)
+  Eigen::Array4f a_origin;              // mm, bvh_a's origin posed, B's frame
+  // The same on all four lanes (for the wide nodes' posing): R_BA(i, k), |R_BA(i, k)|, and
+  // a_origin[i].
+  Eigen::Array4f Rb[3][3], absRb[3][3], ob[3];
+  // Scratch (sized once).
+  std::vector<detail::NodePair> stack;
+  detail::ExactScratch scratch;
+  // Per call: the pose, A's vertices posed at it, the stamp of the per-pose caches.
+  detail::PosedA posed;
+  ContactSet* out = nullptr;
+  std::size_t pairs = 0;
+  // Temporal coherence (big models, DetectionParams::reuse_margin_mm): the element pairs whose
+  // boxes overlapped with A's boxes grown by the margin at kept_pose. Every pair that can
+  // touch at a pose where no point of A is further than the margin from where it was at
+  // kept_pose is among them, so such a pose tests only those. A kept pair turned away
+  // carries a certificate (Cert): while A has moved and turned less than it allows, the
+  // pair is skipped.
+  static constexpr std::size_t kMaxKept = 1 << 14;
+  using Cert = detail::Cert;  // exact.hpp; the motion bound is motion_bound
+  // The kept pairs, and their certificates counted from kept_pose (kept_lin, kept_rot,
+  // rounded down; side by side, so that four are checked at once): both measures are
+  // metrics, so a pair certified at a pose `lin` from kept_pose holds at any pose less
+  // than `lin` minus that from kept_pose. Tight while A moves on (the usual servo loop),
+  // and it makes the check two comparisons with this call's distances from kept_pose.
+  // Padded to a multiple of 4 with certificates that always hold.
+  std::vector<detail::NodePair> kept;  // (A position, B position) in the BVHs' element lists
+  std::vector<float> kept_lin, kept_rot;
+  std::size_t num_kept = 0;
+  bool kept_valid = false, recording = false, kept_overflow = false, reused = false;
+  Pose kept_pose, last_pose;
+  double moved_from_kept = 0, turned_from_kept = 0;  // this call's pose from kept_pose
+  // Kept pairs serve or are kept only at poses where |(R^T R - I) o_A| <= tab.orth_allow:
+  // the certificates of B's points seen from A hold for rotations; a rotation rounded to
+  // float (1e-7) is well within it, a pose further off orthonormal is detected from scratch.
+  bool have_last = false;
+  float grow = 0;    // mm, added to A's posed boxes in this call
+  // Finishing the contacts (finish.hpp): what it reads, and its scratch.
+  detail::FinishContext finishing;
+  detail::FinishScratch finish_scratch;
+
+  Impl(const Polyhedron& ma, const Polyhedron& mb, const Params& params_in)
+      : a(ma), b(mb), all(params_in), prm(params_in.detection),
+        tab(a, b, params_in, 0.5 * (ma.bbox_min() + ma.bbox_max())), scratch(tab), posed(a) {
+    const double eps = tab.eps, depth = tab.depth, in_plane = tab.in_plane;
+    bvh_a = detail::Bvh(ma, 0.0, 1, tab.origin_A, leaves_for(ma));
+    // The boxes are single precision: widen B's by far more than the rounding of the
+    // overlap test's few float operations on coordinates of this scale.
+    const double float_slack = 1e-5 * std::max(tab.reach, 1.0);
+    // B's boxes grow by the deepest band and the in-plane allowance, so that every pair the
+    // exact tests could accept has overlapping boxes.
+    // A pair the tests accept is within max(eps, depth) across the plane and in_plane along
+    // it, so within max(eps, depth, hypot(eps, in_plane)) of B's element.
+    bvh_b = detail::Bvh(mb, std::max({eps, depth, std::hypot(eps, in_plane)}) + tab.geo_tol + float_slack, 1, Vec3::Zero(), leaves_for(mb));
+    big = is_big(ma) || is_big(mb);
+    stack.resize(detail::stack_capacity(bvh_a, bvh_b));
+    if (big) {
+      a_wide.resize(bvh_a.wide().size());
+      a_elem.resize(bvh_a.elements().size());
+      for (const Vertex& v : ma.vertices()) a_vert.emplace_back() << (v.p - bvh_a.origin()).cast<float>(), 0.0f;
+      a_vert_posed.resize(ma.num_vertices());
+      if (prm.use_bvh && prm.reuse_margin_mm > 0) {
+        kept.resize(kMaxKept);
+        kept_lin.resize(kMaxKept + 3);
+        kept_rot.resize(kMaxKept + 3);
+      }
+    } else {
+      a_box.resize(bvh_a.nodes().size());
+    }
+    for (const Face& F : mb.faces()) plane_b.push_back({F.normal, F.offset, 0});
+    for (const Edge& E : mb.edges()) seg_b.push_back({mb.vertex(E.v0).p, E.dir, E.length, 0});
+    plane_a.resize(ma.num_faces());
+    seg_a.resize(ma.num_edges());
+    constexpr std::size_t kKeyIndices = std::size_t{1} << 24;
+    finishing.a = &a;
+    finishing.b = &b;
+    finishing.epsilon_mm = eps;
+    finishing.dominance_fit = prm.dominance_fit;
+    finishing.dominance_penalty = prm.dominance_penalty;
+    finishing.cos_plane_tolerance = tab.cos_max_tol;
+    finishing.small_indices = std::max({ma.num_vertices(), ma.num_edges(), ma.num_faces(), mb.num_vertices(),
+                                        mb.num_edges(), mb.num_faces()}) < kKeyIndices;
+  }
+
+  // Small models: does A's BVH node `ia` (posed) overlap B's node? The axis-aligned boxes
+  // in B's frame, then, for inner nodes, B's box on A's node's own axes.
+  __attribute__((always_inline)) bool overlap(std::int32_t ia, const detail::BvhNode& A, const detail::BvhNode& B) {
+    PosedBox& P = a_box[static_cast<std::size_t>(ia)];
+    if (P.stamp != posed.stamp) pose_box(P, A);
+    const Eigen::Vector3f d = P.c - B.center;
+    if (std::abs(d.x()) > P.h.x() + B.half.x() || std::abs(d.y()) > P.h.y() + B.half.y() ||
+        std::abs(d.z()) > P.h.z() + B.half.z())
+      return false;
+    if (A.leaf()) return true;
+    // B's box on A's axes: centre offset R^T d, half extents |R^T| B.half.
+    for (int k = 0; k < 3; ++k) {
+      const float dk = Rf(0, k) * d.x() + Rf(1, k) * d.y() + Rf(2, k) * d.z();
+      const float hk = absRf(0, k) * B.half.x() + absRf(1, k) * B.half.y() + absRf(2, k) * B.half.z();
+      if (std::abs(dk) > A.half[k] + hk) return false;
+    }
+    return true;
+  }
+
+  // A's vertex v posed, single precision (rounding as in pose_wide).
+  const Eigen::Array4f& posed_vertex(VertexId v) {
+    PosedVertex& P = a_vert_posed[v.index()];
+    if (P.stamp != posed.stamp) {
+      const Eigen::Array4f& q = a_vert[v.index()];
+      P.p = Rcol[0] * q[0] + Rcol[1] * q[1] + Rcol[2] * q[2] + a_origin;
+      P.stamp = posed.stamp;
+    }
+    return P.p;
+  }
+
+  // A big model's element at position i of its BVH, posed: the box of its posed vertices.
+  __attribute__((noinline)) void pose_element(PosedElem& P, int i) {
+    P.stamp = posed.stamp;
+    Eigen::Array4f lo = Eigen::Array4f::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
+    auto add = [&](VertexId v) {
+      const Eigen::Array4f& p = posed_vertex(v);
+      lo = lo.min(p);
+      hi = hi.max(p);
+    };
+    const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(i)];
+    switch (x.kind) {
+      case ElementKind::kVertex:
+        add(VertexId(x.index));
+        break;
+      case ElementKind::kEdge:
+        add(a.edges()[static_cast<std::size_t>(x.index)].v0);
+        add(a.edges()[static_cast<std::size_t>(x.index)].v1);
+        break;
+      case ElementKind::kFace:
+        for (VertexId v : a.faces()[static_cast<std::size_t>(x.index)].vertices) add(v);
+        break;
+    }
+    P.box.c = 0.5f * (lo + hi);
+    P.box.h = (0.5f * (hi - lo) + 2.4e-7f * P.box.c.abs()) * 1.0000003f + Eigen::Array4f(grow, grow, grow, 0.0f);
+  }
+
+  // Does A's element at position ia of its BVH (posed) overlap B's element at ib?
+  bool element_boxes_overlap(int ia, int ib) {
+    PosedElem& P = a_elem[static_cast<std::size_t>(ia)];
+    if (P.stamp != posed.stamp) pose_element(P, ia);
+    return !detail::boxes_apart(P.box, bvh_b.element_boxes()[static_cast<std::size_t>(ib)]);
+  }
+
+  // A's node at the current pose: its box in B's frame.
+  __attribute__((noinline)) void pose_box(PosedBox& P, const detail::BvhNode& N) {
+    P.stamp = posed.stamp;
+    detail::round_out(posed.pose.apply(N.center.cast<double>()), absR * N.half.cast<double>(), P.c, P.h);
+  }
+
+  // A big model's wide node w at the current pose, in B's frame, in single precision. Its
+  // centres are relative to bvh_a's origin (within A's size), whose posed place is computed
+  // in double once per call, so the rounding (a few parts in 1e7 of A's size plus that
+  // place) stays far below B's boxes' float slack wherever the two boxes could overlap. The
+  // posed axis-aligned box of the oriented box bounds the node as well: the overlap of the
+  // two is kept.
+  const detail::Box4& posed_wide(std::int32_t w) {
+    PosedWide& P = a_wide[static_cast<std::size_t>(w)];
+    if (P.stamp != posed.stamp) pose_wide(P, w);
+    return P.box;
+  }
+  __attribute__((noinline)) void pose_wide(PosedWide& P, std::int32_t w) {
+    using V = Eigen::Array4f;
+    P.stamp = posed.stamp;
+    const detail::Box4& N = bvh_a.wide()[static_cast<std::size_t>(w)].box;
+    detail::Box4& Q = P.box;
+    // Unrolled: at -O2 GCC keeps these loops of 3 and spills the temporaries.
+    CF_UNROLL3
+    for (int k = 0; k < 3; ++k)
+      CF_UNROLL3
+      for (int i = 0; i < 3; ++i) Q.ax[k][i] = N.ax[k][0] * Rb[i][0] + N.ax[k][1] * Rb[i][1] + N.ax[k][2] * Rb[i][2];
+    CF_UNROLL3
+    for (int i = 0; i < 3; ++i) {
+      const V c = N.c[0] * Rb[i][0] + N.c[1] * Rb[i][1] + N.c[2] * Rb[i][2] + ob[i];
+      const V oc = N.oc[0] * Rb[i][0] + N.oc[1] * Rb[i][1] + N.oc[2] * Rb[i][2] + ob[i];
+      const V h = N.h[0] * absRb[i][0] + N.h[1] * absRb[i][1] + N.h[2] * absRb[i][2];
+      const V oh = Q.ax[0][i].abs() * N.oh[0] + Q.ax[1][i].abs() * N.oh[1] + Q.ax[2][i].abs() * N.oh[2];
+      const V lo = (c - h).max(oc - oh), hi = (c + h).min(oc + oh);
+      Q.c[i] = 0.5f * (lo + hi);
+      // Widened by the rounding of the midpoint and of the half difference.
+      Q.h[i] = ((0.5f * (hi - lo)).max(0.0f) + 2.4e-7f * Q.c[i].abs()) * 1.0000003f + grow;
+      Q.oc[i] = oc;
+      Q.oh[i] = N.oh[i] + grow;
+    }
+  }
+
+  const Plane& posed_plane_a(int f) {
+    Plane& P = plane_a[static_cast<std::size_t>(f)];
+    if (P.stamp != posed.stamp) {
+      const Face& F = a.faces()[static_cast<std::size_t>(f)];
+      P.n = posed.pose.R_BA * F.normal;
+      P.off = F.offset + P.n.dot(posed.pose.t_BA);
+      P.stamp = posed.stamp;
+    }
+    return P;
+  }
+  const Seg& posed_seg_a(int e) {
+    Seg& S = seg_a[static_cast<std::size_t>(e)];
+    if (S.stamp != posed.stamp) {
+      const Edge& E = a.edges()[static_cast<std::size_t>(e)];
+      S.p0 = posed.world(a, E.v0);
+      S.dir = posed.pose.R_BA * E.dir;
+      S.len = E.length;
+      S.stamp = posed.stamp;
+    }
+    return S;
+  }
+  // Cheap necessary conditions of each type's exact test (same tolerances, looser or
+  // equal), so that most pairs are turned away before the exact test loads the features.
+  bool segment_in_band(const Vec3& p0, const Vec3& dir, double len, const Vec3& n, double off) const {
+    const double h0 = n.dot(p0) - off, h1 = h0 + len * n.dot(dir);
+    return std::min(h0, h1) <= tab.eps + tab.geo_tol && std::max(h0, h1) >= -tab.depth - tab.geo_tol;
+  }
+  // in_band with room for the rounding of a differently ordered computation.
+  bool near_band(double d) const { return d <= tab.eps + tab.geo_tol && d >= -tab.depth - tab.geo_tol; }
+  // How far heights h0 <= h1 (or one height) lie outside near_band's band.
+  double band_gap(double lo, double hi) const { return std::max(lo - tab.eps - tab.geo_tol, -tab.depth - tab.geo_tol - hi); }
+
+  // With kCertify, a pair turned away also gets its certificate in *ct. A height over B's
+  // plane moves at most as far as A's points. A unit vector of A turns by at most
+  // |R1 - R0|_F, so a dot product's margin d is a rotational certificate d. A height over
+  // A's plane of B's point q is (R n_A).(q - o) up to a constant (o: A's origin posed), so
+  // it moves by at most the motion bound times max(1, |q - o| / tab.r_a). Where two conditions
+  // fail, either one keeps the pair away.
+  template <bool kCertify>
+  __attribute__((always_inline)) bool may_touch(ElementKind ka, int ia, ElementKind kb, int ib, Cert* ct) {
+    using K = ElementKind;
+    if (ka == K::kVertex) {  // v-f
+      const Plane& B = plane_b[static_cast<std::size_t>(ib)];
+      const double h = B.n.dot(posed.world(a, VertexId(ia))) - B.off;
+      if (near_band(h)) return true;
+      if constexpr (kCertify) ct->lin = band_gap(h, h) - tab.geo_tol;
+      return false;
+    }
+    if (ka == K::kEdge) {
+      const Seg& A = posed_seg_a(ia);
+      if (kb == K::kFace) {  // e-f
+        const Plane& B = plane_b[static_cast<std::size_t>(ib)];
+        const double tilt = std::abs(A.dir.dot(B.n)) - (tab.sin_max_tol + 1e-12);
+        if constexpr (!kCertify) {
+          return tilt <= 0 && segment_in_band(A.p0, A.dir, A.len, B.n, B.off);
+        } else {
+          const double h0 = B.n.dot(A.p0) - B.off, h1 = h0 + A.len * B.n.dot(A.dir);
+          const double gap = band_gap(std::min(h0, h1), std::max(h0, h1));
+          if (tilt <= 0 && gap <= 0) return true;
+          ct->lin = gap - tab.geo_tol;
+          ct->rot = tilt - tab.geo_tol;
+          return false;
+        }
+      }
+      // e-e: not near-parallel, and the lines within the band of each other.
+      const Seg& B = seg_b[static_cast<std::size_t>(ib)];
+      const Vec3 n = A.dir.cross(B.dir);
+      const double sn = n.norm();
+      const double parallel =
+          std::max(tab.sin_tol_edge_a[static_cast<std::size_t>(ia)], tab.sin_tol_edge_b[static_cast<std::size_t>(ib)]) - 1e-12 - sn;
+      if (parallel >= 0) {
+        // n turns by at most as much as A's direction.
+        if constexpr (kCertify) ct->rot = parallel - tab.geo_tol;
+        return false;
+      }
+      const Vec3 r = A.p0 - B.p0;
+      const double band = std::max(tab.eps, tab.depth) + tab.geo_tol;
+      const double apart = std::abs(n.dot(r)) - band * sn;
+      if (apart > 0) {
+        // n.r moves by at most |dn| |r| + |dr| (|n| <= 1, |dn| <= bound / tab.r_a, |dr| <=
+        // bound), band sn by band |dn|.
+        if constexpr (kCertify) ct->lin = apart / (1 + (r.norm() + band) / tab.r_a) - tab.geo_tol;
+        return false;
+      }
+      // The lines' closest points (as in ee) beyond the segments by at most tab.in_plane.
+      const double bb = A.dir.dot(B.dir), c = A.dir.dot(r), f = B.dir.dot(r);
+      const double den = 1 - bb * bb;
+      const double s = (bb * f - c) / den, t = (f - bb * c) / den;
+      if (std::max({0.0, -s, s - A.len}) + std::max({0.0, -t, t - B.len}) <= tab.in_plane + tab.geo_tol) return true;
+      // No certificate: the closest points move too fast near parallel.
+      return false;
+    }
+    const Plane& A = posed_plane_a(ia);
+    if (kb == K::kFace) {  // f-f
+      const double tilt = tab.cos_max_tol - 1e-12 + A.n.dot(plane_b[static_cast<std::size_t>(ib)].n);
+      if (tilt <= 0) return true;
+      if constexpr (kCertify) ct->rot = tilt - tab.geo_tol;
+      return false;
+    }
+    if (kb == K::kEdge) {  // f-e
+      const Seg& B = seg_b[static_cast<std::size_t>(ib)];
+      const double tilt = std::abs(A.n.dot(B.dir)) - (tab.sin_max_tol + 1e-12);
+      if constexpr (!kCertify) {
+        return tilt <= 0 && segment_in_band(B.p0, B.dir, B.len, A.n, A.off);
+      } else {
+        const double h0 = A.n.dot(B.p0) - A.off, h1 = h0 + B.len * A.n.dot(B.dir);
+        const double gap = band_gap(std::min(h0, h1), std::max(h0, h1));
+        if (tilt <= 0 && gap <= 0) return true;
+        const double reach = std::max((B.p0 - posed.origin_posed).norm(), (B.p0 + B.len * B.dir - posed.origin_posed).norm());
+        ct->lin = tab.seen_from_a(gap, reach);
+        ct->rot = tilt - tab.geo_tol;
+        return false;
+      }
+    }
+    const Vec3& q = b.vertex(VertexId(ib)).p;  // f-v
+    const double h = A.n.dot(q) - A.off;
+    if (near_band(h)) return true;
+    if constexpr (kCertify) ct->lin = tab.seen_from_a(band_gap(h, h), (q - posed.origin_posed).norm());
+    return false;
+  }
+
+  // Elements at positions ia, ib of the two BVHs' element lists, in leaves that overlap
+  // where B's leaves hold no element lanes (B small).
+  __attribute__((always_inline)) void pair(int ia, int ib) {
+    const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
+    const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];
+    if (!detail::kinds_can_touch(detail::kind_bit(x.kind), detail::kind_bit(y.kind))) return;
+    if (big && !element_boxes_overlap(ia, ib)) return;
+    boxed_pair(ia, ib, x, y);
+  }
+
+  // The kept pairs at a pose served from them: those whose certificates do not hold
+  // (four checked at once) go through the cheap rejections and the exact test, and get
+  // their new certificates. Not through the element boxes: with the certificates, posing
+  // A's elements for them cost more than the boxes saved (5% more instructions).
+  void reuse_kept() {
+    // Rounded up, so that a skip is never wrong by rounding.
+    const float moved = static_cast<float>(moved_from_kept) * 1.000001f;
+    const float turned = static_cast<float>(turned_from_kept) * 1.000001f;
+    const Eigen::Array4f moved4 = Eigen::Array4f::Constant(moved), turned4 = Eigen::Array4f::Constant(turned);
+    for (std::size_t k = 0; k < num_kept; k += 4) {
+      const Eigen::Map<const Eigen::Array4f> lin(kept_lin.data() + k), rot(kept_rot.data() + k);
+      unsigned test = ~(detail::greater_mask4(lin, moved4) | detail::greater_mask4(rot, turned4)) & 0xFu;
+      while (test != 0) {
+        const std::size_t i = k + static_cast<std::size_t>(__builtin_ctz(test));
+        test &= test - 1;
+        kept_pair(i);
+      }
+    }
+  }
+
+  __attribute__((always_inline)) void kept_pair(std::size_t i) {
+    const int ia = kept[i].a, ib = kept[i].b;
+    const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
+    const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];
+    ++pairs;
+    store(i, certified_test(x, y));
+  }
+
+  // The cheap rejection and the exact test of a pair, for kept pairs: the certificate of
+  // whichever turned it away (none when it passed both).
+  __attribute__((always_inline)) Cert certified_test(const detail::BvhElement& x, const detail::BvhElement& y) {
+    Cert c;
+    if (may_touch<true>(x.kind, x.index, y.kind, y.index, &c)) c = exact(x, y);
+    return c;
+  }
+
+  // Keeps pair i's certificate, from this call's pose, counted from kept_pose.
+  void store(std::size_t i, const Cert& c) {
+    const double lin = c.lin - moved_from_kept, rot = c.rot - turned_from_kept;
+    kept_lin[i] = lin > 0 ? static_cast<float>(lin) * 0.999999f : 0.0f;
+    kept_rot[i] = rot > 0 ? static_cast<float>(rot) * 0.999999f : 0.0f;
+  }
+
+  // Leaves of the two BVHs whose boxes overlap: their element pairs whose kinds can touch
+  // and whose own boxes overlap. B's face-group leaves hold their element boxes on SIMD
+  // lanes: each of A's elements is tested against all of them at once.
+  void leaf_pair(const detail::BvhNode& A, const detail::BvhNode& B) {
+    if (bvh_b.leaf_boxes().empty()) {
+      for (int i = 0; i < A.count; ++i)
+        for (int j = 0; j < B.count; ++j) pair(A.element() + i, B.element() + j);
+      return;
+    }
+    const detail::LeafBoxes& L = bvh_b.leaf_boxes()[static_cast<std::size_t>(bvh_b.leaf_index(B))];
+    for (int i = 0; i < A.count; ++i) {
+      const int ia = A.element() + i;
+      const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
+      unsigned lanes = L.touchable_by[static_cast<std::size_t>(x.kind)];
+      if (lanes == 0) continue;
+      PosedElem& P = a_elem[static_cast<std::size_t>(ia)];
+      if (P.stamp != posed.stamp) pose_element(P, ia);
+      lanes &= detail::overlapping_lanes(P.box, L);
+      while (lanes != 0) {
+        const int ib = B.element() + __builtin_ctz(lanes);
+        lanes &= lanes - 1;
+        boxed_pair(ia, ib, x, bvh_b.elements()[static_cast<std::size_t>(ib)]);
+      }
+    }
+  }
+
+  // A pair past the kinds and the boxes.
+  __attribute__((always_inline)) void boxed_pair(int ia, int ib, const detail::BvhElement& x,
+                                                 const detail::BvhElement& y) {
+    ++pairs;
+    if (!recording) {
+      if (may_touch<false>(x.kind, x.index, y.kind, y.index, nullptr)) exact(x, y);
+      return;
+    }
+    const Cert c = certified_test(x, y);
+    if (num_kept < kept.size()) {
+      kept[num_kept] = {ia, ib};
+      store(num_kept++, c);
+    } else {
+      kept_overflow = true;
+    }
+  }
+
+  // Bounds how far any point of A moves from pose p0 to p1 (mm): the move of bvh_a's origin
+  // plus |R1 - R0| times A's reach from it (Frobenius norm, a bound of the spectral norm for
+  // any matrices).
+  double motion_bound(const Pose& p0, const Pose& p1) const {
+    const Vec3& o = bvh_a.origin();
+    return (p1.apply(o) - p0.apply(o)).norm() + (p1.R_BA - p0.R_BA).norm() * tab.r_a;
+  }
+
+  // The exact test of a pair (exact.hpp): its contact goes to the output; returns the
+  // certificate of a pair turned away.
+  __attribute__((always_inline)) Cert exact(const detail::BvhElement& x, const detail::BvhElement& y) {
+    detail::PairOutcome o = detail::exact_test(tab, posed, scratch, x.kind, x.index, y.kind, y.index);
+    if (o.contact) out->push(*o.contact);
+    return o.cert;
+  }
+
+  void detect(const Pose& p, ContactSet& cs) {
+    posed.pose = p;
+    const Pose& pose = posed.pose;
+    out = &cs;
+    cs.clear();
+    pairs = 0;
+    ++posed.stamp;  // 64 bits: never wraps, so the per-pose caches need no reset
+    if (!prm.use_bvh) {
+      // Every pair straight to the exact tests: the reference for the culling (boxes and
+      // the cheap rejections alike).
+      for (const detail::BvhElement& x : bvh_a.elements())
+        for (const detail::BvhElement& y : bvh_b.elements()) {
+          ++pairs;
+          exact(x, y);
+        }
+      detail::finish_contacts(finishing, finish_scratch, cs);
+      out = nullptr;
+      return;
+    }
+    absR = pose.R_BA.cwiseAbs();
+    Rf = pose.R_BA.cast<float>();
+    absRf = absR.cast<float>();
+    for (int k = 0; k < 3; ++k) Rcol[k] << Rf.col(k), 0.0f;
+    posed.origin_posed = pose.apply(bvh_a.origin());
+    a_origin << posed.origin_posed.cast<float>(), 0.0f;
+    for (int i = 0; i < 3 && big; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        Rb[i][k].setConstant(Rf(i, k));
+        absRb[i][k].setConstant(absRf(i, k));
+      }
+      ob[i].setConstant(a_origin[i]);
+    }
+    reused = false;
+    grow = 0;
+    recording = false;
+    if (!kept.empty()) {
+      const double moved = have_last ? motion_bound(last_pose, pose) : std::numeric_limits<double>::infinity();
+      last_pose = pose;
+      have_last = true;
+      const bool rotation = ((pose.R_BA.transpose() * pose.R_BA - Mat3::Identity()) * bvh_a.origin()).norm() <= tab.orth_allow;
+      moved_from_kept = kept_valid ? motion_bound(kept_pose, pose) : std::numeric_limits<double>::infinity();
+      if (rotation && moved_from_kept <= prm.reuse_margin_mm) {
+        reused = true;
+        turned_from_kept = (pose.R_BA - kept_pose.R_BA).norm();
+        posed.certifying = true;
+        reuse_kept();
+        posed.certifying = false;
+        detail::finish_contacts(finishing, finish_scratch, cs);
+        out = nullptr;
+        return;
+      }
+      // Keep pairs for the next poses only while A moves slowly enough for them to serve a
+      // few; otherwise (poses far apart) the grown boxes would only cost.
+      kept_valid = false;
+      recording = rotation && moved <= 0.5 * prm.reuse_margin_mm;
+      if (recording) {
+        grow = static_cast<float>(prm.reuse_margin_mm);
+        num_kept = 0;
+        kept_overflow = false;
+        moved_from_kept = turned_from_kept = 0;  // this pose is the new kept_pose
+        posed.certifying = true;
+      }
+    }
+    // The stack is sized for the trees' depths, so the descents cannot overflow it.
+    const auto leaves = [this](const detail::BvhNode& A, const detail::BvhNode& B) { leaf_pair(A, B); };
+    const bool complete =
+        big ? detail::descend_wide(
+                  bvh_a, bvh_b,
+                  [this](std::int32_t w) -> const detail::Box4& { return posed_wide(w); },
+                  stack.data(), stack.size(), leaves)
+            : detail::descend(
+                  bvh_a, bvh_b,
+                  [this](std::int32_t ia, std::int32_t, const detail::BvhNode& A,
+                         const detail::BvhNode& B) { return overlap(ia, A, B); },
+                  stack.data(), stack.size(), leaves);
+    CF_DEMAND(complete);
+    if (recording && !kept_overflow) {
+      kept_valid = true;
+      kept_pose = pose;
+      // Padding that is always skipped.
+      for (std::size_t k = num_kept; k % 4 != 0; ++k) kept_lin[k] = std::numeric_limits<float>::infinity();
+    }
+    recording = posed.certifying = false;
+    detail::finish_contacts(finishing, finish_scratch, cs);
+    out = nullptr;
+  }
+};
+
+ContactDetector::ContactDetector(const Polyhedron& a, const Polyhedron& b, const Params& params)
+    : impl_(std::make_unique<Impl>(a, b, params)) {}
+ContactDetector::~ContactDetector() = default;
+ContactDetector::ContactDetector(ContactDetector&&) noexcept = default;
+ContactDetector& ContactDetector::operator=(ContactDetector&&) noexcept = default;
+
+void ContactDetector::detect(const Pose& pose, ContactSet& out) { impl_->detect(pose, out); }
+const Params& ContactDetector::params() const { return impl_->all; }
+const Polyhedron& ContactDetector::model_a() const { return impl_->a; }
+const Polyhedron& ContactDetector::model_b() const { return impl_->b; }
+std::size_t ContactDetector::last_pairs_tested() const { return impl_->pairs; }
+bool ContactDetector::last_reused_pairs() const { return impl_->reused; }
+
+}  // namespace cf
