@@ -692,8 +692,10 @@ class JsonWalker {
         for (auto item : object) {
           simdjson::ondemand::field field;
           check_step(std::move(item).get(field), at);
+          // The key's position first: unescaping consumes it.
+          const char* key_at = field.key().raw();
           std::string_view key;
-          check(field.unescaped_key().get(key), field.key().raw());
+          check(field.unescaped_key().get(key), key_at);
           key_.assign(key.data(), key.size());
           sax.key(key_);
           value(field.value(), sax, depth + 1);
