@@ -2,6 +2,7 @@
 
 #include "bvh.hpp"
 #include "check.hpp"
+#include "cheap.hpp"
 #include "exact.hpp"
 #include "finish.hpp"
 
@@ -64,22 +65,7 @@ struct ContactDetector::Impl {
   // tested in the leaf, and nodes tested as oriented boxes too.
   bool big = false;
   Mat3 absR = Mat3::Identity();
-  // Compact copies of what the cheap rejections read (most pairs the boxes pass are not
-  // contacts: on 2,000-face spheres about 1 in 80 is), so that a rejection touches a few
-  // contiguous bytes rather than the polyhedra's feature records. B's are fixed; A's are
-  // posed on first use per call.
-  struct Plane {
-    Vec3 n;             // unit outward normal, B's frame
-    double off = 0;     // mm: plane { x : n . x == off }
-    std::uint64_t stamp = 0;
-  };
-  struct Seg {
-    Vec3 p0, dir;       // mm, B's frame; dir unit
-    double len = 0;     // mm
-    std::uint64_t stamp = 0;
-  };
-  std::vector<Plane> plane_b, plane_a;
-  std::vector<Seg> seg_b, seg_a;
+  detail::CheapRejections cheap;  // cheap.hpp
   Eigen::Matrix3f Rf = Eigen::Matrix3f::Identity(), absRf = Eigen::Matrix3f::Identity();
   Eigen::Array4f Rcol[3];  // R_BA's columns, lane 3 zero (A's vertices' posing)
   Eigen::Array4f a_origin;              // mm, bvh_a's origin posed, B's frame
@@ -124,7 +110,7 @@ struct ContactDetector::Impl {
 
   Impl(const Polyhedron& ma, const Polyhedron& mb, const Params& params_in)
       : a(ma), b(mb), all(params_in), prm(params_in.detection),
-        tab(a, b, params_in, 0.5 * (ma.bbox_min() + ma.bbox_max())), scratch(tab), posed(a) {
+        tab(a, b, params_in, 0.5 * (ma.bbox_min() + ma.bbox_max())), cheap(tab), scratch(tab), posed(a) {
     const double eps = tab.eps, depth = tab.depth, in_plane = tab.in_plane;
     bvh_a = detail::Bvh(ma, 0.0, 1, tab.origin_A, leaves_for(ma));
     // The boxes are single precision: widen B's by far more than the rounding of the
@@ -150,10 +136,6 @@ struct ContactDetector::Impl {
     } else {
       a_box.resize(bvh_a.nodes().size());
     }
-    for (const Face& F : mb.faces()) plane_b.push_back({F.normal, F.offset, 0});
-    for (const Edge& E : mb.edges()) seg_b.push_back({mb.vertex(E.v0).p, E.dir, E.length, 0});
-    plane_a.resize(ma.num_faces());
-    seg_a.resize(ma.num_edges());
     constexpr std::size_t kKeyIndices = std::size_t{1} << 24;
     finishing.a = &a;
     finishing.b = &b;
@@ -269,130 +251,6 @@ struct ContactDetector::Impl {
       Q.oh[i] = N.oh[i] + grow;
     }
   }
-
-  const Plane& posed_plane_a(int f) {
-    Plane& P = plane_a[static_cast<std::size_t>(f)];
-    if (P.stamp != posed.stamp) {
-      const Face& F = a.faces()[static_cast<std::size_t>(f)];
-      P.n = posed.pose.R_BA * F.normal;
-      P.off = F.offset + P.n.dot(posed.pose.t_BA);
-      P.stamp = posed.stamp;
-    }
-    return P;
-  }
-  const Seg& posed_seg_a(int e) {
-    Seg& S = seg_a[static_cast<std::size_t>(e)];
-    if (S.stamp != posed.stamp) {
-      const Edge& E = a.edges()[static_cast<std::size_t>(e)];
-      S.p0 = posed.world(a, E.v0);
-      S.dir = posed.pose.R_BA * E.dir;
-      S.len = E.length;
-      S.stamp = posed.stamp;
-    }
-    return S;
-  }
-  // Cheap necessary conditions of each type's exact test (same tolerances, looser or
-  // equal), so that most pairs are turned away before the exact test loads the features.
-  bool segment_in_band(const Vec3& p0, const Vec3& dir, double len, const Vec3& n, double off) const {
-    const double h0 = n.dot(p0) - off, h1 = h0 + len * n.dot(dir);
-    return std::min(h0, h1) <= tab.eps + tab.geo_tol && std::max(h0, h1) >= -tab.depth - tab.geo_tol;
-  }
-  // in_band with room for the rounding of a differently ordered computation.
-  bool near_band(double d) const { return d <= tab.eps + tab.geo_tol && d >= -tab.depth - tab.geo_tol; }
-  // How far heights h0 <= h1 (or one height) lie outside near_band's band.
-  double band_gap(double lo, double hi) const { return std::max(lo - tab.eps - tab.geo_tol, -tab.depth - tab.geo_tol - hi); }
-
-  // With kCertify, a pair turned away also gets its certificate in *ct. A height over B's
-  // plane moves at most as far as A's points. A unit vector of A turns by at most
-  // |R1 - R0|_F, so a dot product's margin d is a rotational certificate d. A height over
-  // A's plane of B's point q is (R n_A).(q - o) up to a constant (o: A's origin posed), so
-  // it moves by at most the motion bound times max(1, |q - o| / tab.r_a). Where two conditions
-  // fail, either one keeps the pair away.
-  template <bool kCertify>
-  __attribute__((always_inline)) bool may_touch(ElementKind ka, int ia, ElementKind kb, int ib, Cert* ct) {
-    using K = ElementKind;
-    if (ka == K::kVertex) {  // v-f
-      const Plane& B = plane_b[static_cast<std::size_t>(ib)];
-      const double h = B.n.dot(posed.world(a, VertexId(ia))) - B.off;
-      if (near_band(h)) return true;
-      if constexpr (kCertify) ct->lin = band_gap(h, h) - tab.geo_tol;
-      return false;
-    }
-    if (ka == K::kEdge) {
-      const Seg& A = posed_seg_a(ia);
-      if (kb == K::kFace) {  // e-f
-        const Plane& B = plane_b[static_cast<std::size_t>(ib)];
-        const double tilt = std::abs(A.dir.dot(B.n)) - (tab.sin_max_tol + 1e-12);
-        if constexpr (!kCertify) {
-          return tilt <= 0 && segment_in_band(A.p0, A.dir, A.len, B.n, B.off);
-        } else {
-          const double h0 = B.n.dot(A.p0) - B.off, h1 = h0 + A.len * B.n.dot(A.dir);
-          const double gap = band_gap(std::min(h0, h1), std::max(h0, h1));
-          if (tilt <= 0 && gap <= 0) return true;
-          ct->lin = gap - tab.geo_tol;
-          ct->rot = tilt - tab.geo_tol;
-          return false;
-        }
-      }
-      // e-e: not near-parallel, and the lines within the band of each other.
-      const Seg& B = seg_b[static_cast<std::size_t>(ib)];
-      const Vec3 n = A.dir.cross(B.dir);
-      const double sn = n.norm();
-      const double parallel =
-          std::max(tab.sin_tol_edge_a[static_cast<std::size_t>(ia)], tab.sin_tol_edge_b[static_cast<std::size_t>(ib)]) - 1e-12 - sn;
-      if (parallel >= 0) {
-        // n turns by at most as much as A's direction.
-        if constexpr (kCertify) ct->rot = parallel - tab.geo_tol;
-        return false;
-      }
-      const Vec3 r = A.p0 - B.p0;
-      const double band = std::max(tab.eps, tab.depth) + tab.geo_tol;
-      const double apart = std::abs(n.dot(r)) - band * sn;
-      if (apart > 0) {
-        // n.r moves by at most |dn| |r| + |dr| (|n| <= 1, |dn| <= bound / tab.r_a, |dr| <=
-        // bound), band sn by band |dn|.
-        if constexpr (kCertify) ct->lin = apart / (1 + (r.norm() + band) / tab.r_a) - tab.geo_tol;
-        return false;
-      }
-      // The lines' closest points (as in ee) beyond the segments by at most tab.in_plane.
-      const double bb = A.dir.dot(B.dir), c = A.dir.dot(r), f = B.dir.dot(r);
-      const double den = 1 - bb * bb;
-      const double s = (bb * f - c) / den, t = (f - bb * c) / den;
-      if (std::max({0.0, -s, s - A.len}) + std::max({0.0, -t, t - B.len}) <= tab.in_plane + tab.geo_tol) return true;
-      // No certificate: the closest points move too fast near parallel.
-      return false;
-    }
-    const Plane& A = posed_plane_a(ia);
-    if (kb == K::kFace) {  // f-f
-      const double tilt = tab.cos_max_tol - 1e-12 + A.n.dot(plane_b[static_cast<std::size_t>(ib)].n);
-      if (tilt <= 0) return true;
-      if constexpr (kCertify) ct->rot = tilt - tab.geo_tol;
-      return false;
-    }
-    if (kb == K::kEdge) {  // f-e
-      const Seg& B = seg_b[static_cast<std::size_t>(ib)];
-      const double tilt = std::abs(A.n.dot(B.dir)) - (tab.sin_max_tol + 1e-12);
-      if constexpr (!kCertify) {
-        return tilt <= 0 && segment_in_band(B.p0, B.dir, B.len, A.n, A.off);
-      } else {
-        const double h0 = A.n.dot(B.p0) - A.off, h1 = h0 + B.len * A.n.dot(B.dir);
-        const double gap = band_gap(std::min(h0, h1), std::max(h0, h1));
-        if (tilt <= 0 && gap <= 0) return true;
-        const double reach = std::max((B.p0 - posed.origin_posed).norm(), (B.p0 + B.len * B.dir - posed.origin_posed).norm());
-        ct->lin = tab.seen_from_a(gap, reach);
-        ct->rot = tilt - tab.geo_tol;
-        return false;
-      }
-    }
-    const Vec3& q = b.vertex(VertexId(ib)).p;  // f-v
-    const double h = A.n.dot(q) - A.off;
-    if (near_band(h)) return true;
-    if constexpr (kCertify) ct->lin = tab.seen_from_a(band_gap(h, h), (q - posed.origin_posed).norm());
-    return false;
-  }
-
-  // Elements at positions ia, ib of the two BVHs' element lists, in leaves that overlap
-  // where B's leaves hold no element lanes (B small).
   __attribute__((always_inline)) void pair(int ia, int ib) {
     const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
     const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];
@@ -433,7 +291,7 @@ struct ContactDetector::Impl {
   // whichever turned it away (none when it passed both).
   __attribute__((always_inline)) Cert certified_test(const detail::BvhElement& x, const detail::BvhElement& y) {
     Cert c;
-    if (may_touch<true>(x.kind, x.index, y.kind, y.index, &c)) c = exact(x, y);
+    if (cheap.may_touch<true>(tab, posed, x.kind, x.index, y.kind, y.index, &c)) c = exact(x, y);
     return c;
   }
 
@@ -475,7 +333,7 @@ struct ContactDetector::Impl {
                                                  const detail::BvhElement& y) {
     ++pairs;
     if (!recording) {
-      if (may_touch<false>(x.kind, x.index, y.kind, y.index, nullptr)) exact(x, y);
+      if (cheap.may_touch<false>(tab, posed, x.kind, x.index, y.kind, y.index, nullptr)) exact(x, y);
       return;
     }
     const Cert c = certified_test(x, y);

@@ -7,6 +7,8 @@
 // rings), and the servo step must not allocate (SPEC section 7). tests/detector_test.cpp
 // checks this code against boost::geometry::intersection.
 
+#include "model/point_location.hpp"
+
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -33,32 +35,16 @@ struct Loc2 {
 };
 
 inline Loc2 locate(const Poly2& P, const Vec2& q) {
-  Loc2 out;
-  double best2 = std::numeric_limits<double>::infinity();
-  bool inside = false;
+  PointLocator loc(q);
   for (int l = 0; l < P.num_loops; ++l) {
     const int b = P.lb[l], e = P.lb[l + 1];
-    for (int i = b; i < e; ++i) {
-      const Vec2& p0 = P.pts[i];
-      const Vec2& p1 = P.pts[i + 1 == e ? b : i + 1];
-      const Vec2 d = p1 - p0;
-      const double len2 = d.squaredNorm();
-      const double s = len2 > 0 ? std::clamp((q - p0).dot(d) / len2, 0.0, 1.0) : 0.0;
-      const Vec2 c = p0 + s * d;
-      const double d2 = (c - q).squaredNorm();
-      if (d2 < best2) {
-        best2 = d2;
-        out.closest = c;
-        out.seg_dir = d;
-      }
-      if ((p0.y() > q.y()) != (p1.y() > q.y())) {
-        const double x = p0.x() + (q.y() - p0.y()) / (p1.y() - p0.y()) * (p1.x() - p0.x());
-        if (x > q.x()) inside = !inside;
-      }
-    }
+    for (int i = b; i < e; ++i) loc.segment(P.pts[i], P.pts[i + 1 == e ? b : i + 1], l, i - b);
   }
-  out.dist = std::sqrt(best2);
-  out.inside = inside;
+  Loc2 out;
+  out.inside = loc.inside;
+  out.dist = loc.distance();
+  out.closest = loc.closest;
+  out.seg_dir = loc.seg_dir;
   return out;
 }
 

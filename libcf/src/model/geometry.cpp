@@ -1,6 +1,7 @@
 #include <cf/geometry.hpp>
 
 #include "check.hpp"
+#include "model/point_location.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -27,34 +28,19 @@ ClosestPoints swapped(const ClosestPoints& c) { return {c.distance, c.p_b, c.p_a
 
 FaceLocation locate_in_face(const Polyhedron& m, FaceId f, const Vec2& q) {
   const Face& F = m.face(f);
-  FaceLocation out;
-  double best2 = std::numeric_limits<double>::infinity();
-  bool inside = false;
+  detail::PointLocator loc(q);
   for (std::size_t l = 0; l < F.loops_2d.size(); ++l) {
     const auto& loop = F.loops_2d[l];
-    for (std::size_t i = 0, n = loop.size(); i < n; ++i) {
-      const Vec2& a = loop[i];
-      const Vec2& b = loop[i + 1 == n ? 0 : i + 1];
-      const Vec2 ab = b - a;
-      const double len2 = ab.squaredNorm();
-      const double s = len2 > 0 ? std::clamp((q - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-      const Vec2 c = a + s * ab;
-      const double d2 = (c - q).squaredNorm();
-      if (d2 < best2) {
-        best2 = d2;
-        out.closest = c;
-        out.loop = static_cast<int>(l);
-        out.segment = static_cast<int>(i);
-      }
-      if ((a.y() > q.y()) != (b.y() > q.y())) {
-        const double x = a.x() + (q.y() - a.y()) / (b.y() - a.y()) * (b.x() - a.x());
-        if (x > q.x()) inside = !inside;
-      }
-    }
+    for (std::size_t i = 0, n = loop.size(); i < n; ++i)
+      loc.segment(loop[i], loop[i + 1 == n ? 0 : i + 1], static_cast<int>(l), static_cast<int>(i));
   }
-  out.boundary_distance = std::sqrt(best2);
+  FaceLocation out;
+  out.closest = loc.closest;
+  out.loop = loc.loop;
+  out.segment = loc.index;
+  out.boundary_distance = loc.distance();
   // A point exactly on the boundary is not in the open region.
-  out.inside = inside && out.boundary_distance > 0;
+  out.inside = loc.inside && out.boundary_distance > 0;
   return out;
 }
 
