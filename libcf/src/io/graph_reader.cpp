@@ -618,7 +618,7 @@ class JsonWalker {
       check(doc_.get_value().get(root), first);
       value(root, sax, 0);
     } else {
-      scalar_document(type, sax, first);
+      scalar(doc_, type, sax, first);
     }
     // current_location() is OUT_OF_BOUNDS once every token has been read.
     if (const char* rest = nullptr; doc_.current_location().get(rest) == simdjson::SUCCESS)
@@ -716,59 +716,38 @@ class JsonWalker {
         sax.end_array();
         return;
       }
-      case json_type::number: {
-        simdjson::ondemand::number n;
-        if (v.get_number().get(n) != simdjson::SUCCESS) return number_fallback(v.raw_json_token(), sax, at);
-        emit_number(n, sax);
+      default:
+        scalar(v, type, sax, at);
         return;
-      }
-      case json_type::string: {
-        std::string_view s;
-        check(v.get_string().get(s), at);
-        string_.assign(s.data(), s.size());
-        sax.string(string_);
-        return;
-      }
-      case json_type::boolean: {
-        bool b = false;
-        if (v.get_bool().get(b) != simdjson::SUCCESS) fail_at(at, "invalid literal");
-        sax.boolean(b);
-        return;
-      }
-      case json_type::null: {
-        bool is_null = false;
-        if (v.is_null().get(is_null) != simdjson::SUCCESS || !is_null) fail_at(at, "invalid literal");
-        sax.null();
-        return;
-      }
     }
   }
 
-  template <class Sax>
-  void scalar_document(simdjson::ondemand::json_type type, Sax& sax, const char* at) {
+  /// A scalar value or scalar document (simdjson's value and document share the getters).
+  template <class Node, class Sax>
+  void scalar(Node& node, simdjson::ondemand::json_type type, Sax& sax, const char* at) {
     using simdjson::ondemand::json_type;
     switch (type) {
       case json_type::number: {
         simdjson::ondemand::number n;
-        if (doc_.get_number().get(n) != simdjson::SUCCESS) return number_fallback(doc_.raw_json_token(), sax, at);
+        if (node.get_number().get(n) != simdjson::SUCCESS) return number_fallback(node.raw_json_token(), sax, at);
         return emit_number(n, sax);
       }
       case json_type::string: {
-        std::string_view s;
-        check(doc_.get_string().get(s), at);
-        string_.assign(s.data(), s.size());
+        std::string_view str;
+        check(node.get_string().get(str), at);
+        string_.assign(str.data(), str.size());
         sax.string(string_);
         return;
       }
       case json_type::boolean: {
         bool b = false;
-        if (doc_.get_bool().get(b) != simdjson::SUCCESS) fail_at(at, "invalid literal");
+        if (node.get_bool().get(b) != simdjson::SUCCESS) fail_at(at, "invalid literal");
         sax.boolean(b);
         return;
       }
       case json_type::null: {
         bool is_null = false;
-        if (doc_.is_null().get(is_null) != simdjson::SUCCESS || !is_null) fail_at(at, "invalid literal");
+        if (node.is_null().get(is_null) != simdjson::SUCCESS || !is_null) fail_at(at, "invalid literal");
         sax.null();
         return;
       }
