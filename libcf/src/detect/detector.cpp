@@ -2,6 +2,7 @@
 
 #include "bvh.hpp"
 #include "check.hpp"
+#include "all_pairs.hpp"
 #include "cheap.hpp"
 #include "exact.hpp"
 #include "finish.hpp"
@@ -369,13 +370,7 @@ struct ContactDetector::Impl {
     pairs = 0;
     ++posed.stamp;  // 64 bits: never wraps, so the per-pose caches need no reset
     if (!prm.use_bvh) {
-      // Every pair straight to the exact tests: the reference for the culling (boxes and
-      // the cheap rejections alike).
-      for (const detail::BvhElement& x : bvh_a.elements())
-        for (const detail::BvhElement& y : bvh_b.elements()) {
-          ++pairs;
-          exact(x, y);
-        }
+      pairs = detail::detect_all_pairs(tab, posed, scratch, cs);  // the reference (all_pairs.hpp)
       detail::finish_contacts(finishing, finish_scratch, cs);
       out = nullptr;
       return;
