@@ -4,6 +4,7 @@
 #include "check.hpp"
 #include "all_pairs.hpp"
 #include "cheap.hpp"
+#include "coherence.hpp"
 #include "exact.hpp"
 #include "finish.hpp"
 
@@ -80,30 +81,10 @@ struct ContactDetector::Impl {
   detail::PosedA posed;
   ContactSet* out = nullptr;
   std::size_t pairs = 0;
-  // Temporal coherence (big models, DetectionParams::reuse_margin_mm): the element pairs whose
-  // boxes overlapped with A's boxes grown by the margin at kept_pose. Every pair that can
-  // touch at a pose where no point of A is further than the margin from where it was at
-  // kept_pose is among them, so such a pose tests only those. A kept pair turned away
-  // carries a certificate (Cert): while A has moved and turned less than it allows, the
-  // pair is skipped.
-  static constexpr std::size_t kMaxKept = 1 << 14;
-  using Cert = detail::Cert;  // exact.hpp; the motion bound is motion_bound
-  // The kept pairs, and their certificates counted from kept_pose (kept_lin, kept_rot,
-  // rounded down; side by side, so that four are checked at once): both measures are
-  // metrics, so a pair certified at a pose `lin` from kept_pose holds at any pose less
-  // than `lin` minus that from kept_pose. Tight while A moves on (the usual servo loop),
-  // and it makes the check two comparisons with this call's distances from kept_pose.
-  // Padded to a multiple of 4 with certificates that always hold.
-  std::vector<detail::NodePair> kept;  // (A position, B position) in the BVHs' element lists
-  std::vector<float> kept_lin, kept_rot;
-  std::size_t num_kept = 0;
-  bool kept_valid = false, recording = false, kept_overflow = false, reused = false;
-  Pose kept_pose, last_pose;
-  double moved_from_kept = 0, turned_from_kept = 0;  // this call's pose from kept_pose
-  // Kept pairs serve or are kept only at poses where |(R^T R - I) o_A| <= tab.orth_allow:
-  // the certificates of B's points seen from A hold for rotations; a rotation rounded to
-  // float (1e-7) is well within it, a pose further off orthonormal is detected from scratch.
-  bool have_last = false;
+  // Temporal coherence (coherence.hpp): the pairs kept at a pose and their certificates.
+  using Cert = detail::Cert;
+  detail::KeptPairs kept;
+  bool recording = false, reused = false;
   float grow = 0;    // mm, added to A's posed boxes in this call
   // Finishing the contacts (finish.hpp): what it reads, and its scratch.
   detail::FinishContext finishing;
@@ -129,11 +110,7 @@ struct ContactDetector::Impl {
       a_elem.resize(bvh_a.elements().size());
       for (const Vertex& v : ma.vertices()) a_vert.emplace_back() << (v.p - bvh_a.origin()).cast<float>(), 0.0f;
       a_vert_posed.resize(ma.num_vertices());
-      if (prm.use_bvh && prm.reuse_margin_mm > 0) {
-        kept.resize(kMaxKept);
-        kept_lin.resize(kMaxKept + 3);
-        kept_rot.resize(kMaxKept + 3);
-      }
+      if (prm.use_bvh && prm.reuse_margin_mm > 0) kept.enable();
     } else {
       a_box.resize(bvh_a.nodes().size());
     }
@@ -260,47 +237,12 @@ struct ContactDetector::Impl {
     boxed_pair(ia, ib, x, y);
   }
 
-  // The kept pairs at a pose served from them: those whose certificates do not hold
-  // (four checked at once) go through the cheap rejections and the exact test, and get
-  // their new certificates. Not through the element boxes: with the certificates, posing
-  // A's elements for them cost more than the boxes saved (5% more instructions).
-  void reuse_kept() {
-    // Rounded up, so that a skip is never wrong by rounding.
-    const float moved = static_cast<float>(moved_from_kept) * 1.000001f;
-    const float turned = static_cast<float>(turned_from_kept) * 1.000001f;
-    const Eigen::Array4f moved4 = Eigen::Array4f::Constant(moved), turned4 = Eigen::Array4f::Constant(turned);
-    for (std::size_t k = 0; k < num_kept; k += 4) {
-      const Eigen::Map<const Eigen::Array4f> lin(kept_lin.data() + k), rot(kept_rot.data() + k);
-      unsigned test = ~(detail::greater_mask4(lin, moved4) | detail::greater_mask4(rot, turned4)) & 0xFu;
-      while (test != 0) {
-        const std::size_t i = k + static_cast<std::size_t>(__builtin_ctz(test));
-        test &= test - 1;
-        kept_pair(i);
-      }
-    }
-  }
-
-  __attribute__((always_inline)) void kept_pair(std::size_t i) {
-    const int ia = kept[i].a, ib = kept[i].b;
-    const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
-    const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];
-    ++pairs;
-    store(i, certified_test(x, y));
-  }
-
   // The cheap rejection and the exact test of a pair, for kept pairs: the certificate of
   // whichever turned it away (none when it passed both).
   __attribute__((always_inline)) Cert certified_test(const detail::BvhElement& x, const detail::BvhElement& y) {
     Cert c;
     if (cheap.may_touch<true>(tab, posed, x.kind, x.index, y.kind, y.index, &c)) c = exact(x, y);
     return c;
-  }
-
-  // Keeps pair i's certificate, from this call's pose, counted from kept_pose.
-  void store(std::size_t i, const Cert& c) {
-    const double lin = c.lin - moved_from_kept, rot = c.rot - turned_from_kept;
-    kept_lin[i] = lin > 0 ? static_cast<float>(lin) * 0.999999f : 0.0f;
-    kept_rot[i] = rot > 0 ? static_cast<float>(rot) * 0.999999f : 0.0f;
   }
 
   // Leaves of the two BVHs whose boxes overlap: their element pairs whose kinds can touch
@@ -337,21 +279,7 @@ struct ContactDetector::Impl {
       if (cheap.may_touch<false>(tab, posed, x.kind, x.index, y.kind, y.index, nullptr)) exact(x, y);
       return;
     }
-    const Cert c = certified_test(x, y);
-    if (num_kept < kept.size()) {
-      kept[num_kept] = {ia, ib};
-      store(num_kept++, c);
-    } else {
-      kept_overflow = true;
-    }
-  }
-
-  // Bounds how far any point of A moves from pose p0 to p1 (mm): the move of bvh_a's origin
-  // plus |R1 - R0| times A's reach from it (Frobenius norm, a bound of the spectral norm for
-  // any matrices).
-  double motion_bound(const Pose& p0, const Pose& p1) const {
-    const Vec3& o = bvh_a.origin();
-    return (p1.apply(o) - p0.apply(o)).norm() + (p1.R_BA - p0.R_BA).norm() * tab.r_a;
+    kept.record(ia, ib, certified_test(x, y));
   }
 
   // The exact test of a pair (exact.hpp): its contact goes to the output; returns the
@@ -391,32 +319,30 @@ struct ContactDetector::Impl {
     reused = false;
     grow = 0;
     recording = false;
-    if (!kept.empty()) {
-      const double moved = have_last ? motion_bound(last_pose, pose) : std::numeric_limits<double>::infinity();
-      last_pose = pose;
-      have_last = true;
-      const bool rotation = ((pose.R_BA.transpose() * pose.R_BA - Mat3::Identity()) * bvh_a.origin()).norm() <= tab.orth_allow;
-      moved_from_kept = kept_valid ? motion_bound(kept_pose, pose) : std::numeric_limits<double>::infinity();
-      if (rotation && moved_from_kept <= prm.reuse_margin_mm) {
-        reused = true;
-        turned_from_kept = (pose.R_BA - kept_pose.R_BA).norm();
-        posed.certifying = true;
-        reuse_kept();
-        posed.certifying = false;
-        detail::finish_contacts(finishing, finish_scratch, cs);
-        out = nullptr;
-        return;
-      }
-      // Keep pairs for the next poses only while A moves slowly enough for them to serve a
-      // few; otherwise (poses far apart) the grown boxes would only cost.
-      kept_valid = false;
-      recording = rotation && moved <= 0.5 * prm.reuse_margin_mm;
-      if (recording) {
-        grow = static_cast<float>(prm.reuse_margin_mm);
-        num_kept = 0;
-        kept_overflow = false;
-        moved_from_kept = turned_from_kept = 0;  // this pose is the new kept_pose
-        posed.certifying = true;
+    if (kept.enabled()) {
+      switch (kept.start(tab, pose, prm.reuse_margin_mm)) {
+        case detail::KeptPairs::Mode::kServe:
+          // The kept pairs whose certificates do not hold go through the cheap rejections and
+          // the exact test. Not through the element boxes: with the certificates, posing A's
+          // elements for them cost more than the boxes saved (5% more instructions).
+          reused = true;
+          posed.certifying = true;
+          kept.serve([this](int ia, int ib) {
+            ++pairs;
+            return certified_test(bvh_a.elements()[static_cast<std::size_t>(ia)],
+                                  bvh_b.elements()[static_cast<std::size_t>(ib)]);
+          });
+          posed.certifying = false;
+          detail::finish_contacts(finishing, finish_scratch, cs);
+          out = nullptr;
+          return;
+        case detail::KeptPairs::Mode::kRecord:
+          recording = true;
+          grow = static_cast<float>(prm.reuse_margin_mm);
+          posed.certifying = true;
+          break;
+        case detail::KeptPairs::Mode::kOff:
+          break;
       }
     }
     // The stack is sized for the trees' depths, so the descents cannot overflow it.
@@ -432,12 +358,7 @@ struct ContactDetector::Impl {
                          const detail::BvhNode& B) { return overlap(ia, A, B); },
                   stack.data(), stack.size(), leaves);
     CF_DEMAND(complete);
-    if (recording && !kept_overflow) {
-      kept_valid = true;
-      kept_pose = pose;
-      // Padding that is always skipped.
-      for (std::size_t k = num_kept; k % 4 != 0; ++k) kept_lin[k] = std::numeric_limits<float>::infinity();
-    }
+    if (recording) kept.finish_recording(pose);
     recording = posed.certifying = false;
     detail::finish_contacts(finishing, finish_scratch, cs);
     out = nullptr;
