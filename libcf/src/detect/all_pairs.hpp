@@ -12,7 +12,8 @@ namespace cf::detail {
 
 /// Pushes every contact at `p.pose` into `out` (unsorted, unfinished); returns the number
 /// of pairs tested.
-inline std::size_t detect_all_pairs(const PairTables& t, PosedA& p, ExactScratch& s, ContactSet& out) {
+inline std::size_t detect_all_pairs(const PairTables& t, PosedA& p, ExactScratch& s,
+                                    ContactSet& out) {
   const auto count = [](const Polyhedron& m, ElementKind k) {
     return static_cast<int>(k == ElementKind::kVertex ? m.num_vertices()
                             : k == ElementKind::kEdge ? m.num_edges()

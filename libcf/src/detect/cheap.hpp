@@ -31,7 +31,8 @@ class CheapRejections {
   // it moves by at most the motion bound times max(1, |q - o| / r_a). Where two conditions
   // fail, either one keeps the pair away.
   template <bool kCertify>
-  __attribute__((always_inline)) bool may_touch(const PairTables& t, PosedA& p, ElementKind ka, int ia, ElementKind kb, int ib, Cert* ct) {
+  __attribute__((always_inline)) bool may_touch(const PairTables& t, PosedA& p, ElementKind ka,
+                                                int ia, ElementKind kb, int ib, Cert* ct) {
     using K = ElementKind;
     if (ka == K::kVertex) {  // v-f
       const Plane& B = plane_b[static_cast<std::size_t>(ib)];
@@ -60,8 +61,9 @@ class CheapRejections {
       const Seg& B = seg_b[static_cast<std::size_t>(ib)];
       const Vec3 n = A.dir.cross(B.dir);
       const double sn = n.norm();
-      const double parallel =
-          std::max(t.sin_tol_edge_a[static_cast<std::size_t>(ia)], t.sin_tol_edge_b[static_cast<std::size_t>(ib)]) - 1e-12 - sn;
+      const double parallel = std::max(t.sin_tol_edge_a[static_cast<std::size_t>(ia)],
+                                       t.sin_tol_edge_b[static_cast<std::size_t>(ib)]) -
+                              1e-12 - sn;
       if (parallel >= 0) {
         // n turns by at most as much as A's direction.
         if constexpr (kCertify) ct->rot = parallel - t.geo_tol;
@@ -80,7 +82,8 @@ class CheapRejections {
       const double bb = A.dir.dot(B.dir), c = A.dir.dot(r), f = B.dir.dot(r);
       const double den = 1 - bb * bb;
       const double s = (bb * f - c) / den, u = (f - bb * c) / den;
-      if (std::max({0.0, -s, s - A.len}) + std::max({0.0, -u, u - B.len}) <= t.in_plane + t.geo_tol) return true;
+      if (std::max({0.0, -s, s - A.len}) + std::max({0.0, -u, u - B.len}) <= t.in_plane + t.geo_tol)
+        return true;
       // No certificate: the closest points move too fast near parallel.
       return false;
     }
@@ -100,7 +103,8 @@ class CheapRejections {
         const double h0 = A.n.dot(B.p0) - A.off, h1 = h0 + B.len * A.n.dot(B.dir);
         const double gap = band_gap(t, std::min(h0, h1), std::max(h0, h1));
         if (tilt <= 0 && gap <= 0) return true;
-        const double reach = std::max((B.p0 - p.origin_posed).norm(), (B.p0 + B.len * B.dir - p.origin_posed).norm());
+        const double reach = std::max((B.p0 - p.origin_posed).norm(),
+                                      (B.p0 + B.len * B.dir - p.origin_posed).norm());
         ct->lin = t.seen_from_a(gap, reach);
         ct->rot = tilt - t.geo_tol;
         return false;
@@ -112,9 +116,6 @@ class CheapRejections {
     if constexpr (kCertify) ct->lin = t.seen_from_a(band_gap(t, h, h), (q - p.origin_posed).norm());
     return false;
   }
-
-  // Elements at positions ia, ib of the two BVHs' element lists, in leaves that overlap
-  // where B's leaves hold no element lanes (B small).
 
  private:
   struct Plane {
@@ -148,16 +149,20 @@ class CheapRejections {
     }
     return S;
   }
-  // Cheap necessary conditions of each type's exact test (same tolerances, looser or
-  // equal), so that most pairs are turned away before the exact test loads the features.
-  static bool segment_in_band(const PairTables& t, const Vec3& p0, const Vec3& dir, double len, const Vec3& n, double off) {
+  // Does the segment reach the band of the plane (n, off)?
+  static bool segment_in_band(const PairTables& t, const Vec3& p0, const Vec3& dir, double len,
+                              const Vec3& n, double off) {
     const double h0 = n.dot(p0) - off, h1 = h0 + len * n.dot(dir);
     return std::min(h0, h1) <= t.eps + t.geo_tol && std::max(h0, h1) >= -t.depth - t.geo_tol;
   }
   // in_band with room for the rounding of a differently ordered computation.
-  static bool near_band(const PairTables& t, double d) { return d <= t.eps + t.geo_tol && d >= -t.depth - t.geo_tol; }
+  static bool near_band(const PairTables& t, double d) {
+    return d <= t.eps + t.geo_tol && d >= -t.depth - t.geo_tol;
+  }
   // How far heights h0 <= h1 (or one height) lie outside near_band's band.
-  static double band_gap(const PairTables& t, double lo, double hi) { return std::max(lo - t.eps - t.geo_tol, -t.depth - t.geo_tol - hi); }
+  static double band_gap(const PairTables& t, double lo, double hi) {
+    return std::max(lo - t.eps - t.geo_tol, -t.depth - t.geo_tol - hi);
+  }
 
   std::vector<Plane> plane_b, plane_a;
   std::vector<Seg> seg_b, seg_a;

@@ -43,11 +43,13 @@ class KeptPairs {
   /// t.orth_allow at A's origin are neither: the certificates of B's points seen from A
   /// hold for rotations only.
   Mode start(const PairTables& t, const Pose& pose, double margin_mm) {
-    const double moved = have_last_ ? motion_bound(t, last_pose_, pose) : std::numeric_limits<double>::infinity();
+    const double moved =
+        have_last_ ? motion_bound(t, last_pose_, pose) : std::numeric_limits<double>::infinity();
     last_pose_ = pose;
     have_last_ = true;
     const bool rotation =
-        ((pose.R_BA.transpose() * pose.R_BA - Mat3::Identity()) * t.origin_A).norm() <= t.orth_allow;
+        ((pose.R_BA.transpose() * pose.R_BA - Mat3::Identity()) * t.origin_A).norm() <=
+        t.orth_allow;
     moved_ = valid_ ? motion_bound(t, kept_pose_, pose) : std::numeric_limits<double>::infinity();
     if (rotation && moved_ <= margin_mm) {
       turned_ = (pose.R_BA - kept_pose_.R_BA).norm();
@@ -71,7 +73,8 @@ class KeptPairs {
     // Rounded up, so that a skip is never wrong by rounding.
     const float moved = static_cast<float>(moved_) * 1.000001f;
     const float turned = static_cast<float>(turned_) * 1.000001f;
-    const Eigen::Array4f moved4 = Eigen::Array4f::Constant(moved), turned4 = Eigen::Array4f::Constant(turned);
+    const Eigen::Array4f moved4 = Eigen::Array4f::Constant(moved),
+                         turned4 = Eigen::Array4f::Constant(turned);
     for (std::size_t k = 0; k < num_; k += 4) {
       const Eigen::Map<const Eigen::Array4f> lin(lin_.data() + k), rot(rot_.data() + k);
       unsigned todo = ~(greater_mask4(lin, moved4) | greater_mask4(rot, turned4)) & 0xFu;
@@ -113,7 +116,7 @@ class KeptPairs {
     rot_[i] = rot > 0 ? static_cast<float>(rot) * 0.999999f : 0.0f;
   }
 
-  std::vector<NodePair> pairs_;  // (A position, B position) in the trees' element lists
+  std::vector<NodePair> pairs_;   // (A position, B position) in the trees' element lists
   std::vector<float> lin_, rot_;  // side by side, padded to a multiple of 4
   std::size_t num_ = 0;
   bool valid_ = false, overflow_ = false, have_last_ = false;

@@ -229,6 +229,8 @@ struct ContactDetector::Impl {
       Q.oh[i] = N.oh[i] + grow;
     }
   }
+  // Elements at positions ia, ib of the two BVHs' element lists, in leaves that overlap
+  // where B's leaves hold no element lanes (B small).
   __attribute__((always_inline)) void pair(int ia, int ib) {
     const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
     const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];

@@ -38,7 +38,8 @@ Mat3 task_frame(const Vec3& y, const Vec3& x_hint) {
 }
 
 // Minimum distance between 2D segments that do not cross, and the parameter on the first.
-double segment_segment_2d(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d, double* t_on_first) {
+double segment_segment_2d(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d,
+                          double* t_on_first) {
   auto point_seg = [](const Vec2& p, const Vec2& s0, const Vec2& s1, double* t) {
     const Vec2 r = s1 - s0;
     const double len2 = r.squaredNorm();
@@ -59,8 +60,10 @@ double segment_segment_2d(const Vec2& a, const Vec2& b, const Vec2& c, const Vec
 
 // How far the deeper wing of edge E dips below its face's tolerance under a contact plane
 // of normal n (E's model frame); > 0 exactly when the solid around E runs into the plane.
-double wedge_dip(const Vec3& n, const EdgeWings& w, const Edge& E, const std::vector<double>& sin_tol_face) {
-  return std::max(-sin_tol_face[E.left.index()] - n.dot(w.left), -sin_tol_face[E.right.index()] - n.dot(w.right));
+double wedge_dip(const Vec3& n, const EdgeWings& w, const Edge& E,
+                 const std::vector<double>& sin_tol_face) {
+  return std::max(-sin_tol_face[E.left.index()] - n.dot(w.left),
+                  -sin_tol_face[E.right.index()] - n.dot(w.right));
 }
 
 PairOutcome turned_away(double lin, double rot) {
@@ -71,8 +74,8 @@ PairOutcome turned_away(double lin, double rot) {
 // Turned away for good whatever the pose (a reflex edge).
 PairOutcome never() { return turned_away(0, std::numeric_limits<double>::infinity()); }
 
-PairOutcome contact(PcType type, int ia, int ib, double d, const Vec3& p_W, const Vec3& origin, const Mat3& R_WT,
-                    double misfit) {
+PairOutcome contact(PcType type, int ia, int ib, double d, const Vec3& p_W, const Vec3& origin,
+                    const Mat3& R_WT, double misfit) {
   PairOutcome o;
   ContactPc& c = o.contact.emplace();
   c.pc = {type, ia, ib};
@@ -91,8 +94,9 @@ PairOutcome contact(PcType type, int ia, int ib, double d, const Vec3& p_W, cons
 // first to the last point over the face; 0 beside the face). Turned away for the segment's
 // heights or its in-plane gap, it leaves in *lin how far the segment must move (in the
 // face's frame) to pass them.
-bool line_on_face(const PairTables& t, ExactScratch& s, const Polyhedron& m, const FlatFaces& flat, int f,
-                  const Vec3& s0, const Vec3& s1, double* t_c, double* d, double* gap, double* span, double* lin) {
+bool line_on_face(const PairTables& t, ExactScratch& s, const Polyhedron& m, const FlatFaces& flat,
+                  int f, const Vec3& s0, const Vec3& s1, double* t_c, double* d, double* gap,
+                  double* span, double* lin) {
   const Face& F = m.faces()[static_cast<std::size_t>(f)];
   const double h0 = F.normal.dot(s0) - F.offset, h1 = F.normal.dot(s1) - F.offset;
   if (std::min(h0, h1) > t.eps || std::max(h0, h1) < -t.depth) {
@@ -127,7 +131,8 @@ bool line_on_face(const PairTables& t, ExactScratch& s, const Polyhedron& m, con
     for (int l = 0; l < P.num_loops; ++l)
       for (int i = P.lb[l]; i < P.lb[l + 1]; ++i) {
         double tt;
-        const double g = segment_segment_2d(a2, b2, P.pts[i], P.pts[i + 1 == P.lb[l + 1] ? P.lb[l] : i + 1], &tt);
+        const double g = segment_segment_2d(a2, b2, P.pts[i],
+                                            P.pts[i + 1 == P.lb[l + 1] ? P.lb[l] : i + 1], &tt);
         if (g < best) best = g, tb = tt;
       }
     if (best > t.in_plane) {
@@ -157,11 +162,19 @@ FlatFaces::FlatFaces(const Polyhedron& m) {
   }
   face_first.push_back(static_cast<int>(loop_begin.size()));
   loop_begin.push_back(static_cast<int>(pts.size()));
-  for (std::size_t f = 0; f < m.num_faces(); ++f) convex.push_back(is_convex(poly(static_cast<int>(f))));
+  for (std::size_t f = 0; f < m.num_faces(); ++f)
+    convex.push_back(is_convex(poly(static_cast<int>(f))));
 }
 
-PairTables::PairTables(const Polyhedron& ma, const Polyhedron& mb, const Params& params, const Vec3& origin)
-    : a(&ma), b(&mb), prm(params.detection), flat_a(ma), flat_b(mb), wings_a(wings_of(ma)), wings_b(wings_of(mb)),
+PairTables::PairTables(const Polyhedron& ma, const Polyhedron& mb, const Params& params,
+                       const Vec3& origin)
+    : a(&ma),
+      b(&mb),
+      prm(params.detection),
+      flat_a(ma),
+      flat_b(mb),
+      wings_a(wings_of(ma)),
+      wings_b(wings_of(mb)),
       origin_A(origin) {
   auto check = [](double v, const char* name, bool positive) {
     if (!std::isfinite(v) || v < 0 || (positive && v == 0))
@@ -184,7 +197,8 @@ PairTables::PairTables(const Polyhedron& ma, const Polyhedron& mb, const Params&
   geo_tol = 1e-9 * std::max(scale, 1.0);
   area_tol = 1e-12 * std::max(scale * scale, 1.0);
   reach = ma.size() + mb.size();
-  for (const Vertex& v : mb.vertices()) reach = std::max(reach, v.p.cwiseAbs().maxCoeff() + ma.size());
+  for (const Vertex& v : mb.vertices())
+    reach = std::max(reach, v.p.cwiseAbs().maxCoeff() + ma.size());
   orth_allow = 1e-5 * std::max({reach, origin_A.norm(), 1.0});
   for (const Vertex& v : ma.vertices()) r_a = std::max(r_a, (v.p - origin_A).norm());
   // A face's tilt scale is its size, sqrt(area).
@@ -201,7 +215,8 @@ ExactScratch::ExactScratch(const PairTables& t) {
   std::size_t max_loops = 1;
   for (const Face& F : t.a->faces()) max_loops = std::max(max_loops, F.loops.size());
   q_lb.resize(max_loops + 1);
-  params.resize(static_cast<std::size_t>(4 + 4 * std::max(t.flat_a.max_face_points, t.flat_b.max_face_points)));
+  params.resize(static_cast<std::size_t>(
+      4 + 4 * std::max(t.flat_a.max_face_points, t.flat_b.max_face_points)));
   clip_cap = t.flat_a.max_face_points + t.flat_b.max_face_points;
   clip_buf.resize(2 * static_cast<std::size_t>(clip_cap));
 }
@@ -249,8 +264,9 @@ PairOutcome face_vertex(const PairTables& t, PosedA& P, int fa, int v) {
   if (gap > t.in_plane) {
     // B's vertex as A sees it, R^T (q - o) + const, moves at most the bound times
     // max(1, |q - o| / r_a).
-    return P.certifying ? turned_away(t.seen_from_a(gap - t.in_plane, (q - P.origin_posed).norm()), 0)
-                        : PairOutcome{};
+    return P.certifying
+               ? turned_away(t.seen_from_a(gap - t.in_plane, (q - P.origin_posed).norm()), 0)
+               : PairOutcome{};
   }
   const Vec3 nW = pose.R_BA * F.normal;
   const Vec3 onA = q - h * nW;
@@ -270,8 +286,8 @@ PairOutcome edge_face(const PairTables& t, PosedA& P, ExactScratch& s, int e, in
   const Vec3 dW = pose.R_BA * E.dir;
   const double sin_ang = std::min(1.0, std::abs(dW.dot(F.normal)));
   if (sin_ang > t.sin_max_tol) return {};
-  const double dip =
-      wedge_dip(pose.R_BA.transpose() * F.normal, t.wings_a[static_cast<std::size_t>(e)], E, t.sin_tol_face_a);
+  const double dip = wedge_dip(pose.R_BA.transpose() * F.normal,
+                               t.wings_a[static_cast<std::size_t>(e)], E, t.sin_tol_face_a);
   if (dip > 0) return turned_away(0, dip - t.geo_tol);
   double tc, d, gap, span, lin = 0;
   if (!line_on_face(t, s, *t.b, t.flat_b, fb, p0, p1, &tc, &d, &gap, &span, &lin))
@@ -298,7 +314,8 @@ PairOutcome face_edge(const PairTables& t, PosedA& P, ExactScratch& s, int fa, i
   const Vec3 dA = Rt * E.dir;
   const double sin_ang = std::min(1.0, std::abs(dA.dot(F.normal)));
   if (sin_ang > t.sin_max_tol) return {};
-  const double dip = wedge_dip(pose.R_BA * F.normal, t.wings_b[static_cast<std::size_t>(e)], E, t.sin_tol_face_b);
+  const double dip =
+      wedge_dip(pose.R_BA * F.normal, t.wings_b[static_cast<std::size_t>(e)], E, t.sin_tol_face_b);
   if (dip > 0) return turned_away(0, dip - t.geo_tol);
   const Vec3& q0 = b.vertex(E.v0).p;
   const Vec3& q1 = b.vertex(E.v1).p;
@@ -308,7 +325,8 @@ PairOutcome face_edge(const PairTables& t, PosedA& P, ExactScratch& s, int fa, i
     // B's segment as A sees it moves at most the bound times max(1, |q - o| / r_a).
     if (!P.certifying) return {};
     return turned_away(
-        t.seen_from_a(lin, std::max((q0 - P.origin_posed).norm(), (q1 - P.origin_posed).norm())), 0);
+        t.seen_from_a(lin, std::max((q0 - P.origin_posed).norm(), (q1 - P.origin_posed).norm())),
+        0);
   }
   const double tol = t.tol_for(span > 0 ? span * E.length : E.length);
   const double ang = std::asin(sin_ang);
@@ -364,7 +382,8 @@ PairOutcome face_face(const PairTables& t, PosedA& P, ExactScratch& s, int fa, i
     s_hi = std::max(s_hi, sq);
   };
   Overlap2 ov;
-  if (!(t.flat_a.convex[static_cast<std::size_t>(fa)] && t.flat_b.convex[static_cast<std::size_t>(fb)] &&
+  if (!(t.flat_a.convex[static_cast<std::size_t>(fa)] &&
+        t.flat_b.convex[static_cast<std::size_t>(fb)] &&
         overlap_convex(t.flat_b.poly(fb), Q, s.clip_buf.data(), s.clip_cap, ov, visit)))
     ov = overlap(t.flat_b.poly(fb), Q, t.geo_tol, s.params.data(), visit);
   if (!(ov.area > t.area_tol)) return {};
@@ -392,7 +411,8 @@ PairOutcome edge_edge(const PairTables& t, PosedA& P, int ea, int eb) {
   Vec3 n = uA.cross(uB);
   const double sn = n.norm();
   // The tolerance of the shorter edge (atan(eps / L) falls with L): the larger sine.
-  if (sn <= std::max(t.sin_tol_edge_a[static_cast<std::size_t>(ea)], t.sin_tol_edge_b[static_cast<std::size_t>(eb)]))
+  if (sn <= std::max(t.sin_tol_edge_a[static_cast<std::size_t>(ea)],
+                     t.sin_tol_edge_b[static_cast<std::size_t>(eb)]))
     return {};  // near-parallel: not e-e
   n /= sn;
   // Closest points of the two lines (unit directions): s along A, u along B.
@@ -413,8 +433,8 @@ PairOutcome edge_edge(const PairTables& t, PosedA& P, int ea, int eb) {
   const double d = (pA - pB).dot(n);
   if (!t.in_band(d)) return {};
   // The wedges of the two edges must lie on their own sides of the contact plane.
-  const double dip_a =
-      wedge_dip(pose.R_BA.transpose() * n, t.wings_a[static_cast<std::size_t>(ea)], EA, t.sin_tol_face_a);
+  const double dip_a = wedge_dip(pose.R_BA.transpose() * n, t.wings_a[static_cast<std::size_t>(ea)],
+                                 EA, t.sin_tol_face_a);
   const double dip_b = wedge_dip(-n, t.wings_b[static_cast<std::size_t>(eb)], EB, t.sin_tol_face_b);
   if (dip_a > 0 || dip_b > 0) {
     // n = m / |m| (m = uA x uB, |m| = sn) turns by at most 2 |dm| / sn <= 2 rho / sn, A's
@@ -424,7 +444,8 @@ PairOutcome edge_edge(const PairTables& t, PosedA& P, int ea, int eb) {
     const double flip = std::abs(side) / (2 * (sumB - sumA).norm() / sn + sA.norm());
     return turned_away(0, std::min(turn, flip) - t.geo_tol);
   }
-  return contact(PcType::kEE, ea, eb, d, pA, pB, task_frame(n, uB), std::abs(d) / t.eps + over / t.eps);
+  return contact(PcType::kEE, ea, eb, d, pA, pB, task_frame(n, uB),
+                 std::abs(d) / t.eps + over / t.eps);
 }
 
 }  // namespace cf::detail

@@ -70,7 +70,8 @@ struct PairTables {
   double eps = 1;       ///< mm, Params::epsilon_mm
   double depth = 1;     ///< mm, max_penetration_mm
   double in_plane = 1;  ///< mm, in_plane_tolerance_mm or epsilon
-  double geo_tol = 0;   ///< mm, coincidence of boundaries in 2D: far below any feature, above rounding
+  double geo_tol =
+      0;  ///< mm, coincidence of boundaries in 2D: far below any feature, above rounding
   double area_tol = 0;  ///< mm^2
   FlatFaces flat_a, flat_b;
   std::vector<EdgeWings> wings_a, wings_b;
@@ -78,15 +79,16 @@ struct PairTables {
   std::vector<double> sin_tol_face_a, sin_tol_face_b, sin_tol_edge_a, sin_tol_edge_b;
   double sin_max_tol = 0, cos_max_tol = 1;
   Vec3 origin_A = Vec3::Zero();  ///< mm, A's frame
-  double r_a = 0;       ///< mm, A's furthest vertex from origin_A
-  double reach = 0;     ///< mm, bounds every coordinate of B and A's size
+  double r_a = 0;                ///< mm, A's furthest vertex from origin_A
+  double reach = 0;              ///< mm, bounds every coordinate of B and A's size
   /// mm: how far |(R^T R - I) o_A| may be at a pose whose certificates count (a rotation
   /// rounded to float is well within it).
   double orth_allow = 0;
 
   /// rad: the largest angular tolerance any pair can get.
   double max_tol() const {
-    return prm.angular_tolerance_rad > 0 ? prm.angular_tolerance_rad : prm.max_angular_tolerance_rad;
+    return prm.angular_tolerance_rad > 0 ? prm.angular_tolerance_rad
+                                         : prm.max_angular_tolerance_rad;
   }
   /// rad: the angular tolerance of a contact region of this extent (mm).
   double tol_for(double extent) const {
@@ -144,8 +146,8 @@ PairOutcome edge_edge(const PairTables& t, PosedA& p, int ea, int eb);
 /// The test of the pair's types (A's element kind ka, B's kb); an empty outcome for kinds
 /// that form no PC. Inline: the servo loop's detection calls it for every pair that passes
 /// the cheap rejections.
-inline PairOutcome exact_test(const PairTables& t, PosedA& p, ExactScratch& s, ElementKind ka, int ia,
-                              ElementKind kb, int ib) {
+inline PairOutcome exact_test(const PairTables& t, PosedA& p, ExactScratch& s, ElementKind ka,
+                              int ia, ElementKind kb, int ib) {
   switch (ka) {
     case ElementKind::kVertex:
       if (kb == ElementKind::kFace) return vertex_face(t, p, ia, ib);

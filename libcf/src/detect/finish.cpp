@@ -18,22 +18,24 @@ static_assert(ContactSet::kCapacity <= 256, "a contact's position is 8 bits of i
 void sort_contacts(bool small_indices, FinishScratch& s, ContactSet& cs) {
   const int n = cs.size();
   if (!small_indices || n <= kFewContacts) {
-    std::sort(cs.begin(), cs.end(), [](const ContactPc& x, const ContactPc& y) { return x.pc < y.pc; });
+    std::sort(cs.begin(), cs.end(),
+              [](const ContactPc& x, const ContactPc& y) { return x.pc < y.pc; });
     return;
   }
   for (int i = 0; i < n; ++i) {
     const Pc& p = cs[i].pc;
-    s.sort_keys[static_cast<std::size_t>(i)] = static_cast<std::uint64_t>(p.type) << 56 |
-                                               static_cast<std::uint64_t>(p.a) << 32 |
-                                               static_cast<std::uint64_t>(p.b) << 8 | static_cast<std::uint64_t>(i);
+    s.sort_keys[static_cast<std::size_t>(i)] =
+        static_cast<std::uint64_t>(p.type) << 56 | static_cast<std::uint64_t>(p.a) << 32 |
+        static_cast<std::uint64_t>(p.b) << 8 | static_cast<std::uint64_t>(i);
   }
   std::sort(s.sort_keys.begin(), s.sort_keys.begin() + n);
   int first_moved = 0;
-  while (first_moved < n &&
-         (s.sort_keys[static_cast<std::size_t>(first_moved)] & 0xFFu) == static_cast<std::uint64_t>(first_moved))
+  while (first_moved < n && (s.sort_keys[static_cast<std::size_t>(first_moved)] & 0xFFu) ==
+                                static_cast<std::uint64_t>(first_moved))
     ++first_moved;
   for (int i = first_moved; i < n; ++i)
-    s.sort_buf[static_cast<std::size_t>(i)] = cs[static_cast<int>(s.sort_keys[static_cast<std::size_t>(i)] & 0xFFu)];
+    s.sort_buf[static_cast<std::size_t>(i)] =
+        cs[static_cast<int>(s.sort_keys[static_cast<std::size_t>(i)] & 0xFFu)];
   for (int i = first_moved; i < n; ++i) cs[i] = s.sort_buf[static_cast<std::size_t>(i)];
 }
 
@@ -66,10 +68,12 @@ void finish_contacts(const FinishContext& ctx, FinishScratch& s, ContactSet& cs)
   const Polyhedron& b = *ctx.b;
   const auto dominated_by = [&](const ContactPc& ci, PcType type) {
     const auto t = static_cast<std::size_t>(type);
-    const ElementKind ai = a_kind(ci.pc.type), bi = b_kind(ci.pc.type), aj = a_kind(type), bj = b_kind(type);
+    const ElementKind ai = a_kind(ci.pc.type), bi = b_kind(ci.pc.type), aj = a_kind(type),
+                      bj = b_kind(type);
     for (int k = 0; k < num_dom[t]; ++k) {
       const ContactPc& cj = cs[s.dominators[t][static_cast<std::size_t>(k)]];
-      if (in_closure(a, ai, ci.pc.a, aj, cj.pc.a) && in_closure(b, bi, ci.pc.b, bj, cj.pc.b)) return true;
+      if (in_closure(a, ai, ci.pc.a, aj, cj.pc.a) && in_closure(b, bi, ci.pc.b, bj, cj.pc.b))
+        return true;
     }
     return false;
   };
@@ -105,7 +109,8 @@ void finish_contacts(const FinishContext& ctx, FinishScratch& s, ContactSet& cs)
     for (int g = 0; g < groups; ++g) {
       const ContactPc& cj = cs[s.reps[static_cast<std::size_t>(g)]];
       const Vec3 nj = cj.R_WT.col(1);
-      if (ni.dot(nj) >= ctx.cos_plane_tolerance && std::abs(nj.dot(ci.origin_W - cj.origin_W)) <= eps &&
+      if (ni.dot(nj) >= ctx.cos_plane_tolerance &&
+          std::abs(nj.dot(ci.origin_W - cj.origin_W)) <= eps &&
           std::abs(ni.dot(cj.origin_W - ci.origin_W)) <= eps) {
         ci.plane = static_cast<std::int16_t>(g);
         break;

@@ -16,10 +16,10 @@ struct FinishContext {
   const Polyhedron* a = nullptr;
   const Polyhedron* b = nullptr;
   double epsilon_mm = 1;
-  double dominance_fit = 0.25;      ///< DetectionParams::dominance_fit
-  double dominance_penalty = 1;     ///< DetectionParams::dominance_penalty
-  double cos_plane_tolerance = 1;   ///< cos of the largest angular tolerance: one contact plane
-  bool small_indices = false;       ///< every element index fits the sort keys' 24 bits
+  double dominance_fit = 0.25;     ///< DetectionParams::dominance_fit
+  double dominance_penalty = 1;    ///< DetectionParams::dominance_penalty
+  double cos_plane_tolerance = 1;  ///< cos of the largest angular tolerance: one contact plane
+  bool small_indices = false;      ///< every element index fits the sort keys' 24 bits
 };
 
 /// Scratch of finish_contacts, sized once: it allocates nothing.
