@@ -108,6 +108,23 @@ cf::ContactPc wall_pc(const cf::Pose& p) {
   return c;
 }
 
+// An identification result as an application could fill it: the CF (-1: none) and its PCs,
+// and every detected contact. The status is what CfIdentifier would say of it.
+std::unique_ptr<cf::Identification> identification(int cf, const std::vector<cf::ContactPc>& cf_pcs,
+                                                   const std::vector<cf::ContactPc>& detected) {
+  auto id = std::make_unique<cf::Identification>();
+  id->cf = cf::CfId(cf);
+  id->status = cf >= 0 ? cf::IdStatus::kMatchedByFit
+               : detected.empty() ? cf::IdStatus::kNoContact
+                                  : cf::IdStatus::kOutsideGraph;
+  for (const cf::ContactPc& c : cf_pcs) {
+    id->cf_pcs[static_cast<std::size_t>(id->num_cf_pcs++)] = c;
+    id->pcs.insert(c.pc);
+  }
+  for (const cf::ContactPc& c : detected) id->contacts.push(c);
+  return id;
+}
+
 }  // namespace
 
 TEST_CASE("renderer bookkeeping: CF, motion and status over given identifications", "[renderer]") {
@@ -116,8 +133,7 @@ TEST_CASE("renderer bookkeeping: CF, motion and status over given identification
   double t = 0;
   auto tick = [&](const cf::Pose& p, int cf, std::vector<cf::ContactPc> pcs) -> const cf::HapticResult& {
     t += 0.001;
-    return r.step_identified(p, t, cf::CfId(cf), pcs.data(), static_cast<int>(pcs.size()), pcs.data(),
-                             static_cast<int>(pcs.size()));
+    return r.step_identified(p, t, *identification(cf, pcs, pcs));
   };
   const cf::HapticResult& a = tick(at(70, 40, 40), -1, {});
   CHECK(a.status == cf::RenderStatus::kNoContact);
@@ -153,8 +169,9 @@ TEST_CASE("renderer bookkeeping: CF, motion and status over given identification
   // Contacts that no CF fits.
   std::vector<cf::ContactPc> odd = {floor_pc(at(35.5, 35.5, 40))};
   t += 0.001;
-  const cf::HapticResult& nf = r.step_identified(at(35.5, 35.5, 40), t, cf::CfId(), nullptr, 0, odd.data(), 1);
+  const cf::HapticResult& nf = r.step_identified(at(35.5, 35.5, 40), t, *identification(-1, {}, odd));
   CHECK(nf.status == cf::RenderStatus::kNoFittingCf);
+  CHECK(std::string(nf.identification) == "outside-graph");
   CHECK(nf.cf == cf::CfId());
   CHECK(nf.force->num_pcs == 1);
   CHECK(std::string(cf::to_string(nf.status)) == "no_fitting_cf");
@@ -268,6 +285,7 @@ TEST_CASE("the servo step allocates nothing", "[renderer]") {
   cf::Pose p = at(70, 40, 40);
   double t = 0;
   r.step(p, t += 0.001);  // warm-up outside the count
+  const auto given = identification(0, {floor_pc(at(70, 35.5, 40))}, {floor_pc(at(70, 35.5, 40))});
   const long before = g_allocations.load();
   for (int i = 0; i < 3000; ++i) {
     if (i < 450) p.t_BA.y() -= 0.01;                   // land
@@ -275,8 +293,7 @@ TEST_CASE("the servo step allocates nothing", "[renderer]") {
     else p.t_BA.y() += 0.01;                           // lift off the floor
     r.step(p, t += 0.001);
   }
-  const cf::ContactPc c = floor_pc(at(70, 35.5, 40));
-  r.step_identified(at(70, 35.5, 40), t += 0.001, cf::CfId(0), &c, 1, &c, 1);
+  r.step_identified(at(70, 35.5, 40), t += 0.001, *given);
   CHECK(g_allocations.load() - before == 0);
 }
 

@@ -58,17 +58,11 @@ class HapticRenderer {
   /// One servo tick at time t_s (s, increasing) and pose of A. No heap allocation.
   const HapticResult& step(const Pose& pose, double t_s);
 
-  /// The same without detection: renders given identification results. `cf` is the chosen
-  /// CF (invalid when none fits), `cf_pcs` its PCs, `detected` every candidate contact (used
-  /// for the conservative rendering when no CF fits), `approaching` the contacts within
-  /// epsilon in planes the CF leaves apart (Identification::approaching; eq. (1) only). For
-  /// tests and for applications with their own identification.
-  const HapticResult& step_identified(const Pose& pose, double t_s, CfId cf, const ContactPc* cf_pcs,
-                                      int n_cf, const ContactPc* detected, int n_detected,
-                                      const char* identification = "", const ContactPc* approaching = nullptr,
-                                      int n_approaching = 0);
-
-  /// The same with a CfIdentifier's result (what step() does after identifying).
+  /// The same after identification: renders a CfIdentifier's result (what step() does
+  /// after identifying), or one an application filled itself. It reads `cf` (invalid when
+  /// none fits), `cf_pcs`/`num_cf_pcs` (the CF's PCs), `contacts` (every candidate, for the
+  /// conservative rendering when no CF fits), `approaching`/`num_approaching` (contacts
+  /// within epsilon in planes the CF leaves apart; eq. (1) only) and `status`.
   const HapticResult& step_identified(const Pose& pose, double t_s, const Identification& id);
 
   /// Forgets the history (previous CF, anchors, filters).

@@ -56,18 +56,15 @@ const HapticResult& HapticRenderer::step(const Pose& pose, double t_s) {
   return step_identified(pose, t_s, impl_->ident.step(pose));
 }
 
-const HapticResult& HapticRenderer::step_identified(const Pose& pose, double t_s,
-                                                    const Identification& id) {
-  return step_identified(pose, t_s, id.cf, id.cf_pcs.data(), id.has_cf() ? id.num_cf_pcs : 0,
-                         id.contacts.begin(), id.contacts.size(), to_string(id.status),
-                         id.approaching.data(), id.has_cf() ? id.num_approaching : 0);
-}
-
-const HapticResult& HapticRenderer::step_identified(const Pose& pose, double t_s, CfId cf,
-                                                    const ContactPc* cf_pcs, int n_cf,
-                                                    const ContactPc* detected, int n_detected,
-                                                    const char* identification, const ContactPc* approaching,
-                                                    int n_approaching) {
+const HapticResult& HapticRenderer::step_identified(const Pose& pose, double t_s, const Identification& id) {
+  const CfId cf = id.cf;
+  const ContactPc* cf_pcs = id.cf_pcs.data();
+  const int n_cf = id.has_cf() ? id.num_cf_pcs : 0;
+  const ContactPc* detected = id.contacts.begin();
+  const int n_detected = id.contacts.size();
+  const char* identification = to_string(id.status);
+  const ContactPc* approaching = id.approaching.data();
+  const int n_approaching = id.has_cf() ? id.num_approaching : 0;
   Impl& m = *impl_;
   HapticResult& r = m.result;
   r.t_s = t_s;
