@@ -35,7 +35,6 @@ detail::Leaves leaves_for(const Polyhedron& m) {
 struct ContactDetector::Impl {
   Polyhedron a, b;
   Params all;           // as given (params())
-  DetectionParams prm;  // all.detection
   // The exact tests' tables (exact.hpp): the model pair and the tolerances, built once.
   detail::PairTables tab;
   detail::Bvh bvh_a, bvh_b;
@@ -91,7 +90,7 @@ struct ContactDetector::Impl {
   detail::FinishScratch finish_scratch;
 
   Impl(const Polyhedron& ma, const Polyhedron& mb, const Params& params_in)
-      : a(ma), b(mb), all(params_in), prm(params_in.detection),
+      : a(ma), b(mb), all(params_in),
         tab(a, b, params_in, 0.5 * (ma.bbox_min() + ma.bbox_max())), cheap(tab), scratch(tab), posed(a) {
     const double eps = tab.eps, depth = tab.depth, in_plane = tab.in_plane;
     bvh_a = detail::Bvh(ma, 0.0, 1, tab.origin_A, leaves_for(ma));
@@ -110,7 +109,7 @@ struct ContactDetector::Impl {
       a_elem.resize(bvh_a.elements().size());
       for (const Vertex& v : ma.vertices()) a_vert.emplace_back() << (v.p - bvh_a.origin()).cast<float>(), 0.0f;
       a_vert_posed.resize(ma.num_vertices());
-      if (prm.use_bvh && prm.reuse_margin_mm > 0) kept.enable();
+      if (tab.prm.use_bvh && tab.prm.reuse_margin_mm > 0) kept.enable();
     } else {
       a_box.resize(bvh_a.nodes().size());
     }
@@ -118,8 +117,8 @@ struct ContactDetector::Impl {
     finishing.a = &a;
     finishing.b = &b;
     finishing.epsilon_mm = eps;
-    finishing.dominance_fit = prm.dominance_fit;
-    finishing.dominance_penalty = prm.dominance_penalty;
+    finishing.dominance_fit = tab.prm.dominance_fit;
+    finishing.dominance_penalty = tab.prm.dominance_penalty;
     finishing.cos_plane_tolerance = tab.cos_max_tol;
     finishing.small_indices = std::max({ma.num_vertices(), ma.num_edges(), ma.num_faces(), mb.num_vertices(),
                                         mb.num_edges(), mb.num_faces()}) < kKeyIndices;
@@ -299,7 +298,7 @@ struct ContactDetector::Impl {
     cs.clear();
     pairs = 0;
     ++posed.stamp;  // 64 bits: never wraps, so the per-pose caches need no reset
-    if (!prm.use_bvh) {
+    if (!tab.prm.use_bvh) {
       pairs = detail::detect_all_pairs(tab, posed, scratch, cs);  // the reference (all_pairs.hpp)
       detail::finish_contacts(finishing, finish_scratch, cs);
       out = nullptr;
@@ -322,7 +321,7 @@ struct ContactDetector::Impl {
     grow = 0;
     recording = false;
     if (kept.enabled()) {
-      switch (kept.start(tab, pose, prm.reuse_margin_mm)) {
+      switch (kept.start(tab, pose, tab.prm.reuse_margin_mm)) {
         case detail::KeptPairs::Mode::kServe:
           // The kept pairs whose certificates do not hold go through the cheap rejections and
           // the exact test. Not through the element boxes: with the certificates, posing A's
@@ -340,7 +339,7 @@ struct ContactDetector::Impl {
           return;
         case detail::KeptPairs::Mode::kRecord:
           recording = true;
-          grow = static_cast<float>(prm.reuse_margin_mm);
+          grow = static_cast<float>(tab.prm.reuse_margin_mm);
           posed.certifying = true;
           break;
         case detail::KeptPairs::Mode::kOff:
