@@ -5,6 +5,7 @@
 // servo loop's trajectory (where pairs kept between nearby poses serve; "Cold" without
 // them). Each benchmark times every call itself and reports the median and the 99.9th
 // percentile as counters (median_us, p999_us).
+#include <cf/detector.hpp>
 #include <cf/identifier.hpp>
 
 #include "runtime_models.hpp"

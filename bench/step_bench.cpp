@@ -12,6 +12,7 @@
 // minimum of each tick over replays of the trajectory from reset()); see below.
 
 #include "runtime_models.hpp"
+#include "trajectories.hpp"
 
 #include <cf/detector.hpp>
 #include <cf/force.hpp>
@@ -32,36 +33,9 @@
 
 namespace {
 
-struct Tick {
-  double t;
-  cf::Pose pose;
-};
+using Tick = cf::testdata::Tick;
 
-std::vector<Tick> load_ticks() {
-  std::vector<Tick> out;
-  double t_off = 0;
-  for (const char* name : {"guarded", "slide", "corner", "rotate", "break"}) {
-    std::ifstream in(std::string(CF_SOURCE_DIR) + "/data/trajectories/cube_lblock_" + name + ".csv");
-    std::string line;
-    std::getline(in, line);  // header
-    double last = 0;
-    while (std::getline(in, line)) {
-      double v[8];
-      char c;
-      std::istringstream ss(line);
-      ss >> v[0];
-      for (int i = 1; i < 8; ++i) ss >> c >> v[i];
-      Tick k;
-      k.t = t_off + v[0];
-      k.pose.t_BA = {v[1], v[2], v[3]};
-      k.pose.R_BA = Eigen::Quaterniond(v[4], v[5], v[6], v[7]).normalized().toRotationMatrix();
-      out.push_back(k);
-      last = k.t;
-    }
-    t_off = last + 0.001;
-  }
-  return out;
-}
+std::vector<Tick> load_ticks() { return cf::testdata::cube_lblock_ticks(CF_SOURCE_DIR); }
 
 std::unique_ptr<cf::CfGraph> load_graph(std::string* which) {
   const char* env = std::getenv("CF_STEP_BENCH_GRAPH");
@@ -107,14 +81,14 @@ void BM_ServoStep(benchmark::State& state) {
   for (auto _ : state) {
     const Tick& k = ticks[i];
     const auto a = std::chrono::steady_clock::now();
-    const cf::HapticResult& r = renderer.step(k.pose, t_base + k.t);
+    const cf::HapticResult& r = renderer.step(k.X_WA, t_base + k.t_s);
     const auto b = std::chrono::steady_clock::now();
     benchmark::DoNotOptimize(r.F_W.data());
     contact_ticks += r.status != cf::RenderStatus::kNoContact;
     if (ns.size() < ns.capacity()) ns.push_back(std::chrono::duration<double, std::nano>(b - a).count());
     if (++i == ticks.size()) {
       i = 0;
-      t_base += ticks.back().t + 0.001;
+      t_base += ticks.back().t_s + 0.001;
     }
   }
   report(state, ns);
@@ -134,7 +108,7 @@ void BM_DetectOnly(benchmark::State& state) {
   std::size_t i = 0;
   for (auto _ : state) {
     const auto a = std::chrono::steady_clock::now();
-    det.detect(ticks[i].pose, *set);
+    det.detect(ticks[i].X_WA, *set);
     const auto b = std::chrono::steady_clock::now();
     benchmark::DoNotOptimize(set->size());
     if (ns.size() < ns.capacity()) ns.push_back(std::chrono::duration<double, std::nano>(b - a).count());
@@ -260,7 +234,7 @@ void BM_ServoStepIntrinsic(benchmark::State& state) {
       const Tick& k = ticks[i];
       TickRecord& t = rec[i];
       const auto a = std::chrono::steady_clock::now();
-      const cf::HapticResult& r = full.step(k.pose, k.t);
+      const cf::HapticResult& r = full.step(k.X_WA, k.t_s);
       const auto b = std::chrono::steady_clock::now();
       benchmark::DoNotOptimize(r.F_W.data());
       t.full_ns = std::min(t.full_ns, elapsed_ns(a, b));
@@ -284,11 +258,11 @@ void BM_ServoStepIntrinsic(benchmark::State& state) {
       const Tick& k = ticks[i];
       TickRecord& t = rec[i];
       auto a = std::chrono::steady_clock::now();
-      const cf::Identification& id = ident.step(k.pose);
+      const cf::Identification& id = ident.step(k.X_WA);
       auto b = std::chrono::steady_clock::now();
       t.ident_ns = std::min(t.ident_ns, elapsed_ns(a, b));
       a = std::chrono::steady_clock::now();
-      const cf::HapticResult& r = split.step_identified(k.pose, k.t, id);
+      const cf::HapticResult& r = split.step_identified(k.X_WA, k.t_s, id);
       b = std::chrono::steady_clock::now();
       t.force_ns = std::min(t.force_ns, elapsed_ns(a, b));
       nondet += !(t.F_W == r.F_W);
@@ -298,7 +272,7 @@ void BM_ServoStepIntrinsic(benchmark::State& state) {
     for (std::size_t i = 0; i < ticks.size(); ++i) {
       TickRecord& t = rec[i];
       const auto a = std::chrono::steady_clock::now();
-      det.detect(ticks[i].pose, *set);
+      det.detect(ticks[i].X_WA, *set);
       const auto b = std::chrono::steady_clock::now();
       benchmark::DoNotOptimize(set->size());
       t.detect_ns = std::min(t.detect_ns, elapsed_ns(a, b));
@@ -330,7 +304,7 @@ void BM_ServoStepIntrinsic(benchmark::State& state) {
          "combinations,freedom_rows,pairs_tested\n";
     for (std::size_t i = 0; i < rec.size(); ++i) {
       const TickRecord& t = rec[i];
-      f << i << ',' << ticks[i].t << ',' << t.full_ns << ',' << t.ident_ns << ',' << t.force_ns << ','
+      f << i << ',' << ticks[i].t_s << ',' << t.full_ns << ',' << t.ident_ns << ',' << t.force_ns << ','
         << t.detect_ns << ',' << t.cf << ',' << cf::to_string(t.motion) << ',' << cf::to_string(t.status) << ','
         << t.ident_status << ',' << t.num_pcs << ',' << t.num_detected << ',' << t.combinations << ','
         << t.freedom_rows << ',' << t.pairs_tested << '\n';

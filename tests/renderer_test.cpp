@@ -233,7 +233,7 @@ TEST_CASE("one parameter tree: epsilon, detection and identification reach the r
   CHECK_THROWS_WITH(cf::HapticRenderer(g, bad), Catch::Contains("parameter reuse_margin_mm must be non-negative"));
   bad = P;
   bad.identification.max_combinations = 0;
-  CHECK_THROWS_WITH(cf::HapticRenderer(g, bad), Catch::Contains("parameter max_combinations must be at least 1"));
+  CHECK_THROWS_WITH(cf::HapticRenderer(g, bad), Catch::Contains("cf::Params: parameter identification.max_combinations must be at least 1, got 0"));
 }
 
 TEST_CASE("a second plane's contact pushes from epsilon on, without a step at its gain", "[renderer]") {

@@ -6,7 +6,6 @@
 /// fit. Bounded time, no heap allocation per step. docs/runtime.md describes the rules.
 
 #include <cf/contact.hpp>
-#include <cf/detector.hpp>
 #include <cf/graph.hpp>
 #include <cf/params.hpp>
 
@@ -58,12 +57,13 @@ struct Identification {
   bool has_cf() const { return cf.valid(); }
 };
 
-/// Identifies the CF at each servo tick. Create one per thread; the graph is shared,
-/// read-only, and must outlive the identifier.
+/// Identifies the CF at each servo tick: cf::detect and cf::identify on its own CfModel and
+/// CfState, the previous CF advancing as cf::classify_motion advances it. Create one per
+/// thread; the graph is shared, read-only, and must outlive the identifier.
 class CfIdentifier {
  public:
   /// Uses `params.epsilon_mm`, `params.detection` and `params.identification`.
-  /// @throws cf::Error when a parameter is out of range (see ContactDetector).
+  /// @throws cf::Error when a parameter is out of range (named in the message).
   explicit CfIdentifier(const CfGraph& graph, const Params& params = {});
   ~CfIdentifier();
   CfIdentifier(CfIdentifier&&) noexcept;
@@ -79,7 +79,6 @@ class CfIdentifier {
   CfId previous() const;
   const Identification& last() const;
   const CfGraph& graph() const;
-  const ContactDetector& detector() const;
 
   struct Impl;
 

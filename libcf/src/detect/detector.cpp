@@ -1,5 +1,7 @@
 #include <cf/detector.hpp>
 
+#include "detect.hpp"
+
 #include "bvh.hpp"
 #include "check.hpp"
 #include "all_pairs.hpp"
@@ -14,7 +16,7 @@
 #include <string>
 #include <vector>
 
-namespace cf {
+namespace cf::detail {
 
 
 // BVH leaves of a model: one element for small models (with bigger leaves, leaf boxes of the
@@ -27,17 +29,59 @@ namespace cf {
 // leaf (on 2,000-face spheres 7% fewer instructions than leaves of 2 elements of any kind,
 // 15% fewer at the paper's epsilon). docs/performance.md has the figures.
 constexpr std::size_t kBigModelElements = 256;
-bool is_big(const Polyhedron& m) { return m.num_vertices() + m.num_edges() + m.num_faces() >= kBigModelElements; }
-detail::Leaves leaves_for(const Polyhedron& m) {
+static bool is_big(const Polyhedron& m) { return m.num_vertices() + m.num_edges() + m.num_faces() >= kBigModelElements; }
+static detail::Leaves leaves_for(const Polyhedron& m) {
   return is_big(m) ? detail::Leaves::kFaceGroups : detail::Leaves::kElements;
 }
 
-struct ContactDetector::Impl {
+// The immutable part: the models, their trees and the exact tests' tables.
+struct DetectModel {
   Polyhedron a, b;
-  Params all;           // as given (params())
+  Params all;  // as given (params())
   // The exact tests' tables (exact.hpp): the model pair and the tolerances, built once.
-  detail::PairTables tab;
-  detail::Bvh bvh_a, bvh_b;
+  PairTables tab;
+  Bvh bvh_a, bvh_b;
+  // A model of kBigModelElements or more: leaves of face groups, each element's own box
+  // tested in the leaf, and nodes tested as oriented boxes too.
+  bool big = false;
+  std::vector<Eigen::Array4f> a_vert;  // mm, A's vertices relative to bvh_a.origin(), A's frame
+  FinishContext finishing;  // what finish_contacts reads (finish.hpp)
+
+  DetectModel(const Polyhedron& ma, const Polyhedron& mb, const Params& params_in)
+      : a(ma), b(mb), all(params_in), tab(a, b, params_in, 0.5 * (ma.bbox_min() + ma.bbox_max())) {
+    const double eps = tab.eps, depth = tab.depth, in_plane = tab.in_plane;
+    bvh_a = Bvh(a, 0.0, 1, tab.origin_A, leaves_for(a));
+    // The boxes are single precision: widen B's by far more than the rounding of the
+    // overlap test's few float operations on coordinates of this scale.
+    const double float_slack = 1e-5 * std::max(tab.reach, 1.0);
+    // B's boxes grow by the deepest band and the in-plane allowance, so that every pair the
+    // exact tests could accept has overlapping boxes.
+    // A pair the tests accept is within max(eps, depth) across the plane and in_plane along
+    // it, so within max(eps, depth, hypot(eps, in_plane)) of B's element.
+    bvh_b = Bvh(b, std::max({eps, depth, std::hypot(eps, in_plane)}) + tab.geo_tol + float_slack, 1, Vec3::Zero(),
+                leaves_for(b));
+    big = is_big(a) || is_big(b);
+    if (big)
+      for (const Vertex& v : a.vertices()) a_vert.emplace_back() << (v.p - bvh_a.origin()).cast<float>(), 0.0f;
+    constexpr std::size_t kKeyIndices = std::size_t{1} << 24;
+    finishing.a = &a;
+    finishing.b = &b;
+    finishing.epsilon_mm = eps;
+    finishing.dominance_fit = tab.prm.dominance_fit;
+    finishing.dominance_penalty = tab.prm.dominance_penalty;
+    finishing.cos_plane_tolerance = tab.cos_max_tol;
+    finishing.small_indices = std::max({a.num_vertices(), a.num_edges(), a.num_faces(), b.num_vertices(),
+                                        b.num_edges(), b.num_faces()}) < kKeyIndices;
+  }
+  DetectModel(const DetectModel&) = delete;  // tab and finishing point into a and b
+  DetectModel& operator=(const DetectModel&) = delete;
+};
+
+// The per-thread part: the caches of the current pose, scratch and the kept pairs. Its
+// methods read the model through `mp`, set by detect().
+struct DetectState {
+  const DetectModel* mp = nullptr;
+
   // A's nodes' (and elements') boxes in B's frame at the current pose (computed on first
   // use per call).
   struct PosedBox {
@@ -56,15 +100,11 @@ struct ContactDetector::Impl {
     std::uint64_t stamp = 0;
   };
   std::vector<PosedElem> a_elem;
-  std::vector<Eigen::Array4f> a_vert;  // mm, A's vertices relative to bvh_a.origin(), A's frame
   struct PosedVertex {
     Eigen::Array4f p;  // mm, B's frame
     std::uint64_t stamp = 0;
   };
   std::vector<PosedVertex> a_vert_posed;
-  // A model of kBigModelElements or more: leaves of face groups, each element's own box
-  // tested in the leaf, and nodes tested as oriented boxes too.
-  bool big = false;
   Mat3 absR = Mat3::Identity();
   detail::CheapRejections cheap;  // cheap.hpp
   Eigen::Matrix3f Rf = Eigen::Matrix3f::Identity(), absRf = Eigen::Matrix3f::Identity();
@@ -85,43 +125,18 @@ struct ContactDetector::Impl {
   detail::KeptPairs kept;
   bool recording = false, reused = false;
   float grow = 0;    // mm, added to A's posed boxes in this call
-  // Finishing the contacts (finish.hpp): what it reads, and its scratch.
-  detail::FinishContext finishing;
-  detail::FinishScratch finish_scratch;
+  detail::FinishScratch finish_scratch;  // finish.hpp
 
-  Impl(const Polyhedron& ma, const Polyhedron& mb, const Params& params_in)
-      : a(ma), b(mb), all(params_in),
-        tab(a, b, params_in, 0.5 * (ma.bbox_min() + ma.bbox_max())), cheap(tab), scratch(tab), posed(a) {
-    const double eps = tab.eps, depth = tab.depth, in_plane = tab.in_plane;
-    bvh_a = detail::Bvh(ma, 0.0, 1, tab.origin_A, leaves_for(ma));
-    // The boxes are single precision: widen B's by far more than the rounding of the
-    // overlap test's few float operations on coordinates of this scale.
-    const double float_slack = 1e-5 * std::max(tab.reach, 1.0);
-    // B's boxes grow by the deepest band and the in-plane allowance, so that every pair the
-    // exact tests could accept has overlapping boxes.
-    // A pair the tests accept is within max(eps, depth) across the plane and in_plane along
-    // it, so within max(eps, depth, hypot(eps, in_plane)) of B's element.
-    bvh_b = detail::Bvh(mb, std::max({eps, depth, std::hypot(eps, in_plane)}) + tab.geo_tol + float_slack, 1, Vec3::Zero(), leaves_for(mb));
-    big = is_big(ma) || is_big(mb);
-    stack.resize(detail::stack_capacity(bvh_a, bvh_b));
-    if (big) {
-      a_wide.resize(bvh_a.wide().size());
-      a_elem.resize(bvh_a.elements().size());
-      for (const Vertex& v : ma.vertices()) a_vert.emplace_back() << (v.p - bvh_a.origin()).cast<float>(), 0.0f;
-      a_vert_posed.resize(ma.num_vertices());
-      if (tab.prm.use_bvh && tab.prm.reuse_margin_mm > 0) kept.enable();
+  explicit DetectState(const DetectModel& m) : cheap(m.tab), scratch(m.tab), posed(m.a) {
+    stack.resize(stack_capacity(m.bvh_a, m.bvh_b));
+    if (m.big) {
+      a_wide.resize(m.bvh_a.wide().size());
+      a_elem.resize(m.bvh_a.elements().size());
+      a_vert_posed.resize(m.a.num_vertices());
+      if (m.tab.prm.use_bvh && m.tab.prm.reuse_margin_mm > 0) kept.enable();
     } else {
-      a_box.resize(bvh_a.nodes().size());
+      a_box.resize(m.bvh_a.nodes().size());
     }
-    constexpr std::size_t kKeyIndices = std::size_t{1} << 24;
-    finishing.a = &a;
-    finishing.b = &b;
-    finishing.epsilon_mm = eps;
-    finishing.dominance_fit = tab.prm.dominance_fit;
-    finishing.dominance_penalty = tab.prm.dominance_penalty;
-    finishing.cos_plane_tolerance = tab.cos_max_tol;
-    finishing.small_indices = std::max({ma.num_vertices(), ma.num_edges(), ma.num_faces(), mb.num_vertices(),
-                                        mb.num_edges(), mb.num_faces()}) < kKeyIndices;
   }
 
   // Small models: does A's BVH node `ia` (posed) overlap B's node? The axis-aligned boxes
@@ -145,9 +160,10 @@ struct ContactDetector::Impl {
 
   // A's vertex v posed, single precision (rounding as in pose_wide).
   const Eigen::Array4f& posed_vertex(VertexId v) {
+    const DetectModel& M = *mp;
     PosedVertex& P = a_vert_posed[v.index()];
     if (P.stamp != posed.stamp) {
-      const Eigen::Array4f& q = a_vert[v.index()];
+      const Eigen::Array4f& q = M.a_vert[v.index()];
       P.p = Rcol[0] * q[0] + Rcol[1] * q[1] + Rcol[2] * q[2] + a_origin;
       P.stamp = posed.stamp;
     }
@@ -156,6 +172,7 @@ struct ContactDetector::Impl {
 
   // A big model's element at position i of its BVH, posed: the box of its posed vertices.
   __attribute__((noinline)) void pose_element(PosedElem& P, int i) {
+    const DetectModel& M = *mp;
     P.stamp = posed.stamp;
     Eigen::Array4f lo = Eigen::Array4f::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
     auto add = [&](VertexId v) {
@@ -163,17 +180,17 @@ struct ContactDetector::Impl {
       lo = lo.min(p);
       hi = hi.max(p);
     };
-    const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(i)];
+    const detail::BvhElement& x = M.bvh_a.elements()[static_cast<std::size_t>(i)];
     switch (x.kind) {
       case ElementKind::kVertex:
         add(VertexId(x.index));
         break;
       case ElementKind::kEdge:
-        add(a.edges()[static_cast<std::size_t>(x.index)].v0);
-        add(a.edges()[static_cast<std::size_t>(x.index)].v1);
+        add(M.a.edges()[static_cast<std::size_t>(x.index)].v0);
+        add(M.a.edges()[static_cast<std::size_t>(x.index)].v1);
         break;
       case ElementKind::kFace:
-        for (VertexId v : a.faces()[static_cast<std::size_t>(x.index)].vertices) add(v);
+        for (VertexId v : M.a.faces()[static_cast<std::size_t>(x.index)].vertices) add(v);
         break;
     }
     P.box.c = 0.5f * (lo + hi);
@@ -182,9 +199,10 @@ struct ContactDetector::Impl {
 
   // Does A's element at position ia of its BVH (posed) overlap B's element at ib?
   bool element_boxes_overlap(int ia, int ib) {
+    const DetectModel& M = *mp;
     PosedElem& P = a_elem[static_cast<std::size_t>(ia)];
     if (P.stamp != posed.stamp) pose_element(P, ia);
-    return !detail::boxes_apart(P.box, bvh_b.element_boxes()[static_cast<std::size_t>(ib)]);
+    return !detail::boxes_apart(P.box, M.bvh_b.element_boxes()[static_cast<std::size_t>(ib)]);
   }
 
   // A's node at the current pose: its box in B's frame.
@@ -205,9 +223,10 @@ struct ContactDetector::Impl {
     return P.box;
   }
   __attribute__((noinline)) void pose_wide(PosedWide& P, std::int32_t w) {
+    const DetectModel& M = *mp;
     using V = Eigen::Array4f;
     P.stamp = posed.stamp;
-    const detail::Box4& N = bvh_a.wide()[static_cast<std::size_t>(w)].box;
+    const detail::Box4& N = M.bvh_a.wide()[static_cast<std::size_t>(w)].box;
     detail::Box4& Q = P.box;
     // Unrolled: at -O2 GCC keeps these loops of 3 and spills the temporaries.
     CF_UNROLL3
@@ -231,18 +250,20 @@ struct ContactDetector::Impl {
   // Elements at positions ia, ib of the two BVHs' element lists, in leaves that overlap
   // where B's leaves hold no element lanes (B small).
   __attribute__((always_inline)) void pair(int ia, int ib) {
-    const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
-    const detail::BvhElement& y = bvh_b.elements()[static_cast<std::size_t>(ib)];
+    const DetectModel& M = *mp;
+    const detail::BvhElement& x = M.bvh_a.elements()[static_cast<std::size_t>(ia)];
+    const detail::BvhElement& y = M.bvh_b.elements()[static_cast<std::size_t>(ib)];
     if (!detail::kinds_can_touch(detail::kind_bit(x.kind), detail::kind_bit(y.kind))) return;
-    if (big && !element_boxes_overlap(ia, ib)) return;
+    if (M.big && !element_boxes_overlap(ia, ib)) return;
     boxed_pair(ia, ib, x, y);
   }
 
   // The cheap rejection and the exact test of a pair, for kept pairs: the certificate of
   // whichever turned it away (none when it passed both).
   __attribute__((always_inline)) Cert certified_test(const detail::BvhElement& x, const detail::BvhElement& y) {
+    const DetectModel& M = *mp;
     Cert c;
-    if (cheap.may_touch<true>(tab, posed, x.kind, x.index, y.kind, y.index, &c)) c = exact(x, y);
+    if (cheap.may_touch<true>(M.tab, posed, x.kind, x.index, y.kind, y.index, &c)) c = exact(x, y);
     return c;
   }
 
@@ -250,15 +271,16 @@ struct ContactDetector::Impl {
   // and whose own boxes overlap. B's face-group leaves hold their element boxes on SIMD
   // lanes: each of A's elements is tested against all of them at once.
   void leaf_pair(const detail::BvhNode& A, const detail::BvhNode& B) {
-    if (bvh_b.leaf_boxes().empty()) {
+    const DetectModel& M = *mp;
+    if (M.bvh_b.leaf_boxes().empty()) {
       for (int i = 0; i < A.count; ++i)
         for (int j = 0; j < B.count; ++j) pair(A.element() + i, B.element() + j);
       return;
     }
-    const detail::LeafBoxes& L = bvh_b.leaf_boxes()[static_cast<std::size_t>(bvh_b.leaf_index(B))];
+    const detail::LeafBoxes& L = M.bvh_b.leaf_boxes()[static_cast<std::size_t>(M.bvh_b.leaf_index(B))];
     for (int i = 0; i < A.count; ++i) {
       const int ia = A.element() + i;
-      const detail::BvhElement& x = bvh_a.elements()[static_cast<std::size_t>(ia)];
+      const detail::BvhElement& x = M.bvh_a.elements()[static_cast<std::size_t>(ia)];
       unsigned lanes = L.touchable_by[static_cast<std::size_t>(x.kind)];
       if (lanes == 0) continue;
       PosedElem& P = a_elem[static_cast<std::size_t>(ia)];
@@ -267,7 +289,7 @@ struct ContactDetector::Impl {
       while (lanes != 0) {
         const int ib = B.element() + __builtin_ctz(lanes);
         lanes &= lanes - 1;
-        boxed_pair(ia, ib, x, bvh_b.elements()[static_cast<std::size_t>(ib)]);
+        boxed_pair(ia, ib, x, M.bvh_b.elements()[static_cast<std::size_t>(ib)]);
       }
     }
   }
@@ -275,9 +297,10 @@ struct ContactDetector::Impl {
   // A pair past the kinds and the boxes.
   __attribute__((always_inline)) void boxed_pair(int ia, int ib, const detail::BvhElement& x,
                                                  const detail::BvhElement& y) {
+    const DetectModel& M = *mp;
     ++pairs;
     if (!recording) {
-      if (cheap.may_touch<false>(tab, posed, x.kind, x.index, y.kind, y.index, nullptr)) exact(x, y);
+      if (cheap.may_touch<false>(M.tab, posed, x.kind, x.index, y.kind, y.index, nullptr)) exact(x, y);
       return;
     }
     kept.record(ia, ib, certified_test(x, y));
@@ -286,21 +309,23 @@ struct ContactDetector::Impl {
   // The exact test of a pair (exact.hpp): its contact goes to the output; returns the
   // certificate of a pair turned away.
   __attribute__((always_inline)) Cert exact(const detail::BvhElement& x, const detail::BvhElement& y) {
-    detail::PairOutcome o = detail::exact_test(tab, posed, scratch, x.kind, x.index, y.kind, y.index);
+    const DetectModel& M = *mp;
+    detail::PairOutcome o = detail::exact_test(M.tab, posed, scratch, x.kind, x.index, y.kind, y.index);
     if (o.contact) out->push(*o.contact);
     return o.cert;
   }
 
-  void detect(const Pose& p, ContactSet& cs) {
+  void detect(const DetectModel& M, const Pose& p, ContactSet& cs) {
+    mp = &M;
     posed.pose = p;
     const Pose& pose = posed.pose;
     out = &cs;
     cs.clear();
     pairs = 0;
     ++posed.stamp;  // 64 bits: never wraps, so the per-pose caches need no reset
-    if (!tab.prm.use_bvh) {
-      pairs = detail::detect_all_pairs(tab, posed, scratch, cs);  // the reference (all_pairs.hpp)
-      detail::finish_contacts(finishing, finish_scratch, cs);
+    if (!M.tab.prm.use_bvh) {
+      pairs = detail::detect_all_pairs(M.tab, posed, scratch, cs);  // the reference (all_pairs.hpp)
+      detail::finish_contacts(M.finishing, finish_scratch, cs);
       out = nullptr;
       return;
     }
@@ -308,9 +333,9 @@ struct ContactDetector::Impl {
     Rf = pose.R_BA.cast<float>();
     absRf = absR.cast<float>();
     for (int k = 0; k < 3; ++k) Rcol[k] << Rf.col(k), 0.0f;
-    posed.origin_posed = pose.apply(bvh_a.origin());
+    posed.origin_posed = pose.apply(M.bvh_a.origin());
     a_origin << posed.origin_posed.cast<float>(), 0.0f;
-    for (int i = 0; i < 3 && big; ++i) {
+    for (int i = 0; i < 3 && M.big; ++i) {
       for (int k = 0; k < 3; ++k) {
         Rb[i][k].setConstant(Rf(i, k));
         absRb[i][k].setConstant(absRf(i, k));
@@ -321,25 +346,25 @@ struct ContactDetector::Impl {
     grow = 0;
     recording = false;
     if (kept.enabled()) {
-      switch (kept.start(tab, pose, tab.prm.reuse_margin_mm)) {
+      switch (kept.start(M.tab, pose, M.tab.prm.reuse_margin_mm)) {
         case detail::KeptPairs::Mode::kServe:
           // The kept pairs whose certificates do not hold go through the cheap rejections and
           // the exact test. Not through the element boxes: with the certificates, posing A's
           // elements for them cost more than the boxes saved (5% more instructions).
           reused = true;
           posed.certifying = true;
-          kept.serve([this](int ia, int ib) {
+          kept.serve([this, &M](int ia, int ib) {
             ++pairs;
-            return certified_test(bvh_a.elements()[static_cast<std::size_t>(ia)],
-                                  bvh_b.elements()[static_cast<std::size_t>(ib)]);
+            return certified_test(M.bvh_a.elements()[static_cast<std::size_t>(ia)],
+                                  M.bvh_b.elements()[static_cast<std::size_t>(ib)]);
           });
           posed.certifying = false;
-          detail::finish_contacts(finishing, finish_scratch, cs);
+          detail::finish_contacts(M.finishing, finish_scratch, cs);
           out = nullptr;
           return;
         case detail::KeptPairs::Mode::kRecord:
           recording = true;
-          grow = static_cast<float>(tab.prm.reuse_margin_mm);
+          grow = static_cast<float>(M.tab.prm.reuse_margin_mm);
           posed.certifying = true;
           break;
         case detail::KeptPairs::Mode::kOff:
@@ -349,34 +374,59 @@ struct ContactDetector::Impl {
     // The stack is sized for the trees' depths, so the descents cannot overflow it.
     const auto leaves = [this](const detail::BvhNode& A, const detail::BvhNode& B) { leaf_pair(A, B); };
     const bool complete =
-        big ? detail::descend_wide(
-                  bvh_a, bvh_b,
+        M.big ? detail::descend_wide(
+                  M.bvh_a, M.bvh_b,
                   [this](std::int32_t w) -> const detail::Box4& { return posed_wide(w); },
                   stack.data(), stack.size(), leaves)
             : detail::descend(
-                  bvh_a, bvh_b,
+                  M.bvh_a, M.bvh_b,
                   [this](std::int32_t ia, std::int32_t, const detail::BvhNode& A,
                          const detail::BvhNode& B) { return overlap(ia, A, B); },
                   stack.data(), stack.size(), leaves);
     CF_DEMAND(complete);
     if (recording) kept.finish_recording(pose);
     recording = posed.certifying = false;
-    detail::finish_contacts(finishing, finish_scratch, cs);
+    detail::finish_contacts(M.finishing, finish_scratch, cs);
     out = nullptr;
   }
 };
 
+void DetectModelDelete::operator()(const DetectModel* m) const { delete m; }
+void DetectStateDelete::operator()(DetectState* s) const { delete s; }
+DetectModelPtr make_detect_model(const Polyhedron& a, const Polyhedron& b, const Params& params) {
+  return DetectModelPtr(new DetectModel(a, b, params));
+}
+DetectStatePtr make_detect_state(const DetectModel& m) { return DetectStatePtr(new DetectState(m)); }
+void detect(const DetectModel& m, DetectState& s, const Pose& pose, ContactSet& out) { s.detect(m, pose, out); }
+const Params& params_of(const DetectModel& m) { return m.all; }
+const Polyhedron& model_a_of(const DetectModel& m) { return m.a; }
+const Polyhedron& model_b_of(const DetectModel& m) { return m.b; }
+std::size_t pairs_tested(const DetectState& s) { return s.pairs; }
+bool reused_pairs(const DetectState& s) { return s.reused; }
+
+}  // namespace cf::detail
+
+namespace cf {
+
+struct ContactDetector::Impl {
+  detail::DetectModelPtr model;
+  detail::DetectStatePtr state;
+};
+
 ContactDetector::ContactDetector(const Polyhedron& a, const Polyhedron& b, const Params& params)
-    : impl_(std::make_unique<Impl>(a, b, params)) {}
+    : impl_(std::make_unique<Impl>()) {
+  impl_->model = detail::make_detect_model(a, b, params);
+  impl_->state = detail::make_detect_state(*impl_->model);
+}
 ContactDetector::~ContactDetector() = default;
 ContactDetector::ContactDetector(ContactDetector&&) noexcept = default;
 ContactDetector& ContactDetector::operator=(ContactDetector&&) noexcept = default;
 
-void ContactDetector::detect(const Pose& pose, ContactSet& out) { impl_->detect(pose, out); }
-const Params& ContactDetector::params() const { return impl_->all; }
-const Polyhedron& ContactDetector::model_a() const { return impl_->a; }
-const Polyhedron& ContactDetector::model_b() const { return impl_->b; }
-std::size_t ContactDetector::last_pairs_tested() const { return impl_->pairs; }
-bool ContactDetector::last_reused_pairs() const { return impl_->reused; }
+void ContactDetector::detect(const Pose& pose, ContactSet& out) { detail::detect(*impl_->model, *impl_->state, pose, out); }
+const Params& ContactDetector::params() const { return detail::params_of(*impl_->model); }
+const Polyhedron& ContactDetector::model_a() const { return detail::model_a_of(*impl_->model); }
+const Polyhedron& ContactDetector::model_b() const { return detail::model_b_of(*impl_->model); }
+std::size_t ContactDetector::last_pairs_tested() const { return detail::pairs_tested(*impl_->state); }
+bool ContactDetector::last_reused_pairs() const { return detail::reused_pairs(*impl_->state); }
 
 }  // namespace cf

@@ -1,5 +1,8 @@
 #include <cf/identifier.hpp>
 
+#include "identify.hpp"
+#include "../check.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -71,11 +74,13 @@ bool closures_meet(const Polyhedron& m, ElementKind ki, int i, ElementKind kj, i
 
 }  // namespace
 
-struct CfIdentifier::Impl {
-  const CfGraph* graph;
+namespace detail {
+
+struct IdentifyScratch {
+  // Set per call by identify().
+  const CfGraph* graph = nullptr;
   IdentificationParams prm;
-  ContactDetector detector;
-  Identification res;
+  Identification* res = nullptr;
   CfId prev;
   // Per step scratch (fixed size).
   std::array<std::array<std::int16_t, ContactSet::kCapacity>, kMaxGroups> members{};
@@ -93,9 +98,6 @@ struct CfIdentifier::Impl {
   };
   static constexpr std::size_t kHeldMemo = 1024;
   std::array<HeldEntry, kHeldMemo> held_memo{};
-
-  Impl(const CfGraph& g, const Params& p)
-      : graph(&g), prm(p.identification), detector(g.model_a(), g.model_b(), p) {}
 
   bool holds(const Pc& pc) {
     const std::uint64_t k = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(pc.a)) << 34) ^
@@ -123,7 +125,7 @@ struct CfIdentifier::Impl {
   // Returns 0 when every contact is apart, 1 when some need explaining, 2 when one is
   // neither.
   int accounted(int g, const int* chosen, int nchosen, double apart_beyond) const {
-    const ContactSet& cs = res.contacts;
+    const ContactSet& cs = res->contacts;
     int worst = 0;
     for (int k = 0; k < count[static_cast<std::size_t>(g)]; ++k) {
       const ContactPc& c = cs[members[static_cast<std::size_t>(g)][static_cast<std::size_t>(k)]];
@@ -156,7 +158,7 @@ struct CfIdentifier::Impl {
   // False when a skipped plane is not accounted for, when its tier is worse than
   // `tier_bound`, or when no CF has this PC set.
   bool rank(const int* chosen, int n, const bool* taken, int G, int tier_bound, Ranked& r) const {
-    const ContactSet& cs = res.contacts;
+    const ContactSet& cs = res->contacts;
     r.partial = n < G;
     double farthest = 0;
     for (int i = 0; i < n; ++i) farthest = std::max(farthest, cs[chosen[i]].distance);
@@ -186,7 +188,7 @@ struct CfIdentifier::Impl {
   // the enumeration would end on it anyway (it is one interpretation), so it is the result.
   bool try_previous(int G) {
     if (!prev.valid()) return false;
-    const ContactSet& cs = res.contacts;
+    const ContactSet& cs = res->contacts;
     const PcSet& want = graph->cf(prev).pcs;
     int chosen[3];
     int n = 0;
@@ -203,21 +205,21 @@ struct CfIdentifier::Impl {
     }
     Ranked r;
     if (!rank(chosen, n, taken.data(), G, 0, r) || !r.unbeatable()) return false;
-    res.combinations = 1;
+    res->combinations = 1;
     set_result(IdStatus::kMatchedPrevious, r.id, chosen, n, r.misfit, r.partial);
     return true;
   }
 
   void set_result(IdStatus st, CfId id, const int* chosen, int n, double misfit, bool partial) {
     // The planes the CF leaves apart: their nearest contacts approach.
-    const ContactSet& cs = res.contacts;
+    const ContactSet& cs = res->contacts;
     double farthest = 0;
     std::array<bool, kMaxGroups> held{};
     for (int i = 0; i < n; ++i) {
       farthest = std::max(farthest, cs[chosen[i]].distance);
       held[static_cast<std::size_t>(cs[chosen[i]].plane)] = true;
     }
-    res.num_approaching = 0;
+    res->num_approaching = 0;
     for (int g = 0; g < cs.num_planes() && partial; ++g) {
       if (held[static_cast<std::size_t>(g)] || accounted(g, chosen, n, farthest + prm.touch_distance_mm) != 0) continue;
       int best = -1;
@@ -225,41 +227,39 @@ struct CfIdentifier::Impl {
         const int i = members[static_cast<std::size_t>(g)][static_cast<std::size_t>(k)];
         if (best < 0 || cs[i].distance < cs[best].distance) best = i;
       }
-      if (best >= 0 && res.num_approaching < static_cast<int>(res.approaching.size()))
-        res.approaching[static_cast<std::size_t>(res.num_approaching++)] = cs[best];
+      if (best >= 0 && res->num_approaching < static_cast<int>(res->approaching.size()))
+        res->approaching[static_cast<std::size_t>(res->num_approaching++)] = cs[best];
     }
-    res.status = st;
-    res.cf = id;
-    res.misfit = misfit;
-    res.partial_cover = partial;
-    res.pcs = PcSet();
-    for (int i = 0; i < n; ++i) res.pcs.insert(res.contacts[chosen[i]].pc);
-    res.num_cf_pcs = 0;
-    for (const Pc& pc : res.pcs)
+    res->status = st;
+    res->cf = id;
+    res->misfit = misfit;
+    res->partial_cover = partial;
+    res->pcs = PcSet();
+    for (int i = 0; i < n; ++i) res->pcs.insert(res->contacts[chosen[i]].pc);
+    res->num_cf_pcs = 0;
+    for (const Pc& pc : res->pcs)
       for (int i = 0; i < n; ++i)
-        if (res.contacts[chosen[i]].pc == pc) res.cf_pcs[static_cast<std::size_t>(res.num_cf_pcs++)] = res.contacts[chosen[i]];
+        if (res->contacts[chosen[i]].pc == pc) res->cf_pcs[static_cast<std::size_t>(res->num_cf_pcs++)] = res->contacts[chosen[i]];
   }
 
-  const Identification& step(const Pose& pose) {
-    ContactSet& cs = res.contacts;
-    detector.detect(pose, cs);
-    res.combinations = 0;
-    res.capped = false;
-    res.num_cf_pcs = 0;
-    res.pcs = PcSet();
-    res.cf = CfId();
-    res.misfit = 0;
-    res.partial_cover = false;
-    res.num_approaching = 0;
+  void run() {
+    const ContactSet& cs = res->contacts;
+    res->combinations = 0;
+    res->capped = false;
+    res->num_cf_pcs = 0;
+    res->pcs = PcSet();
+    res->cf = CfId();
+    res->misfit = 0;
+    res->partial_cover = false;
+    res->num_approaching = 0;
     if (cs.empty()) {
-      res.status = IdStatus::kNoContact;
-      prev = CfId();
-      return res;
+      res->status = IdStatus::kNoContact;
+      return;
     }
     const int G = cs.num_planes();
     if (G > kMaxGroups) {
-      res.status = IdStatus::kTooManyPlanes;
-      return res;
+      res->status = IdStatus::kTooManyPlanes;
+      return;
     }
     // Members of each plane, best fit first (ties: canonical PC order, as detected).
     count.fill(0);
@@ -285,7 +285,7 @@ struct CfIdentifier::Impl {
       for (int i = 0; i < count[static_cast<std::size_t>(g)]; ++i)
         if (holds(cs[m[static_cast<std::size_t>(i)]].pc)) c[static_cast<std::size_t>(nc++)] = m[static_cast<std::size_t>(i)];
     }
-    if (try_previous(G)) return res;
+    if (try_previous(G)) return;
 
     // Enumerate one choosable member or none per plane (none last), at most 3 chosen, every
     // skipped plane accounted for (apart or explained). Rank: no plane left to an
@@ -304,7 +304,7 @@ struct CfIdentifier::Impl {
     const long walk_cap = 16L * prm.max_combinations;
     for (;;) {
       if (++walk > walk_cap) {
-        res.capped = true;
+        res->capped = true;
         break;
       }
       int chosen[3];
@@ -319,11 +319,11 @@ struct CfIdentifier::Impl {
         }
       }
       if (!too_many && n > 0) {
-        if (res.combinations >= prm.max_combinations) {
-          res.capped = true;
+        if (res->combinations >= prm.max_combinations) {
+          res->capped = true;
           break;
         }
-        ++res.combinations;
+        ++res->combinations;
         Ranked r;
         if (rank(chosen, n, taken.data(), G, best.tier, r) && r.better_than(best)) {
           best = r;
@@ -342,36 +342,40 @@ struct CfIdentifier::Impl {
     const double best_misfit = best.misfit;
     const int best_cat = best.cat;
     if (!best_id.valid()) {
-      res.status = G > 3 ? IdStatus::kTooManyPlanes : IdStatus::kOutsideGraph;
-      return res;
+      res->status = G > 3 ? IdStatus::kTooManyPlanes : IdStatus::kOutsideGraph;
+      return;
     }
     IdStatus st = best_cat == 0   ? IdStatus::kMatchedPrevious
                   : best_cat == 1 ? IdStatus::kMatchedNeighbour
                   : prev.valid()  ? IdStatus::kNonNeighbourJump
                                   : IdStatus::kMatchedByFit;
     set_result(st, best_id, best_chosen, best_n, best_misfit, best_partial);
-    prev = best_id;
-    return res;
   }
 };
 
-CfIdentifier::CfIdentifier(const CfGraph& graph, const Params& params)
-    : impl_(std::make_unique<Impl>(graph, params)) {
-  if (params.identification.max_combinations < 1)
-    throw Error("CfIdentifier: parameter max_combinations must be at least 1, got " +
-                std::to_string(params.identification.max_combinations));
-  if (!std::isfinite(params.identification.touch_distance_mm) || params.identification.touch_distance_mm < 0)
-    throw Error("CfIdentifier: parameter touch_distance_mm must be finite and non-negative, got " +
-                std::to_string(params.identification.touch_distance_mm));
+
+void IdentifyScratchDelete::operator()(IdentifyScratch* s) const { delete s; }
+IdentifyScratchPtr make_identify_scratch() { return IdentifyScratchPtr(new IdentifyScratch()); }
+
+void identify(const CfGraph& graph, const IdentificationParams& params, CfId previous, IdentifyScratch& s,
+              Identification& id) {
+  s.graph = &graph;
+  s.prm = params;
+  s.res = &id;
+  s.prev = previous;
+  s.run();
+  s.res = nullptr;
 }
-CfIdentifier::~CfIdentifier() = default;
-CfIdentifier::CfIdentifier(CfIdentifier&&) noexcept = default;
-CfIdentifier& CfIdentifier::operator=(CfIdentifier&&) noexcept = default;
-const Identification& CfIdentifier::step(const Pose& pose) { return impl_->step(pose); }
-void CfIdentifier::reset() { impl_->prev = CfId(); }
-CfId CfIdentifier::previous() const { return impl_->prev; }
-const Identification& CfIdentifier::last() const { return impl_->res; }
-const CfGraph& CfIdentifier::graph() const { return *impl_->graph; }
-const ContactDetector& CfIdentifier::detector() const { return impl_->detector; }
+
+void check_identification_params(const IdentificationParams& params) {
+  if (params.max_combinations < 1)
+    throw Error("cf::Params: parameter identification.max_combinations must be at least 1, got " +
+                std::to_string(params.max_combinations));
+  if (!std::isfinite(params.touch_distance_mm) || params.touch_distance_mm < 0)
+    throw Error("cf::Params: parameter identification.touch_distance_mm must be finite and non-negative, got " +
+                std::to_string(params.touch_distance_mm));
+}
+
+}  // namespace detail
 
 }  // namespace cf

@@ -1,0 +1,229 @@
+// The servo tick as stages over an immutable model and a per-thread state (SPEC section 6),
+// and the two objects that hold a model and a state: HapticRenderer and CfIdentifier.
+
+#include <cf/identifier.hpp>
+#include <cf/renderer.hpp>
+#include <cf/servo.hpp>
+
+#include "servo_impl.hpp"
+
+#include "../check.hpp"
+
+#include <algorithm>
+#include <array>
+#include <optional>
+
+namespace cf {
+
+const char* to_string(RenderStatus status) {
+  switch (status) {
+    case RenderStatus::kNoContact:
+      return "no_contact";
+    case RenderStatus::kOk:
+      return "ok";
+    case RenderStatus::kNoFittingCf:
+      return "no_fitting_cf";
+    case RenderStatus::kUnlistedTransition:
+      return "unlisted_transition";
+  }
+  return "ok";
+}
+
+// ---- CfModel, CfState ----
+
+CfModel::Impl::Impl(const CfGraph& g, const Params& p)
+    : graph(&g), params(p), detect(detail::make_detect_model(g.model_a(), g.model_b(), p)) {
+  detail::check_identification_params(p.identification);
+}
+
+CfModel::CfModel(const CfGraph& graph, const Params& params)
+    : impl_(std::make_unique<const Impl>(graph, params)) {}
+CfModel::~CfModel() = default;
+CfModel::CfModel(CfModel&&) noexcept = default;
+CfModel& CfModel::operator=(CfModel&&) noexcept = default;
+const CfGraph& CfModel::graph() const { return *impl_->graph; }
+const Params& CfModel::params() const { return impl_->params; }
+const Polyhedron& CfModel::model_a() const { return impl_->graph->model_a(); }
+const Polyhedron& CfModel::model_b() const { return impl_->graph->model_b(); }
+
+CfState::Impl::Impl(const CfModel::Impl& m)
+    : model(&m),
+      detect(detail::make_detect_state(*m.detect)),
+      identify(detail::make_identify_scratch()),
+      force(m.graph->model_a(), m.graph->model_b(), m.params) {}
+
+CfState::CfState(const CfModel& model)
+    : impl_(std::make_unique<Impl>(internal::Access::get(model))) {}
+CfState::~CfState() = default;
+CfState::CfState(CfState&&) noexcept = default;
+CfState& CfState::operator=(CfState&&) noexcept = default;
+
+void CfState::reset() {
+  impl_->force.reset();
+  impl_->previous = CfId();
+  impl_->result = HapticResult();
+}
+CfId CfState::previous() const { return impl_->previous; }
+const ContactSet& CfState::contacts() const { return impl_->id.contacts; }
+const Identification& CfState::identification() const { return impl_->id; }
+const HapticResult& CfState::result() const { return impl_->result; }
+std::size_t CfState::last_pairs_tested() const { return detail::pairs_tested(*impl_->detect); }
+bool CfState::last_reused_pairs() const { return detail::reused_pairs(*impl_->detect); }
+
+// ---- the stages ----
+
+namespace {
+
+// The state's own part, checked to belong to the model (a comparison: stays on in Release).
+CfState::Impl& state_of(const CfModel::Impl& m, CfState& state, const char* stage) {
+  CfState::Impl& s = internal::Access::get(state);
+  CF_REQUIRE(s.model == &m,
+             std::string("cf::") + stage + ": the CfState was made for another CfModel");
+  return s;
+}
+
+}  // namespace
+
+const ContactSet& detect(const CfModel& model, CfState& state, const Pose& X_WA) {
+  const CfModel::Impl& m = internal::Access::get(model);
+  CfState::Impl& s = state_of(m, state, "detect");
+  detail::detect(*m.detect, *s.detect, X_WA, s.id.contacts);
+  return s.id.contacts;
+}
+
+const Identification& identify(const CfModel& model, CfState& state, const ContactSet& contacts) {
+  const CfModel::Impl& m = internal::Access::get(model);
+  CfState::Impl& s = state_of(m, state, "identify");
+  if (&contacts != &s.id.contacts) s.id.contacts = contacts;
+  detail::identify(*m.graph, m.params.identification, s.previous, *s.identify, s.id);
+  return s.id;
+}
+
+PriorMotion classify_motion(const CfModel& model, CfState& state, const Identification& id) {
+  const CfModel::Impl& m = internal::Access::get(model);
+  CfState::Impl& s = state_of(m, state, "classify_motion");
+  PriorMotion pm;
+  if (id.has_cf() && id.num_cf_pcs > 0) {
+    PcSet cur;
+    for (int i = 0; i < std::min(id.num_cf_pcs, PcSet::kMaxPcs); ++i)
+      cur.insert(id.cf_pcs[static_cast<std::size_t>(i)].pc);
+    const PcSet prev = s.previous.valid() ? m.graph->cf(s.previous).pcs : PcSet();
+    pm = classify_prior_motion(prev, cur, m.graph, s.previous, id.cf);
+  }
+  s.previous = detail::next_previous(s.previous, id);
+  return pm;
+}
+
+const HapticResult& compute_force(const CfModel& model, CfState& state, const Pose& X_WA,
+                                  double t_s, const Identification& id, const PriorMotion& motion) {
+  const CfModel::Impl& m = internal::Access::get(model);
+  CfState::Impl& s = state_of(m, state, "compute_force");
+  HapticResult& r = s.result;
+  const ContactPc* detected = id.contacts.begin();
+  const int n_detected = id.contacts.size();
+  r.t_s = t_s;
+  r.identification = to_string(id.status);
+  r.num_detected = n_detected;
+  r.pcs = PcSet();
+  r.cf = CfId();
+  const ForceResult* fr = nullptr;
+  if (id.has_cf() && id.num_cf_pcs > 0) {
+    // Canonical order, so that PriorMotion::gained indexes the rendered array.
+    const int n = std::min(id.num_cf_pcs, PcSet::kMaxPcs);
+    std::copy(id.cf_pcs.begin(), id.cf_pcs.begin() + n, s.ordered.begin());
+    std::sort(s.ordered.begin(), s.ordered.begin() + n,
+              [](const ContactPc& a, const ContactPc& b) { return a.pc < b.pc; });
+    r.cf = id.cf;
+    for (int i = 0; i < n; ++i) r.pcs.insert(s.ordered[static_cast<std::size_t>(i)].pc);
+    if (motion.transition_in_graph) {
+      r.status = RenderStatus::kOk;
+      fr = &s.force.step(X_WA, t_s, s.ordered.data(), n, motion, false, id.approaching.data(),
+                         id.num_approaching);
+    } else {
+      r.status = RenderStatus::kUnlistedTransition;
+      const bool have_detected = n_detected > 0;
+      fr = &s.force.step(X_WA, t_s, have_detected ? detected : s.ordered.data(),
+                         have_detected ? n_detected : n, motion, true);
+    }
+  } else if (n_detected > 0) {
+    r.status = RenderStatus::kNoFittingCf;
+    fr = &s.force.step(X_WA, t_s, detected, n_detected, PriorMotion(), true);
+  } else {
+    r.status = RenderStatus::kNoContact;
+    fr = &s.force.step(X_WA, t_s, nullptr, 0, PriorMotion(), false);
+  }
+  r.motion = fr->motion;
+  r.F_W = fr->F_W;
+  r.M_W = fr->M_W;
+  r.F_A = fr->F_A;
+  r.M_A = fr->M_A;
+  r.force = fr;
+  return r;
+}
+
+const HapticResult& step(const CfModel& model, CfState& state, const Pose& X_WA, double t_s) {
+  const ContactSet& contacts = detect(model, state, X_WA);
+  const Identification& id = identify(model, state, contacts);
+  const PriorMotion motion = classify_motion(model, state, id);
+  return compute_force(model, state, X_WA, t_s, id, motion);
+}
+
+// ---- HapticRenderer ----
+
+struct HapticRenderer::Impl {
+  Impl(const CfGraph& g, const Params& p) : own(std::in_place, g, p), model(&*own), state(*model) {}
+  explicit Impl(const CfModel& m) : model(&m), state(m) {}
+  std::optional<CfModel> own;  // when the renderer built its model
+  const CfModel* model;
+  CfState state;
+};
+
+HapticRenderer::HapticRenderer(const CfGraph& graph, const Params& params)
+    : impl_(std::make_unique<Impl>(graph, params)) {}
+HapticRenderer::HapticRenderer(const CfModel& model) : impl_(std::make_unique<Impl>(model)) {}
+HapticRenderer::~HapticRenderer() = default;
+HapticRenderer::HapticRenderer(HapticRenderer&&) noexcept = default;
+HapticRenderer& HapticRenderer::operator=(HapticRenderer&&) noexcept = default;
+
+const HapticResult& HapticRenderer::step(const Pose& pose, double t_s) {
+  return cf::step(*impl_->model, impl_->state, pose, t_s);
+}
+const HapticResult& HapticRenderer::step_identified(const Pose& pose, double t_s,
+                                                    const Identification& id) {
+  const PriorMotion motion = classify_motion(*impl_->model, impl_->state, id);
+  return compute_force(*impl_->model, impl_->state, pose, t_s, id, motion);
+}
+void HapticRenderer::reset() { impl_->state.reset(); }
+const HapticResult& HapticRenderer::result() const { return impl_->state.result(); }
+const CfGraph& HapticRenderer::graph() const { return impl_->model->graph(); }
+const Params& HapticRenderer::params() const { return impl_->model->params(); }
+const CfModel& HapticRenderer::model() const { return *impl_->model; }
+const CfState& HapticRenderer::state() const { return impl_->state; }
+
+// ---- CfIdentifier ----
+
+struct CfIdentifier::Impl {
+  Impl(const CfGraph& g, const Params& p) : model(g, p), state(model) {}
+  CfModel model;
+  CfState state;
+};
+
+CfIdentifier::CfIdentifier(const CfGraph& graph, const Params& params)
+    : impl_(std::make_unique<Impl>(graph, params)) {}
+CfIdentifier::~CfIdentifier() = default;
+CfIdentifier::CfIdentifier(CfIdentifier&&) noexcept = default;
+CfIdentifier& CfIdentifier::operator=(CfIdentifier&&) noexcept = default;
+
+const Identification& CfIdentifier::step(const Pose& pose) {
+  const Identification& id =
+      identify(impl_->model, impl_->state, detect(impl_->model, impl_->state, pose));
+  CfState::Impl& s = internal::Access::get(impl_->state);
+  s.previous = detail::next_previous(s.previous, id);
+  return id;
+}
+void CfIdentifier::reset() { internal::Access::get(impl_->state).previous = CfId(); }
+CfId CfIdentifier::previous() const { return impl_->state.previous(); }
+const Identification& CfIdentifier::last() const { return impl_->state.identification(); }
+const CfGraph& CfIdentifier::graph() const { return impl_->model.graph(); }
+
+}  // namespace cf

@@ -1,0 +1,42 @@
+#pragma once
+// What CfModel and CfState hold, for the stages (servo.cpp) and nothing else.
+
+#include <cf/force.hpp>
+#include <cf/model.hpp>
+#include <cf/servo.hpp>
+#include <cf/state.hpp>
+
+#include "../detect/detect.hpp"
+#include "../identify/identify.hpp"
+
+#include <array>
+
+namespace cf {
+
+struct CfModel::Impl {
+  Impl(const CfGraph& g, const Params& p);
+  const CfGraph* graph;
+  Params params;
+  detail::DetectModelPtr detect;  // trees and tables (detect/detector.cpp)
+};
+
+struct CfState::Impl {
+  explicit Impl(const CfModel::Impl& m);
+  const CfModel::Impl* model;  // the model it was sized for: the stages check it
+  detail::DetectStatePtr detect;
+  detail::IdentifyScratchPtr identify;
+  Identification id;  // detect() writes id.contacts, identify() the rest
+  CfId previous;      // written by classify_motion only (detail::next_previous)
+  ForceModel force;   // stick anchors, held loads, filters
+  std::array<ContactPc, PcSet::kMaxPcs> ordered{};  // the CF's PCs in canonical order
+  HapticResult result;
+};
+
+namespace internal {
+struct Access {
+  static const CfModel::Impl& get(const CfModel& m) { return *m.impl_; }
+  static CfState::Impl& get(CfState& s) { return *s.impl_; }
+};
+}  // namespace internal
+
+}  // namespace cf
