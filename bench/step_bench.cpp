@@ -58,6 +58,14 @@ std::unique_ptr<cf::CfGraph> load_graph(std::string* which) {
       cf::CfGraph::from_parts(cf::testmodels::cube(), cf::testmodels::l_block(), std::move(cfs), std::move(tr)));
 }
 
+// The paper's literal servo step (no proxy): the device pose is A's pose. The figures of
+// BM_ServoStep and BM_ServoStepIntrinsic are of it; the proxy's are BM_ServoStepProxy*.
+cf::Params literal_params() {
+  cf::Params p;
+  p.proxy.enabled = false;
+  return p;
+}
+
 void report(benchmark::State& state, std::vector<double>& ns) {
   if (ns.empty()) return;
   std::sort(ns.begin(), ns.end());
@@ -72,7 +80,7 @@ void BM_ServoStep(benchmark::State& state) {
   std::string which;
   const auto graph = load_graph(&which);
   const std::vector<Tick> ticks = load_ticks();
-  cf::HapticRenderer renderer(*graph);
+  cf::HapticRenderer renderer(*graph, literal_params());
   std::vector<double> ns;
   ns.reserve(2'000'000);
   std::size_t i = 0;
@@ -218,7 +226,7 @@ void BM_ServoStepIntrinsic(benchmark::State& state) {
   std::string which;
   const auto graph = load_graph(&which);
   const std::vector<Tick> ticks = load_ticks();
-  cf::HapticRenderer full(*graph), split(*graph);
+  cf::HapticRenderer full(*graph, literal_params()), split(*graph, literal_params());
   const cf::Params ip;  // as the renderer's identifier
   cf::CfIdentifier ident(*graph, ip);
   cf::ContactDetector det(graph->model_a(), graph->model_b(), ip);
@@ -340,5 +348,62 @@ void BM_ForceOnlyIntrinsic(benchmark::State& state) {
 BENCHMARK(BM_ForceOnlyIntrinsic)->Iterations(static_cast<benchmark::IterationCount>(reps_from_env()))->Unit(benchmark::kMillisecond);
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------
+// The servo step with the proxy on (SPEC 6b, the default), intrinsic as above (minimum of
+// each tick over R replays from reset()): over the bundled trajectories (A's pose within
+// the detection band: the proxy is the device pose on all but a few ticks), and over a
+// scripted hand that presses into B: down 5 mm into the floor (0.3 s), slide 15 mm while
+// pressed (0.6 s), press into the inner corner wall 3 mm (0.4 s), lift out (0.3 s); 1,600
+// ticks at 1 kHz, nearly all of them held by the proxy. Counters as above, plus
+// `constrained_share` (ticks on which the proxy held A back) and `passes_max`.
+
+std::vector<Tick> press_ticks() {
+  std::vector<Tick> out;
+  for (int k = 1; k <= 1600; ++k) {
+    const double t = k / 1000.0;
+    const double down = std::min(t / 0.3, 1.0) * 7.0;                     // 2 mm above, to 5 mm in
+    const double slide = std::clamp((t - 0.3) / 0.6, 0.0, 1.0) * 15.0;    // x 70 -> 55
+    const double wall = std::clamp((t - 0.9) / 0.4, 0.0, 1.0) * 23.0;     // x 55 -> 32: 3 mm into the wall
+    const double up = std::clamp((t - 1.3) / 0.3, 0.0, 1.0) * 20.0;
+    Tick tick;
+    tick.t_s = t;
+    tick.X_WA.t_BA = {70 - slide - wall, 37 - down + up, 40};
+    out.push_back(tick);
+  }
+  return out;
+}
+
+void proxy_intrinsic(benchmark::State& state, const std::vector<Tick>& ticks) {
+  std::string which;
+  const auto graph = load_graph(&which);
+  cf::HapticRenderer r(*graph);
+  std::vector<double> best(ticks.size(), 1e300);
+  long constrained = 0, passes_max = 0;
+  bool first = true;
+  for (auto _ : state) {
+    r.reset();
+    for (std::size_t i = 0; i < ticks.size(); ++i) {
+      const auto a = std::chrono::steady_clock::now();
+      const cf::HapticResult& res = r.step(ticks[i].X_WA, ticks[i].t_s);
+      const auto b = std::chrono::steady_clock::now();
+      benchmark::DoNotOptimize(res.F_W.data());
+      best[i] = std::min(best[i], elapsed_ns(a, b));
+      if (first) {
+        constrained += res.proxy->constrained ? 1 : 0;
+        passes_max = std::max<long>(passes_max, res.proxy->substeps);
+      }
+    }
+    first = false;
+  }
+  report_intrinsic(state, "", best);
+  state.counters["constrained_share"] = static_cast<double>(constrained) / static_cast<double>(ticks.size());
+  state.counters["passes_max"] = static_cast<double>(passes_max);
+}
+
+void BM_ServoStepProxyIntrinsic(benchmark::State& state) { proxy_intrinsic(state, load_ticks()); }
+BENCHMARK(BM_ServoStepProxyIntrinsic)->Iterations(static_cast<benchmark::IterationCount>(reps_from_env()))->Unit(benchmark::kMillisecond);
+void BM_ServoStepProxyPressIntrinsic(benchmark::State& state) { proxy_intrinsic(state, press_ticks()); }
+BENCHMARK(BM_ServoStepProxyPressIntrinsic)->Iterations(static_cast<benchmark::IterationCount>(reps_from_env()))->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

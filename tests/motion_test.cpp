@@ -1,10 +1,13 @@
 // Freedoms of CFs from the contact constraints, the "approximately along" test of paper
 // Fig. 10, and the prior-motion classification of paper section 4.2.
 
-#include "fixtures.hpp"
 #include <cf/motion.hpp>
+#include "fixtures.hpp"
 
 #include <catch2/catch.hpp>
+
+#include <optional>
+#include <string>
 
 #include <cmath>
 
@@ -163,7 +166,40 @@ TEST_CASE("prior motion from the previous and current PC sets (paper section 4.2
   CHECK(std::string(cf::to_string(cf::MotionType::kNone)) == "none");
 }
 
-TEST_CASE("freedoms from constraint points: the relation the generator and the run time share", "[motion]") {
+TEST_CASE(
+    "several PCs broken at once are MT5 through the graph (SPEC 4: lose is any proper subset)",
+    "[motion]") {
+  // The cube seated in the corner block's three walls leaving two of them in one tick: the
+  // graph lists single losses; the run time derives the double one from the PC sets.
+  const cf::CfGraph g =
+      cf::CfGraph::load(std::string(CF_SOURCE_DIR) + "/data/graphs/cube_corner_block.json");
+  std::optional<cf::CfId> seat, one;
+  for (std::size_t i = 0; i < g.num_cfs() && !seat; ++i)
+    if (g.cf(cf::CfId(static_cast<std::int32_t>(i))).pcs.size() == 3) {
+      const cf::PcSet& s = g.cf(cf::CfId(static_cast<std::int32_t>(i))).pcs;
+      for (int k = 0; k < 3 && !one; ++k)
+        if (const auto id = g.find(cf::PcSet({s[k]}))) {
+          seat = cf::CfId(static_cast<std::int32_t>(i));
+          one = *id;
+        }
+    }
+  REQUIRE(seat);
+  REQUIRE(one);
+  const cf::PcSet& three = g.cf(*seat).pcs;
+  const cf::PcSet& single = g.cf(*one).pcs;
+  bool listed = false;
+  for (const cf::Transition& tr : g.out_transitions(*seat)) listed = listed || tr.to == *one;
+  CHECK_FALSE(listed);  // two PCs lost: not among the graph's transitions
+  const cf::PriorMotion pm = cf::classify_prior_motion(three, single, &g, *seat, *one);
+  CHECK(pm.type == cf::MotionType::kMT5);
+  CHECK(pm.transition_in_graph);
+  // A change together with a loss is still no transition of the graph.
+  const cf::PriorMotion other = cf::classify_prior_motion(single, three, &g, *one, *seat);
+  CHECK_FALSE(other.transition_in_graph);
+}
+
+TEST_CASE("freedoms from constraint points: the relation the generator and the run time share",
+          "[motion]") {
   const cf::Params P;
   // Three points of a floor (normal +y): translations in the floor and the spin about y.
   const cf::ConstraintPoint floor[] = {{{0, 0, 0}, Y}, {{20, 0, 0}, Y}, {{0, 0, 20}, Y}};
@@ -184,11 +220,13 @@ TEST_CASE("freedoms from constraint points: the relation the generator and the r
   CHECK(free.translation_dof == 3);
 }
 
-TEST_CASE("freedoms from constraint points: bad arguments are refused with the reason", "[motion]") {
+TEST_CASE("freedoms from constraint points: bad arguments are refused with the reason",
+          "[motion]") {
   const cf::Params P;
   cf::ConstraintPoint many[cf::Freedoms::kMaxRows + 1];
   CHECK_THROWS_WITH(cf::freedoms_from_points(many, cf::Freedoms::kMaxRows + 1, {0, 0, 0}, 20.0, P),
                     "computing freedoms: at most 9 constraint points, got 10");
-  CHECK_THROWS_WITH(cf::freedoms_from_points(many, 1, {0, 0, 0}, 0.0, P),
-                    Catch::Matchers::StartsWith("computing freedoms: the length scale must be positive"));
+  CHECK_THROWS_WITH(
+      cf::freedoms_from_points(many, 1, {0, 0, 0}, 0.0, P),
+      Catch::Matchers::StartsWith("computing freedoms: the length scale must be positive"));
 }

@@ -119,7 +119,7 @@ TEST_CASE("a CfState is refused by a model it was not made for", "[servo]") {
   CHECK_THROWS_WITH(cf::detect(m2, s, X_WA),
                     "cf::detect: the CfState was made for another CfModel");
   CHECK_THROWS_WITH(cf::step(m2, s, X_WA, 0.0),
-                    "cf::detect: the CfState was made for another CfModel");
+                    "cf::move_proxy: the CfState was made for another CfModel");
   const cf::Identification id;
   CHECK_THROWS_WITH(cf::identify(m2, s, id.contacts),
                     "cf::identify: the CfState was made for another CfModel");

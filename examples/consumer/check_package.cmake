@@ -3,9 +3,13 @@
 #   1. installs libcf alone (its build directory's install rules) into a private prefix;
 #   2. checks that no installed public header includes Boost, nlohmann_json or CGAL;
 #   3. configures examples/consumer against that prefix with Boost, nlohmann_json and CGAL
-#      made unfindable, builds it and runs it (it exits 0 when the cube's volume is right).
+#      made unfindable, builds it and runs it (it exits 0 when the cube's volume is right
+#      and its servo loop renders the slab's push);
+#   4. the same for examples/haptic_loop (when HAPTIC_LOOP_SOURCE_DIR is set), run for 1.5 s
+#      at 1 kHz with --check on GRAPH (a device pressing into the L-block's floor).
 # Inputs: CF_LIBCF_BINARY_DIR, CF_CONFIG, CONSUMER_SOURCE_DIR, WORK_DIR, GENERATOR,
-#         MAKE_PROGRAM, CXX_COMPILER, CXX_COMPILER_LAUNCHER (optional).
+#         MAKE_PROGRAM, CXX_COMPILER, CXX_COMPILER_LAUNCHER (optional),
+#         HAPTIC_LOOP_SOURCE_DIR and GRAPH (optional).
 cmake_minimum_required(VERSION 3.20)
 
 foreach(var CF_LIBCF_BINARY_DIR CONSUMER_SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER)
@@ -71,5 +75,26 @@ endif()
 execute_process(COMMAND "${program}" RESULT_VARIABLE result)
 if(NOT result EQUAL 0)
   message(FATAL_ERROR "cf_consumer exited with ${result} (expected 0: volume 1000 mm^3)")
+endif()
+
+if(HAPTIC_LOOP_SOURCE_DIR)
+  message(STATUS "4. configure, build and run examples/haptic_loop against the installed package")
+  set(loop_build "${WORK_DIR}/build-loop")
+  set(loop_args ${configure_args})
+  list(TRANSFORM loop_args REPLACE "^${CONSUMER_SOURCE_DIR}$" "${HAPTIC_LOOP_SOURCE_DIR}")
+  list(TRANSFORM loop_args REPLACE "^${consumer_build}$" "${loop_build}")
+  execute_process(COMMAND "${CMAKE_COMMAND}" ${loop_args} COMMAND_ERROR_IS_FATAL ANY)
+  execute_process(COMMAND "${CMAKE_COMMAND}" --build "${loop_build}" --config "${CF_CONFIG}"
+                  COMMAND_ERROR_IS_FATAL ANY)
+  set(loop "${loop_build}/cf_haptic_loop")
+  if(NOT EXISTS "${loop}")
+    set(loop "${loop_build}/${CF_CONFIG}/cf_haptic_loop")
+  endif()
+  execute_process(COMMAND "${loop}" --graph "${GRAPH}" --rate 1000 --duration 1.5 --check
+                          --trace "${WORK_DIR}/trace.csv" --device "${WORK_DIR}/device.csv"
+                  RESULT_VARIABLE result)
+  if(NOT result EQUAL 0)
+    message(FATAL_ERROR "cf_haptic_loop --check exited with ${result}")
+  endif()
 endif()
 message(STATUS "installed package OK")

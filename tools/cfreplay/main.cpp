@@ -25,15 +25,19 @@ int main(int argc, char** argv) {
       "cfreplay: replays a trajectory of A against the CF graph and writes the haptic force and\n"
       "moment of every servo tick.\n"
       "  POSES.csv: header t,tx,ty,tz,qw,qx,qy,qz (s, mm, unit quaternion of R; x_B = R x_A + t)\n"
-      "  OUT.csv:   t,cf,pcs,motion,Fx,Fy,Fz,Mx,My,Mz (world; N, N mm), then the same in A's\n"
-      "             frame (FAx..MAz), the status and the per-PC friction regimes\n"
-      "             (then approaching:PC for each contact pushing by eq. (1) alone).\n"
+      "  POSES.csv is the device: where the hand holds A. With the proxy (default) A is rendered\n"
+      "  at a proxy pose that never goes into B (SPEC 6b).\n"
+      "  OUT.csv:   t,cf,pcs,motion,Fx,Fy,Fz,Mx,My,Mz (the rendered wrench: coupling + contact at\n"
+      "             the proxy + gravity; world; N, N mm), then the same in A's frame (FAx..MAz),\n"
+      "             the status, the per-PC friction regimes (then approaching:PC for each contact\n"
+      "             pushing by eq. (1) alone), the proxy pose proxy_tx..proxy_qz and the contact\n"
+      "             wrench Fcx..Mcz (what B exerts on A).\n"
       "Defaults are the paper's: m 0.5 kg, g 9.8 N/kg along -y, K 2.3 N/mm, K_p 1.6 N/mm,\n"
       "mu 0.7, mu_D 0.08, epsilon 1 mm (docs/force-model.md).",
       "cfreplay"};
   std::string graph_path, traj_path, out_path, plot_path;
   cf::Params P;
-  std::string friction = "anchor", moment_ref = "origin", centroid = "vertex";
+  std::string friction = "anchor", moment_ref = "origin", centroid = "vertex", proxy = "on";
   app.add_option("--graph", graph_path, "CF graph file (cfgen's output)")->required()->type_name("GRAPH.json");
   app.add_option("--trajectory", traj_path, "poses of A, one row per servo tick")
       ->required()
@@ -45,6 +49,14 @@ int main(int argc, char** argv) {
                  "s_pj reading: 'anchor' (displacement since sticking, rate independent) or 'per-tick' "
                  "(the paper's literal one-tick displacement)")
       ->check(CLI::IsMember({"anchor", "per-tick"}));
+  app.add_option("--proxy", proxy,
+                 "'on': the trajectory is the device and A is rendered at a proxy that stays out of B, "
+                 "felt through a spring (SPEC 6b); 'off': A's pose is the trajectory (the paper's literal model)")
+      ->check(CLI::IsMember({"on", "off"}));
+  app.add_option("--proxy-stiffness", P.proxy.stiffness_N_per_mm, "the proxy coupling's stiffness, N/mm")
+      ->check(finite_range(1e-9, 1e9));
+  app.add_option("--proxy-damping", P.proxy.damping_N_s_per_mm, "the proxy coupling's damping, N s/mm")
+      ->check(finite_range(0, 1e9));
   app.add_option("--hold", P.hold_fcy_threshold_N, "hold F_cy while it changes by less than this (N); 0: off")
       ->check(finite_range(0, 1e6));
   app.add_option("--tau", P.interpolation_time_constant_s,
@@ -74,6 +86,7 @@ int main(int argc, char** argv) {
     std::cerr << "cfreplay: " << e.what() << " (see cfreplay --help)\n";
     return 2;
   }
+  P.proxy.enabled = proxy == "on";
   P.friction_displacement =
       friction == "per-tick" ? cf::FrictionDisplacement::kPerTick : cf::FrictionDisplacement::kStickAnchor;
   P.moment_reference = moment_ref == "centroid" ? cf::MomentReference::kACentroid : cf::MomentReference::kAOrigin;

@@ -18,6 +18,10 @@ Scenarios (the cube A against the L-block or the corner block B):
   cube_lblock_rotate.csv    land, tip about a bottom edge and back             (MT3, MT2)
   cube_lblock_break.csv     from the corner, leave the wall, then lift off     (MT5, none)
   cube_corner_seat.csv      corner block: land, slide into x wall, then z wall (three f-f)
+  cube_lblock_press.csv     a device pressing: from 1 mm above the floor to 10 mm inside it,
+                            hold, slide 15 mm while pressed, pull out (for the proxy, SPEC 6b:
+                            `cfreplay --proxy off` renders nothing but gravity once A is
+                            deeper than 1 mm)
 """
 import argparse
 import math
@@ -203,6 +207,16 @@ def main():
     s.move((corner_x + 5, rest_y + 5, 40), 0.25)  # lift off the floor
     s.hold(0.05)
     scripts["cube_lblock_break.csv"] = s
+
+    touch_y = floor + h                         # cube centre when its bottom touches the floor
+    s = Script((70, touch_y + 1, 40))
+    s.move((70, touch_y - 10, 40), 0.5)         # 1 mm above to 10 mm inside, 22 mm/s
+    s.hold(0.3)
+    s.move((55, touch_y - 10, 40), 0.6)         # slide 15 mm while pressed, 25 mm/s
+    s.hold(0.2)
+    s.move((55, touch_y + 5, 40), 0.3)          # pull out
+    s.hold(0.1)
+    scripts["cube_lblock_press.csv"] = s
 
     c_rest_y = c_floor + h + DIST
     c_x, c_z = c_wall_x + h + DIST, c_wall_z + h + DIST

@@ -1,5 +1,7 @@
 #include "replay_io.hpp"
 
+#include <Eigen/Geometry>
+
 #include <cf/file_io.hpp>
 
 #include <algorithm>
@@ -108,16 +110,22 @@ std::vector<Sample> read_trajectory(const std::string& path) {
 }
 
 const char* output_header() {
-  return "t,cf,pcs,motion,Fx,Fy,Fz,Mx,My,Mz,FAx,FAy,FAz,MAx,MAy,MAz,status,regimes";
+  return "t,cf,pcs,motion,Fx,Fy,Fz,Mx,My,Mz,FAx,FAy,FAz,MAx,MAy,MAz,status,regimes,"
+         "proxy_tx,proxy_ty,proxy_tz,proxy_qw,proxy_qx,proxy_qy,proxy_qz,Fcx,Fcy,Fcz,Mcx,Mcy,Mcz";
 }
 
 std::string format_row(const Row& r) {
-  char buf[512];
+  // The proxy's attitude as a unit quaternion with qw >= 0 (one of the two that name it).
+  Eigen::Quaterniond q(r.X_WP.R_BA);
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  char buf[1024];
   std::snprintf(buf, sizeof buf,
-                "%.6f,%d,%s,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%s,%s", r.t, r.cf,
-                r.pcs.c_str(), r.motion.c_str(), r.F_W.x(), r.F_W.y(), r.F_W.z(), r.M_W.x(), r.M_W.y(), r.M_W.z(),
-                r.F_A.x(), r.F_A.y(), r.F_A.z(), r.M_A.x(), r.M_A.y(), r.M_A.z(), r.status.c_str(),
-                r.regimes.c_str());
+                "%.6f,%d,%s,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%s,%s,"
+                "%.9g,%.9g,%.9g,%.12f,%.12f,%.12f,%.12f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g",
+                r.t, r.cf, r.pcs.c_str(), r.motion.c_str(), r.F_W.x(), r.F_W.y(), r.F_W.z(), r.M_W.x(), r.M_W.y(),
+                r.M_W.z(), r.F_A.x(), r.F_A.y(), r.F_A.z(), r.M_A.x(), r.M_A.y(), r.M_A.z(), r.status.c_str(),
+                r.regimes.c_str(), r.X_WP.t_BA.x(), r.X_WP.t_BA.y(), r.X_WP.t_BA.z(), q.w(), q.x(), q.y(), q.z(),
+                r.Fc_W.x(), r.Fc_W.y(), r.Fc_W.z(), r.Mc_W.x(), r.Mc_W.y(), r.Mc_W.z());
   return buf;
 }
 
@@ -243,10 +251,14 @@ std::string svg_plot(const std::vector<Row>& rows, const std::string& title) {
     o << "<text transform=\"translate(15," << fmt(y0 + panel_h / 2) << ") rotate(-90)\" text-anchor=\"middle\">"
       << (panel == 0 ? "force F (N, world)" : "moment M (N mm, world)") << "</text>\n";
 
-    // Series, with min/max per pixel column so that spikes survive.
+    // Series, with min/max per pixel column so that spikes survive: the rendered wrench (full),
+    // then the contact wrench (dashed; it differs while the proxy holds A out of B).
     const int cols = static_cast<int>(plot_w);
-    for (int c = 0; c < 3; ++c) {
-      o << "<polyline fill=\"none\" stroke=\"" << colors[c] << "\" stroke-width=\"1.2\" points=\"";
+    for (int series = 0; series < 6; ++series) {
+      const int c = series % 3;
+      const bool contact = series >= 3;
+      o << "<polyline fill=\"none\" stroke=\"" << colors[c] << "\" stroke-width=\"1.2\""
+        << (contact ? " stroke-dasharray=\"4,3\" opacity=\"0.7\"" : "") << " points=\"";
       int col = -1;
       double mn = 0, mx = 0, last = 0;
       auto flush = [&]() {
@@ -256,7 +268,7 @@ std::string svg_plot(const std::vector<Row>& rows, const std::string& title) {
           << fmt(Y(last)) << " ";
       };
       for (const Row& r : rows) {
-        const double v = (panel == 0 ? r.F_W : r.M_W)(c);
+        const double v = (contact ? (panel == 0 ? r.Fc_W : r.Mc_W) : (panel == 0 ? r.F_W : r.M_W))(c);
         const int cc = std::min(cols - 1, static_cast<int>((X(r.t) - left)));
         if (cc != col) {
           flush();
@@ -269,9 +281,9 @@ std::string svg_plot(const std::vector<Row>& rows, const std::string& title) {
       }
       flush();
       o << "\"/>\n";
-      const char* names[2][3] = {{"Fx", "Fy", "Fz"}, {"Mx", "My", "Mz"}};
-      o << "<text x=\"" << fmt(left + plot_w - 120 + 40 * c) << "\" y=\"" << fmt(y0 - 6) << "\" fill=\""
-        << colors[c] << "\">" << names[panel][c] << "</text>\n";
+      const char* names[2][2][3] = {{{"Fx", "Fy", "Fz"}, {"Mx", "My", "Mz"}}, {{"Fcx", "Fcy", "Fcz"}, {"Mcx", "Mcy", "Mcz"}}};
+      o << "<text x=\"" << fmt(left + plot_w - 260 + 45 * series) << "\" y=\"" << fmt(y0 - 6) << "\" fill=\""
+        << colors[c] << "\">" << names[contact ? 1 : 0][panel][c] << (contact ? " (dashed)" : "") << "</text>\n";
     }
   }
   o << "<text x=\"" << fmt(left + plot_w / 2) << "\" y=\"" << fmt(H - 10) << "\" text-anchor=\"middle\">time (s)"

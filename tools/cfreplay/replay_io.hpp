@@ -39,6 +39,10 @@ struct Row {
   Vec3 F_W = Vec3::Zero(), M_W = Vec3::Zero(), F_A = Vec3::Zero(), M_A = Vec3::Zero();
   std::string status;   ///< identification / rendering status
   std::string regimes;  ///< per-PC friction regimes joined by ';'
+  Pose X_WP;            ///< where A was rendered: the proxy pose (the device pose without it)
+  /// What B exerts on A (eqs. (1)-(8) plus the proxy's constraint forces), about the
+  /// moment's reference point, world axes.
+  Vec3 Fc_W = Vec3::Zero(), Mc_W = Vec3::Zero();
 };
 
 /// The output header (SPEC 5b columns first).
@@ -53,7 +57,8 @@ void write_file_atomic(const std::string& path, const std::string& text,
                        const std::vector<std::string>& inputs = {});
 
 /// An SVG of force and moment components against time, with background bands labelled
-/// with the CF id and the motion type of each run of equal (cf, motion).
+/// with the CF id and the motion type of each run of equal (cf, motion): the rendered wrench
+/// in full lines, the contact wrench dashed.
 std::string svg_plot(const std::vector<Row>& rows, const std::string& title);
 
 }  // namespace cf::replay

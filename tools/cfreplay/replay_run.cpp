@@ -18,6 +18,9 @@ Row make_row(const HapticResult& r) {
   row.F_A = r.F_A;
   row.M_A = r.M_A;
   row.status = to_string(r.status);
+  row.X_WP = r.X_WP;
+  row.Fc_W = r.F_contact_W;
+  row.Mc_W = r.M_contact_W;
   if (r.force != nullptr) {
     for (int k = 0; k < r.force->num_pcs; ++k) row.regimes += (k ? ";" : "") + std::string(to_string(r.force->pcs[k].regime));
     // Approaching contacts (eq. (1) only) follow, named, as they are not among the pcs.

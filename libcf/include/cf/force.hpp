@@ -66,6 +66,7 @@ struct ForceResult {
   Vec3 reference_W = Vec3::Zero();  ///< moment reference point, mm
   Vec3 centroid_W = Vec3::Zero();   ///< p_g, mm
   Vec3 F_contact_W = Vec3::Zero();  ///< eq. (7) in the world (after interpolation)
+  Vec3 M_contact_W = Vec3::Zero();  ///< N mm, eq. (8) about reference_W (after interpolation)
   Vec3 F_gravity_W = Vec3::Zero();  ///< m g along -y
   Vec3 F_W = Vec3::Zero();          ///< haptic force F_h = F_c + F_g, world axes
   Vec3 M_W = Vec3::Zero();          ///< N mm, haptic moment about reference_W, world axes

@@ -88,6 +88,37 @@ struct IdentificationParams {
   double touch_distance_mm = 0.001;
 };
 
+/// The proxy (SPEC section 6b, docs/force-model.md "The proxy"): a 6-DOF god-object pose of
+/// A that follows the device pose but never penetrates B by more than max_penetration_mm,
+/// and a spring (and damper) coupling the device to it.
+struct ProxyParams {
+  /// false: no proxy; A's pose is the device pose (the paper's literal model).
+  bool enabled = true;
+  /// N/mm. The coupling's translational stiffness, which is also the proxy's metric:
+  /// rotations are weighted by stiffness_N_per_mm times A's inertia per unit mass about the
+  /// grip point (mm^2; that of A's bounding box), so the rotational stiffness is
+  /// stiffness_N_per_mm * J (N mm/rad). The default is eq. (1)'s K, so that past the
+  /// surface the normal force keeps eq. (1)'s slope, and the device's passivity needs are
+  /// those of the paper's own band: physical damping above k T / 2 (1.15 N s/m at 1 kHz).
+  double stiffness_N_per_mm = 2.3;
+  /// N s/mm. Coupling damping on the device-proxy velocity difference (rotations weighted
+  /// as the stiffness is). 0 by default: virtual damping adds to the physical damping a
+  /// sampled spring needs to stay passive (b_device > k T / 2 + damping).
+  double damping_N_s_per_mm = 0.0;
+  /// mm. Deepest penetration of B the proxy is left with (linearisation and solver
+  /// residue); a deeper result is corrected before the tick ends.
+  double max_penetration_mm = 0.01;
+  /// mm, A's frame: where the device holds A; the coupling acts there.
+  Vec3 grip_point_A = Vec3::Zero();
+  /// Most sub-steps of one tick's swept motion: each moves every point of A by at most
+  /// 0.75 epsilon, so that no wall is crossed between two detections.
+  int max_substeps = 256;
+  /// Projected Gauss-Seidel sweeps of the constraint solve per (sub-)step (at most).
+  int solver_iterations = 60;
+  /// Friction acts inside the proxy step: a contact that sticks does not slide.
+  bool friction = true;
+};
+
 /// All parameters of the run time: the contact threshold, detection, identification,
 /// friction, gravity and smoothing. ContactDetector, CfIdentifier, ForceModel and
 /// HapticRenderer each read the parts they need from one Params.
@@ -144,6 +175,7 @@ struct Params {
   // --- Detection and identification ---
   DetectionParams detection;
   IdentificationParams identification;
+  ProxyParams proxy;
 };
 
 }  // namespace cf

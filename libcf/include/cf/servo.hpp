@@ -1,15 +1,17 @@
 #pragma once
 /// @file
-/// One servo tick of SPEC section 6 as four stages, each a free function of the immutable
+/// One servo tick of SPEC section 6 as stages, each a free function of the immutable
 /// CfModel, the thread's CfState and the previous stage's result (after FCL's
 /// request/result structs and Box2D's free functions):
 ///
+///     const Pose X_WA = cf::move_proxy(model, state, X_WD, t_s).X_WP;  // SPEC 6b
 ///     const ContactSet& contacts = cf::detect(model, state, X_WA);
 ///     const Identification& id   = cf::identify(model, state, contacts);
 ///     const PriorMotion motion   = cf::classify_motion(model, state, id);
 ///     const HapticResult& out    = cf::compute_force(model, state, X_WA, t_s, id, motion);
 ///
-/// or all four at once with cf::step(model, state, X_WA, t_s). None allocates. An
+/// or all at once, with the coupling added, by cf::step(model, state, X_WD, t_s). None
+/// allocates. An
 /// application may replace a stage (fill an Identification itself, say) and call the next.
 /// Every function throws cf::Error when `state` was made for another model.
 
@@ -18,9 +20,11 @@
 #include <cf/identifier.hpp>
 #include <cf/model.hpp>
 #include <cf/motion.hpp>
+#include <cf/proxy.hpp>
 #include <cf/state.hpp>
 #include <cf/types.hpp>
 
+#include <array>
 #include <cstdint>
 
 namespace cf {
@@ -45,15 +49,35 @@ struct HapticResult {
   RenderStatus status = RenderStatus::kNoContact;
   /// The identification's own status word (cf::to_string(IdStatus)), for diagnostics.
   const char* identification = "";
-  int num_detected = 0;     ///< candidate PCs the detector found
-  Vec3 F_W = Vec3::Zero();  ///< N, haptic force F_c + F_g, world axes
-  Vec3 M_W = Vec3::Zero();  ///< N mm, haptic moment about the reference point, world axes
-  Vec3 F_A = Vec3::Zero();  ///< N, in A's axes
-  Vec3 M_A = Vec3::Zero();  ///< N mm, in A's axes (paper eq. (9))
+  int num_detected = 0;  ///< candidate PCs the detector found
+  /// N, the rendered force, world axes: F_c + F_g at X_WP, plus the coupling with the proxy
+  /// on (docs/force-model.md "The proxy").
+  Vec3 F_W = Vec3::Zero();
+  Vec3 M_W = Vec3::Zero();  ///< N mm, the rendered moment about the reference point, world axes
+  Vec3 F_A = Vec3::Zero();  ///< N, F_W in A's axes (at X_WP)
+  Vec3 M_A = Vec3::Zero();  ///< N mm, M_W in A's axes (paper eq. (9))
+  Pose X_WD;                ///< the device pose given to the tick
+  Pose X_WP;                ///< where A was rendered: the proxy pose (X_WD with the proxy off)
+  /// N and N mm about the reference point, world axes: what B exerts on A, eqs. (1)-(8)
+  /// at X_WP plus the proxy's constraint forces. At rest it balances the coupling.
+  Vec3 F_contact_W = Vec3::Zero();
+  Vec3 M_contact_W = Vec3::Zero();
+  /// N, per rendered PC (in the order of force->pcs): the normal load the proxy's hard
+  /// constraints add to F_cy there (the multipliers of its point contacts: its corners). So
+  /// PC j's load is force->pcs[j].F_cy + constraint_load_N[j]. Zeros with the proxy off.
+  std::array<double, ForceResult::kMaxPcs> constraint_load_N{};
+  /// The proxy step (poses, constraints, coupling); null with the proxy off. Points into
+  /// the state; valid until its next step.
+  const ProxyResult* proxy = nullptr;
   /// Per-PC diagnostics (type, task frame, distance, s_pj, regime, force), the freedoms and
   /// the contact/gravity split. Points into the state; valid until its next compute_force.
   const ForceResult* force = nullptr;
 };
+
+/// Stage 0 (with ProxyParams::enabled): moves the proxy towards the device pose X_WD (mm,
+/// B's frame) as far as B allows (SPEC 6b) and computes the coupling. The stages below then
+/// run at the proxy pose. The result lives in `state` until the next move_proxy.
+const ProxyResult& move_proxy(const CfModel& model, CfState& state, const Pose& X_WD, double t_s);
 
 /// Stage 1: the candidate PCs at the pose X_WA of A (mm, in B's frame, which is the world),
 /// in canonical PC order with `dominated` and `plane` set (docs/runtime.md). The result
@@ -79,7 +103,9 @@ PriorMotion classify_motion(const CfModel& model, CfState& state, const Identifi
 const HapticResult& compute_force(const CfModel& model, CfState& state, const Pose& X_WA,
                                   double t_s, const Identification& id, const PriorMotion& motion);
 
-/// The four stages in order: one servo tick.
-const HapticResult& step(const CfModel& model, CfState& state, const Pose& X_WA, double t_s);
+/// One servo tick at the device pose X_WD: with the proxy on (the default), move_proxy,
+/// then the four stages at the proxy pose, and the coupling added to the rendered wrench;
+/// with it off, the four stages at X_WD (the paper's literal model).
+const HapticResult& step(const CfModel& model, CfState& state, const Pose& X_WD, double t_s);
 
 }  // namespace cf

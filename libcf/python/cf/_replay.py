@@ -13,9 +13,13 @@ class ReplayResult:
     status (N,) str         'no_contact', 'ok', 'no_fitting_cf', 'unlisted_transition'
     identification (N,) str the identifier's status ('matched-previous', ...)
     num_detected (N,) int32 candidate PCs detected
-    F_W, M_W (N, 3)         haptic force (N) and moment (N mm) in the world frame
+    F_W, M_W (N, 3)         the rendered force (N) and moment (N mm) in the world frame: the
+                            coupling to the proxy, the contact at the proxy and gravity
     F_A, M_A (N, 3)         the same in A's frame
-    F_contact_W, F_gravity_W (N, 3)  the contact and gravity parts of F_W
+    F_contact_W, M_contact_W (N, 3)  what B exerts on A (eqs. (1)-(8) plus the proxy's
+                            constraint forces); F_gravity_W (N, 3) the weight
+    proxy_p (N, 3), proxy_q (N, 4)   the proxy pose A was rendered at (mm; w, x, y, z), the
+                            device pose when the proxy is off or nothing held it back
     conservative (N,) bool  rendered with the conservative laws
     dof (N,) int32          freedoms the force model computed (6 when it did not)
     regimes (N,) str        per-PC friction regimes, as cfreplay's regimes column
@@ -24,7 +28,8 @@ class ReplayResult:
     """
 
     _FIELDS = ("t_s", "cf", "pcs", "motion", "status", "identification", "num_detected", "F_W", "M_W",
-               "F_A", "M_A", "F_contact_W", "F_gravity_W", "conservative", "dof", "regimes")
+               "F_A", "M_A", "F_contact_W", "M_contact_W", "F_gravity_W", "proxy_p", "proxy_q", "conservative",
+               "dof", "regimes")
 
     def __init__(self, d):
         self._rows = d.pop("_rows")

@@ -8,6 +8,8 @@
 
 #include <cf/renderer.hpp>
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -49,9 +51,12 @@ py::dict step_dict(const cf::HapticResult& r) {
   d["F_A"] = vec(r.F_A);
   d["M_A"] = vec(r.M_A);
   d["regimes"] = row.regimes;
+  d["F_contact_W"] = vec(r.F_contact_W);
+  d["M_contact_W"] = vec(r.M_contact_W);
+  d["proxy_p"] = vec(r.X_WP.t_BA);
+  d["proxy_constrained"] = r.proxy != nullptr && r.proxy->constrained;
   if (r.force != nullptr) {
     const cf::ForceResult& f = *r.force;
-    d["F_contact_W"] = vec(f.F_contact_W);
     d["F_gravity_W"] = vec(f.F_gravity_W);
     d["reference_W"] = vec(f.reference_W);
     d["centroid_W"] = vec(f.centroid_W);
@@ -191,7 +196,7 @@ void bind_render(py::module_& m) {
         auto rows = std::make_unique<ReplayRows>();
         std::vector<std::int32_t> num_detected(N);
         std::vector<std::string> identification(N);
-        std::vector<double> Fc(3 * N, 0.0), Fg(3 * N, 0.0);
+        std::vector<double> Fc(3 * N, 0.0), Mc(3 * N, 0.0), Fg(3 * N, 0.0);
         std::vector<std::uint8_t> conservative(N, 0);
         std::vector<std::int32_t> dof(N, 6);
         {
@@ -200,11 +205,12 @@ void bind_render(py::module_& m) {
           rows->rows = cf::replay::run(g, samples, P, [&](const cf::replay::Sample&, const cf::HapticResult& r) {
             num_detected[i] = r.num_detected;
             identification[i] = r.identification;
+            for (int k = 0; k < 3; ++k) {
+              Fc[3 * i + static_cast<std::size_t>(k)] = r.F_contact_W[k];
+              Mc[3 * i + static_cast<std::size_t>(k)] = r.M_contact_W[k];
+            }
             if (r.force != nullptr) {
-              for (int k = 0; k < 3; ++k) {
-                Fc[3 * i + static_cast<std::size_t>(k)] = r.force->F_contact_W[k];
-                Fg[3 * i + static_cast<std::size_t>(k)] = r.force->F_gravity_W[k];
-              }
+              for (int k = 0; k < 3; ++k) Fg[3 * i + static_cast<std::size_t>(k)] = r.force->F_gravity_W[k];
               conservative[i] = r.force->conservative;
               dof[i] = r.force->freedoms.dof;
             }
@@ -214,7 +220,8 @@ void bind_render(py::module_& m) {
 
         py::dict d;
         const std::vector<py::ssize_t> shape3{n, 3};
-        py::array_t<double> tt(n), FW(shape3), MW(shape3), FA(shape3), MA(shape3), FC(shape3), FG(shape3);
+        py::array_t<double> tt(n), FW(shape3), MW(shape3), FA(shape3), MA(shape3), FC(shape3), MC(shape3), FG(shape3),
+            PP(shape3), PQ(std::vector<py::ssize_t>{n, 4});
         py::array_t<std::int32_t> cfa(n), nd(n), dofa(n);
         py::array_t<bool> cons(n);
         py::list pcs, motion, status, regimes, ident;
@@ -231,8 +238,16 @@ void bind_render(py::module_& m) {
             FA.mutable_at(i, k) = r.F_A[k];
             MA.mutable_at(i, k) = r.M_A[k];
             FC.mutable_at(i, k) = Fc[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(k)];
+            MC.mutable_at(i, k) = Mc[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(k)];
+            PP.mutable_at(i, k) = r.X_WP.t_BA[k];
             FG.mutable_at(i, k) = Fg[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(k)];
           }
+          Eigen::Quaterniond q(r.X_WP.R_BA);
+          if (q.w() < 0) q.coeffs() = -q.coeffs();
+          PQ.mutable_at(i, 0) = q.w();
+          PQ.mutable_at(i, 1) = q.x();
+          PQ.mutable_at(i, 2) = q.y();
+          PQ.mutable_at(i, 3) = q.z();
           pcs.append(r.pcs);
           motion.append(r.motion);
           status.append(r.status);
@@ -251,6 +266,9 @@ void bind_render(py::module_& m) {
         d["F_A"] = FA;
         d["M_A"] = MA;
         d["F_contact_W"] = FC;
+        d["M_contact_W"] = MC;
+        d["proxy_p"] = PP;
+        d["proxy_q"] = PQ;
         d["F_gravity_W"] = FG;
         d["conservative"] = cons;
         d["dof"] = dofa;

@@ -78,6 +78,12 @@ const std::vector<DoubleField>& double_fields() {
        "margin of the element pairs kept between ticks (mm); 0: off"},
       {"touch_distance_mm", CF_FIELD(identification.touch_distance_mm), 0, 1e6,
        "contacts a CF must hold: those within this of touching (mm)"},
+      {"proxy_stiffness_N_per_mm", CF_FIELD(proxy.stiffness_N_per_mm), 1e-9, 1e9,
+       "the proxy coupling's stiffness (N/mm)"},
+      {"proxy_damping_N_s_per_mm", CF_FIELD(proxy.damping_N_s_per_mm), 0, 1e9,
+       "the proxy coupling's damping (N s/mm)"},
+      {"proxy_max_penetration_mm", CF_FIELD(proxy.max_penetration_mm), 1e-9, 1e3,
+       "deepest penetration of B the proxy is left with (mm)"},
   };
   return f;
 }
@@ -163,10 +169,16 @@ void set_param(cf::Params& P, const std::string& key, const py::handle& value, c
     P.moment_reference = enum_value(kMomentRef, value, where);
   } else if (key == "moment_point_A") {
     P.moment_point_A = vec3_value("moment_point_A", value, where);
-  } else if (key == "render_approaching" || key == "use_bvh") {
+  } else if (key == "proxy_grip_point_A") {
+    P.proxy.grip_point_A = vec3_value("proxy_grip_point_A", value, where);
+  } else if (key == "render_approaching" || key == "use_bvh" || key == "proxy" || key == "proxy_friction") {
     if (!py::isinstance<py::bool_>(value))
       fail(where + ": " + key + " must be True or False, got " + std::string(py::repr(value)));
-    (key == "use_bvh" ? P.detection.use_bvh : P.render_approaching) = value.cast<bool>();
+    bool& field = key == "use_bvh"     ? P.detection.use_bvh
+                  : key == "proxy"     ? P.proxy.enabled
+                  : key == "proxy_friction" ? P.proxy.friction
+                                       : P.render_approaching;
+    field = value.cast<bool>();
   } else if (key == "max_combinations") {
     if (!py::isinstance<py::int_>(value) || py::isinstance<py::bool_>(value) || value.cast<long long>() < 1 ||
         value.cast<long long>() > 1000000000)
@@ -176,7 +188,8 @@ void set_param(cf::Params& P, const std::string& key, const py::handle& value, c
     std::string names;
     for (const DoubleField& f : double_fields()) names += std::string(names.empty() ? "" : ", ") + f.name;
     names += std::string(", ") + kFriction.name + ", " + kCentroid.name + ", " + kMomentRef.name +
-             ", moment_point_A, render_approaching, use_bvh, max_combinations";
+             ", moment_point_A, render_approaching, use_bvh, max_combinations, proxy, proxy_friction, "
+             "proxy_grip_point_A";
     fail(where + ": unknown parameter '" + key + "' (parameters: " + names + ")");
   }
 }
@@ -191,6 +204,9 @@ py::dict params_to_dict(const cf::Params& P) {
   d["render_approaching"] = P.render_approaching;
   d["use_bvh"] = P.detection.use_bvh;
   d["max_combinations"] = P.identification.max_combinations;
+  d["proxy"] = P.proxy.enabled;
+  d["proxy_friction"] = P.proxy.friction;
+  d["proxy_grip_point_A"] = py::array_t<double>(3, P.proxy.grip_point_A.data());
   return d;
 }
 

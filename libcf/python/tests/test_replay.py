@@ -134,6 +134,31 @@ def test_detection_and_identification_parameters_are_reachable(l_graph):
         cf.Params(use_bvh="yes")
 
 
+def test_the_proxy_keeps_a_pressing_device_in_contact(l_graph):
+    # The bundled press: from 1 mm above the floor to 10 mm inside it, slide, pull out.
+    t, p, q = cf.read_trajectory(DATA / "trajectories" / "cube_lblock_press.csv")
+    inside = p[:, 1] < 35.0  # the cube's bottom below the floor's top (y = 20)
+    on = cf.replay(l_graph, t, p, q)
+    off = cf.replay(l_graph, t, p, q, proxy=False)
+    assert inside.sum() > 1500
+    assert (on.cf[inside] >= 0).all()
+    assert (off.cf[inside] < 0).sum() > 0.9 * inside.sum()
+    # The proxy stays on the floor (within its 0.01 mm), the device goes 10 mm below it,
+    # and the push there is K (epsilon + 10 mm) less the weight: 2.3 * 11 - 4.9 N.
+    assert on.proxy_p[inside, 1].min() >= 35.0 - 0.01
+    deepest = np.argmin(p[:, 1])
+    assert on.F_W[deepest, 1] == pytest.approx(2.3 * 11 - 4.9, abs=1e-3)
+    assert on.F_contact_W[deepest, 1] == pytest.approx(2.3 * 11, abs=1e-3)
+    # Off, A's pose is the device's.
+    np.testing.assert_array_equal(off.proxy_p, p)
+    params = cf.Params(proxy=False, proxy_stiffness_N_per_mm=1.5, proxy_friction=False)
+    assert params.to_dict()["proxy"] is False and params.proxy_stiffness_N_per_mm == 1.5
+    with pytest.raises(cf.Error, match=r"^Params: proxy must be True or False, got 1$"):
+        cf.Params(proxy=1)
+    with pytest.raises(cf.Error, match=r"^Params: proxy_stiffness_N_per_mm must be a finite number in \[1e-09, 1e\+09\], got 0$"):
+        cf.Params(proxy_stiffness_N_per_mm=0.0)
+
+
 def test_replay_errors_carry_messages(l_graph):
     t, p, q = cf.read_trajectory(DATA / "trajectories" / "cube_lblock_guarded.csv")
     with pytest.raises(cf.Error, match=r"^replay: p must have shape \(N, 3\) with N = len\(t\) = \d+, got \(\d+, 2\)$"):

@@ -34,6 +34,24 @@ DetectStatePtr make_detect_state(const DetectModel& m);
 /// heap allocation.
 void detect(const DetectModel& m, DetectState& s, const Pose& pose, ContactSet& out);
 
+/// The contacts of the last detection and the pose they are of, so that a pose detected
+/// twice in a row (the proxy's last pose, then the stages at it) is detected once.
+struct DetectedAt {
+  ContactSet* out = nullptr;  // where detections go
+  Pose pose;
+  bool valid = false;
+};
+/// `at.out` holds the contacts at `pose`: detected unless they already are.
+inline const ContactSet& detect_at(const DetectModel& m, DetectState& s, const Pose& pose,
+                                   DetectedAt& at) {
+  if (!(at.valid && at.pose.t_BA == pose.t_BA && at.pose.R_BA == pose.R_BA)) {
+    detect(m, s, pose, *at.out);
+    at.pose = pose;
+    at.valid = true;
+  }
+  return *at.out;
+}
+
 const Params& params_of(const DetectModel& m);
 const Polyhedron& model_a_of(const DetectModel& m);
 const Polyhedron& model_b_of(const DetectModel& m);

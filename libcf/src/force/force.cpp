@@ -334,6 +334,7 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
   filt_valid_ = true;
 
   r.F_contact_W = filt_F_;
+  r.M_contact_W = filt_M_;
   r.F_gravity_W = Vec3(0.0, -P.mass_kg * P.gravity_N_per_kg, 0.0);
   r.F_W = r.F_contact_W + r.F_gravity_W;
   r.M_W = filt_M_ + (r.centroid_W - r.reference_W).cross(r.F_gravity_W);

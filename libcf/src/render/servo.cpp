@@ -32,7 +32,10 @@ const char* to_string(RenderStatus status) {
 // ---- CfModel, CfState ----
 
 CfModel::Impl::Impl(const CfGraph& g, const Params& p)
-    : graph(&g), params(p), detect(detail::make_detect_model(g.model_a(), g.model_b(), p)) {
+    : graph(&g),
+      params(p),
+      detect(detail::make_detect_model(g.model_a(), g.model_b(), p)),
+      proxy(g.model_a(), p) {
   detail::check_identification_params(p.identification);
 }
 
@@ -50,7 +53,9 @@ CfState::Impl::Impl(const CfModel::Impl& m)
     : model(&m),
       detect(detail::make_detect_state(*m.detect)),
       identify(detail::make_identify_scratch()),
-      force(m.graph->model_a(), m.graph->model_b(), m.params) {}
+      force(m.graph->model_a(), m.graph->model_b(), m.params) {
+  detected.out = &id.contacts;
+}
 
 CfState::CfState(const CfModel& model)
     : impl_(std::make_unique<Impl>(internal::Access::get(model))) {}
@@ -60,6 +65,9 @@ CfState& CfState::operator=(CfState&&) noexcept = default;
 
 void CfState::reset() {
   impl_->force.reset();
+  impl_->proxy.has_prev = false;
+  impl_->proxy.num_sliding = 0;
+  impl_->proxy.num_warm = 0;
   impl_->previous = CfId();
   impl_->result = HapticResult();
 }
@@ -84,17 +92,26 @@ CfState::Impl& state_of(const CfModel::Impl& m, CfState& state, const char* stag
 
 }  // namespace
 
+const ProxyResult& move_proxy(const CfModel& model, CfState& state, const Pose& X_WD, double t_s) {
+  const CfModel::Impl& m = internal::Access::get(model);
+  CfState::Impl& s = state_of(m, state, "move_proxy");
+  detail::move_proxy(m.proxy, *m.detect, *s.detect, s.detected, s.proxy, X_WD, t_s);
+  return s.proxy.result;
+}
+
 const ContactSet& detect(const CfModel& model, CfState& state, const Pose& X_WA) {
   const CfModel::Impl& m = internal::Access::get(model);
   CfState::Impl& s = state_of(m, state, "detect");
-  detail::detect(*m.detect, *s.detect, X_WA, s.id.contacts);
-  return s.id.contacts;
+  return detail::detect_at(*m.detect, *s.detect, X_WA, s.detected);
 }
 
 const Identification& identify(const CfModel& model, CfState& state, const ContactSet& contacts) {
   const CfModel::Impl& m = internal::Access::get(model);
   CfState::Impl& s = state_of(m, state, "identify");
-  if (&contacts != &s.id.contacts) s.id.contacts = contacts;
+  if (&contacts != &s.id.contacts) {
+    s.id.contacts = contacts;
+    s.detected.valid = false;  // no longer the contacts of the last detection
+  }
   detail::identify(*m.graph, m.params.identification, s.previous, *s.identify, s.id);
   return s.id;
 }
@@ -157,15 +174,63 @@ const HapticResult& compute_force(const CfModel& model, CfState& state, const Po
   r.M_W = fr->M_W;
   r.F_A = fr->F_A;
   r.M_A = fr->M_A;
+  r.X_WD = X_WA;
+  r.X_WP = X_WA;
+  r.F_contact_W = fr->F_contact_W;
+  r.M_contact_W = fr->M_contact_W;
+  r.constraint_load_N.fill(0);
   r.force = fr;
+  r.proxy = nullptr;
   return r;
 }
 
-const HapticResult& step(const CfModel& model, CfState& state, const Pose& X_WA, double t_s) {
+namespace {
+
+// With the proxy: the rendered wrench gains the coupling, the contact wrench the proxy's
+// constraint forces, and each rendered PC the normal load of its point constraints.
+void add_proxy(const CfModel::Impl& m, CfState::Impl& s) {
+  HapticResult& r = s.result;
+  const ProxyResult& p = s.proxy.result;
+  const ForceResult& fr = *r.force;
+  const Vec3 ref = fr.reference_W;
+  const Vec3& g_A = m.params.proxy.grip_point_A;
+  const Vec3 g_D = p.X_WD.apply(g_A), g_P = p.X_WP.apply(g_A);
+  r.X_WD = p.X_WD;
+  r.X_WP = p.X_WP;
+  r.F_W += p.F_coupling_W;
+  r.M_W += p.M_coupling_W + (g_D - ref).cross(p.F_coupling_W);
+  r.F_A = p.X_WP.R_BA.transpose() * r.F_W;
+  r.M_A = p.X_WP.R_BA.transpose() * r.M_W;
+  r.F_contact_W += p.F_constraint_W;
+  r.M_contact_W += p.M_constraint_W + (g_P - ref).cross(p.F_constraint_W);
+  r.proxy = &p;
+  const Polyhedron& A = m.graph->model_a();
+  const Polyhedron& B = m.graph->model_b();
+  for (int i = 0; i < fr.num_pcs; ++i) {
+    const PcForce& f = fr.pcs[static_cast<std::size_t>(i)];
+    double& load = r.constraint_load_N[static_cast<std::size_t>(i)];
+    load = 0;
+    for (int j = 0; j < p.num_contacts; ++j) {
+      const Pc& c = p.contacts[static_cast<std::size_t>(j)].pc;
+      if (c == f.pc || (in_closure(A, a_kind(c.type), c.a, a_kind(f.pc.type), f.pc.a) &&
+                        in_closure(B, b_kind(c.type), c.b, b_kind(f.pc.type), f.pc.b)))
+        load += p.contacts[static_cast<std::size_t>(j)].normal_load_N;
+    }
+  }
+}
+
+}  // namespace
+
+const HapticResult& step(const CfModel& model, CfState& state, const Pose& X_WD, double t_s) {
+  const CfModel::Impl& m = internal::Access::get(model);
+  const bool proxy = m.params.proxy.enabled;
+  const Pose& X_WA = proxy ? move_proxy(model, state, X_WD, t_s).X_WP : X_WD;
   const ContactSet& contacts = detect(model, state, X_WA);
   const Identification& id = identify(model, state, contacts);
   const PriorMotion motion = classify_motion(model, state, id);
-  return compute_force(model, state, X_WA, t_s, id, motion);
+  const HapticResult& r = compute_force(model, state, X_WA, t_s, id, motion);
+  if (proxy) add_proxy(m, internal::Access::get(state));
+  return r;
 }
 
 // ---- HapticRenderer ----

@@ -8,6 +8,7 @@
 
 #include "../detect/detect.hpp"
 #include "../identify/identify.hpp"
+#include "../proxy/proxy.hpp"
 
 #include <array>
 
@@ -18,6 +19,7 @@ struct CfModel::Impl {
   const CfGraph* graph;
   Params params;
   detail::DetectModelPtr detect;  // trees and tables (detect/detector.cpp)
+  detail::ProxyModel proxy;       // A's metric about the grip point (proxy/proxy.cpp)
 };
 
 struct CfState::Impl {
@@ -25,9 +27,11 @@ struct CfState::Impl {
   const CfModel::Impl* model;  // the model it was sized for: the stages check it
   detail::DetectStatePtr detect;
   detail::IdentifyScratchPtr identify;
-  Identification id;  // detect() writes id.contacts, identify() the rest
-  CfId previous;      // written by classify_motion only (detail::next_previous)
-  ForceModel force;   // stick anchors, held loads, filters
+  Identification id;            // detect() writes id.contacts, identify() the rest
+  detail::DetectedAt detected;  // the pose id.contacts are of (the proxy detects there too)
+  CfId previous;                // written by classify_motion only (detail::next_previous)
+  ForceModel force;             // stick anchors, held loads, filters
+  detail::ProxyState proxy;     // the proxy pose and its history
   std::array<ContactPc, PcSet::kMaxPcs> ordered{};  // the CF's PCs in canonical order
   HapticResult result;
 };

@@ -1,0 +1,387 @@
+// The 6-DOF god-object proxy (SPEC 6b; docs/force-model.md "The proxy"): each tick the
+// proxy moves towards the device pose along the swept path, in sub-steps short enough that
+// detection sees every wall, and at each sub-step takes the motion closest to its target in
+// the coupling's metric under the linearised non-penetration constraints of its point
+// contacts (v-f, f-v, e-e: the corners of every contact region) and Coulomb friction, by
+// projected Gauss-Seidel on the constraint forces.
+
+#include "proxy.hpp"
+
+#include "../check.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace cf::detail {
+
+namespace {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+
+// mm. Gauss-Seidel stops when no row's update moves the proxy by more than this: it only
+// has to find the active set, the projection after it is exact (polish).
+constexpr double kSolveTolerance_mm = 1e-5;
+
+// Share of epsilon a point of A may move between two detections. A feature of B it could
+// reach was within epsilon, so detected and constrained; below 1 to leave room for the
+// in-plane tolerances at the boundary of a face.
+constexpr double kSweepShare = 0.75;
+
+Vec3 rotation_vector(const Mat3& R) {
+  const Eigen::AngleAxisd aa(R);
+  return aa.angle() * aa.axis();
+}
+Mat3 rotation_matrix(const Vec3& w) {
+  const double a = w.norm();
+  if (a == 0) return Mat3::Identity();
+  return Eigen::AngleAxisd(a, w / a).toRotationMatrix();
+}
+
+bool is_point_type(PcType t) { return t == PcType::kVF || t == PcType::kFV || t == PcType::kEE; }
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw Error("cf::Params: parameter proxy." + what);
+}
+
+// One constraint row: a . xi >= lo (normal) or = 0 (tangent), xi = (v, w) about the grip.
+struct Row {
+  Vec6 a, Wa;    // the row and the inverse metric times it
+  double G = 1;  // a . W a
+};
+
+// Grip point of a pose, world frame.
+Vec3 grip(const Pose& X, const Vec3& g_A) { return X.apply(g_A); }
+
+Pose moved(const Pose& X, const Vec3& g_A, const Vec3& v, const Vec3& w) {
+  Pose Y;
+  Y.R_BA = rotation_matrix(w) * X.R_BA;
+  const Vec3 g = grip(X, g_A) + v;
+  Y.t_BA = g - Y.R_BA * g_A;
+  return Y;
+}
+
+// Projected Gauss-Seidel converges slowly on the redundant rows of contact regions (four
+// corners of a face on a plane, with friction on each), and what it leaves unconverged
+// drifts the proxy from tick to tick; how it shares a region's load among the corners is
+// arbitrary. So its result only chooses the active set: the normal rows it loads, and per
+// contact plane (group) whether friction holds. A group slides when every loaded corner's
+// friction is at its bound; its friction is then kinetic, mu_D times the group's normal
+// load, each corner along its solve's direction, applied as given. Otherwise every loaded corner of
+// the group sticks (the region holds as a whole, however the corners share the load). The motion is
+// the exact projection of the target onto that set in the coupling's metric (Gram-Schmidt over the
+// rows, dependent rows dropped), kept when it satisfies every normal row. `lambda` leaves with the
+// sliding groups' kinetic friction; `slides[g]` tells them.
+Vec6 polish(const Vec6& xi_pgs, const Vec6& xi_d, const Row* rows, double* lambda,
+            const double* dist, const double* mu, const int* group, int m, double k,
+            const Mat3& Winv_rot, double mu_kinetic, bool* slides) {
+  auto W = [&](const Vec6& u) {
+    Vec6 w;
+    w << u.head<3>() / k, Winv_rot * u.tail<3>();
+    return w;
+  };
+  constexpr int kGroups = ProxyResult::kMaxContacts;
+  std::array<double, kGroups> load{};
+  std::array<bool, kGroups> saturated{};
+  for (int g = 0; g < kGroups; ++g) {
+    saturated[static_cast<std::size_t>(g)] = true;
+    slides[g] = false;
+  }
+  for (int j = 0; j < m; ++j) {
+    const auto g = static_cast<std::size_t>(group[j]);
+    const double ln = lambda[3 * j], l1 = lambda[3 * j + 1], l2 = lambda[3 * j + 2];
+    if (ln <= 0) continue;
+    load[g] += ln;
+    if (!(mu[j] > 0 && std::hypot(l1, l2) >= mu[j] * ln * (1 - 1e-6))) saturated[g] = false;
+  }
+  for (int g = 0; g < kGroups; ++g)
+    slides[g] = load[static_cast<std::size_t>(g)] > 0 && saturated[static_cast<std::size_t>(g)];
+  // Sliding groups: each corner's friction (all at their bounds) to mu_D times its load, in
+  // its own direction (so a region turning about its normal keeps its torsional friction).
+  Vec6 xe = xi_d;  // the target moved by the kinetic friction of sliding groups
+  for (int j = 0; j < m; ++j) {
+    if (!slides[group[j]]) continue;
+    const double len = std::hypot(lambda[3 * j + 1], lambda[3 * j + 2]);
+    const double sc = len > 0 ? mu_kinetic * lambda[3 * j] / len : 0.0;
+    lambda[3 * j + 1] *= sc;
+    lambda[3 * j + 2] *= sc;
+    xe += rows[3 * j + 1].Wa * lambda[3 * j + 1] + rows[3 * j + 2].Wa * lambda[3 * j + 2];
+  }
+  std::array<Vec6, 6> Q, WQ;
+  std::array<double, 6> C{};
+  int nq = 0;
+  auto add = [&](const Row& row, double b) {
+    if (nq == 6) return;
+    Vec6 u = row.a;
+    double c = b;
+    for (int l = 0; l < nq; ++l) {
+      const double p = WQ[static_cast<std::size_t>(l)].dot(row.a);
+      u -= p * Q[static_cast<std::size_t>(l)];
+      c -= p * C[static_cast<std::size_t>(l)];
+    }
+    const Vec6 Wu = W(u);
+    const double n2 = u.dot(Wu);
+    if (!(n2 > 1e-10 * row.G)) return;  // dependent on the rows before
+    const double sc = 1 / std::sqrt(n2);
+    Q[static_cast<std::size_t>(nq)] = sc * u;
+    WQ[static_cast<std::size_t>(nq)] = sc * Wu;
+    C[static_cast<std::size_t>(nq++)] = sc * c;
+  };
+  for (int j = 0; j < m; ++j) {
+    if (lambda[3 * j] <= 0) continue;
+    add(rows[3 * j], -dist[j]);
+    if (mu[j] > 0 && !slides[group[j]]) {
+      add(rows[3 * j + 1], 0);
+      add(rows[3 * j + 2], 0);
+    }
+  }
+  Vec6 xi = xe;
+  for (int l = 0; l < nq; ++l)
+    xi += WQ[static_cast<std::size_t>(l)] *
+          (C[static_cast<std::size_t>(l)] - Q[static_cast<std::size_t>(l)].dot(xe));
+  for (int j = 0; j < m; ++j)
+    if (dist[j] + rows[3 * j].a.dot(xi) < -1e-9) return xi_pgs;
+  return xi;
+}
+
+}  // namespace
+
+ProxyModel::ProxyModel(const Polyhedron& a, const Params& p)
+    : prm(p.proxy), epsilon_mm(p.epsilon_mm), mu_static(p.mu_static), mu_kinetic(p.mu_kinetic) {
+  const ProxyParams& q = p.proxy;
+  require(std::isfinite(q.stiffness_N_per_mm) && q.stiffness_N_per_mm > 0,
+          "stiffness_N_per_mm must be finite and positive, got " +
+              std::to_string(q.stiffness_N_per_mm));
+  require(std::isfinite(q.damping_N_s_per_mm) && q.damping_N_s_per_mm >= 0,
+          "damping_N_s_per_mm must be finite and non-negative, got " +
+              std::to_string(q.damping_N_s_per_mm));
+  require(std::isfinite(q.max_penetration_mm) && q.max_penetration_mm > 0,
+          "max_penetration_mm must be finite and positive, got " +
+              std::to_string(q.max_penetration_mm));
+  require(q.grip_point_A.allFinite(), "grip_point_A must be finite");
+  require(q.max_substeps >= 1,
+          "max_substeps must be at least 1, got " + std::to_string(q.max_substeps));
+  require(q.solver_iterations >= 1,
+          "solver_iterations must be at least 1, got " + std::to_string(q.solver_iterations));
+  // A's bounding box as a solid: its inertia per unit mass about its centre, moved to the
+  // grip point. The metric only has to weigh radians against millimetres as A's mass does.
+  const Vec3 lo = a.bbox_min(), hi = a.bbox_max(), size = hi - lo, c = 0.5 * (lo + hi);
+  const double x2 = size.x() * size.x(), y2 = size.y() * size.y(), z2 = size.z() * size.z();
+  Mat3 Jc = Mat3::Zero();
+  Jc.diagonal() << (y2 + z2) / 12, (x2 + z2) / 12, (x2 + y2) / 12;
+  const Vec3 r = c - q.grip_point_A;
+  J_A = Jc + (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
+  // A flat or needle-like A: keep every axis weighted (1e-6 of the largest).
+  const double floor = 1e-6 * std::max(J_A.trace(), 1e-12);
+  for (int k = 0; k < 3; ++k) J_A(k, k) = std::max(J_A(k, k), floor);
+  Jinv_A = J_A.inverse();
+  for (const Vertex& v : a.vertices()) reach_mm = std::max(reach_mm, (v.p - q.grip_point_A).norm());
+}
+
+void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, DetectedAt& at,
+                ProxyState& s, const Pose& X_WD, double t_s) {
+  const ProxyParams& q = pm.prm;
+  const double k = q.stiffness_N_per_mm;
+  ProxyResult& r = s.result;
+  r.X_WD = X_WD;
+  r.constrained = false;
+  r.substeps = 0;
+  r.iterations = 0;
+  r.num_contacts = 0;
+  if (!s.has_prev) {
+    // The first tick: the proxy starts at the device.
+    s.X_WP = X_WD;
+    s.X_WP_prev = X_WD;
+    s.X_WD_prev = X_WD;
+    s.t_prev_s = t_s;
+  }
+  const Vec3& g_A = q.grip_point_A;
+  // Conservative advancement: each pass takes the motion towards the device that the
+  // constraints at the current pose allow; a motion that would move some point of A by
+  // more than kSweepShare of epsilon is cut to that length, so that no wall is crossed between two
+  // detections (the passes follow the proxy's own motion, not the device's: a proxy held at
+  // the surface by a device 20 mm inside takes one pass).
+  const double step_len = kSweepShare * pm.epsilon_mm;
+  Pose X = s.X_WP;
+  static constexpr int kMaxRows = 3 * ProxyResult::kMaxContacts;
+  std::array<Row, kMaxRows> rows;
+  std::array<double, kMaxRows> lambda{};
+  std::array<double, ProxyResult::kMaxContacts> dist{}, mu{};
+  std::array<int, ProxyResult::kMaxContacts> group{};       // contact plane, clamped to the array
+  std::array<bool, ProxyResult::kMaxContacts> slides{};     // by group, from the last polish
+  std::array<ContactPc, ProxyResult::kMaxContacts> used{};  // copies: detection reuses its set
+  int m = 0;  // point contacts used as constraints in the last solve
+  for (int pass = 0; pass < q.max_substeps; ++pass) {
+    ++r.substeps;
+    const ContactSet& contacts = detect_at(dm, ds, X, at);
+    const Vec3 g = grip(X, g_A);
+    Vec6 xi_d;
+    xi_d << grip(X_WD, g_A) - g, rotation_vector(X_WD.R_BA * X.R_BA.transpose());
+    // The constraints: the point contacts (the corners of every contact region).
+    m = 0;
+    bool blocking = false;
+    const Mat3 Winv_rot = X.R_BA * pm.Jinv_A * X.R_BA.transpose() / k;
+    for (const ContactPc& c : contacts) {
+      if (!is_point_type(c.pc.type) || m == ProxyResult::kMaxContacts) continue;
+      const Vec3 rr = c.p_W - g;
+      const int j = m++;
+      used[static_cast<std::size_t>(j)] = c;
+      dist[static_cast<std::size_t>(j)] = c.distance;
+      group[static_cast<std::size_t>(j)] =
+          std::clamp<int>(c.plane, 0, ProxyResult::kMaxContacts - 1);
+      for (int axis = 0; axis < 3; ++axis) {
+        const Vec3 dir = c.R_WT.col(axis == 0 ? 1 : axis == 1 ? 0 : 2);
+        Row& row = rows[static_cast<std::size_t>(3 * j + axis)];
+        row.a << dir, rr.cross(dir);
+        row.Wa << dir / k, Winv_rot * rr.cross(dir);
+        row.G = row.a.dot(row.Wa);
+        lambda[static_cast<std::size_t>(3 * j + axis)] = 0;
+      }
+      if (c.distance + rows[static_cast<std::size_t>(3 * j)].a.dot(xi_d) < 0) blocking = true;
+      for (int i = 0; i < s.num_warm; ++i)
+        if (s.warm_pc[static_cast<std::size_t>(i)] == c.pc)
+          for (int axis = 0; axis < 3; ++axis)
+            lambda[static_cast<std::size_t>(3 * j + axis)] =
+                s.warm_lambda[static_cast<std::size_t>(i)][static_cast<std::size_t>(axis)];
+      bool slid = false;
+      for (int i = 0; i < s.num_sliding && !slid; ++i)
+        slid = s.sliding[static_cast<std::size_t>(i)] == c.pc;
+      mu[static_cast<std::size_t>(j)] = q.friction ? (slid ? pm.mu_kinetic : pm.mu_static) : 0.0;
+    }
+    Vec6 xi = xi_d;
+    if (blocking) {
+      r.constrained = true;
+      for (int i = 0; i < 3 * m; ++i)
+        xi += rows[static_cast<std::size_t>(i)].Wa * lambda[static_cast<std::size_t>(i)];
+      // Projected Gauss-Seidel on the constraint forces (N): xi = xi_d + W sum a_i lambda_i.
+      for (int it = 0; it < q.solver_iterations; ++it) {
+        ++r.iterations;
+        double change = 0;  // mm, largest displacement a row's update made
+        for (int j = 0; j < m; ++j) {
+          const auto J = static_cast<std::size_t>(j);
+          Row& rn = rows[3 * J];
+          double& ln = lambda[3 * J];
+          const double ln_new = std::max(0.0, ln - (dist[J] + rn.a.dot(xi)) / rn.G);
+          xi += rn.Wa * (ln_new - ln);
+          change = std::max(change, std::abs(ln_new - ln) * rn.G);
+          ln = ln_new;
+          if (mu[J] == 0) continue;
+          Row& r1 = rows[3 * J + 1];
+          Row& r2 = rows[3 * J + 2];
+          double& l1 = lambda[3 * J + 1];
+          double& l2 = lambda[3 * J + 2];
+          double n1 = l1 - r1.a.dot(xi) / r1.G, n2 = l2 - r2.a.dot(xi) / r2.G;
+          const double cap = mu[J] * ln, len = std::hypot(n1, n2);
+          if (len > cap) {
+            const double sc = len > 0 ? cap / len : 0.0;
+            n1 *= sc;
+            n2 *= sc;
+          }
+          xi += r1.Wa * (n1 - l1) + r2.Wa * (n2 - l2);
+          change = std::max({change, std::abs(n1 - l1) * r1.G, std::abs(n2 - l2) * r2.G});
+          l1 = n1;
+          l2 = n2;
+        }
+        if (change < kSolveTolerance_mm) break;
+      }
+      xi = polish(xi, xi_d, rows.data(), lambda.data(), dist.data(), mu.data(), group.data(), m, k,
+                  Winv_rot, pm.mu_kinetic, slides.data());
+      // A group that broke away slides for the rest of the tick (kinetic bounds in the
+      // passes after this one), not only from the next tick on.
+      for (int j = 0; j < m; ++j) {
+        const Pc& pc = used[static_cast<std::size_t>(j)].pc;
+        if (!slides[static_cast<std::size_t>(group[static_cast<std::size_t>(j)])]) continue;
+        bool known = false;
+        for (int i = 0; i < s.num_sliding && !known; ++i)
+          known = s.sliding[static_cast<std::size_t>(i)] == pc;
+        if (!known && s.num_sliding < ProxyResult::kMaxContacts)
+          s.sliding[static_cast<std::size_t>(s.num_sliding++)] = pc;
+      }
+      // The next pass of this tick starts from these forces (warm start).
+      s.num_warm = 0;
+      for (int j = 0; j < m; ++j) {
+        const auto J = static_cast<std::size_t>(j);
+        if (lambda[3 * J] <= 0) continue;
+        s.warm_pc[static_cast<std::size_t>(s.num_warm)] = used[J].pc;
+        s.warm_lambda[static_cast<std::size_t>(s.num_warm++)] = {lambda[3 * J], lambda[3 * J + 1],
+                                                                 lambda[3 * J + 2]};
+      }
+    }
+    const double sweep = xi.head<3>().norm() + xi.tail<3>().norm() * pm.reach_mm;
+    if (sweep > step_len) {
+      // Too long to be sure of: advance by step_len and look again.
+      const double f = step_len / sweep;
+      X = moved(X, g_A, f * xi.head<3>(), f * xi.tail<3>());
+      continue;
+    }
+    if (!blocking) {
+      X = X_WD;  // nothing in the way: the proxy is the device, exactly
+      slides.fill(false);
+      for (int i = 0; i < 3 * m; ++i) lambda[static_cast<std::size_t>(i)] = 0;
+      break;
+    }
+    X = moved(X, g_A, xi.head<3>(), xi.tail<3>());
+    // Done unless a rotation's second-order error (|w|^2 r / 2 at most) may exceed the
+    // allowed depth: then the new pose is detected, and a point contact deeper than that
+    // starts another pass. A translation is exact in the linearisation, and a sweep of at
+    // most step_len < epsilon meets no contact the pose's detection (within epsilon) did not list.
+    const double w2 = xi.tail<3>().squaredNorm();
+    if (0.5 * w2 * pm.reach_mm <= 0.5 * q.max_penetration_mm) break;
+    double deepest = 0;
+    for (const ContactPc& c : detect_at(dm, ds, X, at))
+      if (is_point_type(c.pc.type)) deepest = std::min(deepest, c.distance);
+    if (deepest >= -q.max_penetration_mm) break;
+  }
+  s.X_WP = X;
+  r.X_WP = X;
+  // The last solve's constraint forces: reported, and the contacts that slid remembered.
+  const Vec3 g_P = grip(X, g_A);
+  r.F_constraint_W.setZero();
+  r.M_constraint_W.setZero();
+  s.num_sliding = 0;
+  s.num_warm = 0;
+  for (int j = 0; j < m; ++j) {
+    const auto J = static_cast<std::size_t>(j);
+    const ContactPc& c = used[J];
+    const double ln = lambda[3 * J];
+    ProxyContact& pc = r.contacts[static_cast<std::size_t>(r.num_contacts++)];
+    pc.pc = c.pc;
+    pc.p_W = c.p_W;
+    pc.n_W = c.R_WT.col(1);
+    pc.distance_mm = c.distance;
+    pc.normal_load_N = ln;
+    pc.friction_W = lambda[3 * J + 1] * c.R_WT.col(0) + lambda[3 * J + 2] * c.R_WT.col(2);
+    pc.sliding = ln > 0 && mu[J] > 0 && slides[static_cast<std::size_t>(group[J])];
+    if (pc.sliding) s.sliding[static_cast<std::size_t>(s.num_sliding++)] = c.pc;
+    if (ln > 0) {
+      s.warm_pc[static_cast<std::size_t>(s.num_warm)] = c.pc;
+      s.warm_lambda[static_cast<std::size_t>(s.num_warm++)] = {ln, lambda[3 * J + 1],
+                                                               lambda[3 * J + 2]};
+    }
+    const Vec3 f = ln * pc.n_W + pc.friction_W;
+    r.F_constraint_W += f;
+    r.M_constraint_W += (c.p_W - g_P).cross(f);
+  }
+  // The coupling on the hand, about the grip point at the device: spring and damper.
+  const Vec3 g_D = grip(X_WD, g_A);
+  const Mat3 J_W = X_WD.R_BA * pm.J_A * X_WD.R_BA.transpose();
+  const Vec3 theta = rotation_vector(X.R_BA * X_WD.R_BA.transpose());  // device to proxy
+  r.F_coupling_W = k * (g_P - g_D);
+  r.M_coupling_W = k * (J_W * theta);
+  const double dt = t_s - s.t_prev_s;
+  if (s.has_prev && dt > 0 && q.damping_N_s_per_mm > 0) {
+    const Vec3 dv = (g_P - grip(s.X_WP_prev, g_A)) - (g_D - grip(s.X_WD_prev, g_A));
+    const Vec3 dw = rotation_vector(X.R_BA * s.X_WP_prev.R_BA.transpose()) -
+                    rotation_vector(X_WD.R_BA * s.X_WD_prev.R_BA.transpose());
+    r.F_coupling_W += q.damping_N_s_per_mm * dv / dt;
+    r.M_coupling_W += q.damping_N_s_per_mm * (J_W * dw) / dt;
+  }
+  s.has_prev = true;
+  s.X_WP_prev = X;
+  s.X_WD_prev = X_WD;
+  s.t_prev_s = t_s;
+}
+
+}  // namespace cf::detail
