@@ -757,15 +757,24 @@ void Classifier::pcs_and_planes(const Scene& S, Verdict& V) const {
     }
 }
 
-void Classifier::clearance(const Scene& S, Verdict& V) const {
+void Classifier::clearance(const Scene& S, Verdict& V, const CfKey* outside) const {
   const double tol = tol_.len;
   double best = kInf;
   std::string what;
   const Poly& A = A_;
   const Poly& B = B_;
+  // With `outside`: only pairs that no PC of it dominates (x in the closure of its A
+  // element and y in the closure of its B element).
+  auto dominated = [&](int kx, int x, int ky, int y) {
+    if (outside == nullptr) return false;
+    for (const Pc& pc : *outside)
+      if (A.in_closure(kx, x, kind_a(pc.type), pc.a) && B.in_closure(ky, y, kind_b(pc.type), pc.b)) return true;
+    return false;
+  };
   for (std::size_t va = 0; va < A.V.size(); ++va)
     for (std::size_t fb = 0; fb < B.F.size(); ++fb) {
       if (S.av[va].dist(bf_[fb]) >= best) continue;
+      if (dominated(0, static_cast<int>(va), 2, static_cast<int>(fb))) continue;
       double d = point_face_dist(B, B.F[fb], S.pa[va]);
       if (d > tol && d < best) {
         best = d;
@@ -775,6 +784,7 @@ void Classifier::clearance(const Scene& S, Verdict& V) const {
   for (std::size_t vb = 0; vb < B.V.size(); ++vb)
     for (std::size_t fa = 0; fa < A.F.size(); ++fa) {
       if (S.af[fa].dist(bv_[vb]) >= best) continue;
+      if (dominated(2, static_cast<int>(fa), 0, static_cast<int>(vb))) continue;
       double d = point_face_dist(A, A.F[fa], S.pb_a[vb]);
       if (d > tol && d < best) {
         best = d;
@@ -784,6 +794,7 @@ void Classifier::clearance(const Scene& S, Verdict& V) const {
   for (std::size_t ea = 0; ea < A.E.size(); ++ea)
     for (std::size_t eb = 0; eb < B.E.size(); ++eb) {
       if (S.ae[ea].dist(be_[eb]) >= best) continue;
+      if (dominated(1, static_cast<int>(ea), 1, static_cast<int>(eb))) continue;
       double d = seg_seg_dist(S.pa[A.E[ea].v0], S.pa[A.E[ea].v1], B.V[B.E[eb].v0].p, B.V[B.E[eb].v1].p, nullptr, nullptr);
       if (d > tol && d < best) {
         best = d;
@@ -794,7 +805,14 @@ void Classifier::clearance(const Scene& S, Verdict& V) const {
   V.clearance_what = what;
 }
 
-Verdict Classifier::classify(const Pose& X, bool with_clearance) const {
+double Classifier::clearance_outside(const Pose& X, const CfKey& pcs) const {
+  const Scene S = scene(X);
+  Verdict V;
+  clearance(S, V, &pcs);
+  return V.clearance;
+}
+
+Classifier::Scene Classifier::scene(const Pose& X) const {
   Scene S;
   S.X = X;
   const Poly& A = A_;
@@ -818,6 +836,11 @@ Verdict Classifier::classify(const Pose& X, bool with_clearance) const {
   }
   S.pb_a.resize(B_.V.size());
   for (std::size_t i = 0; i < B_.V.size(); ++i) S.pb_a[i] = X.inv(B_.V[i].p);
+  return S;
+}
+
+Verdict Classifier::classify(const Pose& X, bool with_clearance) const {
+  const Scene S = scene(X);
   Verdict V;
   touches(S, V);
   cone_checks(S, V);

@@ -89,6 +89,9 @@ class Classifier {
  public:
   Classifier(const Poly& A, const Poly& B, Tolerances tol);
   Verdict classify(const Pose& X, bool with_clearance = true) const;
+  /// The clearance counting only pairs that no PC of `pcs` dominates: how far the nearest
+  /// contact that would not be another reading of these PCs is (kInf when none).
+  double clearance_outside(const Pose& X, const CfKey& pcs) const;
   /// Only the interior test (touches + cones + containment); cheaper, no PCs.
   bool interiors_disjoint(const Pose& X, std::string* why = nullptr) const;
   const Tolerances& tol() const { return tol_; }
@@ -101,7 +104,8 @@ class Classifier {
   void cone_checks(const Scene& S, Verdict& V) const;
   void containment(const Scene& S, Verdict& V) const;
   void pcs_and_planes(const Scene& S, Verdict& V) const;
-  void clearance(const Scene& S, Verdict& V) const;
+  void clearance(const Scene& S, Verdict& V, const CfKey* outside = nullptr) const;
+  Scene scene(const Pose& X) const;
   const Poly& A_;
   const Poly& B_;
   Tolerances tol_;

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <random>
 #include <set>
 #include <sstream>
@@ -131,6 +132,12 @@ std::string RecallResult::details() const {
 }
 
 namespace {
+
+std::string fmt17(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -291,6 +298,12 @@ RecallResult run_pair(const Mesh& A, const Mesh& B, const std::string& dir, cons
     // Second opinions before anything counts: the same classification at tol/10 and tol*10
     // (a CF whose PCs change within that range is dropped), and for misses a Monte-Carlo
     // search for points of A inside B (a safety net under the exact test).
+    // With a kept directory: samples.csv, the CFs the oracle realised that the graph holds.
+    std::unique_ptr<std::ofstream> samples_out;
+    if (!o.keep_dir.empty()) {
+      samples_out = std::make_unique<std::ofstream>(fs::path(dir) / "samples.csv");
+      *samples_out << "pcs,free_clearance_mm,R00,R01,R02,R10,R11,R12,R20,R21,R22,tx,ty,tz\n";
+    }
     Tolerances tlo = tol, thi = tol;
     tlo.len /= 10;
     thi.len *= 10;
@@ -304,6 +317,17 @@ RecallResult run_pair(const Mesh& A, const Mesh& B, const std::string& dir, cons
       ++r.sampled;
       if (in_graph.count(k)) {
         ++r.found;
+        if (samples_out) {
+          // The CF's pose for the run time's identification test (tests/identify_oracle_test):
+          // its PCs, how far the nearest contact that is not another reading of them is,
+          // and the pose.
+          const double free_mm = C.clearance_outside(s.pose, k);
+          *samples_out << key_string(k) << ',' << (std::isfinite(free_mm) ? free_mm : 1e9);
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) *samples_out << ',' << fmt17(s.pose.R(i, j));
+          for (int i = 0; i < 3; ++i) *samples_out << ',' << fmt17(s.pose.t(i));
+          *samples_out << '\n';
+        }
         continue;
       }
       Verdict v = C.classify(s.pose, false);

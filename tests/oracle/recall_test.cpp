@@ -32,6 +32,9 @@ void run_seed(std::uint64_t seed) {
   o.budget_s = 15.0;         // a cap only: the sampler stops after sampler_rounds rounds,
   o.sampler_rounds = 8000;   // which takes about 3 s and makes the run deterministic
   o.threads = 2;
+#ifdef CF_ORACLE_KEEP_DIR
+  o.keep_dir = CF_ORACLE_KEEP_DIR;  // pair, graph and samples.csv for identify_oracle_test
+#endif
   if (const char* b = std::getenv("ORACLE_BUDGET")) o.budget_s = std::atof(b);
   if (const char* k = std::getenv("ORACLE_ROUNDS")) o.sampler_rounds = std::atol(k);
   if (const char* j = std::getenv("ORACLE_THREADS")) o.threads = std::atoi(j);

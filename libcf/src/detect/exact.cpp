@@ -94,9 +94,35 @@ PairOutcome contact(PcType type, int ia, int ib, double d, const Vec3& p_W, cons
 // first to the last point over the face; 0 beside the face). Turned away for the segment's
 // heights or its in-plane gap, it leaves in *lin how far the segment must move (in the
 // face's frame) to pass them.
+// Whether the 2D segment c0-c1 lies along one boundary edge of the flat face P (within tol
+// of it at both ends): the open face does not touch it, only that edge does.
+// Misfit added to a contact whose open elements do not touch, only their boundaries: a line
+// contact whose part over the face lies along one of the face's boundary edges or does not
+// enter the face (the touch is the edges', degenerate), an e-e crossing at an end of an edge
+// (a vertex on an edge), a v-f or f-v whose vertex is on the face's boundary or beside it. A reading that keeps the contact region whole, e.g. the e-f of
+// the neighbouring face, must rank above it (docs/runtime.md).
+constexpr double kAlongBoundaryPenalty = 1.0;
+
+bool along_boundary(const Poly2& P, const Vec2& c0, const Vec2& c1, double tol) {
+  const auto dist = [](const Vec2& x, const Vec2& a, const Vec2& b) {
+    const Vec2 ab = b - a;
+    const double l2 = ab.squaredNorm();
+    const double u = l2 > 0 ? std::clamp((x - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+    return (x - (a + u * ab)).norm();
+  };
+  for (int l = 0; l < P.num_loops; ++l)
+    for (int i = P.lb[l]; i < P.lb[l + 1]; ++i) {
+      const Vec2& a = P.pts[i];
+      const Vec2& b = P.pts[i + 1 == P.lb[l + 1] ? P.lb[l] : i + 1];
+      if (dist(c0, a, b) <= tol && dist(c1, a, b) <= tol) return true;
+    }
+  return false;
+}
+
 bool line_on_face(const PairTables& t, ExactScratch& s, const Polyhedron& m, const FlatFaces& flat,
                   int f, const Vec3& s0, const Vec3& s1, double* t_c, double* d, double* gap,
-                  double* span, double* lin) {
+                  double* span, double* lin, bool* on_boundary) {
+  *on_boundary = false;
   const Face& F = m.faces()[static_cast<std::size_t>(f)];
   const double h0 = F.normal.dot(s0) - F.offset, h1 = F.normal.dot(s1) - F.offset;
   if (std::min(h0, h1) > t.eps || std::max(h0, h1) < -t.depth) {
@@ -124,6 +150,9 @@ bool line_on_face(const PairTables& t, ExactScratch& s, const Polyhedron& m, con
     *d = dmin;
     *gap = 0;
     *span = last - first;
+    // The clipped ends lie up to the clipping's slack beyond the boundary: 10 geo_tol, far
+    // below any feature still.
+    *on_boundary = along_boundary(flat.poly(f), a2 + first * (b2 - a2), a2 + last * (b2 - a2), 10 * t.geo_tol);
   } else {
     // Beside the face: the nearest in-plane approach to its boundary.
     const Poly2 P = flat.poly(f);
@@ -143,6 +172,7 @@ bool line_on_face(const PairTables& t, ExactScratch& s, const Polyhedron& m, con
     *d = h0 + tb * (h1 - h0);
     *gap = best;
     *span = 0;
+    *on_boundary = true;  // the segment does not enter the face: at most its boundary touches
   }
   return t.in_band(*d);
 }
@@ -239,8 +269,10 @@ PairOutcome vertex_face(const PairTables& t, PosedA& P, int v, int fb) {
   const double gap = (loc.inside || loc.dist <= t.geo_tol) ? 0.0 : loc.dist;
   // The vertex's projection on B's plane moves at most as far as the vertex.
   if (gap > t.in_plane) return turned_away(gap - t.in_plane - t.geo_tol, 0);
+  // On the face's boundary (a vertex on an edge, or outside): the open face does not touch.
+  const bool boundary = !loc.inside || loc.dist <= 10 * t.geo_tol;
   return contact(PcType::kVF, v, fb, h, p, p - h * F.normal, task_frame(F.normal, F.u),
-                 std::abs(h) / t.eps + gap / t.eps);
+                 std::abs(h) / t.eps + gap / t.eps + (boundary ? kAlongBoundaryPenalty : 0.0));
 }
 
 // ---- f-v: face of A on vertex of B ---------------------------------------------------------
@@ -270,8 +302,9 @@ PairOutcome face_vertex(const PairTables& t, PosedA& P, int fa, int v) {
   }
   const Vec3 nW = pose.R_BA * F.normal;
   const Vec3 onA = q - h * nW;
+  const bool boundary = !loc.inside || loc.dist <= 10 * t.geo_tol;  // as in v-f
   return contact(PcType::kFV, fa, v, h, onA, onA, task_frame(-nW, pose.R_BA * F.u),
-                 std::abs(h) / t.eps + gap / t.eps);
+                 std::abs(h) / t.eps + gap / t.eps + (boundary ? kAlongBoundaryPenalty : 0.0));
 }
 
 // ---- e-f: edge of A on face of B -----------------------------------------------------------
@@ -290,7 +323,8 @@ PairOutcome edge_face(const PairTables& t, PosedA& P, ExactScratch& s, int e, in
                                t.wings_a[static_cast<std::size_t>(e)], E, t.sin_tol_face_a);
   if (dip > 0) return turned_away(0, dip - t.geo_tol);
   double tc, d, gap, span, lin = 0;
-  if (!line_on_face(t, s, *t.b, t.flat_b, fb, p0, p1, &tc, &d, &gap, &span, &lin))
+  bool on_boundary = false;
+  if (!line_on_face(t, s, *t.b, t.flat_b, fb, p0, p1, &tc, &d, &gap, &span, &lin, &on_boundary))
     return turned_away(lin - t.geo_tol, 0);  // A's segment moves at most the bound
   // The tilt at which the part of the edge over the face stays within epsilon (the whole
   // edge beside the face).
@@ -300,7 +334,7 @@ PairOutcome edge_face(const PairTables& t, PosedA& P, ExactScratch& s, int e, in
   const Vec3 p = p0 + tc * (p1 - p0);
   const double hc = F.normal.dot(p) - F.offset;
   return contact(PcType::kEF, e, fb, d, p, p - hc * F.normal, task_frame(F.normal, dW),
-                 ang / tol + std::abs(d) / t.eps + gap / t.eps);
+                 ang / tol + std::abs(d) / t.eps + gap / t.eps + (on_boundary ? kAlongBoundaryPenalty : 0.0));
 }
 
 // ---- f-e: face of A on edge of B -----------------------------------------------------------
@@ -321,7 +355,8 @@ PairOutcome face_edge(const PairTables& t, PosedA& P, ExactScratch& s, int fa, i
   const Vec3& q1 = b.vertex(E.v1).p;
   const Vec3 q0A = pose.inverse_apply(q0), q1A = pose.inverse_apply(q1);
   double tc, d, gap, span, lin = 0;
-  if (!line_on_face(t, s, *t.a, t.flat_a, fa, q0A, q1A, &tc, &d, &gap, &span, &lin)) {
+  bool on_boundary = false;
+  if (!line_on_face(t, s, *t.a, t.flat_a, fa, q0A, q1A, &tc, &d, &gap, &span, &lin, &on_boundary)) {
     // B's segment as A sees it moves at most the bound times max(1, |q - o| / r_a).
     if (!P.certifying) return {};
     return turned_away(
@@ -334,7 +369,7 @@ PairOutcome face_edge(const PairTables& t, PosedA& P, ExactScratch& s, int fa, i
   const Vec3 qcA = q0A + tc * (q1A - q0A);
   const Vec3 onA = pose.apply(qcA - (F.normal.dot(qcA) - F.offset) * F.normal);
   return contact(PcType::kFE, fa, e, d, onA, onA, task_frame(-(pose.R_BA * F.normal), E.dir),
-                 ang / tol + std::abs(d) / t.eps + gap / t.eps);
+                 ang / tol + std::abs(d) / t.eps + gap / t.eps + (on_boundary ? kAlongBoundaryPenalty : 0.0));
 }
 
 // ---- f-f: face of A on face of B -----------------------------------------------------------
@@ -444,8 +479,11 @@ PairOutcome edge_edge(const PairTables& t, PosedA& P, int ea, int eb) {
     const double flip = std::abs(side) / (2 * (sumB - sumA).norm() / sn + sA.norm());
     return turned_away(0, std::min(turn, flip) - t.geo_tol);
   }
+  // A crossing at an end of either edge is a vertex on an edge (degenerate): the open edges
+  // do not cross there.
+  const bool at_end = std::min({std::abs(s), std::abs(s - EA.length), std::abs(u), std::abs(u - EB.length)}) <= t.geo_tol;
   return contact(PcType::kEE, ea, eb, d, pA, pB, task_frame(n, uB),
-                 std::abs(d) / t.eps + over / t.eps);
+                 std::abs(d) / t.eps + over / t.eps + (at_end ? kAlongBoundaryPenalty : 0.0));
 }
 
 }  // namespace cf::detail

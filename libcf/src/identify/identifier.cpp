@@ -80,6 +80,7 @@ struct IdentifyScratch {
   // Set per call by identify().
   const CfGraph* graph = nullptr;
   IdentificationParams prm;
+  double eps_mm = 1;  // Params::epsilon_mm
   Identification* res = nullptr;
   CfId prev;
   // Per step scratch (fixed size).
@@ -138,35 +139,67 @@ struct IdentifyScratch {
     return worst;
   }
 
+  // Whether plane g holds a contact that touches (within touch_distance_mm), that nothing
+  // dominates and whose shape fits exactly (misfit below 1e-6 without the distance term): a
+  // whole reading of some touch, which a reading that leaves it to an explanation loses.
+  bool exact_touch(int g) const {
+    const ContactSet& cs = res->contacts;
+    for (int k = 0; k < count[static_cast<std::size_t>(g)]; ++k) {
+      const ContactPc& c = cs[members[static_cast<std::size_t>(g)][static_cast<std::size_t>(k)]];
+      if (!c.dominated && std::abs(c.distance) <= prm.touch_distance_mm &&
+          c.misfit - std::abs(c.distance) / eps_mm < 1e-6)
+        return true;
+    }
+    return false;
+  }
+
   // An interpretation that is a CF, with its rank keys (docs/runtime.md, Identification).
   struct Ranked {
     int tier = 2;    // 0: every skipped plane apart; 1: some explained
     int dom = 4;     // dominated PCs chosen
+    int left = 64;   // skipped planes holding an exact, undominated touch (another reading)
     int cat = 3;     // 0 previous CF, 1 its neighbour, 2 other
     double misfit = 0;
     CfId id;
     int n = 0;
     bool partial = false;
+    // Whole contact regions first (fewest dominated PCs: a fragment of a line or plane
+    // contact read as points ranks below the whole), then planes accounted for, then the
+    // history, then the fit (docs/runtime.md).
     bool better_than(const Ranked& o) const {
-      return tier != o.tier ? tier < o.tier : dom != o.dom ? dom < o.dom : cat != o.cat ? cat < o.cat : misfit < o.misfit;
+      return dom != o.dom     ? dom < o.dom
+             : tier != o.tier ? tier < o.tier
+             : left != o.left ? left < o.left
+             : cat != o.cat   ? cat < o.cat
+                              : misfit < o.misfit;
     }
     // Nothing can rank above: the previous CF is one PC set, so one interpretation.
-    bool unbeatable() const { return tier == 0 && dom == 0 && cat == 0; }
+    bool unbeatable() const { return tier == 0 && dom == 0 && left == 0 && cat == 0; }
   };
 
   // Ranks the interpretation `chosen` (contact indices; taken[g]: plane g has one of them).
-  // False when a skipped plane is not accounted for, when its tier is worse than
-  // `tier_bound`, or when no CF has this PC set.
-  bool rank(const int* chosen, int n, const bool* taken, int G, int tier_bound, Ranked& r) const {
+  // False when a skipped plane is not accounted for, when it ranks below `bound` on the
+  // first two keys (dominated PCs, then tier), or when no CF has this PC set.
+  bool rank(const int* chosen, int n, const bool* taken, int G, const Ranked& bound, Ranked& r) const {
     const ContactSet& cs = res->contacts;
     r.partial = n < G;
+    r.dom = 0;
     double farthest = 0;
-    for (int i = 0; i < n; ++i) farthest = std::max(farthest, cs[chosen[i]].distance);
+    for (int i = 0; i < n; ++i) {
+      farthest = std::max(farthest, cs[chosen[i]].distance);
+      r.dom += cs[chosen[i]].dominated;
+    }
+    if (r.dom > bound.dom) return false;
     const double apart_beyond = farthest + prm.touch_distance_mm;
     r.tier = 0;
-    for (int g = 0; g < G && r.tier < 2 && r.partial; ++g)
-      if (!taken[g]) r.tier = std::max(r.tier, accounted(g, chosen, n, apart_beyond));
-    if (r.tier >= 2 || r.tier > tier_bound) return false;
+    r.left = 0;
+    for (int g = 0; g < G && r.tier < 2 && r.partial; ++g) {
+      if (taken[g]) continue;
+      const int a = accounted(g, chosen, n, apart_beyond);
+      r.tier = std::max(r.tier, a);
+      if (a == 1 && exact_touch(g)) ++r.left;
+    }
+    if (r.tier >= 2 || (r.dom == bound.dom && r.tier > bound.tier)) return false;
     PcSet key;
     for (int i = 0; i < n; ++i) key.insert(cs[chosen[i]].pc);
     const std::optional<CfId> id = graph->find(key);
@@ -174,11 +207,7 @@ struct IdentifyScratch {
     r.id = *id;
     r.cat = (prev.valid() && *id == prev) ? 0 : (prev.valid() && graph->adjacent(prev, *id)) ? 1 : 2;
     r.misfit = 0;
-    r.dom = 0;
-    for (int i = 0; i < n; ++i) {
-      r.misfit += cs[chosen[i]].misfit;
-      r.dom += cs[chosen[i]].dominated;
-    }
+    for (int i = 0; i < n; ++i) r.misfit += cs[chosen[i]].misfit;
     r.n = n;
     return true;
   }
@@ -204,7 +233,10 @@ struct IdentifyScratch {
       chosen[n++] = found;
     }
     Ranked r;
-    if (!rank(chosen, n, taken.data(), G, 0, r) || !r.unbeatable()) return false;
+    Ranked bound;
+    bound.dom = 0;
+    bound.tier = 0;
+    if (!rank(chosen, n, taken.data(), G, bound, r) || !r.unbeatable()) return false;
     res->combinations = 1;
     set_result(IdStatus::kMatchedPrevious, r.id, chosen, n, r.misfit, r.partial);
     return true;
@@ -325,7 +357,7 @@ struct IdentifyScratch {
         }
         ++res->combinations;
         Ranked r;
-        if (rank(chosen, n, taken.data(), G, best.tier, r) && r.better_than(best)) {
+        if (rank(chosen, n, taken.data(), G, best, r) && r.better_than(best)) {
           best = r;
           std::copy(chosen, chosen + n, best_chosen);
           if (best.unbeatable()) break;
@@ -357,10 +389,11 @@ struct IdentifyScratch {
 void IdentifyScratchDelete::operator()(IdentifyScratch* s) const { delete s; }
 IdentifyScratchPtr make_identify_scratch() { return IdentifyScratchPtr(new IdentifyScratch()); }
 
-void identify(const CfGraph& graph, const IdentificationParams& params, CfId previous, IdentifyScratch& s,
-              Identification& id) {
+void identify(const CfGraph& graph, const IdentificationParams& params, double epsilon_mm, CfId previous,
+              IdentifyScratch& s, Identification& id) {
   s.graph = &graph;
   s.prm = params;
+  s.eps_mm = epsilon_mm;
   s.res = &id;
   s.prev = previous;
   s.run();

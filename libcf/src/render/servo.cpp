@@ -112,7 +112,7 @@ const Identification& identify(const CfModel& model, CfState& state, const Conta
     s.id.contacts = contacts;
     s.detected.valid = false;  // no longer the contacts of the last detection
   }
-  detail::identify(*m.graph, m.params.identification, s.previous, *s.identify, s.id);
+  detail::identify(*m.graph, m.params.identification, m.params.epsilon_mm, s.previous, *s.identify, s.id);
   return s.id;
 }
 
