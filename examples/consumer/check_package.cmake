@@ -44,9 +44,9 @@ foreach(header IN LISTS headers)
   endif()
 endforeach()
 
-message(STATUS "3. configure, build and run examples/consumer against the installed package")
-set(configure_args --no-warn-unused-cli
-  -S "${CONSUMER_SOURCE_DIR}" -B "${consumer_build}" -G "${GENERATOR}"
+# Configures SOURCE against the installed package into BUILD, builds it, runs PROGRAM with
+# the remaining arguments and fails unless it exits 0.
+set(common_args --no-warn-unused-cli -G "${GENERATOR}"
   "-DCMAKE_BUILD_TYPE=${CF_CONFIG}"
   "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}"
   "-DCMAKE_PREFIX_PATH=${prefix}"
@@ -57,44 +57,35 @@ set(configure_args --no-warn-unused-cli
   -DCMAKE_DISABLE_FIND_PACKAGE_nlohmann_json=ON
   -DCMAKE_DISABLE_FIND_PACKAGE_CGAL=ON)
 if(MAKE_PROGRAM)
-  list(APPEND configure_args "-DCMAKE_MAKE_PROGRAM=${MAKE_PROGRAM}")
+  list(APPEND common_args "-DCMAKE_MAKE_PROGRAM=${MAKE_PROGRAM}")
 endif()
 if(CXX_COMPILER_LAUNCHER)
-  list(APPEND configure_args "-DCMAKE_CXX_COMPILER_LAUNCHER=${CXX_COMPILER_LAUNCHER}")
+  list(APPEND common_args "-DCMAKE_CXX_COMPILER_LAUNCHER=${CXX_COMPILER_LAUNCHER}")
 endif()
-execute_process(COMMAND "${CMAKE_COMMAND}" ${configure_args} COMMAND_ERROR_IS_FATAL ANY)
-execute_process(COMMAND "${CMAKE_COMMAND}" --build "${consumer_build}" --config "${CF_CONFIG}"
-                COMMAND_ERROR_IS_FATAL ANY)
+function(build_and_run source build program expectation)
+  execute_process(COMMAND "${CMAKE_COMMAND}" ${common_args} -S "${source}" -B "${build}" COMMAND_ERROR_IS_FATAL ANY)
+  execute_process(COMMAND "${CMAKE_COMMAND}" --build "${build}" --config "${CF_CONFIG}" COMMAND_ERROR_IS_FATAL ANY)
+  # Ninja/Makefiles put the program in the build directory, multi-config generators in a
+  # per-configuration subdirectory.
+  set(exe "${build}/${program}")
+  if(NOT EXISTS "${exe}")
+    set(exe "${build}/${CF_CONFIG}/${program}")
+  endif()
+  execute_process(COMMAND "${exe}" ${ARGN} RESULT_VARIABLE result)
+  if(NOT result EQUAL 0)
+    message(FATAL_ERROR "${program} exited with ${result} (expected 0: ${expectation})")
+  endif()
+endfunction()
 
-# Ninja/Makefiles put the program in the build directory, multi-config generators in a
-# per-configuration subdirectory.
-set(program "${consumer_build}/cf_consumer")
-if(NOT EXISTS "${program}")
-  set(program "${consumer_build}/${CF_CONFIG}/cf_consumer")
-endif()
-execute_process(COMMAND "${program}" RESULT_VARIABLE result)
-if(NOT result EQUAL 0)
-  message(FATAL_ERROR "cf_consumer exited with ${result} (expected 0: volume 1000 mm^3)")
-endif()
+message(STATUS "3. configure, build and run examples/consumer against the installed package")
+build_and_run("${CONSUMER_SOURCE_DIR}" "${consumer_build}" cf_consumer
+              "volume 1000 mm^3 and the slab pushing the cube up")
 
 if(HAPTIC_LOOP_SOURCE_DIR)
   message(STATUS "4. configure, build and run examples/haptic_loop against the installed package")
-  set(loop_build "${WORK_DIR}/build-loop")
-  set(loop_args ${configure_args})
-  list(TRANSFORM loop_args REPLACE "^${CONSUMER_SOURCE_DIR}$" "${HAPTIC_LOOP_SOURCE_DIR}")
-  list(TRANSFORM loop_args REPLACE "^${consumer_build}$" "${loop_build}")
-  execute_process(COMMAND "${CMAKE_COMMAND}" ${loop_args} COMMAND_ERROR_IS_FATAL ANY)
-  execute_process(COMMAND "${CMAKE_COMMAND}" --build "${loop_build}" --config "${CF_CONFIG}"
-                  COMMAND_ERROR_IS_FATAL ANY)
-  set(loop "${loop_build}/cf_haptic_loop")
-  if(NOT EXISTS "${loop}")
-    set(loop "${loop_build}/${CF_CONFIG}/cf_haptic_loop")
-  endif()
-  execute_process(COMMAND "${loop}" --graph "${GRAPH}" --rate 1000 --duration 1.5 --check
-                          --trace "${WORK_DIR}/trace.csv" --device "${WORK_DIR}/device.csv"
-                  RESULT_VARIABLE result)
-  if(NOT result EQUAL 0)
-    message(FATAL_ERROR "cf_haptic_loop --check exited with ${result}")
-  endif()
+  build_and_run("${HAPTIC_LOOP_SOURCE_DIR}" "${WORK_DIR}/build-loop" cf_haptic_loop
+                "--check: the rate held, a CF on every tick inside B, the proxy on the surface"
+                --graph "${GRAPH}" --rate 1000 --duration 1.5 --check
+                --trace "${WORK_DIR}/trace.csv" --device "${WORK_DIR}/device.csv")
 endif()
 message(STATUS "installed package OK")
