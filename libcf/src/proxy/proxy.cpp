@@ -137,13 +137,30 @@ Vec6 polish(const Vec6& xi_pgs, const Vec6& xi_d, const Row* rows, double* lambd
       add(rows[3 * j + 2], 0);
     }
   }
-  Vec6 xi = xe;
-  for (int l = 0; l < nq; ++l)
-    xi += WQ[static_cast<std::size_t>(l)] *
-          (C[static_cast<std::size_t>(l)] - Q[static_cast<std::size_t>(l)].dot(xe));
-  for (int j = 0; j < m; ++j)
-    if (dist[j] + rows[3 * j].a.dot(xi) < -1e-9) return xi_pgs;
-  return xi;
+  // The projection; a normal row it violates (a corner Gauss-Seidel left unloaded, which the
+  // motion would push into B) joins the active set, with its friction rows when its group
+  // sticks, and the projection is redone: one row per round, while the rows stay independent.
+  for (int round = 0; round <= 6; ++round) {
+    Vec6 xi = xe;
+    for (int l = 0; l < nq; ++l)
+      xi += WQ[static_cast<std::size_t>(l)] *
+            (C[static_cast<std::size_t>(l)] - Q[static_cast<std::size_t>(l)].dot(xe));
+    int worst = -1;
+    double worst_gap = -1e-9;
+    for (int j = 0; j < m; ++j) {
+      const double gap = dist[j] + rows[3 * j].a.dot(xi);
+      if (gap < worst_gap) worst_gap = gap, worst = j;
+    }
+    if (worst < 0) return xi;
+    const int before = nq;
+    add(rows[3 * worst], -dist[worst]);
+    if (mu[worst] > 0 && !slides[group[worst]]) {
+      add(rows[3 * worst + 1], 0);
+      add(rows[3 * worst + 2], 0);
+    }
+    if (nq == before) break;  // dependent on the active rows: they cannot all hold
+  }
+  return xi_pgs;
 }
 
 }  // namespace
@@ -323,12 +340,9 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
       break;
     }
     X = moved(X, g_A, xi.head<3>(), xi.tail<3>());
-    // Done unless a rotation's second-order error (|w|^2 r / 2 at most) may exceed the
-    // allowed depth: then the new pose is detected, and a point contact deeper than that
-    // starts another pass. A translation is exact in the linearisation, and a sweep of at
-    // most step_len < epsilon meets no contact the pose's detection (within epsilon) did not list.
-    const double w2 = xi.tail<3>().squaredNorm();
-    if (0.5 * w2 * pm.reach_mm <= 0.5 * q.max_penetration_mm) break;
+    // Done when the new pose keeps every point contact within the allowed depth; otherwise
+    // (a rotation's second-order error, a contact the linearisation misjudged) another pass
+    // pushes it out. The detection is the one the stages then use at this pose (cached).
     double deepest = 0;
     for (const ContactPc& c : detect_at(dm, ds, X, at))
       if (is_point_type(c.pc.type)) deepest = std::min(deepest, c.distance);
