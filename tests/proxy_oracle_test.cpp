@@ -15,9 +15,9 @@
 //    the end of each hold grows strictly with the depth of the device (1 < 3 < 6 mm), on the
 //    runs where the proxy did not turn by more than kTipRad. A push whose line passes beside
 //    the support tips A over its edge (the proxy turns, its CF changes): there the push along
-//    the first normal falls, as for a part pushed off a ledge. The count of turned runs is
-//    printed: about half of them today, though the hand holds A at the oracle's contact
-//    point (an open question of the proxy, docs/force-model.md "Limits");
+//    the first normal falls, as for a part pushed off a ledge. The hand holds A at the middle
+//    of the contact's corners (as the oracle sees them); the count of turned runs is printed
+//    (13 of 160 today: docs/force-model.md, "The proxy", Limits);
 //  - after pulling out to 10 mm outside, X_WP is X_WD exactly and F_W is gravity alone. (Not
 //    3 mm: a proxy tipped onto B's side face can stay wedged there by friction under the
 //    coupling's torque until the hand pulls far enough to overcome it, as a real part would.)
@@ -555,8 +555,10 @@ void run_sample(const cf::CfModel& model, const oracle::Classifier& C,
   if (tipped) {
     ++S.cf_changed;
     if (std::getenv("CF_PROXY_ORACLE_VERBOSE"))
-      std::printf("  tipped %s: turned %.3g rad; holds: %s | %s | %s\n", tag.c_str(), hold_turn,
-                  hold_info[0].c_str(), hold_info[1].c_str(), hold_info[2].c_str());
+      std::printf(
+          "  tipped %s: turned %.3g rad (held at %s in A's frame, push %s); holds: %s | %s | %s\n",
+          tag.c_str(), hold_turn, vec_str(model.params().proxy.grip_point_A).c_str(),
+          vec_str(d).c_str(), hold_info[0].c_str(), hold_info[1].c_str(), hold_info[2].c_str());
   } else if (hold_force[0] < hold_force[1] && hold_force[1] < hold_force[2]) {
     ++S.monotonic;
   } else {
@@ -607,16 +609,27 @@ PairSummary check_pair(const fs::path& dir) {
         continue;
       }
       ++S.run;
-      // The hand holds A at the middle of its contact (ProxyParams::grip_point_A): the push
-      // line passes through the support, as when an operator presses a part onto a seat, so
+      // The hand holds A at the middle of its PCs' touch points (ProxyParams::grip_point_A): the
+      // push line passes through the support, as when an operator presses a part onto a seat, so
       // the proxy is not expected to tip. (Held at A's frame origin, which the generated
       // shapes put at a corner, most pushes pass beside the support and tip A over its edge.)
       const oracle::Verdict V = C.classify(s.X, false);
       oracle::Vec3 c = oracle::Vec3::Zero();
       int k = 0;
-      for (int i : V.pcs) {
-        const oracle::Touch& t = V.touches[static_cast<std::size_t>(i)];
-        const bool segment = t.p1 != t.p0;
+      // The corners of the PCs' contact regions: the touching pairs of a vertex or of two
+      // edges that a PC dominates (their elements in the closures of the PC's).
+      for (const oracle::Touch& t : V.touches) {
+        const int ka = oracle::kind_a(t.type), kb = oracle::kind_b(t.type);
+        if (!(ka == 0 || kb == 0 || (ka == 1 && kb == 1))) continue;
+        bool of_a_pc = false;
+        for (int i : V.pcs) {
+          const oracle::Touch& pc = V.touches[static_cast<std::size_t>(i)];
+          of_a_pc = of_a_pc || (C.A().in_closure(ka, t.a, oracle::kind_a(pc.type), pc.a) &&
+                                C.B().in_closure(kb, t.b, oracle::kind_b(pc.type), pc.b));
+        }
+        if (!of_a_pc) continue;
+        // A point touch's place is p0 (p1 is not set for it); a collinear e-e is a segment.
+        const bool segment = t.type == oracle::PcType::EEC;
         c += segment ? 0.5 * (t.p0 + t.p1) : t.p0;
         ++k;
       }
