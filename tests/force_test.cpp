@@ -5,8 +5,8 @@
 // floor is the plane y = 0 (normal +y), walls are given per test. Defaults: K = 2.3 N/mm,
 // K_p = 1.6 N/mm, mu = 0.7, mu_D = 0.08, eps = 1 mm, m g = 4.9 N along -y.
 
-#include "fixtures.hpp"
 #include <cf/force.hpp>
+#include "fixtures.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -137,7 +137,7 @@ TEST_CASE("guarded impact: eq. (2) inside the friction cone, eq. (5) outside", "
     const cf::ForceResult& r = model.step(pose, 0.001, &c, 1, prior(cf::MotionType::kMT1));
     CHECK(r.motion == cf::MotionType::kMT1);
     CHECK(r.pcs[0].regime == cf::Regime::kImpactStatic);
-    CHECK(r.pcs[0].F_cy == Approx(0.92).margin(kTol));             // 2.3 * 0.4
+    CHECK(r.pcs[0].F_cy == Approx(0.92).margin(kTol));                // 2.3 * 0.4
     CHECK(r.pcs[0].F_T.x() == Approx(0.92 * 0.3 / -1).margin(kTol));  // F_cy a / b
     CHECK(r.pcs[0].F_T.z() == Approx(0).margin(kTol));
     // The stick anchor carries the impact friction into the next ticks (eq. (4)).
@@ -241,7 +241,8 @@ TEST_CASE("MT2.b: sliding along the floor-wall line is kinetic at both PCs", "[f
   CHECK((r->F_W - cf::Vec3(-1.15, 1.15 - 4.9, -0.184)).norm() < kTol);
 }
 
-TEST_CASE("MT2.a second situation: tipping about an axis the CF does not allow (Fig. 10-i)", "[force]") {
+TEST_CASE("MT2.a second situation: tipping about an axis the CF does not allow (Fig. 10-i)",
+          "[force]") {
   Fixture fx;
   cf::ForceModel model(fx.A, fx.B);
   cf::Pose p0 = at(0, 0.5, 0);
@@ -261,7 +262,8 @@ TEST_CASE("MT2.a second situation: tipping about an axis the CF does not allow (
   CHECK(friction(r.pcs[0]) == Approx(0.7 * 1.15).margin(kTol));
 }
 
-TEST_CASE("MT2.c: rotation about a contact edge keeps the edge static, the face slides", "[force]") {
+TEST_CASE("MT2.c: rotation about a contact edge keeps the edge static, the face slides",
+          "[force]") {
   // A's edge 9 (x = 20, y = 0, along z) on the floor, A's +z face (1) on a wall z = 20.5
   // facing -z. A turns about the edge line (20, 0.5, z) of the world.
   Fixture fx;
@@ -322,7 +324,8 @@ TEST_CASE("MT4: gaining a wall PC inside and outside its friction cone", "[force
     SECTION("then MT5: losing the wall, the floor stays static while eq. (3) holds") {
       const cf::Pose p2 = at(-0.4, 0.5, 0.05);
       const cf::ContactPc c2 = floor_pc(p2);
-      const cf::PriorMotion pm5 = cf::classify_prior_motion(cf::PcSet({cs[0].pc, cs[1].pc}), cf::PcSet({c2.pc}));
+      const cf::PriorMotion pm5 =
+          cf::classify_prior_motion(cf::PcSet({cs[0].pc, cs[1].pc}), cf::PcSet({c2.pc}));
       REQUIRE(pm5.type == cf::MotionType::kMT5);
       const cf::ForceResult& r5 = model.step(p2, 0.003, &c2, 1, pm5);
       CHECK(r5.motion == cf::MotionType::kMT5);
@@ -388,10 +391,12 @@ TEST_CASE("conservative rendering: dominated interpretations do not add up", "[f
   const cf::Pose p0 = at(0, 0.5, 0);
   // f-f of the bottom face and e-f of its edge 9 on the same floor: the edge bounds the
   // face, so the f-f dominates it.
-  const cf::ContactPc cs[] = {floor_pc(p0), contact(cf::PcType::kEF, 9, 3, 0.5, {20, 0.5, 10}, X, Y)};
+  const cf::ContactPc cs[] = {floor_pc(p0),
+                              contact(cf::PcType::kEF, 9, 3, 0.5, {20, 0.5, 10}, X, Y)};
   model.step(p0, 0.000, cs, 2, prior(cf::MotionType::kNone), true);
   const cf::Pose p1 = at(1, 0.5, 0);
-  const cf::ContactPc cs1[] = {floor_pc(p1), contact(cf::PcType::kEF, 9, 3, 0.5, {21, 0.5, 10}, X, Y)};
+  const cf::ContactPc cs1[] = {floor_pc(p1),
+                               contact(cf::PcType::kEF, 9, 3, 0.5, {21, 0.5, 10}, X, Y)};
   const cf::ForceResult& r = model.step(p1, 0.001, cs1, 2, prior(cf::MotionType::kMT2a), true);
   CHECK(r.conservative);
   CHECK(r.motion == cf::MotionType::kNone);
@@ -451,7 +456,8 @@ TEST_CASE("friction never exceeds mu F_cy over random motions", "[force]") {
       if (what >= 3) cs[n++] = wall_pc(pose, pose.apply({20, 10, 10}).x() + depth(rng));
       cf::PcSet cur;
       for (int k = 0; k < n; ++k) cur.insert(cs[k].pc);
-      const cf::ForceResult& r = model.step(pose, 0.001 * i, cs, n, cf::classify_prior_motion(prev, cur));
+      const cf::ForceResult& r =
+          model.step(pose, 0.001 * i, cs, n, cf::classify_prior_motion(prev, cur));
       for (int k = 0; k < r.num_pcs; ++k) {
         CHECK(friction(r.pcs[k]) <= 0.7 * r.pcs[k].F_cy * (1 + 1e-12) + 1e-12);
         ++checked;
@@ -459,5 +465,29 @@ TEST_CASE("friction never exceeds mu F_cy over random motions", "[force]") {
       prev = cur;
     }
     CHECK(checked > 4000);
+  }
+}
+
+TEST_CASE("a tick of kMaxPcs PCs that all differ from the last tick's reuses the stale slots",
+          "[force]") {
+  // 16 v-f contacts, then 16 others: the slots of the first tick's PCs must be taken over
+  // (they used to be freed only after the new PCs asked for slots).
+  Fixture fx;
+  cf::ForceModel model(fx.A, fx.B);
+  const cf::Pose pose = at(0, 0.5, 0);
+  for (int tick = 0; tick < 3; ++tick) {
+    std::vector<cf::ContactPc> cs;
+    for (int v = 0; v < 8; ++v)
+      for (int f = 0; f < 2; ++f)
+        cs.push_back(contact(cf::PcType::kVF, v, 2 * tick + f, 0.5,
+                             pose.apply(fx.A.vertex(cf::VertexId(v)).p), X, Y));
+    REQUIRE(static_cast<int>(cs.size()) == cf::ForceResult::kMaxPcs);
+    const cf::ForceResult& r =
+        model.step(pose, 0.001 * (tick + 1), cs.data(), static_cast<int>(cs.size()),
+                   prior(cf::MotionType::kMT2a));
+    CHECK(r.num_pcs == cf::ForceResult::kMaxPcs);
+    CHECK_FALSE(r.truncated);
+    // Each contact 0.5 mm into the band: K (epsilon - 0.5) = 1.15 N along +y, 16 of them.
+    CHECK(r.F_contact_W.y() == Approx(16 * 1.15).margin(1e-9));
   }
 }

@@ -3,6 +3,8 @@
 
 #include <cf/force.hpp>
 
+#include "../check.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -61,15 +63,21 @@ ForceModel::Slot* ForceModel::find_slot(const Pc& pc) {
 }
 
 ForceModel::Slot* ForceModel::new_slot(const Pc& pc) {
+  // A free slot, else one whose PC is not rendered this tick (step() marks this tick's PCs
+  // first, so such a slot is stale): with at most kMaxPcs PCs per tick one always exists.
+  Slot* stale = nullptr;
   for (Slot& s : slots_) {
     if (!s.used) {
-      s = Slot();
-      s.used = true;
-      s.pc = pc;
-      return &s;
+      stale = &s;
+      break;
     }
+    if (!s.seen && stale == nullptr) stale = &s;
   }
-  return nullptr;
+  CF_DEMAND(stale != nullptr);
+  *stale = Slot();
+  stale->used = true;
+  stale->pc = pc;
+  return stale;
 }
 
 namespace {
@@ -120,6 +128,10 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
   }
   if (m == 0) r.motion = MotionType::kNone;
 
+  // This tick's PCs that have slots keep them (new_slot may take any other).
+  for (int k = 0; k < m; ++k)
+    if (Slot* s = find_slot(pcs[idx[k]].pc)) s->seen = true;
+
   // --- Per-PC geometry, normal force, s_pj ---
   Vec3 dir_static[ForceResult::kMaxPcs];
   Vec3 dir_kinetic[ForceResult::kMaxPcs];
@@ -141,7 +153,7 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
     Slot* s = find_slot(c.pc);
     const bool fresh = s == nullptr;
     if (fresh) {
-      s = new_slot(c.pc);  // capacity equals kMaxPcs, and stale slots are freed each tick
+      s = new_slot(c.pc);  // one exists: at most kMaxPcs PCs, stale slots are reused
       s->anchor_A = p_A;
       s->anchor_W = c.p_W;
     }
