@@ -30,11 +30,32 @@ export function parseReplay(text, name, numCfs) {
     if (!Number.isInteger(cf) || cf < -1 || cf >= numCfs)
       throw new Error(`${name} line ${i + 1}: CF ${f[1]} is not in the graph (${numCfs} CFs)`);
     const v = (a, b, c) => new Vector3(...[a, b, c].map((k) => number(f[k], name, i + 1, cols[k])));
+    // Where A was rendered, when the CSV says (cfreplay's proxy_* columns): the proxy pose,
+    // which stays out of B while the device goes in.
+    let proxy = null;
+    if (at('proxy_tx') >= 0 && at('proxy_qz') >= 0) {
+      const k0 = at('proxy_tx');
+      const q = [0, 1, 2, 3, 4, 5, 6].map((k) => number(f[k0 + k], name, i + 1, cols[k0 + k]));
+      proxy = quatPose(q[0], q[1], q[2], q[3], q[4], q[5], q[6], name, i + 1);
+    }
     rows.push({ t: number(f[0], name, i + 1, 't'), cf, pcs: f[2], motion: f[3], F: v(4, 5, 6), M: v(7, 8, 9),
-      status: at('status') >= 0 ? f[at('status')] : '' });
+      status: at('status') >= 0 ? f[at('status')] : '', proxy });
   }
   if (!rows.length) throw new Error(`${name}: no rows after the header`);
   return rows;
+}
+
+// A pose {R: rows of the rotation, t} from a translation and a quaternion (normalised).
+function quatPose(tx, ty, tz, qw0, qx0, qy0, qz0, name, line) {
+  const n = Math.hypot(qw0, qx0, qy0, qz0);
+  if (!(n > 0)) throw new Error(`${name} line ${line}: the quaternion is zero`);
+  const [w, x, y, z] = [qw0 / n, qx0 / n, qy0 / n, qz0 / n];
+  return {
+    R: [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+      [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]],
+    t: [tx, ty, tz],
+  };
 }
 
 // Poses {R: rows of the rotation, t} from rows t,tx,ty,tz,qw,qx,qy,qz.
@@ -46,15 +67,7 @@ export function parseTrajectory(text, name) {
     const f = ls[i].split(',');
     if (f.length !== 8) throw new Error(`${name} line ${i + 1}: ${f.length} fields, expected 8`);
     const [, tx, ty, tz, qw0, qx0, qy0, qz0] = f.map((x, k) => number(x, name, i + 1, TRAJECTORY_HEADER.split(',')[k]));
-    const n = Math.hypot(qw0, qx0, qy0, qz0);
-    if (!(n > 0)) throw new Error(`${name} line ${i + 1}: the quaternion is zero`);
-    const [w, x, y, z] = [qw0 / n, qx0 / n, qy0 / n, qz0 / n];
-    poses.push({
-      R: [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]],
-      t: [tx, ty, tz],
-    });
+    poses.push(quatPose(tx, ty, tz, qw0, qx0, qy0, qz0, name, i + 1));
   }
   return poses;
 }

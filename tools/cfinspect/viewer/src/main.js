@@ -489,7 +489,7 @@ function loadReplay(csvText, trajText, name) {
   $('time').disabled = false;
   $('play').disabled = false;
   $('replay-msg').textContent = `${name}: ${rows.length} ticks, ${fmt(rows[rows.length - 1].t - rows[0].t)} s` +
-    (poses ? '' : ' (no trajectory: A is drawn at the witness of each tick\'s CF)');
+    (poses || rows[0].proxy ? '' : ' (no trajectory: A is drawn at the witness of each tick\'s CF)');
   $('replay-msg').className = 'muted';
   setTick(0);
   const k = rows.findIndex((row) => row.cf >= 0);  // aim at the first contact
@@ -501,7 +501,9 @@ function setTick(i) {
   if (!r) return;
   r.tick = Math.max(0, Math.min(r.rows.length - 1, i));
   const row = r.rows[r.tick];
-  const pose = r.poses ? r.poses[r.tick] : row.cf >= 0 ? graph.cfs[row.cf].witness : null;
+  // A where it was rendered: the proxy pose when the CSV has it (the device may be inside
+  // B), else the trajectory's pose, else the witness of the tick's CF.
+  const pose = row.proxy ? row.proxy : r.poses ? r.poses[r.tick] : row.cf >= 0 ? graph.cfs[row.cf].witness : null;
   showCf(row.cf, pose, true);
   if (!pose && row.cf < 0) { arrows.F.visible = arrows.M.visible = false;
 for (const a of [arrows.F, arrows.M])  // drawn over the models: A's origin is inside A

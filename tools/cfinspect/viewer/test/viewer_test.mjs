@@ -182,6 +182,12 @@ try {
   const row = replayRows[later.tick];
   check(later.selected === Number(row[1]) && later.info.includes(`motion ${row[3]}`), `tick ${later.tick}: CF ${row[1]} and motion ${row[3]} shown`, later.info);
   check(later.arrows.F, 'the force arrow is drawn');
+  // A is drawn where it was rendered: cfreplay's proxy pose columns of that tick.
+  const hdr = readFileSync(replayCsv, 'utf8').split('\n')[0].split(',');
+  const pt = ['proxy_tx', 'proxy_ty', 'proxy_tz'].map((c) => Number(row[hdr.indexOf(c)]));
+  const drawn = [later.pose[12], later.pose[13], later.pose[14]];  // Matrix4.toArray: column-major
+  check(hdr.indexOf('proxy_tx') > 0 && pt.every((x, i) => Math.abs(x - drawn[i]) < 1e-6),
+    `tick ${later.tick}: A at the proxy pose (${pt.join(', ')})`, JSON.stringify(later.pose));
   check((await pixels(rp)).sum !== px0.sum, 'the canvas changes as the replay runs');
   // The time slider: the tick whose CF is the most frequent contact.
   const k = replayRows.findIndex((r) => r[1] !== '-1' && r[1] === replayRows[replayRows.length >> 1][1]);
