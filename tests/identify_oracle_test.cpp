@@ -10,13 +10,15 @@
 #include <cf/graph.hpp>
 #include <cf/servo.hpp>
 
+#include "pc_lists.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -32,15 +34,6 @@ namespace {
 // The floor for this test over all pairs together, and per pair the level the
 // checks written apart from the project ask for.
 constexpr double kMinShareAll = 0.999, kMinSharePerPair = 0.995;
-
-std::set<std::string> split(const std::string& s, char sep) {
-  std::set<std::string> out;
-  std::string item;
-  std::istringstream in(s);
-  while (std::getline(in, item, sep))
-    if (!item.empty()) out.insert(item);
-  return out;
-}
 
 struct PairResult {
   std::string dir;
@@ -66,18 +59,22 @@ PairResult check_pair(const fs::path& dir) {
     ++r.unambiguous;
     cf::Pose X;
     for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) X.R_BA(i, j) = std::stod(f[static_cast<std::size_t>(2 + 3 * i + j)]);
+      for (int j = 0; j < 3; ++j)
+        X.R_BA(i, j) = std::stod(f[static_cast<std::size_t>(2 + 3 * i + j)]);
       X.t_BA(i) = std::stod(f[static_cast<std::size_t>(11 + i)]);
     }
     cf::CfState state(model);  // a cold start: no previous CF
     const cf::Identification& id = cf::identify(model, state, cf::detect(model, state, X));
-    const std::set<std::string> want = split(f[0], ' ');
-    const std::set<std::string> got = id.has_cf() ? split(cf::to_string(id.pcs), ';') : std::set<std::string>{};
+    const std::set<std::string> want = cf::testdata::pc_strings(f[0], ' ');
+    const std::set<std::string> got = id.has_cf()
+                                          ? cf::testdata::pc_strings(cf::to_string(id.pcs), ';')
+                                          : std::set<std::string>{};
     if (got == want) {
       ++r.correct;
     } else {
       std::ostringstream w;
-      w << "  wanted " << f[0] << ", read " << (id.has_cf() ? cf::to_string(id.pcs) : std::string("none")) << " ("
+      w << "  wanted " << f[0] << ", read "
+        << (id.has_cf() ? cf::to_string(id.pcs) : std::string("none")) << " ("
         << cf::to_string(id.status) << ", " << id.contacts.size() << " contacts) at R,t =";
       for (std::size_t k = 2; k < 14; ++k) w << (k == 2 ? " " : ",") << f[k];
       r.wrong.push_back(w.str());
@@ -88,20 +85,24 @@ PairResult check_pair(const fs::path& dir) {
 
 }  // namespace
 
-TEST_CASE("identification from a cold start at the oracle's unambiguous poses", "[identify][oracle]") {
+TEST_CASE("identification from a cold start at the oracle's unambiguous poses",
+          "[identify][oracle]") {
   const char* env = std::getenv("CF_ORACLE_KEEP_DIR");
   const fs::path kept(env != nullptr ? env : CF_ORACLE_KEEP_DIR);
   std::vector<fs::path> dirs;
   if (fs::is_directory(kept))
     for (const auto& e : fs::directory_iterator(kept))
-      if (fs::exists(e.path() / "samples.csv") && fs::exists(e.path() / "G.json")) dirs.push_back(e.path());
+      if (fs::exists(e.path() / "samples.csv") && fs::exists(e.path() / "G.json"))
+        dirs.push_back(e.path());
   std::sort(dirs.begin(), dirs.end());
-  INFO("no samples in " << kept.string() << ": run the recall test first (ctest runs it as a fixture)");
+  INFO("no samples in " << kept.string()
+                        << ": run the recall test first (ctest runs it as a fixture)");
   REQUIRE(!dirs.empty());
   int all = 0, all_correct = 0;
   for (const fs::path& d : dirs) {
     const PairResult r = check_pair(d);
-    std::cout << r.dir << ": " << r.correct << " of " << r.unambiguous << " unambiguous poses identified\n";
+    std::cout << r.dir << ": " << r.correct << " of " << r.unambiguous
+              << " unambiguous poses identified\n";
     for (const std::string& w : r.wrong) std::cout << w << "\n";
     all += r.unambiguous;
     all_correct += r.correct;

@@ -44,6 +44,7 @@
 #include "classify.hpp"
 #include "graph.hpp"
 #include "motion.hpp"
+#include "pc_lists.hpp"
 #include "poly.hpp"
 
 #include <catch2/catch.hpp>
@@ -423,17 +424,6 @@ std::string vec_str(const Eigen::Vector3d& v) {
   return b;
 }
 
-// A PC list as a set of "type:a:b" strings (the oracle separates them with spaces, libcf
-// with ';').
-std::set<std::string> pc_set(const std::string& list, char sep) {
-  std::set<std::string> out;
-  std::string item;
-  std::istringstream in(list);
-  while (std::getline(in, item, sep))
-    if (!item.empty()) out.insert(item);
-  return out;
-}
-
 void run_sample(const cf::CfModel& model, const oracle::Classifier& C,
                 const oracle::Classifier& C_delta, const Sample& s, const oracle::Vec3& d,
                 const oracle::Vec3& p, const std::string& seed, PairSummary& S) {
@@ -455,7 +445,7 @@ void run_sample(const cf::CfModel& model, const oracle::Classifier& C,
   double hold_force[3] = {0, 0, 0};
   std::set<std::string> hold_cf[3];  // the rendered CF's PCs at the end of each hold
   double hold_turn = 0;              // rad, the most the proxy turned from the device at a hold
-  const std::set<std::string> s_key = pc_set(s.pcs, ' ');
+  const std::set<std::string> s_key = cf::testdata::pc_strings(s.pcs, ' ');
   std::string hold_info[3];  // the proxy at the end of each hold, for the failure message
   double max_depth = 0;
   for (std::size_t k = 0; k < ticks.size(); ++k) {
@@ -509,7 +499,7 @@ void run_sample(const cf::CfModel& model, const oracle::Classifier& C,
                     (r.X_WP.t_BA - s.X.t - (r.X_WP.t_BA - s.X.t).dot(d) * d).norm(),
                     Eigen::AngleAxisd(r.X_WP.R_BA * r.X_WD.R_BA.transpose()).angle());
       hold_info[h] = b + cf::to_string(r.pcs) + "] " + cf::to_string(r.status);
-      hold_cf[h] = pc_set(cf::to_string(r.pcs), ';');
+      hold_cf[h] = cf::testdata::pc_strings(cf::to_string(r.pcs), ';');
       hold_turn =
           std::max(hold_turn, Eigen::AngleAxisd(r.X_WP.R_BA * r.X_WD.R_BA.transpose()).angle());
     }

@@ -37,15 +37,17 @@ Mat3 task_frame(const Vec3& y, const Vec3& x_hint) {
   return R;
 }
 
+// Distance from p to the 2D segment s0-s1, and the parameter of the nearest point on it.
+double point_seg(const Vec2& p, const Vec2& s0, const Vec2& s1, double* t) {
+  const Vec2 r = s1 - s0;
+  const double len2 = r.squaredNorm();
+  *t = len2 > 0 ? std::clamp((p - s0).dot(r) / len2, 0.0, 1.0) : 0.0;
+  return (s0 + *t * r - p).norm();
+}
+
 // Minimum distance between 2D segments that do not cross, and the parameter on the first.
 double segment_segment_2d(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d,
                           double* t_on_first) {
-  auto point_seg = [](const Vec2& p, const Vec2& s0, const Vec2& s1, double* t) {
-    const Vec2 r = s1 - s0;
-    const double len2 = r.squaredNorm();
-    *t = len2 > 0 ? std::clamp((p - s0).dot(r) / len2, 0.0, 1.0) : 0.0;
-    return (s0 + *t * r - p).norm();
-  };
   double t, best, tb;
   best = point_seg(c, a, b, &tb);
   double v = point_seg(d, a, b, &t);
@@ -87,38 +89,35 @@ PairOutcome contact(PcType type, int ia, int ib, double d, const Vec3& p_W, cons
   return o;
 }
 
+// Misfit added to a contact whose open elements do not touch, only their boundaries: a line
+// contact whose part over the face lies along one of the face's boundary edges or does not
+// enter the face (the touch is the edges', degenerate), an e-e crossing at an end of an edge
+// (a vertex on an edge), a v-f or f-v whose vertex is on the face's boundary or beside it. A
+// reading that keeps the contact region whole, e.g. the e-f of the neighbouring face, must
+// rank above it (docs/runtime.md).
+constexpr double kAlongBoundaryPenalty = 1.0;
+
+// Whether the 2D segment c0-c1 lies along one boundary edge of the flat face P (within tol
+// of it at both ends): the open face does not touch it, only that edge does.
+bool along_boundary(const Poly2& P, const Vec2& c0, const Vec2& c1, double tol) {
+  double t;
+  for (int l = 0; l < P.num_loops; ++l)
+    for (int i = P.lb[l]; i < P.lb[l + 1]; ++i) {
+      const Vec2& a = P.pts[i];
+      const Vec2& b = P.pts[i + 1 == P.lb[l + 1] ? P.lb[l] : i + 1];
+      if (point_seg(c0, a, b, &t) <= tol && point_seg(c1, a, b, &t) <= tol) return true;
+    }
+  return false;
+}
+
 // Line contact of segment s0->s1 (in the face's model frame) against face f of model m
 // (flat f): shared by e-f (m = B, segment world) and f-e (m = A, segment in A's frame).
 // Returns false when not a contact; else the region's centroid parameter, its deepest
 // height, the in-plane gap and the region's extent as a share of the segment (from the
 // first to the last point over the face; 0 beside the face). Turned away for the segment's
 // heights or its in-plane gap, it leaves in *lin how far the segment must move (in the
-// face's frame) to pass them.
-// Whether the 2D segment c0-c1 lies along one boundary edge of the flat face P (within tol
-// of it at both ends): the open face does not touch it, only that edge does.
-// Misfit added to a contact whose open elements do not touch, only their boundaries: a line
-// contact whose part over the face lies along one of the face's boundary edges or does not
-// enter the face (the touch is the edges', degenerate), an e-e crossing at an end of an edge
-// (a vertex on an edge), a v-f or f-v whose vertex is on the face's boundary or beside it. A reading that keeps the contact region whole, e.g. the e-f of
-// the neighbouring face, must rank above it (docs/runtime.md).
-constexpr double kAlongBoundaryPenalty = 1.0;
-
-bool along_boundary(const Poly2& P, const Vec2& c0, const Vec2& c1, double tol) {
-  const auto dist = [](const Vec2& x, const Vec2& a, const Vec2& b) {
-    const Vec2 ab = b - a;
-    const double l2 = ab.squaredNorm();
-    const double u = l2 > 0 ? std::clamp((x - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
-    return (x - (a + u * ab)).norm();
-  };
-  for (int l = 0; l < P.num_loops; ++l)
-    for (int i = P.lb[l]; i < P.lb[l + 1]; ++i) {
-      const Vec2& a = P.pts[i];
-      const Vec2& b = P.pts[i + 1 == P.lb[l + 1] ? P.lb[l] : i + 1];
-      if (dist(c0, a, b) <= tol && dist(c1, a, b) <= tol) return true;
-    }
-  return false;
-}
-
+// face's frame) to pass them. *on_boundary: the part over the face lies along the face's
+// boundary, or the segment does not enter the face at all.
 bool line_on_face(const PairTables& t, ExactScratch& s, const Polyhedron& m, const FlatFaces& flat,
                   int f, const Vec3& s0, const Vec3& s1, double* t_c, double* d, double* gap,
                   double* span, double* lin, bool* on_boundary) {
@@ -152,7 +151,8 @@ bool line_on_face(const PairTables& t, ExactScratch& s, const Polyhedron& m, con
     *span = last - first;
     // The clipped ends lie up to the clipping's slack beyond the boundary: 10 geo_tol, far
     // below any feature still.
-    *on_boundary = along_boundary(flat.poly(f), a2 + first * (b2 - a2), a2 + last * (b2 - a2), 10 * t.geo_tol);
+    *on_boundary =
+        along_boundary(flat.poly(f), a2 + first * (b2 - a2), a2 + last * (b2 - a2), 10 * t.geo_tol);
   } else {
     // Beside the face: the nearest in-plane approach to its boundary.
     const Poly2 P = flat.poly(f);
@@ -333,8 +333,9 @@ PairOutcome edge_face(const PairTables& t, PosedA& P, ExactScratch& s, int e, in
   if (ang > tol) return {};
   const Vec3 p = p0 + tc * (p1 - p0);
   const double hc = F.normal.dot(p) - F.offset;
-  return contact(PcType::kEF, e, fb, d, p, p - hc * F.normal, task_frame(F.normal, dW),
-                 ang / tol + std::abs(d) / t.eps + gap / t.eps + (on_boundary ? kAlongBoundaryPenalty : 0.0));
+  return contact(
+      PcType::kEF, e, fb, d, p, p - hc * F.normal, task_frame(F.normal, dW),
+      ang / tol + std::abs(d) / t.eps + gap / t.eps + (on_boundary ? kAlongBoundaryPenalty : 0.0));
 }
 
 // ---- f-e: face of A on edge of B -----------------------------------------------------------
@@ -368,8 +369,9 @@ PairOutcome face_edge(const PairTables& t, PosedA& P, ExactScratch& s, int fa, i
   if (ang > tol) return {};
   const Vec3 qcA = q0A + tc * (q1A - q0A);
   const Vec3 onA = pose.apply(qcA - (F.normal.dot(qcA) - F.offset) * F.normal);
-  return contact(PcType::kFE, fa, e, d, onA, onA, task_frame(-(pose.R_BA * F.normal), E.dir),
-                 ang / tol + std::abs(d) / t.eps + gap / t.eps + (on_boundary ? kAlongBoundaryPenalty : 0.0));
+  return contact(
+      PcType::kFE, fa, e, d, onA, onA, task_frame(-(pose.R_BA * F.normal), E.dir),
+      ang / tol + std::abs(d) / t.eps + gap / t.eps + (on_boundary ? kAlongBoundaryPenalty : 0.0));
 }
 
 // ---- f-f: face of A on face of B -----------------------------------------------------------
@@ -481,7 +483,8 @@ PairOutcome edge_edge(const PairTables& t, PosedA& P, int ea, int eb) {
   }
   // A crossing at an end of either edge is a vertex on an edge (degenerate): the open edges
   // do not cross there.
-  const bool at_end = std::min({std::abs(s), std::abs(s - EA.length), std::abs(u), std::abs(u - EB.length)}) <= t.geo_tol;
+  const bool at_end = std::min({std::abs(s), std::abs(s - EA.length), std::abs(u),
+                                std::abs(u - EB.length)}) <= t.geo_tol;
   return contact(PcType::kEE, ea, eb, d, pA, pB, task_frame(n, uB),
                  std::abs(d) / t.eps + over / t.eps + (at_end ? kAlongBoundaryPenalty : 0.0));
 }

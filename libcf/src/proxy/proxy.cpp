@@ -40,7 +40,7 @@ Mat3 rotation_matrix(const Vec3& w) {
   return Eigen::AngleAxisd(a, w / a).toRotationMatrix();
 }
 
-bool is_point_type(PcType t) { return t == PcType::kVF || t == PcType::kFV || t == PcType::kEE; }
+bool is_point_type(PcType t) { return extent(t) == PcExtent::kPoint; }
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw Error("cf::Params: parameter proxy." + what);
@@ -230,6 +230,17 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
   std::array<bool, ProxyResult::kMaxContacts> slides{};     // by group, from the last polish
   std::array<ContactPc, ProxyResult::kMaxContacts> used{};  // copies: detection reuses its set
   int m = 0;  // point contacts used as constraints in the last solve
+  // The loaded contacts' constraint forces, by PC: a later solve starts from them.
+  const auto remember_forces = [&] {
+    s.num_warm = 0;
+    for (int j = 0; j < m; ++j) {
+      const auto J = static_cast<std::size_t>(j);
+      if (lambda[3 * J] <= 0) continue;
+      s.warm_pc[static_cast<std::size_t>(s.num_warm)] = used[J].pc;
+      s.warm_lambda[static_cast<std::size_t>(s.num_warm++)] = {lambda[3 * J], lambda[3 * J + 1],
+                                                               lambda[3 * J + 2]};
+    }
+  };
   for (int pass = 0; pass < q.max_substeps; ++pass) {
     ++r.substeps;
     const ContactSet& contacts = detect_at(dm, ds, X, at);
@@ -316,15 +327,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
         if (!known && s.num_sliding < ProxyResult::kMaxContacts)
           s.sliding[static_cast<std::size_t>(s.num_sliding++)] = pc;
       }
-      // The next pass of this tick starts from these forces (warm start).
-      s.num_warm = 0;
-      for (int j = 0; j < m; ++j) {
-        const auto J = static_cast<std::size_t>(j);
-        if (lambda[3 * J] <= 0) continue;
-        s.warm_pc[static_cast<std::size_t>(s.num_warm)] = used[J].pc;
-        s.warm_lambda[static_cast<std::size_t>(s.num_warm++)] = {lambda[3 * J], lambda[3 * J + 1],
-                                                                 lambda[3 * J + 2]};
-      }
+      remember_forces();  // the next pass of this tick starts from them
     }
     const double sweep = xi.head<3>().norm() + xi.tail<3>().norm() * pm.reach_mm;
     if (sweep > step_len) {
@@ -355,7 +358,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
   r.F_constraint_W.setZero();
   r.M_constraint_W.setZero();
   s.num_sliding = 0;
-  s.num_warm = 0;
+  remember_forces();  // the next tick starts from them
   for (int j = 0; j < m; ++j) {
     const auto J = static_cast<std::size_t>(j);
     const ContactPc& c = used[J];
@@ -369,11 +372,6 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
     pc.friction_W = lambda[3 * J + 1] * c.R_WT.col(0) + lambda[3 * J + 2] * c.R_WT.col(2);
     pc.sliding = ln > 0 && mu[J] > 0 && slides[static_cast<std::size_t>(group[J])];
     if (pc.sliding) s.sliding[static_cast<std::size_t>(s.num_sliding++)] = c.pc;
-    if (ln > 0) {
-      s.warm_pc[static_cast<std::size_t>(s.num_warm)] = c.pc;
-      s.warm_lambda[static_cast<std::size_t>(s.num_warm++)] = {ln, lambda[3 * J + 1],
-                                                               lambda[3 * J + 2]};
-    }
     const Vec3 f = ln * pc.n_W + pc.friction_W;
     r.F_constraint_W += f;
     r.M_constraint_W += (c.p_W - g_P).cross(f);

@@ -112,7 +112,8 @@ const Identification& identify(const CfModel& model, CfState& state, const Conta
     s.id.contacts = contacts;
     s.detected.valid = false;  // no longer the contacts of the last detection
   }
-  detail::identify(*m.graph, m.params.identification, m.params.epsilon_mm, s.previous, *s.identify, s.id);
+  detail::identify(*m.graph, m.params.identification, m.params.epsilon_mm, s.previous, *s.identify,
+                   s.id);
   return s.id;
 }
 
@@ -212,8 +213,7 @@ void add_proxy(const CfModel::Impl& m, CfState::Impl& s) {
     load = 0;
     for (int j = 0; j < p.num_contacts; ++j) {
       const Pc& c = p.contacts[static_cast<std::size_t>(j)].pc;
-      if (c == f.pc || (in_closure(A, a_kind(c.type), c.a, a_kind(f.pc.type), f.pc.a) &&
-                        in_closure(B, b_kind(c.type), c.b, b_kind(f.pc.type), f.pc.b)))
+      if (c == f.pc || dominates(A, B, f.pc, c))  // a corner of this PC's region
         load += p.contacts[static_cast<std::size_t>(j)].normal_load_N;
     }
   }
