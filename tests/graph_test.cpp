@@ -766,6 +766,8 @@ TEST_CASE("the reader rejects malformed JSON with the line and column", "[graph]
       {R"("version": 1,)", R"("version": 1.,)", "line 3, column 13 near '1': invalid number"},
       {R"("version": 1,)", R"("version": 1e,)", "line 3, column 13 near '1': invalid number"},
       {R"("version": 1,)", R"("version": -,)", "line 3, column 13 near '-': invalid number"},
+      // An integer past 64 bits (read as a double) must still end where the token ends.
+      {R"("version": 1,)", R"("version": 91111111111111111111z1,)", "line 3, column 13 near '9': invalid number"},
       {R"("version": 1,)", R"("version": tru,)", "line 3, column 13 near 't': invalid literal"},
       {R"("version": 1,)", R"("version": nul,)", "line 3, column 13 near 'n': invalid literal"},
       {R"("version": 1,)", R"("version": 1,,)", "line 3, column 15 near ',': The JSON document has an " + kStructure},

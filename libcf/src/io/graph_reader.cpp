@@ -770,9 +770,12 @@ class JsonWalker {
   void number_fallback(simdjson::simdjson_result<std::string_view> token, Sax& sax, const char* at) {
     std::string_view raw;
     if (std::move(token).get(raw) != simdjson::SUCCESS) fail_at(at, "invalid number");
-    // The token runs to the next structural character; the number is its leading part.
+    // The token runs to the next structural character: the number, then at most white space
+    // (anything else, '1e400z' say, is not a number).
     std::size_t len = 0;
     while (len < raw.size() && std::strchr("+-.0123456789eE", raw[len]) != nullptr) ++len;
+    if (raw.find_first_not_of(" \t\n\r", len) != std::string_view::npos)
+      fail_at(at, kInvalidNumber);
     raw = raw.substr(0, len);
     const std::string_view digits = raw.substr(!raw.empty() && raw[0] == '-' ? 1 : 0);
     const bool long_integer = digits.size() >= 20 && digits[0] != '0' &&
@@ -784,11 +787,13 @@ class JsonWalker {
       return;
     }
     if (r.ec == std::errc::result_out_of_range) fail_at(at, "number out of the range of a double");
-    fail_at(at, "invalid number (RFC 8259: an optional minus, digits without leading zeros, an optional "
-                "fraction and exponent)");
+    fail_at(at, kInvalidNumber);
   }
 
   inline static const std::string kEmpty;
+  static constexpr const char* kInvalidNumber =
+      "invalid number (RFC 8259: an optional minus, digits without leading zeros, an optional fraction and "
+      "exponent)";
   simdjson::padded_string copy_;     // when the caller's bytes have no padding
   simdjson::padded_string_view text_;  // simdjson reads up to SIMDJSON_PADDING bytes past the end
   const std::string& source_;
