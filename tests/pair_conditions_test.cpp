@@ -36,6 +36,12 @@ using Pair = cf::test::AnalysedPair;
 
 cf::gen::PairConditions exact_conditions(const Pair& p) { return {p.ai, p.bi, kLengthTol, kAngleTol}; }
 
+double bbox_diagonal(const Polyhedron& m) {
+  Vec3 lo = m.vertices()[0].p, hi = lo;
+  for (const auto& v : m.vertices()) lo = lo.cwiseMin(v.p), hi = hi.cwiseMax(v.p);
+  return (hi - lo).norm();
+}
+
 }  // namespace
 
 TEST_CASE("the normal cones of a cube: a face's normal, an edge's arc, a corner's octant") {
@@ -159,8 +165,11 @@ TEST_CASE("every pair of PCs of every CF of the bundled graphs passes") {
     INFO(name);
     const cf::CfGraph g = cf::CfGraph::load(std::string(CF_SOURCE_DIR) + "/data/graphs/" + name);
     const Pair p(g.model_a(), g.model_b());
-    // As enumerate.cpp builds them for the default --angle-margin (1e-3 rad).
-    const cf::gen::PairConditions pc(p.ai, p.bi, kLengthTol, kAngleTol, std::asin(0.5 * std::sin(1e-3)) - kAngleTol);
+    // As enumerate.cpp builds them for the default --angle-margin (1e-3 rad) and --min-margin
+    // (2e-4 of the smaller model's bounding-box diagonal).
+    const double diag = std::min(bbox_diagonal(p.A), bbox_diagonal(p.B));
+    const cf::gen::PairConditions pc(p.ai, p.bi, kLengthTol, kAngleTol, std::asin(0.5 * std::sin(1e-3)) - kAngleTol,
+                                     0.5 * 2e-4 * diag);
     std::size_t pairs = 0, rejected = 0;
     for (std::size_t i = 0; i < g.num_cfs(); ++i) {
       const cf::PcSet& s = g.cf(cf::CfId(static_cast<int>(i))).pcs;
@@ -176,4 +185,33 @@ TEST_CASE("every pair of PCs of every CF of the bundled graphs passes") {
     CHECK(pairs > 500);
     CHECK(rejected == 0);
   }
+}
+
+TEST_CASE("contact points inside their elements: faces that meet only at B's convex edge are rejected") {
+  // The cube's top (+z) against the L-block's end (z = 0, outward -z) and its front (+y)
+  // against the block's underside (y = 0, outward -y). The end and the underside meet at
+  // their common edge, so the two contacts hold at once only on that edge: on the boundary
+  // of both of B's faces. Angles (pi/2 each side), distances and heights over the closed
+  // faces all allow it; over the points the generator's margin inside the faces, the cube's
+  // front lies at heights of at least that margin behind the end's plane, the underside's
+  // points at least that margin in front of it.
+  const Pair p(cf::tools::load_model(model("cube.off")), cf::tools::load_model(model("l_block.off")));
+  const int a_top = cf::test::face_with_plane(p.A, Vec3(0, 0, 1), 15);
+  const int a_front = cf::test::face_with_plane(p.A, Vec3(0, 1, 0), 15);
+  const int b_end = cf::test::face_with_plane(p.B, Vec3(0, 0, -1), 0);
+  const int b_under = cf::test::face_with_plane(p.B, Vec3(0, -1, 0), 0);
+  REQUIRE(std::min({a_top, a_front, b_end, b_under}) >= 0);
+  const Pc x{PcType::kFF, a_top, b_end}, y{PcType::kFF, a_front, b_under};
+  constexpr double kContactMargin = 0.005;  // mm, half the default min_margin for the cube (2e-4 x 52 mm)
+  const cf::gen::PairConditions inside(p.ai, p.bi, kLengthTol, kAngleTol, 0, kContactMargin);
+  CHECK(exact_conditions(p).compatible(x, y));
+  CHECK_FALSE(inside.compatible(x, y));
+  CHECK_FALSE(inside.compatible(y, x));
+  // The same faces with the cube's bottom on the slab and its left face on the wall (the inner
+  // corner, a valid CF) still pass.
+  const int a_bottom = cf::test::face_with_plane(p.A, Vec3(0, -1, 0), 15);
+  const int a_left = cf::test::face_with_plane(p.A, Vec3(-1, 0, 0), 15);
+  const int slab_top = cf::test::face_with_plane(p.B, Vec3(0, 1, 0), 20);
+  const int wall_side = cf::test::face_with_plane(p.B, Vec3(1, 0, 0), 20);
+  CHECK(inside.compatible(Pc{PcType::kFF, a_bottom, slab_top}, Pc{PcType::kFF, a_left, wall_side}));
 }

@@ -191,6 +191,47 @@ std::vector<Vec3> closure_points(const Polyhedron& m, ElementKind k, int i) {
   return out;
 }
 
+std::vector<Vec3> inset_closure_points(const Polyhedron& m, ElementKind k, int i, double margin) {
+  std::vector<Vec3> whole = closure_points(m, k, i);
+  if (margin <= 0 || k == ElementKind::kVertex) return whole;
+  if (k == ElementKind::kEdge) {
+    const Edge& e = m.edges()[i];
+    if (e.length <= 2 * margin) return whole;
+    return {whole[0] + margin * e.dir, whole[1] - margin * e.dir};
+  }
+  const Face& f = m.faces()[i];
+  if (f.loops.size() != 1) return whole;
+  const std::vector<VertexId>& loop = f.loops[0];
+  const std::size_t n = loop.size();
+  std::vector<Vec3> p(n), into(n);  // corners; unit in-plane normals of side k (p[k] to p[k+1]), inwards
+  for (std::size_t c = 0; c < n; ++c) p[c] = m.vertex(loop[c]).p;
+  for (std::size_t c = 0; c < n; ++c) {
+    const Vec3 d = p[(c + 1) % n] - p[c];
+    if (d.norm() < 1e-12) return whole;
+    into[c] = f.normal.cross(d).normalized();  // the loop turns counter-clockwise about the normal
+  }
+  std::vector<Vec3> out;
+  for (std::size_t c = 0; c < n; ++c) {
+    const Vec3 &w_in = into[(c + n - 1) % n], &w_out = into[c];
+    const double turn = w_in.cross(w_out).dot(f.normal);
+    if (turn < -1e-12) return whole;  // a reflex corner
+    // The corner moved so that it is `margin` from both sides' lines: p + a w_in + b w_out
+    // with (a w_in + b w_out) . w_in == (a w_in + b w_out) . w_out == margin.
+    const double g = w_in.dot(w_out);
+    if (1 - g < 1e-12) {
+      out.push_back(p[c] + margin * w_in);  // a straight corner
+      continue;
+    }
+    const double ab = margin / (1 + g);
+    out.push_back(p[c] + ab * (w_in + w_out));
+  }
+  // Too small a face: the moved corners leave some side's strip.
+  for (const Vec3& q : out)
+    for (std::size_t c = 0; c < n; ++c)
+      if ((q - p[c]).dot(into[c]) < margin * (1 - 1e-9)) return whole;
+  return out;
+}
+
 std::vector<Vec3> closure_directions(const Polyhedron& m, ElementKind k, int i) {
   std::vector<Vec3> out;
   if (k == ElementKind::kEdge) out.push_back(m.edges()[i].dir);

@@ -44,6 +44,12 @@ bool point_inside(const Polyhedron& m, const Vec3& p, double boundary_tol);
 
 /// Vertices of an element's closure (model frame, mm).
 std::vector<Vec3> closure_points(const Polyhedron& m, ElementKind k, int i);
+/// Vertices of the closure of the points of an element at least `margin` (mm) inside it:
+/// an edge's points that far from both ends; a convex face's points whose in-plane disc of
+/// that radius lies in the face (sides moved inwards). A vertex, a face with reflex corners
+/// or holes, or an element too small to hold such a point keeps its whole closure, which
+/// still contains every such point.
+std::vector<Vec3> inset_closure_points(const Polyhedron& m, ElementKind k, int i, double margin);
 /// Unit directions of the edges in an element's closure (none for a vertex).
 std::vector<Vec3> closure_directions(const Polyhedron& m, ElementKind k, int i);
 

@@ -256,9 +256,11 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   // ranges widened by far more than rounding (1e-9 rad: the slack's effect on the angle
   // between two edges' normals is second order, 2.5e-7 rad for the default angle margin);
   // normal cones shrunk by verify's local slack.
+  // Contact points range over the points min_margin inside their elements; half of it, as the
+  // LP's margin is checked only to its rounding.
   constexpr double kAngleTol = 1e-9;
   const PairConditions pair_ok(Ai, Bi, 1e-9 * search.scale() + opt.search.touch_tol, kAngleTol,
-                               std::asin(search.verified_local_slack()) - kAngleTol);
+                               std::asin(search.verified_local_slack()) - kAngleTol, 0.5 * opt.search.min_margin);
   std::size_t singles_paired = 0;  // valid[0][0, singles_paired) have been paired with each other
   // Level 2 over the valid single PCs not paired yet (with every valid single PC).
   auto build_pairs = [&] {

@@ -191,7 +191,8 @@ double cone_cone_distance(const NormalCone& p, const NormalCone& q, double tol) 
   return d;
 }
 
-PairConditions::Side PairConditions::build(const ModelInfo& info, double cone_margin, double angle_tol) {
+PairConditions::Side PairConditions::build(const ModelInfo& info, double cone_margin, double angle_tol,
+                                           double contact_margin) {
   const Polyhedron& m = *info.model;
   Side side;
   side.cones = cones_of(info, cone_margin);
@@ -201,7 +202,7 @@ PairConditions::Side PairConditions::build(const ModelInfo& info, double cone_ma
     side.offset[static_cast<std::size_t>(k)] = static_cast<int>(elems.size());
     for (std::size_t i = 0; i < side.cones[static_cast<std::size_t>(k)].size(); ++i) {
       elems.push_back({static_cast<ElementKind>(k), static_cast<int>(i)});
-      points.push_back(closure_points(m, static_cast<ElementKind>(k), static_cast<int>(i)));
+      points.push_back(inset_closure_points(m, static_cast<ElementKind>(k), static_cast<int>(i), contact_margin));
     }
   }
   side.n = static_cast<int>(elems.size());
@@ -237,8 +238,9 @@ PairConditions::Side PairConditions::build(const ModelInfo& info, double cone_ma
 }
 
 PairConditions::PairConditions(const ModelInfo& A, const ModelInfo& B, double length_tol, double angle_tol,
-                               double cone_margin)
-    : a_(build(A, cone_margin, angle_tol)), b_(build(B, cone_margin, angle_tol)), length_tol_(length_tol),
+                               double cone_margin, double contact_margin)
+    : a_(build(A, cone_margin, angle_tol, contact_margin)), b_(build(B, cone_margin, angle_tol, contact_margin)),
+      length_tol_(length_tol),
       angle_tol_(angle_tol) {}
 
 const NormalCone& PairConditions::cone(bool of_a, ElementKind k, int i) const {

@@ -32,10 +32,14 @@ class PairConditions {
   /// vertices: the generator verifies a witness only when every contact normal is at least
   /// that far inside them (WitnessSearch::verify's local non-penetration slack), so a pair
   /// that needs a normal closer to a cone's boundary cannot be in the graph.
+  /// contact_margin (mm): the generator verifies a witness only with each contact point at
+  /// least min_margin inside its elements (the witness search's LP, refine's check), so the
+  /// distances and heights range over those points (inset_closure_points); pass at most
+  /// min_margin, less to allow for the LP's rounding.
   /// Precomputes what each model allows for every ordered pair of its elements (memory and
   /// time quadratic in the number of elements), so `compatible` is a few comparisons.
   PairConditions(const ModelInfo& A, const ModelInfo& B, double length_tol, double angle_tol,
-                 double cone_margin = 0);
+                 double cone_margin = 0, double contact_margin = 0);
 
   /// False when x and y cannot hold at one pose: the distance between the contact points,
   /// the angle between the contact normals, or the height of one contact point over the
@@ -66,7 +70,7 @@ class PairConditions {
                    static_cast<std::size_t>(offset[static_cast<int>(ky)] + y)];
     }
   };
-  static Side build(const ModelInfo& m, double cone_margin, double angle_tol);
+  static Side build(const ModelInfo& m, double cone_margin, double angle_tol, double contact_margin);
 
   Side a_, b_;
   double length_tol_, angle_tol_;

@@ -1,0 +1,77 @@
+// Tests of the generator's per-model facts (tools/cfgen/analysis.cpp): the points of an
+// element at least a margin inside it, worked out by hand on the cube and the L-block.
+
+#include "cfgen/analysis.hpp"
+#include "fixtures.hpp"
+#include "mesh/model_loader.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <string>
+
+using cf::ElementKind;
+using cf::Vec3;
+
+namespace {
+
+// Sums and products of exact inputs: rounding only.
+constexpr double kLength = 1e-12;
+
+std::string model(const std::string& name) { return std::string(CF_SOURCE_DIR) + "/data/models/" + name; }
+
+bool holds(const std::vector<Vec3>& pts, const Vec3& q) {
+  return std::any_of(pts.begin(), pts.end(), [&](const Vec3& p) { return (p - q).norm() < kLength; });
+}
+
+}  // namespace
+
+TEST_CASE("inset closure points: an edge's ends moved in, a convex face's corners moved in, others whole") {
+  const cf::Polyhedron cube = cf::tools::load_model(model("cube.off"));  // [-15, 15]^3
+  const cf::Polyhedron l = cf::tools::load_model(model("l_block.off"));
+  constexpr double m = 0.25;  // mm
+
+  // A vertex is itself.
+  const int corner = cf::test::vertex_at(cube, Vec3(15, 15, 15));
+  REQUIRE(corner >= 0);
+  CHECK(cf::gen::inset_closure_points(cube, ElementKind::kVertex, corner, m) ==
+        std::vector<Vec3>{Vec3(15, 15, 15)});
+
+  // An edge of 30 mm keeps [m, 30 - m].
+  for (std::size_t e = 0; e < cube.num_edges(); ++e) {
+    const std::vector<Vec3> pts = cf::gen::inset_closure_points(cube, ElementKind::kEdge, int(e), m);
+    REQUIRE(pts.size() == 2);
+    const Vec3 a = cube.edge_point(cf::EdgeId(int(e)), 0), b = cube.edge_point(cf::EdgeId(int(e)), 1);
+    CHECK((pts[0] - a).norm() == Approx(m).margin(kLength));
+    CHECK((pts[1] - b).norm() == Approx(m).margin(kLength));
+    CHECK((pts[1] - pts[0]).norm() == Approx(30 - 2 * m).margin(kLength));
+  }
+  // An edge shorter than twice the margin keeps its ends.
+  CHECK(cf::gen::inset_closure_points(cube, ElementKind::kEdge, 0, 16).size() == 2);
+  CHECK(cf::gen::inset_closure_points(cube, ElementKind::kEdge, 0, 16)[0] == cube.edge_point(cf::EdgeId(0), 0));
+
+  // The cube's top: the square [-15 + m, 15 - m]^2 at z = 15.
+  const int top = cf::test::face_with_plane(cube, Vec3(0, 0, 1), 15);
+  REQUIRE(top >= 0);
+  const std::vector<Vec3> sq = cf::gen::inset_closure_points(cube, ElementKind::kFace, top, m);
+  REQUIRE(sq.size() == 4);
+  const double c = 15 - m;
+  for (const Vec3& q : {Vec3(c, c, 15), Vec3(-c, c, 15), Vec3(c, -c, 15), Vec3(-c, -c, 15)}) CHECK(holds(sq, q));
+  // A 30 mm square holds one point 15 mm inside (its centre) and none farther: whole.
+  CHECK(holds(cf::gen::inset_closure_points(cube, ElementKind::kFace, top, 15), Vec3(0, 0, 15)));
+  CHECK(holds(cf::gen::inset_closure_points(cube, ElementKind::kFace, top, 16), Vec3(15, 15, 15)));
+
+  // The L-block's end (z = 0) is L-shaped, a reflex corner at (20, 20): its whole closure.
+  const int end = cf::test::face_with_plane(l, Vec3(0, 0, -1), 0);
+  REQUIRE(end >= 0);
+  const std::vector<Vec3> lpts = cf::gen::inset_closure_points(l, ElementKind::kFace, end, m);
+  CHECK(lpts.size() == 6);
+  CHECK(holds(lpts, Vec3(20, 20, 0)));
+  CHECK(holds(lpts, Vec3(120, 0, 0)));
+  // Its slab's top (y = 20, x in [20, 120], z in [0, 80]) is a rectangle.
+  const int slab_top = cf::test::face_with_plane(l, Vec3(0, 1, 0), 20);
+  const std::vector<Vec3> r = cf::gen::inset_closure_points(l, ElementKind::kFace, slab_top, m);
+  REQUIRE(r.size() == 4);
+  for (const Vec3& q : {Vec3(20 + m, 20, m), Vec3(120 - m, 20, m), Vec3(20 + m, 20, 80 - m), Vec3(120 - m, 20, 80 - m)})
+    CHECK(holds(r, q));
+}
