@@ -830,7 +830,6 @@ Pc pc_of(const PcSet& pcs, ElementKind ka, int a, ElementKind kb, int b) {
   return {};
 }
 
-constexpr ElementKind kKinds[] = {ElementKind::kVertex, ElementKind::kEdge, ElementKind::kFace};
 
 // Lower bounds on the distance between an element of A and an element of B at one pose, from
 // a face's plane: when every vertex of the other element's closure lies on one side of it,
@@ -900,31 +899,50 @@ NearElements near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& p
 
 // The element pairs (A's kind, B's kind, A's element, B's element, in that nesting order)
 // not proven farther apart than `reach` at `pose`: near the other model, then by bounding
-// spheres, then by a face's plane. verify and contacts_at measure only these.
+// spheres, then by a face's plane. verify and contacts_at measure only these. Produced one at
+// a time, so that a caller that stops at the first obstacle (verify, on most failed poses)
+// does not pay for the rest.
 struct ElementPair {
   ElementKind ka, kb;
   int a, b;
 };
 
-std::vector<ElementPair> near_pairs(const ModelInfo& A, const ModelInfo& B, const Pose& pose, double reach) {
-  const NearElements near = near_elements(A, B, pose, reach);
-  const PlaneBound planes(*A.model, *B.model, pose);
-  std::vector<ElementPair> out;
-  for (ElementKind ka : kKinds)
-    for (ElementKind kb : kKinds) {
-      const auto ia = static_cast<std::size_t>(ka), ib = static_cast<std::size_t>(kb);
-      for (int a : near.a[ia])
-        for (int b : near.b[ib]) {
-          const auto& sa = A.spheres[ia][static_cast<std::size_t>(a)];
-          const auto& sb = B.spheres[ib][static_cast<std::size_t>(b)];
-          const Vec3& ca = near.a_centers[ia][static_cast<std::size_t>(a)];
-          if ((ca - sb.first).norm() - sa.second - sb.second > reach) continue;
-          if (planes.lower(ka, a, kb, b) > reach) continue;
-          out.push_back({ka, kb, a, b});
+class NearPairs {
+ public:
+  NearPairs(const ModelInfo& A, const ModelInfo& B, const Pose& pose, double reach)
+      : A_(A), B_(B), reach_(reach), near_(near_elements(A, B, pose, reach)), planes_(*A.model, *B.model, pose) {}
+
+  /// The next pair, false when there is none.
+  bool next(ElementPair& out) {
+    for (; kind_ < 9; ++kind_, i_ = 0, j_ = 0) {
+      const auto ia = static_cast<std::size_t>(kind_ / 3), ib = static_cast<std::size_t>(kind_ % 3);
+      const std::vector<int>& as = near_.a[ia];
+      const std::vector<int>& bs = near_.b[ib];
+      for (; i_ < as.size(); ++i_, j_ = 0)
+        while (j_ < bs.size()) {
+          const int a = as[i_], b = bs[j_++];
+          const auto& sa = A_.spheres[ia][static_cast<std::size_t>(a)];
+          const auto& sb = B_.spheres[ib][static_cast<std::size_t>(b)];
+          const Vec3& ca = near_.a_centers[ia][static_cast<std::size_t>(a)];
+          if ((ca - sb.first).norm() - sa.second - sb.second > reach_) continue;
+          const auto ka = static_cast<ElementKind>(ia), kb = static_cast<ElementKind>(ib);
+          if (planes_.lower(ka, a, kb, b) > reach_) continue;
+          out = {ka, kb, a, b};
+          return true;
         }
     }
-  return out;
-}
+    return false;
+  }
+
+ private:
+  const ModelInfo& A_;
+  const ModelInfo& B_;
+  double reach_;
+  NearElements near_;
+  PlaneBound planes_;
+  int kind_ = 0;  // A's kind * 3 + B's kind
+  std::size_t i_ = 0, j_ = 0;
+};
 
 }  // namespace
 
@@ -1078,7 +1096,8 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
   int touching_pcs = 0;
   // Pairs proven farther apart than good_clearance can neither touch nor lower the clearance
   // below what counts as good: not measured.
-  for (const ElementPair& e : near_pairs(A_, B_, pose, p_.good_clearance)) {
+  NearPairs near(A_, B_, pose, p_.good_clearance);
+  for (ElementPair e; near.next(e);) {
     const ElementKind ka = e.ka, kb = e.kb;
     const int a = e.a, b = e.b;
     const double d = element_distance(A, pose, ka, a, B, kb, b).distance;
@@ -1146,7 +1165,8 @@ bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) 
       if (in_closure(A, c.ka, c.a, e.ka, e.a) && in_closure(B, c.kb, c.b, e.kb, e.b)) return true;
     return false;
   };
-  for (const ElementPair& e : near_pairs(A_, B_, pose, p_.touch_tol)) {
+  NearPairs near(A_, B_, pose, p_.touch_tol);
+  for (ElementPair e; near.next(e);) {
     if (!bounded_by_close(e)) {
       if (e.ka == K::kFace && e.kb == K::kFace) continue;
       if (element_distance(A, pose, e.ka, e.a, B, e.kb, e.b).distance > p_.touch_tol) continue;
