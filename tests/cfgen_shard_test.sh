@@ -2,7 +2,7 @@
 # Sharded and resumable cfgen runs end to end (docs/generator.md, "Shards", "Checkpoints"):
 # two shards of the cube against the L-block, merged in reverse order from another directory,
 # must give the bundled graph byte for byte, and so must a run resumed from a checkpoint that
-# lost some of its chunks; parts that do not make one whole run and checkpoints of other runs
+# lost some of its chunks, and mpirun -n 2 with and without a checkpoint; parts that do not make one whole run and checkpoints of other runs
 # are refused with a message that names the problem, and nothing is written.
 #
 #   cfgen_shard_test.sh CFGEN SOURCE_DIR WORK_DIR [MPIEXEC]
@@ -70,27 +70,37 @@ check "model changed" 1 "are not the files the shards read" "$cfgen" merge copy.
 if [[ -n $mpiexec ]]; then
   check "mpirun -n 2" 0 "" env -C "$src" "$mpiexec" -n 2 --oversubscribe --allow-run-as-root "$cfgen" \
     data/models/cube.off data/models/l_block.off -o "$work/mpi.json" -q -j 1
-  if cmp -s mpi.json "$src/data/graphs/cube_l_block.json"; then
-    echo "ok   mpirun -n 2: the graph equals data/graphs/cube_l_block.json"
-  else
-    echo "FAIL mpirun -n 2: the graph differs from data/graphs/cube_l_block.json"
-    fail=1
-  fi
+  # With a checkpoint, then resumed by one process: every stage's chunks are kept by rank 0.
+  check "mpirun -n 2 --checkpoint" 0 "" env -C "$src" "$mpiexec" -n 2 --oversubscribe --allow-run-as-root "$cfgen" \
+    data/models/cube.off data/models/l_block.off --checkpoint "$work/mpick" -o "$work/mpi_ck.json" -q -j 1
+  mpichunks=$(ls mpick/stage*_chunk*.json 2>/dev/null | wc -l)
+  check "resumed from mpirun's checkpoint" 0 "resumed $mpichunks finished chunks" \
+    env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off --checkpoint "$work/mpick" -o "$work/mpi_ck2.json" -j 2
+  for g in mpi.json mpi_ck.json mpi_ck2.json; do
+    if cmp -s "$g" "$src/data/graphs/cube_l_block.json"; then
+      echo "ok   $g equals data/graphs/cube_l_block.json"
+    else
+      echo "FAIL $g differs from data/graphs/cube_l_block.json"
+      fail=1
+    fi
+  done
 else
   echo "skip mpirun (cfgen built without MPI)"
 fi
 
-# Checkpoints: a whole run keeps every chunk; with chunks 3 and later removed (as if killed),
-# the rerun resumes the first three and writes the same graph.
+# Checkpoints: a whole run keeps every chunk of every stage; with all but the chunks of the
+# first two stages (level 1, the first level-2 round) and three of the third removed (as if
+# killed), the rerun resumes those and writes the same graph.
 check "checkpointed run" 0 "" env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off \
   --checkpoint "$work/ck" -o "$work/ck1.json" -q -j 2
-nchunks=$(ls ck/level2_chunk_*.json 2>/dev/null | wc -l)
-if [[ $nchunks -lt 4 ]]; then
-  echo "FAIL the checkpoint holds $nchunks chunks, expected at least 4"
+nchunks=$(ls ck/stage*_chunk*.json 2>/dev/null | wc -l)
+if [[ $nchunks -lt 100 ]]; then
+  echo "FAIL the checkpoint holds $nchunks chunks, expected at least 100 (64 a stage)"
   fail=1
 fi
-find ck -name 'level2_chunk_*.json' ! -name 'level2_chunk_00000[012].json' -delete
-check "resumed run" 0 "resumed 3 finished chunks of the first level-2 round" \
+find ck -name 'stage*_chunk*.json' ! -name 'stage0000[01]_chunk*.json' ! -name 'stage00003_chunk000[012].json' -delete
+nkept=$(ls ck/stage*_chunk*.json | wc -l)
+check "resumed run" 0 "resumed $nkept finished chunks" \
   env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off --checkpoint "$work/ck" -o "$work/ck2.json" -j 2
 for g in ck1.json ck2.json; do
   if cmp -s "$g" "$src/data/graphs/cube_l_block.json"; then
@@ -102,8 +112,11 @@ for g in ck1.json ck2.json; do
 done
 check "checkpoint of other options" 1 "was made from other models or options" \
   "$cfgen" "$A" "$B" --max-pcs 2 --checkpoint ck -o g.json
-echo "garbage" >ck/level2_chunk_000001.json
-check "damaged chunk" 1 "reading checkpoint chunk '.*level2_chunk_000001.json': not JSON" \
+cp ck/stage00001_chunk0002.json ck/stage00001_chunk0003.json
+check "chunk of other tasks" 1 "reading checkpoint chunk '.*stage00001_chunk0003.json': made by another run" \
+  env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off --checkpoint "$work/ck" -o "$work/g.json"
+echo "garbage" >ck/stage00001_chunk0001.json
+check "damaged chunk" 1 "reading checkpoint chunk '.*stage00001_chunk0001.json': not JSON" \
   env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off --checkpoint "$work/ck" -o "$work/g.json"
 touch not_a_dir
 check "checkpoint is a file" 1 "checkpoint 'not_a_dir': exists and is not a directory" \

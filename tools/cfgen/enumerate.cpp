@@ -70,6 +70,45 @@ void parallel_for(std::size_t n, int threads, const std::function<void(std::size
 
 }  // namespace
 
+TaskResult run_task(const WitnessSearch& search, const Task& task) {
+  TaskResult r;
+  switch (task.kind) {
+    case Task::Kind::kFind:
+      r.witness = search.find(task.pcs, task.seeds);
+      break;
+    case Task::Kind::kFindOrRefine:
+      r.witness = search.find(task.pcs, {task.pose.R_BA});
+      if (!r.witness.found) r.witness = search.refine(task.pcs, task.pose);
+      break;
+    case Task::Kind::kExplore: {
+      r.met = explore_translations(search, task.pcs, task.pose);
+      std::vector<Discovery> more = explore_rotations(search, task.pcs, task.pose);
+      r.met.insert(r.met.end(), more.begin(), more.end());
+      for (const Pose& q : turned_witnesses(search, task.pcs, task.pose)) {
+        more = explore_translations(search, task.pcs, q);
+        r.met.insert(r.met.end(), more.begin(), more.end());
+      }
+      break;
+    }
+  }
+  return r;
+}
+
+std::vector<TaskResult> run_tasks(const WitnessSearch& search, const std::vector<Task>& tasks, int threads,
+                                  const std::function<void(std::size_t)>& tick) {
+  if (threads <= 0) threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  std::vector<TaskResult> out(tasks.size());
+  parallel_for(tasks.size(), threads, [&](std::size_t i) { out[i] = run_task(search, tasks[i]); }, tick);
+  return out;
+}
+
+std::size_t chunk_size(std::size_t tasks) {
+  // About 64 chunks a stage: enough to share among processes and to lose little when killed,
+  // few enough files; at most 1024 tasks (about a minute of the slowest searches) a chunk.
+  constexpr std::size_t kChunks = 64, kMin = 8, kMax = 1024;
+  return std::clamp<std::size_t>((tasks + kChunks - 1) / kChunks, kMin, kMax);
+}
+
 std::vector<Transition> transitions_between(const std::vector<CfRecord>& cfs, const Polyhedron& A,
                                             const Polyhedron& B) {
   std::unordered_map<PcSet, int, PcSetHash> index;
@@ -171,6 +210,57 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   int motion_rounds = 0;
   bool first_pair_round = true;  // the first level-2 round (sharded, checkpointed)
 
+  // Every stage of the run, in order: its tasks cut into chunks, each found in the checkpoint,
+  // computed here or handed to another process, and kept when done.
+  std::size_t stages = 0;
+  // ev: where progress goes, null for none.
+  auto run_stage = [&](const std::vector<Task>& tasks, ProgressEvent* ev, Clock::time_point t0) {
+    const std::size_t stage = stages++;
+    const bool report = ev && opt.progress;
+    if (!opt.checkpoint.load && !opt.distribute)
+      return run_tasks(search, tasks, threads, report ? ticker(*ev, t0) : std::function<void(std::size_t)>());
+    const std::size_t n = tasks.size(), size = chunk_size(n);
+    std::vector<std::vector<Task>> chunks;
+    for (std::size_t b = 0; b < n; b += size)
+      chunks.emplace_back(tasks.begin() + static_cast<std::ptrdiff_t>(b),
+                          tasks.begin() + static_cast<std::ptrdiff_t>(std::min(n, b + size)));
+    std::vector<TaskResult> res(n);
+    std::vector<std::size_t> todo;
+    std::size_t done = 0;
+    auto tick = [&](std::size_t d) {
+      if (!report) return;
+      ev->done = done + d;
+      ev->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+      opt.progress(*ev);
+    };
+    auto take = [&](std::size_t k, std::vector<TaskResult>&& r) {
+      if (r.size() != chunks[k].size())
+        throw Error("stage " + std::to_string(stage) + ", chunk " + std::to_string(k) + ": " +
+                    std::to_string(r.size()) + " results for " + std::to_string(chunks[k].size()) + " tasks");
+      if (opt.checkpoint.save) opt.checkpoint.save(stage, k, chunks[k], r);
+      std::move(r.begin(), r.end(), res.begin() + static_cast<std::ptrdiff_t>(k * size));
+      done += chunks[k].size();
+      tick(0);
+    };
+    for (std::size_t k = 0; k < chunks.size(); ++k) {
+      std::vector<TaskResult> kept;
+      if (opt.checkpoint.load && opt.checkpoint.load(stage, k, chunks[k], kept)) {
+        std::move(kept.begin(), kept.end(), res.begin() + static_cast<std::ptrdiff_t>(k * size));
+        done += chunks[k].size();
+      } else {
+        todo.push_back(k);
+      }
+    }
+    if (opt.distribute) {
+      // Progress then moves chunk by chunk, from the thread that takes them.
+      opt.distribute(chunks, todo, [&](std::size_t k) { return run_tasks(search, chunks[k], threads); }, take);
+    } else {
+      for (std::size_t k : todo)
+        take(k, run_tasks(search, chunks[k], threads, report ? std::function<void(std::size_t)>(tick) : nullptr));
+    }
+    return res;
+  };
+
   // given: results computed elsewhere (the shards of the first level-2 round), one per candidate.
   auto run_level = [&](int level, const std::vector<PcSet>& cands,
                        const std::function<std::vector<Mat3>(const PcSet&)>& seeds_of,
@@ -184,33 +274,16 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
                     " results of the first level-2 round, but these models and options give " +
                     std::to_string(cands.size()) + " candidates");
       res = *given;
-    } else if (level == 1 && first_pair_round && opt.checkpoint.load) {
-      // In chunks, each kept as soon as it is done: a killed run loses the chunk in flight.
-      const std::size_t n = cands.size(), size = std::max<std::size_t>(1, opt.checkpoint.chunk_size);
-      for (std::size_t begin = 0, chunk = 0; begin < n; begin += size, ++chunk) {
-        const std::size_t end = std::min(n, begin + size);
-        std::vector<Witness> kept;
-        if (opt.checkpoint.load(chunk, begin, end, kept)) {
-          std::copy(kept.begin(), kept.end(), res.begin() + static_cast<std::ptrdiff_t>(begin));
-          continue;
-        }
-        std::function<void(std::size_t)> tick;
-        if (opt.progress)
-          tick = [&, begin](std::size_t done) {
-            ev.done = begin + done;
-            ev.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-            opt.progress(ev);
-          };
-        parallel_for(end - begin, threads,
-                     [&](std::size_t k) { res[begin + k] = search.find(cands[begin + k], seeds_of(cands[begin + k])); },
-                     tick);
-        opt.checkpoint.save(chunk, begin, end,
-                            std::vector<Witness>(res.begin() + static_cast<std::ptrdiff_t>(begin),
-                                                 res.begin() + static_cast<std::ptrdiff_t>(end)));
-      }
+      ++stages;
     } else {
-      parallel_for(cands.size(), threads, [&](std::size_t i) { res[i] = search.find(cands[i], seeds_of(cands[i])); },
-                   ticker(ev, t0));
+      std::vector<Task> tasks(cands.size());
+      for (std::size_t i = 0; i < cands.size(); ++i) {
+        tasks[i].kind = Task::Kind::kFind;
+        tasks[i].pcs = cands[i];
+        tasks[i].seeds = seeds_of(cands[i]);
+      }
+      std::vector<TaskResult> r = run_stage(tasks, &ev, t0);
+      for (std::size_t i = 0; i < cands.size(); ++i) res[i] = r[i].witness;
     }
     std::size_t found = 0;
     for (std::size_t i = 0; i < cands.size(); ++i) {
@@ -315,34 +388,32 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   auto motion_closure = [&] {
     while (!frontier.empty()) {
       const auto t0 = Clock::now();
-      std::vector<std::vector<Discovery>> met(frontier.size());
       ProgressEvent ev{"motion round " + std::to_string(++motion_rounds), "CFs explored", 0, frontier.size(), 0, false, {}};
-      parallel_for(frontier.size(), threads,
-                   [&](std::size_t i) {
-                     met[i] = explore_translations(search, frontier[i].first, frontier[i].second);
-                     std::vector<Discovery> r = explore_rotations(search, frontier[i].first, frontier[i].second);
-                     met[i].insert(met[i].end(), r.begin(), r.end());
-                     for (const Pose& q : turned_witnesses(search, frontier[i].first, frontier[i].second)) {
-                       r = explore_translations(search, frontier[i].first, q);
-                       met[i].insert(met[i].end(), r.begin(), r.end());
-                     }
-                   },
-                   ticker(ev, t0));
+      std::vector<Task> explore(frontier.size());
+      for (std::size_t i = 0; i < frontier.size(); ++i) {
+        explore[i].kind = Task::Kind::kExplore;
+        explore[i].pcs = frontier[i].first;
+        explore[i].pose = frontier[i].second;
+      }
+      const std::vector<TaskResult> met = run_stage(explore, &ev, t0);
       // The first discovery of each new set, in frontier order: independent of thread count.
       std::vector<Discovery> fresh;
       std::unordered_set<PcSet, PcSetHash> pending;
-      for (const auto& list : met)
-        for (const Discovery& d : list)
+      for (const TaskResult& r : met)
+        for (const Discovery& d : r.met)
           if (d.pcs.size() <= opt.max_pcs && !witness_rot.count(d.pcs) && pending.insert(d.pcs).second)
             fresh.push_back(d);
+      std::vector<Task> search_fresh(fresh.size());
+      for (std::size_t i = 0; i < fresh.size(); ++i) {
+        search_fresh[i].kind = Task::Kind::kFindOrRefine;
+        search_fresh[i].pcs = fresh[i].pcs;
+        search_fresh[i].pose = fresh[i].pose;
+      }
       std::vector<Witness> res(fresh.size());
-      parallel_for(fresh.size(), threads,
-                   [&](std::size_t i) {
-                     Witness w = search.find(fresh[i].pcs, {fresh[i].pose.R_BA});
-                     if (!w.found) w = search.refine(fresh[i].pcs, fresh[i].pose);
-                     res[i] = w;
-                   },
-                   {});
+      {
+        const std::vector<TaskResult> r = run_stage(search_fresh, nullptr, t0);
+        for (std::size_t i = 0; i < fresh.size(); ++i) res[i] = r[i].witness;
+      }
       frontier.clear();
       std::size_t found = 0;
       for (std::size_t i = 0; i < fresh.size(); ++i) {
@@ -363,33 +434,28 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   // Levels and motion to a fixed point: a single PC or a pair that only motion found takes
   // part in the levels above it like any other (a CF's subsets need not be found first).
   if (opt.shard.count > 0) {
-    // Shards of the first level-2 round: their candidates only, results by index. One shard,
-    // or (opt.shard.next) as many as the provider hands out, level 1 done once.
+    // One shard of the first level-2 round: its candidates only, results by index.
     const std::vector<PcSet> c2 = opt.max_pcs >= 2 ? build_pairs() : std::vector<PcSet>{};
     out.first_pair_candidates = c2.size();
-    bool single_done = false;
-    for (;;) {
-      int index = -1;
-      if (opt.shard.next) index = opt.shard.next();
-      else if (!single_done) index = opt.shard.index, single_done = true;
-      if (index < 0) break;
-      std::vector<std::size_t> mine;
-      for (std::size_t i = static_cast<std::size_t>(index); i < c2.size(); i += static_cast<std::size_t>(opt.shard.count))
-        mine.push_back(i);
-      std::vector<Witness> res(mine.size());
-      const auto t0 = Clock::now();
-      ProgressEvent ev{"level 2, shard " + std::to_string(index) + "/" + std::to_string(opt.shard.count),
-                       "candidate sets", 0, mine.size(), 0, false, {}};
-      parallel_for(mine.size(), threads,
-                   [&](std::size_t k) { res[k] = search.find(c2[mine[k]], seeds_from_subsets(c2[mine[k]])); },
-                   ticker(ev, t0));
-      std::size_t found = 0;
-      for (std::size_t k = 0; k < mine.size(); ++k) {
-        found += res[k].found ? 1 : 0;
-        out.shard_results.push_back({mine[k], res[k]});
-      }
-      finished(ev, t0, std::to_string(found) + " valid");
+    const int index = opt.shard.index;
+    std::vector<std::size_t> mine;
+    for (std::size_t i = static_cast<std::size_t>(index); i < c2.size(); i += static_cast<std::size_t>(opt.shard.count))
+      mine.push_back(i);
+    std::vector<Task> tasks(mine.size());
+    for (std::size_t k = 0; k < mine.size(); ++k) {
+      tasks[k].pcs = c2[mine[k]];
+      tasks[k].seeds = seeds_from_subsets(c2[mine[k]]);
     }
+    const auto t0 = Clock::now();
+    ProgressEvent ev{"level 2, shard " + std::to_string(index) + "/" + std::to_string(opt.shard.count),
+                     "candidate sets", 0, mine.size(), 0, false, {}};
+    const std::vector<TaskResult> res = run_tasks(search, tasks, threads, ticker(ev, t0));
+    std::size_t found = 0;
+    for (std::size_t k = 0; k < mine.size(); ++k) {
+      found += res[k].witness.found ? 1 : 0;
+      out.shard_results.push_back({mine[k], res[k].witness});
+    }
+    finished(ev, t0, std::to_string(found) + " valid");
     return out;
   }
   for (;;) {

@@ -2,35 +2,77 @@
 // Level-by-level enumeration of the valid contact formations of a model pair, and the
 // transitions between them (SPEC section 4).
 
+#include "explore.hpp"
 #include "progress.hpp"
 #include "witness.hpp"
 
 #include <cf/graph.hpp>
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
 namespace cf::gen {
 
-/// A slice of the first level-2 search, the bulk of a run: candidate i belongs to shard
-/// i % count. count == 0: no sharding.
+/// A slice of the first level-2 search: candidate i belongs to shard i % count. count == 0:
+/// no sharding.
 struct ShardSpec {
   int index = 0;
   int count = 0;
-  /// When set, the shards to search are handed out one at a time (-1: no more) instead of
-  /// `index` alone: the processes of an MPI run share them dynamically.
-  std::function<int()> next;
 };
 
-/// Keeps the first level-2 round's results in chunks as they are finished, so that a killed
-/// run resumes (cfgen --checkpoint). load: true and `out` filled when chunk [begin, end) was
-/// kept; save: keeps a finished chunk. Chunks do not depend on the thread count.
-struct ChunkStore {
-  std::size_t chunk_size = 2048;
-  std::function<bool(std::size_t chunk, std::size_t begin, std::size_t end, std::vector<Witness>& out)> load;
-  std::function<void(std::size_t chunk, std::size_t begin, std::size_t end, const std::vector<Witness>& results)> save;
+/// One unit of a run's work, a pure function of the models, the search parameters and its
+/// inputs: the same task gives the same result in any process, on any thread.
+struct Task {
+  enum class Kind : std::uint8_t {
+    kFind,          // WitnessSearch::find(pcs, seeds)
+    kFindOrRefine,  // find(pcs, {pose.R_BA}), else refine(pcs, pose): a set met by motion
+    kExplore,       // the motions from the witness `pose` of the CF `pcs` (explore.hpp)
+  };
+  Kind kind = Kind::kFind;
+  PcSet pcs;
+  std::vector<Mat3> seeds;  // kFind
+  Pose pose;                // kFindOrRefine, kExplore
 };
+
+struct TaskResult {
+  Witness witness;              // kFind, kFindOrRefine
+  std::vector<Discovery> met;   // kExplore: the contact sets met, in a fixed order
+};
+
+TaskResult run_task(const WitnessSearch& search, const Task& task);
+
+/// Runs tasks on `threads` threads (0: all cores); results by index, whatever the thread
+/// count. tick(done), when set, is called now and then from one thread.
+std::vector<TaskResult> run_tasks(const WitnessSearch& search, const std::vector<Task>& tasks, int threads,
+                                  const std::function<void(std::size_t)>& tick = {});
+
+/// A run is a sequence of stages (a level's candidates, a motion round's explorations, the
+/// sets they met), numbered from 0 in the order every run with the same models and options
+/// takes; each stage's tasks are cut into chunks that depend only on their number.
+std::size_t chunk_size(std::size_t tasks);
+
+/// Where finished chunks are kept and found again (cfgen --checkpoint). load: true and `out`
+/// filled when chunk `chunk` of stage `stage` was kept (it must have been made from these
+/// tasks, else it throws); save: keeps a finished chunk.
+struct ChunkStore {
+  std::function<bool(std::size_t stage, std::size_t chunk, const std::vector<Task>& tasks,
+                     std::vector<TaskResult>& out)>
+      load;
+  std::function<void(std::size_t stage, std::size_t chunk, const std::vector<Task>& tasks,
+                     const std::vector<TaskResult>& results)>
+      save;
+};
+
+/// Hands a stage's chunks to other processes (an MPI run). Called with every chunk of the
+/// stage and the indices of those still to do; compute(k) returns the results of chunk k
+/// computed here (callable from any one thread), done(k, r) takes the results of chunk k
+/// (computed here or elsewhere; call it from the calling thread). Returns when every chunk
+/// in `todo` is done.
+using Distribute = std::function<void(const std::vector<std::vector<Task>>& chunks, const std::vector<std::size_t>& todo,
+                                      const std::function<std::vector<TaskResult>(std::size_t)>& compute,
+                                      const std::function<void(std::size_t, std::vector<TaskResult>&&)>& done)>;
 
 struct EnumerateOptions {
   SearchParams search;
@@ -43,8 +85,10 @@ struct EnumerateOptions {
   /// candidate order: used instead of searching (cfgen merge). The rest of the run is the
   /// same, so the graph equals an unsharded run's.
   const std::vector<Witness>* first_pairs = nullptr;
-  /// Empty, or where the first level-2 round's finished chunks are kept and found again.
+  /// Empty, or where every stage's finished chunks are kept and found again.
   ChunkStore checkpoint;
+  /// Empty, or how chunks are shared with other processes.
+  Distribute distribute;
   /// Called now and then while a stage runs, and once when it ends (ProgressEvent::finished);
   /// from one thread at a time. Empty to stay quiet.
   std::function<void(const ProgressEvent&)> progress;

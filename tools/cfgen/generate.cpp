@@ -42,14 +42,16 @@ int run_generate(const GenerateArgs& args) {
   // the models (SPEC section 5b).
   const std::vector<std::string> inputs{args.a_path, args.b_path};
   const bool sharded = args.shard.count > 0;
-  if (!args.shard_sink) check_output_path(args.out_path, inputs, sharded ? "writing shard part" : "writing graph");
-  const std::string fingerprint = sharded && !args.shard_sink ? run_fingerprint(args) : std::string();
+  if (!args.serve) check_output_path(args.out_path, inputs, sharded ? "writing shard part" : "writing graph");
+  const std::string fingerprint = sharded ? run_fingerprint(args) : std::string();
   const Polyhedron A = load_model(args.a_path, args.load_a);
   const Polyhedron B = load_model(args.b_path, args.load_b);
-  for (const auto& [m, which, option] : {std::tuple{&A, "A", "--units-a"}, std::tuple{&B, "B", "--units-b"}})
-    if (const std::string w = size_warning(*m, which, option); !w.empty()) std::cerr << "cfgen: warning: " << w << '\n';
+  if (!args.serve)
+    for (const auto& [m, which, option] : {std::tuple{&A, "A", "--units-a"}, std::tuple{&B, "B", "--units-b"}})
+      if (const std::string w = size_warning(*m, which, option); !w.empty()) std::cerr << "cfgen: warning: " << w << '\n';
   const gen::ModelInfo ai = gen::analyse_model(A);
   const gen::ModelInfo bi = gen::analyse_model(B);
+  if (args.serve) return args.serve(gen::WitnessSearch(ai, bi, scaled_search(A, B, args.rel, args.search)), args.threads);
 
   gen::EnumerateOptions opt;
   opt.threads = args.threads;
@@ -62,13 +64,15 @@ int run_generate(const GenerateArgs& args) {
   if (!args.checkpoint_dir.empty()) {
     opt.checkpoint = open_checkpoint(args.checkpoint_dir, run_fingerprint(args), inputs);
     auto load = opt.checkpoint.load;
-    opt.checkpoint.load = [load, &resumed_chunks](std::size_t c, std::size_t b, std::size_t e, std::vector<gen::Witness>& out) {
-      const bool kept = load(c, b, e, out);
+    opt.checkpoint.load = [load, &resumed_chunks](std::size_t stage, std::size_t chunk, const std::vector<gen::Task>& tasks,
+                                                  std::vector<gen::TaskResult>& out) {
+      const bool kept = load(stage, chunk, tasks, out);
       resumed_chunks += kept ? 1 : 0;
       return kept;
     };
   }
   opt.first_pairs = args.first_pairs;
+  opt.distribute = args.distribute;
   const bool terminal = isatty(STDERR_FILENO) != 0;
   gen::ProgressPrinter printer(std::cerr, terminal);
   if (!args.quiet)
@@ -81,12 +85,8 @@ int run_generate(const GenerateArgs& args) {
   printer.finish();
   if (resumed_chunks > 0 && !args.quiet)
     std::cerr << "cfgen: checkpoint '" << args.checkpoint_dir << "': resumed " << resumed_chunks
-              << " finished chunks of the first level-2 round\n";
+              << " finished chunks\n";
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (sharded && args.shard_sink) {
-    args.shard_sink(e.first_pair_candidates, e.shard_results);
-    return 0;
-  }
   if (sharded) {
     ShardPart part;
     part.args = args;

@@ -46,12 +46,15 @@ struct GenerateArgs {
   /// With shard.count > 0: search one shard of the first level-2 round and write a part file
   /// to out_path instead of the graph (cfgen/shard.hpp).
   gen::ShardSpec shard;
-  /// With shard.count > 0 and this set, the shard results go here instead of a part file
-  /// (an MPI run gathers them in memory): (candidates of the first round, results by index).
-  std::function<void(std::size_t, const std::vector<std::pair<std::size_t, gen::Witness>>&)> shard_sink;
+  /// Empty, or how the run's chunks are shared with other processes (rank 0 of an MPI run).
+  gen::Distribute distribute;
+  /// When set, the models are read and analysed as for a run, and then this serves tasks
+  /// with the run's search instead of enumerating (the other ranks of an MPI run); its
+  /// value is the exit status.
+  std::function<int(const gen::WitnessSearch&, int threads)> serve;
   /// cfgen merge: the first level-2 round's results gathered from the parts.
   const std::vector<gen::Witness>* first_pairs = nullptr;
-  /// Non-empty: keep the first level-2 round's finished chunks there and resume from them.
+  /// Non-empty: keep every stage's finished chunks there and resume from them.
   std::string checkpoint_dir;
   /// The model names written into the graph's generator record; empty: a_path, b_path.
   std::string a_label, b_label;

@@ -191,8 +191,8 @@ int main(int argc, char** argv) {
 #ifdef CF_HAVE_GENERATOR
 #ifdef CF_HAVE_MPI
     if (cf::tools::launched_by_mpi()) {
-      if (gen.shard.count > 0 || !gen.checkpoint_dir.empty()) {
-        std::cerr << "cfgen: --shard and --checkpoint are for runs outside mpirun\n";
+      if (gen.shard.count > 0) {
+        std::cerr << "cfgen: --shard is for runs outside mpirun (mpirun shares every stage itself)\n";
         return 2;
       }
       return cf::tools::run_generate_mpi(gen);

@@ -11,10 +11,12 @@ namespace cf::tools {
 /// variables); a plain `cfgen` run never initialises MPI.
 bool launched_by_mpi();
 
-/// Every process of the MPI job runs this with the same arguments: rank 0 hands out shards
-/// of the first level-2 round on request (and searches some itself), gathers the results,
-/// finishes the run with its threads and writes the graph, byte for byte the one a
-/// single-process run writes. Other ranks write nothing. A failing rank aborts the job.
+/// Every process of the MPI job runs this with the same arguments. Rank 0 runs the
+/// enumeration: every stage's chunks (levels, motion rounds) go to idle ranks while it
+/// computes others, and their results are taken by chunk index, so the graph is byte for
+/// byte the one a single-process run writes, and --checkpoint works as in one process. The
+/// other ranks read the models, then compute the chunks they are sent with their threads
+/// and write nothing. A failing rank aborts the job.
 /// @returns the process exit status.
 int run_generate_mpi(GenerateArgs args);
 

@@ -128,7 +128,166 @@ std::vector<std::pair<std::size_t, gen::Witness>> parse_results(const nlohmann::
   return out;
 }
 
+// A pose as 12 numbers (R row by row, then t) and back: doubles round-trip exactly.
+nlohmann::json pose_json(const Pose& p) {
+  nlohmann::json out = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out.push_back(p.R_BA(r, c));
+  for (int r = 0; r < 3; ++r) out.push_back(p.t_BA(r));
+  return out;
+}
+
+nlohmann::json pcs_json(const PcSet& s) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const Pc& pc : s) out.push_back({static_cast<int>(pc.type), pc.a, pc.b});
+  return out;
+}
+
+// Reads what the functions above write; `bad` throws with the problem.
+struct Reader {
+  std::function<void(const std::string&)> bad;
+  Pose pose(const nlohmann::json& j) const {
+    if (!j.is_array() || j.size() != 12) bad("expected a pose of 12 numbers");
+    Pose p;
+    for (int k = 0; k < 12; ++k) {
+      if (!j[k].is_number()) bad("a pose holds a non-number");
+      const double v = j[k].get<double>();
+      if (k < 9) p.R_BA(k / 3, k % 3) = v;
+      else p.t_BA(k - 9) = v;
+    }
+    return p;
+  }
+  PcSet pcs(const nlohmann::json& j) const {
+    if (!j.is_array() || j.empty() || j.size() > PcSet::kMaxPcs) bad("expected a set of 1 to 3 PCs");
+    PcSet s;
+    for (const nlohmann::json& pc : j) {
+      if (!pc.is_array() || pc.size() != 3 || !pc[0].is_number_unsigned() || !pc[1].is_number_unsigned() ||
+          !pc[2].is_number_unsigned() || pc[0].get<unsigned>() > static_cast<unsigned>(PcType::kEE))
+        bad("expected a PC [type, a, b]");
+      if (!s.insert(Pc{static_cast<PcType>(pc[0].get<int>()), pc[1].get<int>(), pc[2].get<int>()}))
+        bad("a PC is repeated");
+    }
+    return s;
+  }
+  gen::Witness witness(const nlohmann::json& j) const {
+    gen::Witness w;
+    if (!j.is_array() || j.empty() || !j[0].is_boolean()) bad("expected a witness [found, ...]");
+    w.found = j[0].get<bool>();
+    if (!w.found) return w;
+    if (j.size() != 4 || !j[2].is_number() || !j[3].is_number()) bad("expected [true, pose, clearance, margin]");
+    w.pose = pose(j[1]);
+    w.clearance = j[2].get<double>();
+    w.margin = j[3].get<double>();
+    return w;
+  }
+};
+
+nlohmann::json witness_json(const gen::Witness& w) {
+  if (!w.found) return nlohmann::json::array({false});
+  return {true, pose_json(w.pose), w.clearance, w.margin};
+}
+
+nlohmann::json tasks_json(const std::vector<gen::Task>& tasks) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const gen::Task& t : tasks) {
+    nlohmann::json seeds = nlohmann::json::array();
+    for (const Mat3& R : t.seeds) {
+      Pose p;
+      p.R_BA = R;
+      seeds.push_back(pose_json(p));
+    }
+    out.push_back({static_cast<int>(t.kind), pcs_json(t.pcs), seeds, pose_json(t.pose)});
+  }
+  return out;
+}
+
+std::vector<gen::Task> parse_tasks(const nlohmann::json& j, const Reader& rd) {
+  if (!j.is_array()) rd.bad("expected an array of tasks");
+  std::vector<gen::Task> out;
+  for (const nlohmann::json& t : j) {
+    if (!t.is_array() || t.size() != 4 || !t[0].is_number_unsigned() ||
+        t[0].get<unsigned>() > static_cast<unsigned>(gen::Task::Kind::kExplore) || !t[2].is_array())
+      rd.bad("expected a task [kind, PCs, seeds, pose]");
+    gen::Task task;
+    task.kind = static_cast<gen::Task::Kind>(t[0].get<int>());
+    task.pcs = rd.pcs(t[1]);
+    for (const nlohmann::json& seed : t[2]) task.seeds.push_back(rd.pose(seed).R_BA);
+    task.pose = rd.pose(t[3]);
+    out.push_back(std::move(task));
+  }
+  return out;
+}
+
+nlohmann::json task_results_json(const std::vector<gen::TaskResult>& results) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const gen::TaskResult& r : results) {
+    nlohmann::json met = nlohmann::json::array();
+    for (const gen::Discovery& d : r.met) met.push_back({pcs_json(d.pcs), pose_json(d.pose)});
+    out.push_back({witness_json(r.witness), met});
+  }
+  return out;
+}
+
+std::vector<gen::TaskResult> parse_task_results(const nlohmann::json& j, const Reader& rd) {
+  if (!j.is_array()) rd.bad("expected an array of results");
+  std::vector<gen::TaskResult> out;
+  for (const nlohmann::json& r : j) {
+    if (!r.is_array() || r.size() != 2 || !r[1].is_array()) rd.bad("expected a result [witness, met]");
+    gen::TaskResult res;
+    res.witness = rd.witness(r[0]);
+    for (const nlohmann::json& d : r[1]) {
+      if (!d.is_array() || d.size() != 2) rd.bad("expected a discovery [PCs, pose]");
+      res.met.push_back({rd.pcs(d[0]), rd.pose(d[1])});
+    }
+    out.push_back(std::move(res));
+  }
+  return out;
+}
+
+std::string hex64(std::uint64_t h) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016" PRIx64, h);
+  return buf;
+}
+
 }  // namespace
+
+std::string tasks_text(std::size_t chunk, const std::vector<gen::Task>& tasks) {
+  return nlohmann::json{{"chunk", chunk}, {"tasks", tasks_json(tasks)}}.dump();
+}
+
+std::vector<gen::Task> tasks_from_text(const std::string& text, const std::string& what, std::size_t& chunk) {
+  const Reader rd{[&](const std::string& problem) -> void { throw Error("reading " + what + ": " + problem); }};
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    rd.bad(std::string("not JSON (") + e.what() + ")");
+  }
+  if (!j.is_object() || !j.contains("chunk") || !j.at("chunk").is_number_unsigned() || !j.contains("tasks"))
+    rd.bad("expected {\"chunk\", \"tasks\"}");
+  chunk = j.at("chunk").get<std::size_t>();
+  return parse_tasks(j.at("tasks"), rd);
+}
+
+std::string task_results_text(std::size_t chunk, const std::vector<gen::TaskResult>& results) {
+  return nlohmann::json{{"chunk", chunk}, {"results", task_results_json(results)}}.dump();
+}
+
+std::vector<gen::TaskResult> task_results_from_text(const std::string& text, const std::string& what,
+                                                    std::size_t& chunk) {
+  const Reader rd{[&](const std::string& problem) -> void { throw Error("reading " + what + ": " + problem); }};
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    rd.bad(std::string("not JSON (") + e.what() + ")");
+  }
+  if (!j.is_object() || !j.contains("chunk") || !j.at("chunk").is_number_unsigned() || !j.contains("results"))
+    rd.bad("expected {\"chunk\", \"results\"}");
+  chunk = j.at("chunk").get<std::size_t>();
+  return parse_task_results(j.at("results"), rd);
+}
 
 gen::ShardSpec parse_shard(const std::string& text) {
   int i = -1, k = -1;
@@ -249,21 +408,6 @@ std::vector<gen::Witness> gather_parts(const std::vector<ShardPart>& parts) {
   return all;
 }
 
-std::string results_text(const std::vector<std::pair<std::size_t, gen::Witness>>& results) {
-  return nlohmann::json{{"results", results_json(results)}}.dump();
-}
-
-std::vector<std::pair<std::size_t, gen::Witness>> results_from_text(const std::string& text, const std::string& what,
-                                                                    std::size_t candidates) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw Error("reading " + what + ": not JSON (" + e.what() + ")");
-  }
-  return parse_results(j, what, "shard results", [&](std::size_t i) { return i < candidates; });
-}
-
 gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& fingerprint,
                                const std::vector<std::string>& inputs) {
   namespace fs = std::filesystem;
@@ -285,32 +429,38 @@ gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& finge
     write_outputs({{manifest, j.dump() + "\n"}}, inputs, "writing checkpoint");
   }
   gen::ChunkStore store;
-  auto chunk_path = [dir](std::size_t chunk) {
-    char name[48];
-    std::snprintf(name, sizeof name, "level2_chunk_%06zu.json", chunk);
+  auto chunk_path = [dir](std::size_t stage, std::size_t chunk) {
+    char name[64];
+    std::snprintf(name, sizeof name, "stage%05zu_chunk%04zu.json", stage, chunk);
     return (fs::path(dir) / name).string();
   };
-  store.load = [=](std::size_t chunk, std::size_t begin, std::size_t end, std::vector<gen::Witness>& out) {
-    const std::string path = chunk_path(chunk);
+  // A chunk is kept with a digest of its tasks: a resumed run must be asking for the same work.
+  auto digest = [](const std::vector<gen::Task>& tasks) { return hex64(fnv1a(0xcbf29ce484222325ULL, tasks_json(tasks).dump())); };
+  store.load = [=](std::size_t stage, std::size_t chunk, const std::vector<gen::Task>& tasks,
+                   std::vector<gen::TaskResult>& out) {
+    const std::string path = chunk_path(stage, chunk);
     std::error_code e;
     if (!fs::exists(path, e)) return false;
     const nlohmann::json j =
-        read_json_file(path, "reading checkpoint chunk", "; remove it to search the chunk again");
+        read_json_file(path, "reading checkpoint chunk", "; remove it to compute the chunk again");
     if (!j.is_object() || j.value("fingerprint", std::string()) != fingerprint ||
-        j.value("begin", std::size_t{0}) != begin || j.value("end", std::size_t{0}) != end)
-      throw Error("reading checkpoint chunk '" + path + "': made by another run (remove it to search the chunk again)");
-    const auto results = parse_results(j, path, "checkpoint chunk", [&](std::size_t i) { return i >= begin && i < end; });
-    if (results.size() != end - begin) throw Error("reading checkpoint chunk '" + path + "': incomplete");
-    out.assign(end - begin, gen::Witness());
-    for (const auto& [i, w] : results) out[i - begin] = w;
+        j.value("stage", std::size_t{0}) != stage || j.value("chunk", std::size_t{0}) != chunk ||
+        j.value("tasks", std::string()) != digest(tasks))
+      throw Error("reading checkpoint chunk '" + path + "': made by another run (remove it to compute the chunk again)");
+    const Reader rd{[&](const std::string& problem) -> void {
+      throw Error("reading checkpoint chunk '" + path + "': " + problem + " (remove it to compute the chunk again)");
+    }};
+    if (!j.contains("results")) rd.bad("missing \"results\"");
+    out = parse_task_results(j.at("results"), rd);
+    if (out.size() != tasks.size())
+      rd.bad(std::to_string(out.size()) + " results for " + std::to_string(tasks.size()) + " tasks");
     return true;
   };
-  store.save = [=](std::size_t chunk, std::size_t begin, std::size_t end, const std::vector<gen::Witness>& res) {
-    std::vector<std::pair<std::size_t, gen::Witness>> indexed;
-    for (std::size_t k = 0; k < res.size(); ++k) indexed.push_back({begin + k, res[k]});
-    const nlohmann::json j = {{"fingerprint", fingerprint}, {"chunk", chunk}, {"begin", begin}, {"end", end},
-                              {"results", results_json(indexed)}};
-    write_outputs({{chunk_path(chunk), j.dump() + "\n"}}, inputs, "writing checkpoint");
+  store.save = [=](std::size_t stage, std::size_t chunk, const std::vector<gen::Task>& tasks,
+                   const std::vector<gen::TaskResult>& res) {
+    const nlohmann::json j = {{"fingerprint", fingerprint}, {"stage", stage}, {"chunk", chunk},
+                              {"tasks", digest(tasks)}, {"results", task_results_json(res)}};
+    write_outputs({{chunk_path(stage, chunk), j.dump() + "\n"}}, inputs, "writing checkpoint");
   };
   return store;
 }

@@ -46,20 +46,21 @@ ShardPart read_part(const std::string& path);
 std::vector<gen::Witness> gather_parts(const std::vector<ShardPart>& parts);
 
 /// cfgen --checkpoint DIR: creates DIR and its manifest (checkpoint.json, the run's
-/// fingerprint), or reopens it; the store keeps the first level-2 round's finished chunks
-/// there (level2_chunk_NNNNNN.json), each written whole.
-/// @throws cf::Error when DIR is not a directory, holds another run's checkpoint, or a kept
-/// chunk is damaged.
+/// fingerprint), or reopens it; the store keeps every stage's finished chunks there
+/// (stageSSSSS_chunkCCCC.json, each with a digest of its tasks), each written whole.
+/// @throws cf::Error when DIR is not a directory or holds another run's checkpoint; the store
+/// throws when a kept chunk is damaged or was made for other tasks.
 gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& fingerprint,
                                const std::vector<std::string>& inputs);
 
-/// Shard results as text and back (an MPI run sends them to rank 0 this way); doubles
-/// round-trip exactly.
-/// @throws cf::Error "reading <what>: <problem>" when the text is not such results or names a
-/// candidate >= candidates.
-std::string results_text(const std::vector<std::pair<std::size_t, gen::Witness>>& results);
-std::vector<std::pair<std::size_t, gen::Witness>> results_from_text(const std::string& text, const std::string& what,
-                                                                    std::size_t candidates);
+/// A chunk of tasks, and its results, as text and back (an MPI run sends them between
+/// processes this way); doubles round-trip exactly.
+/// @throws cf::Error "reading <what>: <problem>" when the text is not such a chunk.
+std::string tasks_text(std::size_t chunk, const std::vector<gen::Task>& tasks);
+std::vector<gen::Task> tasks_from_text(const std::string& text, const std::string& what, std::size_t& chunk);
+std::string task_results_text(std::size_t chunk, const std::vector<gen::TaskResult>& results);
+std::vector<gen::TaskResult> task_results_from_text(const std::string& text, const std::string& what,
+                                                    std::size_t& chunk);
 
 /// `cfgen merge PART... -o GRAPH.json`: 0 on success.
 int run_merge(const std::vector<std::string>& part_paths, const std::string& out_path, int threads,
