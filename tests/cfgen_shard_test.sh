@@ -31,6 +31,17 @@ check() {  # name, expected status, stderr regex, command...
     echo "ok   $name"
   fi
 }
+same_as_golden() {  # graph files that must equal the bundled graph byte for byte
+  local g
+  for g in "$@"; do
+    if cmp -s "$g" "$src/data/graphs/cube_l_block.json"; then
+      echo "ok   $g equals data/graphs/cube_l_block.json"
+    else
+      echo "FAIL $g differs from data/graphs/cube_l_block.json"
+      fail=1
+    fi
+  done
+}
 
 # The shards run where the golden graph was made (the model paths, as typed, go into the
 # graph); the merge runs elsewhere.
@@ -39,12 +50,7 @@ check "shard 0/2" 0 "shard 0/2: [0-9]+ of [0-9]+ level-2 candidates" \
 check "shard 1/2" 0 "" env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off --shard 1/2 \
   -o "$work/p1.part" -q -j 2
 (cd elsewhere && "$cfgen" merge ../p1.part ../p0.part -o merged.json -q -j 2) || fail=1
-if cmp -s elsewhere/merged.json "$src/data/graphs/cube_l_block.json"; then
-  echo "ok   merged graph equals data/graphs/cube_l_block.json"
-else
-  echo "FAIL merged graph differs from data/graphs/cube_l_block.json"
-  fail=1
-fi
+same_as_golden elsewhere/merged.json
 
 check "missing shard" 1 "1 of 2 shards are missing \(shard 1\)" "$cfgen" merge p0.part -o g.json
 check "shard given twice" 1 "shard 0/2 is given twice" "$cfgen" merge p0.part p0.part p1.part -o g.json
@@ -76,14 +82,7 @@ if [[ -n $mpiexec ]]; then
   mpichunks=$(ls mpick/stage*_chunk*.json 2>/dev/null | wc -l)
   check "resumed from mpirun's checkpoint" 0 "resumed $mpichunks finished chunks" \
     env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off --checkpoint "$work/mpick" -o "$work/mpi_ck2.json" -j 2
-  for g in mpi.json mpi_ck.json mpi_ck2.json; do
-    if cmp -s "$g" "$src/data/graphs/cube_l_block.json"; then
-      echo "ok   $g equals data/graphs/cube_l_block.json"
-    else
-      echo "FAIL $g differs from data/graphs/cube_l_block.json"
-      fail=1
-    fi
-  done
+  same_as_golden mpi.json mpi_ck.json mpi_ck2.json
 else
   echo "skip mpirun (cfgen built without MPI)"
 fi
@@ -102,14 +101,7 @@ find ck -name 'stage*_chunk*.json' ! -name 'stage0000[01]_chunk*.json' ! -name '
 nkept=$(ls ck/stage*_chunk*.json | wc -l)
 check "resumed run" 0 "resumed $nkept finished chunks" \
   env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off --checkpoint "$work/ck" -o "$work/ck2.json" -j 2
-for g in ck1.json ck2.json; do
-  if cmp -s "$g" "$src/data/graphs/cube_l_block.json"; then
-    echo "ok   $g equals data/graphs/cube_l_block.json"
-  else
-    echo "FAIL $g differs from data/graphs/cube_l_block.json"
-    fail=1
-  fi
-done
+same_as_golden ck1.json ck2.json
 check "checkpoint of other options" 1 "was made from other models or options" \
   "$cfgen" "$A" "$B" --max-pcs 2 --checkpoint ck -o g.json
 cp ck/stage00001_chunk0002.json ck/stage00001_chunk0003.json

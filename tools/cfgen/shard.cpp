@@ -252,22 +252,36 @@ std::string hex64(std::uint64_t h) {
 
 }  // namespace
 
-std::string tasks_text(std::size_t chunk, const std::vector<gen::Task>& tasks) {
-  return nlohmann::json{{"chunk", chunk}, {"tasks", tasks_json(tasks)}}.dump();
-}
+namespace {
 
-std::vector<gen::Task> tasks_from_text(const std::string& text, const std::string& what, std::size_t& chunk) {
-  const Reader rd{[&](const std::string& problem) -> void { throw Error("reading " + what + ": " + problem); }};
-  nlohmann::json j;
+// {"chunk": N, key: ...} as sent between ranks; `what` names it in errors.
+const nlohmann::json& chunk_message(const std::string& text, const char* key, const Reader& rd, nlohmann::json& j,
+                                    std::size_t& chunk) {
   try {
     j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     rd.bad(std::string("not JSON (") + e.what() + ")");
   }
-  if (!j.is_object() || !j.contains("chunk") || !j.at("chunk").is_number_unsigned() || !j.contains("tasks"))
-    rd.bad("expected {\"chunk\", \"tasks\"}");
+  if (!j.is_object() || !j.contains("chunk") || !j.at("chunk").is_number_unsigned() || !j.contains(key))
+    rd.bad(std::string("expected {\"chunk\", \"") + key + "\"}");
   chunk = j.at("chunk").get<std::size_t>();
-  return parse_tasks(j.at("tasks"), rd);
+  return j.at(key);
+}
+
+Reader message_reader(const std::string& what) {
+  return Reader{[what](const std::string& problem) -> void { throw Error("reading " + what + ": " + problem); }};
+}
+
+}  // namespace
+
+std::string tasks_text(std::size_t chunk, const std::vector<gen::Task>& tasks) {
+  return nlohmann::json{{"chunk", chunk}, {"tasks", tasks_json(tasks)}}.dump();
+}
+
+std::vector<gen::Task> tasks_from_text(const std::string& text, const std::string& what, std::size_t& chunk) {
+  const Reader rd = message_reader(what);
+  nlohmann::json j;
+  return parse_tasks(chunk_message(text, "tasks", rd, j, chunk), rd);
 }
 
 std::string task_results_text(std::size_t chunk, const std::vector<gen::TaskResult>& results) {
@@ -276,17 +290,9 @@ std::string task_results_text(std::size_t chunk, const std::vector<gen::TaskResu
 
 std::vector<gen::TaskResult> task_results_from_text(const std::string& text, const std::string& what,
                                                     std::size_t& chunk) {
-  const Reader rd{[&](const std::string& problem) -> void { throw Error("reading " + what + ": " + problem); }};
+  const Reader rd = message_reader(what);
   nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    rd.bad(std::string("not JSON (") + e.what() + ")");
-  }
-  if (!j.is_object() || !j.contains("chunk") || !j.at("chunk").is_number_unsigned() || !j.contains("results"))
-    rd.bad("expected {\"chunk\", \"results\"}");
-  chunk = j.at("chunk").get<std::size_t>();
-  return parse_task_results(j.at("results"), rd);
+  return parse_task_results(chunk_message(text, "results", rd, j, chunk), rd);
 }
 
 gen::ShardSpec parse_shard(const std::string& text) {
