@@ -399,9 +399,18 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
       // The first discovery of each new set, in frontier order: independent of thread count.
       std::vector<Discovery> fresh;
       std::unordered_set<PcSet, PcSetHash> pending;
+      // Sets the necessary conditions reject cannot be verified: not searched (most are met
+      // with a contact on an element's boundary).
+      auto conditions_hold = [&](const PcSet& t) {
+        for (int x = 0; x < t.size(); ++x)
+          for (int y = x + 1; y < t.size(); ++y)
+            if (!pair_ok.compatible(t[x], t[y])) return false;
+        return search.plausible(t);
+      };
       for (const TaskResult& r : met)
         for (const Discovery& d : r.met)
-          if (d.pcs.size() <= opt.max_pcs && !witness_rot.count(d.pcs) && pending.insert(d.pcs).second)
+          if (d.pcs.size() <= opt.max_pcs && !witness_rot.count(d.pcs) && pending.insert(d.pcs).second &&
+              conditions_hold(d.pcs))
             fresh.push_back(d);
       std::vector<Task> search_fresh(fresh.size());
       for (std::size_t i = 0; i < fresh.size(); ++i) {
