@@ -208,7 +208,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     opt.progress(ev);
   };
   int motion_rounds = 0;
-  bool first_pair_round = true;  // the first level-2 round (sharded, checkpointed)
+  bool first_pair_round = true;  // the first level-2 round (the one --shard splits)
 
   // Every stage of the run, in order: its tasks cut into chunks, each found in the checkpoint,
   // computed here or handed to another process, and kept when done.
