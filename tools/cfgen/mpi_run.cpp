@@ -135,6 +135,14 @@ int run_generate_mpi(GenerateArgs args) {
       std::size_t local_chunk = 0;
       std::vector<gen::TaskResult> local_result;
       std::exception_ptr local_error;
+      // An error on this thread waits for the chunk in hand (declared last: it must go first,
+      // while what the computing thread writes to still exists), then propagates.
+      struct JoinOnExit {
+        std::thread& t;
+        ~JoinOnExit() {
+          if (t.joinable()) t.join();
+        }
+      } join_on_exit{local};
       for (;;) {
         receive();
         hand_out();
