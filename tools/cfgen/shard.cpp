@@ -16,7 +16,7 @@ namespace cf::tools {
 namespace {
 
 constexpr const char* kFormat = "cfgen shard part";
-constexpr int kVersion = 1;
+constexpr int kVersion = 2;  // 2: a witness as in chunks, [found, pose (12), clearance, margin]
 constexpr int kMaxShards = 4096;
 
 // The options that shape the graph, in a fixed order (not the thread count, the output or
@@ -76,58 +76,6 @@ std::uint64_t fnv1a(std::uint64_t h, const std::string& bytes) {
   return h;
 }
 
-// [index, false] or [index, true, R (9), t (3), clearance, margin]: doubles round-trip exactly.
-nlohmann::json results_json(const std::vector<std::pair<std::size_t, gen::Witness>>& results) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const auto& [i, w] : results) {
-    if (!w.found) {
-      out.push_back({i, false});
-      continue;
-    }
-    nlohmann::json R = nlohmann::json::array(), t = nlohmann::json::array();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) R.push_back(w.pose.R_BA(r, c));
-    for (int r = 0; r < 3; ++r) t.push_back(w.pose.t_BA(r));
-    out.push_back({i, true, R, t, w.clearance, w.margin});
-  }
-  return out;
-}
-
-// The "results" array of `j`; `mine(i)` says whether candidate i may appear in this file.
-std::vector<std::pair<std::size_t, gen::Witness>> parse_results(const nlohmann::json& j, const std::string& path,
-                                                                 const std::string& what,
-                                                                 const std::function<bool(std::size_t)>& mine) {
-  auto bad = [&](const std::string& problem) { throw Error("reading " + what + " '" + path + "': " + problem); };
-  if (!j.contains("results") || !j.at("results").is_array()) bad("missing \"results\" array");
-  std::vector<std::pair<std::size_t, gen::Witness>> out;
-  for (const nlohmann::json& r : j.at("results")) {
-    const std::string where = "result " + std::to_string(out.size());
-    if (!r.is_array() || r.size() < 2 || !r[0].is_number_unsigned() || !r[1].is_boolean())
-      bad(where + ": expected [index, found, ...]");
-    const std::size_t i = r[0].get<std::size_t>();
-    if (!mine(i)) bad(where + ": candidate " + std::to_string(i) + " does not belong in this file");
-    gen::Witness w;
-    w.found = r[1].get<bool>();
-    if (w.found) {
-      if (r.size() != 6 || !r[2].is_array() || r[2].size() != 9 || !r[3].is_array() || r[3].size() != 3 ||
-          !r[4].is_number() || !r[5].is_number())
-        bad(where + ": expected [index, true, R (9 numbers), t (3 numbers), clearance, margin]");
-      for (int k = 0; k < 9; ++k) {
-        if (!r[2][k].is_number()) bad(where + ": R holds a non-number");
-        w.pose.R_BA(k / 3, k % 3) = r[2][k].get<double>();
-      }
-      for (int k = 0; k < 3; ++k) {
-        if (!r[3][k].is_number()) bad(where + ": t holds a non-number");
-        w.pose.t_BA(k) = r[3][k].get<double>();
-      }
-      w.clearance = r[4].get<double>();
-      w.margin = r[5].get<double>();
-    }
-    out.push_back({i, w});
-  }
-  return out;
-}
-
 // A pose as 12 numbers (R row by row, then t) and back: doubles round-trip exactly.
 nlohmann::json pose_json(const Pose& p) {
   nlohmann::json out = nlohmann::json::array();
@@ -185,6 +133,35 @@ struct Reader {
 nlohmann::json witness_json(const gen::Witness& w) {
   if (!w.found) return nlohmann::json::array({false});
   return {true, pose_json(w.pose), w.clearance, w.margin};
+}
+
+// [index, witness...] (witness_json with its index in front): doubles round-trip exactly.
+nlohmann::json results_json(const std::vector<std::pair<std::size_t, gen::Witness>>& results) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& [i, w] : results) {
+    nlohmann::json r = witness_json(w);
+    r.insert(r.begin(), i);
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+// The "results" array of `j`; `mine(i)` says whether candidate i may appear in this file.
+std::vector<std::pair<std::size_t, gen::Witness>> parse_results(const nlohmann::json& j, const std::string& path,
+                                                                 const std::string& what,
+                                                                 const std::function<bool(std::size_t)>& mine) {
+  auto bad = [&](const std::string& problem) { throw Error("reading " + what + " '" + path + "': " + problem); };
+  if (!j.contains("results") || !j.at("results").is_array()) bad("missing \"results\" array");
+  std::vector<std::pair<std::size_t, gen::Witness>> out;
+  for (const nlohmann::json& r : j.at("results")) {
+    const std::string where = "result " + std::to_string(out.size());
+    if (!r.is_array() || r.size() < 2 || !r[0].is_number_unsigned()) bad(where + ": expected [index, found, ...]");
+    const std::size_t i = r[0].get<std::size_t>();
+    if (!mine(i)) bad(where + ": candidate " + std::to_string(i) + " does not belong in this file");
+    const Reader rd{[&](const std::string& problem) -> void { bad(where + ": " + problem); }};
+    out.push_back({i, rd.witness(nlohmann::json(r.begin() + 1, r.end()))});
+  }
+  return out;
 }
 
 nlohmann::json tasks_json(const std::vector<gen::Task>& tasks) {
