@@ -44,6 +44,7 @@
 #include "classify.hpp"
 #include "graph.hpp"
 #include "motion.hpp"
+#include "oracle_kept.hpp"
 #include "pc_lists.hpp"
 #include "poly.hpp"
 
@@ -636,14 +637,8 @@ PairSummary check_pair(const fs::path& dir) {
 TEST_CASE("the proxy against the oracle: pushing into B from the oracle's contact poses",
           "[proxy][oracle]") {
   const auto t0 = std::chrono::steady_clock::now();
-  const char* env = std::getenv("CF_ORACLE_KEEP_DIR");
-  const fs::path kept(env != nullptr ? env : CF_ORACLE_KEEP_DIR);
-  std::vector<fs::path> dirs;
-  if (fs::is_directory(kept))
-    for (const auto& e : fs::directory_iterator(kept))
-      if (fs::exists(e.path() / "samples.csv") && fs::exists(e.path() / "G.json"))
-        dirs.push_back(e.path());
-  std::sort(dirs.begin(), dirs.end());
+  const fs::path kept = cf::test::kept_oracle_dir(CF_ORACLE_KEEP_DIR);
+  const std::vector<fs::path> dirs = cf::test::kept_oracle_pairs(kept);
   {
     INFO("no samples in " << kept.string()
                           << ": run the recall test first (ctest runs it as a fixture)");
