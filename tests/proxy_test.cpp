@@ -271,6 +271,46 @@ TEST_CASE("the proxy off is the paper's literal model; on, with no penetration, 
   CHECK(differing == 0);
 }
 
+TEST_CASE("looking ahead along a long translation saves sub-steps and moves the proxy the same",
+          "[proxy]") {
+  const cf::CfGraph& g = cube_l_graph();
+  // A hand pressing 5 mm into the floor, sliding 15 mm (the pressed face breaks away and
+  // releases 2.7 mm of coupling stretch in one tick), into the inner corner's wall, out;
+  // then a jump of 30 mm along x in one tick, in free space.
+  auto device = [](int k) {
+    const double t = k / 1000.0;
+    const double down = std::min(t / 0.3, 1.0) * 7.0;
+    const double slide = std::clamp((t - 0.3) / 0.6, 0.0, 1.0) * 15.0;
+    const double wall = std::clamp((t - 0.9) / 0.4, 0.0, 1.0) * 23.0;
+    const double up = std::clamp((t - 1.3) / 0.3, 0.0, 1.0) * 20.0;
+    cf::Pose p = at(70 - slide - wall, 37 - down + up, 40);
+    if (k > 1600) p.t_BA.x() += 30;
+    return p;
+  };
+  cf::Params off;
+  off.proxy.lookahead_epsilons = 1;
+  cf::HapticRenderer plain(g, off), looking(g);
+  int passes_plain = 0, passes_looking = 0, most_plain = 0, most_looking = 0;
+  double worst_N = 0, worst_mm = 0;
+  for (int k = 1; k <= 1602; ++k) {
+    const cf::HapticResult a = plain.step(device(k), k / 1000.0);
+    const cf::HapticResult& b = looking.step(device(k), k / 1000.0);
+    passes_plain += a.proxy->substeps;
+    passes_looking += b.proxy->substeps;
+    most_plain = std::max(most_plain, a.proxy->substeps);
+    most_looking = std::max(most_looking, b.proxy->substeps);
+    worst_N = std::max(worst_N, (a.F_W - b.F_W).norm());
+    worst_mm = std::max(worst_mm, (a.X_WP.t_BA - b.X_WP.t_BA).norm());
+  }
+  CAPTURE(worst_N, worst_mm, passes_plain, passes_looking, most_plain, most_looking);
+  // Every sub-step solves with the stages' own detection: the proxies agree to the solver's
+  // stopping tolerance (1e-5 mm), the forces to the coupling's stiffness times it (2.3e-5 N).
+  CHECK(worst_mm <= 1e-5);
+  CHECK(worst_N <= 1e-4);
+  CHECK(most_looking < most_plain);  // the jump: 37 sub-steps without, 10 with
+  CHECK(passes_looking < passes_plain);
+}
+
 TEST_CASE("proxy parameters out of range are refused by name", "[proxy]") {
   const cf::CfGraph& g = cube_l_graph();
   cf::Params p;
@@ -286,4 +326,9 @@ TEST_CASE("proxy parameters out of range are refused by name", "[proxy]") {
   p.proxy.damping_N_s_per_mm = -1;
   CHECK_THROWS_WITH(cf::HapticRenderer(g, p),
                     Catch::Contains("proxy.damping_N_s_per_mm must be finite and non-negative"));
+  p = cf::Params();
+  p.proxy.lookahead_epsilons = 0.5;
+  CHECK_THROWS_WITH(
+      cf::HapticRenderer(g, p),
+      "cf::Params: parameter proxy.lookahead_epsilons must be finite and at least 1, got 0.500000");
 }

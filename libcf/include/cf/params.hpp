@@ -111,8 +111,16 @@ struct ProxyParams {
   /// mm, A's frame: where the device holds A; the coupling acts there.
   Vec3 grip_point_A = Vec3::Zero();
   /// Most sub-steps of one tick's swept motion: each moves every point of A by at most
-  /// 0.75 epsilon, so that no wall is crossed between two detections.
+  /// 0.75 epsilon, or a translation as far as the lookahead shows it free, so that no wall
+  /// is crossed between two detections.
   int max_substeps = 256;
+  /// Multiple of epsilon_mm (>= 1). A translation longer than one sub-step (a pressed face
+  /// breaking away, a fast hand) is first looked along with the detection band widened to
+  /// lookahead_epsilons * epsilon_mm, and goes up to 0.75 of that band at once, stopping
+  /// half an epsilon short of the first contact in it: one detection instead of one per
+  /// 0.75 epsilon. Turns step as before. 1 turns it off; where the proxy ends is the same
+  /// either way (the solve at every sub-step uses the stages' own detection).
+  double lookahead_epsilons = 4.0;
   /// Projected Gauss-Seidel sweeps of the constraint solve per (sub-)step (at most).
   int solver_iterations = 60;
   /// Friction acts inside the proxy step: a contact that sticks does not slide.

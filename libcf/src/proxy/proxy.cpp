@@ -165,7 +165,21 @@ Vec6 polish(const Vec6& xi_pgs, const Vec6& xi_d, const Row* rows, double* lambd
 
 }  // namespace
 
-ProxyModel::ProxyModel(const Polyhedron& a, const Params& p)
+namespace {
+Params lookahead_params(const Params& p) {
+  Params w = p;
+  w.epsilon_mm = p.epsilon_mm * p.proxy.lookahead_epsilons;
+  DetectionParams& d = w.detection;
+  // The in-plane tolerance grows with the band as it does by default, so that a feature
+  // within the band but off the end of an edge or face is read through a neighbouring
+  // contact. The derived angular tolerance would grow with the band too and read crossing
+  // edges as parallel ones: pinned at its floor, e-e is read wherever the stages read it.
+  if (!(d.angular_tolerance_rad > 0)) d.max_angular_tolerance_rad = d.min_angular_tolerance_rad;
+  return w;
+}
+}  // namespace
+
+ProxyModel::ProxyModel(const Polyhedron& a, const Polyhedron& b, const Params& p)
     : prm(p.proxy), epsilon_mm(p.epsilon_mm), mu_static(p.mu_static), mu_kinetic(p.mu_kinetic) {
   const ProxyParams& q = p.proxy;
   require(std::isfinite(q.stiffness_N_per_mm) && q.stiffness_N_per_mm > 0,
@@ -182,6 +196,9 @@ ProxyModel::ProxyModel(const Polyhedron& a, const Params& p)
           "max_substeps must be at least 1, got " + std::to_string(q.max_substeps));
   require(q.solver_iterations >= 1,
           "solver_iterations must be at least 1, got " + std::to_string(q.solver_iterations));
+  require(std::isfinite(q.lookahead_epsilons) && q.lookahead_epsilons >= 1,
+          "lookahead_epsilons must be finite and at least 1, got " +
+              std::to_string(q.lookahead_epsilons));
   // A's bounding box as a solid: its inertia per unit mass about its centre, moved to the
   // grip point. The metric only has to weigh radians against millimetres as A's mass does.
   const Vec3 lo = a.bbox_min(), hi = a.bbox_max(), size = hi - lo, c = 0.5 * (lo + hi);
@@ -195,6 +212,11 @@ ProxyModel::ProxyModel(const Polyhedron& a, const Params& p)
   for (int k = 0; k < 3; ++k) J_A(k, k) = std::max(J_A(k, k), floor);
   Jinv_A = J_A.inverse();
   for (const Vertex& v : a.vertices()) reach_mm = std::max(reach_mm, (v.p - q.grip_point_A).norm());
+  if (q.enabled && q.lookahead_epsilons > 1) look = make_detect_model(a, b, lookahead_params(p));
+}
+
+void init_proxy_state(const ProxyModel& pm, ProxyState& s) {
+  s.look = pm.look ? make_detect_state(*pm.look) : nullptr;
 }
 
 void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, DetectedAt& at,
@@ -221,6 +243,29 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
   // detections (the passes follow the proxy's own motion, not the device's: a proxy held at
   // the surface by a device 20 mm inside takes one pass).
   const double step_len = kSweepShare * pm.epsilon_mm;
+  const double look_len = step_len * q.lookahead_epsilons;
+  // A translation longer than step_len looks through the lookahead band (a wide detection)
+  // and goes along the same motion until half an epsilon short of the first contact that
+  // band holds, or look_len: one wide detection instead of one per step_len. The solve at
+  // every pass, and so where the proxy ends, is the stages' own detection's.
+  const auto look_ahead = [&](const Pose& X0, const Vec3& v) {
+    const double len = v.norm();
+    const double floor = step_len / len;
+    const double stop = 1 - 0.5 * step_len / len;  // the last half step: a pass of its own
+    detect(*pm.look, *s.look, X0, s.look_contacts);
+    if (s.look_contacts.overflow()) return floor;
+    double f = std::min(look_len / len, stop);
+    for (const ContactPc& c : s.look_contacts) {
+      if (!is_point_type(c.pc.type)) continue;
+      // Its distance after the whole step (linear in a translation). The solve keeps the
+      // contacts it had at least that far; one it did not have, crossed before the step
+      // ends, stops the step half an epsilon short of it.
+      const double rate = c.R_WT.col(1).dot(v);
+      if (c.distance + rate < -kSolveTolerance_mm)
+        f = std::min(f, (c.distance - 0.5 * pm.epsilon_mm) / -rate);
+    }
+    return std::max(f, floor);
+  };
   Pose X = s.X_WP;
   static constexpr int kMaxRows = 3 * ProxyResult::kMaxContacts;
   std::array<Row, kMaxRows> rows;
@@ -331,8 +376,11 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
     }
     const double sweep = xi.head<3>().norm() + xi.tail<3>().norm() * pm.reach_mm;
     if (sweep > step_len) {
-      // Too long to be sure of: advance by step_len and look again.
-      const double f = step_len / sweep;
+      // Too long to be sure of: advance by step_len and look again; a translation as far as
+      // the lookahead band shows it free. (A turn's contacts in the band would be linearised
+      // about points up to the band's width from where they touch: turns step as before.)
+      const bool translation = xi.tail<3>().norm() * pm.reach_mm <= 1e-6 * step_len;
+      const double f = pm.look && translation ? look_ahead(X, xi.head<3>()) : step_len / sweep;
       X = moved(X, g_A, f * xi.head<3>(), f * xi.tail<3>());
       continue;
     }

@@ -15,8 +15,12 @@ namespace cf::detail {
 
 struct ProxyModel {
   /// @throws cf::Error naming a proxy parameter out of range.
-  ProxyModel(const Polyhedron& a, const Params& params);
+  ProxyModel(const Polyhedron& a, const Polyhedron& b, const Params& params);
   ProxyParams prm;
+  // Detection through the lookahead band (ProxyParams::lookahead_epsilons), null when off.
+  // A superset of the stages' point contacts: a wider band, the same in-plane tolerance and
+  // no wider angular tolerance (which would read crossing edges as parallel ones).
+  DetectModelPtr look;
   double epsilon_mm = 1;
   double mu_static = 0.7, mu_kinetic = 0.08;
   Mat3 J_A = Mat3::Identity();     // mm^2, A's inertia per unit mass about the grip point, A's axes
@@ -38,7 +42,12 @@ struct ProxyState {
   std::array<std::array<double, 3>, ProxyResult::kMaxContacts> warm_lambda{};
   int num_warm = 0;
   ProxyResult result;
+  DetectStatePtr look;     // for ProxyModel::look
+  ContactSet look_contacts;
 };
+
+/// A state for `pm` (its lookahead detection's state sized).
+void init_proxy_state(const ProxyModel& pm, ProxyState& s);
 
 /// Moves the proxy towards X_WP (SPEC 6b) and fills s.result (coupling included). Detects
 /// with `ds` into `at` (the stages' own contact set), so that the stages at the final proxy

@@ -35,7 +35,7 @@ CfModel::Impl::Impl(const CfGraph& g, const Params& p)
     : graph(&g),
       params(p),
       detect(detail::make_detect_model(g.model_a(), g.model_b(), p)),
-      proxy(g.model_a(), p) {
+      proxy(g.model_a(), g.model_b(), p) {
   detail::check_identification_params(p.identification);
 }
 
@@ -55,6 +55,7 @@ CfState::Impl::Impl(const CfModel::Impl& m)
       identify(detail::make_identify_scratch()),
       force(m.graph->model_a(), m.graph->model_b(), m.params) {
   detected.out = &id.contacts;
+  detail::init_proxy_state(m.proxy, proxy);
 }
 
 CfState::CfState(const CfModel& model)
