@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <memory>
 
 namespace cf::gen {
 namespace {
@@ -840,10 +841,13 @@ Pc pc_of(const PcSet& pcs, ElementKind ka, int a, ElementKind kb, int b) {
 // enough to be listed, are far from crossing).
 class PlaneBound {
  public:
-  PlaneBound(const Polyhedron& A, const Polyhedron& B, const Pose& pose) : A_(A), B_(B) {
-    a_in_b_.reserve(A.num_vertices());
+  // a_buf, b_buf: where the posed vertices go (reused storage).
+  PlaneBound(const Polyhedron& A, const Polyhedron& B, const Pose& pose, std::vector<Vec3>& a_buf,
+             std::vector<Vec3>& b_buf)
+      : A_(A), B_(B), a_in_b_(a_buf), b_in_a_(b_buf) {
+    a_in_b_.clear();
     for (const Vertex& v : A.vertices()) a_in_b_.push_back(pose.apply(v.p));
-    b_in_a_.reserve(B.num_vertices());
+    b_in_a_.clear();
     for (const Vertex& v : B.vertices()) b_in_a_.push_back(pose.inverse_apply(v.p));
     // The line bound is compared with distances computed from the same coordinates; its own
     // rounding (a few ulps of the coordinates) is kept off by this much.
@@ -909,7 +913,8 @@ class PlaneBound {
   }
   const Polyhedron& A_;
   const Polyhedron& B_;
-  std::vector<Vec3> a_in_b_, b_in_a_;
+  std::vector<Vec3>& a_in_b_;
+  std::vector<Vec3>& b_in_a_;
   double line_slack_ = 0;  // mm
 };
 
@@ -922,8 +927,11 @@ struct NearElements {
   std::array<std::vector<Vec3>, 3> a_centers;  // A's element sphere centres in B's frame
 };
 
-NearElements near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& pose, double reach) {
-  NearElements out;
+void near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& pose, double reach, NearElements& out) {
+  for (int k = 0; k < 3; ++k) {
+    out.a[static_cast<std::size_t>(k)].clear();
+    out.b[static_cast<std::size_t>(k)].clear();
+  }
   const Vec3 b_in_a = pose.inverse_apply(B.bound.first);
   const Vec3 a_in_b = pose.apply(A.bound.first);
   for (int k = 0; k < 3; ++k) {
@@ -937,8 +945,38 @@ NearElements near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& p
       if ((B.spheres[k][i].first - a_in_b).norm() - B.spheres[k][i].second - A.bound.second <= reach)
         out.b[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
   }
-  return out;
 }
+
+// The buffers of one pair listing, kept per thread and reused: verify and contacts_at list
+// the pairs of a pose hundreds of thousands of times a run, each listing a dozen vectors.
+// Leased by depth, so that a listing inside another would get its own.
+struct NearScratch {
+  NearElements near;
+  std::vector<Vec3> a_in_b, b_in_a;
+};
+class ScratchLease {
+ public:
+  ScratchLease() {
+    Pool& p = pool();
+    if (p.depth == p.items.size()) p.items.push_back(std::make_unique<NearScratch>());
+    s_ = p.items[p.depth++].get();
+  }
+  ~ScratchLease() { --pool().depth; }
+  ScratchLease(const ScratchLease&) = delete;
+  ScratchLease& operator=(const ScratchLease&) = delete;
+  NearScratch& get() const { return *s_; }
+
+ private:
+  struct Pool {
+    std::vector<std::unique_ptr<NearScratch>> items;
+    std::size_t depth = 0;
+  };
+  static Pool& pool() {
+    thread_local Pool p;
+    return p;
+  }
+  NearScratch* s_;
+};
 
 // The element pairs (A's kind, B's kind, A's element, B's element, in that nesting order)
 // not proven farther apart than `reach` at `pose`: near the other model, then by bounding
@@ -953,7 +991,13 @@ struct ElementPair {
 class NearPairs {
  public:
   NearPairs(const ModelInfo& A, const ModelInfo& B, const Pose& pose, double reach)
-      : A_(A), B_(B), reach_(reach), near_(near_elements(A, B, pose, reach)), planes_(*A.model, *B.model, pose) {}
+      : A_(A),
+        B_(B),
+        reach_(reach),
+        near_(lease_.get().near),
+        planes_(*A.model, *B.model, pose, lease_.get().a_in_b, lease_.get().b_in_a) {
+    near_elements(A, B, pose, reach, near_);
+  }
 
   /// The next pair, false when there is none.
   bool next(ElementPair& out) {
@@ -978,10 +1022,11 @@ class NearPairs {
   }
 
  private:
+  ScratchLease lease_;  // first: the members below live in it
   const ModelInfo& A_;
   const ModelInfo& B_;
   double reach_;
-  NearElements near_;
+  NearElements& near_;
   PlaneBound planes_;
   int kind_ = 0;  // A's kind * 3 + B's kind
   std::size_t i_ = 0, j_ = 0;
@@ -1134,8 +1179,10 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
         return reject("two PCs share a contact plane");
     }
   double clearance = std::numeric_limits<double>::infinity();
-  std::vector<double> a_vertex_gap(A.num_vertices(), clearance);
-  std::vector<double> b_vertex_gap(B.num_vertices(), clearance);
+  // Per thread, reused (verify runs hundreds of thousands of times a run).
+  thread_local std::vector<double> a_vertex_gap, b_vertex_gap;
+  a_vertex_gap.assign(A.num_vertices(), clearance);
+  b_vertex_gap.assign(B.num_vertices(), clearance);
   int touching_pcs = 0;
   // Pairs proven farther apart than good_clearance can neither touch nor lower the clearance
   // below what counts as good: not measured.
@@ -1195,7 +1242,9 @@ bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) 
   const Polyhedron& B = *B_.model;
   using K = ElementKind;
   // Pairs within touch_tol (closed elements), and those touching in their open interiors.
-  std::vector<ElementPair> close, touching;
+  thread_local std::vector<ElementPair> close, touching;  // reused, as verify's
+  close.clear();
+  touching.clear();
   // near_pairs lists pairs in ascending kinds, so the pairs of an element pair's boundary
   // elements come before it. Where one of those is within touch_tol, so is the pair (closed
   // elements). Otherwise an edge and a face, or two faces, are farther apart unless the edge
