@@ -18,8 +18,8 @@ struct ProxyModel {
   ProxyModel(const Polyhedron& a, const Polyhedron& b, const Params& params);
   ProxyParams prm;
   // Detection through the lookahead band (ProxyParams::lookahead_epsilons), null when off.
-  // A superset of the stages' point contacts: a wider band, the same in-plane tolerance and
-  // no wider angular tolerance (which would read crossing edges as parallel ones).
+  // A superset of the stages' point contacts: the band and its in-plane tolerance widened,
+  // the angular tolerance not (a wider one would read crossing edges as parallel ones).
   DetectModelPtr look;
   double epsilon_mm = 1;
   double mu_static = 0.7, mu_kinetic = 0.08;
