@@ -839,10 +839,10 @@ Pc pc_of(const PcSet& pcs, ElementKind ka, int a, ElementKind kb, int b) {
 // height apart. From an edge's line: a vertex or an edge is at least its distance from the
 // line of the other side's edge apart (most edge pairs of two models, 95% of those near
 // enough to be listed, are far from crossing).
-class PlaneBound {
+class DistanceBound {
  public:
   // a_buf, b_buf: where the posed vertices go (reused storage).
-  PlaneBound(const Polyhedron& A, const Polyhedron& B, const Pose& pose, std::vector<Vec3>& a_buf,
+  DistanceBound(const Polyhedron& A, const Polyhedron& B, const Pose& pose, std::vector<Vec3>& a_buf,
              std::vector<Vec3>& b_buf)
       : A_(A), B_(B), a_in_b_(a_buf), b_in_a_(b_buf) {
     a_in_b_.clear();
@@ -891,10 +891,7 @@ class PlaneBound {
     x0 -= x0.dot(u) * u;
     Vec3 x1 = p1 - q;
     x1 -= x1.dot(u) * u;
-    const Vec3 d = x1 - x0;
-    const double l2 = d.squaredNorm();
-    const double s = l2 > 0 ? std::clamp(-x0.dot(d) / l2, 0.0, 1.0) : 0.0;
-    return (x0 + s * d).norm();
+    return point_segment(Vec3::Zero(), x0, x1).distance;
   }
 
   // Smallest height of element (k, i) of m (vertices given in f's frame) over f's plane when
@@ -980,7 +977,7 @@ class ScratchLease {
 
 // The element pairs (A's kind, B's kind, A's element, B's element, in that nesting order)
 // not proven farther apart than `reach` at `pose`: near the other model, then by bounding
-// spheres, then by a face's plane. verify and contacts_at measure only these. Produced one at
+// spheres, then by a face's plane or an edge's line. verify and contacts_at measure only these. Produced one at
 // a time, so that a caller that stops at the first obstacle (verify, on most failed poses)
 // does not pay for the rest.
 struct ElementPair {
@@ -995,7 +992,7 @@ class NearPairs {
         B_(B),
         reach_(reach),
         near_(lease_.get().near),
-        planes_(*A.model, *B.model, pose, lease_.get().a_in_b, lease_.get().b_in_a) {
+        bounds_(*A.model, *B.model, pose, lease_.get().a_in_b, lease_.get().b_in_a) {
     near_elements(A, B, pose, reach, near_);
   }
 
@@ -1013,7 +1010,7 @@ class NearPairs {
           const Vec3& ca = near_.a_centers[ia][static_cast<std::size_t>(a)];
           if ((ca - sb.first).norm() - sa.second - sb.second > reach_) continue;
           const auto ka = static_cast<ElementKind>(ia), kb = static_cast<ElementKind>(ib);
-          if (planes_.lower(ka, a, kb, b) > reach_) continue;
+          if (bounds_.lower(ka, a, kb, b) > reach_) continue;
           out = {ka, kb, a, b};
           return true;
         }
@@ -1027,7 +1024,7 @@ class NearPairs {
   const ModelInfo& B_;
   double reach_;
   NearElements& near_;
-  PlaneBound planes_;
+  DistanceBound bounds_;
   int kind_ = 0;  // A's kind * 3 + B's kind
   std::size_t i_ = 0, j_ = 0;
 };
