@@ -30,6 +30,10 @@ constexpr double kSolveTolerance_mm = 1e-5;
 // in-plane tolerances at the boundary of a face.
 constexpr double kSweepShare = 0.75;
 
+// Sweeps a contact group must hold all its loaded corners at the static friction bound before
+// it breaks away (a few: a sticking region can touch the bound while its load settles).
+constexpr int kBreakawaySweeps = 4;
+
 Vec3 rotation_vector(const Mat3& R) {
   const Eigen::AngleAxisd aa(R);
   return aa.angle() * aa.axis();
@@ -49,7 +53,8 @@ void require(bool ok, const std::string& what) {
 // One constraint row: a . xi >= lo (normal) or = 0 (tangent), xi = (v, w) about the grip.
 struct Row {
   Vec6 a, Wa;    // the row and the inverse metric times it
-  double G = 1;  // a . W a
+  double G = 1;      // a . W a
+  double inv_G = 1;  // 1 / G: Gauss-Seidel multiplies (a division is on each update's critical path)
 };
 
 // Grip point of a pose, world frame.
@@ -310,6 +315,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
         row.a << dir, rr.cross(dir);
         row.Wa << dir / k, Winv_rot * rr.cross(dir);
         row.G = row.a.dot(row.Wa);
+        row.inv_G = 1 / row.G;
         lambda[static_cast<std::size_t>(3 * j + axis)] = 0;
       }
       if (c.distance + rows[static_cast<std::size_t>(3 * j)].a.dot(xi_d) < 0) blocking = true;
@@ -328,6 +334,45 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
       r.constrained = true;
       for (int i = 0; i < 3 * m; ++i)
         xi += rows[static_cast<std::size_t>(i)].Wa * lambda[static_cast<std::size_t>(i)];
+      // A contact group (plane) whose loaded corners have all held their friction at the static
+      // bound for kBreakawaySweeps sweeps breaks away: from then on its bounds are kinetic, as
+      // they would be on the next pass. Gauss-Seidel converges very slowly on a region held at
+      // the edge of static cones (the corners trade a torsional pair of forces), and polish would
+      // only scale those forces down to kinetic ones anyway.
+      std::array<int, ProxyResult::kMaxContacts> streak{};
+      const auto break_away = [&](Vec6& x) {
+        if (!(pm.mu_kinetic < pm.mu_static)) return false;
+        std::array<signed char, ProxyResult::kMaxContacts> held;  // by group: -1 unloaded, 0 no, 1 at the bound
+        for (int j = 0; j < m; ++j) held[static_cast<std::size_t>(group[static_cast<std::size_t>(j)])] = -1;
+        for (int j = 0; j < m; ++j) {
+          const auto J = static_cast<std::size_t>(j);
+          signed char& h = held[static_cast<std::size_t>(group[J])];
+          const double ln = lambda[3 * J];
+          if (ln <= 0 || h == 0) continue;
+          const double l1 = lambda[3 * J + 1], l2 = lambda[3 * J + 2], cap = mu[J] * ln * (1 - 1e-6);
+          h = mu[J] == pm.mu_static && l1 * l1 + l2 * l2 >= cap * cap ? 1 : 0;
+        }
+        // Each group counted once (at its first corner): 2 breaks away, 3 does not.
+        bool any = false;
+        for (int j = 0; j < m; ++j) {
+          const auto g = static_cast<std::size_t>(group[static_cast<std::size_t>(j)]);
+          if (held[g] >= 2) continue;
+          streak[g] = held[g] == 1 ? streak[g] + 1 : 0;
+          held[g] = streak[g] >= kBreakawaySweeps ? 2 : 3;
+          any = any || held[g] == 2;
+        }
+        if (!any) return false;
+        for (int j = 0; j < m; ++j) {
+          const auto J = static_cast<std::size_t>(j);
+          if (held[static_cast<std::size_t>(group[J])] != 2) continue;
+          mu[J] = pm.mu_kinetic;
+          const double sc = pm.mu_kinetic / pm.mu_static;
+          x += rows[3 * J + 1].Wa * (lambda[3 * J + 1] * (sc - 1)) + rows[3 * J + 2].Wa * (lambda[3 * J + 2] * (sc - 1));
+          lambda[3 * J + 1] *= sc;
+          lambda[3 * J + 2] *= sc;
+        }
+        return true;
+      };
       // Projected Gauss-Seidel on the constraint forces (N): xi = xi_d + W sum a_i lambda_i.
       for (int it = 0; it < q.solver_iterations; ++it) {
         ++r.iterations;
@@ -336,7 +381,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
           const auto J = static_cast<std::size_t>(j);
           Row& rn = rows[3 * J];
           double& ln = lambda[3 * J];
-          const double ln_new = std::max(0.0, ln - (dist[J] + rn.a.dot(xi)) / rn.G);
+          const double ln_new = std::max(0.0, ln - (dist[J] + rn.a.dot(xi)) * rn.inv_G);
           xi += rn.Wa * (ln_new - ln);
           change = std::max(change, std::abs(ln_new - ln) * rn.G);
           ln = ln_new;
@@ -345,10 +390,11 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
           Row& r2 = rows[3 * J + 2];
           double& l1 = lambda[3 * J + 1];
           double& l2 = lambda[3 * J + 2];
-          double n1 = l1 - r1.a.dot(xi) / r1.G, n2 = l2 - r2.a.dot(xi) / r2.G;
-          const double cap = mu[J] * ln, len = std::hypot(n1, n2);
-          if (len > cap) {
-            const double sc = len > 0 ? cap / len : 0.0;
+          double n1 = l1 - r1.a.dot(xi) * r1.inv_G, n2 = l2 - r2.a.dot(xi) * r2.inv_G;
+          // sqrt, not hypot: the forces are far from overflow, and hypot is several times slower.
+          const double cap = mu[J] * ln, len2 = n1 * n1 + n2 * n2;
+          if (len2 > cap * cap) {
+            const double sc = len2 > 0 ? cap / std::sqrt(len2) : 0.0;
             n1 *= sc;
             n2 *= sc;
           }
@@ -358,6 +404,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
           l2 = n2;
         }
         if (change < kSolveTolerance_mm) break;
+        if (break_away(xi)) continue;
       }
       xi = polish(xi, xi_d, rows.data(), lambda.data(), dist.data(), mu.data(), group.data(), m, k,
                   Winv_rot, pm.mu_kinetic, slides.data());
