@@ -7,6 +7,7 @@
 #include <cf/renderer.hpp>
 
 #include "fixtures.hpp"
+#include "runtime_models.hpp"
 #include "trajectories.hpp"
 
 #include <catch2/catch.hpp>
@@ -181,6 +182,40 @@ TEST_CASE("a pressed face that breaks away settles in a few solver sweeps", "[pr
   CHECK(res.X_WP.t_BA.x() - 67 == Approx(kMuD * kK * pen / kK).epsilon(0.01));
   CHECK(res.X_WP.t_BA.y() == Approx(35).margin(kDelta));
   CHECK(Eigen::AngleAxisd(res.X_WP.R_BA).angle() < 1e-5 / 50);
+}
+
+TEST_CASE("with more point contacts than a solve holds, the nearest are kept and the rest counted",
+          "[proxy]") {
+  // Two faceted spheres (2,000 and 2,016 faces) with a 4 mm band: pressed together, the band
+  // holds over a hundred point contacts (vertex-face and crossing edges), more than the
+  // solve's ProxyResult::kMaxContacts. Pressing 6 mm in, the proxy must still not sink into
+  // B: the nearest contacts are the ones that bind.
+  namespace tm = cf::testmodels;
+  const cf::CfGraph g = cf::CfGraph::from_parts(tm::faceted_sphere(30, 40, 50, cf::Vec3::Zero(), "sphere2000"),
+                                                tm::faceted_sphere(50, 42, 48, cf::Vec3::Zero(), "sphere2016"),
+                                                {}, {});
+  cf::Params p;
+  p.epsilon_mm = p.detection.max_penetration_mm = 4.0;
+  cf::HapticRenderer r(g, p);
+  double t = 0;
+  int most_dropped = 0;
+  double deepest = 0;
+  cf::ContactDetector det(g.model_a(), g.model_b());
+  cf::ContactSet cs;
+  const cf::Vec3 dir = cf::Vec3(0.3, 1, 0.2).normalized();
+  for (int i = 0; i <= 400; ++i) {
+    cf::Pose X;
+    X.t_BA = dir * (80 + 2 - 8.0 * i / 400);  // from 2 mm apart to 6 mm in
+    const cf::HapticResult& res = r.step(X, t += 0.001);
+    most_dropped = std::max(most_dropped, res.proxy->dropped_contacts);
+    if (res.proxy->dropped_contacts > 0) CHECK(res.proxy->num_contacts == cf::ProxyResult::kMaxContacts);
+    det.detect(res.X_WP, cs);
+    for (const cf::ContactPc& c : cs) deepest = std::max(deepest, -c.distance);
+  }
+  INFO("most point contacts left out of a solve: " << most_dropped);
+  CHECK(most_dropped > 0);
+  // The allowed depth (ProxyParams::max_penetration_mm) over an independent detection.
+  CHECK(deepest <= kDelta);
 }
 
 TEST_CASE("a jump of the device through a thin wall in one tick: the proxy stops at the near side",

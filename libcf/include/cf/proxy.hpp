@@ -32,9 +32,14 @@ struct ProxyResult {
   bool constrained = false;
   int substeps = 0;    ///< sub-steps of the swept motion
   int iterations = 0;  ///< solver sweeps, over all sub-steps
-  /// The hard constraints at the final sub-step (the first kMaxContacts).
+  /// The hard constraints at the final sub-step: its point contacts, or the kMaxContacts
+  /// nearest when it had more.
   std::array<ProxyContact, kMaxContacts> contacts{};
   int num_contacts = 0;
+  /// Point contacts of the final sub-step left out of its solve (the farthest ones, beyond
+  /// kMaxContacts); a pass moves no point of A by more than 0.75 epsilon, so only those
+  /// nearer than that could be crossed.
+  int dropped_contacts = 0;
   /// N and N mm about A's grip point at X_WD, world axes: the coupling's wrench on the
   /// operator's hand, k (X_WP - X_WD) + b (velocity difference).
   Vec3 F_coupling_W = Vec3::Zero();

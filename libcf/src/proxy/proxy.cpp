@@ -234,6 +234,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
   r.substeps = 0;
   r.iterations = 0;
   r.num_contacts = 0;
+  r.dropped_contacts = 0;
   if (!s.has_prev) {
     // The first tick: the proxy starts at the device.
     s.X_WP = X_WD;
@@ -279,6 +280,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
   std::array<int, ProxyResult::kMaxContacts> group{};       // contact plane, clamped to the array
   std::array<bool, ProxyResult::kMaxContacts> slides{};     // by group, from the last polish
   std::array<ContactPc, ProxyResult::kMaxContacts> used{};  // copies: detection reuses its set
+  std::array<int, ContactSet::kCapacity> pick{};             // the point contacts used, by index
   int m = 0;  // point contacts used as constraints in the last solve
   // The loaded contacts' constraint forces, by PC: a later solve starts from them.
   const auto remember_forces = [&] {
@@ -298,11 +300,23 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
     Vec6 xi_d;
     xi_d << grip(X_WD, g_A) - g, rotation_vector(X_WD.R_BA * X.R_BA.transpose());
     // The constraints: the point contacts (the corners of every contact region).
+    // With more than kMaxContacts of them, the nearest: a pass moves no point of A by more
+    // than kSweepShare epsilon, so the farthest are the last it could reach.
+    int n_point = 0;
+    for (int i = 0; i < contacts.size(); ++i)
+      if (is_point_type(contacts[i].pc.type)) pick[static_cast<std::size_t>(n_point++)] = i;
+    r.dropped_contacts = std::max(0, n_point - ProxyResult::kMaxContacts);
+    if (r.dropped_contacts > 0) {
+      const auto nearer = [&](int x, int y) { return contacts[x].distance < contacts[y].distance; };
+      std::nth_element(pick.begin(), pick.begin() + ProxyResult::kMaxContacts, pick.begin() + n_point, nearer);
+      std::sort(pick.begin(), pick.begin() + ProxyResult::kMaxContacts);  // detection's order
+      n_point = ProxyResult::kMaxContacts;
+    }
     m = 0;
     bool blocking = false;
     const Mat3 Winv_rot = X.R_BA * pm.Jinv_A * X.R_BA.transpose() / k;
-    for (const ContactPc& c : contacts) {
-      if (!is_point_type(c.pc.type) || m == ProxyResult::kMaxContacts) continue;
+    for (int i = 0; i < n_point; ++i) {
+      const ContactPc& c = contacts[pick[static_cast<std::size_t>(i)]];
       const Vec3 rr = c.p_W - g;
       const int j = m++;
       used[static_cast<std::size_t>(j)] = c;
