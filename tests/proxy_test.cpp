@@ -184,6 +184,23 @@ TEST_CASE("a pressed face that breaks away settles in a few solver sweeps", "[pr
   CHECK(Eigen::AngleAxisd(res.X_WP.R_BA).angle() < 1e-5 / 50);
 }
 
+TEST_CASE("a region pressed harder and pulled within its new static limit sticks", "[proxy]") {
+  // Pressed 2 mm in, then in one tick 4 mm in and 2.5 mm sideways: the pull, K 2.5 = 5.75 N,
+  // is within static friction on the new constraint load, mu K 4 = 6.44 N, but not on the
+  // old one (3.22 N). While the solve raises the loads, friction sits at mu_s times a partial
+  // load: that must not count as breaking away.
+  const cf::CfGraph& g = cube_l_graph();
+  cf::HapticRenderer r(g);
+  double t = 0;
+  press(r, t, at(70, 37, 40), at(70, 33, 40));
+  const cf::HapticResult& res = r.step(at(67.5, 31, 40), t += 0.001);
+  CHECK(res.X_WP.t_BA.x() == Approx(70).margin(1e-6));
+  CHECK(res.X_WP.t_BA.y() == Approx(35).margin(kDelta));
+  bool sliding = false;
+  for (int j = 0; j < res.proxy->num_contacts; ++j) sliding = sliding || res.proxy->contacts[j].sliding;
+  CHECK_FALSE(sliding);
+}
+
 TEST_CASE("with more point contacts than a solve holds, the nearest are kept and the rest counted",
           "[proxy]") {
   // Two faceted spheres (2,000 and 2,016 faces) with a 4 mm band: pressed together, the band
@@ -200,7 +217,7 @@ TEST_CASE("with more point contacts than a solve holds, the nearest are kept and
   double t = 0;
   int most_dropped = 0;
   double deepest = 0;
-  cf::ContactDetector det(g.model_a(), g.model_b());
+  cf::ContactDetector det(g.model_a(), g.model_b(), p);  // sees as deep as the band
   cf::ContactSet cs;
   const cf::Vec3 dir = cf::Vec3(0.3, 1, 0.2).normalized();
   for (int i = 0; i <= 400; ++i) {
@@ -209,6 +226,14 @@ TEST_CASE("with more point contacts than a solve holds, the nearest are kept and
     const cf::HapticResult& res = r.step(X, t += 0.001);
     most_dropped = std::max(most_dropped, res.proxy->dropped_contacts);
     if (res.proxy->dropped_contacts > 0) CHECK(res.proxy->num_contacts == cf::ProxyResult::kMaxContacts);
+    det.detect(res.X_WP, cs);
+    for (const cf::ContactPc& c : cs) deepest = std::max(deepest, -c.distance);
+  }
+  // Out to 2 mm apart, then in to 6 mm deep in one tick: the swept passes with the band full.
+  for (const double gap : {2.0, -6.0}) {
+    cf::Pose X;
+    X.t_BA = dir * (80 + gap);
+    const cf::HapticResult& res = r.step(X, t += 0.001);
     det.detect(res.X_WP, cs);
     for (const cf::ContactPc& c : cs) deepest = std::max(deepest, -c.distance);
   }

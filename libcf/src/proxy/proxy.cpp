@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 namespace cf::detail {
@@ -33,6 +34,9 @@ constexpr double kSweepShare = 0.75;
 // Sweeps a contact group must hold all its loaded corners at the static friction bound before
 // it breaks away (a few: a sticking region can touch the bound while its load settles).
 constexpr int kBreakawaySweeps = 4;
+// Relative change of a group's total normal load over one sweep below which it counts as
+// settled for the breakaway (friction at mu_s times a load within 0.1% of its final value).
+constexpr double kSettledLoad = 1e-3;
 
 Vec3 rotation_vector(const Mat3& R) {
   const Eigen::AngleAxisd aa(R);
@@ -281,6 +285,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
   std::array<bool, ProxyResult::kMaxContacts> slides{};     // by group, from the last polish
   std::array<ContactPc, ProxyResult::kMaxContacts> used{};  // copies: detection reuses its set
   std::array<int, ContactSet::kCapacity> pick{};             // the point contacts used, by index
+  std::array<std::int16_t, ContactSet::kCapacity> plane_group{};  // detection's plane -> group
   int m = 0;  // point contacts used as constraints in the last solve
   // The loaded contacts' constraint forces, by PC: a later solve starts from them.
   const auto remember_forces = [&] {
@@ -306,14 +311,32 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
     for (int i = 0; i < contacts.size(); ++i)
       if (is_point_type(contacts[i].pc.type)) pick[static_cast<std::size_t>(n_point++)] = i;
     r.dropped_contacts = std::max(0, n_point - ProxyResult::kMaxContacts);
+    // Whether the motion to the device runs into a point contact (one that is left out too:
+    // then the pass must not jump to the device).
+    const auto blocks = [&](const ContactPc& c) {
+      return c.distance + c.R_WT.col(1).dot(xi_d.head<3>() + xi_d.tail<3>().cross(c.p_W - g)) < 0;
+    };
+    bool blocking = false;
     if (r.dropped_contacts > 0) {
-      const auto nearer = [&](int x, int y) { return contacts[x].distance < contacts[y].distance; };
+      // Equally near contacts (the corners of a flat region) by index, so the choice is
+      // the same from pass to pass.
+      const auto nearer = [&](int x, int y) {
+        return contacts[x].distance < contacts[y].distance || (contacts[x].distance == contacts[y].distance && x < y);
+      };
       std::nth_element(pick.begin(), pick.begin() + ProxyResult::kMaxContacts, pick.begin() + n_point, nearer);
+      for (int i = ProxyResult::kMaxContacts; i < n_point; ++i)
+        blocking = blocking || blocks(contacts[pick[static_cast<std::size_t>(i)]]);
       std::sort(pick.begin(), pick.begin() + ProxyResult::kMaxContacts);  // detection's order
       n_point = ProxyResult::kMaxContacts;
     }
+    // Contact planes numbered afresh for the contacts used (detection's numbers run over all
+    // its contacts, up to its capacity): at most kMaxContacts groups.
+    for (int i = 0; i < n_point; ++i) {
+      const int pl = contacts[pick[static_cast<std::size_t>(i)]].plane;
+      if (pl >= 0) plane_group[static_cast<std::size_t>(pl)] = -1;
+    }
+    int num_groups = 0;
     m = 0;
-    bool blocking = false;
     const Mat3 Winv_rot = X.R_BA * pm.Jinv_A * X.R_BA.transpose() / k;
     for (int i = 0; i < n_point; ++i) {
       const ContactPc& c = contacts[pick[static_cast<std::size_t>(i)]];
@@ -321,8 +344,13 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
       const int j = m++;
       used[static_cast<std::size_t>(j)] = c;
       dist[static_cast<std::size_t>(j)] = c.distance;
-      group[static_cast<std::size_t>(j)] =
-          std::clamp<int>(c.plane, 0, ProxyResult::kMaxContacts - 1);
+      if (c.plane < 0) {
+        group[static_cast<std::size_t>(j)] = num_groups++;  // ungrouped: a plane of its own
+      } else {
+        std::int16_t& pg = plane_group[static_cast<std::size_t>(c.plane)];
+        if (pg < 0) pg = static_cast<std::int16_t>(num_groups++);
+        group[static_cast<std::size_t>(j)] = pg;
+      }
       for (int axis = 0; axis < 3; ++axis) {
         const Vec3 dir = c.R_WT.col(axis == 0 ? 1 : axis == 1 ? 0 : 2);
         Row& row = rows[static_cast<std::size_t>(3 * j + axis)];
@@ -332,7 +360,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
         row.inv_G = 1 / row.G;
         lambda[static_cast<std::size_t>(3 * j + axis)] = 0;
       }
-      if (c.distance + rows[static_cast<std::size_t>(3 * j)].a.dot(xi_d) < 0) blocking = true;
+      if (blocks(c)) blocking = true;
       for (int i = 0; i < s.num_warm; ++i)
         if (s.warm_pc[static_cast<std::size_t>(i)] == c.pc)
           for (int axis = 0; axis < 3; ++axis)
@@ -354,6 +382,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
       // the edge of static cones (the corners trade a torsional pair of forces), and polish would
       // only scale those forces down to kinetic ones anyway.
       std::array<int, ProxyResult::kMaxContacts> streak{};
+      std::array<double, ProxyResult::kMaxContacts> load_before{};  // N, by group, a sweep ago
       const auto break_away = [&](Vec6& x) {
         if (!(pm.mu_kinetic < pm.mu_static)) return false;
         std::array<signed char, ProxyResult::kMaxContacts> held;  // by group: -1 unloaded, 0 no, 1 at the bound
@@ -366,12 +395,22 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
           const double l1 = lambda[3 * J + 1], l2 = lambda[3 * J + 2], cap = mu[J] * ln * (1 - 1e-6);
           h = mu[J] == pm.mu_static && l1 * l1 + l2 * l2 >= cap * cap ? 1 : 0;
         }
+        // And its load settled (the group's total within kSettledLoad of a sweep ago): while
+        // loads still grow (a fresh contact, a harder press) friction can sit at mu_s times a
+        // partial load of a region that sticks. (The corners' shares may still move: they
+        // trade load as they trade the torsional pair.)
+        std::array<double, ProxyResult::kMaxContacts> load;
+        for (int j = 0; j < m; ++j) load[static_cast<std::size_t>(group[static_cast<std::size_t>(j)])] = 0;
+        for (int j = 0; j < m; ++j)
+          load[static_cast<std::size_t>(group[static_cast<std::size_t>(j)])] += lambda[3 * static_cast<std::size_t>(j)];
         // Each group counted once (at its first corner): 2 breaks away, 3 does not.
         bool any = false;
         for (int j = 0; j < m; ++j) {
           const auto g = static_cast<std::size_t>(group[static_cast<std::size_t>(j)]);
           if (held[g] >= 2) continue;
-          streak[g] = held[g] == 1 ? streak[g] + 1 : 0;
+          const bool settled = std::abs(load[g] - load_before[g]) <= kSettledLoad * load[g];
+          load_before[g] = load[g];
+          streak[g] = held[g] == 1 && settled ? streak[g] + 1 : 0;
           held[g] = streak[g] >= kBreakawaySweeps ? 2 : 3;
           any = any || held[g] == 2;
         }
