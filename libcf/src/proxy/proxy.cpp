@@ -54,6 +54,13 @@ void require(bool ok, const std::string& what) {
   if (!ok) throw Error("cf::Params: parameter proxy." + what);
 }
 
+// A corner's friction (l1, l2) at its Coulomb bound mu ln (to rounding): where Gauss-Seidel
+// left it, the corner would slip.
+bool at_friction_bound(double l1, double l2, double mu, double ln) {
+  const double cap = mu * ln * (1 - 1e-6);
+  return mu > 0 && l1 * l1 + l2 * l2 >= cap * cap;
+}
+
 // One constraint row: a . xi >= lo (normal) or = 0 (tangent), xi = (v, w) about the grip.
 struct Row {
   Vec6 a, Wa;    // the row and the inverse metric times it
@@ -103,7 +110,7 @@ Vec6 polish(const Vec6& xi_pgs, const Vec6& xi_d, const Row* rows, double* lambd
     const double ln = lambda[3 * j], l1 = lambda[3 * j + 1], l2 = lambda[3 * j + 2];
     if (ln <= 0) continue;
     load[g] += ln;
-    if (!(mu[j] > 0 && std::hypot(l1, l2) >= mu[j] * ln * (1 - 1e-6))) saturated[g] = false;
+    if (!at_friction_bound(l1, l2, mu[j], ln)) saturated[g] = false;
   }
   for (int g = 0; g < kGroups; ++g)
     slides[g] = load[static_cast<std::size_t>(g)] > 0 && saturated[static_cast<std::size_t>(g)];
@@ -281,7 +288,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
   std::array<Row, kMaxRows> rows;
   std::array<double, kMaxRows> lambda{};
   std::array<double, ProxyResult::kMaxContacts> dist{}, mu{};
-  std::array<int, ProxyResult::kMaxContacts> group{};       // contact plane, clamped to the array
+  std::array<int, ProxyResult::kMaxContacts> group{};       // contact plane, numbered per pass
   std::array<bool, ProxyResult::kMaxContacts> slides{};     // by group, from the last polish
   std::array<ContactPc, ProxyResult::kMaxContacts> used{};  // copies: detection reuses its set
   std::array<int, ContactSet::kCapacity> pick{};             // the point contacts used, by index
@@ -381,50 +388,45 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
       // they would be on the next pass. Gauss-Seidel converges very slowly on a region held at
       // the edge of static cones (the corners trade a torsional pair of forces), and polish would
       // only scale those forces down to kinetic ones anyway.
-      std::array<int, ProxyResult::kMaxContacts> streak{};
+      std::array<int, ProxyResult::kMaxContacts> streak{};          // by group
       std::array<double, ProxyResult::kMaxContacts> load_before{};  // N, by group, a sweep ago
       const auto break_away = [&](Vec6& x) {
-        if (!(pm.mu_kinetic < pm.mu_static)) return false;
-        std::array<signed char, ProxyResult::kMaxContacts> held;  // by group: -1 unloaded, 0 no, 1 at the bound
-        for (int j = 0; j < m; ++j) held[static_cast<std::size_t>(group[static_cast<std::size_t>(j)])] = -1;
+        if (!(pm.mu_kinetic < pm.mu_static)) return;
+        std::array<bool, ProxyResult::kMaxContacts> loaded, held, breaks;
+        std::array<double, ProxyResult::kMaxContacts> load;
+        for (int g = 0; g < num_groups; ++g) loaded[g] = false, held[g] = true, load[g] = 0;
         for (int j = 0; j < m; ++j) {
           const auto J = static_cast<std::size_t>(j);
-          signed char& h = held[static_cast<std::size_t>(group[J])];
+          const auto g = static_cast<std::size_t>(group[J]);
           const double ln = lambda[3 * J];
-          if (ln <= 0 || h == 0) continue;
-          const double l1 = lambda[3 * J + 1], l2 = lambda[3 * J + 2], cap = mu[J] * ln * (1 - 1e-6);
-          h = mu[J] == pm.mu_static && l1 * l1 + l2 * l2 >= cap * cap ? 1 : 0;
+          if (ln <= 0) continue;
+          loaded[g] = true;
+          load[g] += ln;
+          if (!(mu[J] == pm.mu_static && at_friction_bound(lambda[3 * J + 1], lambda[3 * J + 2], mu[J], ln)))
+            held[g] = false;
         }
         // And its load settled (the group's total within kSettledLoad of a sweep ago): while
         // loads still grow (a fresh contact, a harder press) friction can sit at mu_s times a
         // partial load of a region that sticks. (The corners' shares may still move: they
         // trade load as they trade the torsional pair.)
-        std::array<double, ProxyResult::kMaxContacts> load;
-        for (int j = 0; j < m; ++j) load[static_cast<std::size_t>(group[static_cast<std::size_t>(j)])] = 0;
-        for (int j = 0; j < m; ++j)
-          load[static_cast<std::size_t>(group[static_cast<std::size_t>(j)])] += lambda[3 * static_cast<std::size_t>(j)];
-        // Each group counted once (at its first corner): 2 breaks away, 3 does not.
         bool any = false;
-        for (int j = 0; j < m; ++j) {
-          const auto g = static_cast<std::size_t>(group[static_cast<std::size_t>(j)]);
-          if (held[g] >= 2) continue;
+        for (int g = 0; g < num_groups; ++g) {
           const bool settled = std::abs(load[g] - load_before[g]) <= kSettledLoad * load[g];
           load_before[g] = load[g];
-          streak[g] = held[g] == 1 && settled ? streak[g] + 1 : 0;
-          held[g] = streak[g] >= kBreakawaySweeps ? 2 : 3;
-          any = any || held[g] == 2;
+          streak[g] = loaded[g] && held[g] && settled ? streak[g] + 1 : 0;
+          breaks[g] = streak[g] >= kBreakawaySweeps;
+          any = any || breaks[g];
         }
-        if (!any) return false;
+        if (!any) return;
+        const double sc = pm.mu_kinetic / pm.mu_static;
         for (int j = 0; j < m; ++j) {
           const auto J = static_cast<std::size_t>(j);
-          if (held[static_cast<std::size_t>(group[J])] != 2) continue;
+          if (!breaks[static_cast<std::size_t>(group[J])]) continue;
           mu[J] = pm.mu_kinetic;
-          const double sc = pm.mu_kinetic / pm.mu_static;
           x += rows[3 * J + 1].Wa * (lambda[3 * J + 1] * (sc - 1)) + rows[3 * J + 2].Wa * (lambda[3 * J + 2] * (sc - 1));
           lambda[3 * J + 1] *= sc;
           lambda[3 * J + 2] *= sc;
         }
-        return true;
       };
       // Projected Gauss-Seidel on the constraint forces (N): xi = xi_d + W sum a_i lambda_i.
       for (int it = 0; it < q.solver_iterations; ++it) {
@@ -457,7 +459,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
           l2 = n2;
         }
         if (change < kSolveTolerance_mm) break;
-        if (break_away(xi)) continue;
+        break_away(xi);
       }
       xi = polish(xi, xi_d, rows.data(), lambda.data(), dist.data(), mu.data(), group.data(), m, k,
                   Winv_rot, pm.mu_kinetic, slides.data());
