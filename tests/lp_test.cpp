@@ -200,3 +200,23 @@ TEST_CASE("lp: a touching pose's program, feasible only within tolerance, is sol
   REQUIRE(r.status == Status::kOptimal);
   CHECK(r.x[3] == Approx(0.0).margin(1e-5));  // margin 0, up to the rows' tolerance
 }
+
+TEST_CASE("lp: programs beyond the fixed capacity are refused with a message") {
+  // The solver keeps its work in fixed-size storage; a larger program is a caller's bug and
+  // must say so rather than write past the storage.
+  constexpr int kMax = LinearProgram::kMaxVars;
+  CHECK_THROWS_WITH(LinearProgram(kMax + 1), Catch::Contains("more than kMaxVars variables"));
+  LinearProgram::Coefs row;
+  for (int j = 0; j < kMax; ++j) row.push_back({j, 1.0});
+  CHECK(row.size() == static_cast<std::size_t>(kMax));
+  CHECK_THROWS_WITH(row.push_back({0, 1.0}), Catch::Contains("more than kMaxVars coefficients"));
+  // At the capacity, a program still solves: min sum x subject to x >= 1 in every coordinate.
+  LinearProgram lp(kMax);
+  for (int j = 0; j < kMax; ++j) {
+    lp.c[j] = 1.0;
+    lp.add({{j, 1.0}}, Rel::kGreaterEq, 1.0);
+  }
+  const LpResult r = cf::gen::internal::dense_solve(lp);
+  REQUIRE(r.status == Status::kOptimal);
+  for (int j = 0; j < kMax; ++j) CHECK(r.x[j] == Approx(1.0).margin(1e-9));
+}

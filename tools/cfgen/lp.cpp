@@ -24,6 +24,41 @@ namespace {
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
+constexpr int kMaxVars = LinearProgram::kMaxVars;
+constexpr int kMaxEqs = 2 * kMaxVars;  // equality rows beyond this go to GLPK
+// Storage for the variables' dimension lives in the objects themselves. The maxima are above
+// Eigen's small-product threshold (8), so products pick the same kernels as for MatrixXd.
+using VarMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxVars, kMaxVars>;
+using VarVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxVars, 1>;
+using EqMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxEqs, kMaxVars>;
+using EqMatT = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxVars, kMaxEqs>;
+using EqVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxEqs, 1>;
+using MatMap = Eigen::Map<MatrixXd>;
+using VecMap = Eigen::Map<VectorXd>;
+
+// Per-thread storage for the matrices whose size follows the number of rows, grown and
+// never freed: a run solves some million programs.
+struct Workspace {
+  std::vector<double> G, h, Gz, hz, htol, At, hk, hk_tol, T, tol;
+  std::vector<int> keep, basic, tight;
+  std::vector<char> live;
+};
+
+Workspace& workspace() {
+  thread_local Workspace w;
+  return w;
+}
+
+MatMap as_matrix(std::vector<double>& buf, int rows, int cols) {
+  const std::size_t need = static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols);
+  if (buf.size() < need) buf.resize(need);
+  return MatMap(buf.data(), rows, cols);
+}
+
+VecMap as_vector(std::vector<double>& buf, int rows) {
+  if (buf.size() < static_cast<std::size_t>(rows)) buf.resize(static_cast<std::size_t>(rows));
+  return VecMap(buf.data(), rows);
+}
 
 // Tableau entries below this are zero. The programs' coefficients are unit directions, and a
 // witness near a degenerate pose has entries of 1e-9 that are rounding of zero: pivoting on
@@ -41,13 +76,19 @@ enum class Dual { kOptimal, kInfeasible, kUnbounded };
 // columns (< m) of the rows that were not found redundant.
 struct DualSimplex {
   int d, m;
-  MatrixXd T;              // d constraint rows, then the cost row; last column the right side
-  std::vector<int> basic;  // basic column of each row; columns >= m are artificial
-  std::vector<char> live;  // rows not removed as redundant
-  std::vector<double> tol;  // per column: reduced costs above -tol are non-negative
+  MatMap T;                 // d constraint rows, then the cost row; last column the right side
+  std::vector<int>& basic;  // basic column of each row; columns >= m are artificial
+  std::vector<char>& live;  // rows not removed as redundant
+  std::vector<double>& tol;  // per column: reduced costs above -tol are non-negative
 
-  DualSimplex(const MatrixXd& A, const VectorXd& b) : d(int(A.rows())), m(int(A.cols())) {
-    T = MatrixXd::Zero(d + 1, m + d + 1);
+  DualSimplex(const MatMap& A, const VarVec& b, Workspace& w)
+      : d(int(A.rows())),
+        m(int(A.cols())),
+        T(as_matrix(w.T, d + 1, m + d + 1)),
+        basic(w.basic),
+        live(w.live),
+        tol(w.tol) {
+    T.setZero();
     basic.resize(d);
     live.assign(d, 1);
     tol.assign(m, kCostTol);
@@ -96,7 +137,7 @@ struct DualSimplex {
     return Dual::kUnbounded;  // not reached in practice; treated as "no solution"
   }
 
-  Dual solve(const VectorXd& h, const VectorXd& h_tol) {
+  Dual solve(const VecMap& h, const VecMap& h_tol) {
     // Phase 1: minimise the sum of the artificials.
     T.row(d).setZero();
     for (int i = 0; i < d; ++i) T.row(d) -= T.row(i);
@@ -126,7 +167,8 @@ struct DualSimplex {
 
 // Trust but verify: a solution that misses a row or a bound by more than 1e-7 (1 + |b|) is no
 // solution.
-bool meets_rows(const LinearProgram& lp, const VectorXd& x) {
+template <typename Vec>
+bool meets_rows(const LinearProgram& lp, const Vec& x) {
   using Rel = LinearProgram::Rel;
   for (const auto& r : lp.rows) {
     double v = 0;
@@ -152,6 +194,7 @@ LpResult internal::dense_solve(const LinearProgram& lp) {
   using Rel = LinearProgram::Rel;
   const int n = lp.num_vars;
   LpResult out;
+  Workspace& w = workspace();
 
   // Split the rows and bounds into equalities E x = f and inequalities G x <= h.
   int ne = 0, ni = 0;
@@ -165,8 +208,12 @@ LpResult internal::dense_solve(const LinearProgram& lp) {
       ni += int(lf) + int(uf);
     }
   }
-  MatrixXd E = MatrixXd::Zero(ne, n), G = MatrixXd::Zero(ni, n);
-  VectorXd f(ne), h(ni);
+  if (n > kMaxVars || ne > kMaxEqs) return out;  // not solved here
+  EqMat E = EqMat::Zero(ne, n);
+  EqVec f(ne);
+  MatMap G = as_matrix(w.G, ni, n);
+  G.setZero();
+  VecMap h = as_vector(w.h, ni);
   int ie = 0, ii = 0;
   for (const auto& r : lp.rows) {
     if (r.rel == Rel::kEq) {
@@ -191,28 +238,30 @@ LpResult internal::dense_solve(const LinearProgram& lp) {
   }
 
   // 1. x = x0 + N z over the solutions of the equalities.
-  VectorXd x0 = VectorXd::Zero(n);
-  MatrixXd N = MatrixXd::Identity(n, n);
+  VarVec x0 = VarVec::Zero(n);
+  VarMat N = VarMat::Identity(n, n);
   if (ne > 0) {
-    Eigen::CompleteOrthogonalDecomposition<MatrixXd> cod(E);
+    Eigen::CompleteOrthogonalDecomposition<EqMat> cod(E);
     cod.setThreshold(1e-12);
     x0 = cod.solve(f);
     if ((E * x0 - f).lpNorm<Eigen::Infinity>() > kCostTol * (1 + f.lpNorm<Eigen::Infinity>()))
       return out;  // inconsistent equalities
     // The null space of E: the columns of Q past E^T's rank, from E^T P = Q R.
-    Eigen::ColPivHouseholderQR<MatrixXd> qr(E.transpose());
+    Eigen::ColPivHouseholderQR<EqMatT> qr(E.transpose());
     qr.setThreshold(1e-12);
-    const MatrixXd Q = qr.householderQ();
+    const VarMat Q = qr.householderQ();
     N = Q.rightCols(n - int(qr.rank()));
   }
   const int d = int(N.cols());
-  const VectorXd cz = N.transpose() * Eigen::Map<const VectorXd>(lp.c.data(), n);
-  MatrixXd Gz = G * N;
-  VectorXd hz = h - G * x0;
+  const VarVec cz = N.transpose() * Eigen::Map<const VectorXd>(lp.c.data(), n);
+  MatMap Gz = as_matrix(w.Gz, ni, d);
+  Gz.noalias() = G * N;
+  VecMap hz = as_vector(w.hz, ni);
+  hz.noalias() = h - G * x0;
   // Unit rows; a row with no z in it is a fixed condition on x0.
-  std::vector<int> keep;
-  keep.reserve(ni);
-  VectorXd htol(ni);
+  std::vector<int>& keep = w.keep;
+  keep.clear();
+  VecMap htol = as_vector(w.htol, ni);
   for (int i = 0; i < ni; ++i) {
     const double len = Gz.row(i).norm();
     if (len <= 1e-12) {
@@ -226,25 +275,26 @@ LpResult internal::dense_solve(const LinearProgram& lp) {
   }
   const int m = int(keep.size());
 
-  VectorXd z = VectorXd::Zero(d);
+  VarVec z = VarVec::Zero(d);
   if (d > 0) {
-    MatrixXd At(d, m);
-    VectorXd hk(m), hk_tol(m);
+    MatMap At = as_matrix(w.At, d, m);
+    VecMap hk = as_vector(w.hk, m), hk_tol = as_vector(w.hk_tol, m);
     for (int k = 0; k < m; ++k) {
       At.col(k) = Gz.row(keep[k]).transpose();
       hk[k] = hz[keep[k]];
       hk_tol[k] = htol[keep[k]];
     }
-    DualSimplex ds(At, -cz);
+    DualSimplex ds(At, -cz, w);
     const Dual st = ds.solve(hk, hk_tol);
     if (st != Dual::kOptimal) return out;  // infeasible or unbounded: GLPK decides
     // 3. The primal optimum makes the basic rows tight.
-    std::vector<int> tight;
+    std::vector<int>& tight = w.tight;
+    tight.clear();
     for (int i = 0; i < d; ++i)
       if (ds.live[i] && ds.basic[i] < m) tight.push_back(ds.basic[i]);
     if (!tight.empty()) {
-      MatrixXd Gt(tight.size(), d);
-      VectorXd ht(tight.size());
+      VarMat Gt(tight.size(), d);
+      VarVec ht(tight.size());
       for (std::size_t k = 0; k < tight.size(); ++k) {
         Gt.row(k) = At.col(tight[k]).transpose();
         ht[k] = hk[tight[k]];

@@ -3,6 +3,10 @@
 
 #include <Eigen/Core>
 
+#include <array>
+#include <cstddef>
+#include <initializer_list>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -10,9 +14,37 @@ namespace cf::gen {
 
 /// minimise c.x subject to rows (a_i . x  REL_i  b_i) and per-variable bounds.
 struct LinearProgram {
+  /// At most this many variables: the witness search's programs have ten at most, and the
+  /// solver keeps its work in fixed-size storage (no allocation per program).
+  static constexpr int kMaxVars = 12;
   enum class Rel { kLessEq, kEq, kGreaterEq };
+  /// A row's sparse coefficients (variable, value), stored inline: a program is built and
+  /// solved some million times in a run, and a heap block per row was a tenth of its time.
+  class Coefs {
+   public:
+    Coefs() = default;
+    Coefs(std::initializer_list<std::pair<int, double>> a) {
+      for (const auto& x : a) push_back(x);
+    }
+    Coefs(const std::vector<std::pair<int, double>>& a) {  // NOLINT: implicit on purpose
+      for (const auto& x : a) push_back(x);
+    }
+    /// Throws std::length_error past kMaxVars entries.
+    void push_back(const std::pair<int, double>& x) {
+      if (n_ == kMaxVars) throw std::length_error("LinearProgram row with more than kMaxVars coefficients");
+      v_[n_++] = x;
+    }
+    std::size_t size() const { return n_; }
+    bool empty() const { return n_ == 0; }
+    const std::pair<int, double>* begin() const { return v_.data(); }
+    const std::pair<int, double>* end() const { return v_.data() + n_; }
+
+   private:
+    std::array<std::pair<int, double>, kMaxVars> v_{};
+    std::size_t n_ = 0;
+  };
   struct Row {
-    std::vector<std::pair<int, double>> a;  // sparse coefficients (variable, value)
+    Coefs a;
     Rel rel;
     double b;
   };
@@ -21,16 +53,20 @@ struct LinearProgram {
   std::vector<double> c;                  // objective, size num_vars
   std::vector<std::pair<bool, double>> lower, upper;  // (finite?, value) per variable
 
+  /// Throws std::length_error when n > kMaxVars.
   explicit LinearProgram(int n)
-      : num_vars(n), c(n, 0.0), lower(n, {false, 0.0}), upper(n, {false, 0.0}) {}
-  void add(std::vector<std::pair<int, double>> a, Rel rel, double b) {
-    rows.push_back({std::move(a), rel, b});
+      : num_vars(n), c(n, 0.0), lower(n, {false, 0.0}), upper(n, {false, 0.0}) {
+    if (n > kMaxVars) throw std::length_error("LinearProgram with more than kMaxVars variables");
   }
+  void add(const Coefs& a, Rel rel, double b) { rows.push_back({a, rel, b}); }
 };
+
+/// A program's variables, in fixed-size storage.
+using LpVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, LinearProgram::kMaxVars, 1>;
 
 struct LpResult {
   enum class Status { kOptimal, kInfeasible, kUnbounded } status = Status::kInfeasible;
-  Eigen::VectorXd x;  // the optimum, rounded to double from the exact solution
+  LpVector x;  // the optimum, size num_vars when kOptimal
 };
 
 /// Solves in double precision: a small dense simplex first, GLPK's primal simplex for what it

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <memory>
+#include <stdexcept>
 
 namespace cf::gen {
 namespace {
@@ -547,7 +548,18 @@ namespace {
 // the (u, v) frame: every side with margin s (variable s_var) when it is real boundary.
 struct AffinePoint {
   Vec3 p0 = Vec3::Zero();
-  std::vector<std::pair<int, Vec3>> coef;
+  // (variable, coefficient) pairs: t (3) and up to two parameters; inline, no allocation.
+  struct Coefs {
+    std::array<std::pair<int, Vec3>, 6> v;
+    std::size_t n = 0;
+    Coefs() { v.fill({0, Vec3::Zero()}); }
+    void push_back(const std::pair<int, Vec3>& x) {
+      if (n == v.size()) throw std::length_error("AffinePoint with more than 6 coefficients");
+      v[n++] = x;
+    }
+    const std::pair<int, Vec3>* begin() const { return v.data(); }
+    const std::pair<int, Vec3>* end() const { return v.data() + n; }
+  } coef;
 };
 
 void add_piece_rows(LinearProgram& lp, const ConvexPiece& piece, const Vec3& u, const Vec3& v,
@@ -560,17 +572,17 @@ void add_piece_rows(LinearProgram& lp, const ConvexPiece& piece, const Vec3& u, 
     const double len = g.norm();
     if (len < 1e-12) continue;
     g /= len;
-    std::vector<std::pair<int, double>> row;
+    LinearProgram::Coefs row;
     for (const auto& [j, cvec] : P.coef) row.push_back({j, g.x() * u.dot(cvec) + g.y() * v.dot(cvec)});
     if (piece.boundary[k]) row.push_back({s_var, -1.0});
-    lp.add(std::move(row), Rel::kGreaterEq, g.dot(a) - (g.x() * u.dot(P.p0) + g.y() * v.dot(P.p0)));
+    lp.add(row, Rel::kGreaterEq, g.dot(a) - (g.x() * u.dot(P.p0) + g.y() * v.dot(P.p0)));
   }
 }
 
 void add_eq(LinearProgram& lp, const Vec3& n, const AffinePoint& P, double rhs) {
-  std::vector<std::pair<int, double>> row;
+  LinearProgram::Coefs row;
   for (const auto& [j, cvec] : P.coef) row.push_back({j, n.dot(cvec)});
-  lp.add(std::move(row), Rel::kEq, rhs - n.dot(P.p0));
+  lp.add(row, Rel::kEq, rhs - n.dot(P.p0));
 }
 
 AffinePoint plus_t(Vec3 p0, double sign = 1.0) {
@@ -644,7 +656,8 @@ LinearProgram WitnessSearch::build_lp(const PcSet& pcs, const Mat3& R,
         add_eq(lp, fb.normal, plus_t(R * fa.centroid), fb.offset);
         AffinePoint Q;  // a common point q on B's face plane
         Q.p0 = fb.offset * fb.normal;
-        Q.coef = {{aux, fb.u}, {aux + 1, fb.v}};
+        Q.coef.push_back({aux, fb.u});
+        Q.coef.push_back({aux + 1, fb.v});
         add_piece_rows(lp, B_.pieces[pc.b][pieces[slot++]], fb.u, fb.v, Q, S);
         AffinePoint QA = Q;  // q - t, read in A's rotated face frame
         for (int i = 0; i < 3; ++i) QA.coef.push_back({i, -Vec3::Unit(i)});
@@ -711,7 +724,7 @@ std::vector<Vec3> WitnessSearch::translations(const PcSet& pcs, const Mat3& R,
   lp.c[3] = 0.0;
   auto extremes_at = [&](double floor) {
     lp.lower[3] = {true, floor};
-    std::vector<Eigen::VectorXd> ext;
+    std::vector<LpVector> ext;
     for (int axis = 0; axis < 3; ++axis)
       for (double sign : {1.0, -1.0}) {
         lp.c[axis] = sign;
@@ -721,13 +734,13 @@ std::vector<Vec3> WitnessSearch::translations(const PcSet& pcs, const Mat3& R,
       }
     return ext;
   };
-  const std::vector<Eigen::VectorXd> extremes = extremes_at(0.5 * margin);
+  const std::vector<LpVector> extremes = extremes_at(0.5 * margin);
   if (extremes.empty()) return {best.x.head<3>()};
   if (near_boundary) {
     // Near a wall the contact may have to sit close to its element's boundary: extremes that
     // keep only 5% of the margin (still at least min_margin), pulled a little towards the
     // centre of the first set.
-    Eigen::VectorXd c0 = Eigen::VectorXd::Zero(best.x.size());
+    LpVector c0 = LpVector::Zero(best.x.size());
     for (const auto& x : extremes) c0 += x;
     c0 /= static_cast<double>(extremes.size());
     std::vector<Vec3> out;
@@ -735,7 +748,7 @@ std::vector<Vec3> WitnessSearch::translations(const PcSet& pcs, const Mat3& R,
       out.push_back((0.9 * x + 0.1 * c0).head<3>());
     return out;
   }
-  Eigen::VectorXd center = Eigen::VectorXd::Zero(best.x.size());
+  LpVector center = LpVector::Zero(best.x.size());
   for (const auto& x : extremes) center += x;
   center /= static_cast<double>(extremes.size());
   std::vector<Vec3> out{center.head<3>()};
