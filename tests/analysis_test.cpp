@@ -1,5 +1,6 @@
 // Tests of the generator's per-model facts (tools/cfgen/analysis.cpp): the points of an
-// element at least a margin inside it, worked out by hand on the cube and the L-block.
+// element at least a margin inside it, worked out by hand on the cube and the L-block; the
+// index of the elements' boxes against a brute-force test.
 
 #include "cfgen/analysis.hpp"
 #include "fixtures.hpp"
@@ -8,7 +9,10 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cstdint>
+#include <random>
 #include <string>
+#include <vector>
 
 using cf::ElementKind;
 using cf::Vec3;
@@ -74,4 +78,36 @@ TEST_CASE("inset closure points: an edge's ends moved in, a convex face's corner
   REQUIRE(r.size() == 4);
   for (const Vec3& q : {Vec3(20 + m, 20, m), Vec3(120 - m, 20, m), Vec3(20 + m, 20, 80 - m), Vec3(120 - m, 20, 80 - m)})
     CHECK(holds(r, q));
+}
+
+TEST_CASE("box index: the boxes meeting a query box, as a brute-force test over every box finds them") {
+  // Random boxes on a coarse lattice, so that ends coincide (ties at the sorted bounds) and
+  // queries touch boxes exactly at an end (closed boxes meet there).
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> coord(-6, 6), extent(0, 4);
+  for (int n : {1, 5, 63, 64, 65, 200}) {
+    std::vector<Vec3> lo, hi;
+    for (int i = 0; i < n; ++i) {
+      const Vec3 l(coord(rng), coord(rng), coord(rng));
+      lo.push_back(l);
+      hi.push_back(l + Vec3(extent(rng), extent(rng), extent(rng)));
+    }
+    const cf::gen::BoxIndex index(lo, hi);
+    REQUIRE(index.size() == n);
+    REQUIRE(index.words() == (n + 63) / 64);
+    std::vector<std::uint64_t> bits(static_cast<std::size_t>(index.words()));
+    for (int q = 0; q < 300; ++q) {
+      const Vec3 ql(coord(rng), coord(rng), coord(rng));
+      const Vec3 qh = ql + Vec3(extent(rng), extent(rng), extent(rng));
+      index.query(ql, qh, bits.data());
+      for (int i = 0; i < n; ++i) {
+        const bool meets = (lo[i].array() <= qh.array()).all() && (hi[i].array() >= ql.array()).all();
+        const bool listed = (bits[static_cast<std::size_t>(i / 64)] >> (i % 64)) & 1u;
+        INFO("n " << n << " box " << i << " query " << ql.transpose() << " .. " << qh.transpose());
+        CHECK(listed == meets);
+      }
+      // No bit past the last box.
+      if (n % 64 != 0) CHECK((bits.back() >> (n % 64)) == 0u);
+    }
+  }
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 namespace cf::gen {
@@ -77,6 +78,53 @@ bool point_inside(const Polyhedron& m, const Vec3& p, double boundary_tol) {
     if (!ambiguous) return crossings % 2 == 1;
   }
   return false;  // every direction grazed the boundary: p is on it for all practical purposes
+}
+
+BoxIndex::BoxIndex(const std::vector<Vec3>& lo, const std::vector<Vec3>& hi)
+    : n_(static_cast<int>(lo.size())), words_((n_ + 63) / 64) {
+  const auto n = static_cast<std::size_t>(n_), w = static_cast<std::size_t>(words_);
+  std::vector<int> order(n);
+  for (int ax = 0; ax < 3; ++ax) {
+    auto build = [&](const std::vector<Vec3>& end, std::vector<double>& sorted, std::vector<std::uint64_t>& sets,
+                     bool prefix) {
+      for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<int>(i);
+      std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return end[a][ax] < end[b][ax]; });
+      sorted.resize(n);
+      for (std::size_t r = 0; r < n; ++r) sorted[r] = end[static_cast<std::size_t>(order[r])][ax];
+      sets.assign((n + 1) * w, 0);
+      // prefix: set r holds order[0, r); suffix: set r holds order[r, n). Each set is the
+      // one before it (prefix) or after it (suffix) and one element more.
+      auto bit = [&](std::size_t r, int e) { sets[r * w + static_cast<std::size_t>(e / 64)] |= std::uint64_t{1} << (e % 64); };
+      if (prefix) {
+        for (std::size_t r = 1; r <= n; ++r) {
+          std::copy_n(sets.begin() + static_cast<std::ptrdiff_t>((r - 1) * w), w, sets.begin() + static_cast<std::ptrdiff_t>(r * w));
+          bit(r, order[r - 1]);
+        }
+      } else {
+        for (std::size_t r = n; r-- > 0;) {
+          std::copy_n(sets.begin() + static_cast<std::ptrdiff_t>((r + 1) * w), w, sets.begin() + static_cast<std::ptrdiff_t>(r * w));
+          bit(r, order[r]);
+        }
+      }
+    };
+    build(lo, lo_sorted_[ax], lo_prefix_[ax], true);
+    build(hi, hi_sorted_[ax], hi_suffix_[ax], false);
+  }
+}
+
+void BoxIndex::query(const Vec3& q_lo, const Vec3& q_hi, std::uint64_t* out) const {
+  const auto w = static_cast<std::size_t>(words_);
+  for (std::size_t i = 0; i < w; ++i) out[i] = ~std::uint64_t{0};
+  for (int ax = 0; ax < 3; ++ax) {
+    // lower end <= q_hi: the first r of the lower ends; upper end >= q_lo: from r on.
+    const auto rl = static_cast<std::size_t>(
+        std::upper_bound(lo_sorted_[ax].begin(), lo_sorted_[ax].end(), q_hi[ax]) - lo_sorted_[ax].begin());
+    const auto rh = static_cast<std::size_t>(
+        std::lower_bound(hi_sorted_[ax].begin(), hi_sorted_[ax].end(), q_lo[ax]) - hi_sorted_[ax].begin());
+    const std::uint64_t* pl = lo_prefix_[ax].data() + rl * w;
+    const std::uint64_t* ph = hi_suffix_[ax].data() + rh * w;
+    for (std::size_t i = 0; i < w; ++i) out[i] &= pl[i] & ph[i];
+  }
 }
 
 ModelInfo analyse_model(const Polyhedron& m) {
@@ -156,6 +204,19 @@ ModelInfo analyse_model(const Polyhedron& m) {
     double r = 0;
     for (VertexId v : F.vertices) r = std::max(r, (m.vertex(v).p - c).norm());
     info.spheres[2].push_back({c, r});
+  }
+  {
+    std::vector<Vec3> lo[3], hi[3];
+    auto add_box = [&](int k, const std::vector<VertexId>& vs) {
+      Vec3 l = m.vertex(vs[0]).p, h = l;
+      for (VertexId v : vs) l = l.cwiseMin(m.vertex(v).p), h = h.cwiseMax(m.vertex(v).p);
+      lo[k].push_back(l);
+      hi[k].push_back(h);
+    };
+    for (std::size_t v = 0; v < m.num_vertices(); ++v) add_box(0, {VertexId(static_cast<int>(v))});
+    for (const Edge& E : m.edges()) add_box(1, {E.v0, E.v1});
+    for (const Face& F : m.faces()) add_box(2, F.vertices);
+    for (int k = 0; k < 3; ++k) info.boxes[k] = BoxIndex(lo[k], hi[k]);
   }
   {
     Vec3 lo = m.vertices()[0].p, hi = lo;

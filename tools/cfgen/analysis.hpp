@@ -7,6 +7,8 @@
 
 #include <cf/polyhedron.hpp>
 
+#include <array>
+#include <cstdint>
 #include <vector>
 
 namespace cf::gen {
@@ -23,6 +25,30 @@ struct EdgeWedge {
   Vec3 bisector = Vec3::Zero();  // unit bisector of the two outward normals (convex edges)
 };
 
+/// The axis-aligned boxes of a set of elements, indexed so that the elements whose box meets
+/// a query box come out as a bitset in time O(log n + n / 64): per axis, the elements whose
+/// lower end is at most the query's upper end are a prefix of the elements sorted by lower
+/// end, and those whose upper end is at least the query's lower end a suffix of the elements
+/// sorted by upper end; each prefix and suffix is stored as a bitset.
+class BoxIndex {
+ public:
+  BoxIndex() = default;
+  /// lo[i], hi[i]: element i's box (mm).
+  BoxIndex(const std::vector<Vec3>& lo, const std::vector<Vec3>& hi);
+  int size() const { return n_; }
+  /// 64-bit words of a bitset over the elements.
+  int words() const { return words_; }
+  /// Writes to out[0, words()) the elements whose closed box meets [q_lo, q_hi].
+  void query(const Vec3& q_lo, const Vec3& q_hi, std::uint64_t* out) const;
+
+ private:
+  int n_ = 0, words_ = 0;
+  std::array<std::vector<double>, 3> lo_sorted_, hi_sorted_;
+  // (n + 1) bitsets each: lo_prefix_[a][r] holds the r elements of smallest lower end on axis
+  // a; hi_suffix_[a][r] the elements from the r-th smallest upper end on.
+  std::array<std::vector<std::uint64_t>, 3> lo_prefix_, hi_suffix_;
+};
+
 struct ModelInfo {
   const Polyhedron* model = nullptr;
   std::vector<VertexCone> cones;
@@ -32,6 +58,8 @@ struct ModelInfo {
   // Bounding spheres (center in the model frame, radius, mm) of every element, indexed by
   // kind (vertex, edge, face) then element, for cheap distance lower bounds.
   std::vector<std::pair<Vec3, double>> spheres[3];
+  // The elements' axis-aligned boxes (model frame), indexed for box queries, by kind.
+  BoxIndex boxes[3];
   std::pair<Vec3, double> bound{Vec3::Zero(), 0.0};  // bounding sphere of the whole model
 };
 

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <iostream>
 #include <memory>
@@ -869,6 +870,8 @@ class DistanceBound {
     for (const Vertex& v : B.vertices()) extent = std::max(extent, v.p.lpNorm<Eigen::Infinity>());
     line_slack_ = 1e-12 * extent;
   }
+  /// The slack kept off bounds computed from the posed coordinates (mm).
+  double slack() const { return line_slack_; }
   double lower(ElementKind ka, int a, ElementKind kb, int b) const {
     using K = ElementKind;
     double lb = 0;
@@ -934,6 +937,7 @@ class DistanceBound {
 // than `reach`.
 struct NearElements {
   std::array<std::vector<int>, 3> a, b;
+  std::array<std::vector<std::uint64_t>, 3> b_bits;  // b as bitsets over B's elements
   std::array<std::vector<Vec3>, 3> a_centers;  // A's element sphere centres in B's frame
 };
 
@@ -951,9 +955,12 @@ void near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& pose, dou
         out.a[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
         out.a_centers[static_cast<std::size_t>(k)][i] = pose.apply(A.spheres[k][i].first);
       }
+    out.b_bits[static_cast<std::size_t>(k)].assign(static_cast<std::size_t>(B.boxes[k].words()), 0);
     for (std::size_t i = 0; i < B.spheres[k].size(); ++i)
-      if ((B.spheres[k][i].first - a_in_b).norm() - B.spheres[k][i].second - A.bound.second <= reach)
+      if ((B.spheres[k][i].first - a_in_b).norm() - B.spheres[k][i].second - A.bound.second <= reach) {
         out.b[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
+        out.b_bits[static_cast<std::size_t>(k)][i / 64] |= std::uint64_t{1} << (i % 64);
+      }
   }
 }
 
@@ -963,6 +970,9 @@ void near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& pose, dou
 struct NearScratch {
   NearElements near;
   std::vector<Vec3> a_in_b, b_in_a;
+  std::vector<std::uint64_t> row;  // NearPairs: the elements of B near the current one of A
+  // NearPairs: the boxes of A's elements in B's frame (lo x, y, z, hi x, y, z), by kind.
+  std::array<std::vector<std::array<double, 6>>, 3> a_boxes;
 };
 class ScratchLease {
  public:
@@ -1005,28 +1015,55 @@ class NearPairs {
         B_(B),
         reach_(reach),
         near_(lease_.get().near),
+        row_(lease_.get().row),
         bounds_(*A.model, *B.model, pose, lease_.get().a_in_b, lease_.get().b_in_a) {
     near_elements(A, B, pose, reach, near_);
+    // A's boxes from its vertices in B's frame (the bound's own coordinates, so that the box
+    // test and the distances agree within the bound's slack).
+    const std::vector<Vec3>& p = lease_.get().a_in_b;
+    const Polyhedron& m = *A.model;
+    for (std::size_t k = 0; k < 3; ++k) {
+      auto& boxes = lease_.get().a_boxes[k];
+      boxes.resize(A.spheres[k].size());
+      for (int i : near_.a[k]) {
+        std::array<double, 6>& box = boxes[static_cast<std::size_t>(i)];
+        constexpr double kInf = std::numeric_limits<double>::infinity();
+        box = {kInf, kInf, kInf, -kInf, -kInf, -kInf};
+        auto add = [&](VertexId v) {
+          const Vec3& x = p[v.index()];
+          for (int ax = 0; ax < 3; ++ax) box[ax] = std::min(box[ax], x[ax]), box[3 + ax] = std::max(box[3 + ax], x[ax]);
+        };
+        if (k == 0) add(VertexId(i));
+        else if (k == 1) add(m.edges()[i].v0), add(m.edges()[i].v1);
+        else for (VertexId v : m.faces()[i].vertices) add(v);
+      }
+    }
   }
 
   /// The next pair, false when there is none.
   bool next(ElementPair& out) {
-    for (; kind_ < 9; ++kind_, i_ = 0, j_ = 0) {
+    for (; kind_ < 9; ++kind_, i_ = 0) {
       const auto ia = static_cast<std::size_t>(kind_ / 3), ib = static_cast<std::size_t>(kind_ % 3);
       const std::vector<int>& as = near_.a[ia];
-      const std::vector<int>& bs = near_.b[ib];
-      for (; i_ < as.size(); ++i_, j_ = 0)
-        while (j_ < bs.size()) {
-          const int a = as[i_], b = bs[j_++];
-          const auto& sa = A_.spheres[ia][static_cast<std::size_t>(a)];
-          const auto& sb = B_.spheres[ib][static_cast<std::size_t>(b)];
-          const Vec3& ca = near_.a_centers[ia][static_cast<std::size_t>(a)];
-          if ((ca - sb.first).norm() - sa.second - sb.second > reach_) continue;
-          const auto ka = static_cast<ElementKind>(ia), kb = static_cast<ElementKind>(ib);
-          if (bounds_.lower(ka, a, kb, b) > reach_) continue;
-          out = {ka, kb, a, b};
-          return true;
-        }
+      for (; i_ < as.size(); ++i_) {
+        const int a = as[i_];
+        const auto& sa = A_.spheres[ia][static_cast<std::size_t>(a)];
+        const Vec3& ca = near_.a_centers[ia][static_cast<std::size_t>(a)];
+        if (!row_built_) build_row(ib, lease_.get().a_boxes[ia][static_cast<std::size_t>(a)]);
+        // The row's elements in ascending order, lowest bit of each word first.
+        for (; word_ < row_.size(); ++word_, bits_ = word_ < row_.size() ? row_[word_] : 0)
+          while (bits_ != 0) {
+            const int b = static_cast<int>(word_ * 64) + __builtin_ctzll(bits_);
+            bits_ &= bits_ - 1;
+            const auto& sb = B_.spheres[ib][static_cast<std::size_t>(b)];
+            if ((ca - sb.first).norm() - sa.second - sb.second > reach_) continue;
+            const auto ka = static_cast<ElementKind>(ia), kb = static_cast<ElementKind>(ib);
+            if (bounds_.lower(ka, a, kb, b) > reach_) continue;
+            out = {ka, kb, a, b};
+            return true;
+          }
+        row_built_ = false;
+      }
     }
     return false;
   }
@@ -1036,10 +1073,27 @@ class NearPairs {
   const ModelInfo& A_;
   const ModelInfo& B_;
   double reach_;
+  // The elements of B of kind ib near the other solid whose boxes meet A's element's box
+  // grown by the reach (a box apart by more along an axis is farther than the reach).
+  void build_row(std::size_t ib, const std::array<double, 6>& box) {
+    const BoxIndex& index = B_.boxes[ib];
+    row_.resize(static_cast<std::size_t>(index.words()));
+    const double g = reach_ + bounds_.slack();
+    index.query(Vec3(box[0] - g, box[1] - g, box[2] - g), Vec3(box[3] + g, box[4] + g, box[5] + g), row_.data());
+    const std::vector<std::uint64_t>& in = near_.b_bits[ib];
+    for (std::size_t i = 0; i < row_.size(); ++i) row_[i] &= in[i];
+    word_ = 0;
+    bits_ = row_.empty() ? 0 : row_[0];
+    row_built_ = true;
+  }
+
   NearElements& near_;
+  std::vector<std::uint64_t>& row_;
   DistanceBound bounds_;
   int kind_ = 0;  // A's kind * 3 + B's kind
-  std::size_t i_ = 0, j_ = 0;
+  std::size_t i_ = 0, word_ = 0;
+  std::uint64_t bits_ = 0;  // the row's current word, the elements already listed cleared
+  bool row_built_ = false;
 };
 
 }  // namespace
@@ -1244,7 +1298,9 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
   if (b_vertex_gap[ib] > p_.touch_tol &&
       point_inside(A, pose.inverse_apply(B.vertices()[ib].p), p_.touch_tol))
     return reject("B inside A");
-  return clearance;
+  // Pairs beyond good_clearance are not listed (which of them are depends on the listing's
+  // bounds), so a clearance beyond it is reported as good_clearance: always finite.
+  return std::min(clearance, p_.good_clearance);
 }
 
 bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) const {

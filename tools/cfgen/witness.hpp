@@ -27,7 +27,7 @@ struct SearchParams {
 struct Witness {
   bool found = false;
   Pose pose;
-  double clearance = 0;  // mm, smallest distance between elements not part of a PC
+  double clearance = 0;  // mm, smallest distance between elements not part of a PC, <= good_clearance
   double margin = 0;     // mm, the LP margin of the contacts inside their elements
 };
 
@@ -47,7 +47,8 @@ class WitnessSearch {
   /// Verifies a pose: exactly the PCs of `pcs` hold (every other touching element pair is
   /// dominated by one of them), locally without penetration, pairwise distinct contact
   /// planes, every other pair at least min_clearance apart, neither solid inside the other.
-  /// Returns the clearance, or a negative number when the pose is not a witness.
+  /// Returns the clearance (the smallest distance of such a pair, at most good_clearance: pairs
+  /// farther apart are not measured), or a negative number when the pose is not a witness.
   double verify(const PcSet& pcs, const Pose& pose, std::string* why = nullptr) const;
 
   /// A pair of elements, not part of the contacts, that came too close at a pose verify
