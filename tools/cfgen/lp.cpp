@@ -4,6 +4,7 @@
 #include <glpk.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace cf::gen {
@@ -34,6 +35,7 @@ using EqMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxEqs, 
 using EqMatT = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxVars, kMaxEqs>;
 using EqVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxEqs, 1>;
 using MatMap = Eigen::Map<MatrixXd>;
+using RowMatMap = Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
 using VecMap = Eigen::Map<VectorXd>;
 
 // Per-thread storage for the matrices whose size follows the number of rows, grown and
@@ -42,6 +44,21 @@ struct Workspace {
   std::vector<double> G, h, Gz, hz, htol, At, hk, hk_tol, T, tol;
   std::vector<int> keep, basic, tight;
   std::vector<char> live;
+  // The last equality system and its solution: the witness search solves runs of programs
+  // with the same equalities (the same contacts at one rotation, other objectives or bounds).
+  struct Equalities {
+    bool set = false;
+    bool consistent = false;
+    EqMat E;
+    EqVec f;
+    VarVec x0;
+    VarMat N;
+    bool same(const EqMat& e, const EqVec& g) const {
+      return set && e.rows() == E.rows() && e.cols() == E.cols() &&
+             std::memcmp(e.data(), E.data(), sizeof(double) * static_cast<std::size_t>(e.size())) == 0 &&
+             std::memcmp(g.data(), f.data(), sizeof(double) * static_cast<std::size_t>(g.size())) == 0;
+    }
+  } eq;
 };
 
 Workspace& workspace() {
@@ -49,10 +66,11 @@ Workspace& workspace() {
   return w;
 }
 
-MatMap as_matrix(std::vector<double>& buf, int rows, int cols) {
+template <typename Map = MatMap>
+Map as_matrix(std::vector<double>& buf, int rows, int cols) {
   const std::size_t need = static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols);
   if (buf.size() < need) buf.resize(need);
-  return MatMap(buf.data(), rows, cols);
+  return Map(buf.data(), rows, cols);
 }
 
 VecMap as_vector(std::vector<double>& buf, int rows) {
@@ -76,7 +94,7 @@ enum class Dual { kOptimal, kInfeasible, kUnbounded };
 // columns (< m) of the rows that were not found redundant.
 struct DualSimplex {
   int d, m;
-  MatMap T;                 // d constraint rows, then the cost row; last column the right side
+  RowMatMap T;              // d constraint rows, then the cost row; last column the right side
   std::vector<int>& basic;  // basic column of each row; columns >= m are artificial
   std::vector<char>& live;  // rows not removed as redundant
   std::vector<double>& tol;  // per column: reduced costs above -tol are non-negative
@@ -84,7 +102,7 @@ struct DualSimplex {
   DualSimplex(const MatMap& A, const VarVec& b, Workspace& w)
       : d(int(A.rows())),
         m(int(A.cols())),
-        T(as_matrix(w.T, d + 1, m + d + 1)),
+        T(as_matrix<RowMatMap>(w.T, d + 1, m + d + 1)),
         basic(w.basic),
         live(w.live),
         tol(w.tol) {
@@ -241,16 +259,27 @@ LpResult internal::dense_solve(const LinearProgram& lp) {
   VarVec x0 = VarVec::Zero(n);
   VarMat N = VarMat::Identity(n, n);
   if (ne > 0) {
-    Eigen::CompleteOrthogonalDecomposition<EqMat> cod(E);
-    cod.setThreshold(1e-12);
-    x0 = cod.solve(f);
-    if ((E * x0 - f).lpNorm<Eigen::Infinity>() > kCostTol * (1 + f.lpNorm<Eigen::Infinity>()))
-      return out;  // inconsistent equalities
-    // The null space of E: the columns of Q past E^T's rank, from E^T P = Q R.
-    Eigen::ColPivHouseholderQR<EqMatT> qr(E.transpose());
-    qr.setThreshold(1e-12);
-    const VarMat Q = qr.householderQ();
-    N = Q.rightCols(n - int(qr.rank()));
+    Workspace::Equalities& c = w.eq;
+    if (!c.same(E, f)) {
+      c.set = true;
+      c.E = E;
+      c.f = f;
+      Eigen::CompleteOrthogonalDecomposition<EqMat> cod(E);
+      cod.setThreshold(1e-12);
+      c.x0 = cod.solve(f);
+      c.consistent =
+          (E * c.x0 - f).lpNorm<Eigen::Infinity>() <= kCostTol * (1 + f.lpNorm<Eigen::Infinity>());
+      if (c.consistent) {
+        // The null space of E: the columns of Q past E^T's rank, from E^T P = Q R.
+        Eigen::ColPivHouseholderQR<EqMatT> qr(E.transpose());
+        qr.setThreshold(1e-12);
+        const VarMat Q = qr.householderQ();
+        c.N = Q.rightCols(n - int(qr.rank()));
+      }
+    }
+    if (!c.consistent) return out;  // inconsistent equalities
+    x0 = c.x0;
+    N = c.N;
   }
   const int d = int(N.cols());
   const VarVec cz = N.transpose() * Eigen::Map<const VectorXd>(lp.c.data(), n);

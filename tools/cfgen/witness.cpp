@@ -605,6 +605,7 @@ LinearProgram WitnessSearch::build_lp(const PcSet& pcs, const Mat3& R,
           : pc.type == PcType::kFF || pc.type == PcType::kEE ? 2
                                                               : 0;
   LinearProgram lp(nv);
+  lp.rows.reserve(64);  // a few dozen rows and the cuts translations() adds: no regrowth
   const int S = 3;
   lp.lower[S] = {true, 0.0};
   lp.upper[S] = {true, scale_};
