@@ -206,17 +206,19 @@ ModelInfo analyse_model(const Polyhedron& m) {
     info.spheres[2].push_back({c, r});
   }
   {
-    std::vector<Vec3> lo[3], hi[3];
-    auto add_box = [&](int k, const std::vector<VertexId>& vs) {
+    std::vector<Vec3> lo, hi;
+    auto add_box = [&](const std::vector<VertexId>& vs) {
       Vec3 l = m.vertex(vs[0]).p, h = l;
       for (VertexId v : vs) l = l.cwiseMin(m.vertex(v).p), h = h.cwiseMax(m.vertex(v).p);
-      lo[k].push_back(l);
-      hi[k].push_back(h);
+      lo.push_back(l);
+      hi.push_back(h);
     };
-    for (std::size_t v = 0; v < m.num_vertices(); ++v) add_box(0, {VertexId(static_cast<int>(v))});
-    for (const Edge& E : m.edges()) add_box(1, {E.v0, E.v1});
-    for (const Face& F : m.faces()) add_box(2, F.vertices);
-    for (int k = 0; k < 3; ++k) info.boxes[k] = BoxIndex(lo[k], hi[k]);
+    for (std::size_t v = 0; v < m.num_vertices(); ++v) add_box({VertexId(static_cast<int>(v))});
+    info.box_offset[1] = static_cast<int>(lo.size());
+    for (const Edge& E : m.edges()) add_box({E.v0, E.v1});
+    info.box_offset[2] = static_cast<int>(lo.size());
+    for (const Face& F : m.faces()) add_box(F.vertices);
+    info.boxes = BoxIndex(lo, hi);
   }
   {
     Vec3 lo = m.vertices()[0].p, hi = lo;

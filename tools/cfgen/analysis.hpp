@@ -58,8 +58,10 @@ struct ModelInfo {
   // Bounding spheres (center in the model frame, radius, mm) of every element, indexed by
   // kind (vertex, edge, face) then element, for cheap distance lower bounds.
   std::vector<std::pair<Vec3, double>> spheres[3];
-  // The elements' axis-aligned boxes (model frame), indexed for box queries, by kind.
-  BoxIndex boxes[3];
+  // The axis-aligned boxes (model frame) of all elements, indexed for box queries: vertices,
+  // then edges, then faces; element i of kind k is box_offset[k] + i.
+  BoxIndex boxes;
+  int box_offset[3] = {0, 0, 0};
   std::pair<Vec3, double> bound{Vec3::Zero(), 0.0};  // bounding sphere of the whole model
 };
 

@@ -938,7 +938,7 @@ class DistanceBound {
 // than `reach`.
 struct NearElements {
   std::array<std::vector<int>, 3> a, b;
-  std::array<std::vector<std::uint64_t>, 3> b_bits;  // b as bitsets over B's elements
+  std::vector<std::uint64_t> b_bits;  // b as one bitset over B's boxes (B.boxes' numbering)
   std::array<std::vector<Vec3>, 3> a_centers;  // A's element sphere centres in B's frame
 };
 
@@ -949,6 +949,7 @@ void near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& pose, dou
   }
   const Vec3 b_in_a = pose.inverse_apply(B.bound.first);
   const Vec3 a_in_b = pose.apply(A.bound.first);
+  out.b_bits.assign(static_cast<std::size_t>(B.boxes.words()), 0);
   for (int k = 0; k < 3; ++k) {
     out.a_centers[static_cast<std::size_t>(k)].resize(A.spheres[k].size());
     for (std::size_t i = 0; i < A.spheres[k].size(); ++i)
@@ -956,11 +957,12 @@ void near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& pose, dou
         out.a[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
         out.a_centers[static_cast<std::size_t>(k)][i] = pose.apply(A.spheres[k][i].first);
       }
-    out.b_bits[static_cast<std::size_t>(k)].assign(static_cast<std::size_t>(B.boxes[k].words()), 0);
+
     for (std::size_t i = 0; i < B.spheres[k].size(); ++i)
       if ((B.spheres[k][i].first - a_in_b).norm() - B.spheres[k][i].second - A.bound.second <= reach) {
         out.b[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
-        out.b_bits[static_cast<std::size_t>(k)][i / 64] |= std::uint64_t{1} << (i % 64);
+        const std::size_t bit = static_cast<std::size_t>(B.box_offset[k]) + i;
+        out.b_bits[bit / 64] |= std::uint64_t{1} << (bit % 64);
       }
   }
 }
@@ -971,9 +973,11 @@ void near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& pose, dou
 struct NearScratch {
   NearElements near;
   std::vector<Vec3> a_in_b, b_in_a;
-  std::vector<std::uint64_t> row;  // NearPairs: the elements of B near the current one of A
-  // NearPairs: the boxes of A's elements in B's frame (lo x, y, z, hi x, y, z), by kind.
-  std::array<std::vector<std::array<double, 6>>, 3> a_boxes;
+  // NearPairs: per element of A (A.boxes' numbering), the elements of B whose boxes meet its
+  // box, a bitset of B.boxes.words() words, valid when its stamp is the listing's.
+  std::vector<std::uint64_t> a_rows;
+  std::vector<std::uint64_t> a_row_stamp;
+  std::uint64_t stamp = 0;
 };
 class ScratchLease {
  public:
@@ -1016,29 +1020,13 @@ class NearPairs {
         B_(B),
         reach_(reach),
         near_(lease_.get().near),
-        row_(lease_.get().row),
         bounds_(*A.model, *B.model, pose, lease_.get().a_in_b, lease_.get().b_in_a) {
     near_elements(A, B, pose, reach, near_);
-    // A's boxes from its vertices in B's frame (the bound's own coordinates, so that the box
-    // test and the distances agree within the bound's slack).
-    const std::vector<Vec3>& p = lease_.get().a_in_b;
-    const Polyhedron& m = *A.model;
-    for (std::size_t k = 0; k < 3; ++k) {
-      auto& boxes = lease_.get().a_boxes[k];
-      boxes.resize(A.spheres[k].size());
-      for (int i : near_.a[k]) {
-        std::array<double, 6>& box = boxes[static_cast<std::size_t>(i)];
-        constexpr double kInf = std::numeric_limits<double>::infinity();
-        box = {kInf, kInf, kInf, -kInf, -kInf, -kInf};
-        auto add = [&](VertexId v) {
-          const Vec3& x = p[v.index()];
-          for (int ax = 0; ax < 3; ++ax) box[ax] = std::min(box[ax], x[ax]), box[3 + ax] = std::max(box[3 + ax], x[ax]);
-        };
-        if (k == 0) add(VertexId(i));
-        else if (k == 1) add(m.edges()[i].v0), add(m.edges()[i].v1);
-        else for (VertexId v : m.faces()[i].vertices) add(v);
-      }
-    }
+    NearScratch& sc = lease_.get();
+    ++sc.stamp;
+    const auto na = static_cast<std::size_t>(A.boxes.size());
+    if (sc.a_row_stamp.size() != na) sc.a_row_stamp.assign(na, 0);
+    sc.a_rows.resize(na * static_cast<std::size_t>(B.boxes.words()));
   }
 
   /// The next pair, false when there is none.
@@ -1050,11 +1038,11 @@ class NearPairs {
         const int a = as[i_];
         const auto& sa = A_.spheres[ia][static_cast<std::size_t>(a)];
         const Vec3& ca = near_.a_centers[ia][static_cast<std::size_t>(a)];
-        if (!row_built_) build_row(ib, lease_.get().a_boxes[ia][static_cast<std::size_t>(a)]);
+        if (!row_built_) start_row(ia, a, ib);
         // The row's elements in ascending order, lowest bit of each word first.
-        for (; word_ < row_.size(); ++word_, bits_ = word_ < row_.size() ? row_[word_] : 0)
+        for (; word_ <= last_word_; ++word_, bits_ = word_ <= last_word_ ? row_word(word_) : 0)
           while (bits_ != 0) {
-            const int b = static_cast<int>(word_ * 64) + __builtin_ctzll(bits_);
+            const int b = static_cast<int>(word_ * 64) + __builtin_ctzll(bits_) - B_.box_offset[ib];
             bits_ &= bits_ - 1;
             const auto& sb = B_.spheres[ib][static_cast<std::size_t>(b)];
             if ((ca - sb.first).norm() - sa.second - sb.second > reach_) continue;
@@ -1074,25 +1062,54 @@ class NearPairs {
   const ModelInfo& A_;
   const ModelInfo& B_;
   double reach_;
-  // The elements of B of kind ib near the other solid whose boxes meet A's element's box
-  // grown by the reach (a box apart by more along an axis is farther than the reach).
-  void build_row(std::size_t ib, const std::array<double, 6>& box) {
-    const BoxIndex& index = B_.boxes[ib];
-    row_.resize(static_cast<std::size_t>(index.words()));
-    const double g = reach_ + bounds_.slack();
-    index.query(Vec3(box[0] - g, box[1] - g, box[2] - g), Vec3(box[3] + g, box[4] + g, box[5] + g), row_.data());
-    const std::vector<std::uint64_t>& in = near_.b_bits[ib];
-    for (std::size_t i = 0; i < row_.size(); ++i) row_[i] &= in[i];
-    word_ = 0;
-    bits_ = row_.empty() ? 0 : row_[0];
+  // Starts the row of element a of kind ia against B's elements of kind ib: those near the
+  // other solid whose boxes meet a's box grown by the reach (a box apart by more along an
+  // axis is farther than the reach). The box query runs once per element of A and listing.
+  void start_row(std::size_t ia, int a, std::size_t ib) {
+    NearScratch& sc = lease_.get();
+    const auto words = static_cast<std::size_t>(B_.boxes.words());
+    const auto ga = static_cast<std::size_t>(A_.box_offset[ia] + a);
+    row_ = sc.a_rows.data() + ga * words;
+    if (sc.a_row_stamp[ga] != sc.stamp) {
+      sc.a_row_stamp[ga] = sc.stamp;
+      // a's box from its vertices in B's frame (the bound's own coordinates, so that the box
+      // test and the distances agree within the bound's slack).
+      const std::vector<Vec3>& p = sc.a_in_b;
+      const Polyhedron& m = *A_.model;
+      Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+      auto add = [&](VertexId v) {
+        lo = lo.cwiseMin(p[v.index()]);
+        hi = hi.cwiseMax(p[v.index()]);
+      };
+      if (ia == 0) add(VertexId(a));
+      else if (ia == 1) add(m.edges()[a].v0), add(m.edges()[a].v1);
+      else for (VertexId v : m.faces()[a].vertices) add(v);
+      const Vec3 g = Vec3::Constant(reach_ + bounds_.slack());
+      B_.boxes.query(lo - g, hi + g, row_);
+      for (std::size_t i = 0; i < words; ++i) row_[i] &= near_.b_bits[i];
+    }
+    // B's elements of kind ib are the bits [first_, end_).
+    first_ = static_cast<std::size_t>(B_.box_offset[ib]);
+    end_ = first_ + B_.spheres[ib].size();
+    word_ = first_ / 64;
+    last_word_ = end_ == first_ ? 0 : (end_ - 1) / 64;
+    bits_ = end_ == first_ ? 0 : row_word(word_);
+    if (end_ == first_) word_ = 1;  // an empty range: past last_word_
     row_built_ = true;
+  }
+  // Word w of the row, bits outside [first_, end_) cleared.
+  std::uint64_t row_word(std::size_t w) const {
+    std::uint64_t x = row_[w];
+    if (w == first_ / 64) x &= ~std::uint64_t{0} << (first_ % 64);
+    if (w == (end_ - 1) / 64 && end_ % 64 != 0) x &= ~(~std::uint64_t{0} << (end_ % 64));
+    return x;
   }
 
   NearElements& near_;
-  std::vector<std::uint64_t>& row_;
+  std::uint64_t* row_ = nullptr;  // the current row (in the scratch's a_rows)
   DistanceBound bounds_;
   int kind_ = 0;  // A's kind * 3 + B's kind
-  std::size_t i_ = 0, word_ = 0;
+  std::size_t i_ = 0, word_ = 0, last_word_ = 0, first_ = 0, end_ = 0;
   std::uint64_t bits_ = 0;  // the row's current word, the elements already listed cleared
   bool row_built_ = false;
 };
