@@ -1004,8 +1004,8 @@ class ScratchLease {
 };
 
 // The element pairs (A's kind, B's kind, A's element, B's element, in that nesting order)
-// not proven farther apart than `reach` at `pose`: near the other model, then by bounding
-// spheres, then by a face's plane or an edge's line. verify and contacts_at measure only these. Produced one at
+// not proven farther apart than `reach` at `pose`: near the other model, then by boxes (the
+// index of B's boxes), then by bounding spheres, then by a face's plane or an edge's line. verify and contacts_at measure only these. Produced one at
 // a time, so that a caller that stops at the first obstacle (verify, on most failed poses)
 // does not pay for the rest.
 struct ElementPair {
