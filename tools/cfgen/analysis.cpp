@@ -194,17 +194,6 @@ ModelInfo analyse_model(const Polyhedron& m) {
     const Vec3 b = m.edge_point(EdgeId(static_cast<int>(e)), 1);
     info.spheres[1].push_back({0.5 * (a + b), 0.5 * (b - a).norm()});
   }
-  for (const Face& F : m.faces()) {
-    Vec3 lo = m.vertex(F.vertices[0]).p, hi = lo;
-    for (VertexId v : F.vertices) {
-      lo = lo.cwiseMin(m.vertex(v).p);
-      hi = hi.cwiseMax(m.vertex(v).p);
-    }
-    const Vec3 c = 0.5 * (lo + hi);
-    double r = 0;
-    for (VertexId v : F.vertices) r = std::max(r, (m.vertex(v).p - c).norm());
-    info.spheres[2].push_back({c, r});
-  }
   {
     std::vector<Vec3> lo, hi;
     auto add_box = [&](const std::vector<VertexId>& vs) {
@@ -219,6 +208,14 @@ ModelInfo analyse_model(const Polyhedron& m) {
     info.box_offset[2] = static_cast<int>(lo.size());
     for (const Face& F : m.faces()) add_box(F.vertices);
     info.boxes = BoxIndex(lo, hi);
+    // A face's sphere is centred on its box.
+    for (std::size_t f = 0; f < m.num_faces(); ++f) {
+      const std::size_t i = static_cast<std::size_t>(info.box_offset[2]) + f;
+      const Vec3 c = 0.5 * (lo[i] + hi[i]);
+      double r = 0;
+      for (VertexId v : m.faces()[f].vertices) r = std::max(r, (m.vertex(v).p - c).norm());
+      info.spheres[2].push_back({c, r});
+    }
   }
   {
     Vec3 lo = m.vertices()[0].p, hi = lo;

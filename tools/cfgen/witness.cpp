@@ -937,16 +937,13 @@ class DistanceBound {
 // measuring, found in time linear in the models' size. Every pair left out is farther apart
 // than `reach`.
 struct NearElements {
-  std::array<std::vector<int>, 3> a, b;
-  std::vector<std::uint64_t> b_bits;  // b as one bitset over B's boxes (B.boxes' numbering)
+  std::array<std::vector<int>, 3> a;
+  std::vector<std::uint64_t> b_bits;  // B's, as one bitset in B.boxes' numbering
   std::array<std::vector<Vec3>, 3> a_centers;  // A's element sphere centres in B's frame
 };
 
 void near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& pose, double reach, NearElements& out) {
-  for (int k = 0; k < 3; ++k) {
-    out.a[static_cast<std::size_t>(k)].clear();
-    out.b[static_cast<std::size_t>(k)].clear();
-  }
+  for (auto& a : out.a) a.clear();
   const Vec3 b_in_a = pose.inverse_apply(B.bound.first);
   const Vec3 a_in_b = pose.apply(A.bound.first);
   out.b_bits.assign(static_cast<std::size_t>(B.boxes.words()), 0);
@@ -957,10 +954,8 @@ void near_elements(const ModelInfo& A, const ModelInfo& B, const Pose& pose, dou
         out.a[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
         out.a_centers[static_cast<std::size_t>(k)][i] = pose.apply(A.spheres[k][i].first);
       }
-
     for (std::size_t i = 0; i < B.spheres[k].size(); ++i)
       if ((B.spheres[k][i].first - a_in_b).norm() - B.spheres[k][i].second - A.bound.second <= reach) {
-        out.b[static_cast<std::size_t>(k)].push_back(static_cast<int>(i));
         const std::size_t bit = static_cast<std::size_t>(B.box_offset[k]) + i;
         out.b_bits[bit / 64] |= std::uint64_t{1} << (bit % 64);
       }
@@ -1005,9 +1000,9 @@ class ScratchLease {
 
 // The element pairs (A's kind, B's kind, A's element, B's element, in that nesting order)
 // not proven farther apart than `reach` at `pose`: near the other model, then by boxes (the
-// index of B's boxes), then by bounding spheres, then by a face's plane or an edge's line. verify and contacts_at measure only these. Produced one at
-// a time, so that a caller that stops at the first obstacle (verify, on most failed poses)
-// does not pay for the rest.
+// index of B's boxes), then by bounding spheres, then by a face's plane or an edge's line.
+// verify and contacts_at measure only these. Produced one at a time, so that a caller that
+// stops at the first obstacle (verify, on most failed poses) does not pay for the rest.
 struct ElementPair {
   ElementKind ka, kb;
   int a, b;
