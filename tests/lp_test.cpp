@@ -145,6 +145,28 @@ TEST_CASE("lp: infeasible programs are reported infeasible", "[lp]") {
   }
 }
 
+TEST_CASE("lp: a program the dense solver leaves is infeasible only beyond the rows' tolerance", "[lp]") {
+  // x <= 1 and x >= 1 + gap: solutions may miss a row by 1e-7 (1 + |b|), 2e-7 here. The dense
+  // solver settles neither; a gap inside the tolerance is GLPK's to solve, one a thousand
+  // times wider (beyond the check for programs infeasible by far, 1e-5) is infeasible.
+  auto program = [](double gap) {
+    LinearProgram lp(2);
+    lp.add({{0, 1.0}}, Rel::kLessEq, 1.0);
+    lp.add({{0, 1.0}}, Rel::kGreaterEq, 1.0 + gap);
+    lp.add({{1, 1.0}, {0, -1.0}}, Rel::kLessEq, 0.0);
+    lp.c[1] = -1.0;
+    return lp;
+  };
+  const LinearProgram inside = program(5e-8);
+  CHECK(cf::gen::internal::dense_solve(inside).status == Status::kInfeasible);
+  const LpResult r = cf::gen::solve(inside);
+  REQUIRE(r.status == Status::kOptimal);
+  CHECK(r.x[0] == Approx(1.0).margin(2e-7));
+  CHECK(r.x[1] == Approx(1.0).margin(2e-7));
+  CHECK(cf::gen::solve(program(5e-5)).status != Status::kOptimal);
+  CHECK(cf::gen::solve(program(5e-4)).status != Status::kOptimal);
+}
+
 TEST_CASE("lp: a vertex where many rows meet, and fixed variables", "[lp]") {
   // max s subject to s <= x_i for the 3 coordinates and sum x = 3, s in [0, 10]: the optimum
   // x = (1, 1, 1), s = 1 lies on four rows at once.

@@ -1232,8 +1232,14 @@ bool WitnessSearch::still_blocked(const PcSet& pcs, const Pose& pose, const Obst
 }
 
 double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* why, Obstacle* obstacle) const {
-  auto reject = [&](const std::string& reason) {
+  // The reason is written only when asked for: verify runs millions of times a run, most of
+  // them to reject, and a message built each time was a heap allocation or five.
+  auto reject = [&](const char* reason) {
     if (why) *why = reason;
+    return -1.0;
+  };
+  auto reject_with = [&](const auto& reason) {
+    if (why) *why = reason();
     return -1.0;
   };
   const Polyhedron& A = *A_.model;
@@ -1275,11 +1281,12 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
       if (a_kind(pc.type) == ka && b_kind(pc.type) == kb && pc.a == a && pc.b == b) is_pc = true;
     const bool covered = covered_by(A, B, pcs, ka, a, kb, b);
     if (is_pc) {
-      if (d > p_.touch_tol) return reject("PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " apart by " + std::to_string(d));
+      if (d > p_.touch_tol)
+        return reject_with([&] { return "PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " apart by " + std::to_string(d); });
       // The open elements must touch: a face meeting an edge only at its own boundary
       // realises an edge-edge PC, not face-edge.
       if (!open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol))
-        return reject("PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " touches only on its boundary");
+        return reject_with([&] { return "PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " touches only on its boundary"; });
       ++touching_pcs;
     }
     // Where two elements share open points, A's and B's tangent cones there must have
@@ -1288,15 +1295,20 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
     // of B, which no pair reports as crossing.
     if ((is_pc || covered) && d <= p_.touch_tol && open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol) &&
         !cones_disjoint(pose, ka, a, kb, b))
-      return reject("A and B overlap where " + kind_name(ka) + std::to_string(a) + " touches " +
-                    kind_name(kb) + std::to_string(b));
+      return reject_with([&] {
+        return "A and B overlap where " + kind_name(ka) + std::to_string(a) + " touches " + kind_name(kb) +
+               std::to_string(b);
+      });
     if (!is_pc && !covered) {
       // Closed elements that meet only on their boundaries do not touch: their boundary
       // elements do, and those pairs are judged on their own.
       if (d <= p_.touch_tol && !open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
       if (d < p_.min_clearance) {
         if (obstacle) *obstacle = Obstacle{true, ka, kb, a, b};
-        return reject("extra contact " + kind_name(ka) + std::to_string(a) + "-" + kind_name(kb) + std::to_string(b) + " at " + std::to_string(d));
+        return reject_with([&] {
+          return "extra contact " + kind_name(ka) + std::to_string(a) + "-" + kind_name(kb) + std::to_string(b) +
+                 " at " + std::to_string(d);
+        });
       }
       clearance = std::min(clearance, d);
     }
@@ -1355,21 +1367,22 @@ bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) 
       dominated = j != i && in_closure(A, x.ka, x.a, y.ka, y.a) && in_closure(B, x.kb, x.b, y.kb, y.b);
     }
     if (dominated) continue;
-    auto fail = [&](const std::string& reason) {
-      if (why) *why = reason;
+    // The reason is built only when asked for: contacts_at runs at every step of the motions.
+    auto fail = [&](const char* reason, const char* detail = "") {
+      if (why)
+        *why = reason + kind_name(x.ka) + std::to_string(x.a) + "-" + kind_name(x.kb) + std::to_string(x.b) + detail;
       return false;
     };
-    const std::string name = kind_name(x.ka) + std::to_string(x.a) + "-" + kind_name(x.kb) + std::to_string(x.b);
-    if (x.ka == K::kVertex && x.kb != K::kFace) return fail("degenerate touch " + name);
-    if (x.kb == K::kVertex && x.ka != K::kFace) return fail("degenerate touch " + name);
+    if (x.ka == K::kVertex && x.kb != K::kFace) return fail("degenerate touch ");
+    if (x.kb == K::kVertex && x.ka != K::kFace) return fail("degenerate touch ");
     if (x.ka == K::kEdge && x.kb == K::kEdge &&
         (pose.R_BA * A.edges()[x.a].dir).cross(B.edges()[x.b].dir).norm() < 1e-9)
-      return fail("degenerate touch " + name + " (parallel edges)");
+      return fail("degenerate touch ", " (parallel edges)");
     PcType t = PcType::kFF;
     if (x.ka == K::kFace) t = x.kb == K::kFace ? PcType::kFF : x.kb == K::kEdge ? PcType::kFE : PcType::kFV;
     else if (x.ka == K::kEdge) t = x.kb == K::kFace ? PcType::kEF : PcType::kEE;
     else t = PcType::kVF;
-    if (!out.insert(Pc{t, x.a, x.b})) return fail("more than three PCs");
+    if (!out.insert(Pc{t, x.a, x.b})) return fail("more than three PCs, the fourth ");
   }
   return true;
 }
