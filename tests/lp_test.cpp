@@ -145,7 +145,8 @@ TEST_CASE("lp: infeasible programs are reported infeasible", "[lp]") {
   }
 }
 
-TEST_CASE("lp: a program the dense solver leaves is infeasible only beyond the rows' tolerance", "[lp]") {
+TEST_CASE("lp: a program the dense solver leaves is infeasible only beyond the rows' tolerance",
+          "[lp]") {
   // x <= 1 and x >= 1 + gap: solutions may miss a row by 1e-7 (1 + |b|), 2e-7 here. The dense
   // solver settles neither; a gap inside the tolerance is GLPK's to solve, one a thousand
   // times wider (beyond the check for programs infeasible by far, 1e-5) is infeasible.

@@ -285,7 +285,8 @@ LpResult internal::dense_solve(const LinearProgram& lp) {
   const int d = int(N.cols());
   const VarVec cz = N.transpose() * Eigen::Map<const VectorXd>(lp.c.data(), n);
   MatMap Gz = as_matrix(w.Gz, ni, d);
-  Gz.noalias() = G.lazyProduct(N);  // coefficient-wise: tens of rows by at most 12, below where blocking pays
+  // Coefficient-wise: tens of rows by at most 12 columns, below where a blocked product pays.
+  Gz.noalias() = G.lazyProduct(N);
   VecMap hz = as_vector(w.hz, ni);
   hz.noalias() = h - G * x0;
   // Unit rows; a row with no z in it is a fixed condition on x0.
@@ -393,8 +394,8 @@ namespace {
 
 // True when every x misses some row or bound of lp by far more than the 1e-7 (1 + |b|) that
 // meets_rows allows, so that GLPK could return no solution either: the least violation s of
-// the rows a.x <= b + (1 + |b|) s, over x and s >= -1, is above kSureViolation. A program the
-// dense solver left is infeasible in nine cases of ten, and this program of one more variable
+// the rows a.x <= b + (1 + |b|) s, over x and s >= -1, is above kSureViolation. Nearly every
+// program the dense solver leaves is infeasible by far, and this program of one more variable
 // costs a fraction of GLPK's set-up. False when it cannot tell.
 bool surely_infeasible(const LinearProgram& lp) {
   // A hundred times meets_rows' tolerance: the dense solver's optimum is within its reduced

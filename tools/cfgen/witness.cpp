@@ -1282,11 +1282,15 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
     const bool covered = covered_by(A, B, pcs, ka, a, kb, b);
     if (is_pc) {
       if (d > p_.touch_tol)
-        return reject_with([&] { return "PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " apart by " + std::to_string(d); });
+        return reject_with([&] {
+          return "PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " apart by " + std::to_string(d);
+        });
       // The open elements must touch: a face meeting an edge only at its own boundary
       // realises an edge-edge PC, not face-edge.
       if (!open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol))
-        return reject_with([&] { return "PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " touches only on its boundary"; });
+        return reject_with([&] {
+          return "PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " touches only on its boundary";
+        });
       ++touching_pcs;
     }
     // Where two elements share open points, A's and B's tangent cones there must have
@@ -1296,8 +1300,8 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
     if ((is_pc || covered) && d <= p_.touch_tol && open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol) &&
         !cones_disjoint(pose, ka, a, kb, b))
       return reject_with([&] {
-        return "A and B overlap where " + kind_name(ka) + std::to_string(a) + " touches " + kind_name(kb) +
-               std::to_string(b);
+        return "A and B overlap where " + kind_name(ka) + std::to_string(a) + " touches " +
+               kind_name(kb) + std::to_string(b);
       });
     if (!is_pc && !covered) {
       // Closed elements that meet only on their boundaries do not touch: their boundary
@@ -1306,8 +1310,8 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
       if (d < p_.min_clearance) {
         if (obstacle) *obstacle = Obstacle{true, ka, kb, a, b};
         return reject_with([&] {
-          return "extra contact " + kind_name(ka) + std::to_string(a) + "-" + kind_name(kb) + std::to_string(b) +
-                 " at " + std::to_string(d);
+          return "extra contact " + kind_name(ka) + std::to_string(a) + "-" + kind_name(kb) +
+                 std::to_string(b) + " at " + std::to_string(d);
         });
       }
       clearance = std::min(clearance, d);
@@ -1370,7 +1374,8 @@ bool WitnessSearch::contacts_at(const Pose& pose, PcSet& out, std::string* why) 
     // The reason is built only when asked for: contacts_at runs at every step of the motions.
     auto fail = [&](const char* reason, const char* detail = "") {
       if (why)
-        *why = reason + kind_name(x.ka) + std::to_string(x.a) + "-" + kind_name(x.kb) + std::to_string(x.b) + detail;
+        *why = reason + kind_name(x.ka) + std::to_string(x.a) + "-" + kind_name(x.kb) +
+               std::to_string(x.b) + detail;
       return false;
     };
     if (x.ka == K::kVertex && x.kb != K::kFace) return fail("degenerate touch ");
