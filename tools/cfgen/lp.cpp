@@ -404,10 +404,15 @@ bool surely_infeasible(const LinearProgram& lp) {
   using Rel = LinearProgram::Rel;
   const int n = lp.num_vars, s = n;
   if (n + 1 > LinearProgram::kMaxVars) return false;
-  LinearProgram rl(n + 1);
+  // Per thread and reused, as the dense solver's buffers: no allocation per program.
+  thread_local LinearProgram rl(0);
+  rl.num_vars = n + 1;
+  rl.c.assign(static_cast<std::size_t>(n + 1), 0.0);
+  rl.lower.assign(static_cast<std::size_t>(n + 1), {false, 0.0});
+  rl.upper.assign(static_cast<std::size_t>(n + 1), {false, 0.0});
+  rl.rows.clear();
   rl.c[s] = 1.0;
   rl.lower[s] = {true, -1.0};
-  rl.rows.reserve(2 * lp.rows.size() + 2 * static_cast<std::size_t>(n));
   auto add = [&](const LinearProgram::Coefs& a, double sign, double b) {
     // sign (a.x) - (1 + |b|) s <= sign b
     LinearProgram::Coefs row;
