@@ -74,25 +74,47 @@ double first_contact_translation(const Polyhedron& A, const Polyhedron& B, const
   };
   std::vector<Vec3> pa(A.num_vertices());
   for (std::size_t i = 0; i < pa.size(); ++i) pa[i] = pose.apply(A.vertices()[i].p);
+  // A translation along d keeps the coordinates across d (along e1, e2): a vertex can reach a
+  // face only where its coordinates lie in the face's range of them, and two edges can meet
+  // only where their ranges overlap. A face's range is tested before the point is located in
+  // the face (most of the work, on parts of many faces).
+  const Vec3 e1 = d.unitOrthogonal(), e2 = d.cross(e1);
+  const double cross_slack = 2 * tol + 1e-9 * std::max(A.size(), B.size());  // rounding, mm
+  std::vector<Eigen::Vector2d> ca(pa.size()), cb(B.num_vertices());
+  for (std::size_t i = 0; i < pa.size(); ++i) ca[i] = {e1.dot(pa[i]), e2.dot(pa[i])};
+  for (std::size_t i = 0; i < cb.size(); ++i)
+    cb[i] = {e1.dot(B.vertices()[i].p), e2.dot(B.vertices()[i].p)};
+  // A face's range across d, grown by the slack, from its vertices' coordinates.
+  auto range_of = [&](const Face& F, const std::vector<Eigen::Vector2d>& c) {
+    Eigen::AlignedBox2d r;
+    for (VertexId v : F.vertices) r.extend(c[v.index()]);
+    r.min().array() -= cross_slack;
+    r.max().array() += cross_slack;
+    return r;
+  };
   // Vertices of A against faces of B (closed: a vertex reaching an edge or a vertex of B too).
   for (std::size_t f = 0; f < B.num_faces(); ++f) {
     const Face& F = B.faces()[f];
     const double nd = F.normal.dot(d);
     if (std::abs(nd) < 1e-9) continue;
+    const Eigen::AlignedBox2d range = range_of(F, cb);
     for (std::size_t v = 0; v < pa.size(); ++v) {
       const double s = (F.offset - F.normal.dot(pa[v])) / nd;
-      if (s <= s_min || s >= best) continue;
+      if (s <= s_min || s >= best || !range.contains(ca[v])) continue;
       if (dominated(ElementKind::kVertex, int(v), ElementKind::kFace, int(f))) continue;
       if (B.face_inset(FaceId(int(f)), pa[v] + s * d) >= -tol) take(s);
     }
   }
-  // Vertices of B against faces of A, in A's frame (B moves by -R^T d there).
+  // Vertices of B against faces of A, in A's frame (B moves by -R^T d there); the ranges
+  // across d in B's frame, A's faces posed.
   const Vec3 dA = -(pose.R_BA.transpose() * d);
   for (std::size_t f = 0; f < A.num_faces(); ++f) {
     const Face& F = A.faces()[f];
     const double nd = F.normal.dot(dA);
     if (std::abs(nd) < 1e-9) continue;
+    const Eigen::AlignedBox2d range = range_of(F, ca);
     for (std::size_t v = 0; v < B.num_vertices(); ++v) {
+      if (!range.contains(cb[v])) continue;
       const Vec3 q = pose.inverse_apply(B.vertices()[v].p);
       const double s = (F.offset - F.normal.dot(q)) / nd;
       if (s <= s_min || s >= best) continue;
@@ -100,10 +122,8 @@ double first_contact_translation(const Polyhedron& A, const Polyhedron& B, const
       if (A.face_inset(FaceId(int(f)), q + s * dA) >= -tol) take(s);
     }
   }
-  // Edges against edges: p0 + u ua + s d = q0 + w ub. A translation along d keeps the
-  // coordinates across d: two edges can meet only where their ranges along two axes across d
-  // overlap, and where B's edge lies ahead of A's by a shift in (s_min, best].
-  const Vec3 e1 = d.unitOrthogonal(), e2 = d.cross(e1);
+  // Edges against edges: p0 + u ua + s d = q0 + w ub, where their ranges across d overlap
+  // and B's edge lies ahead of A's by a shift in (s_min, best].
   struct Box {
     double lo[3], hi[3];  // along e1, e2, d
   };
@@ -326,10 +346,43 @@ double first_contact_rotation(const Polyhedron& A, const Polyhedron& B, const Po
     const Vec3 r = x0 - p, r_par = r.dot(u) * u, r_perp = r - r_par;
     return Vec3(p + r_par + std::cos(phi) * r_perp + std::sin(phi) * u.cross(r_perp));
   };
+  // A turning keeps each point's height along the axis and its distance from it: a vertex
+  // can reach a face only where its height lies in the face's range of heights and its
+  // distance is within the face's largest (both at the face's vertices, grown by the slack the
+  // edges' test below keeps).
+  const double turn_slack = 1e3 * tol + 1e-9 * std::max(A.size(), B.size());  // mm
+  auto height_radius = [&](const Vec3& x) {
+    const double z = (x - p).dot(u);
+    return Eigen::Vector2d(z, ((x - p) - z * u).norm());
+  };
+  std::vector<Eigen::Vector2d> hra(pa.size()), hrb(B.num_vertices());
+  for (std::size_t i = 0; i < pa.size(); ++i) hra[i] = height_radius(pa[i]);
+  for (std::size_t i = 0; i < hrb.size(); ++i) hrb[i] = height_radius(B.vertices()[i].p);
+  struct TurnRange {
+    double z_lo, z_hi, r_hi;
+    bool reaches(const Eigen::Vector2d& hr) const {
+      return hr[0] >= z_lo && hr[0] <= z_hi && hr[1] <= r_hi;
+    }
+  };
+  auto turn_range = [&](const Face& F, const std::vector<Eigen::Vector2d>& hr) {
+    TurnRange t{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                0.0};
+    for (VertexId v : F.vertices) {
+      t.z_lo = std::min(t.z_lo, hr[v.index()][0]);
+      t.z_hi = std::max(t.z_hi, hr[v.index()][0]);
+      t.r_hi = std::max(t.r_hi, hr[v.index()][1]);
+    }
+    t.z_lo -= turn_slack;
+    t.z_hi += turn_slack;
+    t.r_hi += turn_slack;
+    return t;
+  };
   // Vertices of A against faces of B.
   for (std::size_t f = 0; f < B.num_faces(); ++f) {
     const Face& F = B.faces()[f];
+    const TurnRange range = turn_range(F, hrb);
     for (std::size_t v = 0; v < pa.size(); ++v) {
+      if (!range.reaches(hra[v])) continue;
       roots.clear();
       circle_plane(pa[v], F.normal, F.offset, 1.0, roots);
       for (double phi : roots) {
@@ -346,7 +399,9 @@ double first_contact_rotation(const Polyhedron& A, const Polyhedron& B, const Po
     const Face& F = A.faces()[f];
     const Vec3 n = pose.R_BA * F.normal;
     const double d = F.offset + n.dot(pose.t_BA);
+    const TurnRange range = turn_range(F, hra);
     for (std::size_t v = 0; v < B.num_vertices(); ++v) {
+      if (!range.reaches(hrb[v])) continue;
       const Vec3& q = B.vertices()[v].p;
       roots.clear();
       const Vec3 r = q - p, r_par = r.dot(u) * u, r_perp = r - r_par;
