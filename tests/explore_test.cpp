@@ -193,6 +193,68 @@ TEST_CASE("verify: a bracket whose foot runs into the wall through the reflex ed
   INFO(why2);
 }
 
+TEST_CASE(
+    "verify names the pair a pose failed on, and a pair that still fails proves a pose refused",
+    "[explore]") {
+  using Kind = cf::gen::WitnessSearch::FailedPair::Kind;
+  // The bracket whose foot runs into the wall (above): it fails where a corner of its inner
+  // face touches the wall (a pair the inner face's PC covers, with the foot on the wall's
+  // inside), and keeps failing there as it slides along the wall; moved off the wall, that
+  // pair no longer touches.
+  Pair bad(
+      load_text("bracket_in2.off",
+                off_prism({{10, 20}, {25, 20}, {25, 50}, {20, 50}, {20, 25}, {10, 25}}, 20, 60)),
+      l_block());
+  const cf::gen::WitnessSearch search(bad.ai, bad.bi, cf::gen::SearchParams{});
+  const int bottom = face_of(bad.A, Vec3(0, -1, 0), -20),
+            inner = face_of(bad.A, Vec3(-1, 0, 0), -20);
+  const int slab = face_of(bad.B, Vec3(0, 1, 0), 20), wall = face_of(bad.B, Vec3(1, 0, 0), 20);
+  const PcSet cf_set({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kFF, inner, wall}});
+  cf::gen::WitnessSearch::FailedPair failed;
+  REQUIRE(search.verify(cf_set, Pose(), nullptr, nullptr, &failed) < 0);
+  CHECK(failed.kind == Kind::kOverlap);
+  CHECK(failed.kb == ElementKind::kFace);
+  CHECK(failed.b == wall);
+  CHECK(search.still_fails(cf_set, Pose(), failed));
+  for (double dz : {-5.0, -1.0, 2.0, 7.0}) {
+    Pose slid;
+    slid.t_BA = Vec3(0, 0, dz);
+    CHECK(search.still_fails(cf_set, slid, failed));
+    CHECK(search.verify(cf_set, slid) < 0);
+  }
+  Pose off_wall;
+  off_wall.t_BA = Vec3(1, 0, 0);
+  CHECK_FALSE(search.still_fails(cf_set, off_wall, failed));
+
+  // A cube face down on the slab, slid towards and into the wall: whenever a pair another
+  // pose failed on still fails, verify refuses the pose (the property that lets the witness
+  // search skip verifying it).
+  Pair p(load_text("cube10f.off", off_box(0, 0, 0, 10, 10, 10)), l_block());
+  const cf::gen::WitnessSearch cube(p.ai, p.bi, cf::gen::SearchParams{});
+  const PcSet on_slab(
+      {Pc{PcType::kFF, face_of(p.A, Vec3(0, -1, 0), 0), face_of(p.B, Vec3(0, 1, 0), 20)}});
+  std::vector<Pose> poses;
+  std::vector<cf::gen::WitnessSearch::FailedPair> pairs;
+  for (int i = 0; i <= 40; ++i) {
+    Pose x;
+    x.R_BA = Eigen::AngleAxisd(0.05 * (i % 7), Vec3::UnitY()).toRotationMatrix();
+    x.t_BA = Vec3(4 + 0.5 * i, 20, 30 + 0.25 * (i % 5));
+    cf::gen::WitnessSearch::FailedPair f;
+    if (cube.verify(on_slab, x, nullptr, nullptr, &f) < 0 && f.kind != Kind::kNone)
+      pairs.push_back(f);
+    poses.push_back(x);
+  }
+  REQUIRE(pairs.size() >= 5);  // the cube is inside the wall for x < 20 (i < 32)
+  int proofs = 0;
+  for (const Pose& x : poses)
+    for (const auto& f : pairs)
+      if (cube.still_fails(on_slab, x, f)) {
+        ++proofs;
+        CHECK(cube.verify(on_slab, x) < 0);
+      }
+  CHECK(proofs > static_cast<int>(pairs.size()));  // pairs prove other poses than their own
+}
+
 TEST_CASE("exploring from a cube on the slab meets the wall, and breaking the slab contact leaves the wall",
           "[explore]") {
   Pair p(load_text("cube10e.off", off_box(0, 0, 0, 10, 10, 10)), l_block());

@@ -1232,6 +1232,23 @@ bool WitnessSearch::still_blocked(const PcSet& pcs, const Pose& pose, const Obst
 }
 
 double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* why, Obstacle* obstacle) const {
+  return verify(pcs, pose, why, obstacle, nullptr);
+}
+
+bool WitnessSearch::still_fails(const PcSet& pcs, const Pose& pose, const FailedPair& f) const {
+  if (f.kind == FailedPair::Kind::kObstacle)
+    return still_blocked(pcs, pose, Obstacle{true, f.ka, f.kb, f.a, f.b});
+  if (f.kind != FailedPair::Kind::kOverlap) return false;
+  // verify's overlap test, for a pair that is a PC or covered by one (as recorded).
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  return element_distance(A, pose, f.ka, f.a, B, f.kb, f.b).distance <= p_.touch_tol &&
+         open_touch(A, pose, f.ka, f.a, B, f.kb, f.b, p_.touch_tol) &&
+         !cones_disjoint(pose, f.ka, f.a, f.kb, f.b);
+}
+
+double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* why,
+                             Obstacle* obstacle, FailedPair* failed) const {
   // The reason is written only when asked for: verify runs millions of times a run, most of
   // them to reject, and a message built each time was a heap allocation or five.
   auto reject = [&](const char* reason) {
@@ -1297,18 +1314,21 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
     // disjoint interiors; pairs that touch only through their boundaries are judged
     // as those boundary pairs. This catches a face of A running through a reflex edge
     // of B, which no pair reports as crossing.
-    if ((is_pc || covered) && d <= p_.touch_tol && open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol) &&
-        !cones_disjoint(pose, ka, a, kb, b))
+    if ((is_pc || covered) && d <= p_.touch_tol &&
+        open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol) && !cones_disjoint(pose, ka, a, kb, b)) {
+      if (failed) *failed = FailedPair{FailedPair::Kind::kOverlap, ka, kb, a, b};
       return reject_with([&] {
         return "A and B overlap where " + kind_name(ka) + std::to_string(a) + " touches " +
                kind_name(kb) + std::to_string(b);
       });
+    }
     if (!is_pc && !covered) {
       // Closed elements that meet only on their boundaries do not touch: their boundary
       // elements do, and those pairs are judged on their own.
       if (d <= p_.touch_tol && !open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
       if (d < p_.min_clearance) {
         if (obstacle) *obstacle = Obstacle{true, ka, kb, a, b};
+        if (failed) *failed = FailedPair{FailedPair::Kind::kObstacle, ka, kb, a, b};
         return reject_with([&] {
           return "extra contact " + kind_name(ka) + std::to_string(a) + "-" + kind_name(kb) +
                  std::to_string(b) + " at " + std::to_string(d);
@@ -1593,6 +1613,35 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
   // Face-piece slots, in the order solve_translation consumes them.
   const std::vector<int> slot_sizes = piece_slots(pcs);
   std::vector<Mat3> near;  // rotations where the contacts held but the pose failed
+  // The pairs recent poses failed on, newest first. A pose whose verdict matters only if it
+  // is a witness (every translation but the first of a rotation's pass or of a cut, whose
+  // obstacle steers the cuts and the skipping of the pass's other translations) is refused without
+  // a verification when one of them still fails there: most poses of a set that has no witness fail
+  // on a pair met before.
+  constexpr std::size_t kRecent = 8;
+  std::array<FailedPair, kRecent> recent{};
+  auto remember = [&](const FailedPair& f) {
+    if (f.kind == FailedPair::Kind::kNone) return;
+    auto same = [&](const FailedPair& g) {
+      return g.kind == f.kind && g.ka == f.ka && g.kb == f.kb && g.a == f.a && g.b == f.b;
+    };
+    auto it = std::find_if(recent.begin(), recent.end(), same);
+    if (it == recent.end()) it = recent.end() - 1;
+    std::rotate(recent.begin(), it, it + 1);
+    recent.front() = f;
+  };
+  // verify for a pose only a witness would change anything at: -1 when a recent pair proves
+  // it fails.
+  auto verify_unless_failing = [&](const Pose& pose) {
+    for (const FailedPair& f : recent) {
+      if (f.kind == FailedPair::Kind::kNone) break;
+      if (still_fails(pcs, pose, f)) return -1.0;
+    }
+    FailedPair f;
+    const double clearance = verify(pcs, pose, nullptr, nullptr, &f);
+    remember(f);
+    return clearance;
+  };
   // Returns true when a good witness was found.
   auto cut_obstacles = [&](const Mat3& R, const std::vector<int>& choice, Vec3 t, Obstacle obstacle) {
     constexpr int kMaxCuts = 4;  // obstacles avoided in turn before giving up on a rotation
@@ -1610,12 +1659,17 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
         Pose pose;
         pose.R_BA = R;
         pose.t_BA = tt;
-        if (&tt != &ts.front() && still_blocked(pcs, pose, obstacle)) continue;
-        Obstacle o;
-        const double clearance = verify(pcs, pose, nullptr, &o);
+        double clearance = -1;
         if (&tt == &ts.front()) {
+          Obstacle o;
+          FailedPair f;
+          clearance = verify(pcs, pose, nullptr, &o, &f);
+          remember(f);
           obstacle = o;
           t = tt;
+        } else {
+          if (still_blocked(pcs, pose, obstacle)) continue;
+          clearance = verify_unless_failing(pose);
         }
         if (clearance >= p_.min_clearance && clearance > best.clearance) {
           best.found = true;
@@ -1646,9 +1700,16 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
           // Nearby translations are often blocked by the same pair: one distance decides.
           if (&t != &ts.front() && still_blocked(pcs, pose, first_obstacle)) continue;
           std::string why;
-          Obstacle obstacle;
-          const double clearance = verify(pcs, pose, debug_ ? &why : nullptr, &obstacle);
-          if (&t == &ts.front()) first_obstacle = obstacle;
+          double clearance = -1;
+          if (&t == &ts.front() || debug_) {
+            Obstacle obstacle;
+            FailedPair f;
+            clearance = verify(pcs, pose, debug_ ? &why : nullptr, &obstacle, &f);
+            remember(f);
+            if (&t == &ts.front()) first_obstacle = obstacle;
+          } else {
+            clearance = verify_unless_failing(pose);
+          }
           if (debug_) std::cerr << "    t " << t.transpose() << " clearance " << clearance << " " << why << "\n";
           if (clearance >= p_.min_clearance && clearance > best.clearance) {
             best.found = true;

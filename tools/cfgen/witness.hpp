@@ -66,6 +66,20 @@ class WitnessSearch {
   /// refuses `pose` too. False proves nothing.
   bool still_blocked(const PcSet& pcs, const Pose& pose, const Obstacle& o) const;
 
+  /// The pair of elements a refused pose failed on: an obstacle (as Obstacle), or a PC or a
+  /// pair a PC covers where A and B overlap (touching, tangent cones not disjoint).
+  struct FailedPair {
+    enum class Kind { kNone, kObstacle, kOverlap } kind = Kind::kNone;
+    ElementKind ka = ElementKind::kVertex, kb = ElementKind::kVertex;
+    int a = -1, b = -1;
+  };
+  /// verify, also naming the pair the pose failed on, when it failed on one.
+  double verify(const PcSet& pcs, const Pose& pose, std::string* why, Obstacle* obstacle,
+                FailedPair* failed) const;
+  /// True when the pair still fails at `pose` as it did where it was recorded: then verify
+  /// refuses `pose` too (at that pair or at one listed before it). False proves nothing.
+  bool still_fails(const PcSet& pcs, const Pose& pose, const FailedPair& f) const;
+
   /// The PCs that hold at a pose: every touching pair of open elements (distance within
   /// touch_tol) that no other touching pair dominates. Returns false, with the reason, when
   /// a non-dominated touch is degenerate (v-v, v-e, e-v, parallel e-e) or more than three
