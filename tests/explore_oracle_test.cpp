@@ -8,6 +8,7 @@
 #include "cfgen/explore.hpp"
 #include "mesh/model_loader.hpp"
 #include "motion.hpp"
+#include "oracle_pose.hpp"
 #include "poly.hpp"
 #include "scratch.hpp"
 #include "shapes.hpp"
@@ -89,13 +90,6 @@ cf::Pose clear_pose(const Pair& p, std::mt19937_64& rng, cf::Vec3& away) {
   return X;
 }
 
-oracle::Pose to_oracle(const cf::Pose& X) {
-  oracle::Pose Y;
-  Y.R = X.R_BA;
-  Y.t = X.t_BA;
-  return Y;
-}
-
 bool same(double a, double b) {
   if (std::isinf(a) || std::isinf(b)) return std::isinf(a) && std::isinf(b);
   return std::abs(a - b) <= kSameEvent;
@@ -118,7 +112,8 @@ TEST_CASE("first contact of a translation: the same event as the oracle's", "[ex
       const double mine = cf::gen::first_contact_translation(p.A, p.B, X, d, 0.0, s_max, kTol, {});
       oracle::Motion m;
       m.u = d;
-      const double theirs = oracle::time_of_impact(p.oA, p.oB, to_oracle(X), m, s_max, kTol);
+      const double theirs =
+          oracle::time_of_impact(p.oA, p.oB, cf::test::to_oracle(X), m, s_max, kTol);
       INFO("seed " << seed << " ("
                    << oracle::pairing_name(static_cast<int>(seed % oracle::kPairings))
                    << "), motion " << k << ": cfgen " << mine << " mm, oracle " << theirs << " mm");
@@ -151,7 +146,8 @@ TEST_CASE("first contact of a rotation: the same event as the oracle's", "[explo
       m.rotation = true;
       m.c = c;
       m.w = u;
-      const double theirs = oracle::time_of_impact(p.oA, p.oB, to_oracle(X), m, phi_max, kTol);
+      const double theirs =
+          oracle::time_of_impact(p.oA, p.oB, cf::test::to_oracle(X), m, phi_max, kTol);
       ++cases;
       if (!std::isinf(mine)) ++hits;
       if (!same(mine, theirs)) {

@@ -45,6 +45,7 @@
 #include "graph.hpp"
 #include "motion.hpp"
 #include "oracle_kept.hpp"
+#include "oracle_pose.hpp"
 #include "pc_lists.hpp"
 #include "poly.hpp"
 
@@ -133,19 +134,8 @@ constexpr double kSegInterior = 1e-9;
 // supporting planes happen to cross (a proxy this deep would show in the vertex depths too).
 constexpr double kEeLocalMm = 1.0;
 
-oracle::Pose to_oracle(const cf::Pose& X) {
-  oracle::Pose P;
-  P.R = X.R_BA;
-  P.t = X.t_BA;
-  return P;
-}
-
-cf::Pose to_cf(const oracle::Pose& P) {
-  cf::Pose X;
-  X.R_BA = P.R;
-  X.t_BA = P.t;
-  return X;
-}
+using cf::test::to_cf;
+using cf::test::to_oracle;
 
 double dist_to_surface(const oracle::Poly& P, const oracle::Vec3& x) {
   double best = oracle::kInf;
