@@ -211,7 +211,7 @@ TEST_CASE(
   const int slab = face_of(bad.B, Vec3(0, 1, 0), 20), wall = face_of(bad.B, Vec3(1, 0, 0), 20);
   const PcSet cf_set({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kFF, inner, wall}});
   cf::gen::WitnessSearch::FailedPair failed;
-  REQUIRE(search.verify(cf_set, Pose(), nullptr, nullptr, &failed) < 0);
+  REQUIRE(search.verify(cf_set, Pose(), nullptr, &failed) < 0);
   CHECK(failed.kind == Kind::kOverlap);
   CHECK(failed.kb == ElementKind::kFace);
   CHECK(failed.b == wall);
@@ -240,7 +240,7 @@ TEST_CASE(
     x.R_BA = Eigen::AngleAxisd(0.05 * (i % 7), Vec3::UnitY()).toRotationMatrix();
     x.t_BA = Vec3(4 + 0.5 * i, 20, 30 + 0.25 * (i % 5));
     cf::gen::WitnessSearch::FailedPair f;
-    if (cube.verify(on_slab, x, nullptr, nullptr, &f) < 0 && f.kind != Kind::kNone)
+    if (cube.verify(on_slab, x, nullptr, &f) < 0 && f.kind != Kind::kNone)
       pairs.push_back(f);
     poses.push_back(x);
   }

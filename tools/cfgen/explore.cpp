@@ -127,25 +127,27 @@ double first_contact_translation(const Polyhedron& A, const Polyhedron& B, const
   struct Box {
     double lo[3], hi[3];  // along e1, e2, d
   };
-  auto box_of = [&](const Vec3& a, const Vec3& b) {
+  // An edge's box from its ends: their coordinates across d (computed above) and along d.
+  auto box_of = [&](const Eigen::Vector2d& c0, const Eigen::Vector2d& c1, const Vec3& a, const Vec3& b) {
     Box x;
-    const Vec3 axes[3] = {e1, e2, d};
+    const double u[3] = {c0[0], c0[1], d.dot(a)}, w[3] = {c1[0], c1[1], d.dot(b)};
     for (int k = 0; k < 3; ++k) {
-      const double u = axes[k].dot(a), w = axes[k].dot(b);
-      x.lo[k] = std::min(u, w);
-      x.hi[k] = std::max(u, w);
+      x.lo[k] = std::min(u[k], w[k]);
+      x.hi[k] = std::max(u[k], w[k]);
     }
     return x;
   };
   std::vector<Box> b_boxes(B.num_edges());
-  for (std::size_t eb = 0; eb < B.num_edges(); ++eb)
-    b_boxes[eb] = box_of(B.edge_point(EdgeId(int(eb)), 0), B.edge_point(EdgeId(int(eb)), 1));
+  for (std::size_t eb = 0; eb < B.num_edges(); ++eb) {
+    const Edge& E = B.edges()[eb];
+    b_boxes[eb] = box_of(cb[E.v0.index()], cb[E.v1.index()], B.vertex(E.v0).p, B.vertex(E.v1).p);
+  }
   const double slack = 2 * tol;
   for (std::size_t ea = 0; ea < A.num_edges(); ++ea) {
     const Vec3& p0 = pa[A.edges()[ea].v0.index()];
     const Vec3& p1 = pa[A.edges()[ea].v1.index()];
     const Vec3 ua = p1 - p0;
-    const Box ba = box_of(p0, p1);
+    const Box ba = box_of(ca[A.edges()[ea].v0.index()], ca[A.edges()[ea].v1.index()], p0, p1);
     for (std::size_t eb = 0; eb < B.num_edges(); ++eb) {
       const Box& bb = b_boxes[eb];
       if (bb.lo[0] > ba.hi[0] + slack || ba.lo[0] > bb.hi[0] + slack || bb.lo[1] > ba.hi[1] + slack ||

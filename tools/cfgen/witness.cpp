@@ -1231,13 +1231,8 @@ bool WitnessSearch::still_blocked(const PcSet& pcs, const Pose& pose, const Obst
   return d > p_.touch_tol || open_touch(A, pose, o.ka, o.a, B, o.kb, o.b, p_.touch_tol);
 }
 
-double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* why, Obstacle* obstacle) const {
-  return verify(pcs, pose, why, obstacle, nullptr);
-}
-
 bool WitnessSearch::still_fails(const PcSet& pcs, const Pose& pose, const FailedPair& f) const {
-  if (f.kind == FailedPair::Kind::kObstacle)
-    return still_blocked(pcs, pose, Obstacle{true, f.ka, f.kb, f.a, f.b});
+  if (f.kind == FailedPair::Kind::kObstacle) return still_blocked(pcs, pose, f.obstacle());
   if (f.kind != FailedPair::Kind::kOverlap) return false;
   // verify's overlap test, for a pair that is a PC or covered by one (as recorded).
   const Polyhedron& A = *A_.model;
@@ -1248,7 +1243,7 @@ bool WitnessSearch::still_fails(const PcSet& pcs, const Pose& pose, const Failed
 }
 
 double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* why,
-                             Obstacle* obstacle, FailedPair* failed) const {
+                             FailedPair* failed) const {
   // The reason is written only when asked for: verify runs millions of times a run, most of
   // them to reject, and a message built each time was a heap allocation or five.
   auto reject = [&](const char* reason) {
@@ -1327,7 +1322,6 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
       // elements do, and those pairs are judged on their own.
       if (d <= p_.touch_tol && !open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
       if (d < p_.min_clearance) {
-        if (obstacle) *obstacle = Obstacle{true, ka, kb, a, b};
         if (failed) *failed = FailedPair{FailedPair::Kind::kObstacle, ka, kb, a, b};
         return reject_with([&] {
           return "extra contact " + kind_name(ka) + std::to_string(a) + "-" + kind_name(kb) +
@@ -1638,7 +1632,7 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
       if (still_fails(pcs, pose, f)) return -1.0;
     }
     FailedPair f;
-    const double clearance = verify(pcs, pose, nullptr, nullptr, &f);
+    const double clearance = verify(pcs, pose, nullptr, &f);
     remember(f);
     return clearance;
   };
@@ -1661,11 +1655,10 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
         pose.t_BA = tt;
         double clearance = -1;
         if (&tt == &ts.front()) {
-          Obstacle o;
           FailedPair f;
-          clearance = verify(pcs, pose, nullptr, &o, &f);
+          clearance = verify(pcs, pose, nullptr, &f);
           remember(f);
-          obstacle = o;
+          obstacle = f.obstacle();
           t = tt;
         } else {
           if (still_blocked(pcs, pose, obstacle)) continue;
@@ -1702,11 +1695,10 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
           std::string why;
           double clearance = -1;
           if (&t == &ts.front() || debug_) {
-            Obstacle obstacle;
             FailedPair f;
-            clearance = verify(pcs, pose, debug_ ? &why : nullptr, &obstacle, &f);
+            clearance = verify(pcs, pose, debug_ ? &why : nullptr, &f);
             remember(f);
-            if (&t == &ts.front()) first_obstacle = obstacle;
+            if (&t == &ts.front()) first_obstacle = f.obstacle();
           } else {
             clearance = verify_unless_failing(pose);
           }

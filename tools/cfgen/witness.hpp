@@ -58,8 +58,6 @@ class WitnessSearch {
     ElementKind ka = ElementKind::kVertex, kb = ElementKind::kVertex;
     int a = -1, b = -1;
   };
-  /// verify, also naming the obstacle when the pose failed on one.
-  double verify(const PcSet& pcs, const Pose& pose, std::string* why, Obstacle* obstacle) const;
 
   /// True when the obstacle's pair, neither a PC nor covered by one, is still closer than
   /// min_clearance at `pose` (and touching in open points if within touch_tol): then verify
@@ -72,10 +70,11 @@ class WitnessSearch {
     enum class Kind { kNone, kObstacle, kOverlap } kind = Kind::kNone;
     ElementKind ka = ElementKind::kVertex, kb = ElementKind::kVertex;
     int a = -1, b = -1;
+    /// The obstacle, when the pose failed on one (else an Obstacle not set).
+    Obstacle obstacle() const { return Obstacle{kind == Kind::kObstacle, ka, kb, a, b}; }
   };
   /// verify, also naming the pair the pose failed on, when it failed on one.
-  double verify(const PcSet& pcs, const Pose& pose, std::string* why, Obstacle* obstacle,
-                FailedPair* failed) const;
+  double verify(const PcSet& pcs, const Pose& pose, std::string* why, FailedPair* failed) const;
   /// True when the pair still fails at `pose` as it did where it was recorded: then verify
   /// refuses `pose` too (at that pair or at one listed before it). False proves nothing.
   bool still_fails(const PcSet& pcs, const Pose& pose, const FailedPair& f) const;
