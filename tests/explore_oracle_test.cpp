@@ -6,12 +6,9 @@
 // direction of a translation, heights and distances about the axis of a rotation) exact.
 
 #include "cfgen/explore.hpp"
-#include "mesh/model_loader.hpp"
 #include "motion.hpp"
+#include "oracle_pair.hpp"
 #include "oracle_pose.hpp"
-#include "poly.hpp"
-#include "scratch.hpp"
-#include "shapes.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -30,65 +27,11 @@ constexpr double kSameEvent = 1e-6;
 // parts of this size (1e-9 of their size) would do; both sides take the same value.
 constexpr double kTol = 1e-7;
 
-// The oracle's own polyhedron, rebuilt from the vertices, edges and face loops cfgen read
-// (the oracle derives everything else itself).
-oracle::Poly to_oracle(const cf::Polyhedron& m, const std::string& name) {
-  std::vector<oracle::Vec3> verts;
-  for (const cf::Vertex& v : m.vertices()) verts.push_back(v.p);
-  std::vector<std::array<int, 2>> edges;
-  for (const cf::Edge& e : m.edges())
-    edges.push_back({static_cast<int>(e.v0.index()), static_cast<int>(e.v1.index())});
-  std::vector<std::vector<std::vector<int>>> faces;
-  for (const cf::Face& f : m.faces()) {
-    std::vector<std::vector<int>> loops;
-    for (const auto& loop : f.loops) {
-      loops.emplace_back();
-      for (cf::VertexId v : loop) loops.back().push_back(static_cast<int>(v.index()));
-    }
-    faces.push_back(loops);
-  }
-  return oracle::build_poly(verts, edges, faces, name);
-}
+using Pair = cf::test::OraclePair;
+using cf::test::clear_pose;
+using cf::test::random_unit;
 
-struct Pair {
-  cf::Polyhedron A, B;
-  oracle::Poly oA, oB;
-  cf::Vec3 cA, cB;        // bounding-box centres (own frames)
-  double rA = 0, rB = 0;  // half diagonals
-};
-
-Pair make(std::uint64_t seed) {
-  const oracle::ShapePair sp = oracle::make_pair(seed);
-  const std::string tag = std::to_string(seed);
-  oracle::write_off(sp.A, (cf::test::scratch() / ("A" + tag + ".off")).string());
-  oracle::write_off(sp.B, (cf::test::scratch() / ("B" + tag + ".off")).string());
-  Pair p;
-  p.A = cf::tools::load_model((cf::test::scratch() / ("A" + tag + ".off")).string());
-  p.B = cf::tools::load_model((cf::test::scratch() / ("B" + tag + ".off")).string());
-  p.oA = to_oracle(p.A, "A");
-  p.oB = to_oracle(p.B, "B");
-  p.cA = 0.5 * (p.A.bbox_min() + p.A.bbox_max());
-  p.cB = 0.5 * (p.B.bbox_min() + p.B.bbox_max());
-  p.rA = 0.5 * (p.A.bbox_max() - p.A.bbox_min()).norm();
-  p.rB = 0.5 * (p.B.bbox_max() - p.B.bbox_min()).norm();
-  return p;
-}
-
-cf::Vec3 random_unit(std::mt19937_64& rng) {
-  std::normal_distribution<double> g;
-  cf::Vec3 v(g(rng), g(rng), g(rng));
-  return v.normalized();
-}
-
-// A posed with its bounding sphere clear of B's, along a random direction from B's centre:
-// no pair touches at the start.
-cf::Pose clear_pose(const Pair& p, std::mt19937_64& rng, cf::Vec3& away) {
-  cf::Pose X;
-  X.R_BA = oracle::random_rotation(rng);
-  away = random_unit(rng);
-  X.t_BA = p.cB + (p.rA + p.rB + 1.0) * away - X.R_BA * p.cA;
-  return X;
-}
+Pair make(std::uint64_t seed) { return cf::test::make_oracle_pair(seed); }
 
 bool same(double a, double b) {
   if (std::isinf(a) || std::isinf(b)) return std::isinf(a) && std::isinf(b);

@@ -846,14 +846,14 @@ Pc pc_of(const PcSet& pcs, ElementKind ka, int a, ElementKind kb, int b) {
   return {};
 }
 
-
 // Lower bounds on the distance between an element of A and an element of B at one pose,
 // computed before the exact distance (which locates points in faces and clamps segments: the
 // bulk of verify's and contacts_at's time). From a face's plane: when every vertex of the
 // other element's closure lies on one side of it, the two are at least the nearest vertex's
 // height apart. From an edge's line: a vertex or an edge is at least its distance from the
 // line of the other side's edge apart (most edge pairs of two models, 95% of those near
-// enough to be listed, are far from crossing).
+// enough to be listed, are far from crossing). From where an edge crosses a face's plane
+// outside the face (crossing_gap).
 class DistanceBound {
  public:
   // a_buf, b_buf: where the posed vertices go (reused storage).
@@ -873,7 +873,8 @@ class DistanceBound {
   }
   /// The slack kept off bounds computed from the posed coordinates (mm).
   double slack() const { return line_slack_; }
-  double lower(ElementKind ka, int a, ElementKind kb, int b) const {
+  /// True when element a of A and element b of B are proven farther apart than `reach`.
+  bool farther(ElementKind ka, int a, ElementKind kb, int b, double reach) const {
     using K = ElementKind;
     double lb = 0;
     if (kb == K::kFace) lb = std::max(lb, side(B_.faces()[b], A_, ka, a, a_in_b_));
@@ -896,7 +897,21 @@ class DistanceBound {
       const Vec3& q = B_.vertices()[static_cast<std::size_t>(b)].p;
       lb = std::max(lb, line_gap(p0, u, q, q) - line_slack_);
     }
-    return lb;
+    if (lb > reach) return true;
+    // The bounds above are 0 when an edge crosses the face's plane: then from where it
+    // crosses it.
+    if (lb > 0) return false;
+    if (ka == K::kEdge && kb == K::kFace) {
+      const Edge& e = A_.edges()[a];
+      return crossing_gap(B_, b, a_in_b_[e.v0.index()], a_in_b_[e.v1.index()]) - line_slack_ >
+             reach;
+    }
+    if (ka == K::kFace && kb == K::kEdge) {
+      const Edge& e = B_.edges()[b];
+      return crossing_gap(A_, a, b_in_a_[e.v0.index()], b_in_a_[e.v1.index()]) - line_slack_ >
+             reach;
+    }
+    return false;
   }
 
  private:
@@ -909,6 +924,24 @@ class DistanceBound {
     Vec3 x1 = p1 - q;
     x1 -= x1.dot(u) * u;
     return point_segment(Vec3::Zero(), x0, x1).distance;
+  }
+
+  // For a segment [p0, p1] crossing the plane of face f of m (same frame) outside the face:
+  // a point of the segment at length l from the crossing point x lies l sin(a) above the
+  // plane and at most l cos(a) from x along it (a: the angle between segment and plane), so
+  // its squared distance from the face is at least (l sin a)^2 + (d - l cos a)^2 while
+  // l cos a <= d, where d is x's distance from the face in its plane: at least d sin(a)
+  // over all l. 0 when the segment does not cross the plane or crosses it in the face.
+  // One point location where the exact distance takes three and a segment distance for
+  // each of the face's edges; most edges near a face's plane cross it outside the face.
+  static double crossing_gap(const Polyhedron& m, int f, const Vec3& p0, const Vec3& p1) {
+    const Face& F = m.faces()[f];
+    const double h0 = F.normal.dot(p0) - F.offset, h1 = F.normal.dot(p1) - F.offset;
+    if (!((h0 < 0 && h1 > 0) || (h0 > 0 && h1 < 0))) return 0;
+    const Vec3 x = p0 + (h0 / (h0 - h1)) * (p1 - p0);
+    const FaceLocation loc = locate_in_face(m, FaceId(f), Eigen::Vector2d(F.u.dot(x), F.v.dot(x)));
+    if (loc.inside) return 0;
+    return loc.boundary_distance * std::abs(h1 - h0) / (p1 - p0).norm();
   }
 
   // Smallest height of element (k, i) of m (vertices given in f's frame) over f's plane when
@@ -1042,7 +1075,7 @@ class NearPairs {
             const auto& sb = B_.spheres[ib][static_cast<std::size_t>(b)];
             if ((ca - sb.first).norm() - sa.second - sb.second > reach_) continue;
             const auto ka = static_cast<ElementKind>(ia), kb = static_cast<ElementKind>(ib);
-            if (bounds_.lower(ka, a, kb, b) > reach_) continue;
+            if (bounds_.farther(ka, a, kb, b, reach_)) continue;
             out = {ka, kb, a, b};
             return true;
           }

@@ -1,0 +1,94 @@
+// cfgen's pose verification (WitnessSearch::verify, tools/cfgen/witness.cpp) against the
+// independent oracle's classifier (tests/oracle/classify.cpp, which shares no code with tools/
+// or libcf/), on the oracle's shape families with random proportions and placements. verify
+// measures only the element pairs it cannot prove farther apart than the good clearance (by
+// bounding spheres, boxes, faces' planes, edges' lines and where an edge crosses a face's
+// plane); the oracle measures every pair. So near contact the clearance verify reports, and
+// its refusal of every penetrating pose, must be the oracle's.
+
+#include "cfgen/generate.hpp"
+#include "cfgen/witness.hpp"
+#include "classify.hpp"
+#include "motion.hpp"
+#include "oracle_pair.hpp"
+#include "oracle_pose.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+namespace {
+
+// Both sides measure point-face and segment-segment distances in double precision from
+// coordinates of tens of mm: they agree to rounding, far below this (mm). Clearances this
+// close to one of verify's thresholds are not compared.
+constexpr double kSameDistance = 1e-9;
+// The oracle's first contacts are found to this distance (mm).
+constexpr double kTol = 1e-7;
+
+}  // namespace
+
+TEST_CASE("verify: the oracle's clearance and penetrations, near contact", "[witness][oracle]") {
+  int measured = 0, beyond = 0, too_close = 0, penetrating = 0;
+  for (std::uint64_t seed = 1; seed <= 2 * oracle::kPairings; ++seed) {
+    const cf::test::OraclePair p = cf::test::make_oracle_pair(seed);
+    const cf::gen::ModelInfo ai = cf::gen::analyse_model(p.A), bi = cf::gen::analyse_model(p.B);
+    const cf::gen::SearchParams prm =
+        cf::tools::scaled_search(p.A, p.B, cf::tools::RelativeLengths{});
+    const cf::gen::WitnessSearch search(ai, bi, prm);
+    const oracle::Classifier oracle_at(p.oA, p.oB, oracle::default_tolerances(p.oA, p.oB));
+    std::mt19937_64 rng(3000 + seed);
+    std::uniform_real_distribution<double> spread(-0.5, 0.5);
+    // How far short of the first contact A stops: up to one good clearance past it
+    // (penetrating), up to three before it (clear, below and above the good clearance); every
+    // fourth motion within two minimum clearances of it (below and above the minimum).
+    std::uniform_real_distribution<double> short_of(-1.0, 3.0), just_short_of(0.0, 2.0);
+    for (int k = 0; k < 60; ++k) {
+      cf::Vec3 away;
+      const cf::Pose X = cf::test::clear_pose(p, rng, away);
+      const cf::Vec3 d = (-away + spread(rng) * cf::test::random_unit(rng)).normalized();
+      oracle::Motion m;
+      m.u = d;
+      const double s_max = 2 * (p.rA + p.rB) + 2;
+      const double s_hit =
+          oracle::time_of_impact(p.oA, p.oB, cf::test::to_oracle(X), m, s_max, kTol);
+      if (std::isinf(s_hit)) continue;
+      cf::Pose Y = X;
+      const double back =
+          k % 4 == 0 ? just_short_of(rng) * prm.min_clearance : short_of(rng) * prm.good_clearance;
+      Y.t_BA += (s_hit - back) * d;
+      const oracle::Verdict v = oracle_at.classify(cf::test::to_oracle(Y));
+      std::string why;
+      const double mine = search.verify(cf::PcSet(), Y, &why);
+      INFO("seed " << seed << " ("
+                   << oracle::pairing_name(static_cast<int>(seed % oracle::kPairings))
+                   << "), motion " << k << ": oracle " << v.describe() << ", clearance "
+                   << v.clearance << " mm (" << v.clearance_what << "); verify " << mine << " ("
+                   << why << ")");
+      if (v.penetrating) {
+        CHECK(mine < 0);
+        ++penetrating;
+        continue;
+      }
+      if (!v.touches.empty()) continue;  // within the oracle's touch tolerance, not cfgen's
+      const double c = v.clearance;
+      if (c > prm.good_clearance + kSameDistance) {
+        CHECK(mine == prm.good_clearance);  // reported as good, not measured
+        ++beyond;
+      } else if (c < prm.min_clearance - kSameDistance) {
+        CHECK(mine < 0);
+        ++too_close;
+      } else if (c > prm.min_clearance + kSameDistance && c < prm.good_clearance - kSameDistance) {
+        CHECK(std::abs(mine - c) <= kSameDistance);
+        ++measured;
+      }
+    }
+  }
+  // Every kind of pose is met many times, so each comparison is exercised.
+  CHECK(measured > 200);
+  CHECK(beyond > 200);
+  CHECK(too_close > 50);
+  CHECK(penetrating > 200);
+}
