@@ -422,12 +422,23 @@ double first_contact_rotation(const Polyhedron& A, const Polyhedron& B, const Po
   // a trigonometric polynomial of degree 2 (six coefficients per pair); its sign changes on a
   // fine sampling are refined by bisection, then checked on the segments.
   constexpr int kSamples = 192;
-  double cs[kSamples + 1][2];
-  for (int k = 0; k <= kSamples; ++k) {
-    const double phi = phi_min + (phi_max - phi_min) * k / kSamples;
-    cs[k][0] = std::cos(phi);
-    cs[k][1] = std::sin(phi);
+  // The samples' cosines and sines, kept per thread for the last range asked for: the
+  // closure turns over the same range every time, and the table cost 193 sincos a call.
+  struct SampleTable {
+    double phi_min = 0, phi_max = -1;
+    double cs[kSamples + 1][2];
+  };
+  thread_local SampleTable table;
+  if (table.phi_min != phi_min || table.phi_max != phi_max) {
+    table.phi_min = phi_min;
+    table.phi_max = phi_max;
+    for (int k = 0; k <= kSamples; ++k) {
+      const double phi = phi_min + (phi_max - phi_min) * k / kSamples;
+      table.cs[k][0] = std::cos(phi);
+      table.cs[k][1] = std::sin(phi);
+    }
   }
+  const auto& cs = table.cs;
   // x(phi) = P + cos(phi) C + sin(phi) S for a point turning about (p, u).
   auto circle = [&](const Vec3& x0, Vec3& P, Vec3& C, Vec3& S) {
     const Vec3 r = x0 - p, r_par = r.dot(u) * u;
