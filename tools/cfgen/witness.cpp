@@ -713,10 +713,12 @@ std::vector<Mat3> WitnessSearch::rotation_steps(const PcSet& pcs, const Mat3& R,
 std::vector<Vec3> WitnessSearch::translations(const PcSet& pcs, const Mat3& R,
                                               const std::vector<int>& pieces, double& margin,
                                               bool near_boundary,
-                                              const std::vector<LinearProgram::Row>& cuts) const {
+                                              const std::vector<LinearProgram::Row>& cuts,
+                                              TranslationMemo* memo) const {
   LinearProgram lp = build_lp(pcs, R, pieces);
   lp.rows.insert(lp.rows.end(), cuts.begin(), cuts.end());
-  const LpResult best = solve(lp);
+  const bool memo_set = memo && memo->set;
+  const LpResult best = memo_set ? memo->best : solve(lp);
   margin = best.status == LpResult::Status::kOptimal ? best.x[3] : 0.0;
   if (best.status != LpResult::Status::kOptimal || margin < p_.min_margin) return {};
   // The largest margin is reached on a whole face of the feasible polytope and the solver
@@ -736,7 +738,8 @@ std::vector<Vec3> WitnessSearch::translations(const PcSet& pcs, const Mat3& R,
       }
     return ext;
   };
-  const std::vector<LpVector> extremes = extremes_at(0.5 * margin);
+  const std::vector<LpVector> extremes = memo_set ? memo->half : extremes_at(0.5 * margin);
+  if (memo && !memo_set) *memo = TranslationMemo{true, best, extremes};
   if (extremes.empty()) return {best.x.head<3>()};
   if (near_boundary) {
     // Near a wall the contact may have to sit close to its element's boundary: extremes that
@@ -1713,9 +1716,10 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
     for (int combo = 0; combo < p_.max_piece_combinations; ++combo) {
       // Pass 0: centred translations; pass 1 (only when pass 0 placed the contacts but found
       // no witness): translations close to the elements' boundaries.
+      TranslationMemo memo;
       for (int pass = 0; pass < 2; ++pass) {
         double margin = 0;
-        const std::vector<Vec3> ts = translations(pcs, R, choice, margin, pass == 1);
+        const std::vector<Vec3> ts = translations(pcs, R, choice, margin, pass == 1, {}, &memo);
         if (pass == 0 && !ts.empty() && near.size() < 4) near.push_back(R);
         if (debug_) std::cerr << "  rotation, pass " << pass << ": " << ts.size() << " translations, margin " << margin << "\n";
         Obstacle first_obstacle;

@@ -153,9 +153,18 @@ class WitnessSearch {
   // near_boundary: instead, extremes that keep only 5% of the margin (a contact that must sit
   // close to its element's boundary, e.g. A in a slot barely wider than itself).
   // cuts: extra rows on the translation (variables 0..2), e.g. from separating_cut.
+  // memo: empty, or the programs of an earlier call for the same set, rotation and pieces
+  // without cuts (filled by that call): the largest margin and the extremes that keep half
+  // of it, which both passes start from, solved once.
+  struct TranslationMemo {
+    bool set = false;
+    LpResult best;
+    std::vector<LpVector> half;
+  };
   std::vector<Vec3> translations(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces,
                                  double& margin, bool near_boundary,
-                                 const std::vector<LinearProgram::Row>& cuts = {}) const;
+                                 const std::vector<LinearProgram::Row>& cuts = {},
+                                 TranslationMemo* memo = nullptr) const;
   // A half-space of translations t (a row n.t >= h) in which the obstacle's two elements, A
   // rotated by R, are separated by at least min_clearance: the separating axis (face normals,
   // edge cross products, edge-vertex and vertex-vertex directions of their closures) that
