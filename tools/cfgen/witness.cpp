@@ -776,37 +776,50 @@ bool WitnessSearch::separating_cut(const Mat3& R, const Vec3& t, const Obstacle&
   std::vector<Vec3> da = closure_directions(A, o.ka, o.a), db = closure_directions(B, o.kb, o.b);
   for (Vec3& d : da) d = R * d;
   // Separating axes of two convex hulls: face normals, edge cross products, and for the
-  // lower-dimensional pairs the directions between an edge or a point and a point.
-  std::vector<Vec3> axes;
-  if (o.ka == ElementKind::kFace) axes.push_back(R * A.faces()[o.a].normal);
-  if (o.kb == ElementKind::kFace) axes.push_back(B.faces()[o.b].normal);
-  for (const Vec3& x : da)
-    for (const Vec3& y : db) axes.push_back(x.cross(y));
-  for (const Vec3& p : pa)
-    for (const Vec3& q : pb) {
-      const Vec3 w = q - (p + t);
-      axes.push_back(w);
-      for (const Vec3& x : da) axes.push_back(w - w.dot(x) * x);
-      for (const Vec3& y : db) axes.push_back(w - w.dot(y) * y);
-    }
+  // lower-dimensional pairs the directions between an edge or a point and a point. Each is
+  // tried both ways, in this order (the first of equal moves is kept); hundreds for two
+  // faces, so each axis is taken as it comes, and its opposite from the same extents (the
+  // negated products are exact).
   double best_move = std::numeric_limits<double>::infinity();
-  for (Vec3 n : axes) {
+  auto try_axis = [&](Vec3 n) {
     const double len = n.norm();
-    if (len < 1e-9 * scale_) continue;
+    if (len < 1e-9 * scale_) return;
     n /= len;
-    for (double sign : {1.0, -1.0}) {
-      const Vec3 m = sign * n;  // A on m's side: min over A of m.(p + t) >= max over B of m.q + c
-      double a_min = std::numeric_limits<double>::infinity(), b_max = -a_min;
-      for (const Vec3& p : pa) a_min = std::min(a_min, m.dot(p));
-      for (const Vec3& q : pb) b_max = std::max(b_max, m.dot(q));
+    double a_lo = std::numeric_limits<double>::infinity(), a_hi = -a_lo, b_lo = a_lo, b_hi = -a_lo;
+    for (const Vec3& p : pa) {
+      const double x = n.dot(p);
+      a_lo = std::min(a_lo, x);
+      a_hi = std::max(a_hi, x);
+    }
+    for (const Vec3& q : pb) {
+      const double x = n.dot(q);
+      b_lo = std::min(b_lo, x);
+      b_hi = std::max(b_hi, x);
+    }
+    const double n_t = n.dot(t);
+    // A on m's side: min over A of m.(p + t) >= max over B of m.q + c.
+    auto side = [&](const Vec3& m, double a_min, double b_max, double m_t) {
       const double rhs = b_max - a_min + 2 * p_.min_clearance;
-      const double move = rhs - m.dot(t);
+      const double move = rhs - m_t;
       if (move < best_move) {
         best_move = move;
         cut = {{{0, m.x()}, {1, m.y()}, {2, m.z()}}, LinearProgram::Rel::kGreaterEq, rhs};
       }
+    };
+    side(n, a_lo, b_hi, n_t);
+    side(-n, -a_hi, -b_lo, -n_t);
+  };
+  if (o.ka == ElementKind::kFace) try_axis(R * A.faces()[o.a].normal);
+  if (o.kb == ElementKind::kFace) try_axis(B.faces()[o.b].normal);
+  for (const Vec3& x : da)
+    for (const Vec3& y : db) try_axis(x.cross(y));
+  for (const Vec3& p : pa)
+    for (const Vec3& q : pb) {
+      const Vec3 w = q - (p + t);
+      try_axis(w);
+      for (const Vec3& x : da) try_axis(w - w.dot(x) * x);
+      for (const Vec3& y : db) try_axis(w - w.dot(y) * y);
     }
-  }
   return best_move < std::numeric_limits<double>::infinity();
 }
 
