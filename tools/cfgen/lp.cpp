@@ -95,7 +95,9 @@ enum class Dual { kOptimal, kInfeasible, kUnbounded };
 // columns (< m) of the rows that were not found redundant.
 struct DualSimplex {
   int d, m;
-  RowMatMap T;              // d constraint rows, then the cost row; last column the right side
+  // d constraint rows, then the cost row; m columns, then the right side. The artificial
+  // columns of phase 1 are left out: they never enter the basis and nothing reads them.
+  RowMatMap T;
   std::vector<int>& basic;  // basic column of each row; columns >= m are artificial
   std::vector<char>& live;  // rows not removed as redundant
   std::vector<double>& tol;  // per column: reduced costs above -tol are non-negative
@@ -103,7 +105,7 @@ struct DualSimplex {
   DualSimplex(const MatMap& A, const VarVec& b, Workspace& w)
       : d(int(A.rows())),
         m(int(A.cols())),
-        T(as_matrix<RowMatMap>(w.T, d + 1, m + d + 1)),
+        T(as_matrix<RowMatMap>(w.T, d + 1, m + 1)),
         basic(w.basic),
         live(w.live),
         tol(w.tol) {
@@ -114,8 +116,7 @@ struct DualSimplex {
     for (int i = 0; i < d; ++i) {
       const double s = b[i] < 0 ? -1.0 : 1.0;
       T.row(i).head(m) = s * A.row(i);
-      T(i, m + i) = 1.0;
-      T(i, m + d) = s * b[i];
+      T(i, m) = s * b[i];
       basic[i] = m + i;
     }
   }
@@ -141,7 +142,7 @@ struct DualSimplex {
       double best = 0.0;
       for (int i = 0; i < d; ++i) {
         if (!live[i] || T(i, c) <= kPivotTol) continue;
-        const double ratio = T(i, m + d) / T(i, c);
+        const double ratio = T(i, m) / T(i, c);
         const double tie = 1e-12 * (1 + std::abs(best));
         if (r < 0 || ratio < best - tie) {
           best = ratio;
@@ -160,9 +161,8 @@ struct DualSimplex {
     // Phase 1: minimise the sum of the artificials.
     T.row(d).setZero();
     for (int i = 0; i < d; ++i) T.row(d) -= T.row(i);
-    for (int i = 0; i < d; ++i) T(d, m + i) = 0.0;
     run(m);
-    if (-T(d, m + d) > kPhase1Tol) return Dual::kInfeasible;
+    if (-T(d, m) > kPhase1Tol) return Dual::kInfeasible;
     // Drive the artificials out of the basis; a row where none can leave is redundant.
     for (int i = 0; i < d; ++i) {
       if (basic[i] < m) continue;
