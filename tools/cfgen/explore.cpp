@@ -422,23 +422,29 @@ double first_contact_rotation(const Polyhedron& A, const Polyhedron& B, const Po
   // a trigonometric polynomial of degree 2 (six coefficients per pair); its sign changes on a
   // fine sampling are refined by bisection, then checked on the segments.
   constexpr int kSamples = 192;
-  // The samples' cosines and sines, kept per thread for the last range asked for: the
-  // closure turns over the same range every time, and the table cost 193 sincos a call.
+  // The samples' angles, cosines and sines, kept per thread for the last range asked for:
+  // the closure turns over the same range every time, and computing them takes 193 sincos
+  // (and the angles a division each, for every pair of edges).
   struct SampleTable {
-    double phi_min = 0, phi_max = -1;
+    bool set = false;
+    double phi_min = 0, phi_max = 0;
+    double phi[kSamples + 1];
     double cs[kSamples + 1][2];
   };
   thread_local SampleTable table;
-  if (table.phi_min != phi_min || table.phi_max != phi_max) {
+  if (!table.set || table.phi_min != phi_min || table.phi_max != phi_max) {
+    table.set = true;
     table.phi_min = phi_min;
     table.phi_max = phi_max;
     for (int k = 0; k <= kSamples; ++k) {
       const double phi = phi_min + (phi_max - phi_min) * k / kSamples;
+      table.phi[k] = phi;
       table.cs[k][0] = std::cos(phi);
       table.cs[k][1] = std::sin(phi);
     }
   }
   const auto& cs = table.cs;
+  const auto& phis = table.phi;
   // x(phi) = P + cos(phi) C + sin(phi) S for a point turning about (p, u).
   auto circle = [&](const Vec3& x0, Vec3& P, Vec3& C, Vec3& S) {
     const Vec3 r = x0 - p, r_par = r.dot(u) * u;
@@ -489,11 +495,11 @@ double first_contact_rotation(const Polyhedron& A, const Polyhedron& B, const Po
       auto g_at = [&](double phi) { return g(std::cos(phi), std::sin(phi)); };
       double prev = g(cs[0][0], cs[0][1]);
       for (int k = 1; k <= kSamples; ++k) {
-        const double lo0 = phi_min + (phi_max - phi_min) * (k - 1) / kSamples;
+        const double lo0 = phis[k - 1];
         if (lo0 >= best) break;
         const double val = g(cs[k][0], cs[k][1]);
         if ((prev <= 0) != (val <= 0)) {
-          double lo = lo0, hi = phi_min + (phi_max - phi_min) * k / kSamples, glo = prev;
+          double lo = lo0, hi = phis[k], glo = prev;
           for (int it = 0; it < 60; ++it) {
             const double mid = 0.5 * (lo + hi), gm = g_at(mid);
             if ((glo <= 0) == (gm <= 0)) {

@@ -95,10 +95,10 @@ enum class Dual { kOptimal, kInfeasible, kUnbounded };
 // columns (< m) of the rows that were not found redundant.
 struct DualSimplex {
   int d, m;
-  // d constraint rows, then the cost row; m columns, then the right side. The artificial
-  // columns of phase 1 are left out: they never enter the basis and nothing reads them.
+  // d constraint rows, then the cost row; m columns, then the right side. Phase 1's
+  // artificial columns are not stored: they never enter the basis and nothing reads them.
   RowMatMap T;
-  std::vector<int>& basic;  // basic column of each row; columns >= m are artificial
+  std::vector<int>& basic;  // basic column of each row; m + i: row i's artificial (not stored)
   std::vector<char>& live;  // rows not removed as redundant
   std::vector<double>& tol;  // per column: reduced costs above -tol are non-negative
 
