@@ -717,8 +717,6 @@ std::vector<Vec3> WitnessSearch::translations(const PcSet& pcs, const Mat3& R,
                                               TranslationMemo* memo) const {
   LinearProgram lp = build_lp(pcs, R, pieces);
   lp.rows.insert(lp.rows.end(), cuts.begin(), cuts.end());
-  if (memo && !cuts.empty())
-    throw std::logic_error("translations: a memo holds programs without cuts");
   const bool memo_set = memo && memo->set;
   const LpResult best = memo_set ? memo->best : solve(lp);
   margin = best.status == LpResult::Status::kOptimal ? best.x[3] : 0.0;
@@ -887,9 +885,6 @@ class DistanceBound {
     double extent = 1.0;
     for (const Vec3& p : a_in_b_) extent = std::max(extent, p.lpNorm<Eigen::Infinity>());
     for (const Vertex& v : B.vertices()) extent = std::max(extent, v.p.lpNorm<Eigen::Infinity>());
-    // crossing_gap of a face of A works in A's frame.
-    for (const Vec3& p : b_in_a_) extent = std::max(extent, p.lpNorm<Eigen::Infinity>());
-    for (const Vertex& v : A.vertices()) extent = std::max(extent, v.p.lpNorm<Eigen::Infinity>());
     line_slack_ = 1e-12 * extent;
   }
   /// The slack kept off bounds computed from the posed coordinates (mm).
