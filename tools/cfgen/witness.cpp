@@ -1286,9 +1286,14 @@ bool WitnessSearch::still_fails(const PcSet& pcs, const Pose& pose, const Failed
   // verify's overlap test, for a pair that is a PC or covered by one (as recorded).
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
-  return element_distance(A, pose, f.ka, f.a, B, f.kb, f.b).distance <= p_.touch_tol &&
-         open_touch(A, pose, f.ka, f.a, B, f.kb, f.b, p_.touch_tol) &&
-         !cones_disjoint(pose, f.ka, f.a, f.kb, f.b);
+  return overlap_at(pose, f.ka, f.a, f.kb, f.b,
+                    element_distance(A, pose, f.ka, f.a, B, f.kb, f.b).distance);
+}
+
+bool WitnessSearch::overlap_at(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b,
+                               double d) const {
+  return d <= p_.touch_tol && open_touch(*A_.model, pose, ka, a, *B_.model, kb, b, p_.touch_tol) &&
+         !cones_disjoint(pose, ka, a, kb, b);
 }
 
 double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* why,
@@ -1358,8 +1363,7 @@ double WitnessSearch::verify(const PcSet& pcs, const Pose& pose, std::string* wh
     // disjoint interiors; pairs that touch only through their boundaries are judged
     // as those boundary pairs. This catches a face of A running through a reflex edge
     // of B, which no pair reports as crossing.
-    if ((is_pc || covered) && d <= p_.touch_tol &&
-        open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol) && !cones_disjoint(pose, ka, a, kb, b)) {
+    if ((is_pc || covered) && overlap_at(pose, ka, a, kb, b, d)) {
       if (failed) *failed = FailedPair{FailedPair::Kind::kOverlap, ka, kb, a, b};
       return reject_with([&] {
         return "A and B overlap where " + kind_name(ka) + std::to_string(a) + " touches " +
@@ -1673,6 +1677,12 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
     std::rotate(recent.begin(), it, it + 1);
     recent.front() = f;
   };
+  // verify, keeping the pair the pose failed on (in f) among the recent ones.
+  auto verify_remembering = [&](const Pose& pose, std::string* why, FailedPair& f) {
+    const double clearance = verify(pcs, pose, why, &f);
+    remember(f);
+    return clearance;
+  };
   // verify for a pose only a witness would change anything at: -1 when a recent pair proves
   // it fails.
   auto verify_unless_failing = [&](const Pose& pose) {
@@ -1681,9 +1691,7 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
       if (still_fails(pcs, pose, f)) return -1.0;
     }
     FailedPair f;
-    const double clearance = verify(pcs, pose, nullptr, &f);
-    remember(f);
-    return clearance;
+    return verify_remembering(pose, nullptr, f);
   };
   // Returns true when a good witness was found.
   auto cut_obstacles = [&](const Mat3& R, const std::vector<int>& choice, Vec3 t, Obstacle obstacle) {
@@ -1705,8 +1713,7 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
         double clearance = -1;
         if (&tt == &ts.front()) {
           FailedPair f;
-          clearance = verify(pcs, pose, nullptr, &f);
-          remember(f);
+          clearance = verify_remembering(pose, nullptr, f);
           obstacle = f.obstacle();
           t = tt;
         } else {
@@ -1746,8 +1753,7 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
           double clearance = -1;
           if (&t == &ts.front() || debug_) {
             FailedPair f;
-            clearance = verify(pcs, pose, debug_ ? &why : nullptr, &f);
-            remember(f);
+            clearance = verify_remembering(pose, debug_ ? &why : nullptr, f);
             if (&t == &ts.front()) first_obstacle = f.obstacle();
           } else {
             clearance = verify_unless_failing(pose);

@@ -140,6 +140,10 @@ class WitnessSearch {
   // disjoint interiors (exact for pairs with a face or two edges; vertex-edge and
   // vertex-vertex probe along each cone's inward axis).
   bool cones_disjoint(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b) const;
+  // Whether A and B overlap where element a of A touches element b of B, d apart: they
+  // touch in open points and their tangent cones there are not disjoint (verify's test for a
+  // PC or a pair a PC covers).
+  bool overlap_at(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b, double d) const;
   LinearProgram build_lp(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces) const;
   // The largest margin of the contacts inside their elements at rotation R, negative (down
   // to -scale) when they cannot be placed: how far R is from placing them. -inf when even
