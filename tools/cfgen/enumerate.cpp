@@ -2,14 +2,17 @@
 
 #include "explore.hpp"
 #include "pair_conditions.hpp"
+#include "symmetry.hpp"
 
 #include <cf/geometry.hpp>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cmath>
+#include <condition_variable>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -20,6 +23,20 @@ namespace cf::gen {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// Vertices within this fraction of the length scale D match under a symmetry: far below the
+// touch tolerance (2e-11 D by default), so an image witness is verified as the witness was.
+constexpr double kSymmetryTol = 1e-13;
+// Members of an orbit searched before it counts as failed: each meets the search's fixed
+// samples differently. On the hexagonal peg and hole 2 find 13 orbits more than 1 (4 no more
+// than 2); on the square pair 4 find 2 more than 2.
+constexpr std::size_t kOrbitTries = 4;
+// Witnesses explored by motion per orbit a round adds: the one found, and those found by
+// their own searches for up to three more members, spread over the orbit. Motion from one
+// witness reaches what its place in the CF's region allows; the images of that witness reach
+// the images of the same. On the hexagonal pair 4 find 13 orbits more than 1 at 17% more
+// time, 16 one more than 4.
+constexpr std::size_t kWitnessesPerOrbit = 4;
 
 struct PcSetHash {
   std::size_t operator()(const PcSet& s) const { return s.hash(); }
@@ -110,53 +127,85 @@ std::size_t chunk_size(std::size_t tasks) {
 }
 
 std::vector<Transition> transitions_between(const std::vector<CfRecord>& cfs, const Polyhedron& A,
-                                            const Polyhedron& B) {
+                                            const Polyhedron& B, int threads) {
   std::unordered_map<PcSet, int, PcSetHash> index;
   for (std::size_t i = 0; i < cfs.size(); ++i) index.emplace(cfs[i].pcs, static_cast<int>(i));
-  std::vector<Transition> out;
-  auto push = [&](int from, int to, TransitionKind k) {
-    out.push_back({CfId(from), CfId(to), k});
-  };
-  std::map<Pc, std::vector<Pc>> nb_cache;
-  auto neighbours = [&](const Pc& pc) -> const std::vector<Pc>& {
-    auto it = nb_cache.find(pc);
-    if (it == nb_cache.end()) it = nb_cache.emplace(pc, cf::neighbouring_pcs(pc, A, B)).first;
-    return it->second;
-  };
-  for (std::size_t i = 0; i < cfs.size(); ++i) {
-    const PcSet& s = cfs[i].pcs;
-    const int me = static_cast<int>(i);
-    // gain / lose: drop one PC of a larger CF.
-    if (s.size() > 1)
-      for (int k = 0; k < s.size(); ++k) {
-        PcSet sub;
-        for (int j = 0; j < s.size(); ++j)
-          if (j != k) sub.insert(s[j]);
-        auto it = index.find(sub);
-        if (it != index.end()) {
-          push(it->second, me, TransitionKind::kGain);
-          push(me, it->second, TransitionKind::kLose);
+  // Every PC's neighbours, computed once before the CFs are shared out among the threads.
+  std::map<Pc, std::vector<Pc>> nb;
+  for (const CfRecord& r : cfs)
+    for (const Pc& pc : r.pcs)
+      if (!nb.count(pc)) nb.emplace(pc, cf::neighbouring_pcs(pc, A, B));
+  // The CFs that hold each PC, by CF size.
+  std::array<std::map<Pc, std::vector<int>>, PcSet::kMaxPcs + 1> holding;
+  for (std::size_t i = 0; i < cfs.size(); ++i)
+    for (const Pc& pc : cfs[i].pcs)
+      holding[static_cast<std::size_t>(cfs[i].pcs.size())][pc].push_back(static_cast<int>(i));
+  // Each CF's transitions on its own, joined in CF order (then sorted).
+  std::vector<std::vector<Transition>> per_cf(cfs.size());
+  parallel_for(
+      cfs.size(),
+      threads <= 0 ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency())) : threads,
+      [&](std::size_t i) {
+        std::vector<Transition>& mine = per_cf[i];
+        auto push = [&](int from, int to, TransitionKind k) {
+          mine.push_back({CfId(from), CfId(to), k});
+        };
+        const PcSet& s = cfs[i].pcs;
+        const int me = static_cast<int>(i);
+        // gain / lose: drop one PC of a larger CF.
+        if (s.size() > 1)
+          for (int k = 0; k < s.size(); ++k) {
+            PcSet sub;
+            for (int j = 0; j < s.size(); ++j)
+              if (j != k) sub.insert(s[j]);
+            auto it = index.find(sub);
+            if (it != index.end()) {
+              push(it->second, me, TransitionKind::kGain);
+              push(me, it->second, TransitionKind::kLose);
+            }
+          }
+        // change: replace one or more PCs by neighbouring PCs, keeping the count: the CFs of
+        // this size whose PCs match s's positions one to one, each the same PC or a neighbour.
+        // They all hold some option of the position with the fewest, so only the CFs holding
+        // one of those are tried.
+        const int n = s.size();
+        std::vector<std::vector<Pc>> options(static_cast<std::size_t>(n));
+        std::size_t best = 0, best_count = std::numeric_limits<std::size_t>::max();
+        for (int k = 0; k < n; ++k) {
+          auto& o = options[static_cast<std::size_t>(k)];
+          o.push_back(s[k]);
+          for (const Pc& q : nb.at(s[k])) o.push_back(q);
+          std::sort(o.begin(), o.end());
+          std::size_t count = 0;
+          for (const Pc& q : o)
+            if (auto it = holding[static_cast<std::size_t>(n)].find(q);
+                it != holding[static_cast<std::size_t>(n)].end())
+              count += it->second.size();
+          if (count < best_count) best = static_cast<std::size_t>(k), best_count = count;
         }
-      }
-    // change: replace one or more PCs by neighbouring PCs, keeping the count.
-    std::vector<std::vector<Pc>> options(static_cast<std::size_t>(s.size()));
-    for (int k = 0; k < s.size(); ++k) {
-      options[k].push_back(s[k]);
-      for (const Pc& q : neighbours(s[k])) options[k].push_back(q);
-    }
-    std::vector<std::size_t> pick(options.size(), 0);
-    while (true) {
-      std::size_t d = 0;
-      while (d < pick.size() && ++pick[d] == options[d].size()) pick[d++] = 0;
-      if (d == pick.size()) break;
-      PcSet t;
-      bool ok = true;
-      for (std::size_t k = 0; k < pick.size() && ok; ++k) ok = t.insert(options[k][pick[k]]);
-      if (!ok || t.size() != s.size()) continue;
-      auto it = index.find(t);
-      if (it != index.end() && it->second != me) push(me, it->second, TransitionKind::kChange);
-    }
-  }
+        auto matches = [&](const PcSet& t) {
+          std::array<int, PcSet::kMaxPcs> perm{0, 1, 2};
+          do {
+            bool all = true;
+            for (int k = 0; k < n && all; ++k) {
+              const auto& o = options[static_cast<std::size_t>(k)];
+              all = std::binary_search(o.begin(), o.end(), t[perm[static_cast<std::size_t>(k)]]);
+            }
+            if (all) return true;
+          } while (std::next_permutation(perm.begin(), perm.begin() + n));
+          return false;
+        };
+        for (const Pc& q : options[best]) {
+          auto it = holding[static_cast<std::size_t>(n)].find(q);
+          if (it == holding[static_cast<std::size_t>(n)].end()) continue;
+          for (int j : it->second)
+            if (j != me && matches(cfs[static_cast<std::size_t>(j)].pcs))
+              push(me, j, TransitionKind::kChange);
+        }
+      },
+      {});
+  std::vector<Transition> out;
+  for (const auto& v : per_cf) out.insert(out.end(), v.begin(), v.end());
   std::sort(out.begin(), out.end(), [](const Transition& x, const Transition& y) {
     if (x.from != y.from) return x.from < y.from;
     if (x.to != y.to) return x.to < y.to;
@@ -184,10 +233,41 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   std::unordered_set<PcSet, PcSetHash> seen;
   std::unordered_map<PcSet, Mat3, PcSetHash> witness_rot;  // seeds for the sets above them
   std::vector<std::pair<PcSet, Pose>> frontier;             // valid sets not explored by motion yet
+  // The models' symmetries: a valid set's images are valid, at the image of its witness.
+  const PairSymmetries sym(A, B, kSymmetryTol * search.scale(), opt.use_symmetry);
+  out.symmetries_a = sym.size_a();
+  out.symmetries_b = sym.size_b();
+  // A set found valid, and the images of it that are not known yet, each verified at the image
+  // of the witness (symmetric to rounding). Only the set found is explored by motion: its
+  // images' motions are the images of its own.
   auto accept = [&](int level, const PcSet& s, const Witness& w) {
     valid[level].push_back({s, w});
     witness_rot.emplace(s, w.pose.R_BA);
     frontier.push_back({s, w.pose});
+    for (std::size_t k = 1; k < sym.size(); ++k) {
+      const PcSet t = sym.image(s, k);
+      if (witness_rot.count(t)) continue;
+      Witness v = w;
+      v.pose = sym.image(w.pose, k);
+      v.clearance = search.verify(t, v.pose);
+      if (v.clearance < opt.search.min_clearance) continue;
+      valid[level].push_back({t, v});
+      witness_rot.emplace(t, v.pose.R_BA);
+      seen.insert(t);
+      ++out.levels[level].by_symmetry;
+    }
+  };
+  // The candidates grouped by orbit, each orbit's members in candidate order, the orbits in
+  // the order of their first member.
+  auto orbits_of = [&](const std::vector<PcSet>& cands) {
+    std::vector<std::vector<PcSet>> orbits;
+    std::unordered_map<PcSet, std::size_t, PcSetHash> orbit_of;
+    for (const PcSet& s : cands) {
+      const auto [it, fresh] = orbit_of.emplace(sym.canonical(s), orbits.size());
+      if (fresh) orbits.emplace_back();
+      orbits[it->second].push_back(s);
+    }
+    return orbits;
   };
 
   // Progress: ticks while a stage runs, one event when it ends.
@@ -262,37 +342,60 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   };
 
   // given: results computed elsewhere (the shards of the first level-2 round), one per candidate.
-  auto run_level = [&](int level, const std::vector<PcSet>& cands,
+  auto run_level = [&](int level, const std::vector<PcSet>& all,
                        const std::function<std::vector<Mat3>(const PcSet&)>& seeds_of,
                        const std::vector<Witness>* given = nullptr) {
     const auto t0 = Clock::now();
-    std::vector<Witness> res(cands.size());
-    ProgressEvent ev{"level " + std::to_string(level + 1), "candidate sets", 0, cands.size(), 0, false, {}};
-    if (given) {
-      if (given->size() != cands.size())
-        throw Error("merging shards: the parts hold " + std::to_string(given->size()) +
-                    " results of the first level-2 round, but these models and options give " +
-                    std::to_string(cands.size()) + " candidates");
-      res = *given;
-      ++stages;
-    } else {
-      std::vector<Task> tasks(cands.size());
-      for (std::size_t i = 0; i < cands.size(); ++i) {
-        tasks[i].kind = Task::Kind::kFind;
-        tasks[i].pcs = cands[i];
-        tasks[i].seeds = seeds_of(cands[i]);
+    // One search per orbit: the others follow from its witness. The search samples, and an
+    // orbit's members meet its samples differently, so a failed orbit is searched again at
+    // its next members, up to kOrbitTries.
+    const std::vector<std::vector<PcSet>> orbits = orbits_of(all);
+    std::vector<char> done(orbits.size(), 0);
+    std::size_t searched = 0;
+    const std::size_t before = valid[level].size();
+    ProgressEvent ev{
+        "level " + std::to_string(level + 1), "candidate sets", 0, orbits.size(), 0, false, {}};
+    for (std::size_t attempt = 0; attempt < kOrbitTries; ++attempt) {
+      std::vector<std::size_t> open;
+      for (std::size_t o = 0; o < orbits.size(); ++o)
+        if (!done[o] && attempt < orbits[o].size()) open.push_back(o);
+      if (open.empty()) break;
+      std::vector<Witness> res(open.size());
+      if (attempt == 0 && given) {
+        if (given->size() != open.size())
+          throw Error("merging shards: the parts hold " + std::to_string(given->size()) +
+                      " results of the first level-2 round, but these models and options give " +
+                      std::to_string(open.size()) + " candidates");
+        res = *given;
+        ++stages;
+      } else {
+        std::vector<Task> tasks(open.size());
+        for (std::size_t i = 0; i < open.size(); ++i) {
+          tasks[i].kind = Task::Kind::kFind;
+          tasks[i].pcs = orbits[open[i]][attempt];
+          tasks[i].seeds = seeds_of(tasks[i].pcs);
+        }
+        ev.total = open.size();
+        std::vector<TaskResult> r = run_stage(tasks, attempt == 0 ? &ev : nullptr, t0);
+        for (std::size_t i = 0; i < open.size(); ++i) res[i] = r[i].witness;
       }
-      std::vector<TaskResult> r = run_stage(tasks, &ev, t0);
-      for (std::size_t i = 0; i < cands.size(); ++i) res[i] = r[i].witness;
+      searched += open.size();
+      for (std::size_t i = 0; i < open.size(); ++i) {
+        const PcSet& s = orbits[open[i]][attempt];
+        seen.insert(s);
+        if (res[i].found) accept(level, s, res[i]), done[open[i]] = 1;
+      }
     }
-    std::size_t found = 0;
-    for (std::size_t i = 0; i < cands.size(); ++i) {
-      seen.insert(cands[i]);
-      if (res[i].found) accept(level, cands[i], res[i]), ++found;
-      else failed.push_back(cands[i]);
+    const std::size_t found = valid[level].size() - before;
+    ev.total = searched;
+    // The other members: valid as images above, or failed with their orbit.
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      if (witness_rot.count(all[i])) continue;
+      seen.insert(all[i]);
+      failed.push_back(all[i]);
     }
     LevelStats& st = out.levels[level];
-    st.candidates += cands.size();
+    st.candidates += searched;
     st.seconds += std::chrono::duration<double>(Clock::now() - t0).count();
     finished(ev, t0, std::to_string(found) + " valid");
   };
@@ -388,6 +491,31 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   auto motion_closure = [&] {
     while (!frontier.empty()) {
       const auto t0 = Clock::now();
+      // More witnesses of each new orbit, each found by its own search (kWitnessesPerOrbit).
+      if (sym.size() > 1) {
+        std::vector<Task> more;
+        std::unordered_set<PcSet, PcSetHash> orbits;
+        for (const auto& [s, pose] : frontier) {
+          if (!orbits.insert(sym.canonical(s)).second) continue;
+          std::vector<PcSet> members;
+          for (std::size_t k = 1; k < sym.size(); ++k) members.push_back(sym.image(s, k));
+          std::sort(members.begin(), members.end(), pcset_less);
+          members.erase(std::unique(members.begin(), members.end()), members.end());
+          members.erase(std::remove(members.begin(), members.end(), s), members.end());
+          const std::size_t step =
+              std::max<std::size_t>(1, members.size() / (kWitnessesPerOrbit - 1));
+          for (std::size_t i = 0, n = 1; i < members.size() && n < kWitnessesPerOrbit;
+               i += step, ++n) {
+            Task t;
+            t.pcs = members[i];
+            t.seeds = seeds_from_subsets(members[i]);
+            more.push_back(t);
+          }
+        }
+        const std::vector<TaskResult> r = run_stage(more, nullptr, t0);
+        for (std::size_t i = 0; i < more.size(); ++i)
+          if (r[i].witness.found) frontier.push_back({more[i].pcs, r[i].witness.pose});
+      }
       ProgressEvent ev{"motion round " + std::to_string(++motion_rounds), "CFs explored", 0, frontier.size(), 0, false, {}};
       std::vector<Task> explore(frontier.size());
       for (std::size_t i = 0; i < frontier.size(); ++i) {
@@ -399,6 +527,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
       // The first discovery of each new set, in frontier order: independent of thread count.
       std::vector<Discovery> fresh;
       std::unordered_set<PcSet, PcSetHash> pending;
+      std::unordered_set<PcSet, PcSetHash> pending_orbits;  // one search per orbit a round
       // Sets the necessary conditions reject cannot be verified: not searched (most are met
       // with a contact on an element's boundary).
       auto conditions_hold = [&](const PcSet& t) {
@@ -409,8 +538,9 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
       };
       for (const TaskResult& r : met)
         for (const Discovery& d : r.met)
-          if (d.pcs.size() <= opt.max_pcs && !witness_rot.count(d.pcs) && pending.insert(d.pcs).second &&
-              conditions_hold(d.pcs))
+          if (d.pcs.size() <= opt.max_pcs && !witness_rot.count(d.pcs) &&
+              pending.insert(d.pcs).second && conditions_hold(d.pcs) &&
+              pending_orbits.insert(sym.canonical(d.pcs)).second)
             fresh.push_back(d);
       std::vector<Task> search_fresh(fresh.size());
       for (std::size_t i = 0; i < fresh.size(); ++i) {
@@ -427,6 +557,10 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
       std::size_t found = 0;
       for (std::size_t i = 0; i < fresh.size(); ++i) {
         if (!res[i].found) continue;
+        if (witness_rot.count(fresh[i].pcs)) {
+          frontier.push_back({fresh[i].pcs, fresh[i].pose});
+          continue;
+        }
         const int level = fresh[i].pcs.size() - 1;
         seen.insert(fresh[i].pcs);
         accept(level, fresh[i].pcs, res[i]);
@@ -445,15 +579,18 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   if (opt.shard.count > 0) {
     // One shard of the first level-2 round: its candidates only, results by index.
     const std::vector<PcSet> c2 = opt.max_pcs >= 2 ? build_pairs() : std::vector<PcSet>{};
-    out.first_pair_candidates = c2.size();
     const int index = opt.shard.index;
+    std::vector<PcSet> reps;
+    for (const std::vector<PcSet>& orbit : orbits_of(c2)) reps.push_back(orbit.front());
+    out.first_pair_candidates = reps.size();
     std::vector<std::size_t> mine;
-    for (std::size_t i = static_cast<std::size_t>(index); i < c2.size(); i += static_cast<std::size_t>(opt.shard.count))
+    for (std::size_t i = static_cast<std::size_t>(index); i < reps.size();
+         i += static_cast<std::size_t>(opt.shard.count))
       mine.push_back(i);
     std::vector<Task> tasks(mine.size());
     for (std::size_t k = 0; k < mine.size(); ++k) {
-      tasks[k].pcs = c2[mine[k]];
-      tasks[k].seeds = seeds_from_subsets(c2[mine[k]]);
+      tasks[k].pcs = reps[mine[k]];
+      tasks[k].seeds = seeds_from_subsets(reps[mine[k]]);
     }
     const auto t0 = Clock::now();
     ProgressEvent ev{"level 2, shard " + std::to_string(index) + "/" + std::to_string(opt.shard.count),
@@ -508,22 +645,31 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
         if (x.first[k] != y.first[k]) return x.first[k] < y.first[k];
       return false;
     });
-    for (const auto& [s, w] : valid[l]) {
-      CfRecord r;
-      r.pcs = s;
-      r.witness = w.pose;
-      search.freedoms(s, w.pose, r);
-      for (int k = 0; k < s.size(); ++k) {
-        const auto [n, d] = search.contact_plane(s[k], w.pose);
-        r.planes[static_cast<std::size_t>(k)] = {n.x(), n.y(), n.z(), d};
-      }
-      r.num_planes = s.size();
-      out.cfs.push_back(r);
-      out.min_clearance = std::min(out.min_clearance, w.clearance);
-      out.min_margin = std::min(out.min_margin, search.contact_margin(s, w.pose));
+    // Each CF's record on its own (all cores), in canonical order.
+    std::vector<CfRecord> records(valid[l].size());
+    std::vector<double> margins(valid[l].size());
+    parallel_for(valid[l].size(), threads,
+                 [&](std::size_t i) {
+                   const auto& [s, w] = valid[l][i];
+                   CfRecord& r = records[i];
+                   r.pcs = s;
+                   r.witness = w.pose;
+                   search.freedoms(s, w.pose, r);
+                   for (int k = 0; k < s.size(); ++k) {
+                     const auto [n, d] = search.contact_plane(s[k], w.pose);
+                     r.planes[static_cast<std::size_t>(k)] = {n.x(), n.y(), n.z(), d};
+                   }
+                   r.num_planes = s.size();
+                   margins[i] = search.contact_margin(s, w.pose);
+                 },
+                 {});
+    for (std::size_t i = 0; i < records.size(); ++i) {
+      out.cfs.push_back(records[i]);
+      out.min_clearance = std::min(out.min_clearance, valid[l][i].second.clearance);
+      out.min_margin = std::min(out.min_margin, margins[i]);
     }
   }
-  out.transitions = transitions_between(out.cfs, A, B);
+  out.transitions = transitions_between(out.cfs, A, B, threads);
   return out;
 }
 

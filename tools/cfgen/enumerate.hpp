@@ -78,6 +78,9 @@ struct EnumerateOptions {
   SearchParams search;
   int threads = 0;       // 0: all hardware threads
   int max_pcs = 3;       // 1..3
+  /// Search one set of each orbit of the models' symmetries (symmetry.hpp) and take the others
+  /// as images of its witness; false searches every set.
+  bool use_symmetry = true;
   /// With shard.count > 0, enumerate() searches only this shard's candidates of the first
   /// level-2 round and returns them in Enumeration::shard_results; nothing else is built.
   ShardSpec shard;
@@ -99,6 +102,7 @@ struct LevelStats {
   std::size_t valid = 0;
   double seconds = 0;
   std::size_t by_motion = 0;   // of the valid ones, found by the closure by motion
+  std::size_t by_symmetry = 0;  // of the valid ones, images of another's witness
 };
 
 struct Enumeration {
@@ -107,6 +111,7 @@ struct Enumeration {
   LevelStats levels[3];
   double min_clearance = 0;           // mm, smallest witness clearance in the graph
   double min_margin = 0;              // mm, smallest LP margin of a witness's contacts
+  std::size_t symmetries_a = 1, symmetries_b = 1;  // the models' symmetries, identity included
   std::vector<PcSet> undecided;       // failed candidates with no proof of invalidity
   // Sharded runs only (EnumerateOptions::shard): the number of candidates of the first
   // level-2 round, and this shard's results by candidate index.
@@ -118,6 +123,6 @@ Enumeration enumerate(const ModelInfo& A, const ModelInfo& B, const EnumerateOpt
 
 /// Transitions (gain, lose, change) between the given CFs.
 std::vector<Transition> transitions_between(const std::vector<CfRecord>& cfs, const Polyhedron& A,
-                                            const Polyhedron& B);
+                                            const Polyhedron& B, int threads = 1);
 
 }  // namespace cf::gen

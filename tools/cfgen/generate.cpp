@@ -59,6 +59,7 @@ int run_generate(const GenerateArgs& args) {
   const double diag = length_scale(A, B);
   opt.search = scaled_search(A, B, args.rel, args.search);
   opt.max_pcs = args.max_pcs;
+  opt.use_symmetry = args.symmetry;
   opt.shard = args.shard;
   std::size_t resumed_chunks = 0;
   if (!args.checkpoint_dir.empty()) {
@@ -117,7 +118,10 @@ int run_generate(const GenerateArgs& args) {
     by_kind[to_string(t.kind)] = by_kind.value(to_string(t.kind), 0) + 1;
   nlohmann::json levels = nlohmann::json::array();
   for (const auto& l : e.levels)
-    levels.push_back({{"candidates", l.candidates}, {"valid", l.valid}, {"found_by_motion", l.by_motion}});
+    levels.push_back({{"candidates", l.candidates},
+                      {"valid", l.valid},
+                      {"found_by_motion", l.by_motion},
+                      {"found_by_symmetry", l.by_symmetry}});
   // The undecided sets, in canonical order; only the first kUndecidedListed are listed, so
   // that a pair with many keeps a file of reasonable size (the count is always exact).
   constexpr std::size_t kUndecidedListed = 100;
@@ -130,6 +134,7 @@ int run_generate(const GenerateArgs& args) {
                    {"transitions", e.transitions.size()},
                    {"transitions_by_kind", by_kind},
                    {"levels", levels},
+                   {"symmetries", {{"A", e.symmetries_a}, {"B", e.symmetries_b}}},
                    {"min_witness_clearance_mm", e.cfs.empty() ? 0.0 : e.min_clearance},
                    {"min_witness_margin_mm", e.cfs.empty() ? 0.0 : e.min_margin},
                    {"undecided", e.undecided.size()},
@@ -148,7 +153,8 @@ int run_generate(const GenerateArgs& args) {
                         {"angle_margin_rad", s.angle_margin},
                         {"theta_samples", s.theta_samples},
                         {"max_rotations", s.max_rotations},
-                        {"max_pcs", opt.max_pcs}};
+                        {"max_pcs", opt.max_pcs},
+                        {"symmetry", opt.use_symmetry}};
   meta["generator"] = {{"name", "cfgen"},
                        {"a_model", args.a_label.empty() ? args.a_path : args.a_label},
                        {"b_model", args.b_label.empty() ? args.b_path : args.b_label}};

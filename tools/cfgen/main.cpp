@@ -110,6 +110,10 @@ int main(int argc, char** argv) {
   gen_opts.push_back(app.add_option("--max-pcs", gen.max_pcs, "largest CFs to enumerate")
                          ->check(CLI::Range(1, 3))
                          ->capture_default_str());
+  bool no_symmetry = false;
+  gen_opts.push_back(
+      app.add_flag("--no-symmetry", no_symmetry,
+                   "search every candidate set, not one per orbit of the models' symmetries"));
   // Lengths of the search are relative to the smaller model's bounding-box diagonal D, so
   // that a pair scaled by any factor gives the same graph up to scale.
   gen_opts.push_back(app.add_option("--touch-tol", gen.rel.touch_tol,
@@ -161,6 +165,7 @@ int main(int argc, char** argv) {
     std::cerr << "cfgen: " << e.what() << " (see cfgen --help)\n";
     return 2;
   }
+  gen.symmetry = !no_symmetry;
 
   try {
     cf::tools::LoadOptions load;

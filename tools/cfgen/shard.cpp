@@ -23,6 +23,7 @@ constexpr int kMaxShards = 4096;
 // --quiet, which do not change a byte of it).
 nlohmann::json options_json(const GenerateArgs& a) {
   return {{"max_pcs", a.max_pcs},
+          {"symmetry", a.symmetry},
           {"touch_tol_rel", a.rel.touch_tol},
           {"min_clearance_rel", a.rel.min_clearance},
           {"good_clearance_rel", a.rel.good_clearance},
@@ -337,6 +338,7 @@ ShardPart read_part(const std::string& path) {
   p.args.b_path = field<std::string>(m, "b_path", path);
   const nlohmann::json& o = j.contains("options") ? j.at("options") : nlohmann::json();
   p.args.max_pcs = field<int>(o, "max_pcs", path);
+  p.args.symmetry = field<bool>(o, "symmetry", path);
   p.args.rel.touch_tol = field<double>(o, "touch_tol_rel", path);
   p.args.rel.min_clearance = field<double>(o, "min_clearance_rel", path);
   p.args.rel.good_clearance = field<double>(o, "good_clearance_rel", path);

@@ -64,7 +64,8 @@ def generate(a_path, b_path, output=None, **options):
     cores), ``max_pcs`` (1..3), ``touch_tol``, ``min_clearance``, ``good_clearance``,
     ``min_margin`` (relative to the smaller model's bounding-box diagonal), ``angle_margin``
     (rad), ``theta_samples``, ``max_rotations``, ``units``, ``units_a``, ``units_b``,
-    ``coplanar_rel_tol``, ``quiet`` (default True: no progress on stderr).
+    ``coplanar_rel_tol``, ``symmetry`` (default True: one search per orbit of the models'
+    symmetries; False is ``--no-symmetry``), ``quiet`` (default True: no progress on stderr).
     Raises cf.Error for bad models or options.
     """
     if not HAVE_TOOLS:

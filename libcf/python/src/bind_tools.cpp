@@ -64,10 +64,11 @@ void bind_tools(py::module_& m) {
 
   m.def(
       "generate",
-      [](const std::string& a_path, const std::string& b_path, const std::string& out_path, int threads, bool quiet,
-         int max_pcs, double touch_tol, double min_clearance, double good_clearance, double min_margin,
-         double angle_margin, int theta_samples, int max_rotations, const std::string& units, const std::string& units_a,
-         const std::string& units_b, double coplanar_rel_tol) {
+      [](const std::string& a_path, const std::string& b_path, const std::string& out_path,
+         int threads, bool quiet, int max_pcs, double touch_tol, double min_clearance,
+         double good_clearance, double min_margin, double angle_margin, int theta_samples,
+         int max_rotations, const std::string& units, const std::string& units_a,
+         const std::string& units_b, double coplanar_rel_tol, bool symmetry) {
         const std::string where = "generate";
         // The ranges cfgen's options accept.
         check_int(threads, 0, 1024, "threads", where);
@@ -88,6 +89,7 @@ void bind_tools(py::module_& m) {
         g.threads = threads;
         g.quiet = quiet;
         g.max_pcs = max_pcs;
+        g.symmetry = symmetry;
         g.rel.touch_tol = touch_tol;
         g.rel.min_clearance = min_clearance;
         g.rel.good_clearance = good_clearance;
@@ -105,10 +107,12 @@ void bind_tools(py::module_& m) {
           py::gil_scoped_release release;
           status = cf::tools::run_generate(g);
         }
-        if (status != 0) fail(where + ": cfgen's generator failed with status " + std::to_string(status));
+        if (status != 0)
+          fail(where + ": cfgen's generator failed with status " + std::to_string(status));
       },
-      py::arg("a_path"), py::arg("b_path"), py::arg("output"), py::arg("threads") = 0, py::arg("quiet") = true,
-      py::arg("max_pcs") = 3, py::arg("touch_tol") = cf::tools::RelativeLengths{}.touch_tol,
+      py::arg("a_path"), py::arg("b_path"), py::arg("output"), py::arg("threads") = 0,
+      py::arg("quiet") = true, py::arg("max_pcs") = 3,
+      py::arg("touch_tol") = cf::tools::RelativeLengths{}.touch_tol,
       py::arg("min_clearance") = cf::tools::RelativeLengths{}.min_clearance,
       py::arg("good_clearance") = cf::tools::RelativeLengths{}.good_clearance,
       py::arg("min_margin") = cf::tools::RelativeLengths{}.min_margin,
@@ -117,6 +121,7 @@ void bind_tools(py::module_& m) {
       py::arg("max_rotations") = cf::gen::SearchParams{}.max_rotations, py::arg("units") = "mm",
       py::arg("units_a") = "", py::arg("units_b") = "",
       py::arg("coplanar_rel_tol") = cf::tools::LoadOptions{}.coplanar_rel_tol,
+      py::arg("symmetry") = true,
       "cfgen's generation (cf::tools::run_generate) into the graph file `output`; the package's "
       "cf.generate wraps it.");
 #else

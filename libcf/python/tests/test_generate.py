@@ -30,6 +30,25 @@ def test_generate_equals_cfgen(tmp_path):
     assert cf.generate(a, b, max_pcs=1, threads=2).to_json() == g.to_json()
 
 
+def test_generate_without_symmetry(tmp_path):
+    # symmetry=False is cfgen --no-symmetry: every set searched, the same CFs as one search
+    # per orbit of the cube's 48 symmetries against itself.
+    a = b = DATA / "models" / "cube.off"
+    out = tmp_path / "plain.json"
+    plain = cf.generate(a, b, out, max_pcs=1, threads=2, symmetry=False)
+    ref = tmp_path / "cfgen.json"
+    subprocess.run([tool("CF_CFGEN"), "--quiet", "--no-symmetry", "--max-pcs", "1", "-j", "2", str(a), str(b),
+                    "-o", str(ref)], check=True, capture_output=True)
+    assert out.read_bytes() == ref.read_bytes()
+    by_orbit = cf.generate(a, b, max_pcs=1, threads=2)
+
+    def sets(g):
+        return sorted(tuple((p.type, p.a, p.b) for p in c.pcs) for c in g.cfs)
+
+    assert len(plain.cfs) == 420  # f-f 36, e-f and f-e 72 each, v-f and f-v 48 each, e-e 144
+    assert sets(plain) == sets(by_orbit)
+
+
 def test_generate_errors(tmp_path):
     a = DATA / "models" / "cube.off"
     with pytest.raises(cf.Error, match=r"^generate: max_pcs must be an integer in \[1, 3\], got 4$"):

@@ -1,0 +1,207 @@
+// Tests of the models' symmetries (tools/cfgen/symmetry.cpp) and of the generator's use of
+// them: counts of symmetry groups worked out by hand, the image of a pose checked point by
+// point, and a graph generated with one search per orbit checked for closure under the
+// symmetries and against a run that searches every set.
+
+#include "cfgen/symmetry.hpp"
+#include "analysed_pair.hpp"
+#include "cfgen/enumerate.hpp"
+#include "cfgen/generate.hpp"
+#include "fixtures.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
+
+#include <random>
+#include <set>
+#include <string>
+
+using cf::Pose;
+using cf::Vec3;
+using cf::gen::PairSymmetries;
+using cf::gen::symmetries;
+
+namespace {
+
+// Vertices of the test models are given to 1e-15 relative; rigid maps and their images are
+// exact to a few ulps of coordinates of tens of mm.
+constexpr double kTol = 1e-9;  // mm
+
+cf::Polyhedron moved(const cf::Polyhedron& m, const Eigen::Matrix3d& R, const Vec3& t) {
+  std::vector<Vec3> v;
+  for (const auto& x : m.vertices()) v.push_back(R * x.p + t);
+  std::vector<std::array<int, 2>> e;
+  for (const auto& x : m.edges())
+    e.push_back({static_cast<int>(x.v0.index()), static_cast<int>(x.v1.index())});
+  std::vector<std::vector<std::vector<int>>> f;
+  for (const auto& x : m.faces()) {
+    f.emplace_back();
+    for (const auto& loop : x.loops) {
+      f.back().emplace_back();
+      for (auto id : loop) f.back().back().push_back(static_cast<int>(id.index()));
+    }
+  }
+  return cf::Polyhedron::from_features(m.name(), v, e, f);
+}
+
+int proper(const std::vector<cf::gen::Symmetry>& s) {
+  int n = 0;
+  for (const auto& x : s) n += x.R.determinant() > 0 ? 1 : 0;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("symmetry: the groups of a cube, a box and an L-block, wherever they are placed",
+          "[symmetry]") {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n01;
+  const Eigen::Matrix3d R =
+      Eigen::Quaterniond(n01(rng), n01(rng), n01(rng), n01(rng)).normalized().toRotationMatrix();
+  const Vec3 t(12.5, -3.25, 40);
+  struct Case {
+    cf::Polyhedron m;
+    std::size_t all, rotations;
+  };
+  // A cube: the 48 maps of the octahedral group, 24 of them rotations. A 10 x 20 x 30 box:
+  // the three half turns and the identity, and as many reflections. The L-block: its profile is
+  // symmetric about x = y and its slab about its middle plane.
+  const std::vector<Case> cases = {{cf::test::box(20, 20, 20, "cube"), 48, 24},
+                                   {cf::test::box(10, 20, 30), 8, 4},
+                                   {cf::test::small_l_block(), 4, 2}};
+  for (const Case& c : cases)
+    for (const cf::Polyhedron& m : {c.m, moved(c.m, R, t)}) {
+      INFO(m.name());
+      const auto s = symmetries(m, 1e-13 * m.size());
+      CHECK(s.size() == c.all);
+      CHECK(proper(s) == static_cast<int>(c.rotations));
+      CHECK(s.front().R.isIdentity(0));
+      for (const auto& x : s) {
+        // A bijection on each kind of element that moves every vertex onto its image, and
+        // every edge's ends onto the image edge's ends.
+        for (auto kind :
+             {cf::ElementKind::kVertex, cf::ElementKind::kEdge, cf::ElementKind::kFace}) {
+          std::set<int> image(x.of(kind).begin(), x.of(kind).end());
+          CHECK(image.size() == m.num_elements(kind));
+        }
+        for (std::size_t i = 0; i < m.num_vertices(); ++i)
+          CHECK((x.R * (m.vertices()[i].p - x.c) + x.c -
+                 m.vertices()[static_cast<std::size_t>(x.vertex[i])].p)
+                    .norm() < kTol);
+        for (std::size_t e = 0; e < m.num_edges(); ++e) {
+          const auto& E = m.edges()[e];
+          const auto& F = m.edges()[static_cast<std::size_t>(x.edge[e])];
+          std::set<int> ends = {x.vertex[E.v0.index()], x.vertex[E.v1.index()]};
+          CHECK(ends ==
+                std::set<int>{static_cast<int>(F.v0.index()), static_cast<int>(F.v1.index())});
+        }
+      }
+    }
+}
+
+TEST_CASE("symmetry: a model with no symmetry has only the identity", "[symmetry]") {
+  // A box with one corner cut off by a generic plane: no map but the identity keeps it.
+  const cf::Polyhedron m = cf::test::from_loops("cut box",
+                                                {{0, 0, 0},
+                                                 {30, 0, 0},
+                                                 {30, 20, 0},
+                                                 {0, 20, 0},
+                                                 {0, 0, 10},
+                                                 {21, 0, 10},
+                                                 {30, 7, 10},
+                                                 {30, 20, 10},
+                                                 {0, 20, 10},
+                                                 {30, 0, 4}},
+                                                {{0, 3, 2, 1},
+                                                 {4, 5, 6, 7, 8},
+                                                 {0, 1, 9, 5, 4},
+                                                 {3, 8, 7, 2},
+                                                 {1, 2, 7, 6, 9},
+                                                 {0, 4, 8, 3},
+                                                 {5, 9, 6}});
+  CHECK(symmetries(m, 1e-13 * m.size()).size() == 1);
+  const PairSymmetries off(m, m, 1e-13, false);
+  CHECK(off.size() == 1);
+}
+
+TEST_CASE("symmetry: the image of a pose puts each image element where the symmetry puts it",
+          "[symmetry]") {
+  const cf::Polyhedron A = cf::test::box(10, 20, 30, "A");
+  const cf::Polyhedron B = cf::test::small_l_block();
+  const PairSymmetries sym(A, B, 1e-13 * 50, true);
+  REQUIRE(sym.size_a() == 8);
+  REQUIRE(sym.size_b() == 4);
+  // Pairs of like hand: 4 x 2 rotations and 4 x 2 reflections.
+  REQUIRE(sym.size() == 16);
+  const auto sa = symmetries(A, 1e-13 * 50);
+  const auto sb = symmetries(B, 1e-13 * 50);
+  Pose X;
+  X.R_BA = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  X.t_BA = Vec3(5, 60, -7);
+  std::size_t k = 0;
+  for (const auto& h : sa)
+    for (const auto& g : sb) {
+      if ((h.R.determinant() > 0) != (g.R.determinant() > 0)) continue;
+      const Pose Y = sym.image(X, k);
+      CHECK((Y.R_BA.transpose() * Y.R_BA).isIdentity(1e-12));
+      CHECK(Y.R_BA.determinant() == Approx(1.0).margin(1e-12));
+      // Y(h(p)) = g(X(p)) for every vertex p of A.
+      for (const auto& v : A.vertices()) {
+        const Vec3 hp = h.R * (v.p - h.c) + h.c;
+        const Vec3 gxp = g.R * (X.apply(v.p) - g.c) + g.c;
+        CHECK((Y.apply(hp) - gxp).norm() < kTol);
+      }
+      // The image set maps each PC's elements by the two symmetries.
+      const cf::PcSet s({cf::Pc{cf::PcType::kEF, 3, 4}, cf::Pc{cf::PcType::kVF, 6, 1}});
+      const cf::PcSet t = sym.image(s, k);
+      CHECK(t.contains(cf::Pc{cf::PcType::kEF, h.edge[3], g.face[4]}));
+      CHECK(t.contains(cf::Pc{cf::PcType::kVF, h.vertex[6], g.face[1]}));
+      CHECK(!cf::gen::pcset_less(t, sym.canonical(s)));
+      ++k;
+    }
+  CHECK(k == sym.size());
+}
+
+TEST_CASE(
+    "symmetry: one search per orbit gives a graph closed under the symmetries, every witness "
+    "verified",
+    "[symmetry][cfgen]") {
+  // A 10 mm cube against a 40 x 40 x 10 slab: 48 and 16 symmetries.
+  cf::test::AnalysedPair p(cf::test::box(Vec3(-5, -5, -5), Vec3(5, 5, 5), "cube"),
+                           cf::test::box(Vec3(-20, -20, -5), Vec3(20, 20, 5), "slab"));
+  cf::gen::EnumerateOptions opt;
+  opt.threads = 2;
+  opt.search = cf::tools::scaled_search(p.A, p.B, {});
+  const cf::gen::Enumeration with = cf::gen::enumerate(p.ai, p.bi, opt);
+  opt.use_symmetry = false;
+  const cf::gen::Enumeration without = cf::gen::enumerate(p.ai, p.bi, opt);
+  CHECK(with.symmetries_a == 48);
+  CHECK(with.symmetries_b == 16);
+  CHECK(without.symmetries_a == 1);
+  std::set<std::string> sets_with, sets_without;
+  for (const auto& r : with.cfs) sets_with.insert(cf::to_string(r.pcs));
+  for (const auto& r : without.cfs) sets_without.insert(cf::to_string(r.pcs));
+  // Closed: every image of every CF is a CF, and its witness is verified like any other.
+  const cf::gen::WitnessSearch search(p.ai, p.bi, opt.search);
+  const PairSymmetries sym(p.A, p.B, 1e-13 * search.scale(), true);
+  std::size_t images = 0;
+  for (const auto& r : with.cfs) {
+    CHECK(search.verify(r.pcs, r.witness) >= opt.search.min_clearance);
+    for (std::size_t k = 0; k < sym.size(); ++k)
+      images += sets_with.count(cf::to_string(sym.image(r.pcs, k)));
+  }
+  CHECK(images == with.cfs.size() * sym.size());
+  // The same CFs as searching every set, for a fraction of the searches.
+  CHECK(sets_with == sets_without);
+  std::size_t searched_with = 0, searched_without = 0, by_symmetry = 0;
+  for (int l = 0; l < 3; ++l) {
+    searched_with += with.levels[l].candidates;
+    searched_without += without.levels[l].candidates;
+    by_symmetry += with.levels[l].by_symmetry;
+    CHECK(without.levels[l].by_symmetry == 0);
+  }
+  CHECK(searched_with * 10 < searched_without);
+  // Most CFs are images: an orbit of 768 pairs of maps has dozens of members.
+  CHECK(by_symmetry * 10 > with.cfs.size() * 9);
+}

@@ -1,0 +1,205 @@
+#include "symmetry.hpp"
+
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+
+namespace cf::gen {
+namespace {
+
+// Orthonormal frame (columns) built from two independent vectors; `hand` -1 flips the third
+// axis, so that a map between two such frames of opposite hands is a reflection.
+Mat3 frame(const Vec3& x, const Vec3& y, double hand) {
+  Mat3 F;
+  F.col(0) = x.normalized();
+  F.col(2) = hand * x.cross(y).normalized();
+  F.col(1) = (hand * F.col(2)).cross(F.col(0));
+  return F;
+}
+
+// The vertex whose offset from the centroid is within tol of q, or -1. `order` sorts the
+// vertices by the x of their offsets.
+int find_vertex(const std::vector<Vec3>& P, const std::vector<int>& order, const Vec3& q,
+                double tol) {
+  auto lo = std::lower_bound(order.begin(), order.end(), q.x() - tol, [&](int i, double x) {
+    return P[static_cast<std::size_t>(i)].x() < x;
+  });
+  for (; lo != order.end() && P[static_cast<std::size_t>(*lo)].x() <= q.x() + tol; ++lo)
+    if ((P[static_cast<std::size_t>(*lo)] - q).norm() <= tol) return *lo;
+  return -1;
+}
+
+// The symmetry that maps vertex offsets by R (to within tol), or none.
+bool complete(const Polyhedron& m, const std::vector<Vec3>& P, const std::vector<int>& order,
+              Mat3 R, double tol, Symmetry& out) {
+  const std::size_t n = P.size();
+  std::vector<int> perm(n);
+  for (std::size_t i = 0; i < n; ++i)
+    if ((perm[i] = find_vertex(P, order, R * P[i], tol)) < 0) return false;
+  std::vector<int> sorted = perm;
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return false;
+  // The orthogonal map that fits every correspondence best (Kabsch), of the same hand: the
+  // two vertices R was built from carry the rounding of their own coordinates.
+  Mat3 H = Mat3::Zero();
+  for (std::size_t i = 0; i < n; ++i) H += P[static_cast<std::size_t>(perm[i])] * P[i].transpose();
+  const Eigen::JacobiSVD<Mat3> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3 S = Mat3::Identity();
+  const double hand = R.determinant() > 0 ? 1.0 : -1.0;
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() * hand < 0) S(2, 2) = -1;
+  R = svd.matrixU() * S * svd.matrixV().transpose();
+  for (std::size_t i = 0; i < n; ++i)
+    if ((R * P[i] - P[static_cast<std::size_t>(perm[i])]).norm() > tol) return false;
+  std::map<std::pair<int, int>, int> edge_of;
+  for (std::size_t e = 0; e < m.num_edges(); ++e)
+    edge_of[{static_cast<int>(m.edges()[e].v0.index()),
+             static_cast<int>(m.edges()[e].v1.index())}] = static_cast<int>(e);
+  std::map<std::vector<int>, int> face_of;
+  for (std::size_t f = 0; f < m.num_faces(); ++f) {
+    std::vector<int> vs;
+    for (VertexId v : m.faces()[f].vertices) vs.push_back(static_cast<int>(v.index()));
+    face_of[vs] = static_cast<int>(f);
+  }
+  out.R = R;
+  out.vertex = perm;
+  out.edge.assign(m.num_edges(), -1);
+  for (std::size_t e = 0; e < m.num_edges(); ++e) {
+    const auto& E = m.edges()[e];
+    const int a = perm[E.v0.index()], b = perm[E.v1.index()];
+    auto it = edge_of.find({std::min(a, b), std::max(a, b)});
+    if (it == edge_of.end()) return false;
+    out.edge[e] = it->second;
+  }
+  out.face.assign(m.num_faces(), -1);
+  for (std::size_t f = 0; f < m.num_faces(); ++f) {
+    std::vector<int> vs;
+    for (VertexId v : m.faces()[f].vertices) vs.push_back(perm[v.index()]);
+    std::sort(vs.begin(), vs.end());
+    auto it = face_of.find(vs);
+    if (it == face_of.end()) return false;
+    constexpr double kNormalTol = 1e-9;  // a face's image has the image normal, not its opposite
+    if ((R * m.faces()[f].normal - m.faces()[static_cast<std::size_t>(it->second)].normal).norm() >
+        kNormalTol)
+      return false;
+    out.face[f] = it->second;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::vector<Symmetry> symmetries(const Polyhedron& m, double tol) {
+  const std::size_t n = m.num_vertices();
+  const Vec3 c = m.vertex_centroid();
+  std::vector<Vec3> P(n);
+  for (std::size_t i = 0; i < n; ++i) P[i] = m.vertices()[i].p - c;
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int i, int j) {
+    return P[static_cast<std::size_t>(i)].x() < P[static_cast<std::size_t>(j)].x();
+  });
+  Symmetry identity;
+  identity.c = c;
+  identity.vertex.resize(n);
+  std::iota(identity.vertex.begin(), identity.vertex.end(), 0);
+  identity.edge.resize(m.num_edges());
+  std::iota(identity.edge.begin(), identity.edge.end(), 0);
+  identity.face.resize(m.num_faces());
+  std::iota(identity.face.begin(), identity.face.end(), 0);
+  std::vector<Symmetry> out{identity};
+  if (n < 3) return out;
+  // A symmetry maps the vertex farthest from the centroid, i0, to one as far, and the vertex
+  // i1 that spans the widest angle with it to one as far at the same dot product: the two
+  // frames fix the map.
+  std::size_t i0 = 0, i1 = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (P[i].norm() > P[i0].norm()) i0 = i;
+  for (std::size_t i = 0; i < n; ++i)
+    if (P[i].cross(P[i0]).norm() > P[i1].cross(P[i0]).norm()) i1 = i;
+  if (P[i1].cross(P[i0]).norm() <= tol * std::max(1.0, P[i0].norm())) return out;
+  const double r0 = P[i0].norm(), r1 = P[i1].norm(), d01 = P[i0].dot(P[i1]);
+  for (double hand : {1.0, -1.0}) {
+    const Mat3 F0 = frame(P[i0], P[i1], 1.0);
+    for (std::size_t j0 = 0; j0 < n; ++j0) {
+      if (std::abs(P[j0].norm() - r0) > tol) continue;
+      for (std::size_t j1 = 0; j1 < n; ++j1) {
+        if (j1 == j0 || std::abs(P[j1].norm() - r1) > tol ||
+            std::abs(P[j0].dot(P[j1]) - d01) > tol * (r0 + r1))
+          continue;
+        if (P[j1].cross(P[j0]).norm() <= tol * std::max(1.0, r0)) continue;
+        const Mat3 R = frame(P[j0], P[j1], hand) * F0.transpose();
+        Symmetry s;
+        s.c = c;
+        if (!complete(m, P, order, R, tol, s)) continue;
+        if (std::any_of(out.begin(), out.end(),
+                        [&](const Symmetry& t) { return t.vertex == s.vertex; }))
+          continue;
+        out.push_back(std::move(s));
+      }
+    }
+  }
+  return out;
+}
+
+PairSymmetries::PairSymmetries(const Polyhedron& A, const Polyhedron& B, double tol, bool enabled) {
+  if (enabled) {
+    a_ = symmetries(A, tol);
+    b_ = symmetries(B, tol);
+  } else {
+    a_ = std::vector<Symmetry>(1);
+    b_ = std::vector<Symmetry>(1);
+    for (auto [v, m] : {std::make_pair(&a_[0], &A), std::make_pair(&b_[0], &B)}) {
+      v->c = m->vertex_centroid();
+      v->vertex.resize(m->num_vertices());
+      std::iota(v->vertex.begin(), v->vertex.end(), 0);
+      v->edge.resize(m->num_edges());
+      std::iota(v->edge.begin(), v->edge.end(), 0);
+      v->face.resize(m->num_faces());
+      std::iota(v->face.begin(), v->face.end(), 0);
+    }
+  }
+  for (std::size_t i = 0; i < a_.size(); ++i)
+    for (std::size_t j = 0; j < b_.size(); ++j)
+      if ((a_[i].R.determinant() > 0) == (b_[j].R.determinant() > 0))
+        pairs_.push_back({static_cast<int>(i), static_cast<int>(j)});
+}
+
+PcSet PairSymmetries::image(const PcSet& s, std::size_t k) const {
+  const Symmetry& h = a_[static_cast<std::size_t>(pairs_[k].first)];
+  const Symmetry& g = b_[static_cast<std::size_t>(pairs_[k].second)];
+  PcSet out;  // insert keeps the canonical order, without allocating
+  for (const Pc& pc : s)
+    out.insert(Pc{pc.type, h.of(a_kind(pc.type))[static_cast<std::size_t>(pc.a)],
+                  g.of(b_kind(pc.type))[static_cast<std::size_t>(pc.b)]});
+  return out;
+}
+
+Pose PairSymmetries::image(const Pose& pose, std::size_t k) const {
+  const Symmetry& h = a_[static_cast<std::size_t>(pairs_[k].first)];
+  const Symmetry& g = b_[static_cast<std::size_t>(pairs_[k].second)];
+  // x_B = g(X(h^-1(x_A))), with h(x) = H (x - c_A) + c_A and g(y) = G (y - c_B) + c_B.
+  Pose out;
+  out.R_BA = g.R * pose.R_BA * h.R.transpose();
+  out.t_BA = g.R * (pose.R_BA * h.c + pose.t_BA - g.c) + g.c - out.R_BA * h.c;
+  return out;
+}
+
+bool pcset_less(const PcSet& x, const PcSet& y) {
+  if (x.size() != y.size()) return x.size() < y.size();
+  for (int i = 0; i < x.size(); ++i)
+    if (x[i] != y[i]) return x[i] < y[i];
+  return false;
+}
+
+PcSet PairSymmetries::canonical(const PcSet& s) const {
+  PcSet best = s;
+  for (std::size_t k = 1; k < pairs_.size(); ++k) {
+    const PcSet t = image(s, k);
+    if (pcset_less(t, best)) best = t;
+  }
+  return best;
+}
+
+}  // namespace cf::gen

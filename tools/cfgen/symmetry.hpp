@@ -1,0 +1,53 @@
+#pragma once
+// The symmetries of a model pair: rigid maps of A onto A and of B onto B. When pose X
+// realises a CF of A against B, the pose g X h^-1 realises the CF whose PCs are the images
+// (h of A's element, g of B's element), so the graph is a union of such orbits: the search
+// needs one member of each, and every member's witness follows from one.
+
+#include "analysis.hpp"
+
+#include <cf/pc.hpp>
+
+#include <vector>
+
+namespace cf::gen {
+
+/// A map x -> R (x - c) + c that takes a model onto itself, as permutations of its elements.
+struct Symmetry {
+  Mat3 R = Mat3::Identity();  // orthogonal; det -1 for a reflection
+  Vec3 c = Vec3::Zero();      // mm, model frame: the centroid of the vertices, which it fixes
+  std::vector<int> vertex, edge, face;  // image of each element, by index
+  const std::vector<int>& of(ElementKind k) const {
+    return k == ElementKind::kVertex ? vertex : k == ElementKind::kEdge ? edge : face;
+  }
+};
+
+/// Every symmetry of `m`, the identity first: the orthogonal maps about the vertices'
+/// centroid that take each vertex to a vertex within `tol` (mm), each edge to an edge and
+/// each face to a face with the image normal. Deterministic.
+std::vector<Symmetry> symmetries(const Polyhedron& m, double tol);
+
+/// The pairs (h of A, g of B) of like handedness (both rotations, or both reflections, whose
+/// product with the pose is again a rotation), the identity pair first.
+class PairSymmetries {
+ public:
+  /// Only the identity when `enabled` is false.
+  PairSymmetries(const Polyhedron& A, const Polyhedron& B, double tol, bool enabled);
+  std::size_t size() const { return pairs_.size(); }
+  std::size_t size_a() const { return a_.size(); }
+  std::size_t size_b() const { return b_.size(); }
+  PcSet image(const PcSet& s, std::size_t k) const;
+  /// g X h^-1: the pose that realises image(s, k) when `pose` realises s.
+  Pose image(const Pose& pose, std::size_t k) const;
+  /// The smallest image of s (PCs compared in order): one set per orbit.
+  PcSet canonical(const PcSet& s) const;
+
+ private:
+  std::vector<Symmetry> a_, b_;
+  std::vector<std::pair<int, int>> pairs_;
+};
+
+/// Lexicographic order of PC sets of one size (then by size).
+bool pcset_less(const PcSet& x, const PcSet& y);
+
+}  // namespace cf::gen
