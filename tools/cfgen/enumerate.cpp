@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -261,10 +262,17 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   // the order of their first member.
   auto orbits_of = [&](const std::vector<PcSet>& cands) {
     std::vector<std::vector<PcSet>> orbits;
+    // Every image of each orbit met so far, with its orbit: one pass over the symmetries per
+    // orbit, not per candidate.
     std::unordered_map<PcSet, std::size_t, PcSetHash> orbit_of;
     for (const PcSet& s : cands) {
-      const auto [it, fresh] = orbit_of.emplace(sym.canonical(s), orbits.size());
-      if (fresh) orbits.emplace_back();
+      auto it = orbit_of.find(s);
+      if (it == orbit_of.end()) {
+        for (std::size_t k = 0; k < sym.size(); ++k)
+          orbit_of.emplace(sym.image(s, k), orbits.size());
+        orbits.emplace_back();
+        it = orbit_of.find(s);
+      }
       orbits[it->second].push_back(s);
     }
     return orbits;
@@ -469,17 +477,37 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   std::size_t pairs_tripled = 0;  // valid pairs when the triples were last built
   // Level 3 over every set whose three pairs are valid and that was not searched yet.
   auto triples_level = [&] {
-    std::unordered_set<PcSet, PcSetHash> pairs;
-    for (const auto& [s, w] : valid[1]) pairs.insert(s);
-    std::vector<PcSet> c3;
+    // The valid pairs as partners: for each single PC x, the valid single PCs z (by index
+    // in valid[0]) with {x, z} valid. A pair's third PCs are the partners of both.
+    std::map<Pc, std::size_t> single_at;
+    for (std::size_t i = 0; i < valid[0].size(); ++i) single_at.emplace(valid[0][i].first[0], i);
+    std::map<Pc, std::vector<std::size_t>> partners;
     for (const auto& [s, w] : valid[1])
-      for (const auto& [s1, w1] : valid[0]) {
-        const Pc& z = s1[0];
+      for (int k = 0; k < 2; ++k)
+        if (auto it = single_at.find(s[1 - k]); it != single_at.end())
+          partners[s[k]].push_back(it->second);
+    for (auto& [pc, v] : partners) {
+      std::sort(v.begin(), v.end());
+      v.erase(std::unique(v.begin(), v.end()), v.end());
+    }
+    std::vector<PcSet> c3;
+    std::vector<std::size_t> common;
+    for (const auto& [s, w] : valid[1]) {
+      const auto x = partners.find(s[0]), y = partners.find(s[1]);
+      if (x == partners.end() || y == partners.end()) continue;
+      common.clear();
+      std::set_intersection(x->second.begin(), x->second.end(), y->second.begin(), y->second.end(),
+                            std::back_inserter(common));
+      for (std::size_t i : common) {  // in valid[0]'s order
+        const Pc& z = valid[0][i].first[0];
         if (!(s[1] < z)) continue;  // z beyond both, so each triple is built once
-        if (!pairs.count(PcSet({s[0], z})) || !pairs.count(PcSet({s[1], z}))) continue;
-        PcSet t({s[0], s[1], z});
+        PcSet t;
+        t.insert(s[0]);
+        t.insert(s[1]);
+        t.insert(z);
         if (!seen.count(t) && search.plausible(t)) c3.push_back(t);
       }
+    }
     pairs_tripled = valid[1].size();
     run_level(2, c3, seeds_from_subsets);
   };
