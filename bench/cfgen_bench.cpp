@@ -1,11 +1,13 @@
 // The generator at growing model size (the scale issue; SPEC section 7): an n-gon peg in a
-// block with an n-gon through-hole, n = 3, 4, 6, 8, 12, 16, on 1 and 2 threads. Reports the
+// block with an n-gon through-hole, n = 3, 4, 6, 8, 12, 16, on 1 and 2 threads, with one
+// search per orbit of the pair's symmetries (symmetry:1, cfgen's default) and searching every
+// set (symmetry:0, --no-symmetry). Reports the
 // wall time of the whole enumeration (one iteration: a run takes seconds to an hour) and the
 // CFs found, and the time per valid CF as a counter. The models are written by this file,
 // not read from data/: a peg of radius 10 mm and length 40 mm, a block of outer radius 25 mm
 // and height 20 mm whose hole is 5% wider than the peg, both n-gon prisms (the block a tube).
 //
-//   build/bench/cfgen_bench --benchmark_filter='n:(4|6)/'     # square and hexagonal pegs
+//   build/bench/cfgen_bench --benchmark_filter='n:(4|6)/.*/symmetry:1'   # square and hexagonal pegs
 // Figures go to docs/performance.md, "Graph generation".
 
 #include "cfgen/enumerate.hpp"
@@ -85,11 +87,13 @@ cf::Polyhedron load_text(const std::string& name, const std::string& text) {
 void BM_NgonPegInHole(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const int threads = static_cast<int>(state.range(1));
+  const bool symmetry = state.range(2) != 0;
   const cf::Polyhedron A = load_text("peg", ngon_off(n, 10.0, 0, -20, 20));
   const cf::Polyhedron B = load_text("hole", ngon_off(n, 25.0, 10.5, 0, 20));
   const cf::gen::ModelInfo ai = cf::gen::analyse_model(A), bi = cf::gen::analyse_model(B);
   cf::gen::EnumerateOptions opt;
   opt.threads = threads;
+  opt.use_symmetry = symmetry;
   opt.search = cf::tools::scaled_search(A, B, cf::tools::RelativeLengths{});  // cfgen's defaults
   std::size_t cfs = 0, candidates = 0;
   double seconds = 0;
@@ -109,8 +113,8 @@ void BM_NgonPegInHole(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_NgonPegInHole)
-    ->ArgNames({"n", "threads"})
-    ->ArgsProduct({{3, 4, 6, 8, 12, 16}, {1, 2}})
+    ->ArgNames({"n", "threads", "symmetry"})
+    ->ArgsProduct({{3, 4, 6, 8, 12, 16}, {1, 2}, {1, 0}})
     ->Iterations(1)
     ->UseRealTime()
     ->Unit(benchmark::kSecond);
