@@ -121,8 +121,11 @@ TEST_CASE("symmetry: a model with no symmetry has only the identity", "[symmetry
                                                  {0, 4, 8, 3},
                                                  {5, 9, 6}});
   CHECK(symmetries(m, 1e-13 * m.size()).size() == 1);
-  const PairSymmetries off(m, m, 1e-13, false);
-  CHECK(off.size() == 1);
+  // Against a box: only the box's maps pair with the identity of the same hand (4 rotations).
+  const PairSymmetries pair(m, cf::test::box(10, 20, 30), 1e-13 * m.size(), true);
+  CHECK(pair.size_a() == 1);
+  CHECK(pair.size_b() == 8);
+  CHECK(pair.size() == 4);
 }
 
 TEST_CASE("symmetry: the image of a pose puts each image element where the symmetry puts it",
@@ -182,6 +185,8 @@ TEST_CASE(
   std::set<std::string> sets_with, sets_without;
   for (const auto& r : with.cfs) sets_with.insert(cf::to_string(r.pcs));
   for (const auto& r : without.cfs) sets_without.insert(cf::to_string(r.pcs));
+  CHECK(sets_with.size() == with.cfs.size());  // no CF twice
+  CHECK(sets_without.size() == without.cfs.size());
   // Closed: every image of every CF is a CF, and its witness is verified like any other.
   const cf::gen::WitnessSearch search(p.ai, p.bi, opt.search);
   const PairSymmetries sym(p.A, p.B, 1e-13 * search.scale(), true);

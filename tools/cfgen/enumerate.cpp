@@ -170,6 +170,7 @@ std::vector<Transition> transitions_between(const std::vector<CfRecord>& cfs, co
         // They all hold some option of the position with the fewest, so only the CFs holding
         // one of those are tried.
         const int n = s.size();
+        if (n == 0) return;
         std::vector<std::vector<Pc>> options(static_cast<std::size_t>(n));
         std::size_t best = 0, best_count = std::numeric_limits<std::size_t>::max();
         for (int k = 0; k < n; ++k) {
@@ -365,8 +366,14 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
         "level " + std::to_string(level + 1), "candidate sets", 0, orbits.size(), 0, false, {}};
     for (std::size_t attempt = 0; attempt < kOrbitTries; ++attempt) {
       std::vector<std::size_t> open;
-      for (std::size_t o = 0; o < orbits.size(); ++o)
-        if (!done[o] && attempt < orbits[o].size()) open.push_back(o);
+      for (std::size_t o = 0; o < orbits.size(); ++o) {
+        if (done[o] || attempt >= orbits[o].size()) continue;
+        if (witness_rot.count(orbits[o][attempt])) {
+          done[o] = 1;  // an image of a CF found meanwhile
+          continue;
+        }
+        open.push_back(o);
+      }
       if (open.empty()) break;
       std::vector<Witness> res(open.size());
       if (attempt == 0 && given) {
@@ -392,6 +399,27 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
         const PcSet& s = orbits[open[i]][attempt];
         seen.insert(s);
         if (res[i].found) accept(level, s, res[i]), done[open[i]] = 1;
+      }
+    }
+    // Members of found orbits whose image witness did not verify (rounding at a borderline
+    // pose): searched like any other set.
+    std::vector<Task> rest;
+    for (std::size_t o = 0; o < orbits.size(); ++o)
+      if (done[o])
+        for (const PcSet& m : orbits[o])
+          if (!witness_rot.count(m) && !seen.count(m)) {
+            Task t;
+            t.pcs = m;
+            t.seeds = seeds_of(m);
+            rest.push_back(t);
+          }
+    if (!rest.empty()) {
+      const std::vector<TaskResult> r = run_stage(rest, nullptr, t0);
+      searched += rest.size();
+      for (std::size_t i = 0; i < rest.size(); ++i) {
+        seen.insert(rest[i].pcs);
+        if (r[i].witness.found && !witness_rot.count(rest[i].pcs))
+          accept(level, rest[i].pcs, r[i].witness);
       }
     }
     const std::size_t found = valid[level].size() - before;
@@ -541,8 +569,15 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
           }
         }
         const std::vector<TaskResult> r = run_stage(more, nullptr, t0);
-        for (std::size_t i = 0; i < more.size(); ++i)
-          if (r[i].witness.found) frontier.push_back({more[i].pcs, r[i].witness.pose});
+        for (std::size_t i = 0; i < more.size(); ++i) {
+          if (!r[i].witness.found) continue;
+          if (witness_rot.count(more[i].pcs)) {
+            frontier.push_back({more[i].pcs, r[i].witness.pose});
+          } else {  // its image witness did not verify: a CF by its own witness
+            seen.insert(more[i].pcs);
+            accept(more[i].pcs.size() - 1, more[i].pcs, r[i].witness);
+          }
+        }
       }
       ProgressEvent ev{"motion round " + std::to_string(++motion_rounds), "CFs explored", 0, frontier.size(), 0, false, {}};
       std::vector<Task> explore(frontier.size());

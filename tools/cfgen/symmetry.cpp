@@ -140,6 +140,15 @@ std::vector<Symmetry> symmetries(const Polyhedron& m, double tol) {
       }
     }
   }
+  // The maps found must form a group (the orbits rest on it). A model symmetric only to about
+  // the tolerance could yield some maps and not their products: then none is used.
+  for (const Symmetry& s : out)
+    for (const Symmetry& t : out) {
+      std::vector<int> st(n);
+      for (std::size_t i = 0; i < n; ++i) st[i] = s.vertex[static_cast<std::size_t>(t.vertex[i])];
+      if (std::none_of(out.begin(), out.end(), [&](const Symmetry& u) { return u.vertex == st; }))
+        return {out.front()};
+    }
   return out;
 }
 

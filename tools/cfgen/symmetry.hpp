@@ -24,7 +24,8 @@ struct Symmetry {
 
 /// Every symmetry of `m`, the identity first: the orthogonal maps about the vertices'
 /// centroid that take each vertex to a vertex within `tol` (mm), each edge to an edge and
-/// each face to a face with the image normal. Deterministic.
+/// each face to a face with the image normal. Only the identity when the maps found are not closed
+/// under composition (a model symmetric only to about `tol`). Deterministic.
 std::vector<Symmetry> symmetries(const Polyhedron& m, double tol);
 
 /// The pairs (h of A, g of B) of like handedness (both rotations, or both reflections, whose
