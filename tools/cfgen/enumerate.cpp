@@ -692,22 +692,14 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     for (std::size_t i = 0; i < failed.size(); ++i)
       if (open[i]) out.undecided.push_back(failed[i]);
     finished(ev, t0, std::to_string(out.undecided.size()) + " undecided");
-    std::sort(out.undecided.begin(), out.undecided.end(), [](const PcSet& x, const PcSet& y) {
-      if (x.size() != y.size()) return x.size() < y.size();
-      for (int k = 0; k < x.size(); ++k)
-        if (x[k] != y[k]) return x[k] < y[k];
-      return false;
-    });
+    std::sort(out.undecided.begin(), out.undecided.end(), pcset_less);
   }
 
   out.min_clearance = std::numeric_limits<double>::infinity();
   out.min_margin = std::numeric_limits<double>::infinity();
   for (int l = 0; l < 3; ++l) {
-    std::sort(valid[l].begin(), valid[l].end(), [](const auto& x, const auto& y) {
-      for (int k = 0; k < x.first.size(); ++k)
-        if (x.first[k] != y.first[k]) return x.first[k] < y.first[k];
-      return false;
-    });
+    std::sort(valid[l].begin(), valid[l].end(),
+              [](const auto& x, const auto& y) { return pcset_less(x.first, y.first); });
     // Each CF's record on its own (all cores), in canonical order.
     std::vector<CfRecord> records(valid[l].size());
     std::vector<double> margins(valid[l].size());

@@ -88,6 +88,19 @@ bool complete(const Polyhedron& m, const std::vector<Vec3>& P, const std::vector
   return true;
 }
 
+// The identity map of m.
+Symmetry identity(const Polyhedron& m) {
+  Symmetry s;
+  s.c = m.vertex_centroid();
+  for (auto [perm, count] :
+       {std::make_pair(&s.vertex, m.num_vertices()), std::make_pair(&s.edge, m.num_edges()),
+        std::make_pair(&s.face, m.num_faces())}) {
+    perm->resize(count);
+    std::iota(perm->begin(), perm->end(), 0);
+  }
+  return s;
+}
+
 }  // namespace
 
 std::vector<Symmetry> symmetries(const Polyhedron& m, double tol) {
@@ -100,15 +113,7 @@ std::vector<Symmetry> symmetries(const Polyhedron& m, double tol) {
   std::stable_sort(order.begin(), order.end(), [&](int i, int j) {
     return P[static_cast<std::size_t>(i)].x() < P[static_cast<std::size_t>(j)].x();
   });
-  Symmetry identity;
-  identity.c = c;
-  identity.vertex.resize(n);
-  std::iota(identity.vertex.begin(), identity.vertex.end(), 0);
-  identity.edge.resize(m.num_edges());
-  std::iota(identity.edge.begin(), identity.edge.end(), 0);
-  identity.face.resize(m.num_faces());
-  std::iota(identity.face.begin(), identity.face.end(), 0);
-  std::vector<Symmetry> out{identity};
+  std::vector<Symmetry> out{identity(m)};
   if (n < 3) return out;
   // A symmetry maps the vertex farthest from the centroid, i0, to one as far, and the vertex
   // i1 that spans the widest angle with it to one as far at the same dot product: the two
@@ -153,22 +158,8 @@ std::vector<Symmetry> symmetries(const Polyhedron& m, double tol) {
 }
 
 PairSymmetries::PairSymmetries(const Polyhedron& A, const Polyhedron& B, double tol, bool enabled) {
-  if (enabled) {
-    a_ = symmetries(A, tol);
-    b_ = symmetries(B, tol);
-  } else {
-    a_ = std::vector<Symmetry>(1);
-    b_ = std::vector<Symmetry>(1);
-    for (auto [v, m] : {std::make_pair(&a_[0], &A), std::make_pair(&b_[0], &B)}) {
-      v->c = m->vertex_centroid();
-      v->vertex.resize(m->num_vertices());
-      std::iota(v->vertex.begin(), v->vertex.end(), 0);
-      v->edge.resize(m->num_edges());
-      std::iota(v->edge.begin(), v->edge.end(), 0);
-      v->face.resize(m->num_faces());
-      std::iota(v->face.begin(), v->face.end(), 0);
-    }
-  }
+  a_ = enabled ? symmetries(A, tol) : std::vector<Symmetry>{identity(A)};
+  b_ = enabled ? symmetries(B, tol) : std::vector<Symmetry>{identity(B)};
   for (std::size_t i = 0; i < a_.size(); ++i)
     for (std::size_t j = 0; j < b_.size(); ++j)
       if ((a_[i].R.determinant() > 0) == (b_[j].R.determinant() > 0))
