@@ -675,6 +675,35 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
                       (opt.max_pcs >= 3 && valid[1].size() > pairs_tripled);
     if (!grew) break;
   }
+  // Orbit closure (--thorough): every member of every orbit met, at the image of the witness
+  // found. The search above found each CF on its own, from its own seeds and motions; the
+  // images add the members it missed. Verified on all cores, added in a fixed order.
+  if (opt.close_orbits) {
+    const PairSymmetries full(A, B, kSymmetryTol * search.scale(), true);
+    out.symmetries_a = full.size_a();
+    out.symmetries_b = full.size_b();
+    for (int l = 0; l < 3; ++l) {
+      std::vector<std::pair<PcSet, Witness>> images;
+      std::unordered_set<PcSet, PcSetHash> queued;
+      for (const auto& [s, w] : valid[l])
+        for (std::size_t k = 1; k < full.size(); ++k) {
+          const PcSet t = full.image(s, k);
+          if (witness_rot.count(t) || !queued.insert(t).second) continue;
+          Witness v = w;
+          v.pose = full.image(w.pose, k);
+          images.push_back({t, v});
+        }
+      parallel_for(images.size(), threads,
+                   [&](std::size_t i) { images[i].second.clearance = search.verify(images[i].first, images[i].second.pose); },
+                   {});
+      for (auto& [t, v] : images) {
+        if (v.clearance < opt.search.min_clearance) continue;
+        witness_rot.emplace(t, v.pose.R_BA);
+        valid[l].push_back({t, v});
+        ++out.levels[l].by_symmetry;
+      }
+    }
+  }
   for (int l = 0; l < 3; ++l) out.levels[l].valid = valid[l].size();
 
   // What the search could not decide: failed candidates that motion did not find either and

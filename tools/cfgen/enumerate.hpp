@@ -81,6 +81,10 @@ struct EnumerateOptions {
   /// Search one set of each orbit of the models' symmetries (symmetry.hpp) and take the others
   /// as images of its witness; false searches every set.
   bool use_symmetry = true;
+  /// With use_symmetry false: once every set has been searched, add every image of each CF
+  /// found under the models' symmetries, verified at the image of its witness (cfgen
+  /// --thorough), so that the graph is closed under them.
+  bool close_orbits = false;
   /// With shard.count > 0, enumerate() searches only this shard's candidates of the first
   /// level-2 round and returns them in Enumeration::shard_results; nothing else is built.
   ShardSpec shard;

@@ -59,7 +59,8 @@ int run_generate(const GenerateArgs& args) {
   const double diag = length_scale(A, B);
   opt.search = scaled_search(A, B, args.rel, args.search);
   opt.max_pcs = args.max_pcs;
-  opt.use_symmetry = args.symmetry;
+  opt.use_symmetry = args.symmetry && !args.thorough;
+  opt.close_orbits = args.thorough;
   opt.shard = args.shard;
   std::size_t resumed_chunks = 0;
   if (!args.checkpoint_dir.empty()) {
@@ -155,6 +156,7 @@ int run_generate(const GenerateArgs& args) {
                         {"max_rotations", s.max_rotations},
                         {"max_pcs", opt.max_pcs},
                         {"symmetry", opt.use_symmetry}};
+  if (args.thorough) meta["parameters"]["thorough"] = true;  // absent otherwise: the same bytes as before
   meta["generator"] = {{"name", "cfgen"},
                        {"a_model", args.a_label.empty() ? args.a_path : args.a_label},
                        {"b_model", args.b_label.empty() ? args.b_path : args.b_label}};

@@ -40,6 +40,7 @@ struct GenerateArgs {
   int threads = 0;       ///< worker threads; 0 = hardware concurrency
   bool quiet = false;    ///< no progress on stderr
   int max_pcs = 3;       ///< largest CFs to enumerate (1..3)
+  bool thorough = false;  ///< search every set, then add every image of each CF found (enumerate.hpp)
   bool symmetry = true;  ///< search one set per orbit of the models' symmetries (symmetry.hpp)
   gen::SearchParams search;  ///< angular tolerances and search limits (lengths: `rel`)
   RelativeLengths rel;       ///< lengths of the search, relative to the models' size

@@ -110,10 +110,14 @@ int main(int argc, char** argv) {
   gen_opts.push_back(app.add_option("--max-pcs", gen.max_pcs, "largest CFs to enumerate")
                          ->check(CLI::Range(1, 3))
                          ->capture_default_str());
-  bool no_symmetry = false;
-  gen_opts.push_back(
-      app.add_flag("--no-symmetry", no_symmetry,
-                   "search every candidate set, not one per orbit of the models' symmetries"));
+  bool no_symmetry = false, thorough = false;
+  CLI::Option* no_sym_opt = app.add_flag("--no-symmetry", no_symmetry,
+                                         "search every candidate set, not one per orbit of the models' symmetries");
+  gen_opts.push_back(no_sym_opt);
+  gen_opts.push_back(app.add_flag("--thorough", thorough,
+                                  "search every candidate set as --no-symmetry does, then add every image of each CF "
+                                  "found under the models' symmetries: the most complete graph, at --no-symmetry's cost")
+                         ->excludes(no_sym_opt));
   // Lengths of the search are relative to the smaller model's bounding-box diagonal D, so
   // that a pair scaled by any factor gives the same graph up to scale.
   gen_opts.push_back(app.add_option("--touch-tol", gen.rel.touch_tol,
@@ -166,6 +170,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   gen.symmetry = !no_symmetry;
+  gen.thorough = thorough;
 
   try {
     cf::tools::LoadOptions load;

@@ -22,7 +22,7 @@ constexpr int kMaxShards = 4096;
 // The options that shape the graph, in a fixed order (not the thread count, the output or
 // --quiet, which do not change a byte of it).
 nlohmann::json options_json(const GenerateArgs& a) {
-  return {{"max_pcs", a.max_pcs},
+  nlohmann::json o = {{"max_pcs", a.max_pcs},
           {"symmetry", a.symmetry},
           {"touch_tol_rel", a.rel.touch_tol},
           {"min_clearance_rel", a.rel.min_clearance},
@@ -36,6 +36,9 @@ nlohmann::json options_json(const GenerateArgs& a) {
           {"units_b", a.load_b.units},
           {"coplanar_tol_a", a.load_a.coplanar_rel_tol},
           {"coplanar_tol_b", a.load_b.coplanar_rel_tol}};
+  // Only when set, so that the fingerprints of runs without it are those of earlier builds.
+  if (a.thorough) o["thorough"] = true;
+  return o;
 }
 
 // The JSON document in file `path`; errors read "<what> '<path>': <reason><hint>".
@@ -339,6 +342,7 @@ ShardPart read_part(const std::string& path) {
   const nlohmann::json& o = j.contains("options") ? j.at("options") : nlohmann::json();
   p.args.max_pcs = field<int>(o, "max_pcs", path);
   p.args.symmetry = field<bool>(o, "symmetry", path);
+  p.args.thorough = o.contains("thorough") && field<bool>(o, "thorough", path);
   p.args.rel.touch_tol = field<double>(o, "touch_tol_rel", path);
   p.args.rel.min_clearance = field<double>(o, "min_clearance_rel", path);
   p.args.rel.good_clearance = field<double>(o, "good_clearance_rel", path);

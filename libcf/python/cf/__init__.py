@@ -65,7 +65,8 @@ def generate(a_path, b_path, output=None, **options):
     ``min_margin`` (relative to the smaller model's bounding-box diagonal), ``angle_margin``
     (rad), ``theta_samples``, ``max_rotations``, ``units``, ``units_a``, ``units_b``,
     ``coplanar_rel_tol``, ``symmetry`` (default True: one search per orbit of the models'
-    symmetries; False is ``--no-symmetry``), ``quiet`` (default True: no progress on stderr).
+    symmetries; False is ``--no-symmetry``), ``thorough`` (default False; True is
+    ``--thorough``: every set searched, then every image of each CF added), ``quiet`` (default True: no progress on stderr).
     Raises cf.Error for bad models or options.
     """
     if not HAVE_TOOLS:

@@ -68,7 +68,7 @@ void bind_tools(py::module_& m) {
          int threads, bool quiet, int max_pcs, double touch_tol, double min_clearance,
          double good_clearance, double min_margin, double angle_margin, int theta_samples,
          int max_rotations, const std::string& units, const std::string& units_a,
-         const std::string& units_b, double coplanar_rel_tol, bool symmetry) {
+         const std::string& units_b, double coplanar_rel_tol, bool symmetry, bool thorough) {
         const std::string where = "generate";
         // The ranges cfgen's options accept.
         check_int(threads, 0, 1024, "threads", where);
@@ -90,6 +90,8 @@ void bind_tools(py::module_& m) {
         g.quiet = quiet;
         g.max_pcs = max_pcs;
         g.symmetry = symmetry;
+        if (thorough && !symmetry) fail(where + ": symmetry=False excludes thorough=True");
+        g.thorough = thorough;
         g.rel.touch_tol = touch_tol;
         g.rel.min_clearance = min_clearance;
         g.rel.good_clearance = good_clearance;
@@ -121,7 +123,7 @@ void bind_tools(py::module_& m) {
       py::arg("max_rotations") = cf::gen::SearchParams{}.max_rotations, py::arg("units") = "mm",
       py::arg("units_a") = "", py::arg("units_b") = "",
       py::arg("coplanar_rel_tol") = cf::tools::LoadOptions{}.coplanar_rel_tol,
-      py::arg("symmetry") = true,
+      py::arg("symmetry") = true, py::arg("thorough") = false,
       "cfgen's generation (cf::tools::run_generate) into the graph file `output`; the package's "
       "cf.generate wraps it.");
 #else
