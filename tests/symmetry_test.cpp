@@ -49,6 +49,21 @@ cf::Polyhedron moved(const cf::Polyhedron& m, const Eigen::Matrix3d& R, const Ve
   return cf::Polyhedron::from_features(m.name(), v, e, f);
 }
 
+// The PC sets of an enumeration's CFs, as text.
+std::set<std::string> cf_sets(const cf::gen::Enumeration& e) {
+  std::set<std::string> out;
+  for (const auto& r : e.cfs) out.insert(cf::to_string(r.pcs));
+  return out;
+}
+
+// The generator's defaults for the pair (lengths scaled to it), on two threads.
+cf::gen::EnumerateOptions options_for(const cf::test::AnalysedPair& p) {
+  cf::gen::EnumerateOptions opt;
+  opt.threads = 2;
+  opt.search = cf::tools::scaled_search(p.A, p.B, {});
+  return opt;
+}
+
 int proper(const std::vector<cf::gen::Symmetry>& s) {
   int n = 0;
   for (const auto& x : s) n += x.R.determinant() > 0 ? 1 : 0;
@@ -177,18 +192,14 @@ TEST_CASE(
   // A 10 mm cube against a 40 x 40 x 10 slab: 48 and 16 symmetries.
   cf::test::AnalysedPair p(cf::test::box(Vec3(-5, -5, -5), Vec3(5, 5, 5), "cube"),
                            cf::test::box(Vec3(-20, -20, -5), Vec3(20, 20, 5), "slab"));
-  cf::gen::EnumerateOptions opt;
-  opt.threads = 2;
-  opt.search = cf::tools::scaled_search(p.A, p.B, {});
+  cf::gen::EnumerateOptions opt = options_for(p);
   const cf::gen::Enumeration with = cf::gen::enumerate(p.ai, p.bi, opt);
   opt.use_symmetry = false;
   const cf::gen::Enumeration without = cf::gen::enumerate(p.ai, p.bi, opt);
   CHECK(with.symmetries_a == 48);
   CHECK(with.symmetries_b == 16);
   CHECK(without.symmetries_a == 1);
-  std::set<std::string> sets_with, sets_without;
-  for (const auto& r : with.cfs) sets_with.insert(cf::to_string(r.pcs));
-  for (const auto& r : without.cfs) sets_without.insert(cf::to_string(r.pcs));
+  const std::set<std::string> sets_with = cf_sets(with), sets_without = cf_sets(without);
   CHECK(sets_with.size() == with.cfs.size());  // no CF twice
   CHECK(sets_without.size() == without.cfs.size());
   // Closed: every image of every CF is a CF, and its witness is verified like any other.
@@ -261,9 +272,7 @@ TEST_CASE(
   cf::test::AnalysedPair p(
       cf::tools::load_model(cf::test::write_file("thorough_peg.off", ngon_off(4, 10, 0, -20, 20)), load),
       cf::tools::load_model(cf::test::write_file("thorough_hole.off", ngon_off(4, 25, 10.5, 0, 20)), load));
-  cf::gen::EnumerateOptions opt;
-  opt.threads = 2;
-  opt.search = cf::tools::scaled_search(p.A, p.B, {});
+  cf::gen::EnumerateOptions opt = options_for(p);
   const cf::gen::Enumeration orbit = cf::gen::enumerate(p.ai, p.bi, opt);
   opt.use_symmetry = false;
   const cf::gen::Enumeration every = cf::gen::enumerate(p.ai, p.bi, opt);
@@ -271,10 +280,7 @@ TEST_CASE(
   const cf::gen::Enumeration thorough = cf::gen::enumerate(p.ai, p.bi, opt);
   CHECK(thorough.symmetries_a == 16);
   CHECK(thorough.symmetries_b == 16);
-  std::set<std::string> s_orbit, s_every, s_thorough;
-  for (const auto& r : orbit.cfs) s_orbit.insert(cf::to_string(r.pcs));
-  for (const auto& r : every.cfs) s_every.insert(cf::to_string(r.pcs));
-  for (const auto& r : thorough.cfs) s_thorough.insert(cf::to_string(r.pcs));
+  const std::set<std::string> s_orbit = cf_sets(orbit), s_every = cf_sets(every), s_thorough = cf_sets(thorough);
   REQUIRE(s_thorough.size() == thorough.cfs.size());  // no CF twice
   // The search is the per-set one; the closure only adds, each image verified.
   for (const std::string& s : s_every) CHECK(s_thorough.count(s) == 1);

@@ -682,25 +682,38 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     const PairSymmetries full(A, B, kSymmetryTol * search.scale(), true);
     out.symmetries_a = full.size_a();
     out.symmetries_b = full.size_b();
+    // A set's images from several CFs: the first in canonical order, and where that one does
+    // not verify (rounding at a borderline pose), the next, up to kClosureTries.
+    constexpr std::size_t kClosureTries = 4;
     for (int l = 0; l < 3; ++l) {
-      std::vector<std::pair<PcSet, Witness>> images;
-      std::unordered_set<PcSet, PcSetHash> queued;
-      for (const auto& [s, w] : valid[l])
-        for (std::size_t k = 1; k < full.size(); ++k) {
-          const PcSet t = full.image(s, k);
-          if (witness_rot.count(t) || !queued.insert(t).second) continue;
-          Witness v = w;
-          v.pose = full.image(w.pose, k);
-          images.push_back({t, v});
+      const std::size_t found = valid[l].size();
+      for (std::size_t attempt = 0; attempt < kClosureTries; ++attempt) {
+        std::vector<std::pair<PcSet, Witness>> images;
+        std::unordered_map<PcSet, std::size_t, PcSetHash> sources;  // images met so far, by set
+        for (std::size_t i = 0; i < found; ++i) {
+          const auto& [s, w] = valid[l][i];
+          for (std::size_t k = 1; k < full.size(); ++k) {
+            const PcSet t = full.image(s, k);
+            if (witness_rot.count(t) || sources[t]++ != attempt) continue;
+            Witness v = w;
+            v.pose = full.image(w.pose, k);
+            images.push_back({t, v});
+          }
         }
-      parallel_for(images.size(), threads,
-                   [&](std::size_t i) { images[i].second.clearance = search.verify(images[i].first, images[i].second.pose); },
-                   {});
-      for (auto& [t, v] : images) {
-        if (v.clearance < opt.search.min_clearance) continue;
-        witness_rot.emplace(t, v.pose.R_BA);
-        valid[l].push_back({t, v});
-        ++out.levels[l].by_symmetry;
+        parallel_for(images.size(), threads,
+                     [&](std::size_t i) { images[i].second.clearance = search.verify(images[i].first, images[i].second.pose); },
+                     {});
+        bool refused = false;
+        for (auto& [t, v] : images) {
+          if (v.clearance < opt.search.min_clearance) {
+            refused = true;
+            continue;
+          }
+          witness_rot.emplace(t, v.pose.R_BA);
+          valid[l].push_back({t, v});
+          ++out.levels[l].by_symmetry;
+        }
+        if (!refused) break;
       }
     }
   }
