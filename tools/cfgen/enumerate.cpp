@@ -766,6 +766,12 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
       out.min_margin = std::min(out.min_margin, margins[i]);
     }
   }
+  // The search's own sets are done with: a large pair's candidates take hundreds of MB,
+  // which the transitions and the file need more.
+  std::unordered_set<PcSet, PcSetHash>().swap(seen);
+  std::vector<PcSet>().swap(failed);
+  std::unordered_map<PcSet, Mat3, PcSetHash>().swap(witness_rot);
+  for (auto& v : valid) std::vector<std::pair<PcSet, Witness>>().swap(v);
   out.transitions = transitions_between(out.cfs, A, B, threads);
   return out;
 }

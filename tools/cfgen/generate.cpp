@@ -17,6 +17,7 @@
 #include <iostream>
 #include <thread>
 #include <tuple>
+#include <utility>
 
 #include <unistd.h>
 
@@ -83,7 +84,7 @@ int run_generate(const GenerateArgs& args) {
       if (terminal && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(2)) return;
       printer(ev);
     };
-  const gen::Enumeration e = gen::enumerate(ai, bi, opt);
+  gen::Enumeration e = gen::enumerate(ai, bi, opt);
   printer.finish();
   if (resumed_chunks > 0 && !args.quiet)
     std::cerr << "cfgen: checkpoint '" << args.checkpoint_dir << "': resumed " << resumed_chunks
@@ -164,7 +165,8 @@ int run_generate(const GenerateArgs& args) {
   meta["source_units"] = {{"A", args.load_a.units}, {"B", args.load_b.units}};
 
   const std::size_t n_cfs = e.cfs.size(), n_tr = e.transitions.size();
-  const CfGraph graph = CfGraph::from_parts(A, B, e.cfs, e.transitions, meta.dump());
+  // Moved, not copied: a large graph's records and transitions are hundreds of MB.
+  const CfGraph graph = CfGraph::from_parts(A, B, std::move(e.cfs), std::move(e.transitions), meta.dump());
   check_output_path(args.out_path, inputs, "writing graph");
   graph.save(args.out_path);
   if (n_cfs == 0)

@@ -4,6 +4,8 @@
 #include <cf/polyhedron.hpp>
 #include <cf/types.hpp>
 
+#include "streamed_output.hpp"
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -169,8 +171,18 @@ void check_output_path(const std::string& path, const std::vector<std::string>& 
 
 void write_outputs(const std::vector<OutputFile>& files, const std::vector<std::string>& inputs,
                    const char* what) {
+  std::vector<detail::StreamedOutput> streamed;
+  for (const OutputFile& f : files)
+    streamed.push_back({f.path, [&f](const detail::ByteSink& sink) { sink(f.bytes.data(), f.bytes.size()); }});
+  detail::write_streamed_outputs(streamed, inputs, what);
+}
+
+namespace detail {
+
+void write_streamed_outputs(const std::vector<StreamedOutput>& files, const std::vector<std::string>& inputs,
+                            const char* what) {
   std::vector<std::string> targets, keys;
-  for (const OutputFile& f : files) {
+  for (const StreamedOutput& f : files) {
     targets.push_back(checked_target(f.path, inputs, what));
     keys.push_back(canonical_key(targets.back()));
     for (std::size_t k = 0; k + 1 < keys.size(); ++k)
@@ -193,17 +205,25 @@ void write_outputs(const std::vector<OutputFile>& files, const std::vector<std::
       refuse(what, files[i].path, "cannot create a temporary file in '" + dir_of(target) + "': " + errno_text(e));
     }
     temps.push_back(tmp);
-    const std::string& bytes = files[i].bytes;
-    std::size_t done = 0;
     int err = 0;
-    while (done < bytes.size()) {
-      const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-      if (n < 0) {
-        if (errno == EINTR) continue;
-        err = errno;
-        break;
+    // After a failed write the rest of the bytes are dropped; the error is reported below.
+    const ByteSink sink = [fd, &err](const char* data, std::size_t size) {
+      std::size_t done = 0;
+      while (err == 0 && done < size) {
+        const ssize_t n = ::write(fd, data + done, size - done);
+        if (n < 0) {
+          if (errno != EINTR) err = errno;
+          continue;
+        }
+        done += static_cast<std::size_t>(n);
       }
-      done += static_cast<std::size_t>(n);
+    };
+    try {
+      files[i].produce(sink);
+    } catch (...) {
+      ::close(fd);
+      discard();
+      throw;
     }
     if (err == 0 && ::fsync(fd) != 0) err = errno;
     // An existing target keeps its permissions; a new file gets the usual 0666 & ~umask
@@ -225,6 +245,8 @@ void write_outputs(const std::vector<OutputFile>& files, const std::vector<std::
     }
   }
 }
+
+}  // namespace detail
 
 std::string printable(const std::string& text, std::size_t max) {
   std::string out;

@@ -5,6 +5,7 @@
 #include "graph_schema.hpp"
 #include "json_util.hpp"
 #include "polyhedron_json.hpp"
+#include "streamed_output.hpp"
 
 #include <cf/file_io.hpp>
 
@@ -12,6 +13,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <iterator>
 #include <sstream>
 
@@ -237,14 +239,21 @@ void append_transition(std::string& out, const Transition& t) {
   out += "\"}";
 }
 
+/// Hands on what `out` holds and empties it (writing a file in pieces); null to keep all.
+using Flush = std::function<void(std::string& out)>;
+// A piece of a file written in pieces: large enough that writes are few, small against the
+// graph (a 12-gon peg and hole writes 353 MB).
+constexpr std::size_t kFlushBytes = std::size_t{4} << 20;
+
 /// Appends the items, `sep` between them (",", or ",\n" plus padding).
 void append_items(std::string& out, const CfGraph::Impl& g, bool cfs, const std::string& before,
-                  const std::string& sep) {
+                  const std::string& sep, const Flush* flush) {
   const std::size_t n = cfs ? g.cfs.size() : g.transitions.size();
   for (std::size_t i = 0; i < n; ++i) {
     out += i == 0 ? before : sep;
     if (cfs) append_cf(out, i, g.cfs[i]);
     else append_transition(out, g.transitions[i]);
+    if (flush && out.size() >= kFlushBytes) (*flush)(out);
   }
 }
 
@@ -300,24 +309,25 @@ void print(const ojson& v, int indent, int level, bool items_inline, std::string
   out += "\n" + std::string(static_cast<std::size_t>(indent * level), ' ') + (v.is_object() ? "}" : "]");
 }
 
-}  // namespace
 
-std::string CfGraph::to_json(int indent) const {
-  const Impl& g = impl();
+/// The graph's JSON text (CfGraph::to_json) appended to `out`, handed to `flush` in pieces
+/// when it is set (the rest stays in `out`).
+void emit_json(const CfGraph::Impl& g, int indent, std::string& out, const Flush* flush) {
   const ojson head = graph_json(g, false);
-  std::string out;
-  out.reserve(4096 + g.cfs.size() * 400 + g.transitions.size() * 48);
   if (indent < 0) {
     out = head.dump();
     const std::string tail = ",\"cfs\":[],\"transitions\":[]}";
-    if (!ends_with(out, tail)) return graph_json(g).dump();  // cannot happen: keys are ours
+    if (!ends_with(out, tail)) {  // cannot happen: keys are ours
+      out = graph_json(g).dump();
+      return;
+    }
     out.resize(out.size() - tail.size());
     out += ",\"cfs\":[";
-    append_items(out, g, true, "", ",");
+    append_items(out, g, true, "", ",", flush);
     out += "],\"transitions\":[";
-    append_items(out, g, false, "", ",");
+    append_items(out, g, false, "", ",", flush);
     out += "]}";
-    return out;
+    return;
   }
   print(head, indent, 0, true, out);
   const std::string pad(static_cast<std::size_t>(indent), ' ');
@@ -325,7 +335,8 @@ std::string CfGraph::to_json(int indent) const {
   if (!ends_with(out, tail)) {  // cannot happen: keys are ours
     out.clear();
     print(graph_json(g), indent, 0, true, out);
-    return out + '\n';
+    out += '\n';
+    return;
   }
   out.resize(out.size() - tail.size());
   const std::string item_pad = "\n" + pad + pad;
@@ -333,24 +344,44 @@ std::string CfGraph::to_json(int indent) const {
     const bool empty = cfs ? g.cfs.empty() : g.transitions.empty();
     out += ",\n" + pad + (cfs ? "\"cfs\": [" : "\"transitions\": [");
     if (!empty) {
-      append_items(out, g, cfs, item_pad, "," + item_pad);
+      append_items(out, g, cfs, item_pad, "," + item_pad, flush);
       out += "\n" + pad;
     }
     out += ']';
   }
   out += "\n}\n";
+}
+
+}  // namespace
+
+std::string CfGraph::to_json(int indent) const {
+  const Impl& g = impl();
+  std::string out;
+  out.reserve(4096 + g.cfs.size() * 400 + g.transitions.size() * 48);
+  emit_json(g, indent, out, nullptr);
   return out;
 }
 
 void CfGraph::save(const std::string& path) const {
-  std::string bytes;
   if (is_cbor_path(path)) {
     const std::vector<std::uint8_t> cbor = ojson::to_cbor(graph_json(impl()));
-    bytes.assign(cbor.begin(), cbor.end());
-  } else {
-    bytes = to_json(1);
+    detail::write_file_atomically(path, std::string(cbor.begin(), cbor.end()), "writing graph");
+    return;
   }
-  detail::write_file_atomically(path, bytes, "writing graph");
+  // JSON goes to the file in pieces: a large graph's text is several times its records.
+  const Impl& g = impl();
+  detail::write_streamed_outputs({{path,
+                                   [&g](const detail::ByteSink& sink) {
+                                     std::string out;
+                                     out.reserve(kFlushBytes + 65536);
+                                     const Flush flush = [&sink](std::string& piece) {
+                                       sink(piece.data(), piece.size());
+                                       piece.clear();
+                                     };
+                                     emit_json(g, 1, out, &flush);
+                                     sink(out.data(), out.size());
+                                   }}},
+                                 {}, "writing graph");
 }
 
 CfGraph CfGraph::load(const std::string& path) { return load(path, GraphLoadOptions()); }
