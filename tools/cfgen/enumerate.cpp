@@ -43,6 +43,15 @@ struct PcSetHash {
   std::size_t operator()(const PcSet& s) const { return s.hash(); }
 };
 
+// Candidate sets grouped by orbit: orbit o is members[first[o], first[o + 1]).
+struct OrbitGroups {
+  std::vector<PcSet> members;
+  std::vector<std::size_t> first;
+  std::size_t size() const { return first.empty() ? 0 : first.size() - 1; }
+  std::size_t count(std::size_t o) const { return first[o + 1] - first[o]; }
+  const PcSet& member(std::size_t o, std::size_t k) const { return members[first[o] + k]; }
+};
+
 int element_count(const Polyhedron& m, ElementKind k) {
   return static_cast<int>(k == ElementKind::kVertex ? m.num_vertices()
                           : k == ElementKind::kEdge ? m.num_edges()
@@ -260,8 +269,16 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     }
   };
   // The candidates grouped by orbit, each orbit's members in candidate order, the orbits in
-  // the order of their first member.
+  // the order of their first member. Flat (members, and where each orbit starts): a large
+  // pair without symmetry has tens of millions of candidates, each its own orbit.
   auto orbits_of = [&](const std::vector<PcSet>& cands) {
+    OrbitGroups g;
+    if (sym.size() == 1) {
+      g.members = cands;
+      g.first.resize(cands.size() + 1);
+      for (std::size_t i = 0; i <= cands.size(); ++i) g.first[i] = i;
+      return g;
+    }
     std::vector<std::vector<PcSet>> orbits;
     // Every image of each orbit met so far, with its orbit: one pass over the symmetries per
     // orbit, not per candidate.
@@ -276,7 +293,12 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
       }
       orbits[it->second].push_back(s);
     }
-    return orbits;
+    g.first.push_back(0);
+    for (const auto& o : orbits) {
+      g.members.insert(g.members.end(), o.begin(), o.end());
+      g.first.push_back(g.members.size());
+    }
+    return g;
   };
 
   // Progress: ticks while a stage runs, one event when it ends.
@@ -299,22 +321,19 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   int motion_rounds = 0;
   bool first_pair_round = true;  // the first level-2 round (the one --shard splits)
 
-  // Every stage of the run, in order: its tasks cut into chunks, each found in the checkpoint,
-  // computed here or handed to another process, and kept when done.
+  // Every stage of the run, in order: its n tasks cut into chunks, each found in the
+  // checkpoint, computed here or handed to another process, and kept when done. make(i) gives
+  // task i and take(i, r) receives its result, in task order; the tasks are made a chunk (or,
+  // without a checkpoint, a slice of kSliceTasks) at a time, so that a stage of millions of
+  // candidates holds only the tasks in flight. (Under MPI every chunk is handed out at once.)
+  // The callers' tasks do not depend on what take has seen in the same stage.
   std::size_t stages = 0;
   // ev: where progress goes, null for none.
-  auto run_stage = [&](const std::vector<Task>& tasks, ProgressEvent* ev, Clock::time_point t0) {
+  auto run_stage_made = [&](std::size_t n, const std::function<Task(std::size_t)>& make,
+                            const std::function<void(std::size_t, TaskResult&&)>& take, ProgressEvent* ev,
+                            Clock::time_point t0) {
     const std::size_t stage = stages++;
     const bool report = ev && opt.progress;
-    if (!opt.checkpoint.load && !opt.distribute)
-      return run_tasks(search, tasks, threads, report ? ticker(*ev, t0) : std::function<void(std::size_t)>());
-    const std::size_t n = tasks.size(), size = chunk_size(n);
-    std::vector<std::vector<Task>> chunks;
-    for (std::size_t b = 0; b < n; b += size)
-      chunks.emplace_back(tasks.begin() + static_cast<std::ptrdiff_t>(b),
-                          tasks.begin() + static_cast<std::ptrdiff_t>(std::min(n, b + size)));
-    std::vector<TaskResult> res(n);
-    std::vector<std::size_t> todo;
     std::size_t done = 0;
     auto tick = [&](std::size_t d) {
       if (!report) return;
@@ -322,32 +341,72 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
       ev->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
       opt.progress(*ev);
     };
-    auto take = [&](std::size_t k, std::vector<TaskResult>&& r) {
-      if (r.size() != chunks[k].size())
-        throw Error("stage " + std::to_string(stage) + ", chunk " + std::to_string(k) + ": " +
-                    std::to_string(r.size()) + " results for " + std::to_string(chunks[k].size()) + " tasks");
-      if (opt.checkpoint.save) opt.checkpoint.save(stage, k, chunks[k], r);
-      std::move(r.begin(), r.end(), res.begin() + static_cast<std::ptrdiff_t>(k * size));
-      done += chunks[k].size();
-      tick(0);
+    auto make_range = [&](std::size_t b, std::size_t e) {
+      std::vector<Task> tasks;
+      tasks.reserve(e - b);
+      for (std::size_t i = b; i < e; ++i) tasks.push_back(make(i));
+      return tasks;
     };
-    for (std::size_t k = 0; k < chunks.size(); ++k) {
-      std::vector<TaskResult> kept;
-      if (opt.checkpoint.load && opt.checkpoint.load(stage, k, chunks[k], kept)) {
-        std::move(kept.begin(), kept.end(), res.begin() + static_cast<std::ptrdiff_t>(k * size));
-        done += chunks[k].size();
-      } else {
-        todo.push_back(k);
+    auto take_range = [&](std::size_t b, std::vector<TaskResult>& r) {
+      for (std::size_t i = 0; i < r.size(); ++i) take(b + i, std::move(r[i]));
+      done += r.size();
+    };
+    if (!opt.checkpoint.load && !opt.distribute) {
+      constexpr std::size_t kSliceTasks = std::size_t{1} << 15;
+      for (std::size_t b = 0; b < n; b += kSliceTasks) {
+        const std::size_t e = std::min(n, b + kSliceTasks);
+        std::vector<TaskResult> r =
+            run_tasks(search, make_range(b, e), threads, report ? std::function<void(std::size_t)>(tick) : nullptr);
+        take_range(b, r);
       }
+      return;
     }
-    if (opt.distribute) {
-      // Progress then moves chunk by chunk, from the thread that takes them.
-      opt.distribute(chunks, todo, [&](std::size_t k) { return run_tasks(search, chunks[k], threads); }, take);
-    } else {
-      for (std::size_t k : todo)
-        take(k, run_tasks(search, chunks[k], threads, report ? std::function<void(std::size_t)>(tick) : nullptr));
+    const std::size_t size = chunk_size(n), count = (n + size - 1) / size;
+    auto check = [&](std::size_t k, const std::vector<Task>& tasks, const std::vector<TaskResult>& r) {
+      if (r.size() != tasks.size())
+        throw Error("stage " + std::to_string(stage) + ", chunk " + std::to_string(k) + ": " +
+                    std::to_string(r.size()) + " results for " + std::to_string(tasks.size()) + " tasks");
+    };
+    if (!opt.distribute) {
+      for (std::size_t k = 0; k < count; ++k) {
+        const std::vector<Task> tasks = make_range(k * size, std::min(n, (k + 1) * size));
+        std::vector<TaskResult> r;
+        if (!opt.checkpoint.load(stage, k, tasks, r)) {
+          r = run_tasks(search, tasks, threads, report ? std::function<void(std::size_t)>(tick) : nullptr);
+          check(k, tasks, r);
+          if (opt.checkpoint.save) opt.checkpoint.save(stage, k, tasks, r);
+        }
+        take_range(k * size, r);
+        tick(0);
+      }
+      return;
     }
-    return res;
+    std::vector<std::vector<Task>> chunks;
+    for (std::size_t k = 0; k < count; ++k) chunks.push_back(make_range(k * size, std::min(n, (k + 1) * size)));
+    std::vector<std::vector<TaskResult>> res(count);
+    std::vector<std::size_t> todo;
+    for (std::size_t k = 0; k < count; ++k) {
+      if (opt.checkpoint.load && opt.checkpoint.load(stage, k, chunks[k], res[k])) done += chunks[k].size();
+      else todo.push_back(k);
+    }
+    // Progress then moves chunk by chunk, from the thread that takes them.
+    opt.distribute(chunks, todo, [&](std::size_t k) { return run_tasks(search, chunks[k], threads); },
+                   [&](std::size_t k, std::vector<TaskResult>&& r) {
+                     check(k, chunks[k], r);
+                     if (opt.checkpoint.save) opt.checkpoint.save(stage, k, chunks[k], r);
+                     res[k] = std::move(r);
+                     done += chunks[k].size();
+                     tick(0);
+                   });
+    done = 0;
+    for (std::size_t k = 0; k < count; ++k) take_range(k * size, res[k]);
+  };
+  auto run_stage = [&](const std::vector<Task>& tasks, ProgressEvent* ev, Clock::time_point t0) {
+    std::vector<TaskResult> results(tasks.size());
+    run_stage_made(
+        tasks.size(), [&](std::size_t i) { return tasks[i]; },
+        [&](std::size_t i, TaskResult&& r) { results[i] = std::move(r); }, ev, t0);
+    return results;
   };
 
   // given: results computed elsewhere (the shards of the first level-2 round), one per candidate.
@@ -358,7 +417,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     // One search per orbit: the others follow from its witness. The search samples, and an
     // orbit's members meet its samples differently, so a failed orbit is searched again at
     // its next members, up to kOrbitTries.
-    const std::vector<std::vector<PcSet>> orbits = orbits_of(all);
+    const OrbitGroups orbits = orbits_of(all);
     std::vector<char> done(orbits.size(), 0);
     std::size_t searched = 0;
     const std::size_t before = valid[level].size();
@@ -367,47 +426,50 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     for (std::size_t attempt = 0; attempt < kOrbitTries; ++attempt) {
       std::vector<std::size_t> open;
       for (std::size_t o = 0; o < orbits.size(); ++o) {
-        if (done[o] || attempt >= orbits[o].size()) continue;
-        if (witness_rot.count(orbits[o][attempt])) {
+        if (done[o] || attempt >= orbits.count(o)) continue;
+        if (witness_rot.count(orbits.member(o, attempt))) {
           done[o] = 1;  // an image of a CF found meanwhile
           continue;
         }
         open.push_back(o);
       }
       if (open.empty()) break;
-      std::vector<Witness> res(open.size());
+      auto take = [&](std::size_t i, const Witness& w) {
+        const PcSet& s = orbits.member(open[i], attempt);
+        seen.insert(s);
+        if (w.found) accept(level, s, w), done[open[i]] = 1;
+      };
       if (attempt == 0 && given) {
         if (given->size() != open.size())
           throw Error("merging shards: the parts hold " + std::to_string(given->size()) +
                       " results of the first level-2 round, but these models and options give " +
                       std::to_string(open.size()) + " candidates");
-        res = *given;
+        for (std::size_t i = 0; i < open.size(); ++i) take(i, (*given)[i]);
         ++stages;
       } else {
-        std::vector<Task> tasks(open.size());
-        for (std::size_t i = 0; i < open.size(); ++i) {
-          tasks[i].kind = Task::Kind::kFind;
-          tasks[i].pcs = orbits[open[i]][attempt];
-          tasks[i].seeds = seeds_of(tasks[i].pcs);
-        }
+        // Seeds come from the sets below this level, which the results of this stage do not
+        // change: the tasks are the same whenever they are made.
         ev.total = open.size();
-        std::vector<TaskResult> r = run_stage(tasks, attempt == 0 ? &ev : nullptr, t0);
-        for (std::size_t i = 0; i < open.size(); ++i) res[i] = r[i].witness;
+        run_stage_made(
+            open.size(),
+            [&](std::size_t i) {
+              Task t;
+              t.kind = Task::Kind::kFind;
+              t.pcs = orbits.member(open[i], attempt);
+              t.seeds = seeds_of(t.pcs);
+              return t;
+            },
+            [&](std::size_t i, TaskResult&& r) { take(i, r.witness); }, attempt == 0 ? &ev : nullptr, t0);
       }
       searched += open.size();
-      for (std::size_t i = 0; i < open.size(); ++i) {
-        const PcSet& s = orbits[open[i]][attempt];
-        seen.insert(s);
-        if (res[i].found) accept(level, s, res[i]), done[open[i]] = 1;
-      }
     }
     // Members of found orbits whose image witness did not verify (rounding at a borderline
     // pose): searched like any other set.
     std::vector<Task> rest;
     for (std::size_t o = 0; o < orbits.size(); ++o)
       if (done[o])
-        for (const PcSet& m : orbits[o])
-          if (!witness_rot.count(m) && !seen.count(m)) {
+        for (std::size_t k = 0; k < orbits.count(o); ++k)
+          if (const PcSet& m = orbits.member(o, k); !witness_rot.count(m) && !seen.count(m)) {
             Task t;
             t.pcs = m;
             t.seeds = seeds_of(m);
@@ -644,7 +706,8 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     const std::vector<PcSet> c2 = opt.max_pcs >= 2 ? build_pairs() : std::vector<PcSet>{};
     const int index = opt.shard.index;
     std::vector<PcSet> reps;
-    for (const std::vector<PcSet>& orbit : orbits_of(c2)) reps.push_back(orbit.front());
+    const OrbitGroups orbits = orbits_of(c2);
+    for (std::size_t o = 0; o < orbits.size(); ++o) reps.push_back(orbits.member(o, 0));
     out.first_pair_candidates = reps.size();
     std::vector<std::size_t> mine;
     for (std::size_t i = static_cast<std::size_t>(index); i < reps.size();
