@@ -334,7 +334,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
                             Clock::time_point t0) {
     const std::size_t stage = stages++;
     const bool report = ev && opt.progress;
-    std::size_t done = 0;
+    std::size_t done = 0;  // tasks finished, for the progress
     auto tick = [&](std::size_t d) {
       if (!report) return;
       ev->done = done + d;
@@ -349,7 +349,6 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     };
     auto take_range = [&](std::size_t b, std::vector<TaskResult>& r) {
       for (std::size_t i = 0; i < r.size(); ++i) take(b + i, std::move(r[i]));
-      done += r.size();
     };
     if (!opt.checkpoint.load && !opt.distribute) {
       constexpr std::size_t kSliceTasks = std::size_t{1} << 15;
@@ -357,6 +356,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
         const std::size_t e = std::min(n, b + kSliceTasks);
         std::vector<TaskResult> r =
             run_tasks(search, make_range(b, e), threads, report ? std::function<void(std::size_t)>(tick) : nullptr);
+        done += r.size();
         take_range(b, r);
       }
       return;
@@ -367,39 +367,37 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
         throw Error("stage " + std::to_string(stage) + ", chunk " + std::to_string(k) + ": " +
                     std::to_string(r.size()) + " results for " + std::to_string(tasks.size()) + " tasks");
     };
-    if (!opt.distribute) {
-      for (std::size_t k = 0; k < count; ++k) {
-        const std::vector<Task> tasks = make_range(k * size, std::min(n, (k + 1) * size));
-        std::vector<TaskResult> r;
-        if (!opt.checkpoint.load(stage, k, tasks, r)) {
-          r = run_tasks(search, tasks, threads, report ? std::function<void(std::size_t)>(tick) : nullptr);
-          check(k, tasks, r);
-          if (opt.checkpoint.save) opt.checkpoint.save(stage, k, tasks, r);
-        }
-        take_range(k * size, r);
-        tick(0);
+    // Under MPI, windows of chunks are handed out in turn (their results taken between
+    // windows, on this thread): every chunk of a window is made at once.
+    constexpr std::size_t kWindowChunks = 256;
+    const std::size_t window = opt.distribute ? kWindowChunks : 1;
+    for (std::size_t w0 = 0; w0 < count; w0 += window) {
+      const std::size_t w1 = std::min(count, w0 + window);
+      std::vector<std::vector<Task>> chunks;
+      for (std::size_t k = w0; k < w1; ++k) chunks.push_back(make_range(k * size, std::min(n, (k + 1) * size)));
+      std::vector<std::vector<TaskResult>> res(chunks.size());
+      std::vector<std::size_t> todo;  // within the window
+      for (std::size_t j = 0; j < chunks.size(); ++j) {
+        if (opt.checkpoint.load && opt.checkpoint.load(stage, w0 + j, chunks[j], res[j])) done += chunks[j].size();
+        else todo.push_back(j);
       }
-      return;
+      auto finish = [&](std::size_t j, std::vector<TaskResult>&& r) {
+        check(w0 + j, chunks[j], r);
+        if (opt.checkpoint.save) opt.checkpoint.save(stage, w0 + j, chunks[j], r);
+        res[j] = std::move(r);
+        done += chunks[j].size();
+        tick(0);
+      };
+      if (opt.distribute) {
+        // Progress then moves chunk by chunk, from the thread that takes them.
+        if (!todo.empty())
+          opt.distribute(chunks, todo, [&](std::size_t j) { return run_tasks(search, chunks[j], threads); }, finish);
+      } else {
+        for (std::size_t j : todo)
+          finish(j, run_tasks(search, chunks[j], threads, report ? std::function<void(std::size_t)>(tick) : nullptr));
+      }
+      for (std::size_t j = 0; j < chunks.size(); ++j) take_range((w0 + j) * size, res[j]);
     }
-    std::vector<std::vector<Task>> chunks;
-    for (std::size_t k = 0; k < count; ++k) chunks.push_back(make_range(k * size, std::min(n, (k + 1) * size)));
-    std::vector<std::vector<TaskResult>> res(count);
-    std::vector<std::size_t> todo;
-    for (std::size_t k = 0; k < count; ++k) {
-      if (opt.checkpoint.load && opt.checkpoint.load(stage, k, chunks[k], res[k])) done += chunks[k].size();
-      else todo.push_back(k);
-    }
-    // Progress then moves chunk by chunk, from the thread that takes them.
-    opt.distribute(chunks, todo, [&](std::size_t k) { return run_tasks(search, chunks[k], threads); },
-                   [&](std::size_t k, std::vector<TaskResult>&& r) {
-                     check(k, chunks[k], r);
-                     if (opt.checkpoint.save) opt.checkpoint.save(stage, k, chunks[k], r);
-                     res[k] = std::move(r);
-                     done += chunks[k].size();
-                     tick(0);
-                   });
-    done = 0;
-    for (std::size_t k = 0; k < count; ++k) take_range(k * size, res[k]);
   };
   auto run_stage = [&](const std::vector<Task>& tasks, ProgressEvent* ev, Clock::time_point t0) {
     std::vector<TaskResult> results(tasks.size());
