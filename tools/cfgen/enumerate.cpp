@@ -325,8 +325,8 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   // checkpoint, computed here or handed to another process, and kept when done. make(i) gives
   // task i and take(i, r) receives its result, in task order; the tasks are made a chunk (or,
   // without a checkpoint, a slice of kSliceTasks) at a time, so that a stage of millions of
-  // candidates holds only the tasks in flight. (Under MPI every chunk is handed out at once.)
-  // The callers' tasks do not depend on what take has seen in the same stage.
+  // candidates holds only the tasks in flight (under MPI, a window of chunks). The callers'
+  // tasks do not depend on what take has seen in the same stage.
   std::size_t stages = 0;
   // ev: where progress goes, null for none.
   auto run_stage_made = [&](std::size_t n, const std::function<Task(std::size_t)>& make,
