@@ -49,6 +49,22 @@ def test_generate_without_symmetry(tmp_path):
     assert sets(plain) == sets(by_orbit)
 
 
+def test_generate_thorough(tmp_path):
+    # thorough=True is cfgen --thorough: every set searched, then every image of each CF added
+    # (the cube against itself: the per-set search already finds every single PC).
+    a = b = DATA / "models" / "cube.off"
+    out = tmp_path / "thorough.json"
+    g = cf.generate(a, b, out, max_pcs=1, threads=2, thorough=True)
+    ref = tmp_path / "cfgen.json"
+    subprocess.run([tool("CF_CFGEN"), "--quiet", "--thorough", "--max-pcs", "1", "-j", "2", str(a), str(b),
+                    "-o", str(ref)], check=True, capture_output=True)
+    assert out.read_bytes() == ref.read_bytes()
+    assert len(g.cfs) == 420
+    assert '"thorough": true' in out.read_text()
+    with pytest.raises(cf.Error, match=r"^generate: symmetry=False excludes thorough=True$"):
+        cf.generate(a, b, max_pcs=1, symmetry=False, thorough=True)
+
+
 def test_generate_errors(tmp_path):
     a = DATA / "models" / "cube.off"
     with pytest.raises(cf.Error, match=r"^generate: max_pcs must be an integer in \[1, 3\], got 4$"):
