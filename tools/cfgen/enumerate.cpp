@@ -546,8 +546,11 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
                    const Pc& y = valid[0][j].first[0];
                    for (std::size_t i = 0; i < j; ++i) {
                      const Pc& x = valid[0][i].first[0];
+                     // The table lookups first: they reject most pairs, for less than the
+                     // set and its hash cost.
+                     if (!pair_ok.compatible(x, y)) continue;
                      PcSet s({x, y});
-                     if (seen.count(s) || !pair_ok.compatible(x, y) || !search.plausible(s)) continue;
+                     if (seen.count(s) || !search.plausible(s)) continue;
                      by_j[k].push_back(s);
                    }
                  },
