@@ -9,6 +9,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -110,4 +111,49 @@ TEST_CASE("box index: the boxes meeting a query box, as a brute-force test over 
       if (n % 64 != 0) CHECK((bits.back() >> (n % 64)) == 0u);
     }
   }
+}
+
+TEST_CASE("box index: real-valued boxes, clustered ends and queries beyond every box agree with brute force") {
+  // The search for a query's end runs in one bucket of the sorted ends: ends piled on one
+  // value (a face's vertices on one plane), boxes of zero extent, ends far apart in scale and
+  // queries wholly outside the boxes' range all exercise the bucket bounds.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  auto check_all = [&](const std::vector<Vec3>& lo, const std::vector<Vec3>& hi,
+                       const std::vector<std::pair<Vec3, Vec3>>& queries) {
+    const cf::gen::BoxIndex index(lo, hi);
+    std::vector<std::uint64_t> bits(static_cast<std::size_t>(index.words()));
+    for (const auto& [ql, qh] : queries) {
+      index.query(ql, qh, bits.data());
+      for (std::size_t i = 0; i < lo.size(); ++i) {
+        const bool meets = (lo[i].array() <= qh.array()).all() && (hi[i].array() >= ql.array()).all();
+        const bool listed = (bits[i / 64] >> (i % 64)) & 1u;
+        INFO("box " << i << " query " << ql.transpose() << " .. " << qh.transpose());
+        CHECK(listed == meets);
+      }
+    }
+  };
+  std::vector<Vec3> lo, hi;
+  std::vector<std::pair<Vec3, Vec3>> queries;
+  for (int i = 0; i < 150; ++i) {
+    // A third of the boxes share their lower x and z (one plane), some are points, and the
+    // rest spread over six orders of magnitude.
+    const double s = std::pow(10.0, 3.0 * unit(rng));
+    Vec3 l(i % 3 == 0 ? 2.5 : s * unit(rng), unit(rng), i % 3 == 0 ? -1.0 : s * unit(rng));
+    lo.push_back(l);
+    hi.push_back(i % 5 == 0 ? l : Vec3(l + s * Vec3(unit(rng), unit(rng), unit(rng)).cwiseAbs()));
+  }
+  for (int q = 0; q < 400; ++q) {
+    const double s = std::pow(10.0, 3.5 * unit(rng));
+    Vec3 l = s * Vec3(unit(rng), unit(rng), unit(rng));
+    if (q % 7 == 0) l = lo[static_cast<std::size_t>(q) % lo.size()];  // an end exactly
+    queries.push_back({l, l + s * Vec3(unit(rng), unit(rng), unit(rng)).cwiseAbs()});
+  }
+  queries.push_back({Vec3::Constant(-1e300), Vec3::Constant(-1e299)});  // below every box
+  queries.push_back({Vec3::Constant(1e299), Vec3::Constant(1e300)});    // above every box
+  queries.push_back({Vec3::Constant(-1e300), Vec3::Constant(1e300)});   // around every box
+  check_all(lo, hi, queries);
+  // Every box the same: the ends span nothing, and one bucket holds them all.
+  check_all(std::vector<Vec3>(70, Vec3(1, 2, 3)), std::vector<Vec3>(70, Vec3(1, 2, 3)),
+            {{Vec3(1, 2, 3), Vec3(1, 2, 3)}, {Vec3(0, 0, 0), Vec3(0.5, 5, 5)}, {Vec3(0, 0, 0), Vec3(5, 5, 5)}});
 }

@@ -80,17 +80,51 @@ bool point_inside(const Polyhedron& m, const Vec3& p, double boundary_tol) {
   return false;  // every direction grazed the boundary: p is on it for all practical purposes
 }
 
+void BoxIndex::SortedEnds::build(std::vector<double> sorted) {
+  x = std::move(sorted);
+  // About two buckets an end: most hold one end or none.
+  buckets = std::max<int>(1, 2 * static_cast<int>(x.size()));
+  origin = x.empty() ? 0.0 : x.front();
+  const double span = x.empty() ? 0.0 : x.back() - x.front();
+  per_mm = span > 0 && std::isfinite(span) ? buckets / span : 0.0;
+  // Ends in ascending order fall in ascending buckets: bucket b holds the ends
+  // [first[b], first[b + 1]), first[b] being the number of ends in the buckets before it.
+  first.assign(static_cast<std::size_t>(buckets) + 1, 0);
+  for (double e : x) ++first[static_cast<std::size_t>(bucket(e)) + 1];
+  for (std::size_t b = 1; b < first.size(); ++b) first[b] += first[b - 1];
+}
+
+int BoxIndex::SortedEnds::bucket(double q) const {
+  // Monotone in q (subtraction, a positive factor and the clamp all are, in floating point):
+  // what the exactness of the search rests on.
+  const double v = (q - origin) * per_mm;
+  if (!(v > 0)) return 0;  // also NaN
+  if (v >= buckets - 1) return buckets - 1;
+  return static_cast<int>(v);
+}
+
+std::size_t BoxIndex::SortedEnds::upper_bound(double q) const {
+  const auto b = static_cast<std::size_t>(bucket(q));
+  return static_cast<std::size_t>(std::upper_bound(x.begin() + first[b], x.begin() + first[b + 1], q) - x.begin());
+}
+
+std::size_t BoxIndex::SortedEnds::lower_bound(double q) const {
+  const auto b = static_cast<std::size_t>(bucket(q));
+  return static_cast<std::size_t>(std::lower_bound(x.begin() + first[b], x.begin() + first[b + 1], q) - x.begin());
+}
+
 BoxIndex::BoxIndex(const std::vector<Vec3>& lo, const std::vector<Vec3>& hi)
     : n_(static_cast<int>(lo.size())), words_((n_ + 63) / 64) {
   const auto n = static_cast<std::size_t>(n_), w = static_cast<std::size_t>(words_);
   std::vector<int> order(n);
   for (int ax = 0; ax < 3; ++ax) {
-    auto build = [&](const std::vector<Vec3>& end, std::vector<double>& sorted, std::vector<std::uint64_t>& sets,
+    auto build = [&](const std::vector<Vec3>& end, SortedEnds& ends, std::vector<std::uint64_t>& sets,
                      bool prefix) {
       for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<int>(i);
       std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return end[a][ax] < end[b][ax]; });
-      sorted.resize(n);
+      std::vector<double> sorted(n);
       for (std::size_t r = 0; r < n; ++r) sorted[r] = end[static_cast<std::size_t>(order[r])][ax];
+      ends.build(std::move(sorted));
       sets.assign((n + 1) * w, 0);
       // prefix: set r holds order[0, r); suffix: set r holds order[r, n). Each set is the
       // one before it (prefix) or after it (suffix) and one element more.
@@ -117,10 +151,8 @@ void BoxIndex::query(const Vec3& q_lo, const Vec3& q_hi, std::uint64_t* out) con
   for (std::size_t i = 0; i < w; ++i) out[i] = ~std::uint64_t{0};
   for (int ax = 0; ax < 3; ++ax) {
     // lower end <= q_hi: the first r of the lower ends; upper end >= q_lo: from r on.
-    const auto rl = static_cast<std::size_t>(
-        std::upper_bound(lo_sorted_[ax].begin(), lo_sorted_[ax].end(), q_hi[ax]) - lo_sorted_[ax].begin());
-    const auto rh = static_cast<std::size_t>(
-        std::lower_bound(hi_sorted_[ax].begin(), hi_sorted_[ax].end(), q_lo[ax]) - hi_sorted_[ax].begin());
+    const std::size_t rl = lo_sorted_[ax].upper_bound(q_hi[ax]);
+    const std::size_t rh = hi_sorted_[ax].lower_bound(q_lo[ax]);
     const std::uint64_t* pl = lo_prefix_[ax].data() + rl * w;
     const std::uint64_t* ph = hi_suffix_[ax].data() + rh * w;
     for (std::size_t i = 0; i < w; ++i) out[i] &= pl[i] & ph[i];

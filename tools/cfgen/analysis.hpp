@@ -29,7 +29,9 @@ struct EdgeWedge {
 /// a query box come out as a bitset in time O(log n + n / 64): per axis, the elements whose
 /// lower end is at most the query's upper end are a prefix of the elements sorted by lower
 /// end, and those whose upper end is at least the query's lower end a suffix of the elements
-/// sorted by upper end; each prefix and suffix is stored as a bitset.
+/// sorted by upper end; each prefix and suffix is stored as a bitset. The prefix and suffix
+/// lengths come from a table of buckets over each sorted list (a search within one bucket,
+/// most of them holding an end or none), as verify asks hundreds of times a pose.
 class BoxIndex {
  public:
   BoxIndex() = default;
@@ -42,8 +44,22 @@ class BoxIndex {
   void query(const Vec3& q_lo, const Vec3& q_hi, std::uint64_t* out) const;
 
  private:
+  // Ends sorted along one axis, with buckets over their range: an end x falls in bucket
+  // bucket(x), a monotone function of x, so the ends of the buckets before bucket(q) are below
+  // or at q and those of the buckets after it above or at q: a search for q runs within
+  // bucket(q) alone, exactly.
+  struct SortedEnds {
+    std::vector<double> x;
+    std::vector<int> first;  // first[b]: index of the first end in bucket b or after; buckets + 1
+    double origin = 0, per_mm = 0;
+    int buckets = 1;
+    void build(std::vector<double> sorted);
+    int bucket(double q) const;
+    std::size_t upper_bound(double q) const;  // ends <= q
+    std::size_t lower_bound(double q) const;  // ends < q
+  };
   int n_ = 0, words_ = 0;
-  std::array<std::vector<double>, 3> lo_sorted_, hi_sorted_;
+  std::array<SortedEnds, 3> lo_sorted_, hi_sorted_;
   // (n + 1) bitsets each: lo_prefix_[a][r] holds the r elements of smallest lower end on axis
   // a; hi_suffix_[a][r] the elements from the r-th smallest upper end on.
   std::array<std::vector<std::uint64_t>, 3> lo_prefix_, hi_suffix_;
