@@ -94,25 +94,6 @@ void BoxIndex::SortedEnds::build(std::vector<double> sorted) {
   for (std::size_t b = 1; b < first.size(); ++b) first[b] += first[b - 1];
 }
 
-int BoxIndex::SortedEnds::bucket(double q) const {
-  // Monotone in q (subtraction, a positive factor and the clamp all are, in floating point):
-  // what the exactness of the search rests on.
-  const double v = (q - origin) * per_mm;
-  if (!(v > 0)) return 0;  // also NaN
-  if (v >= buckets - 1) return buckets - 1;
-  return static_cast<int>(v);
-}
-
-std::size_t BoxIndex::SortedEnds::upper_bound(double q) const {
-  const auto b = static_cast<std::size_t>(bucket(q));
-  return static_cast<std::size_t>(std::upper_bound(x.begin() + first[b], x.begin() + first[b + 1], q) - x.begin());
-}
-
-std::size_t BoxIndex::SortedEnds::lower_bound(double q) const {
-  const auto b = static_cast<std::size_t>(bucket(q));
-  return static_cast<std::size_t>(std::lower_bound(x.begin() + first[b], x.begin() + first[b + 1], q) - x.begin());
-}
-
 BoxIndex::BoxIndex(const std::vector<Vec3>& lo, const std::vector<Vec3>& hi)
     : n_(static_cast<int>(lo.size())), words_((n_ + 63) / 64) {
   const auto n = static_cast<std::size_t>(n_), w = static_cast<std::size_t>(words_);

@@ -7,7 +7,9 @@
 
 #include <cf/polyhedron.hpp>
 
+#include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -54,9 +56,22 @@ class BoxIndex {
     double origin = 0, per_mm = 0;
     int buckets = 1;
     void build(std::vector<double> sorted);
-    int bucket(double q) const;
-    std::size_t upper_bound(double q) const;  // ends <= q
-    std::size_t lower_bound(double q) const;  // ends < q
+    int bucket(double q) const {
+      // Monotone in q (subtraction, a positive factor and the clamp all are, in floating
+      // point): what the exactness of the search rests on.
+      const double v = (q - origin) * per_mm;
+      if (!(v > 0)) return 0;  // also NaN
+      if (v >= buckets - 1) return buckets - 1;
+      return static_cast<int>(v);
+    }
+    std::size_t upper_bound(double q) const {  // ends <= q
+      const auto b = static_cast<std::size_t>(bucket(q));
+      return static_cast<std::size_t>(std::upper_bound(x.begin() + first[b], x.begin() + first[b + 1], q) - x.begin());
+    }
+    std::size_t lower_bound(double q) const {  // ends < q
+      const auto b = static_cast<std::size_t>(bucket(q));
+      return static_cast<std::size_t>(std::lower_bound(x.begin() + first[b], x.begin() + first[b + 1], q) - x.begin());
+    }
   };
   int n_ = 0, words_ = 0;
   std::array<SortedEnds, 3> lo_sorted_, hi_sorted_;
