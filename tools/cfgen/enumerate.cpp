@@ -271,12 +271,13 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   // The candidates grouped by orbit, each orbit's members in candidate order, the orbits in
   // the order of their first member. Flat (members, and where each orbit starts): a large
   // pair without symmetry has tens of millions of candidates, each its own orbit.
-  auto orbits_of = [&](const std::vector<PcSet>& cands) {
+  // Takes the candidates: a large pair's are hundreds of MB, not to be held twice.
+  auto orbits_of = [&](std::vector<PcSet> cands) {
     OrbitGroups g;
     if (sym.size() == 1) {
-      g.members = cands;
-      g.first.resize(cands.size() + 1);
-      for (std::size_t i = 0; i <= cands.size(); ++i) g.first[i] = i;
+      g.members = std::move(cands);
+      g.first.resize(g.members.size() + 1);
+      for (std::size_t i = 0; i < g.first.size(); ++i) g.first[i] = i;
       return g;
     }
     std::vector<std::vector<PcSet>> orbits;
@@ -408,14 +409,14 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   };
 
   // given: results computed elsewhere (the shards of the first level-2 round), one per candidate.
-  auto run_level = [&](int level, const std::vector<PcSet>& all,
+  auto run_level = [&](int level, std::vector<PcSet> all,
                        const std::function<std::vector<Mat3>(const PcSet&)>& seeds_of,
                        const std::vector<Witness>* given = nullptr) {
     const auto t0 = Clock::now();
     // One search per orbit: the others follow from its witness. The search samples, and an
     // orbit's members meet its samples differently, so a failed orbit is searched again at
     // its next members, up to kOrbitTries.
-    const OrbitGroups orbits = orbits_of(all);
+    const OrbitGroups orbits = orbits_of(std::move(all));
     std::vector<char> done(orbits.size(), 0);
     std::size_t searched = 0;
     const std::size_t before = valid[level].size();
@@ -485,10 +486,10 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     const std::size_t found = valid[level].size() - before;
     ev.total = searched;
     // The other members: valid as images above, or failed with their orbit.
-    for (std::size_t i = 0; i < all.size(); ++i) {
-      if (witness_rot.count(all[i])) continue;
-      seen.insert(all[i]);
-      failed.push_back(all[i]);
+    for (const PcSet& m : orbits.members) {
+      if (witness_rot.count(m)) continue;
+      seen.insert(m);
+      failed.push_back(m);
     }
     LevelStats& st = out.levels[level];
     st.candidates += searched;
@@ -510,7 +511,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
         c1.push_back(PcSet({Pc{t, a, b}}));
       }
   }
-  run_level(0, c1, [](const PcSet&) { return std::vector<Mat3>{}; });
+  run_level(0, std::move(c1), [](const PcSet&) { return std::vector<Mat3>{}; });
 
   auto seeds_from_subsets = [&](const PcSet& s) {
     std::vector<Mat3> seeds;
@@ -537,9 +538,13 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   // Level 2 over the valid single PCs not paired yet (with every valid single PC).
   auto build_pairs = [&] {
     const std::size_t n = valid[0].size();
+    if (n > std::numeric_limits<std::uint32_t>::max())
+      throw Error("level 2: " + std::to_string(n) + " valid single PCs, more than the pairs' indices hold");
     // Each new single PC against the ones before it, on all cores (the conditions cost
-    // microseconds a pair, and big models have millions of pairs); joined in order.
-    std::vector<std::vector<PcSet>> by_j(n - singles_paired);
+    // microseconds a pair, and big models have millions of pairs); joined in order. Each
+    // partner is kept as its index (a tenth of a set's size) until the sets are built, so
+    // that tens of millions of candidates are not held twice.
+    std::vector<std::vector<std::uint32_t>> by_j(n - singles_paired);
     parallel_for(by_j.size(), threads,
                  [&](std::size_t k) {
                    const std::size_t j = singles_paired + k;
@@ -551,18 +556,24 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
                      if (!pair_ok.compatible(x, y)) continue;
                      PcSet s({x, y});
                      if (seen.count(s) || !search.plausible(s)) continue;
-                     by_j[k].push_back(s);
+                     by_j[k].push_back(static_cast<std::uint32_t>(i));
                    }
                  },
                  {});
+    std::size_t total = 0;
+    for (const auto& v : by_j) total += v.size();
     std::vector<PcSet> c2;
-    for (auto& v : by_j) c2.insert(c2.end(), v.begin(), v.end());
+    c2.reserve(total);
+    for (std::size_t k = 0; k < by_j.size(); ++k) {
+      const Pc& y = valid[0][singles_paired + k].first[0];
+      for (std::uint32_t i : by_j[k]) c2.push_back(PcSet({valid[0][i].first[0], y}));
+      std::vector<std::uint32_t>().swap(by_j[k]);
+    }
     singles_paired = n;
     return c2;
   };
   auto pairs_level = [&] {
-    const std::vector<PcSet> c2 = build_pairs();
-    run_level(1, c2, seeds_from_subsets, first_pair_round ? opt.first_pairs : nullptr);
+    run_level(1, build_pairs(), seeds_from_subsets, first_pair_round ? opt.first_pairs : nullptr);
     first_pair_round = false;
   };
   std::size_t pairs_tripled = 0;  // valid pairs when the triples were last built
@@ -600,7 +611,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
       }
     }
     pairs_tripled = valid[1].size();
-    run_level(2, c3, seeds_from_subsets);
+    run_level(2, std::move(c3), seeds_from_subsets);
   };
 
   // Closure by motion (explore.hpp): from every witness, translations and rotations that keep
@@ -704,10 +715,9 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   // part in the levels above it like any other (a CF's subsets need not be found first).
   if (opt.shard.count > 0) {
     // One shard of the first level-2 round: its candidates only, results by index.
-    const std::vector<PcSet> c2 = opt.max_pcs >= 2 ? build_pairs() : std::vector<PcSet>{};
     const int index = opt.shard.index;
     std::vector<PcSet> reps;
-    const OrbitGroups orbits = orbits_of(c2);
+    const OrbitGroups orbits = orbits_of(opt.max_pcs >= 2 ? build_pairs() : std::vector<PcSet>{});
     for (std::size_t o = 0; o < orbits.size(); ++o) reps.push_back(orbits.member(o, 0));
     out.first_pair_candidates = reps.size();
     std::vector<std::size_t> mine;
