@@ -173,7 +173,9 @@ try {
   const first = await rp.evaluate(() => ({ tick: window.cfViewer.state.replay.tick, pose: window.cfViewer.poseA() }));
   const px0 = await pixels(rp);
   await rp.click('#play');
-  await rp.waitForTimeout(1500);
+  // Until the replay is past tick 10, not for a fixed time: headless Chromium renders in
+  // software, and on a loaded 2-core machine a frame can take most of a second.
+  await rp.waitForFunction(() => window.cfViewer.state.replay.tick > 10, null, { timeout: 30000 }).catch(() => {});
   await rp.click('#play');  // pause
   const later = await rp.evaluate(() => ({ tick: window.cfViewer.state.replay.tick, pose: window.cfViewer.poseA(),
     selected: window.cfViewer.state.selected, arrows: window.cfViewer.arrows(), info: document.querySelector('#tick-info').textContent }));
