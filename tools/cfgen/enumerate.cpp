@@ -269,9 +269,9 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     }
   };
   // The candidates grouped by orbit, each orbit's members in candidate order, the orbits in
-  // the order of their first member. Flat (members, and where each orbit starts): a large
-  // pair without symmetry has tens of millions of candidates, each its own orbit.
-  // Takes the candidates: a large pair's are hundreds of MB, not to be held twice.
+  // the order of their first member. Flat (members, and where each orbit starts), and built
+  // from the candidates it takes with one copy: a large pair has tens of millions of them,
+  // hundreds of MB.
   auto orbits_of = [&](std::vector<PcSet> cands) {
     OrbitGroups g;
     if (sym.size() == 1) {
@@ -280,25 +280,27 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
       for (std::size_t i = 0; i < g.first.size(); ++i) g.first[i] = i;
       return g;
     }
-    std::vector<std::vector<PcSet>> orbits;
-    // Every image of each orbit met so far, with its orbit: one pass over the symmetries per
-    // orbit, not per candidate.
+    // Each candidate's orbit, numbered as first met. Every image of each orbit met so far is
+    // entered with its number: one pass over the symmetries per orbit, not per candidate.
+    std::vector<std::size_t> orbit(cands.size());
+    std::size_t orbits = 0;
     std::unordered_map<PcSet, std::size_t, PcSetHash> orbit_of;
-    for (const PcSet& s : cands) {
-      auto it = orbit_of.find(s);
+    for (std::size_t i = 0; i < cands.size(); ++i) {
+      auto it = orbit_of.find(cands[i]);
       if (it == orbit_of.end()) {
-        for (std::size_t k = 0; k < sym.size(); ++k)
-          orbit_of.emplace(sym.image(s, k), orbits.size());
-        orbits.emplace_back();
-        it = orbit_of.find(s);
+        for (std::size_t k = 0; k < sym.size(); ++k) orbit_of.emplace(sym.image(cands[i], k), orbits);
+        ++orbits;
+        it = orbit_of.find(cands[i]);
       }
-      orbits[it->second].push_back(s);
+      orbit[i] = it->second;
     }
-    g.first.push_back(0);
-    for (const auto& o : orbits) {
-      g.members.insert(g.members.end(), o.begin(), o.end());
-      g.first.push_back(g.members.size());
-    }
+    // Counting sort by orbit, stable: the members of orbit o at [first[o], first[o + 1]).
+    g.first.assign(orbits + 1, 0);
+    for (std::size_t o : orbit) ++g.first[o + 1];
+    for (std::size_t o = 1; o <= orbits; ++o) g.first[o] += g.first[o - 1];
+    std::vector<std::size_t> next(g.first.begin(), g.first.end() - 1);
+    g.members.resize(cands.size());
+    for (std::size_t i = 0; i < cands.size(); ++i) g.members[next[orbit[i]]++] = cands[i];
     return g;
   };
 
