@@ -23,19 +23,19 @@ constexpr int kMaxShards = 4096;
 // --quiet, which do not change a byte of it).
 nlohmann::json options_json(const GenerateArgs& a) {
   nlohmann::json o = {{"max_pcs", a.max_pcs},
-          {"symmetry", a.symmetry},
-          {"touch_tol_rel", a.rel.touch_tol},
-          {"min_clearance_rel", a.rel.min_clearance},
-          {"good_clearance_rel", a.rel.good_clearance},
-          {"min_margin_rel", a.rel.min_margin},
-          {"angle_margin_rad", a.search.angle_margin},
-          {"theta_samples", a.search.theta_samples},
-          {"max_rotations", a.search.max_rotations},
-          {"max_piece_combinations", a.search.max_piece_combinations},
-          {"units_a", a.load_a.units},
-          {"units_b", a.load_b.units},
-          {"coplanar_tol_a", a.load_a.coplanar_rel_tol},
-          {"coplanar_tol_b", a.load_b.coplanar_rel_tol}};
+                      {"symmetry", a.symmetry},
+                      {"touch_tol_rel", a.rel.touch_tol},
+                      {"min_clearance_rel", a.rel.min_clearance},
+                      {"good_clearance_rel", a.rel.good_clearance},
+                      {"min_margin_rel", a.rel.min_margin},
+                      {"angle_margin_rad", a.search.angle_margin},
+                      {"theta_samples", a.search.theta_samples},
+                      {"max_rotations", a.search.max_rotations},
+                      {"max_piece_combinations", a.search.max_piece_combinations},
+                      {"units_a", a.load_a.units},
+                      {"units_b", a.load_b.units},
+                      {"coplanar_tol_a", a.load_a.coplanar_rel_tol},
+                      {"coplanar_tol_b", a.load_b.coplanar_rel_tol}};
   // Only when set, so that the fingerprints of runs without it are those of earlier builds.
   if (a.thorough) o["thorough"] = true;
   return o;
