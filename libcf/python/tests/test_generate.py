@@ -9,16 +9,23 @@ from conftest import DATA, tool
 
 pytestmark = pytest.mark.skipif(not cf.HAVE_TOOLS, reason="built without the CGAL tools")
 
+CUBE = DATA / "models" / "cube.off"
+
+
+def cfgen_bytes(tmp_path, *flags):
+    """The bytes `cfgen --quiet --max-pcs 1 -j 2 FLAGS cube.off cube.off` writes."""
+    ref = tmp_path / "cfgen.json"
+    subprocess.run([tool("CF_CFGEN"), "--quiet", *flags, "--max-pcs", "1", "-j", "2", str(CUBE), str(CUBE),
+                    "-o", str(ref)], check=True, capture_output=True)
+    return ref.read_bytes()
+
 
 def test_generate_equals_cfgen(tmp_path):
     # The cube against itself, single PCs only: about 5 s per run on 2 threads.
-    a = b = DATA / "models" / "cube.off"
+    a = b = CUBE
     out = tmp_path / "py.json"
     g = cf.generate(a, b, out, max_pcs=1, threads=2)
-    ref = tmp_path / "cfgen.json"
-    subprocess.run([tool("CF_CFGEN"), "--quiet", "--max-pcs", "1", "-j", "2", str(a), str(b), "-o", str(ref)],
-                   check=True, capture_output=True)
-    assert out.read_bytes() == ref.read_bytes()
+    assert out.read_bytes() == cfgen_bytes(tmp_path)
     # Every face, edge and vertex pair of the cube that can touch alone: f-f 6 x 6, e-f and
     # f-e 12 x 6 each, v-f and f-v 8 x 6 each, e-e between the 12 x 12 edges (non-parallel).
     types = {}
@@ -33,13 +40,10 @@ def test_generate_equals_cfgen(tmp_path):
 def test_generate_without_symmetry(tmp_path):
     # symmetry=False is cfgen --no-symmetry: every set searched, the same CFs as one search
     # per orbit of the cube's 48 symmetries against itself.
-    a = b = DATA / "models" / "cube.off"
+    a = b = CUBE
     out = tmp_path / "plain.json"
     plain = cf.generate(a, b, out, max_pcs=1, threads=2, symmetry=False)
-    ref = tmp_path / "cfgen.json"
-    subprocess.run([tool("CF_CFGEN"), "--quiet", "--no-symmetry", "--max-pcs", "1", "-j", "2", str(a), str(b),
-                    "-o", str(ref)], check=True, capture_output=True)
-    assert out.read_bytes() == ref.read_bytes()
+    assert out.read_bytes() == cfgen_bytes(tmp_path, "--no-symmetry")
     by_orbit = cf.generate(a, b, max_pcs=1, threads=2)
 
     def sets(g):
@@ -52,13 +56,10 @@ def test_generate_without_symmetry(tmp_path):
 def test_generate_thorough(tmp_path):
     # thorough=True is cfgen --thorough: every set searched, then every image of each CF added
     # (the cube against itself: the per-set search already finds every single PC).
-    a = b = DATA / "models" / "cube.off"
+    a = b = CUBE
     out = tmp_path / "thorough.json"
     g = cf.generate(a, b, out, max_pcs=1, threads=2, thorough=True)
-    ref = tmp_path / "cfgen.json"
-    subprocess.run([tool("CF_CFGEN"), "--quiet", "--thorough", "--max-pcs", "1", "-j", "2", str(a), str(b),
-                    "-o", str(ref)], check=True, capture_output=True)
-    assert out.read_bytes() == ref.read_bytes()
+    assert out.read_bytes() == cfgen_bytes(tmp_path, "--thorough")
     assert len(g.cfs) == 420
     assert '"thorough": true' in out.read_text()
     with pytest.raises(cf.Error, match=r"^generate: symmetry=False excludes thorough=True$"):
