@@ -9,6 +9,7 @@
 #include "cfgen/generate.hpp"
 #include "fixtures.hpp"
 #include "mesh/model_loader.hpp"
+#include "ngon_models.hpp"
 #include "scratch.hpp"
 
 #include <catch2/catch.hpp>
@@ -226,41 +227,6 @@ TEST_CASE(
   CHECK(by_symmetry * 10 > with.cfs.size() * 9);
 }
 
-namespace {
-
-// OFF text of an n-gon prism of circumradius r along y in [y0, y1]; with r_in > 0, a tube
-// with an n-gon hole of circumradius r_in (its rings' quads are merged into one face with a
-// hole by the loader).
-std::string ngon_off(int n, double r, double r_in, double y0, double y1) {
-  std::ostringstream os;
-  os.precision(17);
-  const bool tube = r_in > 0;
-  os << "OFF\n" << (tube ? 4 * n : 2 * n) << ' ' << (tube ? 4 * n : n + 2) << " 0\n";
-  // Rings: outer bottom, outer top, then (a tube) inner bottom, inner top; n vertices each.
-  for (int ring = 0; ring < (tube ? 4 : 2); ++ring) {
-    const double rad = ring < 2 ? r : r_in, y = ring % 2 == 0 ? y0 : y1;
-    for (int i = 0; i < n; ++i)
-      os << rad * std::cos(2 * M_PI * i / n) << ' ' << y << ' ' << rad * std::sin(2 * M_PI * i / n) << '\n';
-  }
-  for (int i = 0, j = 1; i < n; ++i, j = (i + 1) % n) os << "4 " << i << ' ' << n + i << ' ' << n + j << ' ' << j << '\n';
-  if (!tube) {
-    os << n;
-    for (int i = 0; i < n; ++i) os << ' ' << i;
-    os << '\n' << n;
-    for (int i = n - 1; i >= 0; --i) os << ' ' << n + i;
-    os << '\n';
-    return os.str();
-  }
-  for (int i = 0, j = 1; i < n; ++i, j = (i + 1) % n) {
-    os << "4 " << 2 * n + i << ' ' << 2 * n + j << ' ' << 3 * n + j << ' ' << 3 * n + i << '\n';
-    os << "4 " << i << ' ' << j << ' ' << 2 * n + j << ' ' << 2 * n + i << '\n';
-    os << "4 " << n + i << ' ' << 3 * n + i << ' ' << 3 * n + j << ' ' << n + j << '\n';
-  }
-  return os.str();
-}
-
-}  // namespace
-
 TEST_CASE(
     "symmetry: --thorough searches every set, then closes the graph under the symmetries: on a "
     "square peg in its hole it holds every CF of both other modes",
@@ -268,10 +234,8 @@ TEST_CASE(
   // A square peg (r 10 mm, 40 mm long) in a tube whose hole is 5% wider: 16 and 16 maps.
   // Searching every set leaves most orbits partial here, and one search per orbit misses
   // orbits that the per-set search meets by motion.
-  cf::tools::LoadOptions load;
-  cf::test::AnalysedPair p(
-      cf::tools::load_model(cf::test::write_file("thorough_peg.off", ngon_off(4, 10, 0, -20, 20)), load),
-      cf::tools::load_model(cf::test::write_file("thorough_hole.off", ngon_off(4, 25, 10.5, 0, 20)), load));
+  const auto [peg, hole] = cf::test::ngon_peg_and_hole(4, "thorough");
+  cf::test::AnalysedPair p(cf::tools::load_model(peg, {}), cf::tools::load_model(hole, {}));
   cf::gen::EnumerateOptions opt = options_for(p);
   const cf::gen::Enumeration orbit = cf::gen::enumerate(p.ai, p.bi, opt);
   opt.use_symmetry = false;

@@ -38,6 +38,8 @@ constexpr std::size_t kOrbitTries = 4;
 // the images of the same. On the hexagonal pair 4 find 13 orbits more than 1 at 17% more
 // time, 16 one more than 4.
 constexpr std::size_t kWitnessesPerOrbit = 4;
+// Witnesses of neighbouring CFs a failed set is searched again from, after the fixed point.
+constexpr std::size_t kNeighbourSeeds = 16;
 
 struct PcSetHash {
   std::size_t operator()(const PcSet& s) const { return s.hash(); }
@@ -102,6 +104,9 @@ TaskResult run_task(const WitnessSearch& search, const Task& task) {
   switch (task.kind) {
     case Task::Kind::kFind:
       r.witness = search.find(task.pcs, task.seeds);
+      break;
+    case Task::Kind::kFindNear:
+      r.witness = search.find(task.pcs, task.seeds, true);
       break;
     case Task::Kind::kFindOrRefine:
       r.witness = search.find(task.pcs, {task.pose.R_BA});
@@ -322,6 +327,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     opt.progress(ev);
   };
   int motion_rounds = 0;
+  int neighbour_rounds = 0;
   bool first_pair_round = true;  // the first level-2 round (the one --shard splits)
 
   // Every stage of the run, in order: its n tasks cut into chunks, each found in the
@@ -743,13 +749,65 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     finished(ev, t0, std::to_string(found) + " valid");
     return out;
   }
+  // Failed sets near their neighbours (after each fixed point): a CF valid only in a sliver
+  // of orientations (a peg tilted across a hole's rim) is missed by the search's samples, but
+  // the CFs one change away (one PC replaced by a neighbouring PC, cf::neighbouring_pcs) hold
+  // on either side of it, at rotations a few hundredths of a radian from the one it needs.
+  // Each failed set with such CFs, one per orbit, is searched again from their witnesses
+  // alone, climbing past the obstacles met there (WitnessSearch::find, seeds_only). A set is
+  // searched so once: the rounds add CFs, never take one away, so a graph holds every CF the
+  // fixed point before them found. Returns the number of CFs found.
+  std::unordered_set<PcSet, PcSetHash> near_searched;
+  std::map<Pc, std::vector<Pc>> pc_neighbours;
+  auto neighbour_round = [&]() -> std::size_t {
+    const auto t0 = Clock::now();
+    std::vector<Task> tasks;
+    std::unordered_set<PcSet, PcSetHash> orbits;
+    for (const PcSet& s : failed) {
+      if (witness_rot.count(s) || near_searched.count(s) || !orbits.insert(sym.canonical(s)).second)
+        continue;
+      Task t;
+      t.kind = Task::Kind::kFindNear;
+      t.pcs = s;
+      for (int k = 0; k < s.size() && t.seeds.size() < kNeighbourSeeds; ++k) {
+        auto nb = pc_neighbours.find(s[k]);
+        if (nb == pc_neighbours.end())
+          nb = pc_neighbours.emplace(s[k], cf::neighbouring_pcs(s[k], A, B)).first;
+        for (const Pc& q : nb->second) {
+          PcSet n;
+          for (int j = 0; j < s.size(); ++j) n.insert(j == k ? q : s[j]);
+          if (n.size() != s.size()) continue;
+          if (auto it = witness_rot.find(n);
+              it != witness_rot.end() && t.seeds.size() < kNeighbourSeeds)
+            t.seeds.push_back(it->second);
+        }
+      }
+      if (t.seeds.empty()) continue;
+      near_searched.insert(s);
+      tasks.push_back(std::move(t));
+    }
+    const std::string stage = "neighbour round " + std::to_string(++neighbour_rounds);
+    ProgressEvent ev{stage, "failed sets", 0, tasks.size(), 0, false, {}};
+    const std::vector<TaskResult> r = run_stage(tasks, &ev, t0);
+    std::size_t found = 0;
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+      if (!r[i].witness.found || witness_rot.count(tasks[i].pcs)) continue;
+      const int level = tasks[i].pcs.size() - 1;
+      const std::size_t before = valid[level].size();
+      accept(level, tasks[i].pcs, r[i].witness);
+      out.levels[level].by_neighbours += valid[level].size() - before;
+      found += valid[level].size() - before;
+    }
+    finished(ev, t0, std::to_string(found) + " new CFs");
+    return found;
+  };
   for (;;) {
     if (opt.max_pcs >= 2) pairs_level();
     if (opt.max_pcs >= 3) triples_level();
     motion_closure();
     const bool grew = (opt.max_pcs >= 2 && valid[0].size() > singles_paired) ||
                       (opt.max_pcs >= 3 && valid[1].size() > pairs_tripled);
-    if (!grew) break;
+    if (!grew && neighbour_round() == 0) break;
   }
   // Orbit closure (--thorough): every member of every orbit met, at the image of the witness
   // found. The search above found each CF on its own, from its own seeds and motions; the

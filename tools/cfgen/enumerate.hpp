@@ -29,10 +29,11 @@ struct Task {
     kFind,          // WitnessSearch::find(pcs, seeds)
     kFindOrRefine,  // find(pcs, {pose.R_BA}), else refine(pcs, pose): a set met by motion
     kExplore,       // the motions from the witness `pose` of the CF `pcs` (explore.hpp)
+    kFindNear,      // find(pcs, seeds, seeds_only): a failed set near its neighbours' witnesses
   };
   Kind kind = Kind::kFind;
   PcSet pcs;
-  std::vector<Mat3> seeds;  // kFind
+  std::vector<Mat3> seeds;  // kFind, kFindNear
   Pose pose;                // kFindOrRefine, kExplore
 };
 
@@ -107,6 +108,7 @@ struct LevelStats {
   double seconds = 0;
   std::size_t by_motion = 0;   // of the valid ones, found by the closure by motion
   std::size_t by_symmetry = 0;  // of the valid ones, images of another's witness
+  std::size_t by_neighbours = 0;  // of the valid ones, found near their neighbours' witnesses
 };
 
 struct Enumeration {

@@ -123,7 +123,8 @@ int run_generate(const GenerateArgs& args) {
     levels.push_back({{"candidates", l.candidates},
                       {"valid", l.valid},
                       {"found_by_motion", l.by_motion},
-                      {"found_by_symmetry", l.by_symmetry}});
+                      {"found_by_symmetry", l.by_symmetry},
+                      {"found_by_neighbours", l.by_neighbours}});
   // The undecided sets, in canonical order; only the first kUndecidedListed are listed, so
   // that a pair with many keeps a file of reasonable size (the count is always exact).
   constexpr std::size_t kUndecidedListed = 100;

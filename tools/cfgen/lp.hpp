@@ -14,9 +14,10 @@ namespace cf::gen {
 
 /// minimise c.x subject to rows (a_i . x  REL_i  b_i) and per-variable bounds.
 struct LinearProgram {
-  /// At most this many variables: the witness search's programs have ten at most, and the
-  /// solver keeps its work in fixed-size storage (no allocation per program).
-  static constexpr int kMaxVars = 12;
+  /// At most this many variables: the witness search's programs have ten at most, thirteen
+  /// with a turn's three (WitnessSearch::obstacle_step), and the solver keeps its work in
+  /// fixed-size storage (no allocation per program).
+  static constexpr int kMaxVars = 14;
   enum class Rel { kLessEq, kEq, kGreaterEq };
   /// A row's sparse coefficients (variable, value), stored inline: a program is built and
   /// solved some million times in a run, and a heap block per row was a tenth of its time.

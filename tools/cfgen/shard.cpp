@@ -187,7 +187,8 @@ std::vector<gen::Task> parse_tasks(const nlohmann::json& j, const Reader& rd) {
   std::vector<gen::Task> out;
   for (const nlohmann::json& t : j) {
     if (!t.is_array() || t.size() != 4 || !t[0].is_number_unsigned() ||
-        t[0].get<unsigned>() > static_cast<unsigned>(gen::Task::Kind::kExplore) || !t[2].is_array())
+        t[0].get<unsigned>() > static_cast<unsigned>(gen::Task::Kind::kFindNear) ||
+        !t[2].is_array())
       rd.bad("expected a task [kind, PCs, seeds, pose]");
     gen::Task task;
     task.kind = static_cast<gen::Task::Kind>(t[0].get<int>());

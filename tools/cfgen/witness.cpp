@@ -596,7 +596,7 @@ AffinePoint plus_t(Vec3 p0, double sign = 1.0) {
 }  // namespace
 
 LinearProgram WitnessSearch::build_lp(const PcSet& pcs, const Mat3& R,
-                                      const std::vector<int>& pieces) const {
+                                      const std::vector<int>& pieces, int extra_vars) const {
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
   int nv = 4;  // t (0..2), s (3), then per-PC auxiliaries
@@ -604,7 +604,7 @@ LinearProgram WitnessSearch::build_lp(const PcSet& pcs, const Mat3& R,
     nv += pc.type == PcType::kEF || pc.type == PcType::kFE ? 1
           : pc.type == PcType::kFF || pc.type == PcType::kEE ? 2
                                                               : 0;
-  LinearProgram lp(nv);
+  LinearProgram lp(nv + extra_vars);
   lp.rows.reserve(64);  // a few dozen rows and the cuts translations() adds: no regrowth
   const int S = 3;
   lp.lower[S] = {true, 0.0};
@@ -821,6 +821,108 @@ bool WitnessSearch::separating_cut(const Mat3& R, const Vec3& t, const Obstacle&
       for (const Vec3& y : db) try_axis(w - w.dot(y) * y);
     }
   return best_move < std::numeric_limits<double>::infinity();
+}
+
+double WitnessSearch::obstacle_margin(const PcSet& pcs, const Mat3& R,
+                                      const std::vector<int>& pieces,
+                                      const std::vector<Obstacle>& obstacles, const Vec3& t_axes,
+                                      LpVector& x, std::vector<LinearProgram::Row>& cuts) const {
+  constexpr double kNone = -std::numeric_limits<double>::infinity();
+  cuts.clear();
+  LinearProgram lp = build_lp(pcs, R, pieces);
+  lp.lower[3] = {true, -scale_};
+  for (const Obstacle& o : obstacles) {
+    LinearProgram::Row cut;
+    if (!separating_cut(R, t_axes, o, cut)) return kNone;
+    cuts.push_back(cut);
+    // m.t >= rhs becomes m.t - s >= rhs - min_margin: the gap beyond the cut is the margin.
+    cut.a.push_back({3, -1.0});
+    cut.b -= p_.min_margin;
+    lp.rows.push_back(cut);
+  }
+  const LpResult r = solve(lp);
+  if (r.status != LpResult::Status::kOptimal) return kNone;
+  x = r.x;
+  return r.x[3];
+}
+
+bool WitnessSearch::obstacle_step(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces,
+                                  const std::vector<Obstacle>& obstacles, const LpVector& x,
+                                  const std::vector<LinearProgram::Row>& cuts, double turn,
+                                  Mat3& next) const {
+  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
+  if (c.align.size() >= 2 || (c.align.size() == 1 && !c.perp.empty())) return false;  // fixed
+  // The contact rows at R and at R turned by h about each axis: the rows keep their order and
+  // their variables, so the difference of each coefficient and right side, over h, is its
+  // derivative along that turn (the rows are linear in R). A row a(R).x REL b(R) becomes, to
+  // first order in the turn w, a.x + sum_k w_k (da_k.x0 - db_k) REL b, with x0 the solution
+  // at R.
+  constexpr double kH = 1e-6;  // rad
+  LinearProgram lp = build_lp(pcs, R, pieces, 3);
+  const int W = lp.num_vars - 3;
+  const std::size_t contact_rows = lp.rows.size();
+  auto value = [&](const LinearProgram::Coefs& a) {
+    double v = 0;
+    for (const auto& [j, cj] : a) v += cj * x[j];
+    return v;
+  };
+  std::vector<std::array<double, 3>> dw(contact_rows);  // d(row)/dw, zero-initialised
+  for (int k = 0; k < 3; ++k) {
+    const LinearProgram turned = build_lp(pcs, axis_angle(Vec3::Unit(k), kH) * R, pieces);
+    if (turned.rows.size() != contact_rows) return false;
+    for (std::size_t i = 0; i < contact_rows; ++i)
+      dw[i][static_cast<std::size_t>(k)] =
+          ((value(turned.rows[i].a) - value(lp.rows[i].a)) - (turned.rows[i].b - lp.rows[i].b)) /
+          kH;
+  }
+  for (std::size_t i = 0; i < contact_rows; ++i)
+    for (int k = 0; k < 3; ++k)
+      if (dw[i][static_cast<std::size_t>(k)] != 0.0)
+        lp.rows[i].a.push_back({W + k, dw[i][static_cast<std::size_t>(k)]});
+  // Obstacles: each cut's axis m kept fixed in the world (a fixed axis still proves the
+  // elements apart at any pose); every point p of A's element, turned with A, stays beyond B's
+  // extent on it: m.(R p + w x R p + t) - s >= max_B m.q + 2 min_clearance - min_margin.
+  const Polyhedron& A = *A_.model;
+  for (std::size_t i = 0; i < obstacles.size() && i < cuts.size(); ++i) {
+    Vec3 m = Vec3::Zero();
+    for (const auto& [j, cj] : cuts[i].a) m[j] = cj;
+    const std::vector<Vec3> pa = closure_points(A, obstacles[i].ka, obstacles[i].a);
+    double a_min = std::numeric_limits<double>::infinity();
+    for (const Vec3& p : pa) a_min = std::min(a_min, m.dot(R * p));
+    const double b_max = cuts[i].b - 2 * p_.min_clearance + a_min;
+    for (const Vec3& p : pa) {
+      const Vec3 Rp = R * p;
+      const Vec3 g = Rp.cross(m);
+      LinearProgram::Coefs row{{0, m.x()}, {1, m.y()}, {2, m.z()}, {3, -1.0}};
+      for (int k = 0; k < 3; ++k) row.push_back({W + k, g[k]});
+      lp.add(row, Rel::kGreaterEq, b_max + 2 * p_.min_clearance - p_.min_margin - m.dot(Rp));
+    }
+  }
+  // The rotational conditions, to first order: an aligned normal b allows turns about b only;
+  // (R u).w == 0 becomes w.((R u) x w) == -(R u).w.
+  for (const auto& [a, b] : c.align) {
+    Vec3 e1 = b.unitOrthogonal(), e2 = b.cross(e1).normalized();
+    lp.add({{W, e1.x()}, {W + 1, e1.y()}, {W + 2, e1.z()}}, Rel::kEq, 0.0);
+    lp.add({{W, e2.x()}, {W + 1, e2.y()}, {W + 2, e2.z()}}, Rel::kEq, 0.0);
+  }
+  for (const auto& [u, w] : c.perp) {
+    const Vec3 Ru = R * u;
+    const Vec3 g = Ru.cross(w);
+    lp.add({{W, g.x()}, {W + 1, g.y()}, {W + 2, g.z()}}, Rel::kEq, -Ru.dot(w));
+  }
+  lp.lower[3] = {true, -scale_};
+  for (int k = 0; k < 3; ++k) {
+    lp.lower[static_cast<std::size_t>(W + k)] = {true, -turn};
+    lp.upper[static_cast<std::size_t>(W + k)] = {true, turn};
+  }
+  const LpResult r = solve(lp);
+  if (r.status != LpResult::Status::kOptimal) return false;
+  const Vec3 w(r.x[W], r.x[W + 1], r.x[W + 2]);
+  const double ang = w.norm();
+  if (!(ang > 0)) return false;
+  next = axis_angle(w / ang, ang) * R;
+  if (!c.perp.empty() && !project_perp(c, next)) return false;
+  return true;
 }
 
 std::pair<Vec3, double> WitnessSearch::contact_plane(const Pc& pc, const Pose& pose) const {
@@ -1652,14 +1754,23 @@ bool WitnessSearch::refuted(const PcSet& pcs) const {
   return true;
 }
 
-Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) const {
+Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds,
+                            bool seeds_only) const {
   Witness best;
   if (!plausible(pcs)) return best;
-  const std::vector<Mat3> rots = rotation_candidates(pcs, seeds);
+  const std::vector<Mat3> rots = rotation_candidates(pcs, seeds, !seeds_only);
   if (debug_) std::cerr << "find " << to_string(pcs[0]) << (pcs.size() > 1 ? " +" : "") << ": " << rots.size() << " rotations\n";
   // Face-piece slots, in the order solve_translation consumes them.
   const std::vector<int> slot_sizes = piece_slots(pcs);
   std::vector<Mat3> near;  // rotations where the contacts held but the pose failed
+  // Poses where the contacts held and the centred translation met another pair of elements.
+  struct Blocked {
+    Mat3 R;
+    std::vector<int> pieces;
+    Vec3 t;
+    Obstacle obstacle;
+  };
+  std::vector<Blocked> blocked;
   // The pairs recent poses failed on, newest first. A pose whose verdict matters only if it
   // is a witness (every translation but the first of a rotation's pass or of a cut, whose
   // obstacle steers the cuts and the skipping of the pass's other translations) is refused without
@@ -1731,6 +1842,7 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
     }
     return false;
   };
+  constexpr std::size_t kMaxBlocked = 4;  // blocked poses the last stage climbs from
   auto try_rotation = [&](const Mat3& R) {
     std::vector<int> choice(slot_sizes.size(), 0);
     for (int combo = 0; combo < p_.max_piece_combinations; ++combo) {
@@ -1769,6 +1881,8 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
           if (clearance >= p_.min_clearance) break;  // a witness for this rotation; try others
         }
         if (ts.empty() || best.found) break;
+        if (pass == 0 && first_obstacle.set && blocked.size() < kMaxBlocked)
+          blocked.push_back({R, choice, ts.front(), first_obstacle});
         // The contacts were placed but the centred translation ran into another pair of
         // elements: move away from it (a half-space of translations where the pair is apart)
         // and place the contacts again, a few obstacles deep.
@@ -1782,9 +1896,105 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
     }
     return false;
   };
+  const double min_local = std::sin(p_.angle_margin);
+  // Past the obstacles: a set whose contacts hold only in a thin range of orientations (a
+  // peg tilted across a hole's rim, its corner near the far wall) is blocked at every
+  // rotation sampled above, by pairs of elements that a small turn would clear. From each
+  // blocked pose, climb over the rotations the conditions leave free, with the translation
+  // chosen by a program that keeps the contacts inside their elements and pushes every
+  // obstacle met so far beyond its separating cut (obstacle_margin); where that margin
+  // reaches min_margin, try the program's translations, and when one meets a new pair, add
+  // it and climb on.
+  constexpr int kMaxObstacles = 8;     // pairs pushed apart at once
+  constexpr int kMaxEvaluations = 96;  // programs solved per blocked pose
+  constexpr double kFirstTurn = 0.1;   // rad, the largest turn about an axis
+  constexpr double kLastTurn = 1e-3;   // rad
+  auto past_obstacles = [&]() -> Witness {
+    for (const Blocked& b : blocked) {
+      std::vector<Obstacle> obstacles{b.obstacle};
+      auto known = [&](const Obstacle& o) {
+        return std::any_of(obstacles.begin(), obstacles.end(), [&](const Obstacle& x) {
+          return x.ka == o.ka && x.kb == o.kb && x.a == o.a && x.b == o.b;
+        });
+      };
+      Mat3 R = b.R;
+      LpVector x, xq;
+      std::vector<LinearProgram::Row> cuts, cq;
+      double m = obstacle_margin(pcs, R, b.pieces, obstacles, b.t, x, cuts);
+      if (!std::isfinite(m)) continue;
+      double turn = kFirstTurn;
+      for (int evals = 1; evals < kMaxEvaluations;) {
+        if (m >= p_.min_margin) {
+          double margin = 0;
+          const std::vector<Vec3> ts = translations(pcs, R, b.pieces, margin, false, cuts);
+          if (debug_)
+            std::cerr << "  past obstacles: " << obstacles.size() << " cleared, " << ts.size()
+                      << " translations\n";
+          Obstacle next;
+          for (const Vec3& tt : ts) {
+            Pose pose;
+            pose.R_BA = R;
+            pose.t_BA = tt;
+            FailedPair f;
+            const double clearance = verify_remembering(pose, nullptr, f);
+            if (&tt == &ts.front()) next = f.obstacle();
+            if (clearance >= p_.min_clearance) {
+              best.found = true;
+              best.pose = pose;
+              best.clearance = clearance;
+              best.margin = margin;
+              return best;
+            }
+          }
+          if (!next.set || known(next) || static_cast<int>(obstacles.size()) >= kMaxObstacles)
+            break;
+          obstacles.push_back(next);
+          const Vec3 t = x.head<3>();
+          m = obstacle_margin(pcs, R, b.pieces, obstacles, t, x, cuts);
+          ++evals;
+          if (!std::isfinite(m)) break;
+          turn = kFirstTurn;
+          continue;
+        }
+        if (turn < kLastTurn) break;
+        // The step of the program linearised in the turn first; where it does not raise the
+        // margin (at a kink of the smallest margin, or where a cut's best axis changes), the
+        // turns about each axis the conditions leave free.
+        std::vector<Mat3> tries;
+        if (Mat3 Q; obstacle_step(pcs, R, b.pieces, obstacles, x, cuts, turn, Q))
+          tries.push_back(Q);
+        for (const Mat3& Q : rotation_steps(pcs, R, turn)) tries.push_back(Q);
+        bool moved = false;
+        for (const Mat3& Q : tries) {
+          if (evals >= kMaxEvaluations) break;
+          ++evals;
+          if (local_margin(pcs, Q) <= min_local) continue;
+          const double mq = obstacle_margin(pcs, Q, b.pieces, obstacles, x.head<3>(), xq, cq);
+          if (mq > m) {
+            m = mq;
+            R = Q;
+            x = xq;
+            cuts.swap(cq);
+            moved = true;
+            break;
+          }
+        }
+        turn = moved ? std::min(2 * turn, kFirstTurn) : 0.5 * turn;
+      }
+      if (debug_) {
+        std::cerr << "  past obstacles: margin " << m << " with " << obstacles.size()
+                  << " obstacles:";
+        for (const Obstacle& o : obstacles)
+          std::cerr << " " << kind_name(o.ka) << o.a << "-" << kind_name(o.kb) << o.b;
+        std::cerr << "\n";
+      }
+    }
+    return best;
+  };
   for (const Mat3& R : rots)
     if (try_rotation(R)) return best;
   if (best.found) return best;
+  if (seeds_only) return past_obstacles();
   // Two point PCs: rotations built to place both contacts inside their elements, where the
   // spread above left too few locally admissible ones (two e-e crossings) or none that
   // fits (a peg's corner just inside a hole's rim).
@@ -1802,7 +2012,6 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
     constexpr double kFirstStep = 0.2;    // rad
     constexpr double kLastStep = 1e-2;    // rad
     const std::vector<int> first_pieces(slot_sizes.size(), 0);
-    const double min_local = std::sin(p_.angle_margin);
     // Lexicographic: first the local non-penetration slack (a cosine) until it is positive,
     // then the contacts' margin inside their elements (mm).
     auto score = [&](const Mat3& R) {
@@ -1873,7 +2082,6 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
   constexpr int kWalkSteps = 60;      // up to 1.8 rad each way
   constexpr int kInside = 4;          // rotations tried inside each end, kWalkStep apart
   const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
-  const double min_local = std::sin(p_.angle_margin);
   std::vector<Mat3> ends;
   for (const Mat3& R : near)
     for (const std::vector<Mat3>& path : walk_family(c, R, kWalkStep, kWalkSteps)) {
@@ -1885,7 +2093,8 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds) co
     }
   for (const Mat3& R : ends)
     if (try_rotation(R)) return best;
-  return best;
+  if (best.found) return best;
+  return past_obstacles();
 }
 
 void WitnessSearch::freedoms(const PcSet& pcs, const Pose& pose, CfRecord& out) const {

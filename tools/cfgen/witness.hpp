@@ -42,7 +42,9 @@ class WitnessSearch {
   WitnessSearch(const ModelInfo& a, const ModelInfo& b, const SearchParams& p);
 
   /// Searches a witness for `pcs`, trying the seed rotations (witnesses of sub-sets) first.
-  Witness find(const PcSet& pcs, const std::vector<Mat3>& seeds) const;
+  /// With `seeds_only`, tries only the seeds (each projected onto the PCs' rotational
+  /// conditions) and climbs past the obstacles met there: a search near given rotations.
+  Witness find(const PcSet& pcs, const std::vector<Mat3>& seeds, bool seeds_only = false) const;
 
   /// Verifies a pose: exactly the PCs of `pcs` hold (every other touching element pair is
   /// dominated by one of them), locally without penetration, pairwise distinct contact
@@ -144,7 +146,9 @@ class WitnessSearch {
   // touch in open points and their tangent cones there are not disjoint (verify's test for a
   // PC or a pair a PC covers).
   bool overlap_at(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b, double d) const;
-  LinearProgram build_lp(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces) const;
+  // extra_vars: variables after the program's own, for the caller (no rows use them).
+  LinearProgram build_lp(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces,
+                         int extra_vars = 0) const;
   // The largest margin of the contacts inside their elements at rotation R, negative (down
   // to -scale) when they cannot be placed: how far R is from placing them. -inf when even
   // that fails (e.g. parallel contact planes).
@@ -174,6 +178,22 @@ class WitnessSearch {
   // edge cross products, edge-vertex and vertex-vertex directions of their closures) that
   // needs the smallest move from t. False when no axis separates them.
   bool separating_cut(const Mat3& R, const Vec3& t, const Obstacle& o, LinearProgram::Row& cut) const;
+  // The largest s such that, at rotation R, the contacts sit s inside their elements and each
+  // obstacle's two elements are s - min_margin farther apart than its separating cut asks
+  // (the axis chosen at translation t_axes): s >= min_margin places the contacts and clears
+  // every obstacle. -inf when no translation is feasible even with s negative or an obstacle
+  // has no separating axis. `t` receives the program's translation and `cuts` the cuts at R.
+  // `x` receives the program's solution (t, s, the contacts' parameters).
+  double obstacle_margin(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces,
+                         const std::vector<Obstacle>& obstacles, const Vec3& t_axes, LpVector& x,
+                         std::vector<LinearProgram::Row>& cuts) const;
+  // One step of the climb past obstacles: from rotation R with obstacle_margin's solution x
+  // and cuts, the turn (at most `turn` rad about each axis) that the program linearised in
+  // the turn says raises that margin most, kept on the rotational conditions. False when the
+  // conditions leave no turn or the program fails.
+  bool obstacle_step(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces,
+                     const std::vector<Obstacle>& obstacles, const LpVector& x,
+                     const std::vector<LinearProgram::Row>& cuts, double turn, Mat3& next) const;
 
   const ModelInfo& A_;
   const ModelInfo& B_;
