@@ -622,6 +622,15 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
     run_level(2, std::move(c3), seeds_from_subsets);
   };
 
+  // Sets the necessary conditions reject cannot be verified: not searched (most sets that
+  // motion meets have a contact on an element's boundary).
+  auto conditions_hold = [&](const PcSet& t) {
+    for (int x = 0; x < t.size(); ++x)
+      for (int y = x + 1; y < t.size(); ++y)
+        if (!pair_ok.compatible(t[x], t[y])) return false;
+    return search.plausible(t);
+  };
+
   // Closure by motion (explore.hpp): from every witness, translations and rotations that keep
   // some PCs and break the others, to the first contact. Sets met that are not in the graph yet are
   // searched (seeded with the rotation they were met at), and their own witnesses explored
@@ -673,14 +682,6 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
       std::vector<Discovery> fresh;
       std::unordered_set<PcSet, PcSetHash> pending;
       std::unordered_set<PcSet, PcSetHash> pending_orbits;  // one search per orbit a round
-      // Sets the necessary conditions reject cannot be verified: not searched (most are met
-      // with a contact on an element's boundary).
-      auto conditions_hold = [&](const PcSet& t) {
-        for (int x = 0; x < t.size(); ++x)
-          for (int y = x + 1; y < t.size(); ++y)
-            if (!pair_ok.compatible(t[x], t[y])) return false;
-        return search.plausible(t);
-      };
       for (const TaskResult& r : met)
         for (const Discovery& d : r.met)
           if (d.pcs.size() <= opt.max_pcs && !witness_rot.count(d.pcs) &&
@@ -759,33 +760,48 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   // fixed point before them found. Returns the number of CFs found.
   std::unordered_set<PcSet, PcSetHash> near_searched;
   std::map<Pc, std::vector<Pc>> pc_neighbours;
+  // The sets one change away from s (one PC replaced by a neighbouring PC), in a fixed order.
+  auto changes_of = [&](const PcSet& s, const std::function<void(const PcSet&)>& fn) {
+    for (int k = 0; k < s.size(); ++k) {
+      auto nb = pc_neighbours.find(s[k]);
+      if (nb == pc_neighbours.end())
+        nb = pc_neighbours.emplace(s[k], cf::neighbouring_pcs(s[k], A, B)).first;
+      for (const Pc& q : nb->second) {
+        PcSet n;
+        for (int j = 0; j < s.size(); ++j) n.insert(j == k ? q : s[j]);
+        if (n.size() == s.size()) fn(n);
+      }
+    }
+  };
   auto neighbour_round = [&]() -> std::size_t {
     const auto t0 = Clock::now();
     std::vector<Task> tasks;
     std::unordered_set<PcSet, PcSetHash> orbits;
-    for (const PcSet& s : failed) {
+    auto consider = [&](const PcSet& s) {
       if (witness_rot.count(s) || near_searched.count(s) || !orbits.insert(sym.canonical(s)).second)
-        continue;
+        return;
       Task t;
       t.kind = Task::Kind::kFindNear;
       t.pcs = s;
-      for (int k = 0; k < s.size() && t.seeds.size() < kNeighbourSeeds; ++k) {
-        auto nb = pc_neighbours.find(s[k]);
-        if (nb == pc_neighbours.end())
-          nb = pc_neighbours.emplace(s[k], cf::neighbouring_pcs(s[k], A, B)).first;
-        for (const Pc& q : nb->second) {
-          PcSet n;
-          for (int j = 0; j < s.size(); ++j) n.insert(j == k ? q : s[j]);
-          if (n.size() != s.size()) continue;
-          if (auto it = witness_rot.find(n);
-              it != witness_rot.end() && t.seeds.size() < kNeighbourSeeds)
-            t.seeds.push_back(it->second);
-        }
-      }
-      if (t.seeds.empty()) continue;
+      changes_of(s, [&](const PcSet& n) {
+        if (auto it = witness_rot.find(n);
+            it != witness_rot.end() && t.seeds.size() < kNeighbourSeeds)
+          t.seeds.push_back(it->second);
+      });
+      if (t.seeds.empty()) return;
       near_searched.insert(s);
       tasks.push_back(std::move(t));
-    }
+    };
+    // The failed candidates, then the sets one change away from a CF that no level proposed
+    // (a subset of theirs is missing) and that the necessary conditions allow.
+    for (const PcSet& s : failed) consider(s);
+    for (int l = 0; l < 3; ++l)
+      for (std::size_t i = 0; i < valid[l].size(); ++i)
+        changes_of(valid[l][i].first, [&](const PcSet& n) {
+          if (!witness_rot.count(n) && !near_searched.count(n) && !seen.count(n) &&
+              conditions_hold(n))
+            consider(n);
+        });
     const std::string stage = "neighbour round " + std::to_string(++neighbour_rounds);
     ProgressEvent ev{stage, "failed sets", 0, tasks.size(), 0, false, {}};
     const std::vector<TaskResult> r = run_stage(tasks, &ev, t0);

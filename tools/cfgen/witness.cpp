@@ -767,39 +767,79 @@ std::vector<Vec3> WitnessSearch::translations(const PcSet& pcs, const Mat3& R,
   return out;
 }
 
-bool WitnessSearch::separating_cut(const Mat3& R, const Vec3& t, const Obstacle& o,
-                                  LinearProgram::Row& cut) const {
-  const Polyhedron& A = *A_.model;
-  const Polyhedron& B = *B_.model;
-  std::vector<Vec3> pa = closure_points(A, o.ka, o.a), pb = closure_points(B, o.kb, o.b);
-  for (Vec3& p : pa) p = R * p;
-  std::vector<Vec3> da = closure_directions(A, o.ka, o.a), db = closure_directions(B, o.kb, o.b);
-  for (Vec3& d : da) d = R * d;
-  // Separating axes of two convex hulls: face normals, edge cross products, and for the
-  // lower-dimensional pairs the directions between an edge or a point and a point. Each is
-  // tried both ways, in this order (the first of equal moves is kept); hundreds for two
-  // faces, so each axis is taken as it comes, and its opposite from the same extents (the
-  // negated products are exact).
+namespace {
+
+// A convex part of an element: its points and its edges' directions (A's turned by R), and
+// the face's normal (zero for an edge or a vertex).
+struct ConvexPart {
+  std::vector<Vec3> points, dirs;
+  Vec3 normal = Vec3::Zero();
+};
+
+// The closure of element i of kind k of m, turned by R, as one part.
+ConvexPart closure_part(const Polyhedron& m, ElementKind k, int i, const Mat3& R) {
+  ConvexPart c;
+  c.points = closure_points(m, k, i);
+  c.dirs = closure_directions(m, k, i);
+  for (Vec3& p : c.points) p = R * p;
+  for (Vec3& d : c.dirs) d = R * d;
+  if (k == ElementKind::kFace) c.normal = R * m.faces()[i].normal;
+  return c;
+}
+
+// The convex parts of an element: a face's convex pieces where it has more than one (a face
+// with a hole or a reflex corner, whose hull would cover the hole), else its closure.
+std::vector<ConvexPart> convex_parts(const ModelInfo& mi, ElementKind k, int i, const Mat3& R) {
+  const Polyhedron& m = *mi.model;
+  if (k != ElementKind::kFace || mi.pieces[i].size() <= 1) return {closure_part(m, k, i, R)};
+  const Face& f = m.faces()[i];
+  std::vector<ConvexPart> out;
+  for (const ConvexPiece& piece : mi.pieces[i]) {
+    ConvexPart c;
+    c.normal = R * f.normal;
+    const std::size_t n = piece.points.size();
+    for (std::size_t j = 0; j < n; ++j) {
+      const Eigen::Vector2d& a = piece.points[j];
+      c.points.push_back(R * (a.x() * f.u + a.y() * f.v + f.offset * f.normal));
+      const Eigen::Vector2d d = piece.points[(j + 1) % n] - a;
+      if (d.norm() > 0) c.dirs.push_back(R * (d.x() * f.u + d.y() * f.v).normalized());
+    }
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+// The cut (a row n.t >= h on the translation) in which parts a (A's, before translation by t)
+// and b are at least `gap` apart along a separating axis of their hulls: face normals, edge
+// cross products, and for the lower-dimensional pairs the directions between an edge or a
+// point and a point, none within 1e-9 of a direction in `avoid`; of these the one that needs
+// the smallest move from t. Each axis is tried both ways, in this order (the first of equal
+// moves is kept); hundreds for two faces, so each axis is taken as it comes, and its opposite
+// from the same extents (the negated products are exact). False when no axis separates them.
+bool best_cut(const ConvexPart& a, const ConvexPart& b, const Vec3& t, double gap, double scale,
+              const std::vector<Vec3>& avoid, LinearProgram::Row& cut) {
   double best_move = std::numeric_limits<double>::infinity();
   auto try_axis = [&](Vec3 n) {
     const double len = n.norm();
-    if (len < 1e-9 * scale_) return;
+    if (len < 1e-9 * scale) return;
     n /= len;
+    for (const Vec3& d : avoid)
+      if (std::abs(n.dot(d)) > 1 - 1e-9) return;
     double a_lo = std::numeric_limits<double>::infinity(), a_hi = -a_lo, b_lo = a_lo, b_hi = -a_lo;
-    for (const Vec3& p : pa) {
+    for (const Vec3& p : a.points) {
       const double x = n.dot(p);
       a_lo = std::min(a_lo, x);
       a_hi = std::max(a_hi, x);
     }
-    for (const Vec3& q : pb) {
+    for (const Vec3& q : b.points) {
       const double x = n.dot(q);
       b_lo = std::min(b_lo, x);
       b_hi = std::max(b_hi, x);
     }
     const double n_t = n.dot(t);
-    // A on m's side: min over A of m.(p + t) >= max over B of m.q + c.
+    // A on m's side: min over A of m.(p + t) >= max over B of m.q + gap.
     auto side = [&](const Vec3& m, double a_min, double b_max, double m_t) {
-      const double rhs = b_max - a_min + 2 * p_.min_clearance;
+      const double rhs = b_max - a_min + gap;
       const double move = rhs - m_t;
       if (move < best_move) {
         best_move = move;
@@ -809,36 +849,63 @@ bool WitnessSearch::separating_cut(const Mat3& R, const Vec3& t, const Obstacle&
     side(n, a_lo, b_hi, n_t);
     side(-n, -a_hi, -b_lo, -n_t);
   };
-  if (o.ka == ElementKind::kFace) try_axis(R * A.faces()[o.a].normal);
-  if (o.kb == ElementKind::kFace) try_axis(B.faces()[o.b].normal);
-  for (const Vec3& x : da)
-    for (const Vec3& y : db) try_axis(x.cross(y));
-  for (const Vec3& p : pa)
-    for (const Vec3& q : pb) {
+  if (a.normal != Vec3::Zero()) try_axis(a.normal);
+  if (b.normal != Vec3::Zero()) try_axis(b.normal);
+  for (const Vec3& x : a.dirs)
+    for (const Vec3& y : b.dirs) try_axis(x.cross(y));
+  for (const Vec3& p : a.points)
+    for (const Vec3& q : b.points) {
       const Vec3 w = q - (p + t);
       try_axis(w);
-      for (const Vec3& x : da) try_axis(w - w.dot(x) * x);
-      for (const Vec3& y : db) try_axis(w - w.dot(y) * y);
+      for (const Vec3& x : a.dirs) try_axis(w - w.dot(x) * x);
+      for (const Vec3& y : b.dirs) try_axis(w - w.dot(y) * y);
     }
   return best_move < std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+bool WitnessSearch::separating_cut(const Mat3& R, const Vec3& t, const Obstacle& o,
+                                   LinearProgram::Row& cut) const {
+  return best_cut(closure_part(*A_.model, o.ka, o.a, R),
+                  closure_part(*B_.model, o.kb, o.b, Mat3::Identity()), t, 2 * p_.min_clearance,
+                  scale_, {}, cut);
 }
 
 double WitnessSearch::obstacle_margin(const PcSet& pcs, const Mat3& R,
                                       const std::vector<int>& pieces,
                                       const std::vector<Obstacle>& obstacles, const Vec3& t_axes,
-                                      LpVector& x, std::vector<LinearProgram::Row>& cuts) const {
+                                      LpVector& x, std::vector<LinearProgram::Row>& cuts,
+                                      std::vector<std::vector<Vec3>>& cut_points) const {
   constexpr double kNone = -std::numeric_limits<double>::infinity();
   cuts.clear();
+  cut_points.clear();
   LinearProgram lp = build_lp(pcs, R, pieces);
   lp.lower[3] = {true, -scale_};
+  std::vector<Vec3> normals;
+  Pose at;
+  at.R_BA = R;
+  at.t_BA = t_axes;
+  for (const Pc& pc : pcs) normals.push_back(contact_plane(pc, at).first);
   for (const Obstacle& o : obstacles) {
-    LinearProgram::Row cut;
-    if (!separating_cut(R, t_axes, o, cut)) return kNone;
-    cuts.push_back(cut);
-    // m.t >= rhs becomes m.t - s >= rhs - min_margin: the gap beyond the cut is the margin.
-    cut.a.push_back({3, -1.0});
-    cut.b -= p_.min_margin;
-    lp.rows.push_back(cut);
+    const std::vector<ConvexPart> pa = convex_parts(A_, o.ka, o.a, Mat3::Identity());
+    const std::vector<ConvexPart> pb = convex_parts(B_, o.kb, o.b, Mat3::Identity());
+    for (const ConvexPart& a : pa) {
+      ConvexPart turned = a;
+      for (Vec3& p : turned.points) p = R * p;
+      for (Vec3& d : turned.dirs) d = R * d;
+      turned.normal = R * a.normal;
+      for (const ConvexPart& b : pb) {
+        LinearProgram::Row cut;
+        if (!best_cut(turned, b, t_axes, 2 * p_.min_clearance, scale_, normals, cut)) return kNone;
+        cuts.push_back(cut);
+        cut_points.push_back(a.points);
+        // m.t >= rhs becomes m.t - s >= rhs - min_margin: the gap beyond the cut is the margin.
+        cut.a.push_back({3, -1.0});
+        cut.b -= p_.min_margin;
+        lp.rows.push_back(cut);
+      }
+    }
   }
   const LpResult r = solve(lp);
   if (r.status != LpResult::Status::kOptimal) return kNone;
@@ -847,8 +914,8 @@ double WitnessSearch::obstacle_margin(const PcSet& pcs, const Mat3& R,
 }
 
 bool WitnessSearch::obstacle_step(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces,
-                                  const std::vector<Obstacle>& obstacles, const LpVector& x,
-                                  const std::vector<LinearProgram::Row>& cuts, double turn,
+                                  const LpVector& x, const std::vector<LinearProgram::Row>& cuts,
+                                  const std::vector<std::vector<Vec3>>& cut_points, double turn,
                                   Mat3& next) const {
   const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
   if (c.align.size() >= 2 || (c.align.size() == 1 && !c.perp.empty())) return false;  // fixed
@@ -882,15 +949,13 @@ bool WitnessSearch::obstacle_step(const PcSet& pcs, const Mat3& R, const std::ve
   // Obstacles: each cut's axis m kept fixed in the world (a fixed axis still proves the
   // elements apart at any pose); every point p of A's element, turned with A, stays beyond B's
   // extent on it: m.(R p + w x R p + t) - s >= max_B m.q + 2 min_clearance - min_margin.
-  const Polyhedron& A = *A_.model;
-  for (std::size_t i = 0; i < obstacles.size() && i < cuts.size(); ++i) {
+  for (std::size_t i = 0; i < cuts.size() && i < cut_points.size(); ++i) {
     Vec3 m = Vec3::Zero();
     for (const auto& [j, cj] : cuts[i].a) m[j] = cj;
-    const std::vector<Vec3> pa = closure_points(A, obstacles[i].ka, obstacles[i].a);
     double a_min = std::numeric_limits<double>::infinity();
-    for (const Vec3& p : pa) a_min = std::min(a_min, m.dot(R * p));
+    for (const Vec3& p : cut_points[i]) a_min = std::min(a_min, m.dot(R * p));
     const double b_max = cuts[i].b - 2 * p_.min_clearance + a_min;
-    for (const Vec3& p : pa) {
+    for (const Vec3& p : cut_points[i]) {
       const Vec3 Rp = R * p;
       const Vec3 g = Rp.cross(m);
       LinearProgram::Coefs row{{0, m.x()}, {1, m.y()}, {2, m.z()}, {3, -1.0}};
@@ -1906,8 +1971,8 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds,
   // reaches min_margin, try the program's translations, and when one meets a new pair, add
   // it and climb on.
   constexpr int kMaxObstacles = 8;     // pairs pushed apart at once
-  constexpr int kMaxEvaluations = 96;  // programs solved per blocked pose
-  constexpr double kFirstTurn = 0.1;   // rad, the largest turn about an axis
+  constexpr int kMaxEvaluations = 160;  // programs solved per blocked pose
+  constexpr double kFirstTurn = 0.02;   // rad, the largest turn about an axis
   constexpr double kLastTurn = 1e-3;   // rad
   auto past_obstacles = [&]() -> Witness {
     for (const Blocked& b : blocked) {
@@ -1920,10 +1985,22 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds,
       Mat3 R = b.R;
       LpVector x, xq;
       std::vector<LinearProgram::Row> cuts, cq;
-      double m = obstacle_margin(pcs, R, b.pieces, obstacles, b.t, x, cuts);
+      std::vector<std::vector<Vec3>> cut_points, cpq;
+      double m = obstacle_margin(pcs, R, b.pieces, obstacles, b.t, x, cuts, cut_points);
       if (!std::isfinite(m)) continue;
       double turn = kFirstTurn;
+      // A climb that stalls after meeting new obstacles starts again from the blocked pose
+      // with all of them: the first climbs turned without knowing them.
+      std::size_t obstacles_at_start = 1;
       for (int evals = 1; evals < kMaxEvaluations;) {
+        if (turn < kLastTurn && obstacles.size() > obstacles_at_start) {
+          obstacles_at_start = obstacles.size();
+          R = b.R;
+          m = obstacle_margin(pcs, R, b.pieces, obstacles, b.t, x, cuts, cut_points);
+          ++evals;
+          if (!std::isfinite(m)) break;
+          turn = kFirstTurn;
+        }
         if (m >= p_.min_margin) {
           double margin = 0;
           const std::vector<Vec3> ts = translations(pcs, R, b.pieces, margin, false, cuts);
@@ -1950,7 +2027,7 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds,
             break;
           obstacles.push_back(next);
           const Vec3 t = x.head<3>();
-          m = obstacle_margin(pcs, R, b.pieces, obstacles, t, x, cuts);
+          m = obstacle_margin(pcs, R, b.pieces, obstacles, t, x, cuts, cut_points);
           ++evals;
           if (!std::isfinite(m)) break;
           turn = kFirstTurn;
@@ -1961,7 +2038,7 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds,
         // margin (at a kink of the smallest margin, or where a cut's best axis changes), the
         // turns about each axis the conditions leave free.
         std::vector<Mat3> tries;
-        if (Mat3 Q; obstacle_step(pcs, R, b.pieces, obstacles, x, cuts, turn, Q))
+        if (Mat3 Q; obstacle_step(pcs, R, b.pieces, x, cuts, cut_points, turn, Q))
           tries.push_back(Q);
         for (const Mat3& Q : rotation_steps(pcs, R, turn)) tries.push_back(Q);
         bool moved = false;
@@ -1969,16 +2046,20 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds,
           if (evals >= kMaxEvaluations) break;
           ++evals;
           if (local_margin(pcs, Q) <= min_local) continue;
-          const double mq = obstacle_margin(pcs, Q, b.pieces, obstacles, x.head<3>(), xq, cq);
+          const double mq = obstacle_margin(pcs, Q, b.pieces, obstacles, x.head<3>(), xq, cq, cpq);
           if (mq > m) {
             m = mq;
             R = Q;
             x = xq;
             cuts.swap(cq);
+            cut_points.swap(cpq);
             moved = true;
             break;
           }
         }
+        if (debug_)
+          std::cerr << "    turn " << turn << (moved ? " gained, margin " : " no gain, margin ")
+                    << m << "\n";
         turn = moved ? std::min(2 * turn, kFirstTurn) : 0.5 * turn;
       }
       if (debug_) {
@@ -1994,7 +2075,19 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds,
   for (const Mat3& R : rots)
     if (try_rotation(R)) return best;
   if (best.found) return best;
-  if (seeds_only) return past_obstacles();
+  if (seeds_only) {
+    // The neighbours' witnesses are a few hundredths of a radian from where the set holds:
+    // look that close around each, then climb past the obstacles met.
+    std::vector<Mat3> close;
+    for (const Mat3& R : seeds)
+      for (double ang : {0.01, 0.025})
+        for (int ax = 0; ax < 3; ++ax)
+          for (double sg : {1.0, -1.0}) close.push_back(axis_angle(sg * Vec3::Unit(ax), ang) * R);
+    for (const Mat3& R : rotation_candidates(pcs, close, false))
+      if (try_rotation(R)) return best;
+    if (best.found) return best;
+    return past_obstacles();
+  }
   // Two point PCs: rotations built to place both contacts inside their elements, where the
   // spread above left too few locally admissible ones (two e-e crossings) or none that
   // fits (a peg's corner just inside a hole's rim).

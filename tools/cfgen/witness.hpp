@@ -42,8 +42,9 @@ class WitnessSearch {
   WitnessSearch(const ModelInfo& a, const ModelInfo& b, const SearchParams& p);
 
   /// Searches a witness for `pcs`, trying the seed rotations (witnesses of sub-sets) first.
-  /// With `seeds_only`, tries only the seeds (each projected onto the PCs' rotational
-  /// conditions) and climbs past the obstacles met there: a search near given rotations.
+  /// With `seeds_only`, a search near given rotations: tries only the seeds and rotations
+  /// 0.01 and 0.025 rad about each axis from them (projected onto the PCs' rotational
+  /// conditions), then climbs past the obstacles met there.
   Witness find(const PcSet& pcs, const std::vector<Mat3>& seeds, bool seeds_only = false) const;
 
   /// Verifies a pose: exactly the PCs of `pcs` hold (every other touching element pair is
@@ -179,21 +180,26 @@ class WitnessSearch {
   // needs the smallest move from t. False when no axis separates them.
   bool separating_cut(const Mat3& R, const Vec3& t, const Obstacle& o, LinearProgram::Row& cut) const;
   // The largest s such that, at rotation R, the contacts sit s inside their elements and each
-  // obstacle's two elements are s - min_margin farther apart than its separating cut asks
-  // (the axis chosen at translation t_axes): s >= min_margin places the contacts and clears
-  // every obstacle. -inf when no translation is feasible even with s negative or an obstacle
-  // has no separating axis. `t` receives the program's translation and `cuts` the cuts at R.
-  // `x` receives the program's solution (t, s, the contacts' parameters).
+  // obstacle's two elements are s - min_margin farther apart than its separating cuts ask:
+  // s >= min_margin places the contacts and clears every obstacle. An obstacle's face that
+  // is not convex (a hole, a reflex corner) is cut piece by piece, each convex piece against
+  // each of the other element's, along the axis that needs the smallest move from t_axes,
+  // never along a contact's normal (an obstacle next to a contact keeps no gap along it).
+  // -inf when no translation is feasible even with s negative, or a pair of pieces has no
+  // separating axis. `x` receives the program's solution (t, s, the contacts' parameters),
+  // `cuts` the cuts at R and `cut_points` the points of A's piece of each (A's frame).
   double obstacle_margin(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces,
                          const std::vector<Obstacle>& obstacles, const Vec3& t_axes, LpVector& x,
-                         std::vector<LinearProgram::Row>& cuts) const;
-  // One step of the climb past obstacles: from rotation R with obstacle_margin's solution x
-  // and cuts, the turn (at most `turn` rad about each axis) that the program linearised in
-  // the turn says raises that margin most, kept on the rotational conditions. False when the
-  // conditions leave no turn or the program fails.
+                         std::vector<LinearProgram::Row>& cuts,
+                         std::vector<std::vector<Vec3>>& cut_points) const;
+  // One step of the climb past obstacles: from rotation R with obstacle_margin's solution x,
+  // cuts and cut points, the turn (at most `turn` rad about each axis) that the program
+  // linearised in the turn says raises that margin most, kept on the rotational conditions.
+  // False when the conditions leave no turn or the program fails.
   bool obstacle_step(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces,
-                     const std::vector<Obstacle>& obstacles, const LpVector& x,
-                     const std::vector<LinearProgram::Row>& cuts, double turn, Mat3& next) const;
+                     const LpVector& x, const std::vector<LinearProgram::Row>& cuts,
+                     const std::vector<std::vector<Vec3>>& cut_points, double turn,
+                     Mat3& next) const;
 
   const ModelInfo& A_;
   const ModelInfo& B_;
