@@ -14,14 +14,22 @@
 
 #include <catch2/catch.hpp>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <string>
+#include <vector>
 
 namespace {
 
-double angle_between(const cf::Mat3& P, const cf::Mat3& Q) {
-  return std::acos(std::clamp(0.5 * ((P * Q.transpose()).trace() - 1.0), -1.0, 1.0));
+// The rotations find(seeds_only) tries before its climb: the seed, and the seed turned by
+// 0.01 and 0.025 rad about each axis, both ways (sets of point PCs: no projection).
+std::vector<cf::Mat3> tried_before_climb(const cf::Mat3& seed) {
+  std::vector<cf::Mat3> out{seed};
+  for (double ang : {0.01, 0.025})
+    for (int ax = 0; ax < 3; ++ax)
+      for (double sg : {1.0, -1.0})
+        out.push_back(cf::gen::axis_angle(sg * cf::Vec3::Unit(ax), ang) * seed);
+  return out;
 }
 
 }  // namespace
@@ -45,7 +53,7 @@ TEST_CASE(
   std::size_t tried = 0, found = 0, climbed = 0;
   for (const auto& r : e.cfs) {
     if (r.pcs.size() != 2) continue;
-    bool point_pcs = true;  // no rotational condition: the turned rotation is not projected
+    bool point_pcs = true;  // no rotational condition: the rotations tried are not projected
     for (const cf::Pc& pc : r.pcs)
       point_pcs = point_pcs && (pc.type == cf::PcType::kVF || pc.type == cf::PcType::kFV || pc.type == cf::PcType::kEE);
     if (!point_pcs) continue;
@@ -56,14 +64,17 @@ TEST_CASE(
     ++found;
     // The only gate to the graph: whatever the search returns verifies.
     CHECK(search.verify(r.pcs, w.pose) >= opt.search.min_clearance);
-    if (angle_between(w.pose.R_BA, seed) > 1e-9) ++climbed;
+    const std::vector<cf::Mat3> before = tried_before_climb(seed);
+    const bool from_climb = std::none_of(before.begin(), before.end(), [&](const cf::Mat3& R) {
+      return (R - w.pose.R_BA).norm() < 1e-12;  // the same rotation, bit for bit or nearly
+    });
+    climbed += from_climb ? 1 : 0;
   }
-  INFO("tried " << tried << ", found " << found << ", of which " << climbed << " away from the seed");
+  INFO("tried " << tried << ", found " << found << ", of which " << climbed << " by the climb");
   REQUIRE(tried > 1000);
-  // Measured on 7,740 sets: 3,945 found (51%), 1,247 of them (16% of the sets) at a rotation
-  // the climb turned to; the others hold at the seed itself (a pair of point PCs holds over a
-  // range of rotations wider than the turn). Without the climb, none is found away from the
-  // seed. Bounds a little below what was measured, so that only a real loss fails.
-  CHECK(found * 100 >= tried * 45);
-  CHECK(climbed * 10 >= tried);
+  // Measured on 9,324 sets: 6,605 found (71%), 610 of them (6.5% of the sets) at a rotation
+  // the climb turned to (none of the rotations tried before it). Bounds a little below what
+  // was measured, so that only a real loss fails.
+  CHECK(found * 100 >= tried * 65);
+  CHECK(climbed * 100 >= tried * 5);
 }

@@ -754,11 +754,12 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   // of orientations (a peg tilted across a hole's rim) is missed by the search's samples, but
   // the CFs one change away (one PC replaced by a neighbouring PC, cf::neighbouring_pcs) hold
   // on either side of it, at rotations a few hundredths of a radian from the one it needs.
-  // Each failed set with such CFs, one per orbit, is searched again from their witnesses
-  // alone, climbing past the obstacles met there (WitnessSearch::find, seeds_only). A set is
-  // searched so once: the rounds add CFs, never take one away, so a graph holds every CF the
-  // fixed point before them found. Returns the number of CFs found.
-  std::unordered_set<PcSet, PcSetHash> near_searched;
+  // Each failed set with such CFs is searched again near their witnesses (WitnessSearch::find,
+  // seeds_only): one member of an orbit a round, up to kOrbitTries members over the rounds,
+  // as the levels do, each member once. The rounds add CFs, never take one away, so a graph
+  // holds every CF the fixed point before them found. Returns the number of CFs found.
+  std::unordered_set<PcSet, PcSetHash> near_searched;            // members searched so
+  std::unordered_map<PcSet, std::size_t, PcSetHash> near_tries;  // per orbit
   std::map<Pc, std::vector<Pc>> pc_neighbours;
   // The sets one change away from s (one PC replaced by a neighbouring PC), in a fixed order.
   auto changes_of = [&](const PcSet& s, const std::function<void(const PcSet&)>& fn) {
@@ -776,10 +777,9 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
   auto neighbour_round = [&]() -> std::size_t {
     const auto t0 = Clock::now();
     std::vector<Task> tasks;
-    std::unordered_set<PcSet, PcSetHash> orbits;
+    std::unordered_set<PcSet, PcSetHash> round_orbits;
     auto consider = [&](const PcSet& s) {
-      if (witness_rot.count(s) || near_searched.count(s) || !orbits.insert(sym.canonical(s)).second)
-        return;
+      if (witness_rot.count(s) || near_searched.count(s)) return;
       Task t;
       t.kind = Task::Kind::kFindNear;
       t.pcs = s;
@@ -789,6 +789,10 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
           t.seeds.push_back(it->second);
       });
       if (t.seeds.empty()) return;
+      const PcSet orbit = sym.canonical(s);
+      if (round_orbits.count(orbit) || near_tries[orbit] >= kOrbitTries) return;
+      round_orbits.insert(orbit);
+      ++near_tries[orbit];
       near_searched.insert(s);
       tasks.push_back(std::move(t));
     };
@@ -811,7 +815,7 @@ Enumeration enumerate(const ModelInfo& Ai, const ModelInfo& Bi, const EnumerateO
       const int level = tasks[i].pcs.size() - 1;
       const std::size_t before = valid[level].size();
       accept(level, tasks[i].pcs, r[i].witness);
-      out.levels[level].by_neighbours += valid[level].size() - before;
+      ++out.levels[level].by_neighbours;  // its images count under by_symmetry
       found += valid[level].size() - before;
     }
     finished(ev, t0, std::to_string(found) + " new CFs");

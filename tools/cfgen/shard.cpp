@@ -16,7 +16,10 @@ namespace cf::tools {
 namespace {
 
 constexpr const char* kFormat = "cfgen shard part";
-constexpr int kVersion = 2;  // 2: a witness as in chunks, [found, pose (12), clearance, margin]
+// 2: a witness as in chunks, [found, pose (12), clearance, margin]; 3: the witness search
+// climbs past obstacles and the neighbour rounds' tasks (the same tasks give other results,
+// so the parts and checkpoints of version 2 are refused).
+constexpr int kVersion = 3;
 constexpr int kMaxShards = 4096;
 
 // The options that shape the graph, in a fixed order (not the thread count, the output or

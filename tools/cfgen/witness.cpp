@@ -985,6 +985,13 @@ bool WitnessSearch::obstacle_step(const PcSet& pcs, const Mat3& R, const std::ve
   const Vec3 w(r.x[W], r.x[W + 1], r.x[W + 2]);
   const double ang = w.norm();
   if (!(ang > 0)) return false;
+  if (c.align.size() == 1) {
+    // Only turns about the aligned normal keep the alignment; the program meets its rows to
+    // its tolerance, so take w's component along it exactly.
+    const Vec3& b = c.align[0].second;
+    next = axis_angle(b, w.dot(b)) * R;
+    return true;
+  }
   next = axis_angle(w / ang, ang) * R;
   if (!c.perp.empty() && !project_perp(c, next)) return false;
   return true;
