@@ -55,6 +55,18 @@ bool trig_solve(double a, double b, double d, std::vector<double>& out, bool& al
   return true;
 }
 
+// Each rotation turned by each angle (rad) about each coordinate axis, both ways: the
+// rotations a little around given ones, in a fixed order.
+std::vector<Mat3> turned_about_axes(const std::vector<Mat3>& rots,
+                                    std::initializer_list<double> angles) {
+  std::vector<Mat3> out;
+  for (const Mat3& R : rots)
+    for (double ang : angles)
+      for (int ax = 0; ax < 3; ++ax)
+        for (double sg : {1.0, -1.0}) out.push_back(axis_angle(sg * Vec3::Unit(ax), ang) * R);
+  return out;
+}
+
 void add_unique(std::vector<Mat3>& out, const Mat3& R) {
   for (const Mat3& Q : out)
     if ((Q - R).squaredNorm() < 1e-14) return;
@@ -2085,12 +2097,7 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds,
   if (seeds_only) {
     // The neighbours' witnesses are a few hundredths of a radian from where the set holds:
     // look that close around each, then climb past the obstacles met.
-    std::vector<Mat3> close;
-    for (const Mat3& R : seeds)
-      for (double ang : {0.01, 0.025})
-        for (int ax = 0; ax < 3; ++ax)
-          for (double sg : {1.0, -1.0}) close.push_back(axis_angle(sg * Vec3::Unit(ax), ang) * R);
-    for (const Mat3& R : rotation_candidates(pcs, close, false))
+    for (const Mat3& R : rotation_candidates(pcs, turned_about_axes(seeds, {0.01, 0.025}), false))
       if (try_rotation(R)) return best;
     if (best.found) return best;
     return past_obstacles();
@@ -2163,12 +2170,7 @@ Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds,
   if (best.found || near.empty()) return best;
   // The contacts could be placed but the pose touched something else: look closer around
   // those rotations, where valid sets with a narrow range of orientations live.
-  std::vector<Mat3> around;
-  for (const Mat3& R : near)
-    for (double ang : {0.04, 0.12, 0.3})
-      for (int ax = 0; ax < 3; ++ax)
-        for (double sg : {1.0, -1.0}) around.push_back(axis_angle(sg * Vec3::Unit(ax), ang) * R);
-  for (const Mat3& R : rotation_candidates(pcs, around, false))
+  for (const Mat3& R : rotation_candidates(pcs, turned_about_axes(near, {0.04, 0.12, 0.3}), false))
     if (try_rotation(R)) return best;
   if (best.found) return best;
   // A one-parameter family: a part leaning in a gap (a peg tilted in a hole, an edge resting
