@@ -10,7 +10,7 @@
 //   build/bench/cfgen_bench --benchmark_filter='n:(4|6)/.*/symmetry:1'   # square and hexagonal pegs
 // Figures go to docs/performance.md, "Graph generation".
 
-#include "cfgen/enumerate.hpp"
+#include "cfgen/enumerate/enumerate.hpp"
 #include "cfgen/generate.hpp"
 #include "mesh/model_loader.hpp"
 
@@ -92,14 +92,15 @@ void BM_NgonPegInHole(benchmark::State& state) {
   const cf::Polyhedron B = load_text("hole", ngon_off(n, 25.0, 10.5, 0, 20));
   const cf::gen::ModelInfo ai = cf::gen::analyse_model(A), bi = cf::gen::analyse_model(B);
   cf::gen::EnumerateOptions opt;
-  opt.threads = threads;
   opt.use_symmetry = symmetry;
-  opt.search = cf::tools::scaled_search(A, B, cf::tools::RelativeLengths{});  // cfgen's defaults
+  cf::gen::ExecuteOptions exec;
+  exec.threads = threads;
+  const cf::gen::SearchParams search = cf::tools::scaled_search(A, B, cf::tools::RelativeLengths{});  // cfgen's defaults
   std::size_t cfs = 0, candidates = 0;
   double seconds = 0;
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
-    const cf::gen::Enumeration e = cf::gen::enumerate(ai, bi, opt);
+    const cf::gen::Enumeration e = cf::gen::enumerate_pair(ai, bi, search, opt, exec);
     seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     cfs = e.cfs.size();
     candidates = e.levels[1].candidates;

@@ -2,7 +2,7 @@
 // element at least a margin inside it, worked out by hand on the cube and the L-block; the
 // index of the elements' boxes against a brute-force test.
 
-#include "cfgen/analysis.hpp"
+#include "cfgen/verify/analysis.hpp"
 #include "fixtures.hpp"
 #include "mesh/model_loader.hpp"
 

@@ -21,7 +21,7 @@
 // Each model pair is generated once per process (the tests of one pair are SECTIONs of one
 // TEST_CASE, so ctest's one-process-per-test-case does not regenerate it).
 
-#include "cfgen/enumerate.hpp"
+#include "cfgen/enumerate/enumerate.hpp"
 #include "cfgen/generate.hpp"
 #include "mesh/model_loader.hpp"
 
@@ -186,9 +186,10 @@ const Generated& generated(const std::string& key, const std::function<Polyhedro
   g->ai = cf::gen::analyse_model(*g->A);
   g->bi = cf::gen::analyse_model(*g->B);
   cf::gen::EnumerateOptions opt;
-  opt.threads = 2;
   opt.max_pcs = max_pcs;
-  g->e = cf::gen::enumerate(g->ai, g->bi, opt);
+  cf::gen::ExecuteOptions exec;
+  exec.threads = 2;
+  g->e = cf::gen::enumerate_pair(g->ai, g->bi, {}, opt, exec);
   g->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // from_parts is the graph's own consistency check (ranges, distinct faces, transition kinds).
   g->graph = std::make_unique<cf::CfGraph>(
@@ -1843,8 +1844,9 @@ TEST_CASE("cfgen: cube vs L-block", "[cfgen]") {
     // The whole enumeration (all levels) in process: the graph's bytes must not depend on the
     // thread count (the cached graph was generated with 2 threads).
     cf::gen::EnumerateOptions opt;
-    opt.threads = 1;
-    const cf::gen::Enumeration e1 = cf::gen::enumerate(g.ai, g.bi, opt);
+    cf::gen::ExecuteOptions exec;
+    exec.threads = 1;
+    const cf::gen::Enumeration e1 = cf::gen::enumerate_pair(g.ai, g.bi, {}, opt, exec);
     const cf::CfGraph g1 = cf::CfGraph::from_parts(A, B, e1.cfs, e1.transitions);
     CHECK(g1.num_cfs() == g.graph->num_cfs());
     CHECK(g1.to_json(1) == g.graph->to_json(1));

@@ -5,7 +5,7 @@
 // contact. This is what keeps the generator's culling of element pairs (ranges across the
 // direction of a translation, heights and distances about the axis of a rotation) exact.
 
-#include "cfgen/explore.hpp"
+#include "cfgen/decide/explore.hpp"
 #include "motion.hpp"
 #include "oracle_pair.hpp"
 #include "oracle_pose.hpp"

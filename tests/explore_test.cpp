@@ -3,8 +3,8 @@
 // are worked out by hand on boxes and the bundled L-block (slab 120 x 20 x 80 along x and z,
 // wall 0 <= x <= 20 up to y = 80).
 
-#include "cfgen/enumerate.hpp"
-#include "cfgen/explore.hpp"
+#include "cfgen/enumerate/enumerate.hpp"
+#include "cfgen/decide/explore.hpp"
 #include "cfgen/generate.hpp"
 #include "mesh/model_loader.hpp"
 #include "analysed_pair.hpp"

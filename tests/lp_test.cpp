@@ -6,7 +6,7 @@
 
 #include <random>
 
-#include "cfgen/lp.hpp"
+#include "cfgen/verify/lp.hpp"
 
 using cf::gen::LinearProgram;
 using cf::gen::LpResult;

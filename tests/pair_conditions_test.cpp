@@ -3,7 +3,7 @@
 // against the L-block that follow from one measurement each, and soundness on every CF of the
 // bundled graphs (their witnesses were verified apart from these conditions).
 
-#include "cfgen/pair_conditions.hpp"
+#include "cfgen/decide/pair_conditions.hpp"
 #include "analysed_pair.hpp"
 #include "fixtures.hpp"
 #include "mesh/model_loader.hpp"

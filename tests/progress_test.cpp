@@ -1,6 +1,6 @@
 // cfgen's progress display (tools/cfgen/progress.hpp): what a person sees on a terminal and in
 // a log file.
-#include "cfgen/progress.hpp"
+#include "cfgen/execute/progress.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -2,7 +2,7 @@
 // which MPI ranks exchange: every kind of task and result comes back exactly, doubles to
 // the last bit, and text that is not such a chunk is refused with a message naming it.
 
-#include "cfgen/shard.hpp"
+#include "cfgen/execute/shard.hpp"
 
 #include <cf/types.hpp>
 

@@ -3,9 +3,9 @@
 // point, and a graph generated with one search per orbit checked for closure under the
 // symmetries and against a run that searches every set.
 
-#include "cfgen/symmetry.hpp"
+#include "cfgen/enumerate/symmetry.hpp"
 #include "analysed_pair.hpp"
-#include "cfgen/enumerate.hpp"
+#include "cfgen/enumerate/enumerate.hpp"
 #include "cfgen/generate.hpp"
 #include "fixtures.hpp"
 #include "mesh/model_loader.hpp"
@@ -58,11 +58,13 @@ std::set<std::string> cf_sets(const cf::gen::Enumeration& e) {
 }
 
 // The generator's defaults for the pair (lengths scaled to it), on two threads.
-cf::gen::EnumerateOptions options_for(const cf::test::AnalysedPair& p) {
-  cf::gen::EnumerateOptions opt;
-  opt.threads = 2;
-  opt.search = cf::tools::scaled_search(p.A, p.B, {});
-  return opt;
+// cfgen's default search for the pair.
+cf::gen::SearchParams search_for(const cf::test::AnalysedPair& p) { return cf::tools::scaled_search(p.A, p.B, {}); }
+
+cf::gen::Enumeration enumerate(const cf::test::AnalysedPair& p, const cf::gen::EnumerateOptions& opt) {
+  cf::gen::ExecuteOptions exec;
+  exec.threads = 2;
+  return cf::gen::enumerate_pair(p.ai, p.bi, search_for(p), opt, exec);
 }
 
 int proper(const std::vector<cf::gen::Symmetry>& s) {
@@ -193,10 +195,10 @@ TEST_CASE(
   // A 10 mm cube against a 40 x 40 x 10 slab: 48 and 16 symmetries.
   cf::test::AnalysedPair p(cf::test::box(Vec3(-5, -5, -5), Vec3(5, 5, 5), "cube"),
                            cf::test::box(Vec3(-20, -20, -5), Vec3(20, 20, 5), "slab"));
-  cf::gen::EnumerateOptions opt = options_for(p);
-  const cf::gen::Enumeration with = cf::gen::enumerate(p.ai, p.bi, opt);
+  cf::gen::EnumerateOptions opt;
+  const cf::gen::Enumeration with = enumerate(p, opt);
   opt.use_symmetry = false;
-  const cf::gen::Enumeration without = cf::gen::enumerate(p.ai, p.bi, opt);
+  const cf::gen::Enumeration without = enumerate(p, opt);
   CHECK(with.symmetries_a == 48);
   CHECK(with.symmetries_b == 16);
   CHECK(without.symmetries_a == 1);
@@ -204,11 +206,11 @@ TEST_CASE(
   CHECK(sets_with.size() == with.cfs.size());  // no CF twice
   CHECK(sets_without.size() == without.cfs.size());
   // Closed: every image of every CF is a CF, and its witness is verified like any other.
-  const cf::gen::WitnessSearch search(p.ai, p.bi, opt.search);
+  const cf::gen::WitnessSearch search(p.ai, p.bi, search_for(p));
   const PairSymmetries sym(p.A, p.B, 1e-13 * search.scale(), true);
   std::size_t images = 0;
   for (const auto& r : with.cfs) {
-    CHECK(search.verify(r.pcs, r.witness) >= opt.search.min_clearance);
+    CHECK(search.verify(r.pcs, r.witness) >= search.params().min_clearance);
     for (std::size_t k = 0; k < sym.size(); ++k)
       images += sets_with.count(cf::to_string(sym.image(r.pcs, k)));
   }
@@ -236,12 +238,12 @@ TEST_CASE(
   // orbits that the per-set search meets by motion.
   const auto [peg, hole] = cf::test::ngon_peg_and_hole(4, "thorough");
   cf::test::AnalysedPair p(cf::tools::load_model(peg, {}), cf::tools::load_model(hole, {}));
-  cf::gen::EnumerateOptions opt = options_for(p);
-  const cf::gen::Enumeration orbit = cf::gen::enumerate(p.ai, p.bi, opt);
+  cf::gen::EnumerateOptions opt;
+  const cf::gen::Enumeration orbit = enumerate(p, opt);
   opt.use_symmetry = false;
-  const cf::gen::Enumeration every = cf::gen::enumerate(p.ai, p.bi, opt);
+  const cf::gen::Enumeration every = enumerate(p, opt);
   opt.close_orbits = true;
-  const cf::gen::Enumeration thorough = cf::gen::enumerate(p.ai, p.bi, opt);
+  const cf::gen::Enumeration thorough = enumerate(p, opt);
   CHECK(thorough.symmetries_a == 16);
   CHECK(thorough.symmetries_b == 16);
   const std::set<std::string> s_orbit = cf_sets(orbit), s_every = cf_sets(every), s_thorough = cf_sets(thorough);
@@ -257,11 +259,11 @@ TEST_CASE(
   CHECK(searched_thorough == searched_every);
   CHECK(thorough.cfs.size() == every.cfs.size() + by_symmetry);
   CHECK(by_symmetry > 0);
-  const cf::gen::WitnessSearch search(p.ai, p.bi, opt.search);
+  const cf::gen::WitnessSearch search(p.ai, p.bi, search_for(p));
   const PairSymmetries sym(p.A, p.B, 1e-13 * search.scale(), true);
   std::size_t images = 0;
   for (const auto& r : thorough.cfs) {
-    CHECK(search.verify(r.pcs, r.witness) >= opt.search.min_clearance);
+    CHECK(search.verify(r.pcs, r.witness) >= search.params().min_clearance);
     for (std::size_t k = 0; k < sym.size(); ++k) images += s_thorough.count(cf::to_string(sym.image(r.pcs, k)));
   }
   CHECK(images == thorough.cfs.size() * sym.size());  // closed under the maps

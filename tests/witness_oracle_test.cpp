@@ -7,7 +7,7 @@
 // its refusal of every penetrating pose, must be the oracle's.
 
 #include "cfgen/generate.hpp"
-#include "cfgen/witness.hpp"
+#include "cfgen/decide/witness.hpp"
 #include "classify.hpp"
 #include "motion.hpp"
 #include "oracle_pair.hpp"

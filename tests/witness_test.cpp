@@ -5,9 +5,9 @@
 // places the contacts but runs A into another pair of elements.
 
 #include "analysed_pair.hpp"
-#include "cfgen/enumerate.hpp"
+#include "cfgen/enumerate/enumerate.hpp"
 #include "cfgen/generate.hpp"
-#include "cfgen/witness.hpp"
+#include "cfgen/decide/witness.hpp"
 #include "mesh/model_loader.hpp"
 #include "ngon_models.hpp"
 #include "scratch.hpp"
@@ -41,11 +41,12 @@ TEST_CASE(
   const auto [peg, hole] = cf::test::ngon_peg_and_hole(6, "witness");
   cf::test::AnalysedPair p(cf::tools::load_model(peg, {}), cf::tools::load_model(hole, {}));
   cf::gen::EnumerateOptions opt;
-  opt.threads = 2;
   opt.max_pcs = 2;  // the pairs: seconds, not the whole graph
-  opt.search = cf::tools::scaled_search(p.A, p.B, {});
-  const cf::gen::Enumeration e = cf::gen::enumerate(p.ai, p.bi, opt);
-  const cf::gen::WitnessSearch search(p.ai, p.bi, opt.search);
+  cf::gen::ExecuteOptions exec;
+  exec.threads = 2;
+  const cf::gen::SearchParams params = cf::tools::scaled_search(p.A, p.B, {});
+  const cf::gen::Enumeration e = cf::gen::enumerate_pair(p.ai, p.bi, params, opt, exec);
+  const cf::gen::WitnessSearch search(p.ai, p.bi, params);
   // The turn off each witness: larger than the slivers (a few hundredths of a radian), small
   // against the spread the search's own samples keep (0.15 rad).
   constexpr double kTurn = 0.06;  // rad
@@ -63,7 +64,7 @@ TEST_CASE(
     if (!w.found) continue;
     ++found;
     // The only gate to the graph: whatever the search returns verifies.
-    CHECK(search.verify(r.pcs, w.pose) >= opt.search.min_clearance);
+    CHECK(search.verify(r.pcs, w.pose) >= params.min_clearance);
     const std::vector<cf::Mat3> before = tried_before_climb(seed);
     const bool from_climb = std::none_of(before.begin(), before.end(), [&](const cf::Mat3& R) {
       return (R - w.pose.R_BA).norm() < 1e-12;  // the same rotation, bit for bit or nearly

@@ -2,7 +2,7 @@
 // Two models with the generator's per-model analysis (tools/cfgen/analysis.hpp), for the
 // tests of cfgen's parts. Only for tests that link cfgen_core.
 
-#include "cfgen/analysis.hpp"
+#include "cfgen/verify/analysis.hpp"
 
 #include <cf/polyhedron.hpp>
 

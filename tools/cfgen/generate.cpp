@@ -1,8 +1,9 @@
 #include "cfgen/generate.hpp"
 
-#include "cfgen/enumerate.hpp"
-#include "cfgen/progress.hpp"
-#include "cfgen/shard.hpp"
+#include "cfgen/enumerate/enumerate.hpp"
+#include "cfgen/execute/progress.hpp"
+#include "cfgen/execute/stop.hpp"
+#include "cfgen/execute/shard.hpp"
 #include "mesh/model_loader.hpp"
 
 #include <cf/file_io.hpp>
@@ -18,6 +19,8 @@
 #include <thread>
 #include <tuple>
 #include <utility>
+
+#include <csignal>
 
 #include <unistd.h>
 
@@ -37,78 +40,24 @@ gen::SearchParams scaled_search(const Polyhedron& A, const Polyhedron& B, const 
   return base;
 }
 
-int run_generate(const GenerateArgs& args) {
-  const auto t0 = std::chrono::steady_clock::now();
-  // The output path is checked before the work: not a device, FIFO or directory, not one of
-  // the models (SPEC section 5b).
-  const std::vector<std::string> inputs{args.a_path, args.b_path};
-  const bool sharded = args.shard.count > 0;
-  if (!args.serve) check_output_path(args.out_path, inputs, sharded ? "writing shard part" : "writing graph");
-  const std::string fingerprint = sharded ? run_fingerprint(args) : std::string();
-  const Polyhedron A = load_model(args.a_path, args.load_a);
-  const Polyhedron B = load_model(args.b_path, args.load_b);
-  if (!args.serve)
-    for (const auto& [m, which, option] : {std::tuple{&A, "A", "--units-a"}, std::tuple{&B, "B", "--units-b"}})
-      if (const std::string w = size_warning(*m, which, option); !w.empty()) std::cerr << "cfgen: warning: " << w << '\n';
-  const gen::ModelInfo ai = gen::analyse_model(A);
-  const gen::ModelInfo bi = gen::analyse_model(B);
-  if (args.serve) return args.serve(gen::WitnessSearch(ai, bi, scaled_search(A, B, args.rel, args.search)), args.threads);
+namespace {
 
-  gen::EnumerateOptions opt;
-  opt.threads = args.threads;
-  // Lengths scale with the smaller model (RelativeLengths).
-  const double diag = length_scale(A, B);
-  opt.search = scaled_search(A, B, args.rel, args.search);
-  opt.max_pcs = args.max_pcs;
-  opt.use_symmetry = args.symmetry && !args.thorough;
-  opt.close_orbits = args.thorough;
-  opt.shard = args.shard;
-  std::size_t resumed_chunks = 0;
-  if (!args.checkpoint_dir.empty()) {
-    opt.checkpoint = open_checkpoint(args.checkpoint_dir, run_fingerprint(args), inputs);
-    auto load = opt.checkpoint.load;
-    opt.checkpoint.load = [load, &resumed_chunks](std::size_t stage, std::size_t chunk, const std::vector<gen::Task>& tasks,
-                                                  std::vector<gen::TaskResult>& out) {
-      const bool kept = load(stage, chunk, tasks, out);
-      resumed_chunks += kept ? 1 : 0;
-      return kept;
-    };
-  }
-  opt.first_pairs = args.first_pairs;
-  opt.distribute = args.distribute;
-  const bool terminal = isatty(STDERR_FILENO) != 0;
-  gen::ProgressPrinter printer(std::cerr, terminal);
-  if (!args.quiet)
-    opt.progress = [&](const gen::ProgressEvent& ev) {
-      // On a terminal, only runs over a couple of seconds get the updating line.
-      if (terminal && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(2)) return;
-      printer(ev);
-    };
-  gen::Enumeration e = gen::enumerate(ai, bi, opt);
-  printer.finish();
-  if (resumed_chunks > 0 && !args.quiet)
-    std::cerr << "cfgen: checkpoint '" << args.checkpoint_dir << "': resumed " << resumed_chunks
-              << " finished chunks\n";
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (sharded) {
-    ShardPart part;
-    part.args = args;
-    part.args.a_path = std::filesystem::absolute(args.a_path).lexically_normal().string();
-    part.args.b_path = std::filesystem::absolute(args.b_path).lexically_normal().string();
-    part.a_given = args.a_path;
-    part.b_given = args.b_path;
-    part.fingerprint = fingerprint;
-    part.index = args.shard.index;
-    part.count = args.shard.count;
-    part.candidates = e.first_pair_candidates;
-    part.results = e.shard_results;
-    write_part(args.out_path, part);
-    if (!args.quiet)
-      std::cerr << "cfgen: shard " << part.index << "/" << part.count << ": " << part.results.size() << " of "
-                << part.candidates << " level-2 candidates, " << seconds << " s -> " << args.out_path << '\n';
-    return 0;
-  }
+// The exit status of a run stopped on request, after saying what was kept.
+int stopped_status(const GenerateArgs& args) {
+  const int sig = gen::stop_signal();
+  std::cerr << "cfgen: stopped" << (sig == SIGTERM ? " (SIGTERM)" : sig == SIGINT ? " (SIGINT)" : "") << "; ";
+  if (args.checkpoint_dir.empty())
+    std::cerr << "nothing kept (--checkpoint DIR keeps finished work); '" << args.out_path << "' not written\n";
+  else
+    std::cerr << "finished chunks are kept in '" << args.checkpoint_dir
+              << "': the same command resumes from them\n";
+  // 128 + the signal, as a shell reports a process the signal ended.
+  return 128 + (sig ? sig : SIGINT);
+}
 
+// The graph's "meta" record: statistics, the parameters and the generator (docs/graph-format.md).
+nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args, const gen::SearchParams& s,
+                          const gen::EnumerateOptions& opt, double diag) {
   nlohmann::json meta;
   nlohmann::json by_count = nlohmann::json::object(), by_type = nlohmann::json::object();
   for (const CfRecord& r : e.cfs) {
@@ -143,7 +92,6 @@ int run_generate(const GenerateArgs& args) {
                    {"undecided", e.undecided.size()},
                    {"undecided_sets", undecided}};
   // Timing goes to stderr, not into the file, so that the same input gives the same bytes.
-  const auto& s = opt.search;
   meta["parameters"] = {{"length_scale_mm", diag},
                         {"touch_tol_rel", args.rel.touch_tol},
                         {"min_clearance_rel", args.rel.min_clearance},
@@ -160,11 +108,76 @@ int run_generate(const GenerateArgs& args) {
                         {"symmetry", opt.use_symmetry}};
   if (args.thorough) meta["parameters"]["thorough"] = true;  // absent otherwise: the same bytes as before
   meta["generator"] = {{"name", "cfgen"},
-                       {"a_model", args.a_label.empty() ? args.a_path : args.a_label},
-                       {"b_model", args.b_label.empty() ? args.b_path : args.b_label}};
+                       {"a_model", args.a_path},
+                       {"b_model", args.b_path}};
   // Coordinates are stored in mm; the unit each model file was read in (SPEC section 2).
   meta["source_units"] = {{"A", args.load_a.units}, {"B", args.load_b.units}};
 
+  return meta;
+}
+
+}  // namespace
+
+int run_generate(const GenerateArgs& args) {
+  const auto t0 = std::chrono::steady_clock::now();
+  // The output path is checked before the work: not a device, FIFO or directory, not one of
+  // the models (SPEC section 5b).
+  const std::vector<std::string> inputs{args.a_path, args.b_path};
+  // Of K shards, shard 0 writes the graph.
+  const bool writes = !args.serve && args.shard.index == 0;
+  if (writes) check_output_path(args.out_path, inputs, "writing graph");
+  const Polyhedron A = load_model(args.a_path, args.load_a);
+  const Polyhedron B = load_model(args.b_path, args.load_b);
+  if (!args.serve)
+    for (const auto& [m, which, option] : {std::tuple{&A, "A", "--units-a"}, std::tuple{&B, "B", "--units-b"}})
+      if (const std::string w = size_warning(*m, which, option); !w.empty()) std::cerr << "cfgen: warning: " << w << '\n';
+  const gen::ModelInfo ai = gen::analyse_model(A);
+  const gen::ModelInfo bi = gen::analyse_model(B);
+  if (args.serve) return args.serve(gen::WitnessSearch(ai, bi, scaled_search(A, B, args.rel, args.search)), args.threads);
+
+  gen::EnumerateOptions opt;
+  // Lengths scale with the smaller model (RelativeLengths).
+  const double diag = length_scale(A, B);
+  const gen::SearchParams search = scaled_search(A, B, args.rel, args.search);
+  opt.max_pcs = args.max_pcs;
+  opt.use_symmetry = args.symmetry && !args.thorough;
+  opt.close_orbits = args.thorough;
+  gen::ExecuteOptions exec;
+  exec.threads = args.threads;
+  exec.shard = args.shard;
+  if (!args.checkpoint_dir.empty()) exec.checkpoint = open_checkpoint(args.checkpoint_dir, run_fingerprint(args), inputs);
+  exec.distribute = args.distribute;
+  exec.stop = args.stop;
+  const bool terminal = isatty(STDERR_FILENO) != 0;
+  gen::ProgressPrinter printer(std::cerr, terminal);
+  if (!args.quiet)
+    exec.progress = [&](const gen::ProgressEvent& ev) {
+      // On a terminal, only runs over a couple of seconds get the updating line.
+      if (terminal && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(2)) return;
+      printer(ev);
+    };
+  const gen::WitnessSearch ws(ai, bi, search);
+  gen::Executor executor([&ws](const gen::Task& t) { return gen::decide(ws, t); }, exec);
+  gen::Enumeration e;
+  try {
+    e = gen::enumerate(ws, opt, executor);
+  } catch (const gen::Stopped&) {
+    printer.finish();
+    return stopped_status(args);
+  }
+  printer.finish();
+  if (executor.resumed_chunks() > 0 && !args.quiet)
+    std::cerr << "cfgen: checkpoint '" << args.checkpoint_dir << "': resumed " << executor.resumed_chunks()
+              << " finished chunks\n";
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (args.shard.count > 0 && !args.quiet)
+    std::cerr << "cfgen: shard " << args.shard.index << "/" << args.shard.count << ": took "
+              << executor.shared_chunks() << " chunks from the other shards, waited " << executor.waited_seconds()
+              << " s for them, computed " << executor.taken_over_chunks() << " of theirs that did not come"
+              << (writes ? "" : "; shard 0 writes the graph") << '\n';
+  if (!writes) return 0;
+
+  const nlohmann::json meta = graph_meta(e, args, search, opt, diag);
   const std::size_t n_cfs = e.cfs.size(), n_tr = e.transitions.size();
   // Moved, not copied: a large graph's records and transitions are hundreds of MB.
   const CfGraph graph = CfGraph::from_parts(A, B, std::move(e.cfs), std::move(e.transitions), meta.dump());

@@ -1,11 +1,14 @@
 #pragma once
 /// @file
 /// cfgen's graph generation mode (SPEC section 5b): `cfgen A_MODEL B_MODEL -o GRAPH.json`.
-/// main.cpp parses the command line; run_generate does the work (generate.cpp, built when
-/// present, which defines CF_HAVE_GENERATOR).
+/// main.cpp parses the command line; run_generate does the work: it loads the models, makes
+/// the decide layer's WitnessSearch and the execute layer's Executor, runs the enumeration
+/// and writes the graph.
 
-#include "cfgen/enumerate.hpp"
-#include "cfgen/witness.hpp"
+#include "cfgen/decide/witness.hpp"
+#include "cfgen/enumerate/enumerate.hpp"
+#include "cfgen/execute/executor.hpp"
+#include "cfgen/execute/stop.hpp"
 #include "mesh/model_loader.hpp"
 
 #include <functional>
@@ -45,8 +48,9 @@ struct GenerateArgs {
   gen::SearchParams search;  ///< angular tolerances and search limits (lengths: `rel`)
   RelativeLengths rel;       ///< lengths of the search, relative to the models' size
   LoadOptions load_a, load_b;  ///< units and coplanarity tolerance of each model
-  /// With shard.count > 0: search one shard of the first level-2 round and write a part file
-  /// to out_path instead of the graph (cfgen/shard.hpp).
+  /// With shard.count > 0 (checkpoint_dir required, on storage every shard sees): compute this
+  /// shard's chunks of every stage and take the others' from the checkpoint; shard 0 writes
+  /// the graph, the others nothing (docs/generator.md, "Shards").
   gen::ShardSpec shard;
   /// Empty, or how the run's chunks are shared with other processes (rank 0 of an MPI run).
   gen::Distribute distribute;
@@ -54,12 +58,12 @@ struct GenerateArgs {
   /// with the run's search instead of enumerating (the other ranks of an MPI run); its
   /// value is the exit status.
   std::function<int(const gen::WitnessSearch&, int threads)> serve;
-  /// cfgen merge: the first level-2 round's results gathered from the parts.
-  const std::vector<gen::Witness>* first_pairs = nullptr;
+  /// Null, or a flag read between tasks: once set, the run stops, keeps the chunks it
+  /// finished when checkpoint_dir is set, writes nothing else and returns 128 + the signal
+  /// that set it (cfgen/execute/stop.hpp).
+  const gen::StopFlag* stop = nullptr;
   /// Non-empty: keep every stage's finished chunks there and resume from them.
   std::string checkpoint_dir;
-  /// The model names written into the graph's generator record; empty: a_path, b_path.
-  std::string a_label, b_label;
 };
 
 /// Generates the CF graph of A against B and writes it to args.out_path.

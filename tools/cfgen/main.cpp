@@ -1,12 +1,13 @@
 // cfgen: builds CF graphs (SPEC section 5b) and prints the features of a model.
 //   cfgen --features MODEL                 the model object (SPEC section 5) as JSON on stdout
 //   cfgen A_MODEL B_MODEL -o GRAPH.json    the CF graph of A against B
-//   cfgen A_MODEL B_MODEL --shard i/K -o PART, then cfgen merge PART... -o GRAPH.json
+//   cfgen A_MODEL B_MODEL -o GRAPH.json --checkpoint DIR --shard i/K   one of K processes
 
+#include "cfgen/execute/stop.hpp"
 #include "cfgen/generate.hpp"
-#include "cfgen/shard.hpp"
+#include "cfgen/execute/shard.hpp"
 #ifdef CF_HAVE_MPI
-#include "cfgen/mpi_run.hpp"
+#include "cfgen/execute/mpi_run.hpp"
 #endif
 #include "mesh/model_loader.hpp"
 #include "cli_checks.hpp"
@@ -30,52 +31,52 @@ int print_features(const std::string& path, const cf::tools::LoadOptions& opt) {
   return 0;
 }
 
-// cfgen merge PART... -o GRAPH.json [-j N] [-q]
-int merge_main(int argc, char** argv) {
-  CLI::App app{
-      "cfgen merge: joins the part files of a sharded run (cfgen A B --shard i/K -o PART) and\n"
-      "finishes it; the graph equals the one `cfgen A B -o GRAPH.json` writes.",
-      "cfgen merge"};
-  std::vector<std::string> parts;
-  std::string out_path;
-  int threads = 0;
-  bool quiet = false;
-  app.add_option("parts", parts, "the part files, one per shard, in any order")->required()->type_name("PART");
-  app.add_option("-o,--output", out_path, "graph file to write")->required()->type_name("GRAPH.json");
-  app.add_option("-j,--threads", threads, "worker threads (0: all cores)")->check(CLI::Range(0, 1024));
-  app.add_flag("-q,--quiet", quiet, "no progress messages");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::Success& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::cerr << "cfgen merge: " << e.what() << " (see cfgen merge --help)\n";
-    return 2;
-  }
-  try {
-    return cf::tools::run_merge(parts, out_path, threads, quiet);
-  } catch (const cf::Error& e) {
-    std::cerr << "cfgen merge: " << e.what() << '\n';
-    return 1;
-  } catch (const std::bad_alloc&) {
-    std::cerr << "cfgen merge: out of memory\n";
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "cfgen merge: internal error: " << e.what() << '\n';
-    return 3;
-  }
+// The witness search's tolerances and limits (docs/generator.md explains each), added to
+// `added`.
+void add_search_options(CLI::App& app, cf::tools::GenerateArgs& gen, std::vector<CLI::Option*>& added) {
+  auto& sp = gen.search;
+  // Lengths of the search are relative to the smaller model's bounding-box diagonal D, so
+  // that a pair scaled by any factor gives the same graph up to scale.
+  added.push_back(app.add_option("--touch-tol", gen.rel.touch_tol,
+                                    "x D: element pairs closer than this touch (D: the smaller model's bounding-box diagonal)")
+                         ->check(cf::cli::finite_range(1e-15, 1e-5))
+                         ->capture_default_str());
+  added.push_back(app.add_option("--min-clearance", gen.rel.min_clearance,
+                                    "x D: at a witness, every pair not part of a PC is at least this far apart")
+                         ->check(cf::cli::finite_range(1e-9, 0.1))
+                         ->capture_default_str());
+  added.push_back(app.add_option("--good-clearance", gen.rel.good_clearance,
+                                    "x D: stop searching a CF's witness once it is this clear")
+                         ->check(cf::cli::finite_range(1e-9, 1.0))
+                         ->capture_default_str());
+  added.push_back(app.add_option("--min-margin", gen.rel.min_margin,
+                                    "x D: contact point at least this far inside its elements")
+                         ->check(cf::cli::finite_range(1e-9, 0.1))
+                         ->capture_default_str());
+  added.push_back(app.add_option("--angle-margin", sp.angle_margin,
+                                    "rad: local non-penetration slack at each PC")
+                         ->check(cf::cli::finite_range(1e-9, 0.5))
+                         ->capture_default_str());
+  added.push_back(app.add_option("--theta-samples", sp.theta_samples,
+                                    "samples of a one-parameter rotation family")
+                         ->check(CLI::Range(1, 1000))
+                         ->capture_default_str());
+  added.push_back(app.add_option("--max-rotations", sp.max_rotations,
+                                    "rotations tried per candidate set before it is declared invalid")
+                         ->check(CLI::Range(1, 10000))
+                         ->capture_default_str());
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc >= 2 && std::string(argv[1]) == "merge") return merge_main(argc - 1, argv + 1);
   CLI::App app{
       "cfgen: contact-formation graph generator.\n"
       "  cfgen A_MODEL B_MODEL -o GRAPH.json   write the CF graph of A (moving) against B (fixed)\n"
       "  cfgen --features MODEL                print the model's features as JSON\n"
-      "  cfgen A_MODEL B_MODEL --shard i/K -o PART, then cfgen merge PART... -o GRAPH.json\n"
-      "                                        the same graph, its bulk split over K runs\n"
+      "  cfgen A_MODEL B_MODEL -o GRAPH.json --checkpoint DIR --shard i/K\n"
+      "                                        one of K processes that share every stage through\n"
+      "                                        DIR; shard 0 writes the graph\n"
       "Models: closed, outward-oriented polyhedra in OFF, OBJ, STL or PLY (mm).",
       "cfgen"};
   std::string features_path;
@@ -96,16 +97,14 @@ int main(int argc, char** argv) {
   auto* quiet = app.add_flag("-q,--quiet", gen.quiet, "no progress messages");
   std::string shard_text;
   auto* shard = app.add_option("--shard", shard_text,
-                               "search shard i of K of the first level-2 round and write a part file "
-                               "for `cfgen merge` instead of the graph")
+                               "compute shard i of K of every stage, taking the other shards' work from "
+                               "the --checkpoint DIR they share; shard 0 writes the graph")
                     ->type_name("i/K");
   auto* checkpoint = app.add_option("--checkpoint", gen.checkpoint_dir,
                                     "keep finished work in DIR; a rerun with the same models and options "
                                     "resumes from it")
                          ->type_name("DIR");
-  shard->excludes(checkpoint);
-  // Witness-search tolerances and limits (docs/generator.md explains each).
-  auto& sp = gen.search;
+  shard->needs(checkpoint);
   std::vector<CLI::Option*> gen_opts{threads, quiet, shard, checkpoint};
   gen_opts.push_back(app.add_option("--max-pcs", gen.max_pcs, "largest CFs to enumerate")
                          ->check(CLI::Range(1, 3))
@@ -118,36 +117,7 @@ int main(int argc, char** argv) {
                                   "search every candidate set as --no-symmetry does, then add every image of each CF "
                                   "found under the models' symmetries: the most complete graph, at --no-symmetry's cost")
                          ->excludes(no_sym_opt));
-  // Lengths of the search are relative to the smaller model's bounding-box diagonal D, so
-  // that a pair scaled by any factor gives the same graph up to scale.
-  gen_opts.push_back(app.add_option("--touch-tol", gen.rel.touch_tol,
-                                    "x D: element pairs closer than this touch (D: the smaller model's bounding-box diagonal)")
-                         ->check(cf::cli::finite_range(1e-15, 1e-5))
-                         ->capture_default_str());
-  gen_opts.push_back(app.add_option("--min-clearance", gen.rel.min_clearance,
-                                    "x D: at a witness, every pair not part of a PC is at least this far apart")
-                         ->check(cf::cli::finite_range(1e-9, 0.1))
-                         ->capture_default_str());
-  gen_opts.push_back(app.add_option("--good-clearance", gen.rel.good_clearance,
-                                    "x D: stop searching a CF's witness once it is this clear")
-                         ->check(cf::cli::finite_range(1e-9, 1.0))
-                         ->capture_default_str());
-  gen_opts.push_back(app.add_option("--min-margin", gen.rel.min_margin,
-                                    "x D: contact point at least this far inside its elements")
-                         ->check(cf::cli::finite_range(1e-9, 0.1))
-                         ->capture_default_str());
-  gen_opts.push_back(app.add_option("--angle-margin", sp.angle_margin,
-                                    "rad: local non-penetration slack at each PC")
-                         ->check(cf::cli::finite_range(1e-9, 0.5))
-                         ->capture_default_str());
-  gen_opts.push_back(app.add_option("--theta-samples", sp.theta_samples,
-                                    "samples of a one-parameter rotation family")
-                         ->check(CLI::Range(1, 1000))
-                         ->capture_default_str());
-  gen_opts.push_back(app.add_option("--max-rotations", sp.max_rotations,
-                                    "rotations tried per candidate set before it is declared invalid")
-                         ->check(CLI::Range(1, 10000))
-                         ->capture_default_str());
+  add_search_options(app, gen, gen_opts);
   app.add_option("--coplanar-tol", coplanar_tol,
                  "coplanarity tolerance relative to the model's bounding-box diagonal")
       ->check(cf::cli::finite_range(cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol));
@@ -198,7 +168,6 @@ int main(int argc, char** argv) {
     gen.load_a = gen.load_b = load;
     if (!units_a.empty()) gen.load_a.units = units_a;
     if (!units_b.empty()) gen.load_b.units = units_b;
-#ifdef CF_HAVE_GENERATOR
 #ifdef CF_HAVE_MPI
     if (cf::tools::launched_by_mpi()) {
       if (gen.shard.count > 0) {
@@ -208,11 +177,11 @@ int main(int argc, char** argv) {
       return cf::tools::run_generate_mpi(gen);
     }
 #endif
+    // Ctrl-C or a batch system's SIGTERM stops the run between tasks (finished chunks kept
+    // with --checkpoint); a second Ctrl-C ends it at once.
+    cf::gen::stop_on_signals();
+    gen.stop = &cf::gen::signal_stop_flag();
     return cf::tools::run_generate(gen);
-#else
-    std::cerr << "cfgen: graph generation is not built yet\n";
-    return 2;
-#endif
   } catch (const cf::Error& e) {
     std::cerr << "cfgen: " << e.what() << '\n';
     return 1;

@@ -66,12 +66,17 @@ def generate(a_path, b_path, output=None, **options):
     (rad), ``theta_samples``, ``max_rotations``, ``units``, ``units_a``, ``units_b``,
     ``coplanar_rel_tol``, ``symmetry`` (default True: one search per orbit of the models'
     symmetries; False is ``--no-symmetry``), ``thorough`` (default False; True is
-    ``--thorough``: every set searched, then every image of each CF added), ``quiet`` (default True: no progress on stderr).
+    ``--thorough``: every set searched, then every image of each CF added), ``quiet`` (default True: no progress on stderr),
+    ``checkpoint`` (a directory: ``--checkpoint``, finished work kept there and resumed by the
+    same call). Ctrl-C stops the run between tasks and raises KeyboardInterrupt; with
+    ``checkpoint``, the chunks finished so far are kept for the next call.
     Raises cf.Error for bad models or options.
     """
     if not HAVE_TOOLS:
         raise Error("generate: this build of cf has no generator (configured with CF_WITH_CGAL=OFF)")
     a_path, b_path = _os.fspath(a_path), _os.fspath(b_path)
+    if options.get("checkpoint") is not None:
+        options["checkpoint"] = _os.fspath(options["checkpoint"])
     if output is not None:
         _cf.generate(a_path, b_path, _os.fspath(output), **options)
         return load_graph(output)

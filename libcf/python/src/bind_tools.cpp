@@ -4,12 +4,18 @@
 #include "common.hpp"
 
 #ifdef CF_PYTHON_HAVE_TOOLS
+#include "cfgen/execute/stop.hpp"
 #include "cfgen/generate.hpp"
 #include "mesh/model_loader.hpp"
 #endif
 
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
+#include <exception>
+#include <mutex>
+#include <thread>
 
 namespace cfpy {
 
@@ -33,6 +39,47 @@ void check_int(int v, int lo, int hi, const char* name, const std::string& where
   if (v < lo || v > hi)
     fail(where + ": " + name + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
          "], got " + std::to_string(v));
+}
+
+// run_generate on a thread of its own while this one, the caller's, checks Python's signals:
+// Ctrl-C (KeyboardInterrupt) sets the run's stop flag, the run stops between tasks (keeping
+// its finished chunks when it keeps a checkpoint), and the KeyboardInterrupt is raised here.
+int generate_stoppable(cf::tools::GenerateArgs& g) {
+  cf::gen::StopFlag stop{false};
+  g.stop = &stop;
+  std::mutex m;
+  std::condition_variable cv;
+  bool done = false;
+  int status = 0;
+  std::exception_ptr error;
+  std::thread worker([&] {
+    try {
+      status = cf::tools::run_generate(g);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    std::lock_guard<std::mutex> lock(m);
+    done = true;
+    cv.notify_one();
+  });
+  for (bool finished = false; !finished;) {
+    {
+      py::gil_scoped_release release;
+      std::unique_lock<std::mutex> lock(m);
+      finished = cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; });
+    }
+    if (!finished && PyErr_CheckSignals() != 0) {
+      stop = true;
+      {
+        py::gil_scoped_release release;
+        worker.join();
+      }
+      throw py::error_already_set();
+    }
+  }
+  worker.join();
+  if (error) std::rethrow_exception(error);
+  return status;
 }
 
 }  // namespace
@@ -68,7 +115,8 @@ void bind_tools(py::module_& m) {
          int threads, bool quiet, int max_pcs, double touch_tol, double min_clearance,
          double good_clearance, double min_margin, double angle_margin, int theta_samples,
          int max_rotations, const std::string& units, const std::string& units_a,
-         const std::string& units_b, double coplanar_rel_tol, bool symmetry, bool thorough) {
+         const std::string& units_b, double coplanar_rel_tol, bool symmetry, bool thorough,
+         const std::string& checkpoint) {
         const std::string where = "generate";
         // The ranges cfgen's options accept.
         check_int(threads, 0, 1024, "threads", where);
@@ -104,11 +152,8 @@ void bind_tools(py::module_& m) {
         check_units(g.load_a.units, "units_a", where);
         check_units(g.load_b.units, "units_b", where);
         g.load_a.coplanar_rel_tol = g.load_b.coplanar_rel_tol = coplanar_rel_tol;
-        int status;
-        {
-          py::gil_scoped_release release;
-          status = cf::tools::run_generate(g);
-        }
+        g.checkpoint_dir = checkpoint;
+        const int status = generate_stoppable(g);
         if (status != 0)
           fail(where + ": cfgen's generator failed with status " + std::to_string(status));
       },
@@ -123,7 +168,7 @@ void bind_tools(py::module_& m) {
       py::arg("max_rotations") = cf::gen::SearchParams{}.max_rotations, py::arg("units") = "mm",
       py::arg("units_a") = "", py::arg("units_b") = "",
       py::arg("coplanar_rel_tol") = cf::tools::LoadOptions{}.coplanar_rel_tol,
-      py::arg("symmetry") = true, py::arg("thorough") = false,
+      py::arg("symmetry") = true, py::arg("thorough") = false, py::arg("checkpoint") = "",
       "cfgen's generation (cf::tools::run_generate) into the graph file `output`; the package's "
       "cf.generate wraps it.");
 #else

@@ -1,4 +1,4 @@
-#include "cfgen/progress.hpp"
+#include "cfgen/execute/progress.hpp"
 
 #include <cmath>
 #include <cstdio>

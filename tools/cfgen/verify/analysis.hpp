@@ -2,8 +2,8 @@
 // Per-model facts the generator needs again and again: vertex tangent cones, edge wedges,
 // convex partitions of faces, coplanar face groups, and a point-in-solid test.
 
-#include "cgal_support.hpp"
-#include "lp.hpp"
+#include "cfgen/verify/cgal_support.hpp"
+#include "cfgen/verify/lp.hpp"
 
 #include <cf/polyhedron.hpp>
 

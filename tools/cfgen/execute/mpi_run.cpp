@@ -1,6 +1,6 @@
-#include "cfgen/mpi_run.hpp"
+#include "cfgen/execute/mpi_run.hpp"
 
-#include "cfgen/shard.hpp"
+#include "cfgen/execute/shard.hpp"
 
 #include <cf/file_io.hpp>
 #include <cf/types.hpp>
@@ -71,7 +71,7 @@ int run_generate_mpi(GenerateArgs args) {
           if (st.MPI_TAG == kStop) return 0;
           std::size_t chunk = 0;
           const std::vector<gen::Task> tasks = tasks_from_text(text, "a chunk from rank 0", chunk);
-          send_text(task_results_text(chunk, gen::run_tasks(search, tasks, threads)), 0, kResult);
+          send_text(task_results_text(chunk, gen::decide_all([&search](const gen::Task& t) { return gen::decide(search, t); }, tasks, threads)), 0, kResult);
         }
       };
       return run_generate(args);

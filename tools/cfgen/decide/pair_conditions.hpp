@@ -6,7 +6,7 @@
 // condition (a rotation takes A's contact normals and the vector between A's contact points
 // onto B's), so they never reject a valid pair; tolerances only widen the ranges.
 
-#include "analysis.hpp"
+#include "cfgen/verify/analysis.hpp"
 
 #include <cf/pc.hpp>
 

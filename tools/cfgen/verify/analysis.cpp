@@ -1,4 +1,4 @@
-#include "analysis.hpp"
+#include "cfgen/verify/analysis.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,9 +1,14 @@
 #pragma once
-// Witness search for one candidate set of principal contacts: rotations that satisfy the
-// rotational conditions of its f-f / e-f / f-e contacts, a linear program for the translation
-// with the largest margin inside the touching elements, and a verification of the whole pose.
+/// @file
+/// Witness search for one candidate set of principal contacts: rotations that satisfy the
+/// rotational conditions of its f-f / e-f / f-e contacts, a linear program for the translation
+/// with the largest margin inside the touching elements, and the verifier's judgement of the
+/// whole pose. Its parts: find.cpp (the search's stages), witness.cpp (refinement, proofs,
+/// necessary conditions), rotations.cpp (the
+/// rotations tried), translations.cpp (the programs and the climb past obstacles).
 
-#include "analysis.hpp"
+#include "cfgen/verify/lp.hpp"
+#include "cfgen/verify/verifier.hpp"
 
 #include <cf/graph.hpp>
 
@@ -12,16 +17,9 @@
 
 namespace cf::gen {
 
-struct SearchParams {
-  double touch_tol = 1e-9;       // mm: element pairs closer than this touch
-  double min_clearance = 1e-2;   // mm: every pair not part of a PC at least this far apart
-  double good_clearance = 1.0;   // mm: stop searching once a witness is this clear
-  double min_margin = 1e-2;      // mm: contact point at least this far inside its elements
-  double angle_margin = 1e-3;    // rad: local non-penetration with this much slack
-  int theta_samples = 24;        // samples of a one-parameter rotation family
-  int max_rotations = 64;        // rotations tried per candidate
-  int max_piece_combinations = 4;
-};
+namespace internal {
+class FindRun;
+}
 
 /// The outcome of a search: whether a witness was found, and its quality.
 struct Witness {
@@ -31,13 +29,10 @@ struct Witness {
   double margin = 0;     // mm, the LP margin of the contacts inside their elements
 };
 
-/// Whether a PC of `pcs` covers the pair (element a of A, element b of B): each element lies
-/// in the closure of that PC's element on its side (a PC covers its own pair). Touching such
-/// a pair does not change the contact set.
-bool covered_by(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs, ElementKind ka, int a,
-                ElementKind kb, int b);
-
-class WitnessSearch {
+/// The search for witnesses (docs/generator.md, "Layers", decide): rotations from the PCs'
+/// conditions, seeds and samples, translations from linear programs, climbs past obstacles;
+/// every pose it returns is one its Verifier accepts.
+class WitnessSearch : public Verifier {
  public:
   WitnessSearch(const ModelInfo& a, const ModelInfo& b, const SearchParams& p);
 
@@ -47,56 +42,10 @@ class WitnessSearch {
   /// conditions), then climbs past the obstacles met there.
   Witness find(const PcSet& pcs, const std::vector<Mat3>& seeds, bool seeds_only = false) const;
 
-  /// Verifies a pose: exactly the PCs of `pcs` hold (every other touching element pair is
-  /// dominated by one of them), locally without penetration, pairwise distinct contact
-  /// planes, every other pair at least min_clearance apart, neither solid inside the other.
-  /// Returns the clearance (the smallest distance of such a pair, at most good_clearance: pairs
-  /// farther apart are not measured), or a negative number when the pose is not a witness.
-  double verify(const PcSet& pcs, const Pose& pose, std::string* why = nullptr) const;
-
-  /// A pair of elements, not part of the contacts, that came too close at a pose verify
-  /// refused (set: whether there was one).
-  struct Obstacle {
-    bool set = false;
-    ElementKind ka = ElementKind::kVertex, kb = ElementKind::kVertex;
-    int a = -1, b = -1;
-  };
-
-  /// True when the obstacle's pair, neither a PC nor covered by one, is still closer than
-  /// min_clearance at `pose` (and touching in open points if within touch_tol): then verify
-  /// refuses `pose` too. False proves nothing.
-  bool still_blocked(const PcSet& pcs, const Pose& pose, const Obstacle& o) const;
-
-  /// The pair of elements a refused pose failed on: an obstacle (as Obstacle), or a PC or a
-  /// pair a PC covers where A and B overlap (touching, tangent cones not disjoint).
-  struct FailedPair {
-    enum class Kind { kNone, kObstacle, kOverlap } kind = Kind::kNone;
-    ElementKind ka = ElementKind::kVertex, kb = ElementKind::kVertex;
-    int a = -1, b = -1;
-    /// The obstacle, when the pose failed on one (else an Obstacle not set).
-    Obstacle obstacle() const { return Obstacle{kind == Kind::kObstacle, ka, kb, a, b}; }
-  };
-  /// verify, also naming the pair the pose failed on, when it failed on one.
-  double verify(const PcSet& pcs, const Pose& pose, std::string* why, FailedPair* failed) const;
-  /// True when the pair still fails at `pose` as it did where it was recorded: then verify
-  /// refuses `pose` too (at that pair or at one listed before it). False proves nothing.
-  bool still_fails(const PcSet& pcs, const Pose& pose, const FailedPair& f) const;
-
-  /// The PCs that hold at a pose: every touching pair of open elements (distance within
-  /// touch_tol) that no other touching pair dominates. Returns false, with the reason, when
-  /// a non-dominated touch is degenerate (v-v, v-e, e-v, parallel e-e) or more than three
-  /// PCs hold; `out` is then meaningless. An empty `out` means no contact.
-  bool contacts_at(const Pose& pose, PcSet& out, std::string* why = nullptr) const;
-
   /// A witness for `pcs` near `pose`, a pose where they hold (found by a motion): moved
   /// towards the centre of the translations that keep the contacts, or `pose` itself, when
   /// verified with the contacts at least min_margin inside their elements.
   Witness refine(const PcSet& pcs, const Pose& pose) const;
-
-  /// How far inside their open elements the contacts of `pcs` lie at `pose` (mm): for each
-  /// PC the depth of its contact point, of the best of 63 points along its contact edge, or of
-  /// the centroid of its contact region, inside both elements; the smallest over the PCs.
-  double contact_margin(const PcSet& pcs, const Pose& pose) const;
 
   /// For a set `find` found no witness for: true when it is proven invalid within the
   /// search's tolerances (a necessary condition fails, or its rotational conditions leave
@@ -107,26 +56,11 @@ class WitnessSearch {
   /// Cheap necessary conditions on a candidate set (no geometry search).
   bool plausible(const PcSet& pcs) const;
 
-  /// Instantaneous freedoms of the CF at a pose: (dof, translation_dof, pure_rotation).
-  void freedoms(const PcSet& pcs, const Pose& pose, CfRecord& out) const;
-
-  /// Contact plane of a PC at a pose (unit normal pointing into A, offset along it).
-  std::pair<Vec3, double> contact_plane(const Pc& pc, const Pose& pose) const;
-
-  /// The local non-penetration slack (a sine) a verified pose needs at every contact: half
-  /// of sin(angle_margin), the slack the search asks of the rotations it tries.
-  double verified_local_slack() const;
-
-  const ModelInfo& a() const { return A_; }
-  const ModelInfo& b() const { return B_; }
-  const SearchParams& params() const { return p_; }
-  double scale() const { return scale_; }
-
  private:
+  friend class internal::FindRun;  // find's stages (find.cpp)
   // generic_seeds: add each PC's preferred family and a spread of rotations to `seeds`.
   std::vector<Mat3> rotation_candidates(const PcSet& pcs, const std::vector<Mat3>& seeds,
                                         bool generic_seeds = true) const;
-  double local_margin(const PcSet& pcs, const Mat3& R) const;
   // Rotations satisfying the PCs' rotational conditions: the seeds projected onto them, and
   // `samples` spins when one face alignment leaves the spin free.
   std::vector<Mat3> family_samples(const PcSet& pcs, const std::vector<Mat3>& seeds, int samples) const;
@@ -139,14 +73,6 @@ class WitnessSearch {
   std::vector<Mat3> anchored_rotations(const PcSet& pcs) const;
   // Number of convex pieces of each face slot of the LP (build_lp's `pieces`), in its order.
   std::vector<int> piece_slots(const PcSet& pcs) const;
-  // Whether A's and B's tangent cones where element a of A touches element b of B have
-  // disjoint interiors (exact for pairs with a face or two edges; vertex-edge and
-  // vertex-vertex probe along each cone's inward axis).
-  bool cones_disjoint(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b) const;
-  // Whether A and B overlap where element a of A touches element b of B, d apart: they
-  // touch in open points and their tangent cones there are not disjoint (verify's test for a
-  // PC or a pair a PC covers).
-  bool overlap_at(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b, double d) const;
   // extra_vars: variables after the program's own, for the caller (no rows use them).
   LinearProgram build_lp(const PcSet& pcs, const Mat3& R, const std::vector<int>& pieces,
                          int extra_vars = 0) const;
@@ -201,10 +127,6 @@ class WitnessSearch {
                      const std::vector<std::vector<Vec3>>& cut_points, double turn,
                      Mat3& next) const;
 
-  const ModelInfo& A_;
-  const ModelInfo& B_;
-  SearchParams p_;
-  double scale_;
   bool debug_;  // CFGEN_DEBUG set: explain every attempt on stderr
 };
 

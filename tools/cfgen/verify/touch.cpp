@@ -1,4 +1,4 @@
-#include "touch.hpp"
+#include "cfgen/verify/touch.hpp"
 
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/point_xy.hpp>

@@ -6,7 +6,7 @@
 // and places A where obstacles leave it room, which a translation chosen inside the contact
 // region alone does not (a face against a wall that another wall crowds).
 
-#include "witness.hpp"
+#include "cfgen/decide/witness.hpp"
 
 #include <vector>
 

@@ -2,23 +2,13 @@
 // Progress of a long cfgen run, for a person: an updating line on a terminal, one plain line
 // per finished stage otherwise (a log file, a batch job's output).
 
+#include "cfgen/enumerate/stage.hpp"
+
 #include <cstddef>
 #include <ostream>
 #include <string>
 
 namespace cf::gen {
-
-/// One report from the enumeration: a stage under way (finished = false, sent now and then)
-/// or a stage that has just ended (finished = true, sent once).
-struct ProgressEvent {
-  std::string stage;         // "level 2", "motion round 1", ...
-  std::string unit;          // what `done` and `total` count: "candidate sets", "CFs"
-  std::size_t done = 0;
-  std::size_t total = 0;
-  double seconds = 0;        // s since the stage began
-  bool finished = false;
-  std::string result;        // when finished: what the stage found, e.g. "816 valid"
-};
 
 /// Writes ProgressEvents to a stream. On a terminal: one line, rewritten in place, with the
 /// rate and the estimated time left of the stage under way. Otherwise: one line per finished

@@ -1,4 +1,4 @@
-#include "symmetry.hpp"
+#include "cfgen/enumerate/symmetry.hpp"
 
 #include <Eigen/SVD>
 

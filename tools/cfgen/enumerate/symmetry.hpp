@@ -4,7 +4,7 @@
 // (h of A's element, g of B's element), so the graph is a union of such orbits: the search
 // needs one member of each, and every member's witness follows from one.
 
-#include "analysis.hpp"
+#include "cfgen/verify/analysis.hpp"
 
 #include <cf/pc.hpp>
 

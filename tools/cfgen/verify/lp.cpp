@@ -1,4 +1,4 @@
-#include "lp.hpp"
+#include "cfgen/verify/lp.hpp"
 
 #include <Eigen/Dense>
 #include <glpk.h>

@@ -1,4 +1,4 @@
-#include "pair_conditions.hpp"
+#include "cfgen/decide/pair_conditions.hpp"
 
 #include <cf/geometry.hpp>
 

@@ -1,5 +1,5 @@
 // The generator's only CGAL translation unit.
-#include "cgal_support.hpp"
+#include "cfgen/verify/cgal_support.hpp"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>

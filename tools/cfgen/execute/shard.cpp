@@ -1,4 +1,4 @@
-#include "cfgen/shard.hpp"
+#include "cfgen/execute/shard.hpp"
 
 #include <cf/file_io.hpp>
 #include <cf/types.hpp>
@@ -15,10 +15,9 @@
 namespace cf::tools {
 namespace {
 
-constexpr const char* kFormat = "cfgen shard part";
-// 2: a witness as in chunks, [found, pose (12), clearance, margin]; 3: the witness search
-// climbs past obstacles and the neighbour rounds' tasks (the same tasks give other results,
-// so the parts and checkpoints of version 2 are refused).
+// The version of checkpoints and of the fingerprint. 2: a witness as in chunks, [found, pose
+// (12), clearance, margin]; 3: the witness search climbs past obstacles and the neighbour
+// rounds' tasks (the same tasks give other results, so checkpoints of version 2 are refused).
 constexpr int kVersion = 3;
 constexpr int kMaxShards = 4096;
 
@@ -52,20 +51,6 @@ nlohmann::json read_json_file(const std::string& path, const std::string& what, 
     return nlohmann::json::parse(bytes);
   } catch (const nlohmann::json::parse_error& e) {
     throw Error(what + " '" + path + "': not JSON (" + e.what() + ")" + hint);
-  }
-}
-
-[[noreturn]] void bad_part(const std::string& path, const std::string& problem) {
-  throw Error("reading shard part '" + path + "': " + problem);
-}
-
-template <class T>
-T field(const nlohmann::json& j, const char* key, const std::string& path) {
-  if (!j.is_object() || !j.contains(key)) bad_part(path, std::string("missing \"") + key + "\"");
-  try {
-    return j.at(key).get<T>();
-  } catch (const nlohmann::json::exception&) {
-    bad_part(path, std::string("\"") + key + "\" has the wrong type");
   }
 }
 
@@ -140,35 +125,6 @@ struct Reader {
 nlohmann::json witness_json(const gen::Witness& w) {
   if (!w.found) return nlohmann::json::array({false});
   return {true, pose_json(w.pose), w.clearance, w.margin};
-}
-
-// [index, witness...] (witness_json with its index in front): doubles round-trip exactly.
-nlohmann::json results_json(const std::vector<std::pair<std::size_t, gen::Witness>>& results) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const auto& [i, w] : results) {
-    nlohmann::json r = witness_json(w);
-    r.insert(r.begin(), i);
-    out.push_back(std::move(r));
-  }
-  return out;
-}
-
-// The "results" array of `j`; `mine(i)` says whether candidate i may appear in this file.
-std::vector<std::pair<std::size_t, gen::Witness>> parse_results(const nlohmann::json& j, const std::string& path,
-                                                                 const std::string& what,
-                                                                 const std::function<bool(std::size_t)>& mine) {
-  auto bad = [&](const std::string& problem) { throw Error("reading " + what + " '" + path + "': " + problem); };
-  if (!j.contains("results") || !j.at("results").is_array()) bad("missing \"results\" array");
-  std::vector<std::pair<std::size_t, gen::Witness>> out;
-  for (const nlohmann::json& r : j.at("results")) {
-    const std::string where = "result " + std::to_string(out.size());
-    if (!r.is_array() || r.size() < 2 || !r[0].is_number_unsigned()) bad(where + ": expected [index, found, ...]");
-    const std::size_t i = r[0].get<std::size_t>();
-    if (!mine(i)) bad(where + ": candidate " + std::to_string(i) + " does not belong in this file");
-    const Reader rd{[&](const std::string& problem) -> void { bad(where + ": " + problem); }};
-    out.push_back({i, rd.witness(nlohmann::json(r.begin() + 1, r.end()))});
-  }
-  return out;
 }
 
 nlohmann::json tasks_json(const std::vector<gen::Task>& tasks) {
@@ -308,99 +264,6 @@ std::string run_fingerprint(const GenerateArgs& args) {
   return buf;
 }
 
-void write_part(const std::string& path, const ShardPart& part) {
-  const nlohmann::json results = results_json(part.results);
-  const nlohmann::json j = {{"format", kFormat},
-                            {"version", kVersion},
-                            {"shard", part.index},
-                            {"shards", part.count},
-                            {"fingerprint", part.fingerprint},
-                            {"models",
-                             {{"a", part.a_given}, {"b", part.b_given}, {"a_path", part.args.a_path},
-                              {"b_path", part.args.b_path}}},
-                            {"options", options_json(part.args)},
-                            {"candidates", part.candidates},
-                            {"results", results}};
-  write_outputs({{path, j.dump() + "\n"}}, {part.args.a_path, part.args.b_path}, "writing shard part");
-}
-
-ShardPart read_part(const std::string& path) {
-  const nlohmann::json j = read_json_file(path, "reading shard part");
-  if (!j.is_object() || j.value("format", std::string()) != kFormat)
-    bad_part(path, "not a cfgen shard part (no \"format\": \"cfgen shard part\")");
-  const int version = field<int>(j, "version", path);
-  if (version != kVersion)
-    bad_part(path, "version " + std::to_string(version) + ", this cfgen reads version " + std::to_string(kVersion));
-  ShardPart p;
-  p.path = path;
-  p.index = field<int>(j, "shard", path);
-  p.count = field<int>(j, "shards", path);
-  if (p.count < 1 || p.count > kMaxShards || p.index < 0 || p.index >= p.count)
-    bad_part(path, "shard " + std::to_string(p.index) + "/" + std::to_string(p.count) + " is out of range");
-  p.fingerprint = field<std::string>(j, "fingerprint", path);
-  const nlohmann::json& m = j.contains("models") ? j.at("models") : nlohmann::json();
-  p.a_given = field<std::string>(m, "a", path);
-  p.b_given = field<std::string>(m, "b", path);
-  p.args.a_path = field<std::string>(m, "a_path", path);
-  p.args.b_path = field<std::string>(m, "b_path", path);
-  const nlohmann::json& o = j.contains("options") ? j.at("options") : nlohmann::json();
-  p.args.max_pcs = field<int>(o, "max_pcs", path);
-  p.args.symmetry = field<bool>(o, "symmetry", path);
-  p.args.thorough = o.contains("thorough") && field<bool>(o, "thorough", path);
-  p.args.rel.touch_tol = field<double>(o, "touch_tol_rel", path);
-  p.args.rel.min_clearance = field<double>(o, "min_clearance_rel", path);
-  p.args.rel.good_clearance = field<double>(o, "good_clearance_rel", path);
-  p.args.rel.min_margin = field<double>(o, "min_margin_rel", path);
-  p.args.search.angle_margin = field<double>(o, "angle_margin_rad", path);
-  p.args.search.theta_samples = field<int>(o, "theta_samples", path);
-  p.args.search.max_rotations = field<int>(o, "max_rotations", path);
-  p.args.search.max_piece_combinations = field<int>(o, "max_piece_combinations", path);
-  p.args.load_a.units = field<std::string>(o, "units_a", path);
-  p.args.load_b.units = field<std::string>(o, "units_b", path);
-  p.args.load_a.coplanar_rel_tol = field<double>(o, "coplanar_tol_a", path);
-  p.args.load_b.coplanar_rel_tol = field<double>(o, "coplanar_tol_b", path);
-  p.candidates = field<std::size_t>(j, "candidates", path);
-  p.results = parse_results(j, path, "shard part", [&](std::size_t i) {
-    return i < p.candidates && i % static_cast<std::size_t>(p.count) == static_cast<std::size_t>(p.index);
-  });
-  return p;
-}
-
-std::vector<gen::Witness> gather_parts(const std::vector<ShardPart>& parts) {
-  if (parts.empty()) throw Error("merging shards: no part given");
-  const ShardPart& first = parts.front();
-  std::set<int> seen;
-  for (const ShardPart& p : parts) {
-    if (p.fingerprint != first.fingerprint || p.count != first.count || p.candidates != first.candidates)
-      throw Error("merging shards: '" + p.path + "' comes from another run than '" + first.path +
-                  "' (other models, options or shard count)");
-    if (!seen.insert(p.index).second)
-      throw Error("merging shards: shard " + std::to_string(p.index) + "/" + std::to_string(p.count) +
-                  " is given twice ('" + p.path + "')");
-  }
-  if (static_cast<int>(seen.size()) != first.count) {
-    std::string missing;
-    for (int i = 0, n = 0; i < first.count && n < 8; ++i)
-      if (!seen.count(i)) missing += (n++ ? ", " : "") + std::to_string(i);
-    throw Error("merging shards: " + std::to_string(first.count - static_cast<int>(seen.size())) + " of " +
-                std::to_string(first.count) + " shards are missing (shard " + missing +
-                (first.count - static_cast<int>(seen.size()) > 8 ? ", ..." : "") + ")");
-  }
-  std::vector<gen::Witness> all(first.candidates);
-  std::vector<char> have(first.candidates, 0);
-  for (const ShardPart& p : parts)
-    for (const auto& [i, w] : p.results) {
-      if (have[i]) throw Error("merging shards: '" + p.path + "' repeats candidate " + std::to_string(i));
-      have[i] = 1;
-      all[i] = w;
-    }
-  for (std::size_t i = 0; i < have.size(); ++i)
-    if (!have[i])
-      throw Error("merging shards: no part holds candidate " + std::to_string(i) + " (shard " +
-                  std::to_string(i % static_cast<std::size_t>(first.count)) + " is incomplete)");
-  return all;
-}
-
 gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& fingerprint,
                                const std::vector<std::string>& inputs) {
   namespace fs = std::filesystem;
@@ -456,26 +319,6 @@ gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& finge
     write_outputs({{chunk_path(stage, chunk), j.dump() + "\n"}}, inputs, "writing checkpoint");
   };
   return store;
-}
-
-int run_merge(const std::vector<std::string>& part_paths, const std::string& out_path, int threads,
-              bool quiet) {
-  std::vector<ShardPart> parts;
-  for (const std::string& p : part_paths) parts.push_back(read_part(p));
-  const std::vector<gen::Witness> first_pairs = gather_parts(parts);
-  GenerateArgs args = parts.front().args;
-  args.out_path = out_path;
-  args.threads = threads;
-  args.quiet = quiet;
-  if (run_fingerprint(args) != parts.front().fingerprint)
-    throw Error("merging shards: the models '" + args.a_path + "' and '" + args.b_path +
-                "' are not the files the shards read (they changed since)");
-  args.a_label = parts.front().a_given;
-  args.b_label = parts.front().b_given;
-  args.first_pairs = &first_pairs;
-  std::vector<std::string> inputs = part_paths;
-  check_output_path(out_path, inputs, "writing graph");
-  return run_generate(args);
 }
 
 }  // namespace cf::tools

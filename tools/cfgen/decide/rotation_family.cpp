@@ -1,0 +1,196 @@
+#include "cfgen/decide/rotation_family.hpp"
+
+#include <cf/geometry.hpp>
+
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <cmath>
+
+namespace cf::gen::internal {
+namespace {
+
+// Solutions theta of a cos(theta) + b sin(theta) == d; `all` when it holds for every theta.
+bool trig_solve(double a, double b, double d, std::vector<double>& out, bool& all) {
+  const double r = std::hypot(a, b);
+  all = false;
+  if (r < 1e-12) {
+    all = std::abs(d) < kRotTol;
+    return all;
+  }
+  double c = d / r;
+  if (std::abs(c) > 1 + 1e-9) return false;
+  c = std::clamp(c, -1.0, 1.0);
+  const double phi = std::atan2(b, a);
+  const double delta = std::acos(c);
+  out.push_back(phi + delta);
+  if (delta > 1e-9 && delta < M_PI - 1e-9) out.push_back(phi - delta);
+  return true;
+}
+
+// theta maximising trace(S^T Rot(axis, theta) R0): the family member closest to S.
+double closest_theta(const Vec3& axis, const Mat3& R0, const Mat3& S) {
+  const Mat3 Q = R0 * S.transpose();
+  Mat3 K;
+  K << 0, -axis.z(), axis.y(), axis.z(), 0, -axis.x(), -axis.y(), axis.x(), 0;
+  const double c = Q.trace() - axis.dot(Q * axis);
+  const double s = (Q * K).trace();
+  return std::atan2(s, c);
+}
+
+}  // namespace
+
+// Each rotation turned by each angle (rad) about each coordinate axis, both ways: the
+// rotations a little around given ones, in a fixed order.
+std::vector<Mat3> turned_about_axes(const std::vector<Mat3>& rots,
+                                    std::initializer_list<double> angles) {
+  std::vector<Mat3> out;
+  for (const Mat3& R : rots)
+    for (double ang : angles)
+      for (int ax = 0; ax < 3; ++ax)
+        for (double sg : {1.0, -1.0}) out.push_back(axis_angle(sg * Vec3::Unit(ax), ang) * R);
+  return out;
+}
+
+void add_unique(std::vector<Mat3>& out, const Mat3& R) {
+  for (const Mat3& Q : out)
+    if ((Q - R).squaredNorm() < 1e-14) return;
+  out.push_back(R);
+}
+
+// Rotations R = Rot(axis, theta) * R0 satisfying all constraints; finitely many or samples.
+std::vector<Mat3> align_family(const RotConstraints& c, const std::vector<Mat3>& seeds, int samples,
+                               bool* finite_out) {
+  if (c.align.size() >= 2) {
+    // Two alignments fix the rotation. Solving the second as a condition on the spin about
+    // the first meets it at a double root (its dot product is at its maximum, 1), where a
+    // rounding error e in the models' angles moves the answer by sqrt(e): 3e-8 rad for
+    // e = 1e-15, above kRotTol. The least-squares rotation (Kabsch) errs by e itself.
+    if (finite_out) *finite_out = true;
+    Mat3 H = Mat3::Zero();
+    for (const auto& [a, b] : c.align) H += b * a.transpose();
+    Eigen::JacobiSVD<Mat3> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Mat3 D = Mat3::Identity();
+    D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
+    const Mat3 R = svd.matrixU() * D * svd.matrixV().transpose();
+    if (satisfies(c, R)) return {R};
+    return {};
+  }
+  const Vec3 a1 = c.align[0].first, axis = c.align[0].second;
+  const Mat3 R0 = align(a1, axis);
+  std::vector<double> thetas;
+  bool finite = false;
+  auto consider = [&](const Vec3& u0, const Vec3& w, double target) {
+    const Vec3 u = R0 * u0;
+    const Vec3 u_par = u.dot(axis) * axis;
+    const double A = (u - u_par).dot(w);
+    const double B = axis.cross(u).dot(w);
+    const double C = u_par.dot(w);
+    std::vector<double> sol;
+    bool all = false;
+    if (!trig_solve(A, B, target - C, sol, all)) return false;
+    if (all) return true;
+    if (!finite) {
+      thetas = sol;
+      finite = true;
+    }
+    return true;
+  };
+  for (std::size_t i = 1; i < c.align.size(); ++i)
+    if (!consider(c.align[i].first, c.align[i].second, 1.0)) return {};
+  for (const auto& [u, w] : c.perp)
+    if (!consider(u, w, 0.0)) return {};
+  if (finite_out) *finite_out = finite;
+  if (!finite) {
+    for (const Mat3& S : seeds) thetas.push_back(closest_theta(axis, R0, S));
+    for (int k = 0; k < samples; ++k) thetas.push_back(0.1 + 2 * M_PI * k / samples);
+  }
+  std::vector<Mat3> out;
+  for (double th : thetas) {
+    const Mat3 R = axis_angle(axis, th) * R0;
+    if (satisfies(c, R)) add_unique(out, R);
+  }
+  return out;
+}
+
+// Gauss-Newton projection of R onto { (R u_i) . w_i == 0 }.
+bool project_perp(const RotConstraints& c, Mat3& R) {
+  const int k = static_cast<int>(c.perp.size());
+  // At most three conditions: fixed-capacity matrices keep this hot loop off the heap.
+  using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
+  using Jac = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 3, 3>;
+  for (int it = 0; it < 40; ++it) {
+    Vec r(k);
+    Jac J(k, 3);
+    for (int i = 0; i < k; ++i) {
+      const Vec3 Ru = R * c.perp[i].first;
+      r[i] = Ru.dot(c.perp[i].second);
+      J.row(i) = Ru.cross(c.perp[i].second).transpose();
+    }
+    if (r.cwiseAbs().maxCoeff() < 1e-14) return true;
+    const Eigen::Vector3d d = -J.completeOrthogonalDecomposition().solve(r);
+    if (!d.allFinite() || d.norm() < 1e-16) break;
+    const double ang = std::min(d.norm(), 0.5);
+    R = axis_angle(d.normalized(), ang) * R;
+  }
+  return satisfies(c, R);
+}
+
+// Walks a one-parameter family of rotations (one alignment with its spin free, or two
+// perpendicularity conditions) away from R by steps of about h rad, at most n steps along
+// each branch: the rotations along each branch, R excluded. Where the two conditions'
+// gradients coincide (an axis-aligned pose, where branches of the family cross), each branch
+// is entered by a small turn about a coordinate axis projected back onto the conditions.
+// Empty for other families.
+std::vector<std::vector<Mat3>> walk_family(const RotConstraints& c, const Mat3& R, double h,
+                                           int n) {
+  std::vector<std::vector<Mat3>> paths;
+  const bool spin = c.align.size() == 1 && c.perp.empty();
+  if (!spin && !(c.align.empty() && c.perp.size() == 2)) return paths;
+  // The axis keeping the conditions to first order (zero where it is not unique).
+  auto tangent = [&](const Mat3& Q) -> Vec3 {
+    if (spin) return c.align[0].second;
+    const Vec3 w = (Q * c.perp[0].first)
+                       .cross(c.perp[0].second)
+                       .cross((Q * c.perp[1].first).cross(c.perp[1].second));
+    return w.norm() < 1e-6 ? Vec3::Zero() : Vec3(w.normalized());
+  };
+  auto step = [&](const Mat3& Q, const Vec3& axis, Mat3& out) {
+    out = axis_angle(axis, h) * Q;
+    return spin || project_perp(c, out);
+  };
+  std::vector<Mat3> starts;
+  const Vec3 w0 = tangent(R);
+  std::vector<Vec3> kicks;
+  if (w0.norm() > 0)
+    kicks = {w0, -w0};
+  else
+    for (int ax = 0; ax < 3; ++ax)
+      kicks.push_back(Vec3::Unit(ax)), kicks.push_back(-Vec3::Unit(ax));
+  const double min_trace = 1 + 2 * std::cos(0.5 * h);  // a start at least h/2 from R and the others
+  for (const Vec3& k : kicks) {
+    Mat3 Q;
+    if (!step(R, k, Q) || (R.transpose() * Q).trace() > min_trace) continue;
+    bool distinct = true;
+    for (const Mat3& S : starts) distinct = distinct && (S.transpose() * Q).trace() <= min_trace;
+    if (distinct) starts.push_back(Q);
+  }
+  for (const Mat3& first : starts) {
+    std::vector<Mat3> path{first};
+    Mat3 prev = R;
+    for (int k = 1; k < n; ++k) {
+      // Keep turning the way the last step turned, then back onto the conditions: this
+      // follows a branch through points where gradients coincide.
+      const Mat3 cur = path.back();
+      const Eigen::AngleAxisd moved(Mat3(cur * prev.transpose()));  // angle in [0, pi]
+      Mat3 next;
+      if (!step(cur, moved.axis(), next)) break;
+      prev = cur;
+      path.push_back(next);
+    }
+    paths.push_back(std::move(path));
+  }
+  return paths;
+}
+
+}  // namespace cf::gen::internal

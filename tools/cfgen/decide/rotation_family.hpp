@@ -1,0 +1,37 @@
+#pragma once
+// Families of rotations that meet a set of PCs' rotational conditions (private to
+// cfgen/decide): solved, sampled, projected onto and walked along.
+
+#include "cfgen/verify/analysis.hpp"
+#include "cfgen/verify/rotation_conditions.hpp"
+
+#include <initializer_list>
+#include <vector>
+
+namespace cf::gen::internal {
+
+/// Each rotation turned by each angle (rad) about each coordinate axis, both ways: the
+/// rotations a little around given ones, in a fixed order.
+std::vector<Mat3> turned_about_axes(const std::vector<Mat3>& rots,
+                                    std::initializer_list<double> angles);
+
+/// Appends R unless a rotation within 1e-7 (Frobenius) of it is in `out` already.
+void add_unique(std::vector<Mat3>& out, const Mat3& R);
+
+/// Rotations R = Rot(axis, theta) * R0 satisfying all constraints; finitely many or samples.
+/// finite_out: whether the conditions leave finitely many.
+std::vector<Mat3> align_family(const RotConstraints& c, const std::vector<Mat3>& seeds, int samples,
+                               bool* finite_out = nullptr);
+
+/// Gauss-Newton projection of R onto { (R u_i) . w_i == 0 }; false when it does not converge.
+bool project_perp(const RotConstraints& c, Mat3& R);
+
+/// Walks a one-parameter family of rotations (one alignment with its spin free, or two
+/// perpendicularity conditions) away from R by steps of about h rad, at most n steps along
+/// each branch: the rotations along each branch, R excluded. Where the two conditions'
+/// gradients coincide (an axis-aligned pose, where branches of the family cross), each branch
+/// is entered by a small turn about a coordinate axis projected back onto the conditions.
+/// Empty for other families.
+std::vector<std::vector<Mat3>> walk_family(const RotConstraints& c, const Mat3& R, double h, int n);
+
+}  // namespace cf::gen::internal

@@ -1,0 +1,42 @@
+#pragma once
+/// @file
+/// The decide layer's unit of work: one question about one candidate set (find a witness,
+/// refine a pose met by motion, explore motions from a witness), asked of a WitnessSearch.
+/// A task is a pure function of the models, the search parameters and its inputs: the same
+/// task gives the same result in any process, on any thread (docs/generator.md, "Layers").
+
+#include "cfgen/decide/explore.hpp"
+#include "cfgen/decide/witness.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace cf::gen {
+
+struct Task {
+  enum class Kind : std::uint8_t {
+    kFind,          // WitnessSearch::find(pcs, seeds)
+    kFindOrRefine,  // find(pcs, {pose.R_BA}), else refine(pcs, pose): a set met by motion
+    kExplore,       // the motions from the witness `pose` of the CF `pcs` (explore.hpp)
+    kFindNear,      // find(pcs, seeds, seeds_only): a failed set near its neighbours' witnesses
+  };
+  Kind kind = Kind::kFind;
+  PcSet pcs;
+  std::vector<Mat3> seeds;  // kFind, kFindNear
+  Pose pose;                // kFindOrRefine, kExplore
+};
+
+struct TaskResult {
+  Witness witness;             // kFind, kFindOrRefine, kFindNear
+  std::vector<Discovery> met;  // kExplore: the contact sets met, in a fixed order
+};
+
+/// Answers one task with `search`.
+TaskResult decide(const WitnessSearch& search, const Task& task);
+
+/// How a run answers its tasks: decide() bound to the run's search, or a stand-in (the
+/// execute layer's tests). Called from several threads at once.
+using Decide = std::function<TaskResult(const Task&)>;
+
+}  // namespace cf::gen

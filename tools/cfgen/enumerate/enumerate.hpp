@@ -1,0 +1,60 @@
+#pragma once
+/// @file
+/// Which candidate sets to decide (docs/generator.md, "Layers"): the level-by-level
+/// enumeration of the valid contact formations of a model pair, the closure by motion, the
+/// neighbour rounds and the models' symmetries, and the transitions between the CFs found
+/// (docs/spec.md, section 4). The work goes out as stages to a StageRunner (stage.hpp); the
+/// sets are decided by the decide layer's WitnessSearch.
+
+#include "cfgen/decide/witness.hpp"
+#include "cfgen/enumerate/stage.hpp"
+
+#include <cf/graph.hpp>
+
+#include <cstddef>
+#include <utility>
+#include <vector>
+
+namespace cf::gen {
+
+struct EnumerateOptions {
+  int max_pcs = 3;  // 1..3
+  /// Search one set of each orbit of the models' symmetries (symmetry.hpp) and take the others
+  /// as images of its witness; false searches every set.
+  bool use_symmetry = true;
+  /// With use_symmetry false: once every set has been searched, add every image of each CF
+  /// found under the models' symmetries, verified at the image of its witness (cfgen
+  /// --thorough), so that the graph is closed under them.
+  bool close_orbits = false;
+};
+
+struct LevelStats {
+  std::size_t candidates = 0;  // sets that reached the witness search
+  std::size_t valid = 0;
+  double seconds = 0;
+  std::size_t by_motion = 0;      // of the valid ones, found by the closure by motion
+  std::size_t by_symmetry = 0;    // of the valid ones, images of another's witness
+  std::size_t by_neighbours = 0;  // of the valid ones, found near their neighbours' witnesses
+};
+
+struct Enumeration {
+  std::vector<CfRecord> cfs;  // canonical order: by number of PCs, then PC set
+  std::vector<Transition> transitions;
+  LevelStats levels[3];
+  double min_clearance = 0;                        // mm, smallest witness clearance in the graph
+  double min_margin = 0;                           // mm, smallest LP margin of a witness's contacts
+  std::size_t symmetries_a = 1, symmetries_b = 1;  // the models' symmetries, identity included
+  std::vector<PcSet> undecided;                    // failed candidates with no proof of invalidity
+};
+
+/// The CFs of the pair `search` was made for, and their transitions; every stage of the
+/// work goes to `runner`.
+/// @throws Stopped when the runner was asked to stop.
+Enumeration enumerate(const WitnessSearch& search, const EnumerateOptions& opt,
+                      StageRunner& runner);
+
+/// Transitions (gain, lose, change) between the given CFs, computed on the runner's threads.
+std::vector<Transition> transitions_between(const std::vector<CfRecord>& cfs, const Polyhedron& A,
+                                            const Polyhedron& B, StageRunner& runner);
+
+}  // namespace cf::gen

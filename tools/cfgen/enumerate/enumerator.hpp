@@ -1,0 +1,109 @@
+#pragma once
+// The enumeration's state and its steps (private to cfgen/enumerate): one object a run, its
+// steps in levels.cpp (the candidate levels), motion.cpp (closure by motion), neighbours.cpp
+// (neighbour rounds), finish.cpp (orbit closure, proofs, records) and enumerate.cpp (the
+// order of the steps).
+
+#include "cfgen/decide/pair_conditions.hpp"
+#include "cfgen/enumerate/enumerate.hpp"
+#include "cfgen/enumerate/symmetry.hpp"
+
+#include <functional>
+#include <map>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+namespace cf::gen::internal {
+
+// Vertices within this fraction of the length scale D match under a symmetry: far below the
+// touch tolerance (2e-11 D by default), so an image witness is verified as the witness was.
+constexpr double kSymmetryTol = 1e-13;
+// Members of an orbit searched before it counts as failed: each meets the search's fixed
+// samples differently. On the hexagonal peg and hole 2 find 13 orbits more than 1 (4 no more
+// than 2); on the square pair 4 find 2 more than 2.
+constexpr std::size_t kOrbitTries = 4;
+
+struct PcSetHash {
+  std::size_t operator()(const PcSet& s) const { return s.hash(); }
+};
+using PcSetSet = std::unordered_set<PcSet, PcSetHash>;
+template <class T>
+using PcSetMap = std::unordered_map<PcSet, T, PcSetHash>;
+
+// Candidate sets grouped by orbit: orbit o is members[first[o], first[o + 1]).
+struct OrbitGroups {
+  std::vector<PcSet> members;
+  std::vector<std::size_t> first;
+  std::size_t size() const { return first.empty() ? 0 : first.size() - 1; }
+  std::size_t count(std::size_t o) const { return first[o + 1] - first[o]; }
+  const PcSet& member(std::size_t o, std::size_t k) const { return members[first[o] + k]; }
+};
+
+/// The necessary conditions on pairs of PCs that the enumeration applies with `search`.
+PairConditions pair_conditions_for(const WitnessSearch& search);
+
+using SeedsOf = std::function<std::vector<Mat3>(const PcSet&)>;
+
+class Enumerator {
+ public:
+  Enumerator(const WitnessSearch& search, const EnumerateOptions& opt, StageRunner& runner);
+  Enumeration run();
+
+ private:
+  // levels.cpp
+  void accept(int level, const PcSet& s, const Witness& w);
+  OrbitGroups orbits_of(std::vector<PcSet> cands) const;
+  void run_level(int level, std::vector<PcSet> all, const SeedsOf& seeds_of);
+  std::size_t search_orbits(int level, const OrbitGroups& orbits, const SeedsOf& seeds_of,
+                            std::vector<char>& done, ProgressEvent& ev, Clock::time_point t0);
+  std::size_t search_rest(int level, const OrbitGroups& orbits, const SeedsOf& seeds_of,
+                          const std::vector<char>& done, Clock::time_point t0);
+  void singles_level();
+  std::vector<Mat3> seeds_from_subsets(const PcSet& s) const;
+  std::vector<PcSet> build_pairs();
+  void pairs_level();
+  void triples_level();
+  bool conditions_hold(const PcSet& t) const;
+  // motion.cpp
+  void motion_closure();
+  void more_witnesses(Clock::time_point t0);
+  void explore_frontier(Clock::time_point t0);
+  // neighbours.cpp
+  void changes_of(const PcSet& s, const std::function<void(const PcSet&)>& fn);
+  std::size_t neighbour_round();
+  // finish.cpp
+  void close_orbits();
+  void find_undecided();
+  void build_records();
+  void finished(ProgressEvent& ev, Clock::time_point t0, const std::string& result);
+
+  const WitnessSearch& search_;
+  const Polyhedron& A_;
+  const Polyhedron& B_;
+  const EnumerateOptions& opt_;
+  StageRunner& runner_;
+  // The models' symmetries: a valid set's images are valid, at the image of its witness.
+  const PairSymmetries sym_;
+  // The necessary conditions on pairs of PCs (pair_conditions.hpp).
+  const PairConditions pair_ok_;
+
+  Enumeration out_;
+  std::vector<std::pair<PcSet, Witness>> valid_[3];
+  std::vector<PcSet> failed_;  // candidates the search found no witness for
+  // Every set that reached the witness search or was found valid: nothing is searched twice.
+  PcSetSet seen_;
+  PcSetMap<Mat3> witness_rot_;                    // seeds for the sets above them
+  std::vector<std::pair<PcSet, Pose>> frontier_;  // valid sets not explored by motion yet
+  std::size_t singles_paired_ = 0;                // valid_[0][0, singles_paired_) have been paired
+  std::size_t pairs_tripled_ = 0;                 // valid pairs when the triples were last built
+  int motion_rounds_ = 0;
+  int neighbour_rounds_ = 0;
+  // The neighbour rounds' memory: members searched so far, tries per orbit, PC neighbours.
+  PcSetSet near_searched_;
+  PcSetMap<std::size_t> near_tries_;
+  std::map<Pc, std::vector<Pc>> pc_neighbours_;
+};
+
+}  // namespace cf::gen::internal

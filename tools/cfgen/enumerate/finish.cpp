@@ -1,0 +1,114 @@
+// The steps after the fixed point: the orbit closure (--thorough), the proofs of invalidity
+// of the failed candidates, and the CF records.
+
+#include "cfgen/enumerate/enumerator.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <string>
+
+namespace cf::gen::internal {
+
+void Enumerator::finished(ProgressEvent& ev, Clock::time_point t0, const std::string& result) {
+  ev.done = ev.total;
+  ev.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  ev.finished = true;
+  ev.result = result;
+  runner_.report(ev);
+}
+
+// Orbit closure (--thorough): every member of every orbit met, at the image of the witness
+// found. The search found each CF on its own, from its own seeds and motions; the images add
+// the members it missed. Verified on all cores, added in a fixed order.
+void Enumerator::close_orbits() {
+  const PairSymmetries full(A_, B_, kSymmetryTol * search_.scale(), true);
+  out_.symmetries_a = full.size_a();
+  out_.symmetries_b = full.size_b();
+  // A set's images from several CFs: the first in canonical order, and where that one does
+  // not verify (rounding at a borderline pose), the next, up to kClosureTries.
+  constexpr std::size_t kClosureTries = 4;
+  for (int l = 0; l < 3; ++l) {
+    const std::size_t found = valid_[l].size();
+    for (std::size_t attempt = 0; attempt < kClosureTries; ++attempt) {
+      std::vector<std::pair<PcSet, Witness>> images;
+      PcSetMap<std::size_t> sources;  // images met so far, by set
+      for (std::size_t i = 0; i < found; ++i) {
+        const auto& [s, w] = valid_[l][i];
+        for (std::size_t k = 1; k < full.size(); ++k) {
+          const PcSet t = full.image(s, k);
+          if (witness_rot_.count(t) || sources[t]++ != attempt) continue;
+          Witness v = w;
+          v.pose = full.image(w.pose, k);
+          images.push_back({t, v});
+        }
+      }
+      runner_.for_each(images.size(), [&](std::size_t i) {
+        images[i].second.clearance = search_.verify(images[i].first, images[i].second.pose);
+      });
+      bool refused = false;
+      for (auto& [t, v] : images) {
+        if (v.clearance < search_.params().min_clearance) {
+          refused = true;
+          continue;
+        }
+        witness_rot_.emplace(t, v.pose.R_BA);
+        valid_[l].push_back({t, v});
+        ++out_.levels[l].by_symmetry;
+      }
+      if (!refused) break;
+    }
+  }
+}
+
+// What the search could not decide: failed candidates that motion did not find either and
+// that no proof rules out (WitnessSearch::refuted).
+void Enumerator::find_undecided() {
+  PcSetSet known;
+  for (int l = 0; l < 3; ++l)
+    for (const auto& [s, w] : valid_[l]) known.insert(s);
+  std::vector<char> open(failed_.size(), 0);
+  const auto t0 = Clock::now();
+  ProgressEvent ev{
+      "proofs of invalidity", "failed candidate sets", 0, failed_.size(), 0, false, {}};
+  runner_.for_each(
+      failed_.size(),
+      [&](std::size_t i) { open[i] = !known.count(failed_[i]) && !search_.refuted(failed_[i]); },
+      &ev, t0);
+  for (std::size_t i = 0; i < failed_.size(); ++i)
+    if (open[i]) out_.undecided.push_back(failed_[i]);
+  finished(ev, t0, std::to_string(out_.undecided.size()) + " undecided");
+  std::sort(out_.undecided.begin(), out_.undecided.end(), pcset_less);
+}
+
+// Each CF's record (its witness, freedoms and contact planes), in canonical order, and the
+// smallest clearance and margin of the witnesses.
+void Enumerator::build_records() {
+  out_.min_clearance = std::numeric_limits<double>::infinity();
+  out_.min_margin = std::numeric_limits<double>::infinity();
+  for (int l = 0; l < 3; ++l) {
+    std::sort(valid_[l].begin(), valid_[l].end(),
+              [](const auto& x, const auto& y) { return pcset_less(x.first, y.first); });
+    std::vector<CfRecord> records(valid_[l].size());
+    std::vector<double> margins(valid_[l].size());
+    runner_.for_each(valid_[l].size(), [&](std::size_t i) {
+      const auto& [s, w] = valid_[l][i];
+      CfRecord& r = records[i];
+      r.pcs = s;
+      r.witness = w.pose;
+      search_.freedoms(s, w.pose, r);
+      for (int k = 0; k < s.size(); ++k) {
+        const auto [n, d] = search_.contact_plane(s[k], w.pose);
+        r.planes[static_cast<std::size_t>(k)] = {n.x(), n.y(), n.z(), d};
+      }
+      r.num_planes = s.size();
+      margins[i] = search_.contact_margin(s, w.pose);
+    });
+    for (std::size_t i = 0; i < records.size(); ++i) {
+      out_.cfs.push_back(records[i]);
+      out_.min_clearance = std::min(out_.min_clearance, valid_[l][i].second.clearance);
+      out_.min_margin = std::min(out_.min_margin, margins[i]);
+    }
+  }
+}
+
+}  // namespace cf::gen::internal

@@ -1,0 +1,214 @@
+#include "cfgen/execute/executor.hpp"
+
+#include "cfgen/execute/parallel.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <thread>
+#include <string>
+#include <utility>
+
+namespace cf::gen {
+namespace {
+
+// Tasks a slice holds in a stage without checkpoint or other processes.
+constexpr std::size_t kSliceTasks = std::size_t{1} << 15;
+// Under MPI, windows of chunks are handed out in turn (their results taken between windows,
+// on this thread): every chunk of a window is made at once.
+constexpr std::size_t kWindowChunks = 256;
+
+}  // namespace
+
+std::size_t chunk_size(std::size_t tasks) {
+  // About 64 chunks a stage: enough to share among processes and to lose little when killed,
+  // few enough files; at most 1024 tasks (about a minute of the slowest searches) a chunk.
+  constexpr std::size_t kChunks = 64, kMin = 8, kMax = 1024;
+  return std::clamp<std::size_t>((tasks + kChunks - 1) / kChunks, kMin, kMax);
+}
+
+std::vector<TaskResult> decide_all(const Decide& decide, const std::vector<Task>& tasks,
+                                   int threads, const std::function<void(std::size_t)>& tick,
+                                   const StopFlag* stop) {
+  std::vector<TaskResult> out(tasks.size());
+  if (!parallel_for(
+          tasks.size(), resolve_threads(threads), [&](std::size_t i) { out[i] = decide(tasks[i]); },
+          tick, stop))
+    throw Stopped("stopped on request");
+  return out;
+}
+
+Executor::Executor(Decide decide, ExecuteOptions options)
+    : decide_(std::move(decide)), opt_(std::move(options)), threads_(resolve_threads(opt_.threads)) {
+  if (opt_.shard.count > 0 && !opt_.checkpoint.load)
+    throw Error("a shard (" + std::to_string(opt_.shard.index) + "/" +
+                std::to_string(opt_.shard.count) +
+                ") needs a checkpoint directory that every shard sees (--checkpoint DIR)");
+}
+
+void Executor::throw_if_stopped() const {
+  if (opt_.stop && opt_.stop->load()) throw Stopped("stopped on request");
+}
+
+void Executor::tick(const Stage& stage, std::size_t done) const {
+  if (!stage.progress || !opt_.progress) return;
+  stage.progress->done = done;
+  stage.progress->seconds = std::chrono::duration<double>(Clock::now() - stage.started).count();
+  opt_.progress(*stage.progress);
+}
+
+std::vector<Task> Executor::make_range(const Stage& stage, std::size_t begin,
+                                       std::size_t end) const {
+  std::vector<Task> tasks;
+  tasks.reserve(end - begin);
+  for (std::size_t i = begin; i < end; ++i) tasks.push_back(stage.make(i));
+  return tasks;
+}
+
+void Executor::run(const Stage& stage) {
+  const std::size_t number = stages_++;
+  throw_if_stopped();
+  if (!opt_.checkpoint.load && !opt_.distribute)
+    run_slices(stage);
+  else
+    run_chunks(stage, number);
+}
+
+void Executor::run_slices(const Stage& stage) {
+  const bool report = stage.progress && opt_.progress;
+  for (std::size_t b = 0; b < stage.size; b += kSliceTasks) {
+    const std::size_t e = std::min(stage.size, b + kSliceTasks);
+    std::function<void(std::size_t)> ticks;
+    if (report) ticks = [&, b](std::size_t d) { tick(stage, b + d); };
+    std::vector<TaskResult> r =
+        decide_all(decide_, make_range(stage, b, e), threads_, ticks, opt_.stop);
+    for (std::size_t i = 0; i < r.size(); ++i) stage.take(b + i, std::move(r[i]));
+  }
+}
+
+void Executor::run_chunks(const Stage& stage, std::size_t number) {
+  const std::size_t n = stage.size, size = chunk_size(n), count = (n + size - 1) / size;
+  const bool report = stage.progress && opt_.progress;
+  std::size_t done = 0;  // tasks finished, for the progress
+  // Chunks handed to other processes, or shared with other shards, go a window at a time.
+  const std::size_t window = opt_.distribute || opt_.shard.count > 0 ? kWindowChunks : 1;
+  for (std::size_t w0 = 0; w0 < count; w0 += window) {
+    const std::size_t w1 = std::min(count, w0 + window);
+    std::vector<std::vector<Task>> chunks;
+    for (std::size_t k = w0; k < w1; ++k)
+      chunks.push_back(make_range(stage, k * size, std::min(n, (k + 1) * size)));
+    std::vector<std::vector<TaskResult>> res(chunks.size());
+    std::vector<std::size_t> todo;  // within the window
+    for (std::size_t j = 0; j < chunks.size(); ++j) {
+      if (opt_.checkpoint.load && opt_.checkpoint.load(number, w0 + j, chunks[j], res[j])) {
+        done += chunks[j].size();
+        ++resumed_;
+      } else {
+        todo.push_back(j);
+      }
+    }
+    // A resumed run's progress counts the chunks found as done.
+    if (todo.size() < chunks.size()) tick(stage, done);
+    auto finish = [&](std::size_t j, std::vector<TaskResult>&& r) {
+      if (r.size() != chunks[j].size())
+        throw Error("stage " + std::to_string(number) + ", chunk " + std::to_string(w0 + j) + ": " +
+                    std::to_string(r.size()) + " results for " + std::to_string(chunks[j].size()) +
+                    " tasks");
+      if (opt_.checkpoint.save) opt_.checkpoint.save(number, w0 + j, chunks[j], r);
+      res[j] = std::move(r);
+      done += chunks[j].size();
+      tick(stage, done);
+    };
+    // Another shard's chunks come from the checkpoint, once this shard's own are done.
+    std::vector<std::size_t> theirs;
+    if (opt_.shard.count > 0) {
+      std::vector<std::size_t> own;
+      for (std::size_t j : todo) (mine(number, w0 + j) ? own : theirs).push_back(j);
+      todo.swap(own);
+    }
+    if (opt_.distribute) {
+      // Progress then moves chunk by chunk, from the thread that takes them.
+      if (!todo.empty())
+        opt_.distribute(
+            chunks, todo,
+            [&](std::size_t j) { return decide_all(decide_, chunks[j], threads_, {}, opt_.stop); },
+            finish);
+    } else {
+      for (std::size_t j : todo) {
+        std::function<void(std::size_t)> ticks;
+        if (report) ticks = [&](std::size_t d) { tick(stage, done + d); };
+        const auto c0 = Clock::now();
+        finish(j, decide_all(decide_, chunks[j], threads_, ticks, opt_.stop));
+        slowest_chunk_ = std::max(slowest_chunk_, std::chrono::duration<double>(Clock::now() - c0).count());
+      }
+    }
+    // A shard that let a chunk of its wait past the patience is taken as gone for the rest
+    // of the window: its other chunks are computed here without waiting.
+    std::vector<char> gone(static_cast<std::size_t>(std::max(opt_.shard.count, 0)), 0);
+    for (std::size_t j : theirs) {
+      const std::size_t owner = (w0 + j + number) % gone.size();
+      if (!wait_for(number, w0 + j, chunks[j], gone[owner] ? 0.0 : patience(), res[j])) {
+        gone[owner] = 1;
+        ++taken_over_;
+        finish(j, decide_all(decide_, chunks[j], threads_, {}, opt_.stop));
+        continue;
+      }
+      done += chunks[j].size();
+      tick(stage, done);
+    }
+    for (std::size_t j = 0; j < chunks.size(); ++j)
+      for (std::size_t i = 0; i < res[j].size(); ++i)
+        stage.take((w0 + j) * size + i, std::move(res[j][i]));
+  }
+}
+
+bool Executor::mine(std::size_t stage, std::size_t chunk) const {
+  const auto count = static_cast<std::size_t>(opt_.shard.count);
+  // Shifted by the stage, so that the many stages of a chunk or two spread over the shards.
+  return count == 0 || (chunk + stage) % count == static_cast<std::size_t>(opt_.shard.index);
+}
+
+bool Executor::wait_for(std::size_t stage, std::size_t chunk, const std::vector<Task>& tasks,
+                        double patience, std::vector<TaskResult>& out) {
+  // Polled: a chunk takes milliseconds to seconds, so the first looks come quickly, then one
+  // every 100 ms (a stat of one file each).
+  const auto t0 = Clock::now();
+  for (int k = 0;; ++k) {
+    if (opt_.checkpoint.load(stage, chunk, tasks, out)) break;
+    throw_if_stopped();
+    if (std::chrono::duration<double>(Clock::now() - t0).count() >= patience) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(std::min(100, 1 << std::min(k, 7))));
+  }
+  ++shared_;
+  waited_ += std::chrono::duration<double>(Clock::now() - t0).count();
+  return true;
+}
+
+double Executor::patience() const {
+  // Long enough for a chunk that takes three times this shard's slowest.
+  return std::max(opt_.shard_patience, 3 * slowest_chunk_);
+}
+
+void Executor::for_each(std::size_t n, const std::function<void(std::size_t)>& fn,
+                        ProgressEvent* progress, Clock::time_point started) {
+  std::function<void(std::size_t)> ticks;
+  if (progress && opt_.progress) {
+    Stage s;
+    s.progress = progress;
+    s.started = started;
+    ticks = [this, s](std::size_t d) { tick(s, d); };
+  }
+  if (!parallel_for(n, threads_, fn, ticks, opt_.stop)) throw Stopped("stopped on request");
+}
+
+void Executor::report(const ProgressEvent& event) {
+  if (opt_.progress) opt_.progress(event);
+}
+
+Enumeration enumerate_pair(const ModelInfo& A, const ModelInfo& B, const SearchParams& search,
+                           const EnumerateOptions& opt, const ExecuteOptions& exec) {
+  const WitnessSearch ws(A, B, search);
+  Executor executor([&ws](const Task& t) { return decide(ws, t); }, exec);
+  return enumerate(ws, opt, executor);
+}
+
+}  // namespace cf::gen

@@ -1,0 +1,544 @@
+#include "cfgen/verify/verifier.hpp"
+
+#include "cfgen/verify/near_pairs.hpp"
+#include "cfgen/verify/rotation_conditions.hpp"
+#include "cfgen/verify/touch.hpp"
+
+#include <cf/geometry.hpp>
+#include <cf/motion.hpp>
+#include <cf/params.hpp>
+
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+
+namespace cf::gen {
+
+using namespace internal;
+
+Verifier::Verifier(const ModelInfo& a, const ModelInfo& b, const SearchParams& p)
+    : A_(a), B_(b), p_(p), scale_(std::max(a.model->size(), b.model->size())) {}
+
+double Verifier::verified_local_slack() const { return 0.5 * std::sin(p_.angle_margin); }
+
+double Verifier::local_margin(const PcSet& pcs, const Mat3& R) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  double m = 1.0;
+  for (const Pc& pc : pcs) {
+    switch (pc.type) {
+      case PcType::kFF:
+        m = std::min(m, 1.0 - (R * A.faces()[pc.a].normal + B.faces()[pc.b].normal).norm());
+        break;
+      case PcType::kVF: {
+        const auto& cone = A_.cones[pc.a];
+        if (!cone.pointed) return -1;
+        const Vec3 nb = R.transpose() * B.faces()[pc.b].normal;
+        for (const Vec3& r : cone.rays) m = std::min(m, r.dot(nb));
+        break;
+      }
+      case PcType::kFV: {
+        const auto& cone = B_.cones[pc.b];
+        if (!cone.pointed) return -1;
+        const Vec3 na = R * A.faces()[pc.a].normal;
+        for (const Vec3& r : cone.rays) m = std::min(m, r.dot(na));
+        break;
+      }
+      case PcType::kEF: {
+        if (!A.edges()[pc.a].convex) return -1;
+        const Vec3 nb = R.transpose() * B.faces()[pc.b].normal;
+        m = std::min({m, A_.wedges[pc.a].into_left.dot(nb), A_.wedges[pc.a].into_right.dot(nb)});
+        break;
+      }
+      case PcType::kFE: {
+        if (!B.edges()[pc.b].convex) return -1;
+        const Vec3 na = R * A.faces()[pc.a].normal;
+        m = std::min({m, B_.wedges[pc.b].into_left.dot(na), B_.wedges[pc.b].into_right.dot(na)});
+        break;
+      }
+      case PcType::kEE: {
+        if (!A.edges()[pc.a].convex || !B.edges()[pc.b].convex) return -1;
+        Vec3 N = (R * A.edges()[pc.a].dir).cross(B.edges()[pc.b].dir);
+        const double sin_cross = N.norm();
+        if (sin_cross < 1e-9) return -1;
+        N /= sin_cross;
+        auto side = [&](const Vec3& n) {
+          return std::min({-B_.wedges[pc.b].into_left.dot(n), -B_.wedges[pc.b].into_right.dot(n),
+                           (R * A_.wedges[pc.a].into_left).dot(n),
+                           (R * A_.wedges[pc.a].into_right).dot(n)});
+        };
+        m = std::min({m, sin_cross, std::max(side(N), side(-N))});
+        break;
+      }
+    }
+  }
+  return m;
+}
+
+std::pair<Vec3, double> Verifier::contact_plane(const Pc& pc, const Pose& pose) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  switch (pc.type) {
+    case PcType::kFF:
+    case PcType::kEF:
+    case PcType::kVF: {
+      const Face& fb = B.faces()[pc.b];
+      return {fb.normal, fb.offset};
+    }
+    case PcType::kFE:
+    case PcType::kFV: {
+      const Face& fa = A.faces()[pc.a];
+      const Vec3 n = -(pose.R_BA * fa.normal);
+      return {n, n.dot(pose.apply(fa.centroid))};
+    }
+    case PcType::kEE: {
+      const Edge& ea = A.edges()[pc.a];
+      const Edge& eb = B.edges()[pc.b];
+      Vec3 n = (pose.R_BA * ea.dir).cross(eb.dir).normalized();
+      if (B_.wedges[pc.b].bisector.dot(n) < 0) n = -n;  // into A, away from B
+      return {n, n.dot(B.vertices()[eb.v0.index()].p)};
+    }
+  }
+  return {Vec3::UnitY(), 0.0};
+}
+
+std::string kind_name(ElementKind k) {
+  return k == ElementKind::kVertex ? "v" : k == ElementKind::kEdge ? "e" : "f";
+}
+
+namespace {
+
+Pc pc_of(const PcSet& pcs, ElementKind ka, int a, ElementKind kb, int b) {
+  for (const Pc& pc : pcs)
+    if (a_kind(pc.type) == ka && b_kind(pc.type) == kb && pc.a == a && pc.b == b) return pc;
+  return {};
+}
+
+}  // namespace
+
+bool Verifier::cones_disjoint(const Pose& pose, ElementKind ka, int a, ElementKind kb,
+                              int b) const {
+  using K = ElementKind;
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  const double tol = 1e-9;  // on unit directions
+  const Mat3& R = pose.R_BA;
+  // A point on the open touching set, and a short probe length that stays near it.
+  const ClosestPoints cp = element_distance(A, pose, ka, a, B, kb, b);
+  const Vec3 x = cp.p_b;
+  double h = scale_;
+  auto shorten = [&](const Polyhedron& m, ElementKind k, int i) {
+    if (k == K::kVertex)
+      for (EdgeId e : m.vertices()[i].edges) h = std::min(h, m.edge(e).length);
+    else if (k == K::kEdge)
+      h = std::min(h, m.edges()[i].length);
+  };
+  shorten(A, ka, a);
+  shorten(B, kb, b);
+  h *= 1e-4;
+  auto inside_a = [&](const Vec3& p_B) {
+    return point_inside(A, pose.inverse_apply(p_B), 1e-3 * h);
+  };
+  auto inside_b = [&](const Vec3& p_B) { return point_inside(B, p_B, 1e-3 * h); };
+  // B's wedge at a convex edge lies in A's closed outer half-space {y : n . y >= 0}.
+  auto wedge_b_outside = [&](int e, const Vec3& n) {
+    return B.edges()[e].convex && B_.wedges[e].into_left.dot(n) >= -tol &&
+           B_.wedges[e].into_right.dot(n) >= -tol;
+  };
+  auto wedge_a_outside = [&](int e, const Vec3& n) {  // n in B's frame, outward of B
+    return A.edges()[e].convex && (R * A_.wedges[e].into_left).dot(n) >= -tol &&
+           (R * A_.wedges[e].into_right).dot(n) >= -tol;
+  };
+  if (ka == K::kFace && kb == K::kFace)
+    return (R * A.faces()[a].normal).dot(B.faces()[b].normal) < -1 + tol;
+  if (ka == K::kFace && kb == K::kEdge) return wedge_b_outside(b, R * A.faces()[a].normal);
+  if (ka == K::kEdge && kb == K::kFace) return wedge_a_outside(a, B.faces()[b].normal);
+  if (ka == K::kVertex && kb == K::kFace) {
+    const Vec3& n = B.faces()[b].normal;
+    for (const Vec3& r : A_.cones[a].rays)
+      if ((R * r).dot(n) < -tol) return false;
+    return A_.cones[a].pointed || !inside_a(x - h * n);
+  }
+  if (ka == K::kFace && kb == K::kVertex) {
+    const Vec3 n = R * A.faces()[a].normal;
+    for (const Vec3& r : B_.cones[b].rays)
+      if (r.dot(n) < -tol) return false;
+    return B_.cones[b].pointed || !inside_b(x - h * n);
+  }
+  if (ka == K::kEdge && kb == K::kEdge) {
+    const Vec3 da = R * A.edges()[a].dir;
+    const Vec3& db = B.edges()[b].dir;
+    Vec3 N = da.cross(db);
+    if (N.norm() > 1e-9) {
+      // Crossing edges: the only plane that can separate the wedges holds both edges.
+      if (!A.edges()[a].convex || !B.edges()[b].convex) return false;
+      N.normalize();
+      auto side = [&](const Vec3& n) {
+        return std::min({B_.wedges[b].into_left.dot(n), B_.wedges[b].into_right.dot(n),
+                         -(R * A_.wedges[a].into_left).dot(n),
+                         -(R * A_.wedges[a].into_right).dot(n)});
+      };
+      return std::max(side(N), side(-N)) >= -tol;
+    }
+    // Collinear edges: the two wedges' angular sectors about the common line must not overlap.
+    const Vec3 u = B_.wedges[b].into_left, w = db.cross(u);
+    auto angle = [&](const Vec3& v) {
+      const double t = std::atan2(v.dot(w), v.dot(u));
+      return t < 0 ? t + 2 * M_PI : t;
+    };
+    // Each sector as [start, start + width] going round +db from into_right to into_left
+    // (or the reverse), the width being the interior dihedral angle.
+    auto sector = [&](const Vec3& from, const Vec3& to, double width) {
+      double s0 = angle(from), s1 = angle(to);
+      double ccw = s1 - s0;
+      if (ccw < 0) ccw += 2 * M_PI;
+      // The sector runs ccw from `from` when that sweep equals the width, else ccw from `to`.
+      if (std::abs(ccw - width) < 1e-6) return std::pair{s0, width};
+      return std::pair{s1, width};
+    };
+    const auto sb = sector(B_.wedges[b].into_right, B_.wedges[b].into_left, B.edges()[b].dihedral);
+    const auto sa =
+        sector(R * A_.wedges[a].into_right, R * A_.wedges[a].into_left, A.edges()[a].dihedral);
+    auto overlap = [&](std::pair<double, double> p, std::pair<double, double> q) {
+      double off = q.first - p.first;
+      off = std::fmod(off + 4 * M_PI, 2 * M_PI);  // q starts this far ccw from p
+      if (off < p.second - 1e-6) return true;     // q starts inside p
+      return off + q.second > 2 * M_PI + 1e-6;    // q wraps round into p's start
+    };
+    return !overlap(sa, sb) && !overlap(sb, sa);
+  }
+  // A vertex against an edge or a vertex: probe into each solid's cone along its inward
+  // axis and check that the point is outside the other solid.
+  auto inward_b = [&]() -> Vec3 {
+    if (kb == K::kEdge) return -B_.wedges[b].bisector;
+    return B_.cones[b].pointed ? Vec3(B_.cones[b].center) : Vec3::Zero();
+  };
+  auto inward_a = [&]() -> Vec3 {
+    if (ka == K::kEdge) return -(R * A_.wedges[a].bisector);
+    return A_.cones[a].pointed ? Vec3(R * A_.cones[a].center) : Vec3::Zero();
+  };
+  const Vec3 ib = inward_b(), ia = inward_a();
+  if (ib.norm() > 0.5 && inside_a(x + h * ib)) return false;
+  if (ia.norm() > 0.5 && inside_b(x + h * ia)) return false;
+  return true;
+}
+
+double Verifier::verify(const PcSet& pcs, const Pose& pose, std::string* why) const {
+  return verify(pcs, pose, why, nullptr);
+}
+
+bool covered_by(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs, ElementKind ka, int a,
+                ElementKind kb, int b) {
+  for (const Pc& pc : pcs)
+    if (in_closure(A, ka, a, a_kind(pc.type), pc.a) && in_closure(B, kb, b, b_kind(pc.type), pc.b))
+      return true;
+  return false;
+}
+
+bool Verifier::still_blocked(const PcSet& pcs, const Pose& pose, const Obstacle& o) const {
+  if (!o.set) return false;
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  if (covered_by(A, B, pcs, o.ka, o.a, o.kb, o.b)) return false;  // verify judges those otherwise
+  const double d = element_distance(A, pose, o.ka, o.a, B, o.kb, o.b).distance;
+  if (d >= p_.min_clearance) return false;
+  return d > p_.touch_tol || open_touch(A, pose, o.ka, o.a, B, o.kb, o.b, p_.touch_tol);
+}
+
+bool Verifier::still_fails(const PcSet& pcs, const Pose& pose, const FailedPair& f) const {
+  if (f.kind == FailedPair::Kind::kObstacle) return still_blocked(pcs, pose, f.obstacle());
+  if (f.kind != FailedPair::Kind::kOverlap) return false;
+  // verify's overlap test, for a pair that is a PC or covered by one (as recorded).
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  return overlap_at(pose, f.ka, f.a, f.kb, f.b,
+                    element_distance(A, pose, f.ka, f.a, B, f.kb, f.b).distance);
+}
+
+bool Verifier::overlap_at(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b,
+                          double d) const {
+  return d <= p_.touch_tol && open_touch(*A_.model, pose, ka, a, *B_.model, kb, b, p_.touch_tol) &&
+         !cones_disjoint(pose, ka, a, kb, b);
+}
+
+double Verifier::verify(const PcSet& pcs, const Pose& pose, std::string* why,
+                        FailedPair* failed) const {
+  // The reason is written only when asked for: verify runs millions of times a run, most of
+  // them to reject, and a message built each time was a heap allocation or five.
+  auto reject = [&](const char* reason) {
+    if (why) *why = reason;
+    return -1.0;
+  };
+  auto reject_with = [&](const auto& reason) {
+    if (why) *why = reason();
+    return -1.0;
+  };
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  if (local_margin(pcs, pose.R_BA) < verified_local_slack()) return reject("locally penetrating");
+  // Line and plane PCs need their rotational conditions (a rotation found by a motion may
+  // only nearly satisfy them).
+  {
+    const RotConstraints c = rotation_constraints(pcs, A, B);
+    if (!satisfies(c, pose.R_BA)) return reject("a line or plane PC is not parallel to its face");
+  }
+  // Pairwise distinct contact planes.
+  for (int i = 0; i < pcs.size(); ++i)
+    for (int j = i + 1; j < pcs.size(); ++j) {
+      const auto [ni, di] = contact_plane(pcs[i], pose);
+      const auto [nj, dj] = contact_plane(pcs[j], pose);
+      const double c = ni.dot(nj);
+      if (std::abs(c) > 1 - 1e-9 && std::abs(di - (c > 0 ? dj : -dj)) < 1e-6 * scale_)
+        return reject("two PCs share a contact plane");
+    }
+  double clearance = std::numeric_limits<double>::infinity();
+  // Per thread, reused (verify runs hundreds of thousands of times a run).
+  thread_local std::vector<double> a_vertex_gap, b_vertex_gap;
+  a_vertex_gap.assign(A.num_vertices(), clearance);
+  b_vertex_gap.assign(B.num_vertices(), clearance);
+  int touching_pcs = 0;
+  // Pairs proven farther apart than good_clearance can neither touch nor lower the clearance
+  // below what counts as good: not measured.
+  NearPairs near(A_, B_, pose, p_.good_clearance);
+  for (ElementPair e; near.next(e);) {
+    const ElementKind ka = e.ka, kb = e.kb;
+    const int a = e.a, b = e.b;
+    const double d = element_distance(A, pose, ka, a, B, kb, b).distance;
+    if (ka == ElementKind::kVertex) a_vertex_gap[a] = std::min(a_vertex_gap[a], d);
+    if (kb == ElementKind::kVertex) b_vertex_gap[b] = std::min(b_vertex_gap[b], d);
+    bool is_pc = false;
+    for (const Pc& pc : pcs)
+      if (a_kind(pc.type) == ka && b_kind(pc.type) == kb && pc.a == a && pc.b == b) is_pc = true;
+    const bool covered = covered_by(A, B, pcs, ka, a, kb, b);
+    if (is_pc) {
+      if (d > p_.touch_tol)
+        return reject_with([&] {
+          return "PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " apart by " + std::to_string(d);
+        });
+      // The open elements must touch: a face meeting an edge only at its own boundary
+      // realises an edge-edge PC, not face-edge.
+      if (!open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol))
+        return reject_with([&] {
+          return "PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " touches only on its boundary";
+        });
+      ++touching_pcs;
+    }
+    // Where two elements share open points, A's and B's tangent cones there must have
+    // disjoint interiors; pairs that touch only through their boundaries are judged
+    // as those boundary pairs. This catches a face of A running through a reflex edge
+    // of B, which no pair reports as crossing.
+    if ((is_pc || covered) && overlap_at(pose, ka, a, kb, b, d)) {
+      if (failed) *failed = FailedPair{FailedPair::Kind::kOverlap, ka, kb, a, b};
+      return reject_with([&] {
+        return "A and B overlap where " + kind_name(ka) + std::to_string(a) + " touches " +
+               kind_name(kb) + std::to_string(b);
+      });
+    }
+    if (!is_pc && !covered) {
+      // Closed elements that meet only on their boundaries do not touch: their boundary
+      // elements do, and those pairs are judged on their own.
+      if (d <= p_.touch_tol && !open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
+      if (d < p_.min_clearance) {
+        if (failed) *failed = FailedPair{FailedPair::Kind::kObstacle, ka, kb, a, b};
+        return reject_with([&] {
+          return "extra contact " + kind_name(ka) + std::to_string(a) + "-" + kind_name(kb) +
+                 std::to_string(b) + " at " + std::to_string(d);
+        });
+      }
+      clearance = std::min(clearance, d);
+    }
+  }
+  if (touching_pcs != pcs.size()) return reject("a PC is not touching");
+  // Neither solid inside the other: test the vertex of each farthest from the other solid.
+  const auto ia = std::max_element(a_vertex_gap.begin(), a_vertex_gap.end()) - a_vertex_gap.begin();
+  const auto ib = std::max_element(b_vertex_gap.begin(), b_vertex_gap.end()) - b_vertex_gap.begin();
+  if (a_vertex_gap[ia] > p_.touch_tol &&
+      point_inside(B, pose.apply(A.vertices()[ia].p), p_.touch_tol))
+    return reject("A inside B");
+  if (b_vertex_gap[ib] > p_.touch_tol &&
+      point_inside(A, pose.inverse_apply(B.vertices()[ib].p), p_.touch_tol))
+    return reject("B inside A");
+  // Pairs beyond good_clearance are not listed (which of them are depends on the listing's
+  // bounds), so a clearance beyond it is reported as good_clearance: always finite.
+  return std::min(clearance, p_.good_clearance);
+}
+
+bool Verifier::contacts_at(const Pose& pose, PcSet& out, std::string* why) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  using K = ElementKind;
+  // Pairs within touch_tol (closed elements), and those touching in their open interiors.
+  thread_local std::vector<ElementPair> close, touching;  // reused, as verify's
+  close.clear();
+  touching.clear();
+  // near_pairs lists pairs in ascending kinds, so the pairs of an element pair's boundary
+  // elements come before it. Where one of those is within touch_tol, so is the pair (closed
+  // elements). Otherwise an edge and a face, or two faces, are farther apart unless the edge
+  // crosses the face's plane: the distance between two planar regions, or between a segment
+  // and a region it does not cross, is reached on a boundary. near_pairs' plane bound has
+  // already dropped the edges that do not cross, so the costly face-face distance is never
+  // measured here, and the edge-face one only for an edge crossing the face's plane.
+  auto bounded_by_close = [&](const ElementPair& e) {
+    for (const ElementPair& c : close)
+      if (in_closure(A, c.ka, c.a, e.ka, e.a) && in_closure(B, c.kb, c.b, e.kb, e.b)) return true;
+    return false;
+  };
+  NearPairs near(A_, B_, pose, p_.touch_tol);
+  for (ElementPair e; near.next(e);) {
+    if (!bounded_by_close(e)) {
+      if (e.ka == K::kFace && e.kb == K::kFace) continue;
+      if (element_distance(A, pose, e.ka, e.a, B, e.kb, e.b).distance > p_.touch_tol) continue;
+    }
+    close.push_back(e);
+    if (!open_touch(A, pose, e.ka, e.a, B, e.kb, e.b, p_.touch_tol)) continue;
+    touching.push_back(e);
+  }
+  out = PcSet();
+  for (std::size_t i = 0; i < touching.size(); ++i) {
+    const ElementPair& x = touching[i];
+    bool dominated = false;
+    for (std::size_t j = 0; j < touching.size() && !dominated; ++j) {
+      const ElementPair& y = touching[j];
+      dominated =
+          j != i && in_closure(A, x.ka, x.a, y.ka, y.a) && in_closure(B, x.kb, x.b, y.kb, y.b);
+    }
+    if (dominated) continue;
+    // The reason is built only when asked for: contacts_at runs at every step of the motions.
+    auto fail = [&](const char* reason, const char* detail = "") {
+      if (why)
+        *why = reason + kind_name(x.ka) + std::to_string(x.a) + "-" + kind_name(x.kb) +
+               std::to_string(x.b) + detail;
+      return false;
+    };
+    if (x.ka == K::kVertex && x.kb != K::kFace) return fail("degenerate touch ");
+    if (x.kb == K::kVertex && x.ka != K::kFace) return fail("degenerate touch ");
+    if (x.ka == K::kEdge && x.kb == K::kEdge &&
+        (pose.R_BA * A.edges()[x.a].dir).cross(B.edges()[x.b].dir).norm() < 1e-9)
+      return fail("degenerate touch ", " (parallel edges)");
+    PcType t = PcType::kFF;
+    if (x.ka == K::kFace)
+      t = x.kb == K::kFace ? PcType::kFF : x.kb == K::kEdge ? PcType::kFE : PcType::kFV;
+    else if (x.ka == K::kEdge)
+      t = x.kb == K::kFace ? PcType::kEF : PcType::kEE;
+    else
+      t = PcType::kVF;
+    if (!out.insert(Pc{t, x.a, x.b})) return fail("more than three PCs, the fourth ");
+  }
+  return true;
+}
+
+double Verifier::contact_margin(const PcSet& pcs, const Pose& pose) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  double m = std::numeric_limits<double>::infinity();
+  // How far a point of an edge lies inside the open edge and inside the face (B's frame).
+  auto edge_in_face = [&](const Vec3& p0, const Vec3& p1, const Polyhedron& fm, FaceId f,
+                          bool face_on_a) {
+    double best = 0;
+    const double len = (p1 - p0).norm();
+    for (int k = 1; k < 64; ++k) {
+      const double s = k / 64.0;
+      const Vec3 x = p0 + s * (p1 - p0);
+      const double in_face = fm.face_inset(f, face_on_a ? pose.inverse_apply(x) : x);
+      best = std::max(best, std::min({in_face, s * len, (1 - s) * len}));
+    }
+    return best;
+  };
+  for (const Pc& pc : pcs) {
+    switch (pc.type) {
+      case PcType::kVF:
+        m = std::min(m, B.face_inset(FaceId(pc.b), pose.apply(A.vertices()[pc.a].p)));
+        break;
+      case PcType::kFV:
+        m = std::min(m, A.face_inset(FaceId(pc.a), pose.inverse_apply(B.vertices()[pc.b].p)));
+        break;
+      case PcType::kEF:
+        m = std::min(
+            m, edge_in_face(pose.apply(A.edge_point(EdgeId(pc.a), 0)),
+                            pose.apply(A.edge_point(EdgeId(pc.a), 1)), B, FaceId(pc.b), false));
+        break;
+      case PcType::kFE:
+        m = std::min(m, edge_in_face(B.edge_point(EdgeId(pc.b), 0), B.edge_point(EdgeId(pc.b), 1),
+                                     A, FaceId(pc.a), true));
+        break;
+      case PcType::kEE: {
+        const Vec3 p0 = pose.apply(A.edge_point(EdgeId(pc.a), 0)),
+                   p1 = pose.apply(A.edge_point(EdgeId(pc.a), 1));
+        const Vec3& q0 = B.edge_point(EdgeId(pc.b), 0);
+        const Vec3& q1 = B.edge_point(EdgeId(pc.b), 1);
+        const ClosestPoints cp = segment_segment(p0, p1, q0, q1);
+        m = std::min({m, (cp.p_a - p0).norm(), (cp.p_a - p1).norm(), (cp.p_b - q0).norm(),
+                      (cp.p_b - q1).norm()});
+        break;
+      }
+      case PcType::kFF: {
+        // At the centroid of the largest piece of the overlap region.
+        const std::optional<Vec3> x = face_overlap_centroid(A, pose, pc.a, B, pc.b);
+        m = std::min(m,
+                     x ? std::max(0.0, std::min(B.face_inset(FaceId(pc.b), *x),
+                                                A.face_inset(FaceId(pc.a), pose.inverse_apply(*x))))
+                       : 0.0);
+        break;
+      }
+    }
+  }
+  return m;
+}
+
+void Verifier::freedoms(const PcSet& pcs, const Pose& pose, CfRecord& out) const {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  // The run time's constraint points (cf::compute_freedoms): the contact point of a point
+  // PC, two points of a contact line, three of a contact plane, all with the contact normal.
+  const double L = std::max(A.size(), 1e-9);
+  ConstraintPoint pts[Freedoms::kMaxRows];
+  int n = 0;
+  auto add = [&](const Vec3& p, const Vec3& nrm) {
+    if (n < Freedoms::kMaxRows) pts[n++] = {p, nrm};
+  };
+  for (const Pc& pc : pcs) {
+    const Vec3 nrm = contact_plane(pc, pose).first;
+    switch (pc.type) {
+      case PcType::kVF:
+        add(pose.apply(A.vertices()[pc.a].p), nrm);
+        break;
+      case PcType::kFV:
+        add(B.vertices()[pc.b].p, nrm);
+        break;
+      case PcType::kEF:
+        add(pose.apply(A.edge_point(EdgeId(pc.a), 0)), nrm);
+        add(pose.apply(A.edge_point(EdgeId(pc.a), 1)), nrm);
+        break;
+      case PcType::kFE:
+        add(B.edge_point(EdgeId(pc.b), 0), nrm);
+        add(B.edge_point(EdgeId(pc.b), 1), nrm);
+        break;
+      case PcType::kFF: {
+        const Face& fa = A.faces()[pc.a];
+        add(pose.apply(fa.centroid), nrm);
+        add(pose.apply(fa.centroid + L * fa.u), nrm);
+        add(pose.apply(fa.centroid + L * fa.v), nrm);
+        break;
+      }
+      case PcType::kEE:
+        add(element_distance(A, pose, ElementKind::kEdge, pc.a, B, ElementKind::kEdge, pc.b).p_b,
+            nrm);
+        break;
+    }
+  }
+  const Freedoms f = freedoms_from_points(pts, n, pose.t_BA, L, Params{});
+  out.dof = f.dof;
+  out.translation_dof = f.translation_dof;
+  out.pure_rotation = f.pure_rotation;
+}
+
+}  // namespace cf::gen
