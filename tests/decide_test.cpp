@@ -1,0 +1,58 @@
+// The decide layer (tools/cfgen/decide/task.hpp, witness.hpp) on hand-made candidate sets with
+// known answers: a 10 mm cube A against a 40 x 40 x 10 mm slab B. One set in, a result and
+// its evidence out: a witness that the verifier accepts, or a proof of invalidity.
+
+#include "analysed_pair.hpp"
+#include "cfgen/decide/task.hpp"
+#include "fixtures.hpp"
+
+#include <catch2/catch.hpp>
+
+namespace {
+
+using cf::Pc;
+using cf::PcSet;
+using cf::PcType;
+
+constexpr int kBottom = 0, kTop = 1;  // faces of cf::test::box
+
+}  // namespace
+
+TEST_CASE("decide: a face on a face is found, with a witness the verifier accepts", "[decide]") {
+  cf::test::AnalysedPair p(cf::test::box(10, 10, 10, "A"), cf::test::box(40, 40, 10, "B"));
+  const cf::gen::WitnessSearch search(p.ai, p.bi, {});
+  cf::gen::Task t;
+  t.pcs = PcSet({Pc{PcType::kFF, kBottom, kTop}});
+  const cf::gen::TaskResult r = cf::gen::decide(search, t);
+  REQUIRE(r.witness.found);
+  CHECK(search.verify(t.pcs, r.witness.pose) >= search.params().min_clearance);
+  // A's bottom face lies in B's top plane, z = 10 (mm).
+  for (int k = 0; k < 4; ++k)
+    CHECK(r.witness.pose.apply(p.A.vertices()[static_cast<std::size_t>(k)].p).z() == Approx(10).margin(1e-9));
+  // A vertex of A on B's top face, and an edge of A on it: found too.
+  t.pcs = PcSet({Pc{PcType::kVF, 0, kTop}});
+  CHECK(cf::gen::decide(search, t).witness.found);
+  t.pcs = PcSet({Pc{PcType::kEF, 0, kTop}});
+  CHECK(cf::gen::decide(search, t).witness.found);
+  CHECK_FALSE(search.refuted(t.pcs));  // a set with a witness is never refuted
+}
+
+TEST_CASE("decide: sets that cannot hold are not found, and those a necessary condition rules out are refuted",
+          "[decide]") {
+  cf::test::AnalysedPair p(cf::test::box(10, 10, 10, "A"), cf::test::box(40, 40, 10, "B"));
+  const cf::gen::WitnessSearch search(p.ai, p.bi, {});
+  // Two faces of A on one face of B: one contact plane twice.
+  const PcSet one_plane({Pc{PcType::kFF, kBottom, kTop}, Pc{PcType::kFF, kTop, kTop}});
+  CHECK_FALSE(search.plausible(one_plane));
+  CHECK(search.refuted(one_plane));
+  cf::gen::Task t;
+  t.pcs = one_plane;
+  CHECK_FALSE(cf::gen::decide(search, t).witness.found);
+  // A's bottom on B's top and A's top on B's bottom: A above B and below it at once.
+  t.pcs = PcSet({Pc{PcType::kFF, kBottom, kTop}, Pc{PcType::kFF, kTop, kBottom}});
+  CHECK_FALSE(cf::gen::decide(search, t).witness.found);
+  // One vertex of A in two PCs: a point lies in one open element.
+  const PcSet one_vertex({Pc{PcType::kVF, 0, kTop}, Pc{PcType::kVF, 0, 2}});
+  CHECK_FALSE(search.plausible(one_vertex));
+  CHECK(search.refuted(one_vertex));
+}
