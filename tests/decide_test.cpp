@@ -28,7 +28,8 @@ TEST_CASE("decide: a face on a face is found, with a witness the verifier accept
   CHECK(search.verify(t.pcs, r.witness.pose) >= search.params().min_clearance);
   // A's bottom face lies in B's top plane, z = 10 (mm).
   for (int k = 0; k < 4; ++k)
-    CHECK(r.witness.pose.apply(p.A.vertices()[static_cast<std::size_t>(k)].p).z() == Approx(10).margin(1e-9));
+    CHECK(r.witness.pose.apply(p.A.vertices()[static_cast<std::size_t>(k)].p).z() ==
+          Approx(10).margin(1e-9));
   // A vertex of A on B's top face, and an edge of A on it: found too.
   t.pcs = PcSet({Pc{PcType::kVF, 0, kTop}});
   CHECK(cf::gen::decide(search, t).witness.found);
@@ -37,8 +38,10 @@ TEST_CASE("decide: a face on a face is found, with a witness the verifier accept
   CHECK_FALSE(search.refuted(t.pcs));  // a set with a witness is never refuted
 }
 
-TEST_CASE("decide: sets that cannot hold are not found, and those a necessary condition rules out are refuted",
-          "[decide]") {
+TEST_CASE(
+    "decide: sets that cannot hold are not found, and those a necessary condition rules out are "
+    "refuted",
+    "[decide]") {
   cf::test::AnalysedPair p(cf::test::box(10, 10, 10, "A"), cf::test::box(40, 40, 10, "B"));
   const cf::gen::WitnessSearch search(p.ai, p.bi, {});
   // Two faces of A on one face of B: one contact plane twice.

@@ -98,7 +98,8 @@ struct MemoryStore {
       auto it = kept.find({stage, chunk});
       if (it == kept.end()) return false;
       // Not a Catch2 assertion: the shards' threads call this (Catch2 is not thread-safe).
-      if (it->second.first.size() != tasks.size()) throw std::logic_error("a kept chunk of other tasks");
+      if (it->second.first.size() != tasks.size())
+        throw std::logic_error("a kept chunk of other tasks");
       out = it->second.second;
       return true;
     };
@@ -321,7 +322,8 @@ TEST_CASE(
       Catch::Contains("'" + dir.string() + "' was made from other models or options"));
 }
 
-TEST_CASE("shards that share a checkpoint split every stage and each sees every result", "[execute][shard]") {
+TEST_CASE("shards that share a checkpoint split every stage and each sees every result",
+          "[execute][shard]") {
   // Three shards on threads of their own, one store between them (a directory on shared
   // storage in a real run): each decides only its chunks, (chunk + stage) mod 3, and waits
   // for the others'.
@@ -354,12 +356,15 @@ TEST_CASE("shards that share a checkpoint split every stage and each sees every 
   ExecuteOptions bad;
   bad.shard = {1, 2};
   StandIn d;
-  CHECK_THROWS_WITH(Executor(d.decide(), bad),
-                    "a shard (1/2) needs a checkpoint directory that every shard sees (--checkpoint DIR)");
+  CHECK_THROWS_WITH(
+      Executor(d.decide(), bad),
+      "a shard (1/2) needs a checkpoint directory that every shard sees (--checkpoint DIR)");
 }
 
-TEST_CASE("a shard alone finishes the run: the chunks of a shard that never comes are computed after the patience",
-          "[execute][shard]") {
+TEST_CASE(
+    "a shard alone finishes the run: the chunks of a shard that never comes are computed after the "
+    "patience",
+    "[execute][shard]") {
   MemoryStore mem;
   StandIn d;
   ExecuteOptions o;

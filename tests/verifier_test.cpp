@@ -3,8 +3,8 @@
 // hold at a pose, the contact plane, the margin and the freedoms, and the reasons a pose is
 // refused.
 
-#include "analysed_pair.hpp"
 #include "cfgen/verify/verifier.hpp"
+#include "analysed_pair.hpp"
 #include "fixtures.hpp"
 
 #include <catch2/catch.hpp>
@@ -37,8 +37,10 @@ const PcSet kOnTop({Pc{PcType::kFF, kBottom, kTop}});  // A's bottom face on B's
 
 }  // namespace
 
-TEST_CASE("a cube lying on a slab: the face-face PC is a witness, with the contact's plane, margin and freedoms",
-          "[verify]") {
+TEST_CASE(
+    "a cube lying on a slab: the face-face PC is a witness, with the contact's plane, margin and "
+    "freedoms",
+    "[verify]") {
   cf::test::AnalysedPair p(cf::test::box(10, 10, 10, "A"), cf::test::box(40, 40, 10, "B"));
   const cf::gen::Verifier v(p.ai, p.bi, kParams);
   const Pose pose = at({15, 15, 10});  // centred, 15 mm from every side of the slab
@@ -56,7 +58,7 @@ TEST_CASE("a cube lying on a slab: the face-face PC is a witness, with the conta
   CHECK(v.contact_margin(kOnTop, pose) == Approx(5).margin(1e-9));
   cf::CfRecord r;
   v.freedoms(kOnTop, pose, r);
-  CHECK(r.dof == 3);              // slide in the plane (2) and turn about its normal (1)
+  CHECK(r.dof == 3);  // slide in the plane (2) and turn about its normal (1)
   CHECK(r.translation_dof == 2);
 }
 

@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <thread>
 #include <string>
+#include <thread>
 #include <utility>
 
 namespace cf::gen {
@@ -38,7 +38,9 @@ std::vector<TaskResult> decide_all(const Decide& decide, const std::vector<Task>
 }
 
 Executor::Executor(Decide decide, ExecuteOptions options)
-    : decide_(std::move(decide)), opt_(std::move(options)), threads_(resolve_threads(opt_.threads)) {
+    : decide_(std::move(decide)),
+      opt_(std::move(options)),
+      threads_(resolve_threads(opt_.threads)) {
   if (opt_.shard.count > 0 && !opt_.checkpoint.load)
     throw Error("a shard (" + std::to_string(opt_.shard.index) + "/" +
                 std::to_string(opt_.shard.count) +
@@ -138,7 +140,8 @@ void Executor::run_chunks(const Stage& stage, std::size_t number) {
         if (report) ticks = [&](std::size_t d) { tick(stage, done + d); };
         const auto c0 = Clock::now();
         finish(j, decide_all(decide_, chunks[j], threads_, ticks, opt_.stop));
-        slowest_chunk_ = std::max(slowest_chunk_, std::chrono::duration<double>(Clock::now() - c0).count());
+        slowest_chunk_ =
+            std::max(slowest_chunk_, std::chrono::duration<double>(Clock::now() - c0).count());
       }
     }
     // A shard that let a chunk of its wait past the patience is taken as gone for the rest

@@ -46,9 +46,9 @@ using Distribute = std::function<void(
 /// (cfgen --shard i/K --checkpoint DIR): chunk k of stage s is this process's when
 /// (k + s) mod count == index; the others' are read from the checkpoint as they appear. A
 /// chunk that does not appear within the patience (three times the slowest chunk computed
-/// here, at least ExecuteOptions::shard_patience) is computed here, and so are its shard's other chunks of the window:
-/// a chunk's results do not depend on who computes them, so a shard that is slow, gone or
-/// never started costs time, not the graph. count == 0: not sharded.
+/// here, at least ExecuteOptions::shard_patience) is computed here, and so are its shard's other
+/// chunks of the window: a chunk's results do not depend on who computes them, so a shard that is
+/// slow, gone or never started costs time, not the graph. count == 0: not sharded.
 struct ShardSpec {
   int index = 0;
   int count = 0;
@@ -110,8 +110,8 @@ class Executor final : public StageRunner {
   bool mine(std::size_t stage, std::size_t chunk) const;
   // Reads the chunk another shard computes into `out`, waiting until it is in the checkpoint
   // or `patience` s have passed (then false).
-  bool wait_for(std::size_t stage, std::size_t chunk, const std::vector<Task>& tasks, double patience,
-                std::vector<TaskResult>& out);
+  bool wait_for(std::size_t stage, std::size_t chunk, const std::vector<Task>& tasks,
+                double patience, std::vector<TaskResult>& out);
   // s: how long to wait for another shard's chunk before computing it here.
   double patience() const;
   void throw_if_stopped() const;
