@@ -1,4 +1,4 @@
-// Tests of the generator's per-model facts (tools/cfgen/analysis.cpp): the points of an
+// Tests of the generator's per-model facts (tools/cfgen/verify/analysis.cpp): the points of an
 // element at least a margin inside it, worked out by hand on the cube and the L-block; the
 // index of the elements' boxes against a brute-force test.
 

@@ -1,4 +1,4 @@
-// cfgen's exact first contacts (tools/cfgen/explore.cpp) against the independent oracle's
+// cfgen's exact first contacts (tools/cfgen/decide/explore.cpp) against the independent oracle's
 // (tests/oracle/motion.cpp, which shares no code with tools/ or libcf/), on the oracle's shape
 // families with random proportions and placements: A starts clear of B and is translated
 // towards it, or turned about an axis that swings it into B. The two must find the same first

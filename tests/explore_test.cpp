@@ -1,4 +1,4 @@
-// Tests of cfgen's closure by motion (tools/cfgen/explore.cpp) and of the witness checks it
+// Tests of cfgen's closure by motion (tools/cfgen/decide/explore.cpp) and of the witness checks it
 // relies on (WitnessSearch::contacts_at, the tangent-cone test in verify). Poses and answers
 // are worked out by hand on boxes and the bundled L-block (slab 120 x 20 x 80 along x and z,
 // wall 0 <= x <= 20 up to y = 80).

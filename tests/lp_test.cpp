@@ -1,4 +1,4 @@
-// The witness search's small LP solver (tools/cfgen/lp.cpp: a dense simplex, GLPK for what it
+// The witness search's small LP solver (tools/cfgen/verify/lp.cpp: a dense simplex, GLPK for what it
 // leaves) against GLPK's primal simplex alone, a solver written apart from the dense one, on
 // random programs of the witness search's shapes: up to ten variables, equality rows, bounds,
 // and degenerate vertices where many rows meet.

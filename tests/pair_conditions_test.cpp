@@ -1,4 +1,4 @@
-// Tests of the generator's necessary conditions on two PCs (tools/cfgen/pair_conditions.cpp):
+// Tests of the generator's necessary conditions on two PCs (tools/cfgen/decide/pair_conditions.cpp):
 // spherical distances worked out by hand on a cube's normal cones, rejections on the cube
 // against the L-block that follow from one measurement each, and soundness on every CF of the
 // bundled graphs (their witnesses were verified apart from these conditions).
@@ -26,7 +26,7 @@ namespace {
 
 // Closed-form angles evaluated with atan2 on unit vectors: rounding only.
 constexpr double kAngle = 1e-12;
-// Widening used by the generator (enumerate.cpp): far above rounding, far below its margins.
+// Widening used by the generator (tools/cfgen/enumerate/levels.cpp): far above rounding, far below its margins.
 constexpr double kLengthTol = 1e-9;
 constexpr double kAngleTol = 1e-9;
 
@@ -165,7 +165,7 @@ TEST_CASE("every pair of PCs of every CF of the bundled graphs passes") {
     INFO(name);
     const cf::CfGraph g = cf::CfGraph::load(std::string(CF_SOURCE_DIR) + "/data/graphs/" + name);
     const Pair p(g.model_a(), g.model_b());
-    // As enumerate.cpp builds them for the default --angle-margin (1e-3 rad) and --min-margin
+    // As enumerate/levels.cpp builds them for the default --angle-margin (1e-3 rad) and --min-margin
     // (2e-4 of the smaller model's bounding-box diagonal).
     const double diag = std::min(bbox_diagonal(p.A), bbox_diagonal(p.B));
     const cf::gen::PairConditions pc(p.ai, p.bi, kLengthTol, kAngleTol, std::asin(0.5 * std::sin(1e-3)) - kAngleTol,

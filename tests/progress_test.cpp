@@ -1,4 +1,4 @@
-// cfgen's progress display (tools/cfgen/progress.hpp): what a person sees on a terminal and in
+// cfgen's progress display (tools/cfgen/execute/progress.hpp): what a person sees on a terminal and in
 // a log file.
 #include "cfgen/execute/progress.hpp"
 

@@ -1,4 +1,4 @@
-// Tests of the text form of cfgen's chunks of tasks and their results (tools/cfgen/shard.cpp),
+// Tests of the text form of cfgen's chunks of tasks and their results (tools/cfgen/execute/shard.cpp),
 // which MPI ranks exchange: every kind of task and result comes back exactly, doubles to
 // the last bit, and text that is not such a chunk is refused with a message naming it.
 

@@ -1,4 +1,4 @@
-// Tests of the models' symmetries (tools/cfgen/symmetry.cpp) and of the generator's use of
+// Tests of the models' symmetries (tools/cfgen/enumerate/symmetry.cpp) and of the generator's use of
 // them: counts of symmetry groups worked out by hand, the image of a pose checked point by
 // point, and a graph generated with one search per orbit checked for closure under the
 // symmetries and against a run that searches every set.
@@ -57,10 +57,12 @@ std::set<std::string> cf_sets(const cf::gen::Enumeration& e) {
   return out;
 }
 
-// The generator's defaults for the pair (lengths scaled to it), on two threads.
-// cfgen's default search for the pair.
-cf::gen::SearchParams search_for(const cf::test::AnalysedPair& p) { return cf::tools::scaled_search(p.A, p.B, {}); }
+// cfgen's default search for the pair (lengths scaled to it).
+cf::gen::SearchParams search_for(const cf::test::AnalysedPair& p) {
+  return cf::tools::scaled_search(p.A, p.B, {});
+}
 
+// The pair enumerated with the generator's defaults, on two threads.
 cf::gen::Enumeration enumerate(const cf::test::AnalysedPair& p, const cf::gen::EnumerateOptions& opt) {
   cf::gen::ExecuteOptions exec;
   exec.threads = 2;

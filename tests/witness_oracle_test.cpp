@@ -1,4 +1,4 @@
-// cfgen's pose verification (WitnessSearch::verify, tools/cfgen/witness.cpp) against the
+// cfgen's pose verification (WitnessSearch::verify, tools/cfgen/decide/witness.cpp) against the
 // independent oracle's classifier (tests/oracle/classify.cpp, which shares no code with tools/
 // or libcf/), on the oracle's shape families with random proportions and placements. verify
 // measures only the element pairs it cannot prove farther apart than the good clearance (by

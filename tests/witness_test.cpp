@@ -1,4 +1,4 @@
-// Tests of the witness search's search near given rotations (tools/cfgen/witness.cpp,
+// Tests of the witness search's search near given rotations (tools/cfgen/decide/witness.cpp,
 // WitnessSearch::find with seeds_only, and its last stage, the climb past obstacles), on a
 // hexagonal peg in a hexagonal through-hole 5% wider: CFs of a peg tilted across the hole's
 // rim hold only in a sliver of orientations, and a rotation a few hundredths of a radian off

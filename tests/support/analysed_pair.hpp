@@ -1,5 +1,5 @@
 #pragma once
-// Two models with the generator's per-model analysis (tools/cfgen/analysis.hpp), for the
+// Two models with the generator's per-model analysis (tools/cfgen/verify/analysis.hpp), for the
 // tests of cfgen's parts. Only for tests that link cfgen_core.
 
 #include "cfgen/verify/analysis.hpp"

@@ -14,9 +14,7 @@
 
 #include <algorithm>
 #include <chrono>
-#include <filesystem>
 #include <iostream>
-#include <thread>
 #include <tuple>
 #include <utility>
 
@@ -145,6 +143,7 @@ int run_generate(const GenerateArgs& args) {
   gen::ExecuteOptions exec;
   exec.threads = args.threads;
   exec.shard = args.shard;
+  exec.shard_patience = args.shard_patience;
   if (!args.checkpoint_dir.empty()) exec.checkpoint = open_checkpoint(args.checkpoint_dir, run_fingerprint(args), inputs);
   exec.distribute = args.distribute;
   exec.stop = args.stop;

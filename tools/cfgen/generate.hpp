@@ -52,6 +52,8 @@ struct GenerateArgs {
   /// shard's chunks of every stage and take the others' from the checkpoint; shard 0 writes
   /// the graph, the others nothing (docs/generator.md, "Shards").
   gen::ShardSpec shard;
+  /// s: the least a shard waits for another shard's chunk before computing it itself.
+  double shard_patience = 10;
   /// Empty, or how the run's chunks are shared with other processes (rank 0 of an MPI run).
   gen::Distribute distribute;
   /// When set, the models are read and analysed as for a run, and then this serves tasks

@@ -105,7 +105,14 @@ int main(int argc, char** argv) {
                                     "resumes from it")
                          ->type_name("DIR");
   shard->needs(checkpoint);
-  std::vector<CLI::Option*> gen_opts{threads, quiet, shard, checkpoint};
+  auto* patience = app.add_option("--shard-patience", gen.shard_patience,
+                                  "seconds a shard waits at least for another shard's chunk before "
+                                  "computing it itself (raise it where new files take long to be seen, "
+                                  "e.g. NFS)")
+                       ->check(cf::cli::finite_range(0, 1e6))
+                       ->capture_default_str()
+                       ->needs(shard);
+  std::vector<CLI::Option*> gen_opts{threads, quiet, shard, checkpoint, patience};
   gen_opts.push_back(app.add_option("--max-pcs", gen.max_pcs, "largest CFs to enumerate")
                          ->check(CLI::Range(1, 3))
                          ->capture_default_str());

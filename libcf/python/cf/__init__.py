@@ -75,8 +75,11 @@ def generate(a_path, b_path, output=None, **options):
     if not HAVE_TOOLS:
         raise Error("generate: this build of cf has no generator (configured with CF_WITH_CGAL=OFF)")
     a_path, b_path = _os.fspath(a_path), _os.fspath(b_path)
-    if options.get("checkpoint") is not None:
-        options["checkpoint"] = _os.fspath(options["checkpoint"])
+    if "checkpoint" in options:
+        if options["checkpoint"] is None:
+            del options["checkpoint"]
+        else:
+            options["checkpoint"] = _os.fspath(options["checkpoint"])
     if output is not None:
         _cf.generate(a_path, b_path, _os.fspath(output), **options)
         return load_graph(output)

@@ -41,6 +41,7 @@ Executor::Executor(Decide decide, ExecuteOptions options)
     : decide_(std::move(decide)),
       opt_(std::move(options)),
       threads_(resolve_threads(opt_.threads)) {
+  gone_.assign(static_cast<std::size_t>(std::max(opt_.shard.count, 0)), 0);
   if (opt_.shard.count > 0 && !opt_.checkpoint.load)
     throw Error("a shard (" + std::to_string(opt_.shard.index) + "/" +
                 std::to_string(opt_.shard.count) +
@@ -103,7 +104,7 @@ void Executor::run_chunks(const Stage& stage, std::size_t number) {
     for (std::size_t j = 0; j < chunks.size(); ++j) {
       if (opt_.checkpoint.load && opt_.checkpoint.load(number, w0 + j, chunks[j], res[j])) {
         done += chunks[j].size();
-        ++resumed_;
+        ++(mine(number, w0 + j) ? resumed_ : shared_);
       } else {
         todo.push_back(j);
       }
@@ -144,20 +145,11 @@ void Executor::run_chunks(const Stage& stage, std::size_t number) {
             std::max(slowest_chunk_, std::chrono::duration<double>(Clock::now() - c0).count());
       }
     }
-    // A shard that let a chunk of its wait past the patience is taken as gone for the rest
-    // of the window: its other chunks are computed here without waiting.
-    std::vector<char> gone(static_cast<std::size_t>(std::max(opt_.shard.count, 0)), 0);
-    for (std::size_t j : theirs) {
-      const std::size_t owner = (w0 + j + number) % gone.size();
-      if (!wait_for(number, w0 + j, chunks[j], gone[owner] ? 0.0 : patience(), res[j])) {
-        gone[owner] = 1;
-        ++taken_over_;
-        finish(j, decide_all(decide_, chunks[j], threads_, {}, opt_.stop));
-        continue;
-      }
-      done += chunks[j].size();
-      tick(stage, done);
-    }
+    if (!theirs.empty())
+      take_theirs(number, w0, chunks, theirs, res, finish, [&](std::size_t j) {
+        done += chunks[j].size();
+        tick(stage, done);
+      });
     for (std::size_t j = 0; j < chunks.size(); ++j)
       for (std::size_t i = 0; i < res[j].size(); ++i)
         stage.take((w0 + j) * size + i, std::move(res[j][i]));
@@ -170,25 +162,49 @@ bool Executor::mine(std::size_t stage, std::size_t chunk) const {
   return count == 0 || (chunk + stage) % count == static_cast<std::size_t>(opt_.shard.index);
 }
 
-bool Executor::wait_for(std::size_t stage, std::size_t chunk, const std::vector<Task>& tasks,
-                        double patience, std::vector<TaskResult>& out) {
-  // Polled: a chunk takes milliseconds to seconds, so the first looks come quickly, then one
-  // every 100 ms (a stat of one file each).
+void Executor::take_theirs(std::size_t number, std::size_t w0,
+                           const std::vector<std::vector<Task>>& chunks,
+                           std::vector<std::size_t> outstanding,
+                           std::vector<std::vector<TaskResult>>& res, const Finish& finish,
+                           const std::function<void(std::size_t)>& arrived) {
+  // Polled together against one deadline: a chunk takes milliseconds to seconds, so the first
+  // looks come quickly, then one every 100 ms (a stat of one file a chunk).
   const auto t0 = Clock::now();
-  for (int k = 0;; ++k) {
-    if (opt_.checkpoint.load(stage, chunk, tasks, out)) break;
+  const double deadline = patience();
+  const auto k_shards = static_cast<std::size_t>(opt_.shard.count);
+  for (int k = 0; !outstanding.empty(); ++k) {
+    std::vector<std::size_t> still;
+    for (std::size_t j : outstanding) {
+      const std::size_t owner = (w0 + j + number) % k_shards;
+      if (opt_.checkpoint.load(number, w0 + j, chunks[j], res[j])) {
+        gone_[owner] = 0;  // it is back
+        ++shared_;
+        arrived(j);
+      } else if (gone_[owner]) {
+        ++taken_over_;
+        finish(j, decide_all(decide_, chunks[j], threads_, {}, opt_.stop));
+      } else {
+        still.push_back(j);
+      }
+    }
+    outstanding.swap(still);
+    if (outstanding.empty()) break;
     throw_if_stopped();
-    if (std::chrono::duration<double>(Clock::now() - t0).count() >= patience) return false;
+    if (std::chrono::duration<double>(Clock::now() - t0).count() >= deadline) {
+      // Their shards are taken as gone until a chunk of theirs appears: the next pass
+      // computes these chunks, and later stages compute their chunks without waiting.
+      for (std::size_t j : outstanding) gone_[(w0 + j + number) % k_shards] = 1;
+      continue;
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(std::min(100, 1 << std::min(k, 7))));
   }
-  ++shared_;
   waited_ += std::chrono::duration<double>(Clock::now() - t0).count();
-  return true;
 }
 
 double Executor::patience() const {
-  // Long enough for a chunk that takes three times this shard's slowest.
-  return std::max(opt_.shard_patience, 3 * slowest_chunk_);
+  // Long enough for a chunk that takes three times this shard's slowest on one thread (the
+  // other shards may have fewer threads than this one).
+  return std::max(opt_.shard_patience, 3 * slowest_chunk_ * threads_);
 }
 
 void Executor::for_each(std::size_t n, const std::function<void(std::size_t)>& fn,

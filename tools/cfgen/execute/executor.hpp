@@ -46,9 +46,10 @@ using Distribute = std::function<void(
 /// (cfgen --shard i/K --checkpoint DIR): chunk k of stage s is this process's when
 /// (k + s) mod count == index; the others' are read from the checkpoint as they appear. A
 /// chunk that does not appear within the patience (three times the slowest chunk computed
-/// here, at least ExecuteOptions::shard_patience) is computed here, and so are its shard's other
-/// chunks of the window: a chunk's results do not depend on who computes them, so a shard that is
-/// slow, gone or never started costs time, not the graph. count == 0: not sharded.
+/// here on one thread, at least ExecuteOptions::shard_patience) is computed here, and its
+/// shard is taken as gone (its chunks computed here without waiting) until a chunk of its
+/// appears: a chunk's results do not depend on who computes them, so a shard that is slow,
+/// gone or never started costs time, not the graph. count == 0: not sharded.
 struct ShardSpec {
   int index = 0;
   int count = 0;
@@ -108,10 +109,13 @@ class Executor final : public StageRunner {
   std::vector<Task> make_range(const Stage& stage, std::size_t begin, std::size_t end) const;
   void tick(const Stage& stage, std::size_t done) const;
   bool mine(std::size_t stage, std::size_t chunk) const;
-  // Reads the chunk another shard computes into `out`, waiting until it is in the checkpoint
-  // or `patience` s have passed (then false).
-  bool wait_for(std::size_t stage, std::size_t chunk, const std::vector<Task>& tasks,
-                double patience, std::vector<TaskResult>& out);
+  using Finish = std::function<void(std::size_t, std::vector<TaskResult>&&)>;
+  // The other shards' chunks `outstanding` of the window at w0: read into res as they appear
+  // in the checkpoint (then arrived(j)), or, when their shard is gone or lets them wait past
+  // the patience, computed here and passed to finish.
+  void take_theirs(std::size_t number, std::size_t w0, const std::vector<std::vector<Task>>& chunks,
+                   std::vector<std::size_t> outstanding, std::vector<std::vector<TaskResult>>& res,
+                   const Finish& finish, const std::function<void(std::size_t)>& arrived);
   // s: how long to wait for another shard's chunk before computing it here.
   double patience() const;
   void throw_if_stopped() const;
@@ -125,6 +129,7 @@ class Executor final : public StageRunner {
   std::size_t taken_over_ = 0;
   double waited_ = 0;         // s
   double slowest_chunk_ = 0;  // s, of the chunks computed here
+  std::vector<char> gone_;    // per shard: taken as gone until a chunk of its appears
 };
 
 /// The CFs of A against B and their transitions: a WitnessSearch with `search`, its tasks

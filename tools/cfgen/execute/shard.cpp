@@ -8,9 +8,7 @@
 #include <cinttypes>
 #include <cstdio>
 #include <filesystem>
-#include <iostream>
 #include <functional>
-#include <set>
 
 namespace cf::tools {
 namespace {

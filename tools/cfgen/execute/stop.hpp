@@ -22,7 +22,7 @@ struct Stopped : Error {
 StopFlag& signal_stop_flag();
 
 /// From now on, the first SIGINT or SIGTERM sets signal_stop_flag() and records the signal;
-/// a second one ends the process as if no handler were installed. A signal the process
+/// a second signal of either ends the process as if no handler were installed. A signal the process
 /// ignores already (a background job of a non-interactive shell ignores SIGINT) stays ignored.
 void stop_on_signals();
 
