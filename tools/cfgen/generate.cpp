@@ -140,6 +140,7 @@ int run_generate(const GenerateArgs& args) {
   opt.max_pcs = args.max_pcs;
   opt.use_symmetry = args.symmetry && !args.thorough;
   opt.close_orbits = args.thorough;
+  opt.records = writes;  // the other shards stop after the last stage
   gen::ExecuteOptions exec;
   exec.threads = args.threads;
   exec.shard = args.shard;

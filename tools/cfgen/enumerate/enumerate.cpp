@@ -41,6 +41,7 @@ Enumeration Enumerator::run() {
   }
   if (opt_.close_orbits) close_orbits();
   for (int l = 0; l < 3; ++l) out_.levels[l].valid = valid_[l].size();
+  if (!opt_.records) return std::move(out_);
   find_undecided();
   build_records();
   // The search's own sets are done with: a large pair's candidates take hundreds of MB,

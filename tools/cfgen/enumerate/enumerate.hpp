@@ -26,6 +26,9 @@ struct EnumerateOptions {
   /// found under the models' symmetries, verified at the image of its witness (cfgen
   /// --thorough), so that the graph is closed under them.
   bool close_orbits = false;
+  /// False: stop once the last stage has run, with the levels' statistics only: no proofs of
+  /// invalidity, records or transitions (a shard that does not write the graph).
+  bool records = true;
 };
 
 struct LevelStats {
