@@ -71,7 +71,11 @@ class Enumerator {
   void more_witnesses(Clock::time_point t0);
   void explore_frontier(Clock::time_point t0);
   // neighbours.cpp
-  void changes_of(const PcSet& s, const std::function<void(const PcSet&)>& fn);
+  void know_neighbours(const std::vector<Pc>& pcs);
+  void changes_of(const PcSet& s, const std::function<void(const PcSet&)>& fn) const;
+  bool any_change(const PcSet& s, const std::function<bool(const PcSet&)>& pred) const;
+  bool near_candidate(const PcSet& s, PcSet& orbit) const;
+  std::vector<Task> neighbour_tasks();
   std::size_t neighbour_round();
   // finish.cpp
   void close_orbits();

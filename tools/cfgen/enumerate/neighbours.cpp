@@ -11,7 +11,9 @@
 
 #include <cf/geometry.hpp>
 
+#include <algorithm>
 #include <string>
+#include <utility>
 
 namespace cf::gen::internal {
 namespace {
@@ -21,53 +23,122 @@ constexpr std::size_t kNeighbourSeeds = 16;
 
 }  // namespace
 
+// The neighbouring PCs of every PC in `pcs` not known yet, computed on all threads and
+// kept in pc_neighbours_.
+void Enumerator::know_neighbours(const std::vector<Pc>& pcs) {
+  std::vector<Pc> missing;
+  for (const Pc& pc : pcs)
+    if (!pc_neighbours_.count(pc)) missing.push_back(pc);
+  std::sort(missing.begin(), missing.end());
+  missing.erase(std::unique(missing.begin(), missing.end()), missing.end());
+  std::vector<std::vector<Pc>> nb(missing.size());
+  runner_.for_each(missing.size(),
+                   [&](std::size_t i) { nb[i] = cf::neighbouring_pcs(missing[i], A_, B_); });
+  for (std::size_t i = 0; i < missing.size(); ++i)
+    pc_neighbours_.emplace(missing[i], std::move(nb[i]));
+}
+
 // The sets one change away from s (one PC replaced by a neighbouring PC), in a fixed order.
-void Enumerator::changes_of(const PcSet& s, const std::function<void(const PcSet&)>& fn) {
-  for (int k = 0; k < s.size(); ++k) {
-    auto nb = pc_neighbours_.find(s[k]);
-    if (nb == pc_neighbours_.end())
-      nb = pc_neighbours_.emplace(s[k], cf::neighbouring_pcs(s[k], A_, B_)).first;
-    for (const Pc& q : nb->second) {
+// Reads only: every PC of s must be in pc_neighbours_ (know_neighbours).
+void Enumerator::changes_of(const PcSet& s, const std::function<void(const PcSet&)>& fn) const {
+  any_change(s, [&](const PcSet& n) {
+    fn(n);
+    return false;
+  });
+}
+
+// Whether some set one change away from s satisfies `pred` (stops at the first).
+bool Enumerator::any_change(const PcSet& s, const std::function<bool(const PcSet&)>& pred) const {
+  for (int k = 0; k < s.size(); ++k)
+    for (const Pc& q : pc_neighbours_.at(s[k])) {
       PcSet n;
       for (int j = 0; j < s.size(); ++j) n.insert(j == k ? q : s[j]);
-      if (n.size() == s.size()) fn(n);
+      if (n.size() == s.size() && pred(n)) return true;
     }
+  return false;
+}
+
+// Whether a set is worth a neighbour search this round, judged on what the round starts
+// with (each test stays true while the round runs: witnesses and orbits' tries only grow):
+// not valid, not searched near before, its orbit not tried kOrbitTries times, and some set
+// one change away valid. Its orbit goes to `orbit`.
+bool Enumerator::near_candidate(const PcSet& s, PcSet& orbit) const {
+  if (witness_rot_.count(s) || near_searched_.count(s)) return false;
+  if (!any_change(s, [&](const PcSet& n) { return witness_rot_.count(n) > 0; })) return false;
+  orbit = sym_.canonical(s);
+  auto it = near_tries_.find(orbit);
+  return it == near_tries_.end() || it->second < kOrbitTries;
+}
+
+// The sets of a neighbour round, in order: the failed candidates, then the sets one change
+// away from a CF that no level proposed (a subset of theirs is missing) and that the
+// necessary conditions allow. Screened on all threads a block at a time (near_candidate),
+// then taken in order on this thread: one member of an orbit a round.
+std::vector<Task> Enumerator::neighbour_tasks() {
+  // The PCs of the failed sets and of the CFs, then those of the CFs' changes.
+  std::vector<Pc> pcs;
+  for (const PcSet& s : failed_) pcs.insert(pcs.end(), s.begin(), s.end());
+  for (const auto& level : valid_)
+    for (const auto& [s, w] : level) pcs.insert(pcs.end(), s.begin(), s.end());
+  know_neighbours(pcs);
+  std::vector<Pc> next;
+  for (const auto& level : valid_)
+    for (const auto& [s, w] : level)
+      for (const Pc& pc : s)
+        for (const Pc& q : pc_neighbours_.at(pc)) next.push_back(q);
+  know_neighbours(next);
+  std::vector<const PcSet*> from;  // failed sets, or CFs whose changes are screened
+  for (const PcSet& s : failed_) from.push_back(&s);
+  const std::size_t n_failed = from.size();
+  for (const auto& level : valid_)
+    for (const auto& [s, w] : level) from.push_back(&s);
+  std::vector<Task> tasks;
+  PcSetSet round_orbits;
+  constexpr std::size_t kBlock = 4096;
+  std::vector<std::vector<std::pair<PcSet, PcSet>>> kept;  // per set: (candidate, its orbit)
+  for (std::size_t b = 0; b < from.size(); b += kBlock) {
+    const std::size_t e = std::min(from.size(), b + kBlock);
+    kept.assign(e - b, {});
+    runner_.for_each(e - b, [&](std::size_t k) {
+      const PcSet& s = *from[b + k];
+      PcSet orbit;
+      if (b + k < n_failed) {
+        if (near_candidate(s, orbit)) kept[k].emplace_back(s, orbit);
+        return;
+      }
+      changes_of(s, [&](const PcSet& n) {
+        if (!witness_rot_.count(n) && !near_searched_.count(n) && !seen_.count(n) &&
+            conditions_hold(n) && near_candidate(n, orbit))
+          kept[k].emplace_back(n, orbit);
+      });
+    });
+    for (const auto& list : kept)
+      for (const auto& [s, orbit] : list) {
+        // Taken earlier this round, as itself or by another member of its orbit.
+        if (near_searched_.count(s) || round_orbits.count(orbit) ||
+            near_tries_[orbit] >= kOrbitTries)
+          continue;
+        round_orbits.insert(orbit);
+        ++near_tries_[orbit];
+        near_searched_.insert(s);
+        Task t;
+        t.kind = Task::Kind::kFindNear;
+        t.pcs = s;
+        changes_of(s, [&](const PcSet& n) {
+          if (auto it = witness_rot_.find(n);
+              it != witness_rot_.end() && t.seeds.size() < kNeighbourSeeds)
+            t.seeds.push_back(it->second);
+        });
+        tasks.push_back(std::move(t));
+      }
   }
+  return tasks;
 }
 
 // One round; returns the number of CFs found.
 std::size_t Enumerator::neighbour_round() {
   const auto t0 = Clock::now();
-  std::vector<Task> tasks;
-  PcSetSet round_orbits;
-  auto consider = [&](const PcSet& s) {
-    if (witness_rot_.count(s) || near_searched_.count(s)) return;
-    Task t;
-    t.kind = Task::Kind::kFindNear;
-    t.pcs = s;
-    changes_of(s, [&](const PcSet& n) {
-      if (auto it = witness_rot_.find(n);
-          it != witness_rot_.end() && t.seeds.size() < kNeighbourSeeds)
-        t.seeds.push_back(it->second);
-    });
-    if (t.seeds.empty()) return;
-    const PcSet orbit = sym_.canonical(s);
-    if (round_orbits.count(orbit) || near_tries_[orbit] >= kOrbitTries) return;
-    round_orbits.insert(orbit);
-    ++near_tries_[orbit];
-    near_searched_.insert(s);
-    tasks.push_back(std::move(t));
-  };
-  // The failed candidates, then the sets one change away from a CF that no level proposed (a
-  // subset of theirs is missing) and that the necessary conditions allow.
-  for (const PcSet& s : failed_) consider(s);
-  for (int l = 0; l < 3; ++l)
-    for (std::size_t i = 0; i < valid_[l].size(); ++i)
-      changes_of(valid_[l][i].first, [&](const PcSet& n) {
-        if (!witness_rot_.count(n) && !near_searched_.count(n) && !seen_.count(n) &&
-            conditions_hold(n))
-          consider(n);
-      });
+  std::vector<Task> tasks = neighbour_tasks();
   ProgressEvent ev{"neighbour round " + std::to_string(++neighbour_rounds_),
                    "failed sets",
                    0,
