@@ -144,21 +144,24 @@ else
   fi
 fi
 # Ctrl-C (SIGINT) stops a run between tasks: status 130, the finished chunks kept, no graph
-# written; the same command resumes and writes the graph of an uninterrupted run. (A job this
-# script starts in the background ignores SIGINT, and so does cfgen then; --default-signal
-# gives it the disposition it has when started from a terminal.)
-env --default-signal=INT -C "$src" "$cfgen" data/models/peg.off data/models/hole_block.off --no-symmetry --checkpoint "$work/int" \
+# written. The run keeps them in GRAPH.json.ckpt, the directory a run predicted to be long
+# keeps by default; the same command without --checkpoint takes them up, writes the graph of
+# an uninterrupted run and removes the directory. (A job this script starts in the background
+# ignores SIGINT, and so does cfgen then; --default-signal gives it the disposition it has
+# when started from a terminal.)
+ck_int="$work/interrupted.json.ckpt"
+env --default-signal=INT -C "$src" "$cfgen" data/models/peg.off data/models/hole_block.off --no-symmetry --checkpoint "$ck_int" \
   -o "$work/interrupted.json" -j 1 2>int_err.txt &
 pid=$!
 for _ in $(seq 600); do
-  [[ $(ls int/stage*_chunk*.json 2>/dev/null | wc -l) -ge 70 ]] && break
+  [[ $(ls "$ck_int"/stage*_chunk*.json 2>/dev/null | wc -l) -ge 70 ]] && break
   sleep 0.1
 done
 kill -INT "$pid"
 wait "$pid"
 rc=$?
-nint=$(ls int/stage*_chunk*.json 2>/dev/null | wc -l)
-if [[ $rc -ne 130 ]] || ! grep -q "cfgen: stopped (SIGINT); finished chunks are kept in '$work/int'" int_err.txt; then
+nint=$(ls "$ck_int"/stage*_chunk*.json 2>/dev/null | wc -l)
+if [[ $rc -ne 130 ]] || ! grep -q "cfgen: stopped (SIGINT); finished chunks are kept in '$ck_int'" int_err.txt; then
   echo "FAIL SIGINT: status $rc (want 130), stderr:"
   cat int_err.txt
   fail=1
@@ -167,17 +170,38 @@ elif [[ -e interrupted.json ]]; then
   fail=1
 else
   echo "ok   SIGINT: status 130, $nint chunks kept"
-  check "resumed after SIGINT" 0 "resumed $nint finished chunks" env -C "$src" "$cfgen" data/models/peg.off \
-    data/models/hole_block.off --no-symmetry --checkpoint "$work/int" -o "$work/interrupted.json" -j 2
+  check "resumed after SIGINT from GRAPH.json.ckpt" 0 "resumed $nint finished chunks" env -C "$src" "$cfgen" \
+    data/models/peg.off data/models/hole_block.off --no-symmetry -o "$work/interrupted.json" -j 2
   if [[ -e whole.json ]] && cmp -s interrupted.json whole.json; then
     echo "ok   interrupted.json equals an uninterrupted run's graph"
   else
     echo "FAIL interrupted.json differs from an uninterrupted run's graph"
     fail=1
   fi
+  if [[ -e $ck_int ]]; then
+    echo "FAIL $ck_int was not removed once the graph was written"
+    fail=1
+  else
+    echo "ok   the default checkpoint directory removed once the graph was written"
+  fi
 fi
-# SIGTERM (a batch system's) without --checkpoint: status 143, nothing kept, nothing written.
-"$cfgen" "$src/data/models/peg.off" "$src/data/models/hole_block.off" --no-symmetry -o term.json -j 1 2>term_err.txt &
+check "--no-checkpoint with --checkpoint" 2 "--checkpoint excludes --no-checkpoint" \
+  "$cfgen" "$A" "$B" --no-checkpoint --checkpoint ck0 -o g.json
+# --estimate prints the run predicted and writes nothing; the level-1 count is exact (668
+# single PCs of the peg against the block that local convexity allows).
+check "--estimate" 0 "" "$cfgen" "$src/data/models/peg.off" "$src/data/models/hole_block.off" --estimate -j 2
+if grep -q "^level 1: 668 candidate sets in [0-9]* orbits (counted)" out.txt && grep -q "^time: " out.txt &&
+  grep -q "^peak memory: " out.txt; then
+  echo "ok   --estimate: level 1 counted, time and memory predicted"
+else
+  echo "FAIL --estimate printed:"
+  cat out.txt
+  fail=1
+fi
+check "--estimate with -o" 2 "--output excludes --estimate" "$cfgen" "$A" "$B" --estimate -o g.json
+# SIGTERM (a batch system's) with --no-checkpoint: status 143, nothing kept, nothing written.
+"$cfgen" "$src/data/models/peg.off" "$src/data/models/hole_block.off" --no-symmetry --no-checkpoint -o term.json -j 1 \
+  2>term_err.txt &
 pid=$!
 for _ in $(seq 600); do
   grep -q "level 1:" term_err.txt 2>/dev/null && break

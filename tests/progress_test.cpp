@@ -59,3 +59,18 @@ TEST_CASE("in a log, one plain line per finished stage", "[progress]") {
   p.finish();
   CHECK(os.str() == "cfgen: level 2: 1000 candidate sets, 16 valid in 8.0 s\n");
 }
+
+TEST_CASE("with the run predicted, the line gives the run's time left too", "[progress]") {
+  std::ostringstream os;
+  ProgressPrinter p(os, true);
+  p.set_run(100);
+  p(tick(250, 2.0));
+  // The prediction, less the microseconds since it was set: 1 min 40 s.
+  CHECK(os.str().find("6.0 s left; run: about 1 min 40 s left") != std::string::npos);
+  // A run past its prediction: what the stage under way still needs, at its rate.
+  std::ostringstream late;
+  ProgressPrinter q(late, true);
+  q.set_run(1e-9);
+  q(tick(250, 2.0));
+  CHECK(late.str().find("; run: about 6.0 s left") != std::string::npos);
+}

@@ -14,6 +14,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <tuple>
 #include <utility>
@@ -41,13 +43,13 @@ gen::SearchParams scaled_search(const Polyhedron& A, const Polyhedron& B, const 
 namespace {
 
 // The exit status of a run stopped on request, after saying what was kept.
-int stopped_status(const GenerateArgs& args) {
+int stopped_status(const GenerateArgs& args, const std::string& checkpoint_dir) {
   const int sig = gen::stop_signal();
   std::cerr << "cfgen: stopped" << (sig == SIGTERM ? " (SIGTERM)" : sig == SIGINT ? " (SIGINT)" : "") << "; ";
-  if (args.checkpoint_dir.empty())
+  if (checkpoint_dir.empty())
     std::cerr << "nothing kept (--checkpoint DIR keeps finished work); '" << args.out_path << "' not written\n";
   else
-    std::cerr << "finished chunks are kept in '" << args.checkpoint_dir
+    std::cerr << "finished chunks are kept in '" << checkpoint_dir
               << "': the same command resumes from them\n";
   // 128 + the signal, as a shell reports a process the signal ended.
   return 128 + (sig ? sig : SIGINT);
@@ -114,6 +116,42 @@ nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args, c
   return meta;
 }
 
+// "3678" for a count, "~12,000" (two significant digits) for a prediction.
+std::string about(double x, bool exact = false) {
+  if (exact) return std::to_string(std::llround(x));
+  if (x < 10) return "~" + std::to_string(std::llround(x));
+  const double p = std::pow(10.0, std::floor(std::log10(x)) - 1);
+  std::string digits = std::to_string(std::llround(std::round(x / p) * p));
+  for (int i = static_cast<int>(digits.size()) - 3; i > 0; i -= 3) digits.insert(static_cast<std::size_t>(i), ",");
+  return "~" + digits;
+}
+
+void print_estimate(std::ostream& os, const gen::RunEstimate& e, int max_pcs) {
+  std::size_t decided = 0;
+  for (int l = 0; l < max_pcs; ++l) {
+    const gen::LevelEstimate& v = e.levels[l];
+    decided += v.sampled;
+    os << "level " << l + 1 << ": " << about(v.candidates, v.exact) << " candidate sets in "
+       << about(v.orbits, v.exact) << " orbits" << (v.exact ? " (counted)" : "") << ", " << about(v.valid)
+       << " valid, " << about(v.tasks) << " searches\n";
+  }
+  os << "graph: " << about(e.cfs) << " CFs, " << about(e.transitions) << " transitions\n";
+  os << "time: " << gen::human_duration(e.seconds) << " on " << e.threads << " thread" << (e.threads == 1 ? "" : "s")
+     << " (" << gen::human_duration(e.cpu_seconds) << " on one)\n";
+  os << "peak memory: " << about(e.peak_bytes / 1e6) << " MB\n";
+  os << "predicted from " << decided << " sets decided in " << gen::human_duration(e.sample_seconds)
+     << "; within 2x on the pairs measured (docs/performance.md)\n";
+}
+
+// The run predicted with the search and options of the run, on its threads.
+gen::RunEstimate predict(const gen::WitnessSearch& ws, const gen::EnumerateOptions& opt, const GenerateArgs& args) {
+  gen::ExecuteOptions exec;
+  exec.threads = args.threads;
+  exec.stop = args.stop;
+  gen::Executor executor([&ws](const gen::Task& t) { return gen::decide(ws, t); }, exec);
+  return gen::estimate(ws, opt, executor, executor.threads());
+}
+
 }  // namespace
 
 int run_generate(const GenerateArgs& args) {
@@ -122,7 +160,7 @@ int run_generate(const GenerateArgs& args) {
   // the models (SPEC section 5b).
   const std::vector<std::string> inputs{args.a_path, args.b_path};
   // Of K shards, shard 0 writes the graph.
-  const bool writes = !args.serve && args.shard.index == 0;
+  const bool writes = !args.serve && !args.estimate && args.shard.index == 0;
   if (writes) check_output_path(args.out_path, inputs, "writing graph");
   const Polyhedron A = load_model(args.a_path, args.load_a);
   const Polyhedron B = load_model(args.b_path, args.load_b);
@@ -141,11 +179,32 @@ int run_generate(const GenerateArgs& args) {
   opt.use_symmetry = args.symmetry && !args.thorough;
   opt.close_orbits = args.thorough;
   opt.records = writes;  // the other shards stop after the last stage
+  const gen::WitnessSearch ws(ai, bi, search);
+  if (args.estimate) {
+    print_estimate(std::cout, predict(ws, opt, args), opt.max_pcs);
+    std::cout.flush();
+    if (!std::cout) throw Error("writing the estimate to stdout failed");
+    return 0;
+  }
+  // A long run keeps a checkpoint unless told not to, and a checkpoint left by an
+  // interrupted run of the same command is taken up whatever the prediction.
+  std::string checkpoint_dir = args.checkpoint_dir;
+  bool default_checkpoint = false;
+  double predicted = 0;  // s, 0: not predicted
+  const bool may_keep = checkpoint_dir.empty() && !args.no_checkpoint && args.shard.count == 0;
+  // The prediction also gives the progress line the time left of the whole run.
+  if (writes && !args.distribute && (may_keep || !args.quiet)) predicted = predict(ws, opt, args).seconds;
+  if (may_keep && writes && !args.distribute) {
+    const std::string dir = args.out_path + ".ckpt";
+    std::error_code ec;
+    const bool left = std::filesystem::exists(std::filesystem::path(dir) / "checkpoint.json", ec);
+    if (left || predicted > kDefaultCheckpointSeconds) checkpoint_dir = dir, default_checkpoint = true;
+  }
   gen::ExecuteOptions exec;
   exec.threads = args.threads;
   exec.shard = args.shard;
   exec.shard_patience = args.shard_patience;
-  if (!args.checkpoint_dir.empty()) exec.checkpoint = open_checkpoint(args.checkpoint_dir, run_fingerprint(args), inputs);
+  if (!checkpoint_dir.empty()) exec.checkpoint = open_checkpoint(checkpoint_dir, run_fingerprint(args), inputs);
   exec.distribute = args.distribute;
   exec.stop = args.stop;
   const bool terminal = isatty(STDERR_FILENO) != 0;
@@ -156,18 +215,21 @@ int run_generate(const GenerateArgs& args) {
       if (terminal && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(2)) return;
       printer(ev);
     };
-  const gen::WitnessSearch ws(ai, bi, search);
+  if (!args.quiet && default_checkpoint)
+    std::cerr << "cfgen: predicted " << gen::human_duration(predicted) << "; finished work is kept in '"
+              << checkpoint_dir << "' until the graph is written (--no-checkpoint: not kept)\n";
+  printer.set_run(predicted);
   gen::Executor executor([&ws](const gen::Task& t) { return gen::decide(ws, t); }, exec);
   gen::Enumeration e;
   try {
     e = gen::enumerate(ws, opt, executor);
   } catch (const gen::Stopped&) {
     printer.finish();
-    return stopped_status(args);
+    return stopped_status(args, checkpoint_dir);
   }
   printer.finish();
   if (executor.resumed_chunks() > 0 && !args.quiet)
-    std::cerr << "cfgen: checkpoint '" << args.checkpoint_dir << "': resumed " << executor.resumed_chunks()
+    std::cerr << "cfgen: checkpoint '" << checkpoint_dir << "': resumed " << executor.resumed_chunks()
               << " finished chunks\n";
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (args.shard.count > 0 && !args.quiet)
@@ -183,6 +245,7 @@ int run_generate(const GenerateArgs& args) {
   const CfGraph graph = CfGraph::from_parts(A, B, std::move(e.cfs), std::move(e.transitions), meta.dump());
   check_output_path(args.out_path, inputs, "writing graph");
   graph.save(args.out_path);
+  if (default_checkpoint) remove_checkpoint(checkpoint_dir);
   if (n_cfs == 0)
     std::cerr << "cfgen: warning: the graph has no CF: A (" << A.size() << " mm across) and B (" << B.size()
               << " mm across) never touch in a valid contact formation; are the models' units right (--units)?\n";

@@ -66,7 +66,15 @@ struct GenerateArgs {
   const gen::StopFlag* stop = nullptr;
   /// Non-empty: keep every stage's finished chunks there and resume from them.
   std::string checkpoint_dir;
+  /// Empty checkpoint_dir: false keeps one in GRAPH.json.ckpt/ when the run is predicted to
+  /// take over kDefaultCheckpointSeconds (removed once the graph is written); true never.
+  bool no_checkpoint = false;
+  /// Predict the run (counts per level, time, memory) on stdout instead of running it.
+  bool estimate = false;
 };
+
+/// s: a run predicted to take longer keeps a checkpoint unless told not to.
+constexpr double kDefaultCheckpointSeconds = 120;
 
 /// Generates the CF graph of A against B and writes it to args.out_path.
 /// @returns the process exit status (0 on success); errors are one line on stderr.

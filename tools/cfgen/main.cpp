@@ -1,5 +1,6 @@
 // cfgen: builds CF graphs (SPEC section 5b) and prints the features of a model.
 //   cfgen --features MODEL                 the model object (SPEC section 5) as JSON on stdout
+//   cfgen A_MODEL B_MODEL --estimate       the run predicted, on stdout
 //   cfgen A_MODEL B_MODEL -o GRAPH.json    the CF graph of A against B
 //   cfgen A_MODEL B_MODEL -o GRAPH.json --checkpoint DIR --shard i/K   one of K processes
 
@@ -74,6 +75,7 @@ int main(int argc, char** argv) {
       "cfgen: contact-formation graph generator.\n"
       "  cfgen A_MODEL B_MODEL -o GRAPH.json   write the CF graph of A (moving) against B (fixed)\n"
       "  cfgen --features MODEL                print the model's features as JSON\n"
+      "  cfgen A_MODEL B_MODEL --estimate      predict the graph's size, the time and the memory\n"
       "  cfgen A_MODEL B_MODEL -o GRAPH.json --checkpoint DIR --shard i/K\n"
       "                                        one of K processes that share every stage through\n"
       "                                        DIR; shard 0 writes the graph\n"
@@ -105,6 +107,17 @@ int main(int argc, char** argv) {
                                     "resumes from it")
                          ->type_name("DIR");
   shard->needs(checkpoint);
+  auto* no_checkpoint = app.add_flag("--no-checkpoint", gen.no_checkpoint,
+                                     "keep no checkpoint (by default a run predicted to take over 2 minutes "
+                                     "keeps one in GRAPH.json.ckpt/ until the graph is written)")
+                            ->excludes(checkpoint);
+  auto* estimate = app.add_flag("--estimate", gen.estimate,
+                                "print the candidate sets per level, the CFs, time and peak memory predicted "
+                                "for a run (from a few sets decided), and stop")
+                       ->excludes(out)
+                       ->excludes(checkpoint)
+                       ->excludes(no_checkpoint)
+                       ->excludes(shard);
   auto* patience = app.add_option("--shard-patience", gen.shard_patience,
                                   "seconds a shard waits at least for another shard's chunk before "
                                   "computing it itself (raise it where new files take long to be seen, "
@@ -112,7 +125,7 @@ int main(int argc, char** argv) {
                        ->check(cf::cli::finite_range(0, 1e6))
                        ->capture_default_str()
                        ->needs(shard);
-  std::vector<CLI::Option*> gen_opts{threads, quiet, shard, checkpoint, patience};
+  std::vector<CLI::Option*> gen_opts{threads, quiet, shard, checkpoint, patience, no_checkpoint, estimate};
   gen_opts.push_back(app.add_option("--max-pcs", gen.max_pcs, "largest CFs to enumerate")
                          ->check(CLI::Range(1, 3))
                          ->capture_default_str());
@@ -158,7 +171,7 @@ int main(int argc, char** argv) {
       std::cerr << "cfgen: expected A_MODEL B_MODEL -o GRAPH.json or --features MODEL (see cfgen --help)\n";
       return 2;
     }
-    if (gen.out_path.empty()) {
+    if (gen.out_path.empty() && !gen.estimate) {
       std::cerr << "cfgen: missing -o GRAPH.json\n";
       return 2;
     }

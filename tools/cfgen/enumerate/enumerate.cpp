@@ -61,6 +61,11 @@ Enumeration enumerate(const WitnessSearch& search, const EnumerateOptions& opt,
   return internal::Enumerator(search, opt, runner).run();
 }
 
+RunEstimate estimate(const WitnessSearch& search, const EnumerateOptions& opt,
+                     StageRunner& runner, int threads) {
+  return internal::Enumerator(search, opt, runner).estimate(threads);
+}
+
 std::vector<TaskResult> run_tasks(StageRunner& runner, const std::vector<Task>& tasks,
                                   ProgressEvent* progress, Clock::time_point started) {
   std::vector<TaskResult> results(tasks.size());

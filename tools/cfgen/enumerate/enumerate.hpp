@@ -50,6 +50,40 @@ struct Enumeration {
   std::vector<PcSet> undecided;                    // failed candidates with no proof of invalidity
 };
 
+/// One level of a run as predicted (RunEstimate). Candidates are the sets the level proposes;
+/// orbits, of those, the ones searched first (one a orbit); tasks, the searches including
+/// an orbit's retries.
+struct LevelEstimate {
+  double candidates = 0;
+  bool exact = false;  ///< candidates (and orbits) counted, not predicted
+  double orbits = 0;
+  double valid = 0;  ///< CFs the level finds, images included
+  double tasks = 0;
+  double cpu_seconds = 0;   ///< s on one thread of this machine
+  std::size_t sampled = 0;  ///< sets of the level decided to predict it
+};
+
+/// What a run of enumerate() is predicted to find and cost (cfgen --estimate), from its
+/// level-1 candidates counted and a few sets of each level decided (docs/generator.md,
+/// "Estimates"); the constants that turn samples into a run are measured on the pairs
+/// listed in docs/performance.md, where the predictions' errors are.
+struct RunEstimate {
+  LevelEstimate levels[3];
+  double cfs = 0;          ///< CFs in the graph
+  double transitions = 0;  ///< transitions in the graph
+  double cpu_seconds = 0;  ///< s, the whole run on one thread
+  double seconds = 0;      ///< s, the whole run on `threads` threads
+  double peak_bytes = 0;   ///< the run's largest resident size
+  int threads = 1;
+  double sample_seconds = 0;  ///< s the estimate itself took
+};
+
+/// Predicts a run of enumerate() with `opt` on `threads` threads, without running it: the
+/// sets it decides go to `runner`'s threads (for_each), never as stages.
+/// @throws Stopped when the runner was asked to stop.
+RunEstimate estimate(const WitnessSearch& search, const EnumerateOptions& opt, StageRunner& runner,
+                     int threads);
+
 /// The CFs of the pair `search` was made for, and their transitions; every stage of the
 /// work goes to `runner`.
 /// @throws Stopped when the runner was asked to stop.

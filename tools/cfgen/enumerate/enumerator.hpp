@@ -50,6 +50,8 @@ class Enumerator {
  public:
   Enumerator(const WitnessSearch& search, const EnumerateOptions& opt, StageRunner& runner);
   Enumeration run();
+  /// The run's size and cost predicted from samples (estimate.cpp); the enumerator is spent.
+  RunEstimate estimate(int threads);
 
  private:
   // levels.cpp
@@ -61,11 +63,19 @@ class Enumerator {
   std::size_t search_rest(int level, const OrbitGroups& orbits, const SeedsOf& seeds_of,
                           const std::vector<char>& done, Clock::time_point t0);
   void singles_level();
+  std::vector<PcSet> single_candidates() const;
   std::vector<Mat3> seeds_from_subsets(const PcSet& s) const;
   std::vector<PcSet> build_pairs();
   void pairs_level();
   void triples_level();
   bool conditions_hold(const PcSet& t) const;
+  // estimate.cpp
+  struct Sample;
+  Sample sample_sets(int level, const std::vector<PcSet>& pool, const SeedsOf& seeds_of,
+                     std::size_t count);
+  std::vector<PcSet> pair_pool(double& mean_degree);
+  std::vector<PcSet> triple_pool(double& mean_thirds);
+  std::vector<PcSet> triples_with_valid_pairs(const std::vector<PcSet>& pool, double& fraction);
   // motion.cpp
   void motion_closure();
   void more_witnesses(Clock::time_point t0);

@@ -186,6 +186,10 @@ void Enumerator::run_level(int level, std::vector<PcSet> all, const SeedsOf& see
 
 // Level 1: every element pair that local convexity allows.
 void Enumerator::singles_level() {
+  run_level(0, single_candidates(), [](const PcSet&) { return std::vector<Mat3>{}; });
+}
+
+std::vector<PcSet> Enumerator::single_candidates() const {
   const ModelInfo& Ai = search_.a();
   const ModelInfo& Bi = search_.b();
   std::vector<PcSet> c1;
@@ -202,7 +206,7 @@ void Enumerator::singles_level() {
         c1.push_back(PcSet({Pc{t, a, b}}));
       }
   }
-  run_level(0, std::move(c1), [](const PcSet&) { return std::vector<Mat3>{}; });
+  return c1;
 }
 
 // The witness rotations of the set's subsets one PC smaller that are valid.

@@ -1,5 +1,7 @@
 #include "cfgen/execute/progress.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -20,6 +22,12 @@ std::string human_duration(double s) {
   return buf;
 }
 
+double stage_seconds_left(const ProgressEvent& e) {
+  if (e.finished) return 0;
+  if (e.done == 0 || e.seconds <= 0) return -1;
+  return static_cast<double>(e.total - std::min(e.done, e.total)) * e.seconds / static_cast<double>(e.done);
+}
+
 std::string progress_line(const ProgressEvent& e) {
   std::string line = e.stage + ": ";
   if (e.finished) {
@@ -33,7 +41,7 @@ std::string progress_line(const ProgressEvent& e) {
     char buf[32];
     std::snprintf(buf, sizeof buf, rate >= 10 ? "%.0f/s" : "%.2g/s", rate);
     line += std::string(", ") + buf;
-    if (e.total > e.done) line += ", " + human_duration(static_cast<double>(e.total - e.done) / rate) + " left";
+    if (e.total > e.done) line += ", " + human_duration(stage_seconds_left(e)) + " left";
   }
   return line;
 }
@@ -43,10 +51,21 @@ void ProgressPrinter::operator()(const ProgressEvent& e) {
     if (e.finished) os_ << prefix_ << progress_line(e) << '\n' << std::flush;
     return;
   }
-  const std::string line = prefix_ + progress_line(e);
+  std::string line = prefix_ + progress_line(e);
+  if (run_seconds_ > 0) {
+    // The prediction until the run outlives it, then what the stage under way still needs.
+    const double elapsed = std::chrono::duration<double>(Clock::now() - run_start_).count();
+    const double left = std::max(run_seconds_ - elapsed, stage_seconds_left(e));
+    line += left > 0 ? "; run: about " + human_duration(left) + " left" : "; run: finishing";
+  }
   // Pad over the rest of a longer previous line.
   os_ << '\r' << line << std::string(shown_ > line.size() ? shown_ - line.size() : 0, ' ') << std::flush;
   shown_ = line.size();
+}
+
+void ProgressPrinter::set_run(double seconds) {
+  run_seconds_ = seconds;
+  run_start_ = Clock::now();
 }
 
 void ProgressPrinter::finish() {

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cinttypes>
 #include <cstdio>
 #include <filesystem>
@@ -317,6 +318,24 @@ gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& finge
     write_outputs({{chunk_path(stage, chunk), j.dump() + "\n"}}, inputs, "writing checkpoint");
   };
   return store;
+}
+
+void remove_checkpoint(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  std::vector<fs::path> ours;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    const bool chunk = name.rfind("stage", 0) == 0 && name.size() > 5 &&
+                       name.compare(name.size() - 5, 5, ".json") == 0;
+    if (chunk || name == "checkpoint.json") ours.push_back(it->path());
+  }
+  // The manifest last: a directory left half-removed is still a checkpoint.
+  std::sort(ours.begin(), ours.end(), [](const fs::path& x, const fs::path& y) {
+    return (x.filename() == "checkpoint.json") < (y.filename() == "checkpoint.json");
+  });
+  for (const fs::path& p : ours) fs::remove(p, ec);
+  fs::remove(dir, ec);  // only when nothing else is in it
 }
 
 }  // namespace cf::tools

@@ -32,6 +32,10 @@ std::string run_fingerprint(const GenerateArgs& args);
 gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& fingerprint,
                                const std::vector<std::string>& inputs);
 
+/// Removes a checkpoint directory that open_checkpoint made: its manifest and chunk files,
+/// then the directory if nothing else is in it. Errors are ignored (the graph is written).
+void remove_checkpoint(const std::string& dir);
+
 /// A chunk of tasks, and its results, as text and back (an MPI run sends them between
 /// processes this way); doubles round-trip exactly.
 /// @throws cf::Error "reading <what>: <problem>" when the text is not such a chunk.
