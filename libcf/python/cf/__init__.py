@@ -68,7 +68,7 @@ def generate(a_path, b_path, output=None, **options):
     symmetries; False is ``--no-symmetry``), ``thorough`` (default False; True is
     ``--thorough``: every set searched, then every image of each CF added), ``quiet`` (default True: no progress on stderr),
     ``checkpoint`` (a directory: ``--checkpoint``, finished work kept there and resumed by the
-    same call). Ctrl-C stops the run between tasks and raises KeyboardInterrupt; with
+    same call; without it no checkpoint is kept, as ``--no-checkpoint``). Ctrl-C stops the run between tasks and raises KeyboardInterrupt; with
     ``checkpoint``, the chunks finished so far are kept for the next call.
     Raises cf.Error for bad models or options.
     """

@@ -153,6 +153,9 @@ void bind_tools(py::module_& m) {
         check_units(g.load_b.units, "units_b", where);
         g.load_a.coplanar_rel_tol = g.load_b.coplanar_rel_tol = coplanar_rel_tol;
         g.checkpoint_dir = checkpoint;
+        // A checkpoint only when asked for: a call without `output` writes into a temporary
+        // directory, which would take a default checkpoint with it.
+        g.no_checkpoint = checkpoint.empty();
         const int status = generate_stoppable(g);
         if (status != 0)
           fail(where + ": cfgen's generator failed with status " + std::to_string(status));

@@ -56,6 +56,8 @@ class Enumerator {
  private:
   // levels.cpp
   void accept(int level, const PcSet& s, const Witness& w);
+  void prefetch_images(const std::vector<std::pair<PcSet, Pose>>& found);
+  void prefetch_found(const std::vector<Task>& tasks, const std::vector<TaskResult>& results);
   OrbitGroups orbits_of(std::vector<PcSet> cands) const;
   void run_level(int level, std::vector<PcSet> all, const SeedsOf& seeds_of);
   std::size_t search_orbits(int level, const OrbitGroups& orbits, const SeedsOf& seeds_of,
@@ -71,8 +73,9 @@ class Enumerator {
   bool conditions_hold(const PcSet& t) const;
   // estimate.cpp
   struct Sample;
+  void take_unverified(int level, const PcSet& s, const Witness& w);
   Sample sample_sets(int level, const std::vector<PcSet>& pool, const SeedsOf& seeds_of,
-                     std::size_t count);
+                     std::size_t count, std::size_t tries);
   std::vector<PcSet> pair_pool(double& mean_degree);
   std::vector<PcSet> triple_pool(double& mean_thirds);
   std::vector<PcSet> triples_with_valid_pairs(const std::vector<PcSet>& pool, double& fraction);
@@ -118,6 +121,9 @@ class Enumerator {
   PcSetSet near_searched_;
   PcSetMap<std::size_t> near_tries_;
   std::map<Pc, std::vector<Pc>> pc_neighbours_;
+  // The images' clearances of the sets about to be accepted, by set, with the witness pose
+  // they were computed at (prefetch_images); cleared after each batch.
+  PcSetMap<std::pair<Pose, std::vector<double>>> prefetched_;
 };
 
 }  // namespace cf::gen::internal

@@ -2,20 +2,24 @@
 // counted, a few sets of each level decided on this machine, and the levels' sizes and the
 // run's cost extrapolated from them (docs/generator.md, "Estimates").
 //
-// Level 1's candidates and orbits are counted exactly. Its sample gives the fraction valid
-// and the cost of a search. The valid single PCs the sample found (with their images) stand
-// for all of them: the pairs the necessary conditions allow among them, scaled to the
-// predicted number of valid singles, give level 2's candidates; a sample of those pairs,
-// decided, gives its fraction valid and cost. Level 3 the same way from the valid pairs
-// found. What follows the levels (motion, neighbour rounds, records, transitions) is not
-// sampled: its cost is taken in proportion to the orbits the levels search and the CFs they
-// find, with constants measured on the pairs in docs/performance.md.
+// Level 1's candidates and orbits are counted exactly. Its sample (an orbit searched as the
+// run searches one: up to kOrbitTries members) gives the fraction valid and the cost of an
+// orbit. The valid single PCs the sample found (with their images) stand for all of them:
+// the pairs the necessary conditions allow among them, scaled to the predicted number of
+// valid singles, give level 2's candidates; a sample of those, decided, its fraction valid
+// and cost. Level 3 the same way from the valid pairs found, a triple counting as a
+// candidate when its three pairs are valid. What follows the levels (motion, neighbour
+// rounds, the work done per set rather than per orbit, records, transitions) is not
+// sampled: it is taken from the sets the levels find and fail, with constants measured on
+// the pairs in docs/performance.md.
 
 #include "cfgen/enumerate/enumerator.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <random>
 
 #include <sys/resource.h>
@@ -31,29 +35,29 @@ constexpr std::size_t kSamples = 32;
 constexpr std::size_t kRows = 256;
 // Batches of kSamples triples whose unknown pairs are decided, at most, to find level-3
 // candidates to sample.
-constexpr std::size_t kTripleRounds = 4;
+constexpr std::size_t kTripleRounds = 2;
 
 // Constants that turn the levels into a run, fitted (least worst ratio) on the bundled pairs
-// and the n-gon pegs and holes n = 3..9 at one thread; docs/performance.md ("Estimates")
-// gives the errors that remain.
+// and the n-gon pegs and holes n = 3..10 at one thread (scripts/estimate-errors.sh);
+// docs/performance.md ("Estimates") gives the errors that remain.
 //
-// CFs found after the levels (motion and neighbour rounds), per CF the levels find.
-constexpr double kGrowth = 0.35;
-// CPU time after the levels (motion, neighbour rounds), per orbit the levels search, in
-// searches of the sample's mean cost.
-constexpr double kRestPerOrbit = 28.5;
-// CPU time per CF for what is done per member, not per orbit (images verified, records,
-// transitions).
-constexpr double kSecondsPerCf = 300e-6;
-// Of a run's time on one thread, the part that runs on one thread whatever the count (a
-// hexagonal pair's run at two threads used 1.2-1.3 of them).
+// CFs in the graph per CF the levels find: the rounds after them (motion, neighbours, the
+// images of sets found there) add about as many again on the n-gon pairs.
+constexpr double kCfsPerLevelCf = 2.0;
+// CPU time after the levels' searches: the rounds after them and the work done per set, not
+// per orbit (images, the neighbour rounds' screening, records, transitions), which grows a
+// little faster than the sets it is done for, a failed candidate counting twice (its
+// neighbour rounds): kMemberSeconds x (CFs the levels find + 2 failed)^kMemberPower.
+constexpr double kMemberSeconds = 80e-6;  // s, on the machine of docs/performance.md
+constexpr double kMemberPower = 1.1;
+constexpr double kFailedWeight = 2;
+// Of a run's time on one thread, the part that runs on one thread whatever the count.
 constexpr double kSerial = 0.4;
 // Transitions per CF: 15.5-25 on the pairs measured.
 constexpr double kTransitionsPerCf = 18;
-// Resident bytes per CF and per transition at the run's peak (records, the search's sets,
-// the transitions built and sorted): 1.3-1.8 kB per CF in all on the n-gon pairs.
-constexpr double kBytesPerCf = 1200;
-constexpr double kBytesPerTransition = 24;
+// Resident bytes per CF at the run's peak (records, the search's sets, the transitions built
+// and sorted), above what the models take: 1.8-9.5 kB per CF in all on the pairs measured.
+constexpr double kBytesPerCf = 2000;
 
 // k indices spread evenly over [0, n).
 std::vector<std::size_t> spread(std::size_t n, std::size_t k) {
@@ -79,70 +83,94 @@ double peak_resident_bytes() {
 }  // namespace
 
 struct Enumerator::Sample {
-  std::size_t decided = 0, found = 0;
-  double inv_orbit = 0;  // mean of 1 / orbit size over the sets decided
-  double tries = 1;      // mean of min(kOrbitTries, orbit size) over the failed ones
-  double t_found = 0;    // s of CPU, mean of a search that found a witness
-  double t_failed = 0;   // s of CPU, mean of a search that did not
-  double members = 0, found_members = 0;  // orbit sizes summed over the sets decided, the found
+  std::size_t decided = 0;                // orbits sampled
+  std::size_t found = 0;                  // of them, found at one of up to kOrbitTries members
+  double inv_orbit = 0;                   // mean of 1 / orbit size
+  double members = 0, found_members = 0;  // orbit sizes summed over those sampled, the found
+  double searches = 0;                    // mean searches an orbit took
+  double seconds = 0;                     // s of CPU, mean an orbit took (all its searches)
   double valid_fraction() const { return decided ? double(found) / double(decided) : 0; }
-  double mean_seconds() const {
-    return decided
-               ? (double(found) * t_found + double(decided - found) * t_failed) / double(decided)
-               : 0;
-  }
 };
 
-// Decides up to `count` sets spread over `pool` (on the runner's threads, each timed), and
-// accepts those found as the run would.
-Enumerator::Sample Enumerator::sample_sets(int level, const std::vector<PcSet>& pool,
-                                           const SeedsOf& seeds_of, std::size_t count) {
-  const std::vector<std::size_t> idx = spread(pool.size(), count);
-  std::vector<Task> tasks(idx.size());
-  for (std::size_t k = 0; k < idx.size(); ++k) {
-    tasks[k].pcs = pool[idx[k]];
-    tasks[k].seeds = seeds_of(tasks[k].pcs);
+// A found set and its images, taken as valid without verifying them (accept() verifies
+// each): an estimate needs to know which sets are valid, not to prove it.
+void Enumerator::take_unverified(int level, const PcSet& s, const Witness& w) {
+  for (std::size_t g = 0; g < sym_.size(); ++g) {
+    const PcSet t = sym_.image(s, g);
+    if (witness_rot_.count(t)) continue;
+    Witness v = w;
+    v.pose = sym_.image(w.pose, g);
+    witness_rot_.emplace(t, v.pose.R_BA);
+    valid_[level].push_back({t, v});
   }
-  std::vector<TaskResult> res(tasks.size());
-  std::vector<double> sec(tasks.size());
-  runner_.for_each(tasks.size(), [&](std::size_t k) {
-    const double c0 = thread_cpu_seconds();
-    res[k] = decide(search_, tasks[k]);
-    sec[k] = thread_cpu_seconds() - c0;
-  });
-  Sample s;
-  double tries = 0;
-  for (std::size_t k = 0; k < tasks.size(); ++k) {
+}
+
+// The orbits of up to `count` sets spread over `pool`, searched as the run searches an
+// orbit: the set, then, while none is found, up to `tries` of its images in all. Each
+// search timed in CPU seconds of its thread, on the runner's threads.
+Enumerator::Sample Enumerator::sample_sets(int level, const std::vector<PcSet>& pool,
+                                           const SeedsOf& seeds_of, std::size_t count,
+                                           std::size_t tries) {
+  struct Orbit {
+    std::vector<PcSet> members;  // the set sampled first, then its other images in order
+    std::size_t tried = 0;
+    bool found = false;
+    double seconds = 0;
+  };
+  std::vector<Orbit> orbits;
+  for (std::size_t i : spread(pool.size(), count)) {
     std::vector<PcSet> images;
-    for (std::size_t g = 0; g < sym_.size(); ++g) images.push_back(sym_.image(tasks[k].pcs, g));
+    for (std::size_t g = 0; g < sym_.size(); ++g) images.push_back(sym_.image(pool[i], g));
     std::sort(images.begin(), images.end(), pcset_less);
-    const auto size = double(std::unique(images.begin(), images.end()) - images.begin());
+    images.erase(std::unique(images.begin(), images.end()), images.end());
+    Orbit o;
+    o.members.push_back(pool[i]);
+    for (const PcSet& m : images)
+      if (m != pool[i]) o.members.push_back(m);
+    orbits.push_back(std::move(o));
+  }
+  for (std::size_t attempt = 0; attempt < tries; ++attempt) {
+    std::vector<std::size_t> open;
+    for (std::size_t k = 0; k < orbits.size(); ++k) {
+      Orbit& o = orbits[k];
+      if (o.found || attempt >= o.members.size()) continue;
+      if (witness_rot_.count(o.members[attempt]))
+        o.found = true;  // found meanwhile
+      else
+        open.push_back(k);
+    }
+    std::vector<TaskResult> res(open.size());
+    std::vector<double> sec(open.size());
+    runner_.for_each(open.size(), [&](std::size_t j) {
+      Task t;
+      t.pcs = orbits[open[j]].members[attempt];
+      t.seeds = seeds_of(t.pcs);
+      const double c0 = thread_cpu_seconds();
+      res[j] = decide(search_, t);
+      sec[j] = thread_cpu_seconds() - c0;
+    });
+    for (std::size_t j = 0; j < open.size(); ++j) {
+      Orbit& o = orbits[open[j]];
+      ++o.tried;
+      o.seconds += sec[j];
+      if (res[j].witness.found)
+        o.found = true, take_unverified(level, o.members[attempt], res[j].witness);
+    }
+  }
+  Sample s;
+  for (const Orbit& o : orbits) {
+    const auto size = double(o.members.size());
     ++s.decided;
     s.inv_orbit += 1 / size;
     s.members += size;
-    if (res[k].witness.found) s.found_members += size;
-    if (res[k].witness.found) {
-      ++s.found;
-      s.t_found += sec[k];
-      // Its images taken as valid without verifying them (accept() verifies each): an
-      // estimate needs to know which sets are valid, not to prove it.
-      for (std::size_t g = 0; g < sym_.size(); ++g) {
-        const PcSet t = sym_.image(tasks[k].pcs, g);
-        if (witness_rot_.count(t)) continue;
-        Witness v = res[k].witness;
-        v.pose = sym_.image(v.pose, g);
-        witness_rot_.emplace(t, v.pose.R_BA);
-        valid_[level].push_back({t, v});
-      }
-    } else {
-      s.t_failed += sec[k];
-      tries += std::min(double(kOrbitTries), size);
-    }
+    s.searches += double(o.tried);
+    s.seconds += o.seconds;
+    if (o.found) ++s.found, s.found_members += size;
   }
-  const std::size_t failed = s.decided - s.found;
-  if (s.decided) s.inv_orbit /= double(s.decided);
-  if (s.found) s.t_found /= double(s.found);
-  if (failed) s.t_failed /= double(failed), s.tries = tries / double(failed);
+  if (s.decided) {
+    const auto n = double(s.decided);
+    s.inv_orbit /= n, s.searches /= n, s.seconds /= n;
+  }
   return s;
 }
 
@@ -218,8 +246,9 @@ std::vector<PcSet> Enumerator::triples_with_valid_pairs(const std::vector<PcSet>
       }
     std::sort(unknown.begin(), unknown.end(), pcset_less);
     unknown.erase(std::unique(unknown.begin(), unknown.end()), unknown.end());
+    // One search each: a triple is not worth the retries of a level's orbits.
     sample_sets(
-        1, unknown, [this](const PcSet& x) { return seeds_from_subsets(x); }, unknown.size());
+        1, unknown, [this](const PcSet& x) { return seeds_from_subsets(x); }, unknown.size(), 1);
     for (const PcSet& pair : unknown)
       if (!witness_rot_.count(pair)) invalid.insert(pair);
     for (std::size_t i = b; i < e; ++i) {
@@ -240,16 +269,18 @@ std::vector<PcSet> Enumerator::triples_with_valid_pairs(const std::vector<PcSet>
 
 namespace {
 
-// A level's searches and cost from its candidates and its sample: one search per orbit, a
-// failed orbit searched again at up to kOrbitTries members.
+// A level's size and cost from its candidates and its sample. `by_orbit`: the sample took
+// one set of each orbit (orbits weigh by their size), else sets (orbits as often as they
+// have members).
 template <class Sample>
-void extrapolate(LevelEstimate& l, const Sample& s) {
-  const double q = s.valid_fraction();
+void extrapolate(LevelEstimate& l, const Sample& s, bool by_orbit) {
   l.sampled = s.decided;
   if (!l.exact) l.orbits = l.candidates * s.inv_orbit;
+  const double q =
+      by_orbit ? (s.members > 0 ? s.found_members / s.members : 0) : s.valid_fraction();
   l.valid = l.candidates * q;
-  l.tasks = l.orbits * (q + (1 - q) * s.tries);
-  l.cpu_seconds = l.orbits * (q * s.t_found + (1 - q) * s.tries * s.t_failed);
+  l.tasks = l.orbits * s.searches;
+  l.cpu_seconds = l.orbits * s.seconds;
 }
 
 }  // namespace
@@ -271,10 +302,8 @@ RunEstimate Enumerator::estimate(int threads) {
   std::vector<PcSet> firsts;
   for (std::size_t o = 0; o < g1.size(); ++o) firsts.push_back(g1.member(o, 0));
   const Sample s1 = sample_sets(
-      0, firsts, [](const PcSet&) { return std::vector<Mat3>{}; }, kSamples);
-  extrapolate(l1, s1);
-  if (s1.members > 0) l1.valid = l1.candidates * s1.found_members / s1.members;
-  double searches = s1.mean_seconds() * double(s1.decided), decided = double(s1.decided);
+      0, firsts, [](const PcSet&) { return std::vector<Mat3>{}; }, kSamples, kOrbitTries);
+  extrapolate(l1, s1, true);
   if (opt_.max_pcs >= 2 && !valid_[0].empty()) {
     // The valid singles known stand for l1.valid of them: partners scale with their number.
     const double scale = l1.valid / double(valid_[0].size());
@@ -282,32 +311,33 @@ RunEstimate Enumerator::estimate(int threads) {
     const std::vector<PcSet> pool2 = pair_pool(degree);
     LevelEstimate& l2 = e.levels[1];
     l2.candidates = l1.valid * degree * scale / 2;
-    const Sample s2 = sample_sets(1, pool2, subsets, kSamples);
-    extrapolate(l2, s2);
-    searches += s2.mean_seconds() * double(s2.decided), decided += double(s2.decided);
+    const Sample s2 = sample_sets(1, pool2, subsets, kSamples, kOrbitTries);
+    extrapolate(l2, s2, false);
     if (opt_.max_pcs >= 3 && !valid_[1].empty() && l2.candidates > 0) {
       double thirds = 0, all_valid = 0;
       const std::vector<PcSet> pool3 = triples_with_valid_pairs(triple_pool(thirds), all_valid);
       // A third PC makes a candidate when both of its new pairs are valid.
       LevelEstimate& l3 = e.levels[2];
       l3.candidates = l2.valid * thirds * scale * all_valid / 3;
-      const Sample s3 = sample_sets(2, pool3, subsets, kSamples);
-      extrapolate(l3, s3);
-      searches += s3.mean_seconds() * double(s3.decided), decided += double(s3.decided);
+      const Sample s3 = sample_sets(2, pool3, subsets, kSamples, kOrbitTries);
+      extrapolate(l3, s3, false);
     }
   }
-  double level_cpu = 0, orbits = 0, found = 0;
+  double level_cpu = 0, found = 0, failed = 0;
   for (const LevelEstimate& l : e.levels) {
     level_cpu += l.cpu_seconds;
-    orbits += l.orbits;
     found += l.valid;
+    failed += std::max(0.0, l.candidates - l.valid);
   }
-  const double mean_search = decided > 0 ? searches / decided : 0;
-  e.cfs = found * (1 + kGrowth);
+  e.cfs = found * kCfsPerLevelCf;
   e.transitions = e.cfs * kTransitionsPerCf;
-  e.cpu_seconds = level_cpu + kRestPerOrbit * orbits * mean_search + kSecondsPerCf * e.cfs;
+  e.cpu_seconds =
+      level_cpu + kMemberSeconds * std::pow(found + kFailedWeight * failed, kMemberPower);
   e.seconds = e.cpu_seconds * (kSerial + (1 - kSerial) / e.threads);
-  e.peak_bytes = base_bytes + kBytesPerCf * e.cfs + kBytesPerTransition * e.transitions;
+  e.peak_bytes = base_bytes + kBytesPerCf * e.cfs;
+  if (std::getenv("CF_ESTIMATE_DEBUG"))
+    std::fprintf(stderr, "CAL level_cpu %g found %g failed %g base %g\n", level_cpu, found, failed,
+                 base_bytes);
   e.sample_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return e;
 }

@@ -42,18 +42,50 @@ void Enumerator::accept(int level, const PcSet& s, const Witness& w) {
   valid_[level].push_back({s, w});
   witness_rot_.emplace(s, w.pose.R_BA);
   frontier_.push_back({s, w.pose});
+  const auto pre = prefetched_.find(s);
+  const bool have = pre != prefetched_.end() && pre->second.first.R_BA == w.pose.R_BA &&
+                    pre->second.first.t_BA == w.pose.t_BA;
   for (std::size_t k = 1; k < sym_.size(); ++k) {
     const PcSet t = sym_.image(s, k);
     if (witness_rot_.count(t)) continue;
     Witness v = w;
     v.pose = sym_.image(w.pose, k);
-    v.clearance = search_.verify(t, v.pose);
+    v.clearance = have ? pre->second.second[k] : search_.verify(t, v.pose);
     if (v.clearance < search_.params().min_clearance) continue;
     valid_[level].push_back({t, v});
     witness_rot_.emplace(t, v.pose.R_BA);
     seen_.insert(t);
     ++out_.levels[level].by_symmetry;
   }
+}
+
+// Verifies, on all threads, every image of each set found at the image of its witness, for
+// the accept() calls that follow (in order, on this thread): the same clearances accept()
+// would compute, a batch at a time. Images already valid are skipped, as accept() skips
+// them; a set whose witness differs from the one given is verified by accept() itself.
+void Enumerator::prefetch_images(const std::vector<std::pair<PcSet, Pose>>& found) {
+  prefetched_.clear();
+  if (sym_.size() == 1 || found.empty()) return;
+  std::vector<std::vector<double>> clear(found.size());
+  runner_.for_each(found.size(), [&](std::size_t i) {
+    const auto& [s, pose] = found[i];
+    clear[i].assign(sym_.size(), 0);
+    for (std::size_t k = 1; k < sym_.size(); ++k) {
+      const PcSet t = sym_.image(s, k);
+      if (!witness_rot_.count(t)) clear[i][k] = search_.verify(t, sym_.image(pose, k));
+    }
+  });
+  for (std::size_t i = 0; i < found.size(); ++i)
+    prefetched_.emplace(found[i].first, std::make_pair(found[i].second, std::move(clear[i])));
+}
+
+// prefetch_images for the tasks whose result found a witness.
+void Enumerator::prefetch_found(const std::vector<Task>& tasks,
+                                const std::vector<TaskResult>& results) {
+  std::vector<std::pair<PcSet, Pose>> batch;
+  for (std::size_t i = 0; i < tasks.size(); ++i)
+    if (results[i].witness.found) batch.emplace_back(tasks[i].pcs, results[i].witness.pose);
+  prefetch_images(batch);
 }
 
 // The candidates grouped by orbit, each orbit's members in candidate order, the orbits in the
@@ -111,10 +143,11 @@ std::size_t Enumerator::search_orbits(int level, const OrbitGroups& orbits, cons
       open.push_back(o);
     }
     if (open.empty()) break;
+    // Taken once the stage has run, their images verified together (prefetch_images).
+    std::vector<std::pair<std::size_t, Witness>> found;
     auto take = [&](std::size_t i, const Witness& w) {
-      const PcSet& s = orbits.member(open[i], attempt);
-      seen_.insert(s);
-      if (w.found) accept(level, s, w), done[open[i]] = 1;
+      seen_.insert(orbits.member(open[i], attempt));
+      if (w.found) found.emplace_back(i, w);
     };
     // Seeds come from the sets below this level, which the results of this stage do not
     // change: the tasks are the same whenever they are made.
@@ -132,6 +165,11 @@ std::size_t Enumerator::search_orbits(int level, const OrbitGroups& orbits, cons
     stage.progress = attempt == 0 ? &ev : nullptr;
     stage.started = t0;
     runner_.run(stage);
+    std::vector<std::pair<PcSet, Pose>> batch;
+    for (const auto& [i, w] : found) batch.emplace_back(orbits.member(open[i], attempt), w.pose);
+    prefetch_images(batch);
+    for (const auto& [i, w] : found) accept(level, orbits.member(open[i], attempt), w), done[open[i]] = 1;
+    prefetched_.clear();
     searched += open.size();
   }
   return searched;
@@ -153,11 +191,13 @@ std::size_t Enumerator::search_rest(int level, const OrbitGroups& orbits, const 
         }
   if (rest.empty()) return 0;
   const std::vector<TaskResult> r = run_tasks(runner_, rest, nullptr, t0);
+  prefetch_found(rest, r);
   for (std::size_t i = 0; i < rest.size(); ++i) {
     seen_.insert(rest[i].pcs);
     if (r[i].witness.found && !witness_rot_.count(rest[i].pcs))
       accept(level, rest[i].pcs, r[i].witness);
   }
+  prefetched_.clear();
   return rest.size();
 }
 

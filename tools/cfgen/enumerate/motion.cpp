@@ -41,6 +41,7 @@ void Enumerator::more_witnesses(Clock::time_point t0) {
     }
   }
   const std::vector<TaskResult> r = run_tasks(runner_, more, nullptr, t0);
+  prefetch_found(more, r);
   for (std::size_t i = 0; i < more.size(); ++i) {
     if (!r[i].witness.found) continue;
     if (witness_rot_.count(more[i].pcs)) {
@@ -50,6 +51,7 @@ void Enumerator::more_witnesses(Clock::time_point t0) {
       accept(more[i].pcs.size() - 1, more[i].pcs, r[i].witness);
     }
   }
+  prefetched_.clear();
 }
 
 // One motion round: the frontier explored, the new sets met searched, and the frontier
@@ -86,6 +88,7 @@ void Enumerator::explore_frontier(Clock::time_point t0) {
     search_fresh[i].pose = fresh[i].pose;
   }
   const std::vector<TaskResult> res = run_tasks(runner_, search_fresh, nullptr, t0);
+  prefetch_found(search_fresh, res);
   frontier_.clear();
   std::size_t found = 0;
   for (std::size_t i = 0; i < fresh.size(); ++i) {
@@ -103,6 +106,7 @@ void Enumerator::explore_frontier(Clock::time_point t0) {
     ++out_.levels[level].by_motion;
     ++found;
   }
+  prefetched_.clear();
   finished(ev, t0, std::to_string(found) + " new CFs");
 }
 

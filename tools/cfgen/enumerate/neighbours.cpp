@@ -147,6 +147,7 @@ std::size_t Enumerator::neighbour_round() {
                    false,
                    {}};
   const std::vector<TaskResult> r = run_tasks(runner_, tasks, &ev, t0);
+  prefetch_found(tasks, r);
   std::size_t found = 0;
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     if (!r[i].witness.found || witness_rot_.count(tasks[i].pcs)) continue;
@@ -156,6 +157,7 @@ std::size_t Enumerator::neighbour_round() {
     ++out_.levels[level].by_neighbours;  // its images count under by_symmetry
     found += valid_[level].size() - before;
   }
+  prefetched_.clear();
   finished(ev, t0, std::to_string(found) + " new CFs");
   return found;
 }
