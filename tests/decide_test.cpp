@@ -38,6 +38,26 @@ TEST_CASE("decide: a face on a face is found, with a witness the verifier accept
   CHECK_FALSE(search.refuted(t.pcs));  // a set with a witness is never refuted
 }
 
+TEST_CASE("decide: kVerify answers whether a pose is a witness, with its clearance", "[decide]") {
+  cf::test::AnalysedPair p(cf::test::box(10, 10, 10, "A"), cf::test::box(40, 40, 10, "B"));
+  const cf::gen::WitnessSearch search(p.ai, p.bi, {});
+  cf::gen::Task find;
+  find.pcs = PcSet({Pc{PcType::kFF, kBottom, kTop}});
+  const cf::gen::Witness w = cf::gen::decide(search, find).witness;
+  REQUIRE(w.found);
+  cf::gen::Task t;
+  t.kind = cf::gen::Task::Kind::kVerify;
+  t.pcs = find.pcs;
+  t.pose = w.pose;
+  const cf::gen::TaskResult r = cf::gen::decide(search, t);
+  CHECK(r.witness.found);
+  CHECK(r.witness.clearance == search.verify(t.pcs, t.pose));
+  CHECK(r.witness.pose.t_BA == w.pose.t_BA);
+  // 1 mm above the slab, A's bottom face does not touch B's top face: not a witness.
+  t.pose.t_BA.z() += 1;
+  CHECK_FALSE(cf::gen::decide(search, t).witness.found);
+}
+
 TEST_CASE(
     "decide: sets that cannot hold are not found, and those a necessary condition rules out are "
     "refuted",

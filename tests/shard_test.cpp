@@ -36,7 +36,7 @@ bool same(const Pose& a, const Pose& b) { return a.R_BA == b.R_BA && a.t_BA == b
 }  // namespace
 
 TEST_CASE("chunks of tasks and their results round-trip exactly") {
-  std::vector<Task> tasks(4);
+  std::vector<Task> tasks(5);
   tasks[0].kind = Task::Kind::kFind;
   tasks[0].pcs = PcSet({Pc{PcType::kFF, 0, 4}, Pc{PcType::kEE, 7, 16}});
   tasks[0].seeds = {odd_pose(0.1).R_BA, odd_pose(0.7).R_BA};
@@ -49,6 +49,9 @@ TEST_CASE("chunks of tasks and their results round-trip exactly") {
   tasks[3].kind = Task::Kind::kFindNear;
   tasks[3].pcs = PcSet({Pc{PcType::kEE, 3, 8}, Pc{PcType::kVF, 0, 10}});
   tasks[3].seeds = {odd_pose(3.7).R_BA};
+  tasks[4].kind = Task::Kind::kVerify;
+  tasks[4].pcs = PcSet({Pc{PcType::kFV, 5, 1}});
+  tasks[4].pose = odd_pose(4.1);
 
   std::size_t chunk = 0;
   const std::vector<Task> back = cf::tools::tasks_from_text(cf::tools::tasks_text(41, tasks), "tasks", chunk);
@@ -101,8 +104,8 @@ TEST_CASE("text that is not a chunk is refused with what and why") {
   CHECK(refused("{\"tasks\": []}") == "reading a chunk from rank 0: expected {\"chunk\", \"tasks\"}");
   CHECK(refused("{\"chunk\": 1, \"tasks\": [[9, [[0, 1, 2]], [], []]]}") ==
         "reading a chunk from rank 0: expected a task [kind, PCs, seeds, pose]");
-  // One past the last kind (kFindNear, 3).
-  CHECK(refused("{\"chunk\": 1, \"tasks\": [[4, [[0, 1, 2]], [], [1,0,0,0,1,0,0,0,1,0,0,0]]]}") ==
+  // One past the last kind (kVerify, 4).
+  CHECK(refused("{\"chunk\": 1, \"tasks\": [[5, [[0, 1, 2]], [], [1,0,0,0,1,0,0,0,1,0,0,0]]]}") ==
         "reading a chunk from rank 0: expected a task [kind, PCs, seeds, pose]");
   CHECK(refused("{\"chunk\": 1, \"tasks\": [[0, [[0, 1, 2], [0, 1, 2]], [], " + std::string("[1,0,0,0,1,0,0,0,1,0,0,0]]]}")) ==
         "reading a chunk from rank 0: a PC is repeated");

@@ -140,7 +140,7 @@ void print_estimate(std::ostream& os, const gen::RunEstimate& e, int max_pcs) {
      << " (" << gen::human_duration(e.cpu_seconds) << " on one)\n";
   os << "peak memory: " << about(e.peak_bytes / 1e6) << " MB\n";
   os << "predicted from " << decided << " sets decided in " << gen::human_duration(e.sample_seconds)
-     << "; within 2x on the pairs measured (docs/performance.md)\n";
+     << "; its errors on the pairs measured: docs/performance.md, \"Estimates\"\n";
 }
 
 // The run predicted with the search and options of the run, on its threads.

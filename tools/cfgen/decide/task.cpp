@@ -15,6 +15,11 @@ TaskResult decide(const WitnessSearch& search, const Task& task) {
       r.witness = search.find(task.pcs, {task.pose.R_BA});
       if (!r.witness.found) r.witness = search.refine(task.pcs, task.pose);
       break;
+    case Task::Kind::kVerify:
+      r.witness.pose = task.pose;
+      r.witness.clearance = search.verify(task.pcs, task.pose);
+      r.witness.found = r.witness.clearance >= search.params().min_clearance;
+      break;
     case Task::Kind::kExplore: {
       r.met = explore_translations(search, task.pcs, task.pose);
       std::vector<Discovery> more = explore_rotations(search, task.pcs, task.pose);

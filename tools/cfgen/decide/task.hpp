@@ -20,15 +20,16 @@ struct Task {
     kFindOrRefine,  // find(pcs, {pose.R_BA}), else refine(pcs, pose): a set met by motion
     kExplore,       // the motions from the witness `pose` of the CF `pcs` (explore.hpp)
     kFindNear,      // find(pcs, seeds, seeds_only): a failed set near its neighbours' witnesses
+    kVerify,        // verify(pcs, pose): an image of a CF at the image of its witness
   };
   Kind kind = Kind::kFind;
   PcSet pcs;
   std::vector<Mat3> seeds;  // kFind, kFindNear
-  Pose pose;                // kFindOrRefine, kExplore
+  Pose pose;                // kFindOrRefine, kExplore, kVerify
 };
 
 struct TaskResult {
-  Witness witness;             // kFind, kFindOrRefine, kFindNear
+  Witness witness;             // kFind, kFindOrRefine, kFindNear, kVerify (pose and clearance)
   std::vector<Discovery> met;  // kExplore: the contact sets met, in a fixed order
 };
 

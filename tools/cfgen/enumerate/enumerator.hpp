@@ -76,9 +76,8 @@ class Enumerator {
   void take_unverified(int level, const PcSet& s, const Witness& w);
   Sample sample_sets(int level, const std::vector<PcSet>& pool, const SeedsOf& seeds_of,
                      std::size_t count, std::size_t tries);
-  std::vector<PcSet> pair_pool(double& mean_degree);
-  std::vector<PcSet> triple_pool(double& mean_thirds);
-  std::vector<PcSet> triples_with_valid_pairs(const std::vector<PcSet>& pool, double& fraction);
+  std::vector<PcSet> grown_sets(int level, const std::vector<PcSet>& singles, double& mean_added);
+  std::vector<PcSet> with_valid_subsets(const std::vector<PcSet>& pool, double& fraction);
   // motion.cpp
   void motion_closure();
   void more_witnesses(Clock::time_point t0);
@@ -124,6 +123,8 @@ class Enumerator {
   // The images' clearances of the sets about to be accepted, by set, with the witness pose
   // they were computed at (prefetch_images); cleared after each batch.
   PcSetMap<std::pair<Pose, std::vector<double>>> prefetched_;
+  // The estimate's sets searched and not found (estimate.cpp).
+  PcSetSet known_invalid_;
 };
 
 }  // namespace cf::gen::internal

@@ -4,20 +4,18 @@
 //
 // Level 1's candidates and orbits are counted exactly. Its sample (an orbit searched as the
 // run searches one: up to kOrbitTries members) gives the fraction valid and the cost of an
-// orbit. The valid single PCs the sample found (with their images) stand for all of them:
-// the pairs the necessary conditions allow among them, scaled to the predicted number of
-// valid singles, give level 2's candidates; a sample of those, decided, its fraction valid
-// and cost. Level 3 the same way from the valid pairs found, a triple counting as a
-// candidate when its three pairs are valid. What follows the levels (motion, neighbour
-// rounds, the work done per set rather than per orbit, records, transitions) is not
-// sampled: it is taken from the sets the levels find and fail, with constants measured on
-// the pairs in docs/performance.md.
+// orbit. Levels 2 and 3 from the level below: its valid sets known (the sample's, with their
+// images), each with every level-1 candidate the necessary conditions allow, give the sets
+// one PC larger; the share of those whose subsets are all valid (decided for a few hundred)
+// scales them to the level's candidates, and a sample of those, searched, gives the fraction
+// valid and the cost. What follows the levels (motion, neighbour rounds, the work done per
+// set rather than per orbit, records, transitions) is not sampled: it is taken from the sets
+// the levels find and fail, with constants measured on the pairs in docs/performance.md.
 
 #include "cfgen/enumerate/enumerator.hpp"
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
@@ -33,26 +31,25 @@ namespace {
 constexpr std::size_t kSamples = 32;
 // Sets whose partners are counted to predict the next level's candidates.
 constexpr std::size_t kRows = 256;
-// Batches of kSamples triples whose unknown pairs are decided, at most, to find level-3
+// Batches of kSamples sets, at most, whose unknown subsets are decided to find a level's
 // candidates to sample.
-constexpr std::size_t kTripleRounds = 2;
+constexpr std::size_t kGrowRounds = 8;
 
 // Constants that turn the levels into a run, fitted (least worst ratio) on the bundled pairs
 // and the n-gon pegs and holes n = 3..10 at one thread (scripts/estimate-errors.sh);
 // docs/performance.md ("Estimates") gives the errors that remain.
 //
 // CFs in the graph per CF the levels find: the rounds after them (motion, neighbours, the
-// images of sets found there) add about as many again on the n-gon pairs.
-constexpr double kCfsPerLevelCf = 2.0;
+// images of sets found there) add most of as many again.
+constexpr double kCfsPerLevelCf = 1.8;
 // CPU time after the levels' searches: the rounds after them and the work done per set, not
-// per orbit (images, the neighbour rounds' screening, records, transitions), which grows a
-// little faster than the sets it is done for, a failed candidate counting twice (its
-// neighbour rounds): kMemberSeconds x (CFs the levels find + 2 failed)^kMemberPower.
+// per orbit (images, the neighbour rounds' screening, records, transitions), per CF the
+// levels find and per candidate they fail, the latter weighing kFailedWeight times as much
+// (each is screened, and some searched again, in every neighbour round).
 constexpr double kMemberSeconds = 80e-6;  // s, on the machine of docs/performance.md
-constexpr double kMemberPower = 1.1;
-constexpr double kFailedWeight = 2;
+constexpr double kFailedWeight = 4;
 // Of a run's time on one thread, the part that runs on one thread whatever the count.
-constexpr double kSerial = 0.4;
+constexpr double kSerial = 0.25;
 // Transitions per CF: 15.5-25 on the pairs measured.
 constexpr double kTransitionsPerCf = 18;
 // Resident bytes per CF at the run's peak (records, the search's sets, the transitions built
@@ -174,41 +171,22 @@ Enumerator::Sample Enumerator::sample_sets(int level, const std::vector<PcSet>& 
   return s;
 }
 
-// Pairs of the valid single PCs known that the necessary conditions allow: those of up to
-// kRows of them, each with every other. mean_degree: the partners a single PC has among them.
-std::vector<PcSet> Enumerator::pair_pool(double& mean_degree) {
-  const auto& w = valid_[0];
-  const std::vector<std::size_t> rows = spread(w.size(), kRows);
+// The sets one PC larger than up to kRows valid sets of `level` - 1 known (spread over
+// them): each with every level-1 candidate the necessary conditions allow with all of its
+// PCs, shuffled with a fixed seed so that no set and no added PC comes first. mean_added:
+// such PCs per set.
+std::vector<PcSet> Enumerator::grown_sets(int level, const std::vector<PcSet>& singles,
+                                          double& mean_added) {
+  const auto& below = valid_[level - 1];
+  const std::vector<std::size_t> rows = spread(below.size(), kRows);
   std::vector<std::vector<PcSet>> found(rows.size());
   runner_.for_each(rows.size(), [&](std::size_t r) {
-    const Pc& y = w[rows[r]].first[0];
-    for (std::size_t i = 0; i < w.size(); ++i) {
-      const Pc& x = w[i].first[0];
-      if (i == rows[r] || !pair_ok_.compatible(x, y)) continue;
-      PcSet s({x, y});
-      if (search_.plausible(s)) found[r].push_back(s);
-    }
-  });
-  std::vector<PcSet> pool;
-  for (const auto& f : found) pool.insert(pool.end(), f.begin(), f.end());
-  mean_degree = rows.empty() ? 0 : double(pool.size()) / double(rows.size());
-  std::sort(pool.begin(), pool.end(), pcset_less);
-  pool.erase(std::unique(pool.begin(), pool.end()), pool.end());
-  return pool;
-}
-
-// Triples over up to kRows of the valid pairs known, each with every valid single PC known
-// that the necessary conditions allow with both of its PCs (spread over the pairs).
-// mean_thirds: such third PCs per pair.
-std::vector<PcSet> Enumerator::triple_pool(double& mean_thirds) {
-  const auto& w = valid_[0];
-  const std::vector<std::size_t> rows = spread(valid_[1].size(), kRows);
-  std::vector<std::vector<PcSet>> found(rows.size());
-  runner_.for_each(rows.size(), [&](std::size_t r) {
-    const PcSet& p = valid_[1][rows[r]].first;
-    for (const auto& [single, witness] : w) {
+    const PcSet& p = below[rows[r]].first;
+    for (const PcSet& single : singles) {
       const Pc& z = single[0];
-      if (p.contains(z) || !pair_ok_.compatible(p[0], z) || !pair_ok_.compatible(p[1], z)) continue;
+      bool ok = !p.contains(z);
+      for (int k = 0; k < p.size() && ok; ++k) ok = pair_ok_.compatible(p[k], z);
+      if (!ok) continue;
       PcSet t = p;
       t.insert(z);
       if (search_.plausible(t)) found[r].push_back(t);
@@ -216,50 +194,51 @@ std::vector<PcSet> Enumerator::triple_pool(double& mean_thirds) {
   });
   std::vector<PcSet> pool;
   for (const auto& f : found) pool.insert(pool.end(), f.begin(), f.end());
-  mean_thirds = rows.empty() ? 0 : double(pool.size()) / double(rows.size());
-  // In an order that favours no pair and no third PC (each pair's thirds come in the order
-  // of the valid singles, by type): shuffled with a fixed seed.
+  mean_added = rows.empty() ? 0 : double(pool.size()) / double(rows.size());
+  std::sort(pool.begin(), pool.end(), pcset_less);
+  pool.erase(std::unique(pool.begin(), pool.end()), pool.end());
   std::mt19937_64 rng(0x5eed);
   std::shuffle(pool.begin(), pool.end(), rng);
   return pool;
 }
 
-// Of the triples in `pool` (one pair of each known valid), those whose other pairs are valid
-// too, as the run's level-3 candidates are: the unknown pairs decided, kSamples triples at a
-// time, until kSamples such triples are found or kTripleRounds have been tried. `fraction`:
-// the share of the triples tried whose pairs are all valid.
-std::vector<PcSet> Enumerator::triples_with_valid_pairs(const std::vector<PcSet>& pool,
-                                                        double& fraction) {
+// Of `pool`, the sets whose subsets one PC smaller are all valid, as the run's candidates
+// are: their unknown subsets searched once each (a candidate is not worth a level's retries),
+// kSamples sets at a time, until kSamples such sets are found or kGrowRounds batches have
+// been tried. fraction: the share of the sets tried that have them all valid.
+std::vector<PcSet> Enumerator::with_valid_subsets(const std::vector<PcSet>& pool,
+                                                  double& fraction) {
   std::vector<PcSet> out;
-  PcSetSet invalid;
   std::size_t tried = 0;
-  for (std::size_t b = 0; b < pool.size() && b < kTripleRounds * kSamples && out.size() < kSamples;
+  auto subsets = [](const PcSet& s) {
+    std::vector<PcSet> out;
+    for (int k = 0; k < s.size(); ++k) {
+      PcSet sub;
+      for (int j = 0; j < s.size(); ++j)
+        if (j != k) sub.insert(s[j]);
+      out.push_back(sub);
+    }
+    return out;
+  };
+  for (std::size_t b = 0; b < pool.size() && b < kGrowRounds * kSamples && out.size() < kSamples;
        b += kSamples) {
     const std::size_t e = std::min(pool.size(), b + kSamples);
     std::vector<PcSet> unknown;
     for (std::size_t i = b; i < e; ++i)
-      for (int k = 0; k < 3; ++k) {
-        PcSet pair;
-        for (int j = 0; j < 3; ++j)
-          if (j != k) pair.insert(pool[i][j]);
-        if (!witness_rot_.count(pair) && !invalid.count(pair)) unknown.push_back(pair);
-      }
+      for (const PcSet& sub : subsets(pool[i]))
+        if (!witness_rot_.count(sub) && !known_invalid_.count(sub)) unknown.push_back(sub);
     std::sort(unknown.begin(), unknown.end(), pcset_less);
     unknown.erase(std::unique(unknown.begin(), unknown.end()), unknown.end());
-    // One search each: a triple is not worth the retries of a level's orbits.
-    sample_sets(
-        1, unknown, [this](const PcSet& x) { return seeds_from_subsets(x); }, unknown.size(), 1);
-    for (const PcSet& pair : unknown)
-      if (!witness_rot_.count(pair)) invalid.insert(pair);
+    if (!unknown.empty())
+      sample_sets(
+          unknown[0].size() - 1, unknown, [this](const PcSet& x) { return seeds_from_subsets(x); },
+          unknown.size(), 1);
+    for (const PcSet& sub : unknown)
+      if (!witness_rot_.count(sub)) known_invalid_.insert(sub);
     for (std::size_t i = b; i < e; ++i) {
       ++tried;
       bool all = true;
-      for (int k = 0; k < 3 && all; ++k) {
-        PcSet pair;
-        for (int j = 0; j < 3; ++j)
-          if (j != k) pair.insert(pool[i][j]);
-        all = witness_rot_.count(pair) > 0;
-      }
+      for (const PcSet& sub : subsets(pool[i])) all = all && witness_rot_.count(sub) > 0;
       if (all) out.push_back(pool[i]);
     }
   }
@@ -304,24 +283,17 @@ RunEstimate Enumerator::estimate(int threads) {
   const Sample s1 = sample_sets(
       0, firsts, [](const PcSet&) { return std::vector<Mat3>{}; }, kSamples, kOrbitTries);
   extrapolate(l1, s1, true);
-  if (opt_.max_pcs >= 2 && !valid_[0].empty()) {
-    // The valid singles known stand for l1.valid of them: partners scale with their number.
-    const double scale = l1.valid / double(valid_[0].size());
-    double degree = 0;
-    const std::vector<PcSet> pool2 = pair_pool(degree);
-    LevelEstimate& l2 = e.levels[1];
-    l2.candidates = l1.valid * degree * scale / 2;
-    const Sample s2 = sample_sets(1, pool2, subsets, kSamples, kOrbitTries);
-    extrapolate(l2, s2, false);
-    if (opt_.max_pcs >= 3 && !valid_[1].empty() && l2.candidates > 0) {
-      double thirds = 0, all_valid = 0;
-      const std::vector<PcSet> pool3 = triples_with_valid_pairs(triple_pool(thirds), all_valid);
-      // A third PC makes a candidate when both of its new pairs are valid.
-      LevelEstimate& l3 = e.levels[2];
-      l3.candidates = l2.valid * thirds * scale * all_valid / 3;
-      const Sample s3 = sample_sets(2, pool3, subsets, kSamples, kOrbitTries);
-      extrapolate(l3, s3, false);
-    }
+  // Levels 2 and 3: a valid set of the level below and a level-1 candidate the necessary
+  // conditions allow with it make a candidate when its subsets one PC smaller are valid.
+  for (int level = 1; level < opt_.max_pcs && level < 3; ++level) {
+    const LevelEstimate& below = e.levels[level - 1];
+    if (valid_[level - 1].empty() || below.valid <= 0) break;
+    double added = 0, fraction = 0;
+    const std::vector<PcSet> pool = with_valid_subsets(grown_sets(level, c1, added), fraction);
+    LevelEstimate& l = e.levels[level];
+    l.candidates = below.valid * added * fraction / (level + 1);  // each counted by its PCs
+    const Sample sample = sample_sets(level, pool, subsets, kSamples, kOrbitTries);
+    extrapolate(l, sample, false);
   }
   double level_cpu = 0, found = 0, failed = 0;
   for (const LevelEstimate& l : e.levels) {
@@ -331,8 +303,7 @@ RunEstimate Enumerator::estimate(int threads) {
   }
   e.cfs = found * kCfsPerLevelCf;
   e.transitions = e.cfs * kTransitionsPerCf;
-  e.cpu_seconds =
-      level_cpu + kMemberSeconds * std::pow(found + kFailedWeight * failed, kMemberPower);
+  e.cpu_seconds = level_cpu + kMemberSeconds * (found + kFailedWeight * failed);
   e.seconds = e.cpu_seconds * (kSerial + (1 - kSerial) / e.threads);
   e.peak_bytes = base_bytes + kBytesPerCf * e.cfs;
   if (std::getenv("CF_ESTIMATE_DEBUG"))

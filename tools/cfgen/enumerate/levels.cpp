@@ -59,22 +59,30 @@ void Enumerator::accept(int level, const PcSet& s, const Witness& w) {
   }
 }
 
-// Verifies, on all threads, every image of each set found at the image of its witness, for
-// the accept() calls that follow (in order, on this thread): the same clearances accept()
-// would compute, a batch at a time. Images already valid are skipped, as accept() skips
-// them; a set whose witness differs from the one given is verified by accept() itself.
+// Verifies every image of each set found at the image of its witness, for the accept()
+// calls that follow (in order, on this thread): the same clearances accept() would compute,
+// as a stage of tasks (kVerify), so that threads, shards and ranks share them and a
+// checkpoint keeps them. Images already valid are skipped, as accept() skips them; a set
+// whose witness differs from the one given is verified by accept() itself.
 void Enumerator::prefetch_images(const std::vector<std::pair<PcSet, Pose>>& found) {
   prefetched_.clear();
   if (sym_.size() == 1 || found.empty()) return;
-  std::vector<std::vector<double>> clear(found.size());
-  runner_.for_each(found.size(), [&](std::size_t i) {
-    const auto& [s, pose] = found[i];
-    clear[i].assign(sym_.size(), 0);
+  std::vector<Task> tasks;
+  std::vector<std::pair<std::size_t, std::size_t>> of;  // (found, symmetry) of each task
+  for (std::size_t i = 0; i < found.size(); ++i)
     for (std::size_t k = 1; k < sym_.size(); ++k) {
-      const PcSet t = sym_.image(s, k);
-      if (!witness_rot_.count(t)) clear[i][k] = search_.verify(t, sym_.image(pose, k));
+      Task t;
+      t.kind = Task::Kind::kVerify;
+      t.pcs = sym_.image(found[i].first, k);
+      if (witness_rot_.count(t.pcs)) continue;
+      t.pose = sym_.image(found[i].second, k);
+      tasks.push_back(std::move(t));
+      of.emplace_back(i, k);
     }
-  });
+  const std::vector<TaskResult> r = run_tasks(runner_, tasks, nullptr, Clock::now());
+  std::vector<std::vector<double>> clear(found.size(), std::vector<double>(sym_.size(), 0));
+  for (std::size_t j = 0; j < tasks.size(); ++j)
+    clear[of[j].first][of[j].second] = r[j].witness.clearance;
   for (std::size_t i = 0; i < found.size(); ++i)
     prefetched_.emplace(found[i].first, std::make_pair(found[i].second, std::move(clear[i])));
 }
@@ -168,7 +176,8 @@ std::size_t Enumerator::search_orbits(int level, const OrbitGroups& orbits, cons
     std::vector<std::pair<PcSet, Pose>> batch;
     for (const auto& [i, w] : found) batch.emplace_back(orbits.member(open[i], attempt), w.pose);
     prefetch_images(batch);
-    for (const auto& [i, w] : found) accept(level, orbits.member(open[i], attempt), w), done[open[i]] = 1;
+    for (const auto& [i, w] : found)
+      accept(level, orbits.member(open[i], attempt), w), done[open[i]] = 1;
     prefetched_.clear();
     searched += open.size();
   }

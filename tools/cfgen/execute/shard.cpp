@@ -17,7 +17,7 @@ namespace {
 // The version of checkpoints and of the fingerprint. 2: a witness as in chunks, [found, pose
 // (12), clearance, margin]; 3: the witness search climbs past obstacles and the neighbour
 // rounds' tasks (the same tasks give other results, so checkpoints of version 2 are refused).
-constexpr int kVersion = 3;
+constexpr int kVersion = 4;
 constexpr int kMaxShards = 4096;
 
 // The options that shape the graph, in a fixed order (not the thread count, the output or
@@ -145,7 +145,7 @@ std::vector<gen::Task> parse_tasks(const nlohmann::json& j, const Reader& rd) {
   std::vector<gen::Task> out;
   for (const nlohmann::json& t : j) {
     if (!t.is_array() || t.size() != 4 || !t[0].is_number_unsigned() ||
-        t[0].get<unsigned>() > static_cast<unsigned>(gen::Task::Kind::kFindNear) ||
+        t[0].get<unsigned>() > static_cast<unsigned>(gen::Task::Kind::kVerify) ||
         !t[2].is_array())
       rd.bad("expected a task [kind, PCs, seeds, pose]");
     gen::Task task;
