@@ -46,7 +46,9 @@ namespace {
 int stopped_status(const GenerateArgs& args, const std::string& checkpoint_dir) {
   const int sig = gen::stop_signal();
   std::cerr << "cfgen: stopped" << (sig == SIGTERM ? " (SIGTERM)" : sig == SIGINT ? " (SIGINT)" : "") << "; ";
-  if (checkpoint_dir.empty())
+  if (args.estimate)
+    std::cerr << "no estimate printed\n";
+  else if (checkpoint_dir.empty())
     std::cerr << "nothing kept (--checkpoint DIR keeps finished work); '" << args.out_path << "' not written\n";
   else
     std::cerr << "finished chunks are kept in '" << checkpoint_dir
@@ -181,7 +183,11 @@ int run_generate(const GenerateArgs& args) {
   opt.records = writes;  // the other shards stop after the last stage
   const gen::WitnessSearch ws(ai, bi, search);
   if (args.estimate) {
-    print_estimate(std::cout, predict(ws, opt, args), opt.max_pcs);
+    try {
+      print_estimate(std::cout, predict(ws, opt, args), opt.max_pcs);
+    } catch (const gen::Stopped&) {
+      return stopped_status(args, "");
+    }
     std::cout.flush();
     if (!std::cout) throw Error("writing the estimate to stdout failed");
     return 0;
@@ -193,7 +199,11 @@ int run_generate(const GenerateArgs& args) {
   double predicted = 0;  // s, 0: not predicted
   const bool may_keep = checkpoint_dir.empty() && !args.no_checkpoint && args.shard.count == 0;
   // The prediction also gives the progress line the time left of the whole run.
-  if (writes && !args.distribute && (may_keep || !args.quiet)) predicted = predict(ws, opt, args).seconds;
+  try {
+    if (writes && !args.distribute && (may_keep || !args.quiet)) predicted = predict(ws, opt, args).seconds;
+  } catch (const gen::Stopped&) {
+    return stopped_status(args, "");
+  }
   if (may_keep && writes && !args.distribute) {
     const std::string dir = args.out_path + ".ckpt";
     std::error_code ec;
