@@ -86,7 +86,10 @@ class Enumerator {
   void know_neighbours(const std::vector<Pc>& pcs);
   void changes_of(const PcSet& s, const std::function<void(const PcSet&)>& fn) const;
   bool any_change(const PcSet& s, const std::function<bool(const PcSet&)>& pred) const;
-  bool near_candidate(const PcSet& s, PcSet& orbit) const;
+  enum class Near { kNever, kNotYet, kYes };
+  Near near_candidate(const PcSet& s, PcSet& orbit) const;
+  void screen(const PcSet& s, bool failed, char& dead,
+              std::vector<std::pair<PcSet, PcSet>>& kept) const;
   std::vector<Task> neighbour_tasks();
   std::size_t neighbour_round();
   // finish.cpp
@@ -119,6 +122,10 @@ class Enumerator {
   // The neighbour rounds' memory: members searched so far, tries per orbit, PC neighbours.
   PcSetSet near_searched_;
   PcSetMap<std::size_t> near_tries_;
+  // Marks, by index in failed_ and valid_: nothing the set screens can be worth a neighbour
+  // search any more (screen()).
+  std::vector<char> failed_dead_;
+  std::vector<char> cf_dead_[3];
   std::map<Pc, std::vector<Pc>> pc_neighbours_;
   // The images' clearances of the sets about to be accepted, by set, with the witness pose
   // they were computed at (prefetch_images); cleared after each batch.

@@ -59,15 +59,39 @@ bool Enumerator::any_change(const PcSet& s, const std::function<bool(const PcSet
 }
 
 // Whether a set is worth a neighbour search this round, judged on what the round starts
-// with (each test stays true while the round runs: witnesses and orbits' tries only grow):
-// not valid, not searched near before, its orbit not tried kOrbitTries times, and some set
-// one change away valid. Its orbit goes to `orbit`.
-bool Enumerator::near_candidate(const PcSet& s, PcSet& orbit) const {
-  if (witness_rot_.count(s) || near_searched_.count(s)) return false;
-  if (!any_change(s, [&](const PcSet& n) { return witness_rot_.count(n) > 0; })) return false;
+// with: never (valid, searched near before, or its orbit tried kOrbitTries times: each stays
+// so, as witnesses, searches and tries only grow), not yet (no set one change away is
+// valid), or yes, its orbit in `orbit`.
+Enumerator::Near Enumerator::near_candidate(const PcSet& s, PcSet& orbit) const {
+  if (witness_rot_.count(s) || near_searched_.count(s)) return Near::kNever;
+  if (!any_change(s, [&](const PcSet& n) { return witness_rot_.count(n) > 0; }))
+    return Near::kNotYet;
   orbit = sym_.canonical(s);
   auto it = near_tries_.find(orbit);
-  return it == near_tries_.end() || it->second < kOrbitTries;
+  return it == near_tries_.end() || it->second < kOrbitTries ? Near::kYes : Near::kNever;
+}
+
+// Screens one failed set, or the changes of one CF, into `kept`; sets `dead` when nothing it
+// screens can be worth a search in any later round (a failed set that never will be, a CF
+// whose changes never will be), so that later rounds pass it by.
+void Enumerator::screen(const PcSet& s, bool failed, char& dead,
+                        std::vector<std::pair<PcSet, PcSet>>& kept) const {
+  PcSet orbit;
+  if (failed) {
+    const Near r = near_candidate(s, orbit);
+    if (r == Near::kYes) kept.emplace_back(s, orbit);
+    dead = r == Near::kNever;
+    return;
+  }
+  bool never = true;
+  changes_of(s, [&](const PcSet& n) {
+    if (witness_rot_.count(n) || near_searched_.count(n) || seen_.count(n) || !conditions_hold(n))
+      return;
+    const Near r = near_candidate(n, orbit);
+    if (r == Near::kYes) kept.emplace_back(n, orbit);
+    never = never && r == Near::kNever;
+  });
+  dead = never;
 }
 
 // The sets of a neighbour round, in order: the failed candidates, then the sets one change
@@ -87,11 +111,21 @@ std::vector<Task> Enumerator::neighbour_tasks() {
       for (const Pc& pc : s)
         for (const Pc& q : pc_neighbours_.at(pc)) next.push_back(q);
   know_neighbours(next);
-  std::vector<const PcSet*> from;  // failed sets, or CFs whose changes are screened
-  for (const PcSet& s : failed_) from.push_back(&s);
-  const std::size_t n_failed = from.size();
-  for (const auto& level : valid_)
-    for (const auto& [s, w] : level) from.push_back(&s);
+  // Failed sets, or CFs whose changes are screened, with their marks from earlier rounds.
+  failed_dead_.resize(failed_.size(), 0);
+  struct From {
+    const PcSet* set;
+    bool failed;
+    char* dead;
+  };
+  std::vector<From> from;
+  for (std::size_t i = 0; i < failed_.size(); ++i)
+    if (!failed_dead_[i]) from.push_back({&failed_[i], true, &failed_dead_[i]});
+  for (int l = 0; l < 3; ++l) {
+    cf_dead_[l].resize(valid_[l].size(), 0);
+    for (std::size_t i = 0; i < valid_[l].size(); ++i)
+      if (!cf_dead_[l][i]) from.push_back({&valid_[l][i].first, false, &cf_dead_[l][i]});
+  }
   std::vector<Task> tasks;
   PcSetSet round_orbits;
   constexpr std::size_t kBlock = 4096;
@@ -100,17 +134,8 @@ std::vector<Task> Enumerator::neighbour_tasks() {
     const std::size_t e = std::min(from.size(), b + kBlock);
     kept.assign(e - b, {});
     runner_.for_each(e - b, [&](std::size_t k) {
-      const PcSet& s = *from[b + k];
-      PcSet orbit;
-      if (b + k < n_failed) {
-        if (near_candidate(s, orbit)) kept[k].emplace_back(s, orbit);
-        return;
-      }
-      changes_of(s, [&](const PcSet& n) {
-        if (!witness_rot_.count(n) && !near_searched_.count(n) && !seen_.count(n) &&
-            conditions_hold(n) && near_candidate(n, orbit))
-          kept[k].emplace_back(n, orbit);
-      });
+      const From& f = from[b + k];
+      screen(*f.set, f.failed, *f.dead, kept[k]);
     });
     for (const auto& list : kept)
       for (const auto& [s, orbit] : list) {
