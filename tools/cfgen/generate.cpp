@@ -154,6 +154,32 @@ gen::RunEstimate predict(const gen::WitnessSearch& ws, const gen::EnumerateOptio
   return gen::estimate(ws, opt, executor, executor.threads());
 }
 
+// Where a run keeps its checkpoint, and how long it is predicted to take.
+struct RunPlan {
+  std::string checkpoint_dir;       // empty: none
+  bool default_checkpoint = false;  // GRAPH.json.ckpt, removed once the graph is written
+  double predicted = 0;             // s, 0: not predicted
+};
+
+// A long run keeps a checkpoint unless told not to, and a checkpoint left by an interrupted
+// run of the same command is taken up whatever the prediction. The prediction also gives
+// the progress line the time left of the whole run.
+// @throws gen::Stopped when a signal stops the prediction.
+RunPlan plan_run(const gen::WitnessSearch& ws, const gen::EnumerateOptions& opt, const GenerateArgs& args,
+                 bool writes) {
+  RunPlan plan;
+  plan.checkpoint_dir = args.checkpoint_dir;
+  const bool may_keep = writes && !args.distribute && plan.checkpoint_dir.empty() && !args.no_checkpoint &&
+                        args.shard.count == 0;
+  if (writes && !args.distribute && (may_keep || !args.quiet)) plan.predicted = predict(ws, opt, args).seconds;
+  if (!may_keep) return plan;
+  const std::string dir = args.out_path + ".ckpt";
+  std::error_code ec;
+  const bool left = std::filesystem::exists(std::filesystem::path(dir) / "checkpoint.json", ec);
+  if (left || plan.predicted > kDefaultCheckpointSeconds) plan.checkpoint_dir = dir, plan.default_checkpoint = true;
+  return plan;
+}
+
 }  // namespace
 
 int run_generate(const GenerateArgs& args) {
@@ -192,24 +218,15 @@ int run_generate(const GenerateArgs& args) {
     if (!std::cout) throw Error("writing the estimate to stdout failed");
     return 0;
   }
-  // A long run keeps a checkpoint unless told not to, and a checkpoint left by an
-  // interrupted run of the same command is taken up whatever the prediction.
-  std::string checkpoint_dir = args.checkpoint_dir;
-  bool default_checkpoint = false;
-  double predicted = 0;  // s, 0: not predicted
-  const bool may_keep = checkpoint_dir.empty() && !args.no_checkpoint && args.shard.count == 0;
-  // The prediction also gives the progress line the time left of the whole run.
+  RunPlan plan;
   try {
-    if (writes && !args.distribute && (may_keep || !args.quiet)) predicted = predict(ws, opt, args).seconds;
+    plan = plan_run(ws, opt, args, writes);
   } catch (const gen::Stopped&) {
     return stopped_status(args, "");
   }
-  if (may_keep && writes && !args.distribute) {
-    const std::string dir = args.out_path + ".ckpt";
-    std::error_code ec;
-    const bool left = std::filesystem::exists(std::filesystem::path(dir) / "checkpoint.json", ec);
-    if (left || predicted > kDefaultCheckpointSeconds) checkpoint_dir = dir, default_checkpoint = true;
-  }
+  const std::string& checkpoint_dir = plan.checkpoint_dir;
+  const bool default_checkpoint = plan.default_checkpoint;
+  const double predicted = plan.predicted;
   gen::ExecuteOptions exec;
   exec.threads = args.threads;
   exec.shard = args.shard;

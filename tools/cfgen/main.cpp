@@ -68,6 +68,40 @@ void add_search_options(CLI::App& app, cf::tools::GenerateArgs& gen, std::vector
                          ->capture_default_str());
 }
 
+// How the run's work is kept and shared (--shard, --checkpoint, --shard-patience,
+// --no-checkpoint) and --estimate, added to `added`.
+void add_run_options(CLI::App& app, cf::tools::GenerateArgs& gen, std::string& shard_text, CLI::Option* out,
+                     std::vector<CLI::Option*>& added) {
+  auto* shard = app.add_option("--shard", shard_text,
+                               "compute shard i of K of every stage, taking the other shards' work from "
+                               "the --checkpoint DIR they share; shard 0 writes the graph")
+                    ->type_name("i/K");
+  auto* checkpoint = app.add_option("--checkpoint", gen.checkpoint_dir,
+                                    "keep finished work in DIR; a rerun with the same models and options "
+                                    "resumes from it")
+                         ->type_name("DIR");
+  shard->needs(checkpoint);
+  auto* no_checkpoint = app.add_flag("--no-checkpoint", gen.no_checkpoint,
+                                     "keep no checkpoint (by default a run predicted to take over 2 minutes "
+                                     "keeps one in GRAPH.json.ckpt/ until the graph is written)")
+                            ->excludes(checkpoint);
+  auto* estimate = app.add_flag("--estimate", gen.estimate,
+                                "print the candidate sets per level, the CFs, time and peak memory predicted "
+                                "for a run (from a few sets decided), and stop")
+                       ->excludes(out)
+                       ->excludes(checkpoint)
+                       ->excludes(no_checkpoint)
+                       ->excludes(shard);
+  auto* patience = app.add_option("--shard-patience", gen.shard_patience,
+                                  "seconds a shard waits at least for another shard's chunk before "
+                                  "computing it itself (raise it where new files take long to be seen, "
+                                  "e.g. NFS)")
+                       ->check(cf::cli::finite_range(0, 1e6))
+                       ->capture_default_str()
+                       ->needs(shard);
+  for (CLI::Option* o : {shard, checkpoint, patience, no_checkpoint, estimate}) added.push_back(o);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -98,34 +132,8 @@ int main(int argc, char** argv) {
                       ->check(CLI::Range(0, 1024));
   auto* quiet = app.add_flag("-q,--quiet", gen.quiet, "no progress messages");
   std::string shard_text;
-  auto* shard = app.add_option("--shard", shard_text,
-                               "compute shard i of K of every stage, taking the other shards' work from "
-                               "the --checkpoint DIR they share; shard 0 writes the graph")
-                    ->type_name("i/K");
-  auto* checkpoint = app.add_option("--checkpoint", gen.checkpoint_dir,
-                                    "keep finished work in DIR; a rerun with the same models and options "
-                                    "resumes from it")
-                         ->type_name("DIR");
-  shard->needs(checkpoint);
-  auto* no_checkpoint = app.add_flag("--no-checkpoint", gen.no_checkpoint,
-                                     "keep no checkpoint (by default a run predicted to take over 2 minutes "
-                                     "keeps one in GRAPH.json.ckpt/ until the graph is written)")
-                            ->excludes(checkpoint);
-  auto* estimate = app.add_flag("--estimate", gen.estimate,
-                                "print the candidate sets per level, the CFs, time and peak memory predicted "
-                                "for a run (from a few sets decided), and stop")
-                       ->excludes(out)
-                       ->excludes(checkpoint)
-                       ->excludes(no_checkpoint)
-                       ->excludes(shard);
-  auto* patience = app.add_option("--shard-patience", gen.shard_patience,
-                                  "seconds a shard waits at least for another shard's chunk before "
-                                  "computing it itself (raise it where new files take long to be seen, "
-                                  "e.g. NFS)")
-                       ->check(cf::cli::finite_range(0, 1e6))
-                       ->capture_default_str()
-                       ->needs(shard);
-  std::vector<CLI::Option*> gen_opts{threads, quiet, shard, checkpoint, patience, no_checkpoint, estimate};
+  std::vector<CLI::Option*> gen_opts{threads, quiet};
+  add_run_options(app, gen, shard_text, out, gen_opts);
   gen_opts.push_back(app.add_option("--max-pcs", gen.max_pcs, "largest CFs to enumerate")
                          ->check(CLI::Range(1, 3))
                          ->capture_default_str());
