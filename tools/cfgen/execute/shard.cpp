@@ -16,7 +16,9 @@ namespace {
 
 // The version of checkpoints and of the fingerprint. 2: a witness as in chunks, [found, pose
 // (12), clearance, margin]; 3: the witness search climbs past obstacles and the neighbour
-// rounds' tasks (the same tasks give other results, so checkpoints of version 2 are refused).
+// rounds' tasks (the same tasks give other results, so checkpoints of version 2 are refused);
+// 4: the images of each batch of CFs found verified as a stage of kVerify tasks (the stages
+// are numbered differently).
 constexpr int kVersion = 4;
 constexpr int kMaxShards = 4096;
 
