@@ -1,5 +1,5 @@
-// Tests of the models' symmetries (tools/cfgen/enumerate/symmetry.cpp) and of the generator's use of
-// them: counts of symmetry groups worked out by hand, the image of a pose checked point by
+// Tests of the models' symmetries (tools/cfgen/enumerate/symmetry.cpp) and of the generator's use
+// of them: counts of symmetry groups worked out by hand, the image of a pose checked point by
 // point, and a graph generated with one search per orbit checked for closure under the
 // symmetries and against a run that searches every set.
 
@@ -18,8 +18,8 @@
 
 #include <cmath>
 #include <random>
-#include <sstream>
 #include <set>
+#include <sstream>
 #include <string>
 
 using cf::Pose;
@@ -63,7 +63,8 @@ cf::gen::SearchParams search_for(const cf::test::AnalysedPair& p) {
 }
 
 // The pair enumerated with the generator's defaults, on two threads.
-cf::gen::Enumeration enumerate(const cf::test::AnalysedPair& p, const cf::gen::EnumerateOptions& opt) {
+cf::gen::Enumeration enumerate(const cf::test::AnalysedPair& p,
+                               const cf::gen::EnumerateOptions& opt) {
   cf::gen::ExecuteOptions exec;
   exec.threads = 2;
   return cf::gen::enumerate_pair(p.ai, p.bi, search_for(p), opt, exec);
@@ -190,6 +191,30 @@ TEST_CASE("symmetry: the image of a pose puts each image element where the symme
   CHECK(k == sym.size());
 }
 
+TEST_CASE("symmetry: canonical is the least image, the same for every member of an orbit",
+          "[symmetry]") {
+  const cf::Polyhedron A = cf::test::box(10, 20, 30, "A");
+  const cf::Polyhedron B = cf::test::small_l_block();
+  const PairSymmetries sym(A, B, 1e-13 * 50, true);
+  REQUIRE(sym.size() == 16);
+  // Sets of one to three PCs of mixed types spread over both models' elements.
+  std::vector<cf::PcSet> sets;
+  for (int i = 0; i < 40; ++i) {
+    std::vector<cf::Pc> pcs{{cf::PcType::kVF, i % 8, i % static_cast<int>(B.num_faces())}};
+    if (i % 3 > 0)
+      pcs.push_back({cf::PcType::kEE, (i * 5) % 12, (i * 7) % static_cast<int>(B.num_edges())});
+    if (i % 3 > 1) pcs.push_back({cf::PcType::kFV, (i * 3) % 6, (i * 11) % 12});
+    sets.emplace_back(pcs);
+  }
+  for (const cf::PcSet& s : sets) {
+    cf::PcSet least = s;
+    for (std::size_t k = 0; k < sym.size(); ++k)
+      if (cf::gen::pcset_less(sym.image(s, k), least)) least = sym.image(s, k);
+    CHECK(sym.canonical(s) == least);
+    for (std::size_t k = 0; k < sym.size(); ++k) CHECK(sym.canonical(sym.image(s, k)) == least);
+  }
+}
+
 TEST_CASE(
     "symmetry: one search per orbit gives a graph closed under the symmetries, every witness "
     "verified",
@@ -248,7 +273,8 @@ TEST_CASE(
   const cf::gen::Enumeration thorough = enumerate(p, opt);
   CHECK(thorough.symmetries_a == 16);
   CHECK(thorough.symmetries_b == 16);
-  const std::set<std::string> s_orbit = cf_sets(orbit), s_every = cf_sets(every), s_thorough = cf_sets(thorough);
+  const std::set<std::string> s_orbit = cf_sets(orbit), s_every = cf_sets(every),
+                              s_thorough = cf_sets(thorough);
   REQUIRE(s_thorough.size() == thorough.cfs.size());  // no CF twice
   // The search is the per-set one; the closure only adds, each image verified.
   for (const std::string& s : s_every) CHECK(s_thorough.count(s) == 1);
@@ -266,7 +292,8 @@ TEST_CASE(
   std::size_t images = 0;
   for (const auto& r : thorough.cfs) {
     CHECK(search.verify(r.pcs, r.witness) >= search.params().min_clearance);
-    for (std::size_t k = 0; k < sym.size(); ++k) images += s_thorough.count(cf::to_string(sym.image(r.pcs, k)));
+    for (std::size_t k = 0; k < sym.size(); ++k)
+      images += s_thorough.count(cf::to_string(sym.image(r.pcs, k)));
   }
   CHECK(images == thorough.cfs.size() * sym.size());  // closed under the maps
   // On this pair it holds every CF one search per orbit finds (7,508 against 6,724 when

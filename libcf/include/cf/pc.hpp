@@ -101,16 +101,34 @@ class PcSet {
   /// Builds the canonical set.
   /// @throws cf::Error when pcs has more than 3 PCs or repeats one.
   explicit PcSet(const std::vector<Pc>& pcs);
-  /// Inserts keeping the order; returns false when full or already present.
-  bool insert(const Pc& pc);
+  /// Inserts keeping the order; returns false when full or already present. (Inline, as
+  /// contains and ==: the generator's enumeration makes sets by the million.)
+  bool insert(const Pc& pc) {
+    if (size_ == kMaxPcs || contains(pc)) return false;
+    int i = size_;
+    for (; i > 0 && pc < pcs_[static_cast<std::size_t>(i - 1)]; --i)
+      pcs_[static_cast<std::size_t>(i)] = pcs_[static_cast<std::size_t>(i - 1)];
+    pcs_[static_cast<std::size_t>(i)] = pc;
+    ++size_;
+    return true;
+  }
   int size() const { return size_; }
   bool empty() const { return size_ == 0; }
   const Pc& operator[](int i) const { return pcs_[static_cast<std::size_t>(i)]; }
   const Pc* begin() const { return pcs_.data(); }
   const Pc* end() const { return pcs_.data() + size_; }
-  bool contains(const Pc& pc) const;
+  bool contains(const Pc& pc) const {
+    for (int i = 0; i < size_; ++i)
+      if (pcs_[static_cast<std::size_t>(i)] == pc) return true;
+    return false;
+  }
   std::size_t hash() const;
-  friend bool operator==(const PcSet& x, const PcSet& y);
+  friend bool operator==(const PcSet& x, const PcSet& y) {
+    if (x.size_ != y.size_) return false;
+    for (int i = 0; i < x.size_; ++i)
+      if (x.pcs_[static_cast<std::size_t>(i)] != y.pcs_[static_cast<std::size_t>(i)]) return false;
+    return true;
+  }
   friend bool operator!=(const PcSet& x, const PcSet& y) { return !(x == y); }
 
  private:

@@ -242,12 +242,12 @@ void bind_render(py::module_& m) {
             PP.mutable_at(i, k) = r.X_WP.t_BA[k];
             FG.mutable_at(i, k) = Fg[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(k)];
           }
-          Eigen::Quaterniond q(r.X_WP.R_BA);
-          if (q.w() < 0) q.coeffs() = -q.coeffs();
-          PQ.mutable_at(i, 0) = q.w();
-          PQ.mutable_at(i, 1) = q.x();
-          PQ.mutable_at(i, 2) = q.y();
-          PQ.mutable_at(i, 3) = q.z();
+          Eigen::Quaterniond q_WP(r.X_WP.R_BA);
+          if (q_WP.w() < 0) q_WP.coeffs() = -q_WP.coeffs();
+          PQ.mutable_at(i, 0) = q_WP.w();
+          PQ.mutable_at(i, 1) = q_WP.x();
+          PQ.mutable_at(i, 2) = q_WP.y();
+          PQ.mutable_at(i, 3) = q_WP.z();
           pcs.append(r.pcs);
           motion.append(r.motion);
           status.append(r.status);

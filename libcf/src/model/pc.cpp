@@ -117,24 +117,6 @@ PcSet::PcSet(const std::vector<Pc>& pcs) {
     if (!insert(pc)) throw Error("PcSet: PC " + to_string(pc) + " is repeated");
 }
 
-bool PcSet::insert(const Pc& pc) {
-  if (size_ == kMaxPcs || contains(pc)) return false;
-  int i = size_;
-  while (i > 0 && pc < pcs_[static_cast<std::size_t>(i - 1)]) {
-    pcs_[static_cast<std::size_t>(i)] = pcs_[static_cast<std::size_t>(i - 1)];
-    --i;
-  }
-  pcs_[static_cast<std::size_t>(i)] = pc;
-  ++size_;
-  return true;
-}
-
-bool PcSet::contains(const Pc& pc) const {
-  for (int i = 0; i < size_; ++i)
-    if (pcs_[static_cast<std::size_t>(i)] == pc) return true;
-  return false;
-}
-
 std::size_t PcSet::hash() const {
   std::uint64_t h = static_cast<std::uint64_t>(size_);
   for (int i = 0; i < size_; ++i) {
@@ -144,13 +126,6 @@ std::size_t PcSet::hash() const {
     h = mix64(h ^ key ^ (static_cast<std::uint64_t>(pc.type) << 61));
   }
   return static_cast<std::size_t>(h);
-}
-
-bool operator==(const PcSet& x, const PcSet& y) {
-  if (x.size_ != y.size_) return false;
-  for (int i = 0; i < x.size_; ++i)
-    if (x.pcs_[static_cast<std::size_t>(i)] != y.pcs_[static_cast<std::size_t>(i)]) return false;
-  return true;
 }
 
 std::string to_string(const PcSet& pcs) {

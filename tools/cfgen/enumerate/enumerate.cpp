@@ -61,8 +61,8 @@ Enumeration enumerate(const WitnessSearch& search, const EnumerateOptions& opt,
   return internal::Enumerator(search, opt, runner).run();
 }
 
-RunEstimate estimate(const WitnessSearch& search, const EnumerateOptions& opt,
-                     StageRunner& runner, int threads) {
+RunEstimate estimate(const WitnessSearch& search, const EnumerateOptions& opt, StageRunner& runner,
+                     int threads) {
   return internal::Enumerator(search, opt, runner).estimate(threads);
 }
 
@@ -79,81 +79,104 @@ std::vector<TaskResult> run_tasks(StageRunner& runner, const std::vector<Task>& 
   return results;
 }
 
+namespace {
+
+// The CFs of a graph as the transitions look them up: by PC set; the CFs of three PCs by
+// each pair of their PCs (with the CF's set beside its index, read in sequence); every PC's
+// neighbours.
+struct CfIndex {
+  struct Held {
+    PcSet set;
+    int cf;
+  };
+  std::unordered_map<PcSet, int, internal::PcSetHash> by_set;
+  std::unordered_map<PcSet, std::vector<Held>, internal::PcSetHash> triples_by_pair;
+  std::map<Pc, std::vector<Pc>> nb;
+
+  CfIndex(const std::vector<CfRecord>& cfs, const Polyhedron& A, const Polyhedron& B) {
+    for (std::size_t i = 0; i < cfs.size(); ++i) {
+      const PcSet& s = cfs[i].pcs;
+      by_set.emplace(s, static_cast<int>(i));
+      for (int k = 0; k < s.size(); ++k) {
+        if (!nb.count(s[k])) nb.emplace(s[k], cf::neighbouring_pcs(s[k], A, B));
+        if (s.size() == 3)
+          triples_by_pair[internal::without(s, k)].push_back({s, static_cast<int>(i)});
+      }
+    }
+  }
+};
+
+// gain / lose: CF `me` (set s) and the CFs it leaves when it drops one PC.
+void gains_and_losses(const CfIndex& idx, const PcSet& s, int me, std::vector<Transition>& out) {
+  if (s.size() < 2) return;
+  for (int k = 0; k < s.size(); ++k) {
+    auto it = idx.by_set.find(internal::without(s, k));
+    if (it == idx.by_set.end()) continue;
+    out.push_back({CfId(it->second), CfId(me), TransitionKind::kGain});
+    out.push_back({CfId(me), CfId(it->second), TransitionKind::kLose});
+  }
+}
+
+// Whether t's PCs match the positions of `options` one to one, each PC among its position's.
+bool matches(const std::vector<std::vector<Pc>>& options, const PcSet& t) {
+  const int n = t.size();
+  std::array<int, PcSet::kMaxPcs> perm{0, 1, 2};
+  do {
+    bool all = true;
+    for (int k = 0; k < n && all; ++k) {
+      const auto& o = options[static_cast<std::size_t>(k)];
+      all = std::binary_search(o.begin(), o.end(), t[perm[static_cast<std::size_t>(k)]]);
+    }
+    if (all) return true;
+  } while (std::next_permutation(perm.begin(), perm.begin() + n));
+  return false;
+}
+
+// change: the CFs of s's size whose PCs match s's positions one to one, each the same PC or
+// a neighbour (`options`). Every such CF holds one option of each of the first two positions:
+// each pair of those is looked up (as the CF itself when s has two PCs, among the CFs of
+// three PCs holding it when three).
+void changes(const CfIndex& idx, const PcSet& s, int me, std::vector<Transition>& out) {
+  const int n = s.size();
+  std::vector<std::vector<Pc>> options(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) {
+    auto& o = options[static_cast<std::size_t>(k)];
+    o.push_back(s[k]);
+    for (const Pc& q : idx.nb.at(s[k])) o.push_back(q);
+    std::sort(o.begin(), o.end());
+  }
+  auto push = [&](int to) {
+    if (to != me) out.push_back({CfId(me), CfId(to), TransitionKind::kChange});
+  };
+  if (n == 1)
+    for (const Pc& x : options[0])
+      if (auto it = idx.by_set.find(PcSet(std::vector<Pc>{x})); it != idx.by_set.end())
+        push(it->second);
+  if (n < 2) return;
+  for (const Pc& x : options[0])
+    for (const Pc& y : options[1]) {
+      PcSet pair;
+      pair.insert(x);
+      if (!pair.insert(y)) continue;
+      if (n == 2) {
+        if (auto it = idx.by_set.find(pair); it != idx.by_set.end()) push(it->second);
+      } else if (auto it = idx.triples_by_pair.find(pair); it != idx.triples_by_pair.end()) {
+        for (const CfIndex::Held& h : it->second)
+          if (matches(options, h.set)) push(h.cf);
+      }
+    }
+}
+
+}  // namespace
+
 std::vector<Transition> transitions_between(const std::vector<CfRecord>& cfs, const Polyhedron& A,
                                             const Polyhedron& B, StageRunner& runner) {
-  using internal::PcSetHash;
-  std::unordered_map<PcSet, int, PcSetHash> index;
-  for (std::size_t i = 0; i < cfs.size(); ++i) index.emplace(cfs[i].pcs, static_cast<int>(i));
-  // Every PC's neighbours, computed once before the CFs are shared out among the threads.
-  std::map<Pc, std::vector<Pc>> nb;
-  for (const CfRecord& r : cfs)
-    for (const Pc& pc : r.pcs)
-      if (!nb.count(pc)) nb.emplace(pc, cf::neighbouring_pcs(pc, A, B));
-  // The CFs that hold each PC, by CF size.
-  std::array<std::map<Pc, std::vector<int>>, PcSet::kMaxPcs + 1> holding;
-  for (std::size_t i = 0; i < cfs.size(); ++i)
-    for (const Pc& pc : cfs[i].pcs)
-      holding[static_cast<std::size_t>(cfs[i].pcs.size())][pc].push_back(static_cast<int>(i));
+  const CfIndex idx(cfs, A, B);
   // Each CF's transitions on its own, joined in CF order (then sorted).
   std::vector<std::vector<Transition>> per_cf(cfs.size());
   runner.for_each(cfs.size(), [&](std::size_t i) {
-    std::vector<Transition>& mine = per_cf[i];
-    auto push = [&](int from, int to, TransitionKind k) {
-      mine.push_back({CfId(from), CfId(to), k});
-    };
-    const PcSet& s = cfs[i].pcs;
-    const int me = static_cast<int>(i);
-    // gain / lose: drop one PC of a larger CF.
-    if (s.size() > 1)
-      for (int k = 0; k < s.size(); ++k) {
-        PcSet sub;
-        for (int j = 0; j < s.size(); ++j)
-          if (j != k) sub.insert(s[j]);
-        auto it = index.find(sub);
-        if (it != index.end()) {
-          push(it->second, me, TransitionKind::kGain);
-          push(me, it->second, TransitionKind::kLose);
-        }
-      }
-    // change: replace one or more PCs by neighbouring PCs, keeping the count: the CFs of
-    // this size whose PCs match s's positions one to one, each the same PC or a neighbour.
-    // They all hold some option of the position with the fewest, so only the CFs holding
-    // one of those are tried.
-    const int n = s.size();
-    if (n == 0) return;
-    std::vector<std::vector<Pc>> options(static_cast<std::size_t>(n));
-    std::size_t best = 0, best_count = std::numeric_limits<std::size_t>::max();
-    for (int k = 0; k < n; ++k) {
-      auto& o = options[static_cast<std::size_t>(k)];
-      o.push_back(s[k]);
-      for (const Pc& q : nb.at(s[k])) o.push_back(q);
-      std::sort(o.begin(), o.end());
-      std::size_t count = 0;
-      for (const Pc& q : o)
-        if (auto it = holding[static_cast<std::size_t>(n)].find(q);
-            it != holding[static_cast<std::size_t>(n)].end())
-          count += it->second.size();
-      if (count < best_count) best = static_cast<std::size_t>(k), best_count = count;
-    }
-    auto matches = [&](const PcSet& t) {
-      std::array<int, PcSet::kMaxPcs> perm{0, 1, 2};
-      do {
-        bool all = true;
-        for (int k = 0; k < n && all; ++k) {
-          const auto& o = options[static_cast<std::size_t>(k)];
-          all = std::binary_search(o.begin(), o.end(), t[perm[static_cast<std::size_t>(k)]]);
-        }
-        if (all) return true;
-      } while (std::next_permutation(perm.begin(), perm.begin() + n));
-      return false;
-    };
-    for (const Pc& q : options[best]) {
-      auto it = holding[static_cast<std::size_t>(n)].find(q);
-      if (it == holding[static_cast<std::size_t>(n)].end()) continue;
-      for (int j : it->second)
-        if (j != me && matches(cfs[static_cast<std::size_t>(j)].pcs))
-          push(me, j, TransitionKind::kChange);
-    }
+    gains_and_losses(idx, cfs[i].pcs, static_cast<int>(i), per_cf[i]);
+    changes(idx, cfs[i].pcs, static_cast<int>(i), per_cf[i]);
   });
   std::vector<Transition> out;
   for (const auto& v : per_cf) out.insert(out.end(), v.begin(), v.end());

@@ -32,6 +32,14 @@ using PcSetSet = std::unordered_set<PcSet, PcSetHash>;
 template <class T>
 using PcSetMap = std::unordered_map<PcSet, T, PcSetHash>;
 
+/// s without its PC at position k: a subset one PC smaller.
+inline PcSet without(const PcSet& s, int k) {
+  PcSet out;
+  for (int j = 0; j < s.size(); ++j)
+    if (j != k) out.insert(s[j]);
+  return out;
+}
+
 // Candidate sets grouped by orbit: orbit o is members[first[o], first[o + 1]).
 struct OrbitGroups {
   std::vector<PcSet> members;
@@ -87,9 +95,26 @@ class Enumerator {
   void changes_of(const PcSet& s, const std::function<void(const PcSet&)>& fn) const;
   bool any_change(const PcSet& s, const std::function<bool(const PcSet&)>& pred) const;
   enum class Near { kNever, kNotYet, kYes };
-  Near near_candidate(const PcSet& s, PcSet& orbit) const;
-  void screen(const PcSet& s, bool failed, char& dead,
-              std::vector<std::pair<PcSet, PcSet>>& kept) const;
+  // What the screening of a set learned that stays true (neighbours.cpp).
+  struct NearState {
+    PcSet orbit;                // its orbit's canonical member; empty until needed
+    bool checked = false;       // valid_change was worked out against every CF at the time
+    bool valid_change = false;  // a set one change away is valid
+  };
+  struct Kept {
+    PcSet set;
+    PcSet orbit;
+  };
+  Near near_candidate(const PcSet& s, NearState& st,
+                      const PcSetMap<std::vector<Pc>>& new_by_rest) const;
+  Near near_unsearched(const PcSet& s, NearState& st,
+                       const PcSetMap<std::vector<Pc>>& new_by_rest) const;
+  PcSetMap<std::vector<Pc>> new_cfs_by_rest() const;
+  bool valid_change_among(const PcSet& s, const PcSetMap<std::vector<Pc>>& new_by_rest) const;
+  void screen_failed(std::size_t i, const PcSetMap<std::vector<Pc>>& new_by_rest,
+                     std::vector<Kept>& kept);
+  void screen_cf(int level, std::size_t i, const PcSetMap<std::vector<Pc>>& new_by_rest,
+                 std::vector<Kept>& kept);
   std::vector<Task> neighbour_tasks();
   std::size_t neighbour_round();
   // finish.cpp
@@ -126,6 +151,14 @@ class Enumerator {
   // search any more (screen()).
   std::vector<char> failed_dead_;
   std::vector<char> cf_dead_[3];
+  // What the screening learned of each failed set, and of the changes of each CF that are
+  // still worth screening (in the order first screened); the CFs screened at least once; how
+  // many CFs of each level the last round's screening saw.
+  std::vector<NearState> failed_near_;
+  std::vector<std::vector<std::pair<PcSet, NearState>>> cf_near_[3];
+  std::vector<char> cf_screened_[3];
+  std::size_t near_screened_cfs_[3] = {0, 0, 0};
+  bool near_screened_none_ = true;  // this round's new_cfs_by_rest() holds every CF
   std::map<Pc, std::vector<Pc>> pc_neighbours_;
   // The images' clearances of the sets about to be accepted, by set, with the witness pose
   // they were computed at (prefetch_images); cleared after each batch.

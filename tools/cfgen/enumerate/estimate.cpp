@@ -211,14 +211,9 @@ std::vector<PcSet> Enumerator::with_valid_subsets(const std::vector<PcSet>& pool
   std::vector<PcSet> out;
   std::size_t tried = 0;
   auto subsets = [](const PcSet& s) {
-    std::vector<PcSet> out;
-    for (int k = 0; k < s.size(); ++k) {
-      PcSet sub;
-      for (int j = 0; j < s.size(); ++j)
-        if (j != k) sub.insert(s[j]);
-      out.push_back(sub);
-    }
-    return out;
+    std::vector<PcSet> subs;
+    for (int k = 0; k < s.size(); ++k) subs.push_back(without(s, k));
+    return subs;
   };
   for (std::size_t b = 0; b < pool.size() && b < kGrowRounds * kSamples && out.size() < kSamples;
        b += kSamples) {

@@ -262,10 +262,7 @@ std::vector<PcSet> Enumerator::single_candidates() const {
 std::vector<Mat3> Enumerator::seeds_from_subsets(const PcSet& s) const {
   std::vector<Mat3> seeds;
   for (int k = 0; k < s.size(); ++k) {
-    PcSet sub;
-    for (int j = 0; j < s.size(); ++j)
-      if (j != k) sub.insert(s[j]);
-    auto it = witness_rot_.find(sub);
+    auto it = witness_rot_.find(without(s, k));
     if (it != witness_rot_.end()) seeds.push_back(it->second);
   }
   return seeds;

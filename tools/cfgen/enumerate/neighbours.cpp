@@ -61,81 +61,151 @@ bool Enumerator::any_change(const PcSet& s, const std::function<bool(const PcSet
 // Whether a set is worth a neighbour search this round, judged on what the round starts
 // with: never (valid, searched near before, or its orbit tried kOrbitTries times: each stays
 // so, as witnesses, searches and tries only grow), not yet (no set one change away is
-// valid), or yes, its orbit in `orbit`.
-Enumerator::Near Enumerator::near_candidate(const PcSet& s, PcSet& orbit) const {
+// valid), or yes. `st` keeps what later rounds need not work out again: that a valid set is
+// one change away (which stays true), and the set's orbit.
+Enumerator::Near Enumerator::near_candidate(const PcSet& s, NearState& st,
+                                            const PcSetMap<std::vector<Pc>>& new_by_rest) const {
   if (witness_rot_.count(s) || near_searched_.count(s)) return Near::kNever;
-  if (!any_change(s, [&](const PcSet& n) { return witness_rot_.count(n) > 0; }))
-    return Near::kNotYet;
-  orbit = sym_.canonical(s);
-  auto it = near_tries_.find(orbit);
+  return near_unsearched(s, st, new_by_rest);
+}
+
+// near_candidate() for a set known to be neither valid nor searched near.
+Enumerator::Near Enumerator::near_unsearched(const PcSet& s, NearState& st,
+                                             const PcSetMap<std::vector<Pc>>& new_by_rest) const {
+  if (!st.valid_change) {
+    // Checked before, or new_by_rest holds every CF (the first round): the CFs in new_by_rest
+    // are the only ones that can have changed the answer.
+    st.valid_change =
+        st.checked || near_screened_none_
+            ? valid_change_among(s, new_by_rest)
+            : any_change(s, [&](const PcSet& n) { return witness_rot_.count(n) > 0; });
+    st.checked = true;
+    if (!st.valid_change) return Near::kNotYet;
+  }
+  if (st.orbit.empty()) st.orbit = sym_.canonical(s);
+  auto it = near_tries_.find(st.orbit);
   return it == near_tries_.end() || it->second < kOrbitTries ? Near::kYes : Near::kNever;
 }
 
-// Screens one failed set, or the changes of one CF, into `kept`; sets `dead` when nothing it
-// screens can be worth a search in any later round (a failed set that never will be, a CF
-// whose changes never will be), so that later rounds pass it by.
-void Enumerator::screen(const PcSet& s, bool failed, char& dead,
-                        std::vector<std::pair<PcSet, PcSet>>& kept) const {
-  PcSet orbit;
-  if (failed) {
-    const Near r = near_candidate(s, orbit);
-    if (r == Near::kYes) kept.emplace_back(s, orbit);
-    dead = r == Near::kNever;
-    return;
-  }
-  bool never = true;
-  changes_of(s, [&](const PcSet& n) {
-    if (witness_rot_.count(n) || near_searched_.count(n) || seen_.count(n) || !conditions_hold(n))
-      return;
-    const Near r = near_candidate(n, orbit);
-    if (r == Near::kYes) kept.emplace_back(n, orbit);
-    never = never && r == Near::kNever;
-  });
-  dead = never;
+// The CFs found since the last round's screening, by what is left of each when one PC is
+// taken out, with the PC taken out: the changes they are of a set screened before.
+PcSetMap<std::vector<Pc>> Enumerator::new_cfs_by_rest() const {
+  PcSetMap<std::vector<Pc>> out;
+  for (int l = 0; l < 3; ++l)
+    for (std::size_t i = near_screened_cfs_[l]; i < valid_[l].size(); ++i) {
+      const PcSet& c = valid_[l][i].first;
+      for (int k = 0; k < c.size(); ++k) out[without(c, k)].push_back(c[k]);
+    }
+  return out;
 }
 
-// The sets of a neighbour round, in order: the failed candidates, then the sets one change
-// away from a CF that no level proposed (a subset of theirs is missing) and that the
-// necessary conditions allow. Screened on all threads a block at a time (near_candidate),
-// then taken in order on this thread: one member of an orbit a round.
-std::vector<Task> Enumerator::neighbour_tasks() {
-  // The PCs of the failed sets and of the CFs, then those of the CFs' changes.
-  std::vector<Pc> pcs;
-  for (const PcSet& s : failed_) pcs.insert(pcs.end(), s.begin(), s.end());
-  for (const auto& level : valid_)
-    for (const auto& [s, w] : level) pcs.insert(pcs.end(), s.begin(), s.end());
-  know_neighbours(pcs);
-  std::vector<Pc> next;
-  for (const auto& level : valid_)
-    for (const auto& [s, w] : level)
-      for (const Pc& pc : s)
-        for (const Pc& q : pc_neighbours_.at(pc)) next.push_back(q);
-  know_neighbours(next);
-  // Failed sets, or CFs whose changes are screened, with their marks from earlier rounds.
-  failed_dead_.resize(failed_.size(), 0);
-  struct From {
-    const PcSet* set;
-    bool failed;
-    char* dead;
+// Whether one of the CFs in `new_by_rest` is one change away from s: s[j] replaced by a
+// neighbouring PC.
+bool Enumerator::valid_change_among(const PcSet& s,
+                                    const PcSetMap<std::vector<Pc>>& new_by_rest) const {
+  for (int j = 0; j < s.size(); ++j) {
+    auto it = new_by_rest.find(without(s, j));
+    if (it == new_by_rest.end()) continue;
+    const std::vector<Pc>& nb = pc_neighbours_.at(s[j]);
+    for (const Pc& q : it->second)
+      if (std::find(nb.begin(), nb.end(), q) != nb.end()) return true;
+  }
+  return false;
+}
+
+// Screens one failed set into `kept`; marks it dead when it can never be worth a search.
+void Enumerator::screen_failed(std::size_t i, const PcSetMap<std::vector<Pc>>& new_by_rest,
+                               std::vector<Kept>& kept) {
+  const Near r = near_candidate(failed_[i], failed_near_[i], new_by_rest);
+  if (r == Near::kYes) kept.push_back({failed_[i], failed_near_[i].orbit});
+  failed_dead_[i] = r == Near::kNever;
+}
+
+// Screens the changes of CF i of `level` into `kept`: the sets no level proposed (a subset of
+// theirs is missing) and that the necessary conditions allow. The first time, each change is
+// worked out; after, only those that were not passed by for good (kept in cf_near_), in the
+// same order. Marks the CF dead when none is left.
+void Enumerator::screen_cf(int level, std::size_t i, const PcSetMap<std::vector<Pc>>& new_by_rest,
+                           std::vector<Kept>& kept) {
+  std::vector<std::pair<PcSet, NearState>>& mine = cf_near_[level][i];
+  auto keep = [&](const PcSet& n, NearState& st, Near r) {
+    if (r == Near::kYes) kept.push_back({n, st.orbit});
+    return r != Near::kNever;
   };
-  std::vector<From> from;
+  if (!cf_screened_[level][i]) {
+    cf_screened_[level][i] = 1;
+    const PcSet& s = valid_[level][i].first;
+    for (int k = 0; k < s.size(); ++k)
+      for (const Pc& q : pc_neighbours_.at(s[k])) {
+        PcSet n = without(s, k);
+        if (!n.insert(q) || witness_rot_.count(n) || near_searched_.count(n) || seen_.count(n) ||
+            !conditions_hold(n))
+          continue;
+        // When s[k] neighbours q in turn, s is a change of n, and valid.
+        const std::vector<Pc>& back = pc_neighbours_.at(q);
+        NearState st;
+        st.checked = st.valid_change = std::find(back.begin(), back.end(), s[k]) != back.end();
+        if (keep(n, st, near_unsearched(n, st, new_by_rest))) mine.emplace_back(n, st);
+      }
+  } else {
+    std::size_t left = 0;
+    for (auto& [n, st] : mine)
+      if (!seen_.count(n) && keep(n, st, near_candidate(n, st, new_by_rest)))
+        mine[left++] = {n, st};
+    mine.resize(left);
+  }
+  if (mine.empty()) {
+    cf_dead_[level][i] = 1;
+    std::vector<std::pair<PcSet, NearState>>().swap(mine);
+  }
+}
+
+// The sets of a neighbour round, in order: the failed candidates, then the changes of the CFs
+// (screen_cf). Screened on all threads a block at a time, then taken in order on this
+// thread: one member of an orbit a round.
+std::vector<Task> Enumerator::neighbour_tasks() {
+  // The PCs of the failed sets and of the CFs new since the last round, then those of the
+  // new CFs' changes.
+  std::vector<Pc> pcs, next;
+  for (std::size_t i = failed_near_.size(); i < failed_.size(); ++i)
+    pcs.insert(pcs.end(), failed_[i].begin(), failed_[i].end());
+  for (int l = 0; l < 3; ++l)
+    for (std::size_t i = near_screened_cfs_[l]; i < valid_[l].size(); ++i)
+      next.insert(next.end(), valid_[l][i].first.begin(), valid_[l][i].first.end());
+  pcs.insert(pcs.end(), next.begin(), next.end());
+  know_neighbours(pcs);
+  for (std::size_t i = 0, n = next.size(); i < n; ++i)
+    for (const Pc& q : pc_neighbours_.at(next[i])) next.push_back(q);
+  know_neighbours(next);
+  const PcSetMap<std::vector<Pc>> new_by_rest = new_cfs_by_rest();
+  near_screened_none_ = near_screened_cfs_[0] + near_screened_cfs_[1] + near_screened_cfs_[2] == 0;
+  // Failed sets (level -1) and CFs not marked dead by earlier rounds.
+  failed_dead_.resize(failed_.size(), 0);
+  failed_near_.resize(failed_.size());
+  std::vector<std::pair<int, std::size_t>> from;
   for (std::size_t i = 0; i < failed_.size(); ++i)
-    if (!failed_dead_[i]) from.push_back({&failed_[i], true, &failed_dead_[i]});
+    if (!failed_dead_[i]) from.emplace_back(-1, i);
   for (int l = 0; l < 3; ++l) {
     cf_dead_[l].resize(valid_[l].size(), 0);
+    cf_screened_[l].resize(valid_[l].size(), 0);
+    cf_near_[l].resize(valid_[l].size());
+    near_screened_cfs_[l] = valid_[l].size();
     for (std::size_t i = 0; i < valid_[l].size(); ++i)
-      if (!cf_dead_[l][i]) from.push_back({&valid_[l][i].first, false, &cf_dead_[l][i]});
+      if (!cf_dead_[l][i]) from.emplace_back(l, i);
   }
   std::vector<Task> tasks;
   PcSetSet round_orbits;
   constexpr std::size_t kBlock = 4096;
-  std::vector<std::vector<std::pair<PcSet, PcSet>>> kept;  // per set: (candidate, its orbit)
+  std::vector<std::vector<Kept>> kept;  // per item: (candidate, its orbit)
   for (std::size_t b = 0; b < from.size(); b += kBlock) {
     const std::size_t e = std::min(from.size(), b + kBlock);
     kept.assign(e - b, {});
     runner_.for_each(e - b, [&](std::size_t k) {
-      const From& f = from[b + k];
-      screen(*f.set, f.failed, *f.dead, kept[k]);
+      const auto [level, i] = from[b + k];
+      if (level < 0)
+        screen_failed(i, new_by_rest, kept[k]);
+      else
+        screen_cf(level, i, new_by_rest, kept[k]);
     });
     for (const auto& list : kept)
       for (const auto& [s, orbit] : list) {

@@ -3,6 +3,7 @@
 #include <Eigen/SVD>
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <numeric>
 
@@ -196,7 +197,23 @@ bool pcset_less(const PcSet& x, const PcSet& y) {
 PcSet PairSymmetries::canonical(const PcSet& s) const {
   PcSet best = s;
   for (std::size_t k = 1; k < pairs_.size(); ++k) {
-    const PcSet t = image(s, k);
+    const Symmetry& h = a_[static_cast<std::size_t>(pairs_[k].first)];
+    const Symmetry& g = b_[static_cast<std::size_t>(pairs_[k].second)];
+    // Images have s's size: one whose smallest PC comes after best's first is not smaller,
+    // and is passed by before it is sorted (most are).
+    std::array<Pc, PcSet::kMaxPcs> img;
+    Pc least = best[0];
+    bool smaller_first = false;
+    for (int j = 0; j < s.size(); ++j) {
+      const Pc& pc = s[j];
+      img[static_cast<std::size_t>(j)] = {pc.type,
+                                          h.of(a_kind(pc.type))[static_cast<std::size_t>(pc.a)],
+                                          g.of(b_kind(pc.type))[static_cast<std::size_t>(pc.b)]};
+      if (!(least < img[static_cast<std::size_t>(j)])) smaller_first = true;
+    }
+    if (!smaller_first) continue;
+    PcSet t;
+    for (int j = 0; j < s.size(); ++j) t.insert(img[static_cast<std::size_t>(j)]);
     if (pcset_less(t, best)) best = t;
   }
   return best;
