@@ -39,6 +39,7 @@ Enumeration Enumerator::run() {
                       (opt_.max_pcs >= 3 && valid_[1].size() > pairs_tripled_);
     if (!grew && neighbour_round() == 0) break;
   }
+  release_neighbour_rounds();
   if (opt_.close_orbits) close_orbits();
   for (int l = 0; l < 3; ++l) out_.levels[l].valid = valid_[l].size();
   if (!opt_.records) return std::move(out_);

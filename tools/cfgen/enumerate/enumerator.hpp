@@ -8,6 +8,7 @@
 #include "cfgen/enumerate/enumerate.hpp"
 #include "cfgen/enumerate/symmetry.hpp"
 
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <unordered_map>
@@ -97,18 +98,23 @@ class Enumerator {
   enum class Near { kNever, kNotYet, kYes };
   // What the screening of a set learned that stays true (neighbours.cpp).
   struct NearState {
-    PcSet orbit;                // its orbit's canonical member; empty until needed
     bool checked = false;       // valid_change was worked out against every CF at the time
     bool valid_change = false;  // a set one change away is valid
+  };
+  // A change of a CF still worth screening: its PC at position k replaced by q.
+  struct NearChange {
+    Pc q;
+    std::uint8_t k = 0;
+    NearState st;
   };
   struct Kept {
     PcSet set;
     PcSet orbit;
   };
-  Near near_candidate(const PcSet& s, NearState& st,
-                      const PcSetMap<std::vector<Pc>>& new_by_rest) const;
-  Near near_unsearched(const PcSet& s, NearState& st,
-                       const PcSetMap<std::vector<Pc>>& new_by_rest) const;
+  Near near_candidate(const PcSet& s, NearState& st, const PcSetMap<std::vector<Pc>>& new_by_rest,
+                      PcSet& orbit) const;
+  Near near_unsearched(const PcSet& s, NearState& st, const PcSetMap<std::vector<Pc>>& new_by_rest,
+                       PcSet& orbit) const;
   PcSetMap<std::vector<Pc>> new_cfs_by_rest() const;
   bool valid_change_among(const PcSet& s, const PcSetMap<std::vector<Pc>>& new_by_rest) const;
   void screen_failed(std::size_t i, const PcSetMap<std::vector<Pc>>& new_by_rest,
@@ -117,6 +123,7 @@ class Enumerator {
                  std::vector<Kept>& kept);
   std::vector<Task> neighbour_tasks();
   std::size_t neighbour_round();
+  void release_neighbour_rounds();
   // finish.cpp
   void close_orbits();
   void find_undecided();
@@ -151,11 +158,12 @@ class Enumerator {
   // search any more (screen()).
   std::vector<char> failed_dead_;
   std::vector<char> cf_dead_[3];
-  // What the screening learned of each failed set, and of the changes of each CF that are
-  // still worth screening (in the order first screened); the CFs screened at least once; how
+  // What the screening learned of each failed set, and the changes of each CF that are
+  // still worth screening (in the order first screened; 16 bytes each, the orbits worked
+  // out again each round, as a large pair has millions); the CFs screened at least once; how
   // many CFs of each level the last round's screening saw.
   std::vector<NearState> failed_near_;
-  std::vector<std::vector<std::pair<PcSet, NearState>>> cf_near_[3];
+  std::vector<std::vector<NearChange>> cf_near_[3];
   std::vector<char> cf_screened_[3];
   std::size_t near_screened_cfs_[3] = {0, 0, 0};
   bool near_screened_none_ = true;  // this round's new_cfs_by_rest() holds every CF

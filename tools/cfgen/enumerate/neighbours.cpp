@@ -61,17 +61,19 @@ bool Enumerator::any_change(const PcSet& s, const std::function<bool(const PcSet
 // Whether a set is worth a neighbour search this round, judged on what the round starts
 // with: never (valid, searched near before, or its orbit tried kOrbitTries times: each stays
 // so, as witnesses, searches and tries only grow), not yet (no set one change away is
-// valid), or yes. `st` keeps what later rounds need not work out again: that a valid set is
-// one change away (which stays true), and the set's orbit.
+// valid), or yes, its orbit in `orbit`. `st` keeps what later rounds need not work out
+// again: that a valid set is one change away (which stays true).
 Enumerator::Near Enumerator::near_candidate(const PcSet& s, NearState& st,
-                                            const PcSetMap<std::vector<Pc>>& new_by_rest) const {
+                                            const PcSetMap<std::vector<Pc>>& new_by_rest,
+                                            PcSet& orbit) const {
   if (witness_rot_.count(s) || near_searched_.count(s)) return Near::kNever;
-  return near_unsearched(s, st, new_by_rest);
+  return near_unsearched(s, st, new_by_rest, orbit);
 }
 
 // near_candidate() for a set known to be neither valid nor searched near.
 Enumerator::Near Enumerator::near_unsearched(const PcSet& s, NearState& st,
-                                             const PcSetMap<std::vector<Pc>>& new_by_rest) const {
+                                             const PcSetMap<std::vector<Pc>>& new_by_rest,
+                                             PcSet& orbit) const {
   if (!st.valid_change) {
     // Checked before, or new_by_rest holds every CF (the first round): the CFs in new_by_rest
     // are the only ones that can have changed the answer.
@@ -82,8 +84,8 @@ Enumerator::Near Enumerator::near_unsearched(const PcSet& s, NearState& st,
     st.checked = true;
     if (!st.valid_change) return Near::kNotYet;
   }
-  if (st.orbit.empty()) st.orbit = sym_.canonical(s);
-  auto it = near_tries_.find(st.orbit);
+  orbit = sym_.canonical(s);
+  auto it = near_tries_.find(orbit);
   return it == near_tries_.end() || it->second < kOrbitTries ? Near::kYes : Near::kNever;
 }
 
@@ -116,8 +118,9 @@ bool Enumerator::valid_change_among(const PcSet& s,
 // Screens one failed set into `kept`; marks it dead when it can never be worth a search.
 void Enumerator::screen_failed(std::size_t i, const PcSetMap<std::vector<Pc>>& new_by_rest,
                                std::vector<Kept>& kept) {
-  const Near r = near_candidate(failed_[i], failed_near_[i], new_by_rest);
-  if (r == Near::kYes) kept.push_back({failed_[i], failed_near_[i].orbit});
+  PcSet orbit;
+  const Near r = near_candidate(failed_[i], failed_near_[i], new_by_rest, orbit);
+  if (r == Near::kYes) kept.push_back({failed_[i], orbit});
   failed_dead_[i] = r == Near::kNever;
 }
 
@@ -127,14 +130,15 @@ void Enumerator::screen_failed(std::size_t i, const PcSetMap<std::vector<Pc>>& n
 // same order. Marks the CF dead when none is left.
 void Enumerator::screen_cf(int level, std::size_t i, const PcSetMap<std::vector<Pc>>& new_by_rest,
                            std::vector<Kept>& kept) {
-  std::vector<std::pair<PcSet, NearState>>& mine = cf_near_[level][i];
-  auto keep = [&](const PcSet& n, NearState& st, Near r) {
-    if (r == Near::kYes) kept.push_back({n, st.orbit});
+  const PcSet& s = valid_[level][i].first;
+  std::vector<NearChange>& mine = cf_near_[level][i];
+  auto keep = [&](const PcSet& n, const PcSet& orbit, Near r) {
+    if (r == Near::kYes) kept.push_back({n, orbit});
     return r != Near::kNever;
   };
+  PcSet orbit;
   if (!cf_screened_[level][i]) {
     cf_screened_[level][i] = 1;
-    const PcSet& s = valid_[level][i].first;
     for (int k = 0; k < s.size(); ++k)
       for (const Pc& q : pc_neighbours_.at(s[k])) {
         PcSet n = without(s, k);
@@ -143,20 +147,23 @@ void Enumerator::screen_cf(int level, std::size_t i, const PcSetMap<std::vector<
           continue;
         // When s[k] neighbours q in turn, s is a change of n, and valid.
         const std::vector<Pc>& back = pc_neighbours_.at(q);
-        NearState st;
-        st.checked = st.valid_change = std::find(back.begin(), back.end(), s[k]) != back.end();
-        if (keep(n, st, near_unsearched(n, st, new_by_rest))) mine.emplace_back(n, st);
+        NearChange c{q, static_cast<std::uint8_t>(k), {}};
+        c.st.checked = c.st.valid_change = std::find(back.begin(), back.end(), s[k]) != back.end();
+        if (keep(n, orbit, near_unsearched(n, c.st, new_by_rest, orbit))) mine.push_back(c);
       }
   } else {
     std::size_t left = 0;
-    for (auto& [n, st] : mine)
-      if (!seen_.count(n) && keep(n, st, near_candidate(n, st, new_by_rest)))
-        mine[left++] = {n, st};
+    for (NearChange& c : mine) {
+      PcSet n = without(s, c.k);
+      n.insert(c.q);
+      if (!seen_.count(n) && keep(n, orbit, near_candidate(n, c.st, new_by_rest, orbit)))
+        mine[left++] = c;
+    }
     mine.resize(left);
   }
   if (mine.empty()) {
     cf_dead_[level][i] = 1;
-    std::vector<std::pair<PcSet, NearState>>().swap(mine);
+    std::vector<NearChange>().swap(mine);
   }
 }
 
@@ -228,6 +235,20 @@ std::vector<Task> Enumerator::neighbour_tasks() {
       }
   }
   return tasks;
+}
+
+// The rounds' memory, once they are over: the records and the transitions need it more.
+void Enumerator::release_neighbour_rounds() {
+  PcSetSet().swap(near_searched_);
+  PcSetMap<std::size_t>().swap(near_tries_);
+  std::vector<char>().swap(failed_dead_);
+  std::vector<NearState>().swap(failed_near_);
+  for (int l = 0; l < 3; ++l) {
+    std::vector<char>().swap(cf_dead_[l]);
+    std::vector<char>().swap(cf_screened_[l]);
+    std::vector<std::vector<NearChange>>().swap(cf_near_[l]);
+  }
+  std::map<Pc, std::vector<Pc>>().swap(pc_neighbours_);
 }
 
 // One round; returns the number of CFs found.
