@@ -93,8 +93,10 @@ class Enumerator {
   void explore_frontier(Clock::time_point t0);
   // neighbours.cpp
   void know_neighbours(const std::vector<Pc>& pcs);
-  void changes_of(const PcSet& s, const std::function<void(const PcSet&)>& fn) const;
-  bool any_change(const PcSet& s, const std::function<bool(const PcSet&)>& pred) const;
+  template <class R>
+  using ChangeFn = std::function<R(const PcSet& n, int k, const Pc& q)>;
+  void changes_of(const PcSet& s, const ChangeFn<void>& fn) const;
+  bool any_change(const PcSet& s, const ChangeFn<bool>& pred) const;
   enum class Near { kNever, kNotYet, kYes };
   // What the screening of a set learned that stays true (neighbours.cpp).
   struct NearState {

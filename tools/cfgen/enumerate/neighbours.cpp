@@ -38,22 +38,22 @@ void Enumerator::know_neighbours(const std::vector<Pc>& pcs) {
     pc_neighbours_.emplace(missing[i], std::move(nb[i]));
 }
 
-// The sets one change away from s (one PC replaced by a neighbouring PC), in a fixed order.
-// Reads only: every PC of s must be in pc_neighbours_ (know_neighbours).
-void Enumerator::changes_of(const PcSet& s, const std::function<void(const PcSet&)>& fn) const {
-  any_change(s, [&](const PcSet& n) {
-    fn(n);
+// The sets one change away from s (one PC replaced by a neighbouring PC), in a fixed order,
+// each with the position k of the PC replaced and the PC q that replaces it. Reads only:
+// every PC of s must be in pc_neighbours_ (know_neighbours).
+void Enumerator::changes_of(const PcSet& s, const ChangeFn<void>& fn) const {
+  any_change(s, [&](const PcSet& n, int k, const Pc& q) {
+    fn(n, k, q);
     return false;
   });
 }
 
 // Whether some set one change away from s satisfies `pred` (stops at the first).
-bool Enumerator::any_change(const PcSet& s, const std::function<bool(const PcSet&)>& pred) const {
+bool Enumerator::any_change(const PcSet& s, const ChangeFn<bool>& pred) const {
   for (int k = 0; k < s.size(); ++k)
     for (const Pc& q : pc_neighbours_.at(s[k])) {
-      PcSet n;
-      for (int j = 0; j < s.size(); ++j) n.insert(j == k ? q : s[j]);
-      if (n.size() == s.size() && pred(n)) return true;
+      PcSet n = without(s, k);
+      if (n.insert(q) && pred(n, k, q)) return true;
     }
   return false;
 }
@@ -77,10 +77,11 @@ Enumerator::Near Enumerator::near_unsearched(const PcSet& s, NearState& st,
   if (!st.valid_change) {
     // Checked before, or new_by_rest holds every CF (the first round): the CFs in new_by_rest
     // are the only ones that can have changed the answer.
-    st.valid_change =
-        st.checked || near_screened_none_
-            ? valid_change_among(s, new_by_rest)
-            : any_change(s, [&](const PcSet& n) { return witness_rot_.count(n) > 0; });
+    st.valid_change = st.checked || near_screened_none_
+                          ? valid_change_among(s, new_by_rest)
+                          : any_change(s, [&](const PcSet& n, int, const Pc&) {
+                              return witness_rot_.count(n) > 0;
+                            });
     st.checked = true;
     if (!st.valid_change) return Near::kNotYet;
   }
@@ -139,18 +140,15 @@ void Enumerator::screen_cf(int level, std::size_t i, const PcSetMap<std::vector<
   PcSet orbit;
   if (!cf_screened_[level][i]) {
     cf_screened_[level][i] = 1;
-    for (int k = 0; k < s.size(); ++k)
-      for (const Pc& q : pc_neighbours_.at(s[k])) {
-        PcSet n = without(s, k);
-        if (!n.insert(q) || witness_rot_.count(n) || near_searched_.count(n) || seen_.count(n) ||
-            !conditions_hold(n))
-          continue;
-        // When s[k] neighbours q in turn, s is a change of n, and valid.
-        const std::vector<Pc>& back = pc_neighbours_.at(q);
-        NearChange c{q, static_cast<std::uint8_t>(k), {}};
-        c.st.checked = c.st.valid_change = std::find(back.begin(), back.end(), s[k]) != back.end();
-        if (keep(n, orbit, near_unsearched(n, c.st, new_by_rest, orbit))) mine.push_back(c);
-      }
+    changes_of(s, [&](const PcSet& n, int k, const Pc& q) {
+      if (witness_rot_.count(n) || near_searched_.count(n) || seen_.count(n) || !conditions_hold(n))
+        return;
+      // When s[k] neighbours q in turn, s is a change of n, and valid.
+      const std::vector<Pc>& back = pc_neighbours_.at(q);
+      NearChange c{q, static_cast<std::uint8_t>(k), {}};
+      c.st.checked = c.st.valid_change = std::find(back.begin(), back.end(), s[k]) != back.end();
+      if (keep(n, orbit, near_unsearched(n, c.st, new_by_rest, orbit))) mine.push_back(c);
+    });
   } else {
     std::size_t left = 0;
     for (NearChange& c : mine) {
@@ -226,7 +224,7 @@ std::vector<Task> Enumerator::neighbour_tasks() {
         Task t;
         t.kind = Task::Kind::kFindNear;
         t.pcs = s;
-        changes_of(s, [&](const PcSet& n) {
+        changes_of(s, [&](const PcSet& n, int, const Pc&) {
           if (auto it = witness_rot_.find(n);
               it != witness_rot_.end() && t.seeds.size() < kNeighbourSeeds)
             t.seeds.push_back(it->second);

@@ -167,13 +167,16 @@ PairSymmetries::PairSymmetries(const Polyhedron& A, const Polyhedron& B, double 
         pairs_.push_back({static_cast<int>(i), static_cast<int>(j)});
 }
 
-PcSet PairSymmetries::image(const PcSet& s, std::size_t k) const {
+Pc PairSymmetries::image(const Pc& pc, std::size_t k) const {
   const Symmetry& h = a_[static_cast<std::size_t>(pairs_[k].first)];
   const Symmetry& g = b_[static_cast<std::size_t>(pairs_[k].second)];
+  return Pc{pc.type, h.of(a_kind(pc.type))[static_cast<std::size_t>(pc.a)],
+            g.of(b_kind(pc.type))[static_cast<std::size_t>(pc.b)]};
+}
+
+PcSet PairSymmetries::image(const PcSet& s, std::size_t k) const {
   PcSet out;  // insert keeps the canonical order, without allocating
-  for (const Pc& pc : s)
-    out.insert(Pc{pc.type, h.of(a_kind(pc.type))[static_cast<std::size_t>(pc.a)],
-                  g.of(b_kind(pc.type))[static_cast<std::size_t>(pc.b)]});
+  for (const Pc& pc : s) out.insert(image(pc, k));
   return out;
 }
 
@@ -197,19 +200,13 @@ bool pcset_less(const PcSet& x, const PcSet& y) {
 PcSet PairSymmetries::canonical(const PcSet& s) const {
   PcSet best = s;
   for (std::size_t k = 1; k < pairs_.size(); ++k) {
-    const Symmetry& h = a_[static_cast<std::size_t>(pairs_[k].first)];
-    const Symmetry& g = b_[static_cast<std::size_t>(pairs_[k].second)];
     // Images have s's size: one whose smallest PC comes after best's first is not smaller,
     // and is passed by before it is sorted (most are).
     std::array<Pc, PcSet::kMaxPcs> img;
-    Pc least = best[0];
     bool smaller_first = false;
     for (int j = 0; j < s.size(); ++j) {
-      const Pc& pc = s[j];
-      img[static_cast<std::size_t>(j)] = {pc.type,
-                                          h.of(a_kind(pc.type))[static_cast<std::size_t>(pc.a)],
-                                          g.of(b_kind(pc.type))[static_cast<std::size_t>(pc.b)]};
-      if (!(least < img[static_cast<std::size_t>(j)])) smaller_first = true;
+      img[static_cast<std::size_t>(j)] = image(s[j], k);
+      if (!(best[0] < img[static_cast<std::size_t>(j)])) smaller_first = true;
     }
     if (!smaller_first) continue;
     PcSet t;

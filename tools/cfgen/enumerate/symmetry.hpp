@@ -37,6 +37,8 @@ class PairSymmetries {
   std::size_t size() const { return pairs_.size(); }
   std::size_t size_a() const { return a_.size(); }
   std::size_t size_b() const { return b_.size(); }
+  /// The image of one PC, and of a set, under pair k.
+  Pc image(const Pc& pc, std::size_t k) const;
   PcSet image(const PcSet& s, std::size_t k) const;
   /// g X h^-1: the pose that realises image(s, k) when `pose` realises s.
   Pose image(const Pose& pose, std::size_t k) const;
