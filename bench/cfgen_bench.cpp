@@ -7,7 +7,8 @@
 // not read from data/: a peg of radius 10 mm and length 40 mm, a block of outer radius 25 mm
 // and height 20 mm whose hole is 5% wider than the peg, both n-gon prisms (the block a tube).
 //
-//   build/bench/cfgen_bench --benchmark_filter='n:(4|6)/.*/symmetry:1'   # square and hexagonal pegs
+//   build/bench/cfgen_bench --benchmark_filter='n:(4|6)/.*/symmetry:1'   # square and hexagonal
+//   pegs
 // Figures go to docs/performance.md, "Graph generation".
 
 #include "cfgen/enumerate/enumerate.hpp"
@@ -16,6 +17,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <unistd.h>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -23,7 +25,6 @@
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 
 namespace {
 
@@ -73,8 +74,9 @@ std::string ngon_off(int n, double r, double r_in, double y0, double y1) {
 }
 
 cf::Polyhedron load_text(const std::string& name, const std::string& text) {
-  const std::string path =
-      (std::filesystem::temp_directory_path() / ("cfgen_bench_" + std::to_string(getpid()) + "_" + name + ".off")).string();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("cfgen_bench_" + std::to_string(getpid()) + "_" + name + ".off"))
+                               .string();
   {
     std::ofstream f(path);
     f << text;
@@ -95,7 +97,8 @@ void BM_NgonPegInHole(benchmark::State& state) {
   opt.use_symmetry = symmetry;
   cf::gen::ExecuteOptions exec;
   exec.threads = threads;
-  const cf::gen::SearchParams search = cf::tools::scaled_search(A, B, cf::tools::RelativeLengths{});  // cfgen's defaults
+  const cf::gen::SearchParams search =
+      cf::tools::scaled_search(A, B, cf::tools::RelativeLengths{});  // cfgen's defaults
   std::size_t cfs = 0, candidates = 0;
   double seconds = 0;
   for (auto _ : state) {

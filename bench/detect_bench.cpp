@@ -11,9 +11,9 @@
 #include "runtime_models.hpp"
 
 #include <benchmark/benchmark.h>
-#include <fcl/narrowphase/distance.h>
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/math/bv/OBBRSS.h>
+#include <fcl/narrowphase/distance.h>
 
 #include <algorithm>
 #include <chrono>
@@ -64,9 +64,11 @@ std::vector<cf::Pose> sphere_poses(double ra, double rb, double eps) {
   for (int i = 0; i < n; ++i) {
     const double s = static_cast<double>(i) / n;
     const Vec3 dir = Vec3(std::cos(6.283 * s * 3) * std::cos(1.2 * std::sin(6.283 * s)),
-                          std::sin(1.2 * std::sin(6.283 * s)), std::sin(6.283 * s * 3) * std::cos(1.2 * std::sin(6.283 * s)))
+                          std::sin(1.2 * std::sin(6.283 * s)),
+                          std::sin(6.283 * s * 3) * std::cos(1.2 * std::sin(6.283 * s)))
                          .normalized();
-    const Eigen::Matrix3d R = Eigen::AngleAxisd(6.283 * s * 2, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(6.283 * s * 2, Vec3(1, 2, 3).normalized()).toRotationMatrix();
     const double gap = (i % 3 == 2) ? 5.0 : eps * (0.5 * std::sin(6.283 * s * 13) - 0.3);
     p.push_back(make_pose(R, dir * (ra + rb + gap)));
   }
@@ -83,7 +85,8 @@ std::vector<cf::Pose> sphere_trajectory(double ra, double rb, double eps) {
     const double s = static_cast<double>(i) / n;
     const double phi = 0.05 * i / (ra + rb);
     const Vec3 dir = Vec3(std::cos(phi), 0.1 * std::sin(6.283 * s * 3), std::sin(phi)).normalized();
-    const Eigen::Matrix3d R = Eigen::AngleAxisd(0.0005 * i, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(0.0005 * i, Vec3(1, 2, 3).normalized()).toRotationMatrix();
     const double gap = eps * (0.5 * std::sin(6.283 * s * 20) - 0.3);
     p.push_back(make_pose(R, dir * (ra + rb + gap)));
   }
@@ -130,10 +133,12 @@ void triangulate(const cf::Polyhedron& m, std::vector<fcl::Triangle>& tris) {
         bool empty = true;
         for (std::size_t k = 0; k < n && empty; ++k) {
           if (k == i0 || k == i || k == i2) continue;
-          auto side = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v, const Eigen::Vector2d& q) {
+          auto side = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v,
+                         const Eigen::Vector2d& q) {
             return (v - u).x() * (q - u).y() - (v - u).y() * (q - u).x();
           };
-          if (side(a, b, p[k]) >= 0 && side(b, c, p[k]) >= 0 && side(c, a, p[k]) >= 0) empty = false;
+          if (side(a, b, p[k]) >= 0 && side(b, c, p[k]) >= 0 && side(c, a, p[k]) >= 0)
+            empty = false;
         }
         if (!empty) continue;
         tris.emplace_back(idx[i0], idx[i], idx[i2]);
@@ -162,7 +167,9 @@ std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> fcl_model(const cf::Polyhedron& m) 
 void report(benchmark::State& state, std::vector<double>& ns) {
   std::sort(ns.begin(), ns.end());
   if (ns.empty()) return;
-  const auto at = [&](double q) { return ns[std::min(ns.size() - 1, static_cast<std::size_t>(q * ns.size()))]; };
+  const auto at = [&](double q) {
+    return ns[std::min(ns.size() - 1, static_cast<std::size_t>(q * ns.size()))];
+  };
   state.counters["median_us"] = at(0.5) * 1e-3;
   state.counters["p999_us"] = at(0.999) * 1e-3;
   state.counters["max_us"] = ns.back() * 1e-3;
@@ -188,7 +195,8 @@ Pair& cube_l() {
 // threshold eps (and max_penetration_mm) with poses whose gaps scale with it.
 Pair sphere_pair(double eps) {
   return {tm::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000"),
-          tm::faceted_sphere(50, 42, 48, Vec3::Zero(), "sphere2016"), sphere_poses(30, 50, eps), with_epsilon(eps)};
+          tm::faceted_sphere(50, 42, 48, Vec3::Zero(), "sphere2016"), sphere_poses(30, 50, eps),
+          with_epsilon(eps)};
 }
 // The paper's epsilon of 1 mm: a contact spans dozens of candidate PCs (about 47 per tick),
 // more than any CF holds: a stress case.
@@ -209,7 +217,8 @@ Pair& spheres_servo() {
   return p;
 }
 Pair& spheres_fine_servo() {
-  static Pair p{spheres_fine().a, spheres_fine().b, sphere_trajectory(30, 50, 0.1), with_epsilon(0.1)};
+  static Pair p{spheres_fine().a, spheres_fine().b, sphere_trajectory(30, 50, 0.1),
+                with_epsilon(0.1)};
   return p;
 }
 
@@ -232,10 +241,12 @@ void run_cf(benchmark::State& state, const Pair& pr) {
     const auto t1 = std::chrono::steady_clock::now();
     benchmark::DoNotOptimize(&r);
     contacts += static_cast<std::size_t>(r.contacts.size());
-    if (ns.size() < ns.capacity()) ns.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count());
+    if (ns.size() < ns.capacity())
+      ns.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count());
     if (++i == pr.poses.size()) i = 0;
   }
-  state.counters["contacts_per_tick"] = static_cast<double>(contacts) / static_cast<double>(state.iterations());
+  state.counters["contacts_per_tick"] =
+      static_cast<double>(contacts) / static_cast<double>(state.iterations());
   report(state, ns);
 }
 
@@ -253,12 +264,16 @@ void run_detect(benchmark::State& state, const Pair& pr) {
     pairs += det.last_pairs_tested();
     reused += det.last_reused_pairs() ? 1 : 0;
     planes += static_cast<std::size_t>(cs.num_planes());
-    if (ns.size() < ns.capacity()) ns.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count());
+    if (ns.size() < ns.capacity())
+      ns.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count());
     if (++i == pr.poses.size()) i = 0;
   }
-  state.counters["pairs_per_tick"] = static_cast<double>(pairs) / static_cast<double>(state.iterations());
-  state.counters["planes_per_tick"] = static_cast<double>(planes) / static_cast<double>(state.iterations());
-  state.counters["reused_share"] = static_cast<double>(reused) / static_cast<double>(state.iterations());
+  state.counters["pairs_per_tick"] =
+      static_cast<double>(pairs) / static_cast<double>(state.iterations());
+  state.counters["planes_per_tick"] =
+      static_cast<double>(planes) / static_cast<double>(state.iterations());
+  state.counters["reused_share"] =
+      static_cast<double>(reused) / static_cast<double>(state.iterations());
   report(state, ns);
 }
 
@@ -283,7 +298,8 @@ void run_fcl(benchmark::State& state, const Pair& pr) {
     fcl::distance(&oa, &ob, req, res);
     const auto t1 = std::chrono::steady_clock::now();
     benchmark::DoNotOptimize(res.min_distance);
-    if (ns.size() < ns.capacity()) ns.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count());
+    if (ns.size() < ns.capacity())
+      ns.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count());
     if (++i == pr.poses.size()) i = 0;
   }
   report(state, ns);
@@ -299,12 +315,20 @@ void BM_Spheres2000Fine_DetectIdentify(benchmark::State& s) { run_cf(s, spheres_
 void BM_Spheres2000Fine_DetectOnly(benchmark::State& s) { run_detect(s, spheres_fine()); }
 void BM_Spheres2000Fine_FclDistance(benchmark::State& s) { run_fcl(s, spheres_fine()); }
 void BM_Spheres2000Servo_DetectIdentify(benchmark::State& s) { run_cf(s, spheres_servo()); }
-void BM_Spheres2000Servo_DetectIdentifyCold(benchmark::State& s) { run_cf(s, cold(spheres_servo())); }
+void BM_Spheres2000Servo_DetectIdentifyCold(benchmark::State& s) {
+  run_cf(s, cold(spheres_servo()));
+}
 void BM_Spheres2000Servo_DetectOnly(benchmark::State& s) { run_detect(s, spheres_servo()); }
 void BM_Spheres2000Servo_FclDistance(benchmark::State& s) { run_fcl(s, spheres_servo()); }
-void BM_Spheres2000FineServo_DetectIdentify(benchmark::State& s) { run_cf(s, spheres_fine_servo()); }
-void BM_Spheres2000FineServo_DetectIdentifyCold(benchmark::State& s) { run_cf(s, cold(spheres_fine_servo())); }
-void BM_Spheres2000FineServo_DetectOnly(benchmark::State& s) { run_detect(s, spheres_fine_servo()); }
+void BM_Spheres2000FineServo_DetectIdentify(benchmark::State& s) {
+  run_cf(s, spheres_fine_servo());
+}
+void BM_Spheres2000FineServo_DetectIdentifyCold(benchmark::State& s) {
+  run_cf(s, cold(spheres_fine_servo()));
+}
+void BM_Spheres2000FineServo_DetectOnly(benchmark::State& s) {
+  run_detect(s, spheres_fine_servo());
+}
 void BM_Spheres2000FineServo_FclDistance(benchmark::State& s) { run_fcl(s, spheres_fine_servo()); }
 
 }  // namespace

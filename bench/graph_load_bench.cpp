@@ -3,19 +3,19 @@
 // full-precision witnesses. Measures load() of JSON and CBOR, with and without the schema
 // check, and find(). Figures go to docs/performance.md, "Graph loading".
 
-#include "fixtures.hpp"
 #include <cf/graph.hpp>
+#include "fixtures.hpp"
 
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Geometry>
 
+#include <unistd.h>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <random>
 #include <string>
-#include <unistd.h>
 
 namespace {
 
@@ -43,7 +43,9 @@ cf::CfGraph synthetic_graph(std::size_t num_cfs) {
   std::uniform_real_distribution<double> uniform(-50, 50);
   auto witness = [&] {
     cf::Pose p;
-    p.R_BA = Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized().toRotationMatrix();
+    p.R_BA = Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
+                 .normalized()
+                 .toRotationMatrix();
     p.t_BA = cf::Vec3(uniform(rng), uniform(rng), uniform(rng));
     return p;
   };
@@ -121,10 +123,20 @@ void load(benchmark::State& state, const std::string& path) {
 }
 
 void BM_LoadJson(benchmark::State& state) { load(state, files().json); }
-BENCHMARK(BM_LoadJson)->Arg(0)->Arg(1)->ArgName("schema")->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_LoadJson)
+    ->Arg(0)
+    ->Arg(1)
+    ->ArgName("schema")
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
 
 void BM_LoadCbor(benchmark::State& state) { load(state, files().cbor); }
-BENCHMARK(BM_LoadCbor)->Arg(0)->Arg(1)->ArgName("schema")->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_LoadCbor)
+    ->Arg(0)
+    ->Arg(1)
+    ->ArgName("schema")
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
 
 void BM_Save(benchmark::State& state) {
   const cf::CfGraph g = cf::CfGraph::load(files().json);
@@ -138,7 +150,8 @@ void BM_Find(benchmark::State& state) {
   const cf::CfGraph g = cf::CfGraph::load(files().json);
   // Query the sets of every CF, in a scrambled order, built from PCs in reverse order.
   std::vector<cf::PcSet> queries;
-  for (std::size_t i = 0; i < g.num_cfs(); i += 7) queries.push_back(g.cf(cf::CfId(static_cast<int>(i))).pcs);
+  for (std::size_t i = 0; i < g.num_cfs(); i += 7)
+    queries.push_back(g.cf(cf::CfId(static_cast<int>(i))).pcs);
   std::size_t k = 0;
   for (auto _ : state) {
     benchmark::DoNotOptimize(g.find(queries[k]));

@@ -39,7 +39,8 @@ std::vector<Tick> load_ticks() { return cf::testdata::cube_lblock_ticks(CF_SOURC
 
 std::unique_ptr<cf::CfGraph> load_graph(std::string* which) {
   const char* env = std::getenv("CF_STEP_BENCH_GRAPH");
-  const std::string path = env ? env : std::string(CF_SOURCE_DIR) + "/data/graphs/cube_l_block.json";
+  const std::string path =
+      env ? env : std::string(CF_SOURCE_DIR) + "/data/graphs/cube_l_block.json";
   if (std::ifstream(path).good()) {
     *which = path;
     return std::make_unique<cf::CfGraph>(cf::CfGraph::load(path));
@@ -54,8 +55,8 @@ std::unique_ptr<cf::CfGraph> load_graph(std::string* which) {
                                     {cf::CfId(2), cf::CfId(0), cf::TransitionKind::kLose},
                                     {cf::CfId(1), cf::CfId(2), cf::TransitionKind::kGain},
                                     {cf::CfId(2), cf::CfId(1), cf::TransitionKind::kLose}};
-  return std::make_unique<cf::CfGraph>(
-      cf::CfGraph::from_parts(cf::testmodels::cube(), cf::testmodels::l_block(), std::move(cfs), std::move(tr)));
+  return std::make_unique<cf::CfGraph>(cf::CfGraph::from_parts(
+      cf::testmodels::cube(), cf::testmodels::l_block(), std::move(cfs), std::move(tr)));
 }
 
 // The paper's literal servo step (no proxy): the device pose is A's pose. The figures of
@@ -69,7 +70,11 @@ cf::Params literal_params() {
 void report(benchmark::State& state, std::vector<double>& ns) {
   if (ns.empty()) return;
   std::sort(ns.begin(), ns.end());
-  auto q = [&](double p) { return ns[std::min(ns.size() - 1, static_cast<std::size_t>(p * static_cast<double>(ns.size())))] / 1000.0; };
+  auto q = [&](double p) {
+    return ns[std::min(ns.size() - 1,
+                       static_cast<std::size_t>(p * static_cast<double>(ns.size())))] /
+           1000.0;
+  };
   state.counters["median_us"] = q(0.5);
   state.counters["p99_us"] = q(0.99);
   state.counters["p999_us"] = q(0.999);
@@ -93,14 +98,16 @@ void BM_ServoStep(benchmark::State& state) {
     const auto b = std::chrono::steady_clock::now();
     benchmark::DoNotOptimize(r.F_W.data());
     contact_ticks += r.status != cf::RenderStatus::kNoContact;
-    if (ns.size() < ns.capacity()) ns.push_back(std::chrono::duration<double, std::nano>(b - a).count());
+    if (ns.size() < ns.capacity())
+      ns.push_back(std::chrono::duration<double, std::nano>(b - a).count());
     if (++i == ticks.size()) {
       i = 0;
       t_base += ticks.back().t_s + 0.001;
     }
   }
   report(state, ns);
-  state.counters["contact_share"] = static_cast<double>(contact_ticks) / static_cast<double>(state.iterations());
+  state.counters["contact_share"] =
+      static_cast<double>(contact_ticks) / static_cast<double>(state.iterations());
   state.SetLabel(which);
 }
 BENCHMARK(BM_ServoStep)->MinTime(2.0)->Unit(benchmark::kMicrosecond);
@@ -119,7 +126,8 @@ void BM_DetectOnly(benchmark::State& state) {
     det.detect(ticks[i].X_WA, *set);
     const auto b = std::chrono::steady_clock::now();
     benchmark::DoNotOptimize(set->size());
-    if (ns.size() < ns.capacity()) ns.push_back(std::chrono::duration<double, std::nano>(b - a).count());
+    if (ns.size() < ns.capacity())
+      ns.push_back(std::chrono::duration<double, std::nano>(b - a).count());
     if (++i == ticks.size()) i = 0;
   }
   report(state, ns);
@@ -167,7 +175,8 @@ void BM_ForceOnly(benchmark::State& state) {
     const cf::ForceResult& r = model.step(p, t += 0.001, cs.data(), 2, pm);
     const auto b = std::chrono::steady_clock::now();
     benchmark::DoNotOptimize(r.F_W.data());
-    if (ns.size() < ns.capacity()) ns.push_back(std::chrono::duration<double, std::nano>(b - a).count());
+    if (ns.size() < ns.capacity())
+      ns.push_back(std::chrono::duration<double, std::nano>(b - a).count());
   }
   report(state, ns);
 }
@@ -185,8 +194,8 @@ BENCHMARK(BM_ForceOnly)->MinTime(1.0)->Unit(benchmark::kMicrosecond);
 // same tick split into detect + identify (`ident_*`, CfIdentifier::step) and classify +
 // force (`force_*`, HapticRenderer::step_identified, the rest of HapticRenderer::step), plus
 // detection alone (`detect_*`); `max_tick` is the index of the slowest tick and
-// `over20us_ticks` counts the ticks above the 20 us p99.9 target. `nondet_ticks` counts ticks whose force differed between
-// replays or between the full and the split pipeline (must be 0). With
+// `over20us_ticks` counts the ticks above the 20 us p99.9 target. `nondet_ticks` counts ticks whose
+// force differed between replays or between the full and the split pipeline (must be 0). With
 // CF_STEP_BENCH_TICKS=file.csv every tick's minima and state are written there.
 
 std::size_t reps_from_env() {
@@ -208,17 +217,20 @@ struct TickRecord {
 
 double quantile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * static_cast<double>(v.size())))] / 1000.0;
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * static_cast<double>(v.size())))] /
+         1000.0;
 }
 
-void report_intrinsic(benchmark::State& state, const std::string& prefix, const std::vector<double>& ns) {
+void report_intrinsic(benchmark::State& state, const std::string& prefix,
+                      const std::vector<double>& ns) {
   state.counters[prefix + "median_us"] = quantile(ns, 0.5);
   state.counters[prefix + "p99_us"] = quantile(ns, 0.99);
   state.counters[prefix + "p999_us"] = quantile(ns, 0.999);
   state.counters[prefix + "max_us"] = quantile(ns, 1.0);
 }
 
-double elapsed_ns(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b) {
+double elapsed_ns(std::chrono::steady_clock::time_point a,
+                  std::chrono::steady_clock::time_point b) {
   return std::chrono::duration<double, std::nano>(b - a).count();
 }
 
@@ -298,8 +310,8 @@ void BM_ServoStepIntrinsic(benchmark::State& state) {
   report_intrinsic(state, "", full_ns);
   state.counters["max_tick"] =
       static_cast<double>(std::max_element(full_ns.begin(), full_ns.end()) - full_ns.begin());
-  state.counters["over20us_ticks"] =
-      static_cast<double>(std::count_if(full_ns.begin(), full_ns.end(), [](double v) { return v > 20'000.0; }));
+  state.counters["over20us_ticks"] = static_cast<double>(
+      std::count_if(full_ns.begin(), full_ns.end(), [](double v) { return v > 20'000.0; }));
   report_intrinsic(state, "ident_", ident_ns);
   report_intrinsic(state, "force_", force_ns);
   report_intrinsic(state, "detect_", detect_ns);
@@ -308,18 +320,22 @@ void BM_ServoStepIntrinsic(benchmark::State& state) {
   state.SetLabel(which);
   if (const char* out = std::getenv("CF_STEP_BENCH_TICKS")) {
     std::ofstream f(out);
-    f << "tick,t,full_ns,ident_ns,force_ns,detect_ns,cf,motion,status,ident_status,num_pcs,num_detected,"
+    f << "tick,t,full_ns,ident_ns,force_ns,detect_ns,cf,motion,status,ident_status,num_pcs,num_"
+         "detected,"
          "combinations,freedom_rows,pairs_tested\n";
     for (std::size_t i = 0; i < rec.size(); ++i) {
       const TickRecord& t = rec[i];
-      f << i << ',' << ticks[i].t_s << ',' << t.full_ns << ',' << t.ident_ns << ',' << t.force_ns << ','
-        << t.detect_ns << ',' << t.cf << ',' << cf::to_string(t.motion) << ',' << cf::to_string(t.status) << ','
-        << t.ident_status << ',' << t.num_pcs << ',' << t.num_detected << ',' << t.combinations << ','
-        << t.freedom_rows << ',' << t.pairs_tested << '\n';
+      f << i << ',' << ticks[i].t_s << ',' << t.full_ns << ',' << t.ident_ns << ',' << t.force_ns
+        << ',' << t.detect_ns << ',' << t.cf << ',' << cf::to_string(t.motion) << ','
+        << cf::to_string(t.status) << ',' << t.ident_status << ',' << t.num_pcs << ','
+        << t.num_detected << ',' << t.combinations << ',' << t.freedom_rows << ',' << t.pairs_tested
+        << '\n';
     }
   }
 }
-BENCHMARK(BM_ServoStepIntrinsic)->Iterations(static_cast<benchmark::IterationCount>(reps_from_env()))->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ServoStepIntrinsic)
+    ->Iterations(static_cast<benchmark::IterationCount>(reps_from_env()))
+    ->Unit(benchmark::kMillisecond);
 
 // The force model alone (BM_ForceOnly's 2,000-tick sequence), intrinsic per-tick cost: the
 // sequence replayed from reset() R times, minimum per tick.
@@ -345,7 +361,9 @@ void BM_ForceOnlyIntrinsic(benchmark::State& state) {
   }
   report_intrinsic(state, "", ns);
 }
-BENCHMARK(BM_ForceOnlyIntrinsic)->Iterations(static_cast<benchmark::IterationCount>(reps_from_env()))->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ForceOnlyIntrinsic)
+    ->Iterations(static_cast<benchmark::IterationCount>(reps_from_env()))
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
@@ -362,9 +380,10 @@ std::vector<Tick> press_ticks() {
   std::vector<Tick> out;
   for (int k = 1; k <= 1600; ++k) {
     const double t = k / 1000.0;
-    const double down = std::min(t / 0.3, 1.0) * 7.0;                     // 2 mm above, to 5 mm in
-    const double slide = std::clamp((t - 0.3) / 0.6, 0.0, 1.0) * 15.0;    // x 70 -> 55
-    const double wall = std::clamp((t - 0.9) / 0.4, 0.0, 1.0) * 23.0;     // x 55 -> 32: 3 mm into the wall
+    const double down = std::min(t / 0.3, 1.0) * 7.0;                   // 2 mm above, to 5 mm in
+    const double slide = std::clamp((t - 0.3) / 0.6, 0.0, 1.0) * 15.0;  // x 70 -> 55
+    const double wall =
+        std::clamp((t - 0.9) / 0.4, 0.0, 1.0) * 23.0;  // x 55 -> 32: 3 mm into the wall
     const double up = std::clamp((t - 1.3) / 0.3, 0.0, 1.0) * 20.0;
     Tick tick;
     tick.t_s = t;
@@ -397,13 +416,20 @@ void proxy_intrinsic(benchmark::State& state, const std::vector<Tick>& ticks) {
     first = false;
   }
   report_intrinsic(state, "", best);
-  state.counters["constrained_share"] = static_cast<double>(constrained) / static_cast<double>(ticks.size());
+  state.counters["constrained_share"] =
+      static_cast<double>(constrained) / static_cast<double>(ticks.size());
   state.counters["passes_max"] = static_cast<double>(passes_max);
 }
 
 void BM_ServoStepProxyIntrinsic(benchmark::State& state) { proxy_intrinsic(state, load_ticks()); }
-BENCHMARK(BM_ServoStepProxyIntrinsic)->Iterations(static_cast<benchmark::IterationCount>(reps_from_env()))->Unit(benchmark::kMillisecond);
-void BM_ServoStepProxyPressIntrinsic(benchmark::State& state) { proxy_intrinsic(state, press_ticks()); }
-BENCHMARK(BM_ServoStepProxyPressIntrinsic)->Iterations(static_cast<benchmark::IterationCount>(reps_from_env()))->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ServoStepProxyIntrinsic)
+    ->Iterations(static_cast<benchmark::IterationCount>(reps_from_env()))
+    ->Unit(benchmark::kMillisecond);
+void BM_ServoStepProxyPressIntrinsic(benchmark::State& state) {
+  proxy_intrinsic(state, press_ticks());
+}
+BENCHMARK(BM_ServoStepProxyPressIntrinsic)
+    ->Iterations(static_cast<benchmark::IterationCount>(reps_from_env()))
+    ->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

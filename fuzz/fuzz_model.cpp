@@ -21,9 +21,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::string bytes(reinterpret_cast<const char*>(data), size);
   cf::tools::MeshFormat format = cf::tools::MeshFormat::kOff;
   switch (FUZZ_FORMAT) {
-    case 0: format = cf::tools::MeshFormat::kOff; break;
-    case 1: format = cf::tools::MeshFormat::kObj; break;
-    case 2: format = cf::tools::MeshFormat::kStl; break;
+    case 0:
+      format = cf::tools::MeshFormat::kOff;
+      break;
+    case 1:
+      format = cf::tools::MeshFormat::kObj;
+      break;
+    case 2:
+      format = cf::tools::MeshFormat::kStl;
+      break;
     case 3: {
       // Binary STL: the input is the triangle records; the header and the count are made to
       // fit, so that every input takes the binary path.
@@ -37,7 +43,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       bytes = std::move(b);
       break;
     }
-    default: format = cf::tools::MeshFormat::kPly; break;
+    default:
+      format = cf::tools::MeshFormat::kPly;
+      break;
   }
   try {
     const cf::tools::PolygonSoup soup = cf::tools::parse_polygon_soup(bytes, format, "fuzz");

@@ -23,15 +23,20 @@ namespace {
 // Sums and products of exact inputs: rounding only.
 constexpr double kLength = 1e-12;
 
-std::string model(const std::string& name) { return std::string(CF_SOURCE_DIR) + "/data/models/" + name; }
+std::string model(const std::string& name) {
+  return std::string(CF_SOURCE_DIR) + "/data/models/" + name;
+}
 
 bool holds(const std::vector<Vec3>& pts, const Vec3& q) {
-  return std::any_of(pts.begin(), pts.end(), [&](const Vec3& p) { return (p - q).norm() < kLength; });
+  return std::any_of(pts.begin(), pts.end(),
+                     [&](const Vec3& p) { return (p - q).norm() < kLength; });
 }
 
 }  // namespace
 
-TEST_CASE("inset closure points: an edge's ends moved in, a convex face's corners moved in, others whole") {
+TEST_CASE(
+    "inset closure points: an edge's ends moved in, a convex face's corners moved in, others "
+    "whole") {
   const cf::Polyhedron cube = cf::tools::load_model(model("cube.off"));  // [-15, 15]^3
   const cf::Polyhedron l = cf::tools::load_model(model("l_block.off"));
   constexpr double m = 0.25;  // mm
@@ -44,16 +49,19 @@ TEST_CASE("inset closure points: an edge's ends moved in, a convex face's corner
 
   // An edge of 30 mm keeps [m, 30 - m].
   for (std::size_t e = 0; e < cube.num_edges(); ++e) {
-    const std::vector<Vec3> pts = cf::gen::inset_closure_points(cube, ElementKind::kEdge, int(e), m);
+    const std::vector<Vec3> pts =
+        cf::gen::inset_closure_points(cube, ElementKind::kEdge, int(e), m);
     REQUIRE(pts.size() == 2);
-    const Vec3 a = cube.edge_point(cf::EdgeId(int(e)), 0), b = cube.edge_point(cf::EdgeId(int(e)), 1);
+    const Vec3 a = cube.edge_point(cf::EdgeId(int(e)), 0),
+               b = cube.edge_point(cf::EdgeId(int(e)), 1);
     CHECK((pts[0] - a).norm() == Approx(m).margin(kLength));
     CHECK((pts[1] - b).norm() == Approx(m).margin(kLength));
     CHECK((pts[1] - pts[0]).norm() == Approx(30 - 2 * m).margin(kLength));
   }
   // An edge shorter than twice the margin keeps its ends.
   CHECK(cf::gen::inset_closure_points(cube, ElementKind::kEdge, 0, 16).size() == 2);
-  CHECK(cf::gen::inset_closure_points(cube, ElementKind::kEdge, 0, 16)[0] == cube.edge_point(cf::EdgeId(0), 0));
+  CHECK(cf::gen::inset_closure_points(cube, ElementKind::kEdge, 0, 16)[0] ==
+        cube.edge_point(cf::EdgeId(0), 0));
 
   // The cube's top: the square [-15 + m, 15 - m]^2 at z = 15.
   const int top = cf::test::face_with_plane(cube, Vec3(0, 0, 1), 15);
@@ -61,7 +69,8 @@ TEST_CASE("inset closure points: an edge's ends moved in, a convex face's corner
   const std::vector<Vec3> sq = cf::gen::inset_closure_points(cube, ElementKind::kFace, top, m);
   REQUIRE(sq.size() == 4);
   const double c = 15 - m;
-  for (const Vec3& q : {Vec3(c, c, 15), Vec3(-c, c, 15), Vec3(c, -c, 15), Vec3(-c, -c, 15)}) CHECK(holds(sq, q));
+  for (const Vec3& q : {Vec3(c, c, 15), Vec3(-c, c, 15), Vec3(c, -c, 15), Vec3(-c, -c, 15)})
+    CHECK(holds(sq, q));
   // A 30 mm square holds one point 15 mm inside (its centre) and none farther: whole.
   CHECK(holds(cf::gen::inset_closure_points(cube, ElementKind::kFace, top, 15), Vec3(0, 0, 15)));
   CHECK(holds(cf::gen::inset_closure_points(cube, ElementKind::kFace, top, 16), Vec3(15, 15, 15)));
@@ -77,11 +86,13 @@ TEST_CASE("inset closure points: an edge's ends moved in, a convex face's corner
   const int slab_top = cf::test::face_with_plane(l, Vec3(0, 1, 0), 20);
   const std::vector<Vec3> r = cf::gen::inset_closure_points(l, ElementKind::kFace, slab_top, m);
   REQUIRE(r.size() == 4);
-  for (const Vec3& q : {Vec3(20 + m, 20, m), Vec3(120 - m, 20, m), Vec3(20 + m, 20, 80 - m), Vec3(120 - m, 20, 80 - m)})
+  for (const Vec3& q : {Vec3(20 + m, 20, m), Vec3(120 - m, 20, m), Vec3(20 + m, 20, 80 - m),
+                        Vec3(120 - m, 20, 80 - m)})
     CHECK(holds(r, q));
 }
 
-TEST_CASE("box index: the boxes meeting a query box, as a brute-force test over every box finds them") {
+TEST_CASE(
+    "box index: the boxes meeting a query box, as a brute-force test over every box finds them") {
   // Random boxes on a coarse lattice, so that ends coincide (ties at the sorted bounds) and
   // queries touch boxes exactly at an end (closed boxes meet there).
   std::mt19937 rng(7);
@@ -102,7 +113,8 @@ TEST_CASE("box index: the boxes meeting a query box, as a brute-force test over 
       const Vec3 qh = ql + Vec3(extent(rng), extent(rng), extent(rng));
       index.query(ql, qh, bits.data());
       for (int i = 0; i < n; ++i) {
-        const bool meets = (lo[i].array() <= qh.array()).all() && (hi[i].array() >= ql.array()).all();
+        const bool meets =
+            (lo[i].array() <= qh.array()).all() && (hi[i].array() >= ql.array()).all();
         const bool listed = (bits[static_cast<std::size_t>(i / 64)] >> (i % 64)) & 1u;
         INFO("n " << n << " box " << i << " query " << ql.transpose() << " .. " << qh.transpose());
         CHECK(listed == meets);
@@ -113,7 +125,9 @@ TEST_CASE("box index: the boxes meeting a query box, as a brute-force test over 
   }
 }
 
-TEST_CASE("box index: real-valued boxes, clustered ends and queries beyond every box agree with brute force") {
+TEST_CASE(
+    "box index: real-valued boxes, clustered ends and queries beyond every box agree with brute "
+    "force") {
   // The search for a query's end runs in one bucket of the sorted ends: ends piled on one
   // value (a face's vertices on one plane), boxes of zero extent, ends far apart in scale and
   // queries wholly outside the boxes' range all exercise the bucket bounds.
@@ -126,7 +140,8 @@ TEST_CASE("box index: real-valued boxes, clustered ends and queries beyond every
     for (const auto& [ql, qh] : queries) {
       index.query(ql, qh, bits.data());
       for (std::size_t i = 0; i < lo.size(); ++i) {
-        const bool meets = (lo[i].array() <= qh.array()).all() && (hi[i].array() >= ql.array()).all();
+        const bool meets =
+            (lo[i].array() <= qh.array()).all() && (hi[i].array() >= ql.array()).all();
         const bool listed = (bits[i / 64] >> (i % 64)) & 1u;
         INFO("box " << i << " query " << ql.transpose() << " .. " << qh.transpose());
         CHECK(listed == meets);
@@ -155,5 +170,7 @@ TEST_CASE("box index: real-valued boxes, clustered ends and queries beyond every
   check_all(lo, hi, queries);
   // Every box the same: the ends span nothing, and one bucket holds them all.
   check_all(std::vector<Vec3>(70, Vec3(1, 2, 3)), std::vector<Vec3>(70, Vec3(1, 2, 3)),
-            {{Vec3(1, 2, 3), Vec3(1, 2, 3)}, {Vec3(0, 0, 0), Vec3(0.5, 5, 5)}, {Vec3(0, 0, 0), Vec3(5, 5, 5)}});
+            {{Vec3(1, 2, 3), Vec3(1, 2, 3)},
+             {Vec3(0, 0, 0), Vec3(0.5, 5, 5)},
+             {Vec3(0, 0, 0), Vec3(5, 5, 5)}});
 }

@@ -1,8 +1,8 @@
 // The bounding volume tree's boxes (libcf/src/detect/bvh.*): every node's axis-aligned and oriented
 // boxes hold the points of the elements below it, the 4-wide tree holds every node once,
 // and the SIMD box tests agree with plain double-precision ones.
-#include "runtime_models.hpp"
 #include "detect/bvh.hpp"
+#include "runtime_models.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -39,7 +39,8 @@ void points(const cf::Polyhedron& m, const cf::detail::BvhElement& e, std::vecto
       out.push_back(m.edge_point(cf::EdgeId(e.index), 1));
       break;
     case cf::ElementKind::kFace:
-      for (cf::VertexId v : m.faces()[static_cast<std::size_t>(e.index)].vertices) out.push_back(m.vertex(v).p);
+      for (cf::VertexId v : m.faces()[static_cast<std::size_t>(e.index)].vertices)
+        out.push_back(m.vertex(v).p);
       break;
   }
 }
@@ -51,7 +52,8 @@ bool apart_reference(const cf::detail::NodeBox& p, const cf::detail::NodeBox& q)
   const Vec3 d = head(p.oc) - head(q.oc);
   auto apart_on = [&](const Vec3& u) {
     double r = 0;
-    for (int k = 0; k < 3; ++k) r += std::abs(u.dot(head(p.ax[k]))) * p.oh[k] + std::abs(u.dot(head(q.ax[k]))) * q.oh[k];
+    for (int k = 0; k < 3; ++k)
+      r += std::abs(u.dot(head(p.ax[k]))) * p.oh[k] + std::abs(u.dot(head(q.ax[k]))) * q.oh[k];
     return std::abs(u.dot(d)) > r;
   };
   return apart_on(head(p.ax[0])) || apart_on(head(q.ax[0]));
@@ -61,7 +63,8 @@ bool apart_reference(const cf::detail::NodeBox& p, const cf::detail::NodeBox& q)
 // box around it grown by `aabb_grow`.
 cf::detail::NodeBox random_box(std::mt19937& rng, const Vec3& c, double aabb_grow) {
   std::uniform_real_distribution<double> u(-1, 1), h(0.05, 3);
-  const Eigen::Matrix3d R = Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized().toRotationMatrix();
+  const Eigen::Matrix3d R =
+      Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized().toRotationMatrix();
   const Vec3 half(h(rng), h(rng), h(rng));
   cf::detail::NodeBox b;
   for (int k = 0; k < 3; ++k) {
@@ -96,10 +99,12 @@ TEST_CASE("every element is in one leaf, and every node's boxes hold it", "[bvh]
       for (const cf::detail::BvhNode& n : nodes)
         if (n.leaf())
           for (int e = 0; e < n.count; ++e) {
-            const cf::detail::BvhElement& x = t.elements()[static_cast<std::size_t>(n.element() + e)];
+            const cf::detail::BvhElement& x =
+                t.elements()[static_cast<std::size_t>(n.element() + e)];
             const std::size_t base = x.kind == cf::ElementKind::kVertex ? 0
-                                     : x.kind == cf::ElementKind::kEdge ? m.num_vertices()
-                                                                         : m.num_vertices() + m.num_edges();
+                                     : x.kind == cf::ElementKind::kEdge
+                                         ? m.num_vertices()
+                                         : m.num_vertices() + m.num_edges();
             ++seen[base + static_cast<std::size_t>(x.index)];
           }
       CHECK(std::count(seen.begin(), seen.end(), 1) == static_cast<std::ptrdiff_t>(n_elements));
@@ -162,7 +167,8 @@ TEST_CASE("oriented boxes of a curved surface's patches are thin along the norma
   std::size_t n = 0;
   for (std::size_t i = 0; i < t.nodes().size(); ++i) {
     const auto& b = t.boxes()[i];
-    if (b.h.head<3>().maxCoeff() < 2 || b.h.head<3>().maxCoeff() > 10) continue;  // patches of a few facets
+    if (b.h.head<3>().maxCoeff() < 2 || b.h.head<3>().maxCoeff() > 10)
+      continue;  // patches of a few facets
     thin_sum += b.oh[0];
     aabb_sum += b.h.head<3>().minCoeff();
     ++n;
@@ -186,7 +192,8 @@ TEST_CASE("the 4-lane box test agrees with a double-precision separating-axis te
       q.set_lane(j, qs[j]);
     }
     const int s = i % 4;
-    const unsigned got = cf::detail::overlapping_lanes(p, s, q), got_back = cf::detail::overlapping_lanes(q, s, p);
+    const unsigned got = cf::detail::overlapping_lanes(p, s, q),
+                   got_back = cf::detail::overlapping_lanes(q, s, p);
     for (int j = 0; j < 4; ++j) {
       const bool ref = apart_reference(ps[s], qs[j]), ref_back = apart_reference(qs[s], ps[j]);
       // Float and double may differ within rounding of a tie: find those by nudging the box.
@@ -215,12 +222,16 @@ TEST_CASE("the 4-lane box test agrees with a double-precision separating-axis te
   CHECK(near_ties < 4000);
 }
 
-TEST_CASE("face-group leaves hold their element boxes on lanes, tested like one box each", "[bvh]") {
+TEST_CASE("face-group leaves hold their element boxes on lanes, tested like one box each",
+          "[bvh]") {
   const cf::Polyhedron m = tmod::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000");
   const cf::detail::Bvh t(m, 0.5, 1, Vec3::Zero(), cf::detail::Leaves::kFaceGroups);
   // Only face-group trees with one group per leaf carry lanes.
-  CHECK(cf::detail::Bvh(m, 0.5, 1, Vec3::Zero(), cf::detail::Leaves::kElements).leaf_boxes().empty());
-  CHECK(cf::detail::Bvh(m, 0.5, 2, Vec3::Zero(), cf::detail::Leaves::kFaceGroups).leaf_boxes().empty());
+  CHECK(
+      cf::detail::Bvh(m, 0.5, 1, Vec3::Zero(), cf::detail::Leaves::kElements).leaf_boxes().empty());
+  CHECK(cf::detail::Bvh(m, 0.5, 2, Vec3::Zero(), cf::detail::Leaves::kFaceGroups)
+            .leaf_boxes()
+            .empty());
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> off(-2.5, 2.5), half(0, 2);
   std::size_t leaves = 0, hits = 0, misses = 0;
@@ -231,8 +242,9 @@ TEST_CASE("face-group leaves hold their element boxes on lanes, tested like one 
     for (int ka = 0; ka < 3; ++ka) {
       unsigned want = 0;
       for (int j = 0; j < n.count; ++j)
-        if (cf::detail::kinds_can_touch(cf::detail::kind_bit(static_cast<cf::ElementKind>(ka)),
-                                        cf::detail::kind_bit(t.elements()[static_cast<std::size_t>(n.element() + j)].kind)))
+        if (cf::detail::kinds_can_touch(
+                cf::detail::kind_bit(static_cast<cf::ElementKind>(ka)),
+                cf::detail::kind_bit(t.elements()[static_cast<std::size_t>(n.element() + j)].kind)))
           want |= 1u << j;
       CHECK(L.touchable_by[ka] == want);
     }
@@ -241,12 +253,16 @@ TEST_CASE("face-group leaves hold their element boxes on lanes, tested like one 
     const cf::detail::ElemBox& first = t.element_boxes()[static_cast<std::size_t>(n.element())];
     for (int r = 0; r < 4; ++r) {
       cf::detail::ElemBox p;
-      p.c = first.c + Eigen::Array4f(static_cast<float>(off(rng)), static_cast<float>(off(rng)), static_cast<float>(off(rng)), 0);
-      p.h = Eigen::Array4f(static_cast<float>(half(rng)), static_cast<float>(half(rng)), static_cast<float>(half(rng)), 0);
+      p.c = first.c + Eigen::Array4f(static_cast<float>(off(rng)), static_cast<float>(off(rng)),
+                                     static_cast<float>(off(rng)), 0);
+      p.h = Eigen::Array4f(static_cast<float>(half(rng)), static_cast<float>(half(rng)),
+                           static_cast<float>(half(rng)), 0);
       const unsigned got = cf::detail::overlapping_lanes(p, L);
       for (int j = 0; j < cf::detail::LeafBoxes::kLanes; ++j) {
         const bool lane = (got >> j) & 1u;
-        const bool want = j < n.count && !cf::detail::boxes_apart(p, t.element_boxes()[static_cast<std::size_t>(n.element() + j)]);
+        const bool want =
+            j < n.count && !cf::detail::boxes_apart(
+                               p, t.element_boxes()[static_cast<std::size_t>(n.element() + j)]);
         CHECK(lane == want);
         (want ? hits : misses) += 1;
       }
@@ -259,7 +275,8 @@ TEST_CASE("face-group leaves hold their element boxes on lanes, tested like one 
   CHECK(misses > 5000);
 }
 
-TEST_CASE("the 4-wide tree holds every node once, each inner lane opening into its subtree", "[bvh]") {
+TEST_CASE("the 4-wide tree holds every node once, each inner lane opening into its subtree",
+          "[bvh]") {
   const cf::Polyhedron m = tmod::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000");
   const auto leaves = GENERATE(cf::detail::Leaves::kElements, cf::detail::Leaves::kFaceGroups);
   const cf::detail::Bvh t(m, 0.25, 1, Vec3::Zero(), leaves);
@@ -276,7 +293,8 @@ TEST_CASE("the 4-wide tree holds every node once, each inner lane opening into i
     for (int j = 0; j < 4; ++j) {
       if (W.node[j] < 0) {
         CHECK(W.wide[j] == -1);
-        for (unsigned mask = 1; mask < 8; ++mask) CHECK(((W.lanes_holding[mask] | W.lanes_touching[mask]) >> j & 1u) == 0);
+        for (unsigned mask = 1; mask < 8; ++mask)
+          CHECK(((W.lanes_holding[mask] | W.lanes_touching[mask]) >> j & 1u) == 0);
         continue;
       }
       const cf::detail::BvhNode& n = nodes[static_cast<std::size_t>(W.node[j])];
@@ -306,8 +324,10 @@ TEST_CASE("the 4-wide tree holds every node once, each inner lane opening into i
       while (!todo.empty()) {
         const cf::detail::BvhNode& x = nodes[static_cast<std::size_t>(todo.back())];
         todo.pop_back();
-        if (x.leaf()) below += x.count;
-        else todo.insert(todo.end(), {x.left(), x.right()});
+        if (x.leaf())
+          below += x.count;
+        else
+          todo.insert(todo.end(), {x.left(), x.right()});
       }
       for (int k = 0; k < 4; ++k) {
         if (C.node[k] < 0) continue;
@@ -316,8 +336,10 @@ TEST_CASE("the 4-wide tree holds every node once, each inner lane opening into i
         while (!todo.empty()) {
           const cf::detail::BvhNode& x = nodes[static_cast<std::size_t>(todo.back())];
           todo.pop_back();
-          if (x.leaf()) elements += x.count;
-          else todo.insert(todo.end(), {x.left(), x.right()});
+          if (x.leaf())
+            elements += x.count;
+          else
+            todo.insert(todo.end(), {x.left(), x.right()});
         }
       }
       CHECK(count >= 2);

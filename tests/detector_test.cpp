@@ -1,9 +1,9 @@
 #include <cf/detector.hpp>
 #include <cf/geometry.hpp>
 
-#include "runtime_models.hpp"
-#include "fixtures.hpp"
 #include "detect/detector_poly.hpp"
+#include "fixtures.hpp"
+#include "runtime_models.hpp"
 
 #include <boost/geometry.hpp>
 #include <catch2/catch.hpp>
@@ -123,8 +123,8 @@ TEST_CASE("cube on an edge: e-f with the task frame along the edge", "[detector]
   const double h = 15 * std::sqrt(2.0);
   det.detect(pose(rot(M_PI / 4, {0, 0, 1}), {70, 20 + h + 0.25, 40}), cs);
   REQUIRE(count(cs, PcType::kEF) == 1);
-  const cf::ContactPc& c = *std::find_if(cs.begin(), cs.end(),
-                                         [](const cf::ContactPc& x) { return x.pc.type == PcType::kEF; });
+  const cf::ContactPc& c = *std::find_if(
+      cs.begin(), cs.end(), [](const cf::ContactPc& x) { return x.pc.type == PcType::kEF; });
   CHECK(c.pc.a == edge_between(a, 0, 4));  // x = y = -15 turns to (0, -15 sqrt 2)
   CHECK(c.pc.b == 4);
   CHECK(c.distance == Approx(0.25).margin(kTol));
@@ -136,7 +136,8 @@ TEST_CASE("cube on an edge: e-f with the task frame along the edge", "[detector]
   CHECK(cs.num_planes() == 1);
 }
 
-TEST_CASE("a slightly tilted edge gives e-f and the v-f of its lower end (paper Fig. 3)", "[detector]") {
+TEST_CASE("a slightly tilted edge gives e-f and the v-f of its lower end (paper Fig. 3)",
+          "[detector]") {
   const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
@@ -168,7 +169,8 @@ TEST_CASE("a slightly tilted edge gives e-f and the v-f of its lower end (paper 
   }
 }
 
-TEST_CASE("the f-f tolerance follows the overlap's extent along the tilt, whatever the yaw", "[detector]") {
+TEST_CASE("the f-f tolerance follows the overlap's extent along the tilt, whatever the yaw",
+          "[detector]") {
   const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);
   cf::ContactSet cs;
@@ -182,7 +184,8 @@ TEST_CASE("the f-f tolerance follows the overlap's extent along the tilt, whatev
       INFO("yaw " << yaw << ", tilt " << fraction << " x tolerance");
       const Eigen::Matrix3d R = rot(yaw, {0, 1, 0}) * rot(fraction * tol, {1, 0, 0});
       double low = 1e9;
-      for (const Vec3& v : {Vec3(-15, -15, -15), Vec3(15, -15, -15), Vec3(15, -15, 15), Vec3(-15, -15, 15)})
+      for (const Vec3& v :
+           {Vec3(-15, -15, -15), Vec3(15, -15, -15), Vec3(15, -15, 15), Vec3(-15, -15, 15)})
         low = std::min(low, (R * v).y());
       det.detect(pose(R, {70, 20 + 0.2 - low, 40}), cs);
       const cf::ContactPc* ff = find(cs, PcType::kFF, 2, 4);
@@ -191,7 +194,8 @@ TEST_CASE("the f-f tolerance follows the overlap's extent along the tilt, whatev
         CHECK(ff->distance == Approx(0.2).margin(kTol));
         // The overlap's extent along the tilt, measured in the slab's plane: 30 cos(tilt).
         const double angle = fraction * tol;
-        CHECK(ff->misfit == Approx(angle / std::atan(1.0 / (30 * std::cos(angle))) + 0.2).epsilon(1e-9));
+        CHECK(ff->misfit ==
+              Approx(angle / std::atan(1.0 / (30 * std::cos(angle))) + 0.2).epsilon(1e-9));
       } else {
         CHECK_FALSE(ff);
       }
@@ -234,7 +238,8 @@ TEST_CASE("cube on a corner: a single v-f", "[detector]") {
   cf::ContactSet cs;
   // Turn the diagonal to vertex 0 (-15,-15,-15) straight down.
   const Eigen::Matrix3d R =
-      Eigen::Quaterniond::FromTwoVectors(Vec3(-1, -1, -1).normalized(), Vec3(0, -1, 0)).toRotationMatrix();
+      Eigen::Quaterniond::FromTwoVectors(Vec3(-1, -1, -1).normalized(), Vec3(0, -1, 0))
+          .toRotationMatrix();
   const Vec3 v0 = R * Vec3(-15, -15, -15);
   det.detect(pose(R, Vec3(70, 20.4, 40) - v0), cs);
   REQUIRE(cs.size() == 1);
@@ -252,7 +257,8 @@ TEST_CASE("a face of A on a vertex of B: f-v", "[detector]") {
   // A's bottom face (2, normal -y in A) tilted so that it slopes away beyond the wall's
   // corner vertex 11 = (0, 80, 80).
   const Vec3 n = Vec3(0.3, -1, -0.2).normalized();
-  const Eigen::Matrix3d R = Eigen::Quaterniond::FromTwoVectors(Vec3(0, -1, 0), n).toRotationMatrix();
+  const Eigen::Matrix3d R =
+      Eigen::Quaterniond::FromTwoVectors(Vec3(0, -1, 0), n).toRotationMatrix();
   const Vec3 q(0, 80, 80);
   const double h = 0.6;
   det.detect(pose(R, q - h * n - R * Vec3(0, -15, 0)), cs);
@@ -312,7 +318,8 @@ TEST_CASE("overlap of polygons with holes matches Boost.Geometry", "[detector]")
   using BPoint = bg::model::d2::point_xy<double>;
   using BPoly = bg::model::polygon<BPoint, false>;  // counter-clockwise outer rings
   // P: 10 x 10 square with a 4 x 4 hole; Q: an L-shaped hexagon, shifted around.
-  std::vector<cf::detail::Vec2> p = {{0, 0}, {10, 0}, {10, 10}, {0, 10}, {3, 3}, {3, 7}, {7, 7}, {7, 3}};
+  std::vector<cf::detail::Vec2> p = {{0, 0}, {10, 0}, {10, 10}, {0, 10},
+                                     {3, 3}, {3, 7},  {7, 7},   {7, 3}};
   const int plb[] = {0, 4, 8};
   const cf::detail::Poly2 P{p.data(), plb, 2};
   BPoly bp;
@@ -328,7 +335,8 @@ TEST_CASE("overlap of polygons with holes matches Boost.Geometry", "[detector]")
       for (auto& v : q) v -= cf::detail::Vec2(dx, dy);
     const int qlb[] = {0, 6};
     const cf::detail::Poly2 Q{q.data(), qlb, 1};
-    const cf::detail::Overlap2 ov = cf::detail::overlap(P, Q, 1e-9, scratch.data(), [](const auto&) {});
+    const cf::detail::Overlap2 ov =
+        cf::detail::overlap(P, Q, 1e-9, scratch.data(), [](const auto&) {});
     BPoly bq;
     for (const auto& v : q) bg::append(bq.outer(), BPoint(v.x(), v.y()));
     bg::append(bq.outer(), BPoint(q[0].x(), q[0].y()));
@@ -352,7 +360,8 @@ TEST_CASE("overlap of polygons with holes matches Boost.Geometry", "[detector]")
   }
 }
 
-TEST_CASE("overlap of convex polygons by clipping matches the general routine and Boost.Geometry", "[detector]") {
+TEST_CASE("overlap of convex polygons by clipping matches the general routine and Boost.Geometry",
+          "[detector]") {
   namespace bg = boost::geometry;
   using BPoint = bg::model::d2::point_xy<double>;
   using BPoly = bg::model::polygon<BPoint, false>;
@@ -376,7 +385,8 @@ TEST_CASE("overlap of convex polygons by clipping matches the general routine an
   int compared = 0, overlapping = 0;
   for (int k = 0; k < 2000; ++k) {
     std::vector<Vec2> p = convex_poly(Vec2::Zero(), 5);
-    std::vector<Vec2> q = k % 7 == 0 ? p : convex_poly(Vec2(8 * U(rng) - 4, 8 * U(rng) - 4), 1 + 5 * U(rng));
+    std::vector<Vec2> q =
+        k % 7 == 0 ? p : convex_poly(Vec2(8 * U(rng) - 4, 8 * U(rng) - 4), 1 + 5 * U(rng));
     if (k % 7 == 0) std::rotate(q.begin(), q.begin() + 1, q.end());  // the same polygon
     const int plb[] = {0, static_cast<int>(p.size())}, qlb[] = {0, static_cast<int>(q.size())};
     const cf::detail::Poly2 P{p.data(), plb, 1}, Q{q.data(), qlb, 1};
@@ -390,10 +400,11 @@ TEST_CASE("overlap of convex polygons by clipping matches the general routine an
       lo_c = std::min(lo_c, g.dot(v));
       hi_c = std::max(hi_c, g.dot(v));
     }));
-    const cf::detail::Overlap2 og = cf::detail::overlap(P, Q, 1e-9, scratch.data(), [&](const Vec2& v) {
-      lo_g = std::min(lo_g, g.dot(v));
-      hi_g = std::max(hi_g, g.dot(v));
-    });
+    const cf::detail::Overlap2 og =
+        cf::detail::overlap(P, Q, 1e-9, scratch.data(), [&](const Vec2& v) {
+          lo_g = std::min(lo_g, g.dot(v));
+          hi_g = std::max(hi_g, g.dot(v));
+        });
     BPoly bp, bq;
     for (const auto& v : p) bg::append(bp.outer(), BPoint(v.x(), v.y()));
     bg::append(bp.outer(), BPoint(p[0].x(), p[0].y()));
@@ -443,14 +454,16 @@ TEST_CASE("a segment clipped by a convex polygon matches the general routine", "
     bool sharp = true;
     for (int c = 0; c < n; ++c) {
       const Vec2 u = p[static_cast<std::size_t>((c + 1) % n)] - p[static_cast<std::size_t>(c)];
-      const Vec2 v = p[static_cast<std::size_t>((c + 2) % n)] - p[static_cast<std::size_t>((c + 1) % n)];
+      const Vec2 v =
+          p[static_cast<std::size_t>((c + 2) % n)] - p[static_cast<std::size_t>((c + 1) % n)];
       sharp = sharp && cf::detail::cross2(u, v) > 0.01 * u.norm() * v.norm();
     }
     if (!sharp) continue;
     // Segments: random, through two vertices, along an edge (exactly, and beyond its ends).
     Vec2 a(12 * U(rng) - 6, 12 * U(rng) - 6), b(12 * U(rng) - 6, 12 * U(rng) - 6);
     const int i = static_cast<int>(n * U(rng)) % n, j = (i + 1) % n;
-    if (k % 5 == 1) a = p[static_cast<std::size_t>(i)], b = p[static_cast<std::size_t>((i + 2) % n)];
+    if (k % 5 == 1)
+      a = p[static_cast<std::size_t>(i)], b = p[static_cast<std::size_t>((i + 2) % n)];
     if (k % 5 == 2) {
       const Vec2 e = p[static_cast<std::size_t>(j)] - p[static_cast<std::size_t>(i)];
       a = p[static_cast<std::size_t>(i)] - 0.5 * U(rng) * e;
@@ -458,11 +471,12 @@ TEST_CASE("a segment clipped by a convex polygon matches the general routine", "
       ++along;
     }
     double g0 = 2, g1 = -1, len = 0;
-    cf::detail::clip_segment(a, b, P, 1e-9, cf::detail::OnBoundary::kInclude, scratch.data(), [&](double t0, double t1) {
-      g0 = std::min(g0, t0);
-      g1 = std::max(g1, t1);
-      len += t1 - t0;
-    });
+    cf::detail::clip_segment(a, b, P, 1e-9, cf::detail::OnBoundary::kInclude, scratch.data(),
+                             [&](double t0, double t1) {
+                               g0 = std::min(g0, t0);
+                               g1 = std::max(g1, t1);
+                               len += t1 - t0;
+                             });
     double c0 = 0, c1 = 0;
     const bool hit = cf::detail::clip_segment_convex(a, b, P, 1e-9, &c0, &c1);
     INFO("case " << k);
@@ -552,7 +566,8 @@ TEST_CASE("the BVH finds what all pairs find on faceted spheres", "[detector]") 
   // Models centred on their frames' origins, and far from them (single-precision boxes must
   // not lose contacts there).
   const bool far = GENERATE(false, true);
-  const Vec3 ca = far ? Vec3(4000, -3000, 2500) : Vec3::Zero(), cb = far ? Vec3(-2500, 1500, 3000) : Vec3::Zero();
+  const Vec3 ca = far ? Vec3(4000, -3000, 2500) : Vec3::Zero(),
+             cb = far ? Vec3(-2500, 1500, 3000) : Vec3::Zero();
   const cf::Polyhedron a = tmod::faceted_sphere(30, 20, 30, ca);
   const cf::Polyhedron b = tmod::faceted_sphere(50, 21, 32, cb);
   Twin t(a, b, band(eps), all_pairs(band(eps)));
@@ -574,7 +589,8 @@ TEST_CASE("the BVH finds what all pairs find on faceted spheres", "[detector]") 
   CHECK(contacts > 0);
 }
 
-TEST_CASE("the BVH finds what all pairs find for a big model against a small one, either way", "[detector]") {
+TEST_CASE("the BVH finds what all pairs find for a big model against a small one, either way",
+          "[detector]") {
   // A 600-face sphere (face-group leaves, wide nodes) against the paper's L-block and cube
   // (one element per leaf): the culling mixes both kinds of tree.
   const double eps = GENERATE(1.0, 0.1);
@@ -614,12 +630,14 @@ cf::Polyhedron faceted_torus(double R, double r, int around, int across) {
   for (int i = 0; i < around; ++i)
     for (int j = 0; j < across; ++j) {
       const double th = 2 * M_PI * i / around, ph = 2 * M_PI * j / across;
-      v.emplace_back((R + r * std::cos(ph)) * std::cos(th), (R + r * std::cos(ph)) * std::sin(th), r * std::sin(ph));
+      v.emplace_back((R + r * std::cos(ph)) * std::cos(th), (R + r * std::cos(ph)) * std::sin(th),
+                     r * std::sin(ph));
     }
   const auto at = [&](int i, int j) { return (i % around) * across + (j % across); };
   std::vector<std::vector<int>> f;
   for (int i = 0; i < around; ++i)
-    for (int j = 0; j < across; ++j) f.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+    for (int j = 0; j < across; ++j)
+      f.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
   return tmod::from_loops("torus", v, f);
 }
 
@@ -638,7 +656,8 @@ TEST_CASE("the BVH finds what all pairs find in a torus's hole", "[detector]") {
     // The hole's radius is 20 (less the facets' sagitta, ~0.2 mm): A's centre moved 1.6 to
     // 2 mm towards the ring brings that side into the band.
     const double az = M_PI * U(rng);
-    const Vec3 off = (1.8 + 0.2 * U(rng)) * Vec3(std::cos(az), std::sin(az), 0) + Vec3(0, 0, 2 * U(rng));
+    const Vec3 off =
+        (1.8 + 0.2 * U(rng)) * Vec3(std::cos(az), std::sin(az), 0) + Vec3(0, 0, 2 * U(rng));
     const cf::Pose p = pose(rot(3 * U(rng), Vec3(U(rng), U(rng), U(rng))), off);
     t.detect(p);
     INFO("epsilon " << eps << ", pose " << k);
@@ -668,7 +687,8 @@ TEST_CASE("pairs kept between nearby poses give what the hierarchy gives", "[det
   const int n = 400;
   for (int k = 0; k < n; ++k) {
     const double s = static_cast<double>(k) / n;
-    const Vec3 dir = Vec3(std::cos(0.3 * s), 0.03 * std::sin(1.7 * s), std::sin(0.3 * s)).normalized();
+    const Vec3 dir =
+        Vec3(std::cos(0.3 * s), 0.03 * std::sin(1.7 * s), std::sin(0.3 * s)).normalized();
     const Eigen::Matrix3d R = rot(0.2 * s, Vec3(1, 2, 3));
     // The facets lie up to 0.4 mm (sagittas 0.15 and 0.25) inside the spheres: centre gaps
     // swinging by an epsilon around 0.15 mm deep keep the meshes in or near the band.
@@ -688,7 +708,8 @@ TEST_CASE("pairs kept between nearby poses give what the hierarchy gives", "[det
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> U(-1, 1);
   for (int k = 0; k < 20; ++k) {
-    const cf::Pose p = pose(rot(3 * U(rng), Vec3(U(rng), U(rng), U(rng))), Vec3(U(rng), U(rng), U(rng)).normalized() * 80);
+    const cf::Pose p = pose(rot(3 * U(rng), Vec3(U(rng), U(rng), U(rng))),
+                            Vec3(U(rng), U(rng), U(rng)).normalized() * 80);
     t.detect(p);
     CHECK_FALSE(t.det.last_reused_pairs());
     REQUIRE(t.x.size() == t.y.size());
@@ -705,7 +726,8 @@ struct WarmCold {
   std::size_t warm_pairs = 0, cold_pairs = 0;
 };
 WarmCold compare_warm_cold(const cf::Polyhedron& a, const cf::Polyhedron& b, double eps,
-                           const std::vector<cf::Pose>& poses, double reuse_margin_mm = cf::DetectionParams{}.reuse_margin_mm) {
+                           const std::vector<cf::Pose>& poses,
+                           double reuse_margin_mm = cf::DetectionParams{}.reuse_margin_mm) {
   cf::Params prm = band(eps);
   prm.detection.reuse_margin_mm = reuse_margin_mm;
   Twin t(a, b, prm, not_kept(prm));
@@ -765,8 +787,9 @@ TEST_CASE("kept pairs' certificates never hide a contact", "[detector]") {
     std::vector<cf::Pose> poses;
     for (int k = 0; k < n; ++k) {
       const double s = static_cast<double>(k) / n;
-      const Eigen::Matrix3d R = rot(0.03 * std::sin(7 * s), Vec3(std::cos(2 * s), std::sin(2 * s), 0)) *
-                                rot(0.001 * k, Vec3::UnitZ());
+      const Eigen::Matrix3d R =
+          rot(0.03 * std::sin(7 * s), Vec3(std::cos(2 * s), std::sin(2 * s), 0)) *
+          rot(0.001 * k, Vec3::UnitZ());
       const double h = std::sqrt(2700.0 + 60 * 8 - 8 * 8) - 0.7 + eps * 0.6 * std::sin(11 * s);
       poses.push_back(pose(R, Vec3(8, 0, h)));
     }
@@ -792,7 +815,8 @@ TEST_CASE("kept pairs' certificates never hide a contact", "[detector]") {
       const cf::Pose first = pose(R, dir * (80 - 0.2 + 0.4 * eps * U(rng)));
       const cf::Pose second = pose(rot(0.003, Vec3(U(rng), U(rng), U(rng))) * R,
                                    first.t_BA + 0.1 * Vec3(U(rng), U(rng), U(rng)).normalized());
-      for (const cf::Pose* p : {&first, &first, &second, &first, &second, &first}) poses.push_back(*p);
+      for (const cf::Pose* p : {&first, &first, &second, &first, &second, &first})
+        poses.push_back(*p);
     }
     const WarmCold r = compare_warm_cold(a, b, eps, poses);
     CAPTURE(r.contacts, r.reused, r.warm_pairs, r.cold_pairs);
@@ -833,7 +857,8 @@ TEST_CASE("kept pairs serve rotations, and rotations rounded to float", "[detect
   // unchanged; rotations 1e-4 off orthonormal are detected from scratch, results unchanged.
   const double eps = GENERATE(1.0, 0.1);
   const Vec3 centre(300, -400, 0);
-  const cf::Polyhedron a = tmod::faceted_sphere(30, 20, 30, centre), b = tmod::faceted_sphere(50, 21, 32);
+  const cf::Polyhedron a = tmod::faceted_sphere(30, 20, 30, centre),
+                       b = tmod::faceted_sphere(50, 21, 32);
   const int n = 200;
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> U(-1, 1);
@@ -850,7 +875,8 @@ TEST_CASE("kept pairs serve rotations, and rotations rounded to float", "[detect
       }
       // A's centre (R centre + t) 80 mm from B's along a slowly turning direction (0.04
       // mm per tick, and 0.5 mrad).
-      const Vec3 dir = Vec3(std::cos(0.1 * s), 0.02 * std::sin(3 * s), std::sin(0.1 * s)).normalized();
+      const Vec3 dir =
+          Vec3(std::cos(0.1 * s), 0.02 * std::sin(3 * s), std::sin(0.1 * s)).normalized();
       const double gap = eps * 0.6 * std::sin(9 * s) - 0.2;
       poses.push_back(pose(R, dir * (80 + gap) - R * centre));
     }
@@ -858,8 +884,10 @@ TEST_CASE("kept pairs serve rotations, and rotations rounded to float", "[detect
     const WarmCold r = compare_warm_cold(a, b, eps, poses);
     CAPTURE(r.contacts, r.reused);
     CHECK(r.contacts > n / 4);
-    if (far_off) CHECK(r.reused == 0);
-    else CHECK(r.reused > n / 2);
+    if (far_off)
+      CHECK(r.reused == 0);
+    else
+      CHECK(r.reused > n / 2);
   }
 }
 

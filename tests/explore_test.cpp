@@ -3,12 +3,12 @@
 // are worked out by hand on boxes and the bundled L-block (slab 120 x 20 x 80 along x and z,
 // wall 0 <= x <= 20 up to y = 80).
 
-#include "cfgen/enumerate/enumerate.hpp"
 #include "cfgen/decide/explore.hpp"
-#include "cfgen/generate.hpp"
-#include "mesh/model_loader.hpp"
 #include "analysed_pair.hpp"
+#include "cfgen/enumerate/enumerate.hpp"
+#include "cfgen/generate.hpp"
 #include "fixtures.hpp"
+#include "mesh/model_loader.hpp"
 #include "scratch.hpp"
 
 #include <catch2/catch.hpp>
@@ -67,7 +67,9 @@ Polyhedron load_text(const std::string& name, const std::string& text) {
   return cf::tools::load_model(cf::test::write_file(name, text));
 }
 
-Polyhedron l_block() { return cf::tools::load_model(std::string(CF_SOURCE_DIR) + "/data/models/l_block.off"); }
+Polyhedron l_block() {
+  return cf::tools::load_model(std::string(CF_SOURCE_DIR) + "/data/models/l_block.off");
+}
 
 // The index of the face of m with this outward normal and plane offset.
 int face_of(const Polyhedron& m, const Vec3& n, double offset) {
@@ -79,7 +81,8 @@ int face_of(const Polyhedron& m, const Vec3& n, double offset) {
 int edge_of(const Polyhedron& m, const Vec3& a, const Vec3& b) {
   for (std::size_t e = 0; e < m.num_edges(); ++e) {
     const Vec3 p = m.edge_point(cf::EdgeId(int(e)), 0), q = m.edge_point(cf::EdgeId(int(e)), 1);
-    if (((p - a).norm() < 1e-9 && (q - b).norm() < 1e-9) || ((p - b).norm() < 1e-9 && (q - a).norm() < 1e-9))
+    if (((p - a).norm() < 1e-9 && (q - b).norm() < 1e-9) ||
+        ((p - b).norm() < 1e-9 && (q - a).norm() < 1e-9))
       return static_cast<int>(e);
   }
   FAIL("no such edge");
@@ -108,18 +111,21 @@ TEST_CASE("first contact of a translation: exact gap, dominated pairs ignored", 
   Pose pose;
   pose.t_BA = Vec3(50, 33.25, 30);  // 13.25 mm above the slab
   SECTION("falling onto the slab") {
-    const double s = cf::gen::first_contact_translation(A, B, pose, Vec3(0, -1, 0), 1e-8, 1e3, 1e-9, PcSet());
+    const double s =
+        cf::gen::first_contact_translation(A, B, pose, Vec3(0, -1, 0), 1e-8, 1e3, 1e-9, PcSet());
     CHECK(std::abs(s - 13.25) < kExact);
   }
   SECTION("sliding on the slab into the wall: the slab's own pairs do not stop it") {
     pose.t_BA.y() = 20;
     const int top = face_of(A, Vec3(0, -1, 0), 0), slab = face_of(B, Vec3(0, 1, 0), 20);
     const PcSet kept({Pc{PcType::kFF, top, slab}});
-    const double s = cf::gen::first_contact_translation(A, B, pose, Vec3(-1, 0, 0), 1e-8, 1e3, 1e-9, kept);
+    const double s =
+        cf::gen::first_contact_translation(A, B, pose, Vec3(-1, 0, 0), 1e-8, 1e3, 1e-9, kept);
     CHECK(std::abs(s - 30.0) < kExact);  // from x = 50 to the wall's face at x = 20
   }
   SECTION("moving away meets nothing") {
-    const double s = cf::gen::first_contact_translation(A, B, pose, Vec3(0, 1, 0), 1e-8, 1e3, 1e-9, PcSet());
+    const double s =
+        cf::gen::first_contact_translation(A, B, pose, Vec3(0, 1, 0), 1e-8, 1e3, 1e-9, PcSet());
     CHECK(std::isinf(s));
   }
 }
@@ -135,12 +141,12 @@ TEST_CASE("first contact of a rotation: an edge on the slab tilts onto its face"
   const int edge = edge_of(A, Vec3(0, 0, 0), Vec3(0, 0, 10)), slab = face_of(B, Vec3(0, 1, 0), 20);
   const PcSet kept({Pc{PcType::kEF, edge, slab}});
   // Turning back about the edge (-z through (50, 20)) lands the bottom face after `tilt`.
-  const double phi = cf::gen::first_contact_rotation(A, B, pose, Vec3(50, 20, 30), Vec3(0, 0, -1), 1e-9, M_PI,
-                                                     1e-9, kept);
+  const double phi = cf::gen::first_contact_rotation(A, B, pose, Vec3(50, 20, 30), Vec3(0, 0, -1),
+                                                     1e-9, M_PI, 1e-9, kept);
   CHECK(std::abs(phi - tilt) < kAngle);
   // The other way, the opposite face lands after pi/2 - tilt.
-  const double phi2 = cf::gen::first_contact_rotation(A, B, pose, Vec3(50, 20, 30), Vec3(0, 0, 1), 1e-9, M_PI,
-                                                      1e-9, kept);
+  const double phi2 = cf::gen::first_contact_rotation(A, B, pose, Vec3(50, 20, 30), Vec3(0, 0, 1),
+                                                      1e-9, M_PI, 1e-9, kept);
   CHECK(std::abs(phi2 - (M_PI / 2 - tilt)) < kAngle);
 }
 
@@ -165,15 +171,19 @@ TEST_CASE("contacts_at reads the PCs of a pose, and refuses degenerate touches",
   CHECK(why.find("degenerate touch") != std::string::npos);
 }
 
-TEST_CASE("verify: a bracket whose foot runs into the wall through the reflex edge is refused", "[explore]") {
+TEST_CASE("verify: a bracket whose foot runs into the wall through the reflex edge is refused",
+          "[explore]") {
   // A's L section: a foot 10 <= x <= 25, 20 <= y <= 25 and an upright 20 <= x <= 25 up to
   // y = 50. Placed as is (identity pose), its bottom face lies on the slab, its upright's
   // inner face (x = 20) on the wall's face and its reflex edge (20, 25) on that face: every
   // pair of elements meets only on boundaries, yet the foot is 10 mm inside the wall.
-  Pair bad(load_text("bracket_in.off", off_prism({{10, 20}, {25, 20}, {25, 50}, {20, 50}, {20, 25}, {10, 25}}, 20, 60)),
-           l_block());
+  Pair bad(
+      load_text("bracket_in.off",
+                off_prism({{10, 20}, {25, 20}, {25, 50}, {20, 50}, {20, 25}, {10, 25}}, 20, 60)),
+      l_block());
   const cf::gen::WitnessSearch search(bad.ai, bad.bi, cf::gen::SearchParams{});
-  const int bottom = face_of(bad.A, Vec3(0, -1, 0), -20), inner = face_of(bad.A, Vec3(-1, 0, 0), -20);
+  const int bottom = face_of(bad.A, Vec3(0, -1, 0), -20),
+            inner = face_of(bad.A, Vec3(-1, 0, 0), -20);
   const int slab = face_of(bad.B, Vec3(0, 1, 0), 20), wall = face_of(bad.B, Vec3(1, 0, 0), 20);
   const PcSet cf_set({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kFF, inner, wall}});
   std::string why;
@@ -183,10 +193,13 @@ TEST_CASE("verify: a bracket whose foot runs into the wall through the reflex ed
   // The same CF with the foot on the room side: the bracket's convex corner edge lies along
   // the L's reflex edge (collinear edges whose sectors, 90 and 270 degrees, only meet on their
   // sides), which the cone test must accept.
-  Pair good(load_text("bracket_out.off", off_prism({{20, 20}, {35, 20}, {35, 25}, {25, 25}, {25, 50}, {20, 50}}, 20, 60)),
-            l_block());
+  Pair good(
+      load_text("bracket_out.off",
+                off_prism({{20, 20}, {35, 20}, {35, 25}, {25, 25}, {25, 50}, {20, 50}}, 20, 60)),
+      l_block());
   const cf::gen::WitnessSearch search2(good.ai, good.bi, cf::gen::SearchParams{});
-  const int bottom2 = face_of(good.A, Vec3(0, -1, 0), -20), outer2 = face_of(good.A, Vec3(-1, 0, 0), -20);
+  const int bottom2 = face_of(good.A, Vec3(0, -1, 0), -20),
+            outer2 = face_of(good.A, Vec3(-1, 0, 0), -20);
   const PcSet cf_set2({Pc{PcType::kFF, bottom2, slab}, Pc{PcType::kFF, outer2, wall}});
   std::string why2;
   CHECK(search2.verify(cf_set2, Pose(), &why2) >= cf::gen::SearchParams{}.min_clearance);
@@ -240,8 +253,7 @@ TEST_CASE(
     x.R_BA = Eigen::AngleAxisd(0.05 * (i % 7), Vec3::UnitY()).toRotationMatrix();
     x.t_BA = Vec3(4 + 0.5 * i, 20, 30 + 0.25 * (i % 5));
     cf::gen::WitnessSearch::FailedPair f;
-    if (cube.verify(on_slab, x, nullptr, &f) < 0 && f.kind != Kind::kNone)
-      pairs.push_back(f);
+    if (cube.verify(on_slab, x, nullptr, &f) < 0 && f.kind != Kind::kNone) pairs.push_back(f);
     poses.push_back(x);
   }
   REQUIRE(pairs.size() >= 5);  // the cube is inside the wall for x < 20 (i < 32)
@@ -255,8 +267,10 @@ TEST_CASE(
   CHECK(proofs > static_cast<int>(pairs.size()));  // pairs prove other poses than their own
 }
 
-TEST_CASE("exploring from a cube on the slab meets the wall, and breaking the slab contact leaves the wall",
-          "[explore]") {
+TEST_CASE(
+    "exploring from a cube on the slab meets the wall, and breaking the slab contact leaves the "
+    "wall",
+    "[explore]") {
   Pair p(load_text("cube10e.off", off_box(0, 0, 0, 10, 10, 10)), l_block());
   const cf::gen::WitnessSearch search(p.ai, p.bi, cf::gen::SearchParams{});
   const int bottom = face_of(p.A, Vec3(0, -1, 0), 0), left = face_of(p.A, Vec3(-1, 0, 0), 0);
@@ -282,7 +296,7 @@ TEST_CASE("exploring from a cube on the slab meets the wall, and breaking the sl
   REQUIRE(search.verify(two, in_corner) > 0);
   const auto from_two = cf::gen::explore_translations(search, two, in_corner);
   CHECK(has(from_two, PcSet({Pc{PcType::kFF, left, wall}})));  // lifted off the slab
-  CHECK(has(from_two, one));                                    // moved off the wall
+  CHECK(has(from_two, one));                                   // moved off the wall
 }
 
 TEST_CASE("exploring rotations from a vertex on the slab lands an edge", "[explore]") {
@@ -293,7 +307,8 @@ TEST_CASE("exploring rotations from a vertex on the slab lands an edge", "[explo
   // at asin(1 / sqrt 3) = 35.3 degrees above the slab, plus a small turn so none is special.
   Pose pose;
   pose.R_BA = Eigen::AngleAxisd(0.05, Vec3(1, 0, 0)).toRotationMatrix() *
-              Eigen::Quaterniond::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3::UnitY()).toRotationMatrix();
+              Eigen::Quaterniond::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3::UnitY())
+                  .toRotationMatrix();
   pose.t_BA = Vec3(60, 20, 40);
   const int v0 = vertex_of(p.A, Vec3::Zero());
   const PcSet vf({Pc{PcType::kVF, v0, slab}});
@@ -334,19 +349,23 @@ PcSet parse_set(const std::string& text) {
 // a contact set whose rotations place the contacts only in a narrow region (climbing the LP
 // margin); two e-e crossings that no spread rotation holds locally (anchored rotations); a
 // centred translation running into another part of B (separating cuts).
-TEST_CASE("find: CFs of randomly placed pairs that need exact alignments, climbing and cuts", "[explore]") {
+TEST_CASE("find: CFs of randomly placed pairs that need exact alignments, climbing and cuts",
+          "[explore]") {
   struct Case {
     const char* a;
     const char* b;
     std::vector<const char*> sets;
   };
   const std::vector<Case> cases = {
-      {"stairs_box_A.off", "stairs_B.off",
-       {"f-f:0:4 f-f:2:7", "f-f:0:4 f-f:3:7", "e-f:1:4 v-f:5:7", "e-f:4:7 v-f:6:4", "e-f:5:7 v-f:5:4",
-        "e-f:6:7 v-f:7:4", "v-f:0:7 v-f:4:4", "v-f:1:4 e-e:11:16", "f-v:4:5 e-e:6:7",
-        "e-e:1:10 e-e:7:16", "e-e:3:10 e-e:6:16", "e-e:7:16 e-e:8:10"}},
-      {"stairs_slab_A.off", "stairs_steep_B.off",
-       {"e-e:5:6 e-e:6:16", "e-e:5:16 e-e:7:6", "e-e:0:16 e-e:3:8", "e-e:2:16 e-e:8:6", "v-f:0:7 v-f:1:4"}},
+      {"stairs_box_A.off",
+       "stairs_B.off",
+       {"f-f:0:4 f-f:2:7", "f-f:0:4 f-f:3:7", "e-f:1:4 v-f:5:7", "e-f:4:7 v-f:6:4",
+        "e-f:5:7 v-f:5:4", "e-f:6:7 v-f:7:4", "v-f:0:7 v-f:4:4", "v-f:1:4 e-e:11:16",
+        "f-v:4:5 e-e:6:7", "e-e:1:10 e-e:7:16", "e-e:3:10 e-e:6:16", "e-e:7:16 e-e:8:10"}},
+      {"stairs_slab_A.off",
+       "stairs_steep_B.off",
+       {"e-e:5:6 e-e:6:16", "e-e:5:16 e-e:7:6", "e-e:0:16 e-e:3:8", "e-e:2:16 e-e:8:6",
+        "v-f:0:7 v-f:1:4"}},
       {"tslot_box_A.off", "tslot_B.off", {"f-e:5:21"}},
   };
   for (const Case& c : cases) {
@@ -367,7 +386,8 @@ TEST_CASE("find: CFs of randomly placed pairs that need exact alignments, climbi
   }
 }
 
-TEST_CASE("plausible: a dominated PC, and heights over a face-face contact that cannot meet", "[explore]") {
+TEST_CASE("plausible: a dominated PC, and heights over a face-face contact that cannot meet",
+          "[explore]") {
   // A 10 mm cube on the L-block's slab (top y = 20).
   const Pair p(load_text("cube10h.off", off_box(0, 0, 0, 10, 10, 10)), l_block());
   const cf::gen::WitnessSearch search(p.ai, p.bi, cf::gen::SearchParams{});
@@ -381,12 +401,15 @@ TEST_CASE("plausible: a dominated PC, and heights over a face-face contact that 
   CHECK(search.plausible(PcSet({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kFF, side, wall}})));
   // An edge of the bottom face on the slab is dominated by the face-face PC.
   const int bottom_edge = edge_of(p.A, Vec3(0, 0, 0), Vec3(10, 0, 0));
-  CHECK_FALSE(search.plausible(PcSet({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kEF, bottom_edge, slab}})));
+  CHECK_FALSE(
+      search.plausible(PcSet({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kEF, bottom_edge, slab}})));
   // The cube's top (10 mm over the slab) cannot touch the slab's underside (20 mm below it).
   const int top_edge = edge_of(p.A, Vec3(0, 10, 0), Vec3(10, 10, 0));
   (void)top;
-  CHECK_FALSE(search.plausible(PcSet({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kEF, top_edge, slab_under}})));
+  CHECK_FALSE(search.plausible(
+      PcSet({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kEF, top_edge, slab_under}})));
   // A vertical edge of the cube spans heights 0..10; the wall face spans 0..60 over the slab.
   const int vertical_edge = edge_of(p.A, Vec3(0, 0, 0), Vec3(0, 10, 0));
-  CHECK(search.plausible(PcSet({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kEF, vertical_edge, wall}})));
+  CHECK(search.plausible(
+      PcSet({Pc{PcType::kFF, bottom, slab}, Pc{PcType::kEF, vertical_edge, wall}})));
 }

@@ -12,6 +12,8 @@
 #include <valijson/schema_parser.hpp>
 #include <valijson/validator.hpp>
 
+#include <sys/wait.h>
+#include <unistd.h>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -22,8 +24,6 @@
 #include <memory>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -138,8 +138,9 @@ TEST_CASE("a 12-triangle cube has 8 vertices, 12 edges and 6 faces", "[features]
   }
   // Faces are ordered by their lowest input facet: facets 0,1 are the bottom (z = 0).
   CHECK((m.face(cf::FaceId(0)).normal - Vec3(0, 0, -1)).norm() < kExact);
-  CHECK(m.face(cf::FaceId(0)).loops[0] == std::vector<cf::VertexId>{cf::VertexId(0), cf::VertexId(3),
-                                                                   cf::VertexId(2), cf::VertexId(1)});
+  CHECK(m.face(cf::FaceId(0)).loops[0] ==
+        std::vector<cf::VertexId>{cf::VertexId(0), cf::VertexId(3), cf::VertexId(2),
+                                  cf::VertexId(1)});
 }
 
 TEST_CASE("the cube A of the default data", "[features][models]") {
@@ -216,7 +217,8 @@ TEST_CASE("the peg", "[features][models]") {
   check_invariants(m, 0);
 }
 
-TEST_CASE("a block with a through-hole has faces with inner loops and reflex edges", "[features][models]") {
+TEST_CASE("a block with a through-hole has faces with inner loops and reflex edges",
+          "[features][models]") {
   // 80 x 40 x 80 with a 24 x 24 square hole along y: V = 8 outer + 8 hole = 16;
   // F = 4 outer sides + 4 hole walls + top + bottom = 10; E = 12 outer box + 4 rim top +
   // 4 rim bottom + 4 along the hole = 24; top and bottom have one hole each (H = 2), genus 1:
@@ -260,17 +262,18 @@ TEST_CASE("a triangulated model and its polygonal original have identical featur
         cf::to_json(cf::tools::model_from_soup(poly, "poly", same_name)));
 }
 
-TEST_CASE("a vertex where an edge meets a straight face side stays a vertex of that face", "[features]") {
+TEST_CASE("a vertex where an edge meets a straight face side stays a vertex of that face",
+          "[features]") {
   // A 20 x 10 x 10 block whose right half has a sloped front (z = y / 2 for x in [10, 20]):
   // point 1 = (10,0,0) lies in the middle of the straight front side of the bottom face,
   // where the edges of the front face, the step triangle and the slope meet.
-  const std::vector<Vec3> v = {{0, 0, 0},  {10, 0, 0},   {20, 0, 0},   {20, 0, 10},
-                               {0, 0, 10}, {0, 10, 0},   {10, 10, 0},  {10, 10, 5},
+  const std::vector<Vec3> v = {{0, 0, 0},   {10, 0, 0},   {20, 0, 0},  {20, 0, 10},
+                               {0, 0, 10},  {0, 10, 0},   {10, 10, 0}, {10, 10, 5},
                                {20, 10, 5}, {20, 10, 10}, {0, 10, 10}};
   // The bottom polygon starts at 3 so that the fan triangulation below has no sliver.
-  const std::vector<std::vector<int>> f = {{3, 4, 0, 1, 2},   {10, 9, 8, 7, 6, 5}, {0, 5, 6, 1},
-                                           {1, 6, 7},         {1, 7, 8, 2},        {2, 8, 9, 3},
-                                           {4, 3, 9, 10},     {0, 4, 10, 5}};
+  const std::vector<std::vector<int>> f = {{3, 4, 0, 1, 2}, {10, 9, 8, 7, 6, 5}, {0, 5, 6, 1},
+                                           {1, 6, 7},       {1, 7, 8, 2},        {2, 8, 9, 3},
+                                           {4, 3, 9, 10},   {0, 4, 10, 5}};
   // V = 11 (every point), F = 8, E = V + F - 2 = 17.
   for (const bool triangulated : {false, true}) {
     const cf::tools::PolygonSoup soup{v, triangulated ? fan(f) : f};
@@ -329,7 +332,8 @@ TEST_CASE("mesh vertices inside faces and inside edges are not features", "[feat
   // Vertex order follows the mesh index of each corner.
   std::vector<std::pair<int, Vec3>> corners;
   for (const auto& [g, i] : index)
-    if ((g[0] % n == 0) && (g[1] % n == 0) && (g[2] % n == 0)) corners.emplace_back(i, soup.points[i]);
+    if ((g[0] % n == 0) && (g[1] % n == 0) && (g[2] % n == 0))
+      corners.emplace_back(i, soup.points[i]);
   std::sort(corners.begin(), corners.end(), [](auto& x, auto& y) { return x.first < y.first; });
   for (std::size_t k = 0; k < corners.size(); ++k)
     CHECK((m.vertices()[k].p - corners[k].second).norm() < kExact);
@@ -356,15 +360,18 @@ TEST_CASE("single-precision STL input of a rotated model gives the exact feature
         const Vec3 e2 = exact.points[poly[(k + 1) % 6]] - exact.points[poly[k]];
         const Vec3 nn = [&] {
           Vec3 s = Vec3::Zero();
-          for (int j = 0; j < 6; ++j) s += exact.points[poly[j]].cross(exact.points[poly[(j + 1) % 6]]);
+          for (int j = 0; j < 6; ++j)
+            s += exact.points[poly[j]].cross(exact.points[poly[(j + 1) % 6]]);
           return s;
         }();
         if (e1.cross(e2).dot(nn) < 0) r = k;
       }
       REQUIRE(r >= 0);
-      for (int k = 1; k + 1 < 6; ++k) tris.push_back({poly[r], poly[(r + k) % 6], poly[(r + k + 1) % 6]});
+      for (int k = 1; k + 1 < 6; ++k)
+        tris.push_back({poly[r], poly[(r + k) % 6], poly[(r + k + 1) % 6]});
     } else {
-      for (std::size_t k = 1; k + 1 < poly.size(); ++k) tris.push_back({poly[0], poly[k], poly[k + 1]});
+      for (std::size_t k = 1; k + 1 < poly.size(); ++k)
+        tris.push_back({poly[0], poly[k], poly[k + 1]});
     }
   }
   const std::string path = write_file("corner_rotated.stl", binary_stl(moved, tris));
@@ -379,13 +386,14 @@ TEST_CASE("single-precision STL input of a rotated model gives the exact feature
   check_invariants(m, 0);
 }
 
-TEST_CASE("the coplanarity tolerance decides whether a slightly bent facet joins a face", "[features]") {
+TEST_CASE("the coplanarity tolerance decides whether a slightly bent facet joins a face",
+          "[features]") {
   // A 10 mm cube whose top is two quads meeting at a ridge x = 5 raised by delta; the front
   // and back faces run through the ridge points 8 and 9. The tolerance is 1e-5 of the
   // diagonal (17.3 mm), i.e. 1.7e-4 mm.
   auto soup_with_ridge = [](double delta) {
     cf::tools::PolygonSoup s;
-    s.points = {{0, 0, 0},  {10, 0, 0},  {10, 10, 0},  {0, 10, 0},           {0, 0, 10},
+    s.points = {{0, 0, 0},   {10, 0, 0},   {10, 10, 0}, {0, 10, 0},         {0, 0, 10},
                 {10, 0, 10}, {10, 10, 10}, {0, 10, 10}, {5, 0, 10 + delta}, {5, 10, 10 + delta}};
     s.polygons = {{0, 3, 2, 1},    {4, 8, 9, 7}, {8, 5, 6, 9}, {0, 1, 5, 8, 4},
                   {2, 3, 7, 9, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
@@ -469,10 +477,11 @@ std::string validate(const valijson::Schema& schema, const nlohmann::json& j) {
 
 }  // namespace
 
-TEST_CASE("cfgen --features output of every default model validates against the schema", "[cli][schema]") {
+TEST_CASE("cfgen --features output of every default model validates against the schema",
+          "[cli][schema]") {
   const auto schema = load_schema();
-  for (const char* name : {"cube.off", "l_block.off", "l_block_tri.obj", "corner_block.off", "peg.off",
-                           "hole_block.off"}) {
+  for (const char* name : {"cube.off", "l_block.off", "l_block_tri.obj", "corner_block.off",
+                           "peg.off", "hole_block.off"}) {
     INFO(name);
     const Run r = run(quoted(CF_CFGEN) + " --features " + quoted(kData + name));
     REQUIRE(r.status == 0);
@@ -512,8 +521,9 @@ TEST_CASE("cfgen reports bad input in one line with a non-zero status", "[cli]")
     CHECK(r.out == "cfgen: loading '/nonexistent/model.off': cannot open file: no such file\n");
   }
   SECTION("broken model") {
-    const std::string bad = write_file("open.off", "OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
-                                                    "3 0 2 1\n3 0 1 3\n3 0 3 2\n");
+    const std::string bad = write_file("open.off",
+                                       "OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+                                       "3 0 2 1\n3 0 1 3\n3 0 3 2\n");
     const Run r = run(cfgen + " --features " + quoted(bad) + " 2>&1");
     CHECK(r.status == 1);
     CHECK_THAT(r.out, Catch::StartsWith("cfgen: loading '" + bad + "': open boundary: edge"));

@@ -21,9 +21,10 @@ constexpr double kWitnessTol = 1e-9;
 cf::CfGraph generate(const std::string& units, const std::string& out) {
   cf::tools::GenerateArgs args;
   args.a_path = std::string(CF_SOURCE_DIR) + "/data/models/cube.off";
-  args.b_path = cf::test::write_file("slab.off",
-                                     "OFF\n8 6 0\n0 0 0\n100 0 0\n0 20 0\n100 20 0\n0 0 100\n100 0 100\n0 20 100\n100 20 100\n"
-                                     "4 0 2 3 1\n4 4 5 7 6\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n4 1 3 7 5\n");
+  args.b_path = cf::test::write_file(
+      "slab.off",
+      "OFF\n8 6 0\n0 0 0\n100 0 0\n0 20 0\n100 20 0\n0 0 100\n100 0 100\n0 20 100\n100 20 100\n"
+      "4 0 2 3 1\n4 4 5 7 6\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n4 1 3 7 5\n");
   args.out_path = (cf::test::scratch() / out).string();
   args.quiet = true;
   args.threads = 2;

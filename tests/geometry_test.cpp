@@ -1,5 +1,5 @@
-#include "fixtures.hpp"
 #include <cf/geometry.hpp>
+#include "fixtures.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -18,20 +18,26 @@ cf::Polyhedron box(double sx, double sy, double sz) { return cf::test::box(sx, s
 // A 30 x 30 x 10 square frame with a 10 x 10 through-hole at [10,20]^2: its top face
 // (index 1) has a hole.
 cf::Polyhedron frame() {
-  std::vector<Vec3> v = {{0, 0, 0},   {30, 0, 0},   {30, 30, 0},  {0, 30, 0},    // outer bottom
-                         {0, 0, 10},  {30, 0, 10},  {30, 30, 10}, {0, 30, 10},   // outer top
-                         {10, 10, 0}, {20, 10, 0},  {20, 20, 0},  {10, 20, 0},   // inner bottom
-                         {10, 10, 10}, {20, 10, 10}, {20, 20, 10}, {10, 20, 10}}; // inner top
+  std::vector<Vec3> v = {{0, 0, 0},    {30, 0, 0},   {30, 30, 0},  {0, 30, 0},     // outer bottom
+                         {0, 0, 10},   {30, 0, 10},  {30, 30, 10}, {0, 30, 10},    // outer top
+                         {10, 10, 0},  {20, 10, 0},  {20, 20, 0},  {10, 20, 0},    // inner bottom
+                         {10, 10, 10}, {20, 10, 10}, {20, 20, 10}, {10, 20, 10}};  // inner top
   std::vector<std::vector<std::vector<int>>> f = {
-      {{0, 3, 2, 1}, {8, 9, 10, 11}},      // bottom, hole clockwise seen from below
-      {{4, 5, 6, 7}, {12, 15, 14, 13}},    // top
-      {{0, 1, 5, 4}}, {{2, 3, 7, 6}}, {{1, 2, 6, 5}}, {{0, 4, 7, 3}},
+      {{0, 3, 2, 1}, {8, 9, 10, 11}},    // bottom, hole clockwise seen from below
+      {{4, 5, 6, 7}, {12, 15, 14, 13}},  // top
+      {{0, 1, 5, 4}},
+      {{2, 3, 7, 6}},
+      {{1, 2, 6, 5}},
+      {{0, 4, 7, 3}},
       // hole walls, normals pointing into the hole
-      {{8, 12, 13, 9}}, {{10, 14, 15, 11}}, {{9, 13, 14, 10}}, {{8, 11, 15, 12}}};
-  std::vector<std::array<int, 2>> e = {{0, 1},  {1, 2},   {2, 3},   {0, 3},   {4, 5},   {5, 6},
-                                       {6, 7},  {4, 7},   {0, 4},   {1, 5},   {2, 6},   {3, 7},
-                                       {8, 9},  {9, 10},  {10, 11}, {8, 11},  {12, 13}, {13, 14},
-                                       {14, 15}, {12, 15}, {8, 12}, {9, 13},  {10, 14}, {11, 15}};
+      {{8, 12, 13, 9}},
+      {{10, 14, 15, 11}},
+      {{9, 13, 14, 10}},
+      {{8, 11, 15, 12}}};
+  std::vector<std::array<int, 2>> e = {{0, 1},   {1, 2},   {2, 3},   {0, 3},  {4, 5},   {5, 6},
+                                       {6, 7},   {4, 7},   {0, 4},   {1, 5},  {2, 6},   {3, 7},
+                                       {8, 9},   {9, 10},  {10, 11}, {8, 11}, {12, 13}, {13, 14},
+                                       {14, 15}, {12, 15}, {8, 12},  {9, 13}, {10, 14}, {11, 15}};
   return cf::Polyhedron::from_features("frame", v, e, f);
 }
 
@@ -161,8 +167,9 @@ TEST_CASE("face-face and element distances between posed boxes", "[geometry]") {
   CHECK(cf::element_distance(a, pose, ElementKind::kEdge, 1, b, ElementKind::kEdge, 5).distance ==
         Approx(std::sqrt(29.0)).margin(kTol));
   // Vertex-vertex and vertex-edge.
-  CHECK(cf::element_distance(a, pose, ElementKind::kVertex, 0, b, ElementKind::kVertex, 4).distance ==
-        Approx(std::sqrt(29.0)).margin(kTol));
+  CHECK(
+      cf::element_distance(a, pose, ElementKind::kVertex, 0, b, ElementKind::kVertex, 4).distance ==
+      Approx(std::sqrt(29.0)).margin(kTol));
   CHECK(cf::element_distance(a, pose, ElementKind::kVertex, 0, b, ElementKind::kEdge, 4).distance ==
         Approx(2).margin(kTol));
   CHECK(cf::element_distance(a, pose, ElementKind::kEdge, 0, b, ElementKind::kVertex, 5).distance ==

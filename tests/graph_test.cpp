@@ -2,21 +2,21 @@
 // (a floor 40 x 10 and a wall 10 x 40 in the x-y profile, y up, extruded 20 in z).
 // Every witness below realises exactly its CF (checked by hand; see the comments).
 
-#include "fixtures.hpp"
 #include <cf/graph.hpp>
+#include "fixtures.hpp"
 
 #include <catch2/catch.hpp>
 
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <unistd.h>
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 #include <Eigen/Geometry>
 
@@ -81,8 +81,9 @@ cf::CfGraph box_l_graph() {
   std::vector<cf::Transition> transitions = {
       tr(0, 2, K::kGain),   tr(2, 0, K::kLose),   tr(1, 2, K::kGain),   tr(2, 1, K::kLose),
       tr(0, 3, K::kChange), tr(3, 0, K::kChange), tr(3, 4, K::kChange), tr(4, 3, K::kChange)};
-  return cf::CfGraph::from_parts(box(10, 10, 10), l_block(), std::move(cfs), std::move(transitions),
-                                 R"({"stats":{"note":"hand-made test fixture"},"parameters":{"epsilon_mm":1.0}})");
+  return cf::CfGraph::from_parts(
+      box(10, 10, 10), l_block(), std::move(cfs), std::move(transitions),
+      R"({"stats":{"note":"hand-made test fixture"},"parameters":{"epsilon_mm":1.0}})");
 }
 
 }  // namespace cf_test
@@ -111,8 +112,8 @@ std::string slurp(const std::string& path) {
 
 /// A fresh empty directory for files a test writes.
 std::filesystem::path scratch_dir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("cf_graph_test_" + name + "_" +
-                                                             std::to_string(::getpid()));
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("cf_graph_test_" + name + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
@@ -204,7 +205,8 @@ TEST_CASE("find answers any permutation of a CF's PCs, and nothing else", "[grap
   CHECK_FALSE(g.find(PcSet({pc(PcType::kVF, 1, 4)})));
   CHECK_FALSE(g.find(PcSet({pc(PcType::kFF, 2, 4), pc(PcType::kVF, 0, 4)})));
   CHECK_FALSE(g.find(PcSet()));
-  for (std::size_t i = 0; i < g.num_cfs(); ++i) CHECK(g.find(g.cf(CfId(static_cast<int>(i))).pcs) == CfId(static_cast<int>(i)));
+  for (std::size_t i = 0; i < g.num_cfs(); ++i)
+    CHECK(g.find(g.cf(CfId(static_cast<int>(i))).pcs) == CfId(static_cast<int>(i)));
 }
 
 TEST_CASE("transitions are listed per CF by target and answer adjacency", "[graph]") {
@@ -260,17 +262,27 @@ TEST_CASE("to_json round-trips exactly and is deterministic", "[graph]") {
   CHECK(pretty == cf_test::box_l_graph().to_json(2));
   CHECK(compact.find('\n') == std::string::npos);
   // Top-level order: the contract's fixed members first, metadata, then the big arrays.
-  CHECK(compact.rfind(R"({"format":"cf-graph","version":1,"units":"mm","parameters":{"epsilon_mm":1.0},"stats":)", 0) == 0);
+  CHECK(
+      compact.rfind(
+          R"({"format":"cf-graph","version":1,"units":"mm","parameters":{"epsilon_mm":1.0},"stats":)",
+          0) == 0);
   const CfGraph h = CfGraph::from_bytes(compact, "compact", false);
   check_same(g, h);
   CHECK(h.to_json() == compact);
   const CfGraph p = CfGraph::from_bytes(pretty, "pretty", false);
   check_same(g, p);
   CHECK(p.to_json(2) == pretty);
-  CHECK(g.metadata_json() == R"({"parameters":{"epsilon_mm":1.0},"stats":{"note":"hand-made test fixture"}})");
+  CHECK(g.metadata_json() ==
+        R"({"parameters":{"epsilon_mm":1.0},"stats":{"note":"hand-made test fixture"}})");
   // Optional freedoms are written only when known.
-  CHECK(compact.find(R"("id":0,"pcs":[{"type":"f-f","a":2,"b":4}],"witness":{"R":[[1.0,0.0,0.0],[0.0,1.0,0.0],[0.0,0.0,1.0]],"t":[20.0,10.0,5.0]},"dof":3,"translation_dof":2,"pure_rotation":true})") != std::string::npos);
-  CHECK(compact.find(R"({"id":1,"pcs":[{"type":"f-f","a":5,"b":5}],"witness":{"R":[[1.0,0.0,0.0],[0.0,1.0,0.0],[0.0,0.0,1.0]],"t":[10.0,20.0,5.0]}})") != std::string::npos);
+  CHECK(
+      compact.find(
+          R"("id":0,"pcs":[{"type":"f-f","a":2,"b":4}],"witness":{"R":[[1.0,0.0,0.0],[0.0,1.0,0.0],[0.0,0.0,1.0]],"t":[20.0,10.0,5.0]},"dof":3,"translation_dof":2,"pure_rotation":true})") !=
+      std::string::npos);
+  CHECK(
+      compact.find(
+          R"({"id":1,"pcs":[{"type":"f-f","a":5,"b":5}],"witness":{"R":[[1.0,0.0,0.0],[0.0,1.0,0.0],[0.0,0.0,1.0]],"t":[10.0,20.0,5.0]}})") !=
+      std::string::npos);
 }
 
 TEST_CASE("witnesses with arbitrary doubles round-trip exactly through JSON and CBOR", "[graph]") {
@@ -294,9 +306,10 @@ TEST_CASE("witnesses with arbitrary doubles round-trip exactly through JSON and 
         if (cf::a_kind(type) == cf::ElementKind::kFace && i >= 6) continue;
         cf::CfRecord r;
         r.pcs = PcSet({pc(type, i, j)});
-        r.witness.R_BA = Eigen::Quaterniond(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5, uniform() - 0.5)
-                             .normalized()
-                             .toRotationMatrix();
+        r.witness.R_BA =
+            Eigen::Quaterniond(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5, uniform() - 0.5)
+                .normalized()
+                .toRotationMatrix();
         const double s = scales[cfs.size() % 7];
         r.witness.t_BA = cf::Vec3(s * (uniform() - 0.5), -s * uniform(), s);
         cfs.push_back(r);
@@ -335,9 +348,10 @@ TEST_CASE("save writes JSON or CBOR whole and load reads it back", "[graph]") {
   std::size_t entries = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
   CHECK(entries == 2);
-  CHECK_THROWS_WITH(g.save((dir / "no" / "such" / "dir.json").string()),
-                    Catch::Contains("writing graph '" + (dir / "no" / "such" / "dir.json").string() +
-                                    "': the directory '" + (dir / "no" / "such").string() + "' does not exist"));
+  CHECK_THROWS_WITH(
+      g.save((dir / "no" / "such" / "dir.json").string()),
+      Catch::Contains("writing graph '" + (dir / "no" / "such" / "dir.json").string() +
+                      "': the directory '" + (dir / "no" / "such").string() + "' does not exist"));
   std::filesystem::remove_all(dir);
 }
 
@@ -350,8 +364,10 @@ TEST_CASE("schema validation can be skipped or made exhaustive", "[graph]") {
   // Metadata is free-form to the reader; only the schema says "stats" is an object...
   CHECK_NOTHROW(CfGraph::load(bad("schema_violation.json"), none));
   // ... while every structural fault is caught without it.
-  CHECK_THROWS_WITH(CfGraph::load(bad("index_out_of_range.json"), none), Catch::Contains("/cfs/3/pcs/0/b"));
-  CHECK_THROWS_WITH(CfGraph::load(bad("witness_extra_member.json"), none), Catch::Contains("/cfs/2/witness"));
+  CHECK_THROWS_WITH(CfGraph::load(bad("index_out_of_range.json"), none),
+                    Catch::Contains("/cfs/3/pcs/0/b"));
+  CHECK_THROWS_WITH(CfGraph::load(bad("witness_extra_member.json"), none),
+                    Catch::Contains("/cfs/2/witness"));
 }
 
 TEST_CASE("a written graph passes the full schema check, as JSON and as CBOR", "[graph]") {
@@ -379,7 +395,8 @@ namespace {
 
 CfGraph build(std::vector<cf::CfRecord> cfs, std::vector<cf::Transition> tr = {},
               const std::string& meta = "{}") {
-  return CfGraph::from_parts(cf_test::box(10, 10, 10), cf_test::l_block(), std::move(cfs), std::move(tr), meta);
+  return CfGraph::from_parts(cf_test::box(10, 10, 10), cf_test::l_block(), std::move(cfs),
+                             std::move(tr), meta);
 }
 
 cf::CfRecord rec(std::vector<Pc> pcs) {
@@ -395,14 +412,17 @@ cf::Transition tr(int f, int t, TransitionKind k) { return {CfId(f), CfId(t), k}
 TEST_CASE("from_parts rejects indices out of range for the kinds the type names", "[graph]") {
   // The cube has 8 vertices, 12 edges, 6 faces; the L-block 12, 18, 8.
   CHECK_THROWS_WITH(build({rec({pc(PcType::kVF, 8, 0)})}),
-                    Catch::Contains("CF 0, PC 0: v-f PC: a = 8 is not an index into the vertices of model A 'cube' (8 vertices)"));
+                    Catch::Contains("CF 0, PC 0: v-f PC: a = 8 is not an index into the vertices "
+                                    "of model A 'cube' (8 vertices)"));
   CHECK_THROWS_WITH(build({rec({pc(PcType::kFF, 0, 1)}), rec({pc(PcType::kFE, 0, 18)})}),
-                    Catch::Contains("CF 1, PC 0: f-e PC: b = 18 is not an index into the edges of model B 'L-block' (18 edges)"));
+                    Catch::Contains("CF 1, PC 0: f-e PC: b = 18 is not an index into the edges of "
+                                    "model B 'L-block' (18 edges)"));
   CHECK_NOTHROW(build({rec({pc(PcType::kEE, 11, 17)})}));
 }
 
 TEST_CASE("from_parts rejects empty, repeated and coplanar PC sets", "[graph]") {
-  CHECK_THROWS_WITH(build({cf::CfRecord()}), Catch::Contains("CF 0: a CF needs 1 to 3 PCs, this one has none"));
+  CHECK_THROWS_WITH(build({cf::CfRecord()}),
+                    Catch::Contains("CF 0: a CF needs 1 to 3 PCs, this one has none"));
   CHECK_THROWS_WITH(build({rec({pc(PcType::kVF, 0, 4)}), rec({pc(PcType::kVF, 0, 4)})}),
                     Catch::Contains("CF 1: PC set {v-f:0:4} repeats CF 0"));
   CHECK_THROWS_WITH(build({rec({pc(PcType::kVF, 0, 4), pc(PcType::kEF, 3, 4)})}),
@@ -431,11 +451,14 @@ TEST_CASE("from_parts rejects transitions that do not fit their CFs", "[graph]")
                     Catch::Contains("transition 0: to = 4 is not a CF id (the graph has 4 CFs)"));
   CHECK_THROWS_WITH(build(cfs, {tr(-1, 0, TransitionKind::kGain)}),
                     Catch::Contains("transition 0: from = -1 is not a CF id"));
-  CHECK_THROWS_WITH(build(cfs, {tr(1, 1, TransitionKind::kChange)}), Catch::Contains("from CF 1 to itself"));
-  CHECK_THROWS_WITH(build(cfs, {tr(2, 0, TransitionKind::kGain)}),
-                    Catch::Contains("transition 0: kind 'gain' needs the target to be the source plus one PC: "
-                                    "CF 2 {f-f:2:4;f-f:5:5} -> CF 0 {f-f:2:4}"));
-  CHECK_THROWS_WITH(build(cfs, {tr(0, 1, TransitionKind::kLose)}), Catch::Contains("kind 'lose' needs"));
+  CHECK_THROWS_WITH(build(cfs, {tr(1, 1, TransitionKind::kChange)}),
+                    Catch::Contains("from CF 1 to itself"));
+  CHECK_THROWS_WITH(
+      build(cfs, {tr(2, 0, TransitionKind::kGain)}),
+      Catch::Contains("transition 0: kind 'gain' needs the target to be the source plus one PC: "
+                      "CF 2 {f-f:2:4;f-f:5:5} -> CF 0 {f-f:2:4}"));
+  CHECK_THROWS_WITH(build(cfs, {tr(0, 1, TransitionKind::kLose)}),
+                    Catch::Contains("kind 'lose' needs"));
   CHECK_THROWS_WITH(build(cfs, {tr(0, 2, TransitionKind::kChange)}),
                     Catch::Contains("kind 'change' needs the same number of PCs"));
   CHECK_THROWS_WITH(build(cfs, {tr(0, 2, TransitionKind::kGain), tr(0, 3, TransitionKind::kChange),
@@ -531,10 +554,12 @@ TEST_CASE("from_parts accepts a change only where PCs are replaced by neighbouri
                     Catch::Contains("kind 'change' needs the same number of PCs"));
 }
 
-TEST_CASE("from_parts rejects metadata that is not an object or that overrides the graph", "[graph]") {
+TEST_CASE("from_parts rejects metadata that is not an object or that overrides the graph",
+          "[graph]") {
   const std::vector<cf::CfRecord> cfs = {rec({pc(PcType::kFF, 2, 4)})};
   CHECK_THROWS_WITH(build(cfs, {}, "[1]"), Catch::Contains("metadata: expected a JSON object"));
-  CHECK_THROWS_WITH(build(cfs, {}, R"({"cfs":1})"), Catch::Contains("member \"cfs\" is part of the graph itself"));
+  CHECK_THROWS_WITH(build(cfs, {}, R"({"cfs":1})"),
+                    Catch::Contains("member \"cfs\" is part of the graph itself"));
   CHECK_THROWS_WITH(build(cfs, {}, "{"), Catch::Contains("metadata: not valid JSON"));
   CHECK(build(cfs, {}, "").metadata_json() == "{}");
 }
@@ -542,43 +567,59 @@ TEST_CASE("from_parts rejects metadata that is not an object or that overrides t
 // ---- load rejects bad files, naming the file and the JSON pointer ---------------------
 
 TEST_CASE("load: a missing file", "[graph][bad]") {
-  CHECK_THROWS_WITH(CfGraph::load(bad("no_such_file.json")),
-                    Catch::Contains("reading '" + bad("no_such_file.json") + "': cannot open: no such file"));
+  CHECK_THROWS_WITH(
+      CfGraph::load(bad("no_such_file.json")),
+      Catch::Contains("reading '" + bad("no_such_file.json") + "': cannot open: no such file"));
 }
 
 TEST_CASE("load: a directory", "[graph][bad]") {
   CHECK_THROWS_WITH(CfGraph::load(kGraphDir),
-                    Catch::Contains("reading '" + kGraphDir + "': cannot open: is a directory, not a regular file"));
+                    Catch::Contains("reading '" + kGraphDir +
+                                    "': cannot open: is a directory, not a regular file"));
 }
 
-TEST_CASE("load: a FIFO is refused at once, never read (no writer: reading would block)", "[graph][bad]") {
-  const std::string fifo = (std::filesystem::temp_directory_path() / ("cf_graph_fifo_" + std::to_string(::getpid()) + ".json")).string();
+TEST_CASE("load: a FIFO is refused at once, never read (no writer: reading would block)",
+          "[graph][bad]") {
+  const std::string fifo = (std::filesystem::temp_directory_path() /
+                            ("cf_graph_fifo_" + std::to_string(::getpid()) + ".json"))
+                               .string();
   std::remove(fifo.c_str());
   REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
-  CHECK_THROWS_WITH(CfGraph::load(fifo), Catch::Contains("reading '" + fifo + "': cannot open: is a FIFO (named pipe), not a regular file"));
+  CHECK_THROWS_WITH(CfGraph::load(fifo),
+                    Catch::Contains("reading '" + fifo +
+                                    "': cannot open: is a FIFO (named pipe), not a regular file"));
   std::remove(fifo.c_str());
 }
 
-TEST_CASE("load: CBOR and JSON nesting is capped at 256 levels (100,000 used to overflow the stack)", "[graph][bad]") {
+TEST_CASE(
+    "load: CBOR and JSON nesting is capped at 256 levels (100,000 used to overflow the stack)",
+    "[graph][bad]") {
   // {"x": [[[...null...]]]}: a free-form member, 100,000 arrays deep.
   std::string cbor = "\xa1\x61x";
   cbor.append(100000, '\x81');
   cbor += '\xf6';
-  CHECK_THROWS_WITH(CfGraph::from_bytes(cbor, "deep.cbor", true),
-                    Catch::Contains("reading 'deep.cbor': not valid CBOR: nesting deeper than 256 levels"));
+  CHECK_THROWS_WITH(
+      CfGraph::from_bytes(cbor, "deep.cbor", true),
+      Catch::Contains("reading 'deep.cbor': not valid CBOR: nesting deeper than 256 levels"));
   // 256 levels are fine as far as nesting goes (the file then fails for what it lacks).
   std::string ok = "\xa1\x61x";
   ok.append(255, '\x81');
   ok += '\xf6';
   CHECK_THROWS_WITH(CfGraph::from_bytes(ok, "ok.cbor", true), !Catch::Contains("nesting"));
   const std::string json = "{\"x\":" + std::string(100000, '[') + std::string(100000, ']') + "}";
-  CHECK_THROWS_WITH(CfGraph::from_bytes(json, "deep.json", false), Catch::Contains("nesting deeper than 256 levels"));
+  CHECK_THROWS_WITH(CfGraph::from_bytes(json, "deep.json", false),
+                    Catch::Contains("nesting deeper than 256 levels"));
 }
 
-TEST_CASE("load: invalid UTF-8 in a CBOR graph's strings is reported, not an internal error", "[graph][bad]") {
+TEST_CASE("load: invalid UTF-8 in a CBOR graph's strings is reported, not an internal error",
+          "[graph][bad]") {
   // {"format": "\xff"}: nlohmann's dump() throws on invalid UTF-8 unless told to replace it.
-  const std::string cbor = "\xa1\x66" "format" "\x61\xff";
-  CHECK_THROWS_WITH(CfGraph::from_bytes(cbor, "utf8.cbor", true), Catch::Contains("reading 'utf8.cbor' at /format: format is"));
+  const std::string cbor =
+      "\xa1\x66"
+      "format"
+      "\x61\xff";
+  CHECK_THROWS_WITH(CfGraph::from_bytes(cbor, "utf8.cbor", true),
+                    Catch::Contains("reading 'utf8.cbor' at /format: format is"));
 }
 
 TEST_CASE("load: truncated JSON gives the line and column", "[graph][bad]") {
@@ -598,105 +639,127 @@ TEST_CASE("load: corrupt CBOR", "[graph][bad]") {
 }
 
 TEST_CASE("load: a JSON document that is not an object", "[graph][bad]") {
-  CHECK_THROWS_WITH(CfGraph::load(bad("not_object.json")),
-                    Catch::Contains("reading '" + bad("not_object.json") + "' at /: expected a cf-graph object"));
+  CHECK_THROWS_WITH(
+      CfGraph::load(bad("not_object.json")),
+      Catch::Contains("reading '" + bad("not_object.json") + "' at /: expected a cf-graph object"));
 }
 
 TEST_CASE("load: wrong format and version", "[graph][bad]") {
   CHECK_THROWS_WITH(CfGraph::load(bad("wrong_format.json")),
-                    Catch::Contains("'" + bad("wrong_format.json") + "' at /format: format is \"cf-table\", expected \"cf-graph\""));
+                    Catch::Contains("'" + bad("wrong_format.json") +
+                                    "' at /format: format is \"cf-table\", expected \"cf-graph\""));
   CHECK_THROWS_WITH(CfGraph::load(bad("wrong_version.json")),
-                    Catch::Contains("'" + bad("wrong_version.json") + "' at /version: version 2 is not supported"));
+                    Catch::Contains("'" + bad("wrong_version.json") +
+                                    "' at /version: version 2 is not supported"));
 }
 
 TEST_CASE("load: a value of the wrong type", "[graph][bad]") {
-  CHECK_THROWS_WITH(CfGraph::load(bad("wrong_type.json")),
-                    Catch::Contains("'" + bad("wrong_type.json") + "' at /cfs/1/pcs/0/a: expected a non-negative integer index, got \"5\""));
+  CHECK_THROWS_WITH(
+      CfGraph::load(bad("wrong_type.json")),
+      Catch::Contains("'" + bad("wrong_type.json") +
+                      "' at /cfs/1/pcs/0/a: expected a non-negative integer index, got \"5\""));
 }
 
 TEST_CASE("load: a missing member", "[graph][bad]") {
   CHECK_THROWS_WITH(CfGraph::load(bad("missing_witness.json")),
-                    Catch::Contains("'" + bad("missing_witness.json") + "' at /cfs/0: missing member \"witness\""));
+                    Catch::Contains("'" + bad("missing_witness.json") +
+                                    "' at /cfs/0: missing member \"witness\""));
 }
 
 TEST_CASE("load: an element index out of range", "[graph][bad]") {
   CHECK_THROWS_WITH(CfGraph::load(bad("index_out_of_range.json")),
                     Catch::Contains("'" + bad("index_out_of_range.json") +
-                                    "' at /cfs/3/pcs/0/b: e-f PC: b = 99 is not an index into the faces of model B 'L-block' (8 faces)"));
+                                    "' at /cfs/3/pcs/0/b: e-f PC: b = 99 is not an index into the "
+                                    "faces of model B 'L-block' (8 faces)"));
 }
 
 TEST_CASE("load: an unknown PC type", "[graph][bad]") {
   CHECK_THROWS_WITH(CfGraph::load(bad("unknown_pc_type.json")),
-                    Catch::Contains("'" + bad("unknown_pc_type.json") + "' at /cfs/0/pcs/0/type: unknown PC type \"v-v\""));
+                    Catch::Contains("'" + bad("unknown_pc_type.json") +
+                                    "' at /cfs/0/pcs/0/type: unknown PC type \"v-v\""));
 }
 
 TEST_CASE("load: a PC type that does not match the element kinds", "[graph][bad]") {
   // a = 11 is a valid edge of the cube but not a vertex: the type says vertex.
   CHECK_THROWS_WITH(CfGraph::load(bad("kind_mismatch.json")),
                     Catch::Contains("'" + bad("kind_mismatch.json") +
-                                    "' at /cfs/4/pcs/0/a: v-f PC: a = 11 is not an index into the vertices of model A 'cube' (8 vertices)"));
+                                    "' at /cfs/4/pcs/0/a: v-f PC: a = 11 is not an index into the "
+                                    "vertices of model A 'cube' (8 vertices)"));
 }
 
 TEST_CASE("load: a transition to a missing CF", "[graph][bad]") {
-  CHECK_THROWS_WITH(CfGraph::load(bad("missing_cf_transition.json")),
-                    Catch::Contains("'" + bad("missing_cf_transition.json") +
-                                    "' at /transitions/2/to: to = 17 is not a CF id (the graph has 5 CFs)"));
+  CHECK_THROWS_WITH(
+      CfGraph::load(bad("missing_cf_transition.json")),
+      Catch::Contains("'" + bad("missing_cf_transition.json") +
+                      "' at /transitions/2/to: to = 17 is not a CF id (the graph has 5 CFs)"));
 }
 
 TEST_CASE("load: a transition whose kind does not fit its CFs", "[graph][bad]") {
-  CHECK_THROWS_WITH(CfGraph::load(bad("bad_transition_kind.json")),
-                    Catch::Contains("'" + bad("bad_transition_kind.json") +
-                                    "' at /transitions/0/kind: kind 'change' needs the same number of PCs"));
+  CHECK_THROWS_WITH(
+      CfGraph::load(bad("bad_transition_kind.json")),
+      Catch::Contains("'" + bad("bad_transition_kind.json") +
+                      "' at /transitions/0/kind: kind 'change' needs the same number of PCs"));
 }
 
 TEST_CASE("load: a repeated PC set and a repeated PC", "[graph][bad]") {
   CHECK_THROWS_WITH(CfGraph::load(bad("repeated_cf.json")),
-                    Catch::Contains("'" + bad("repeated_cf.json") + "' at /cfs/4: PC set {e-f:0:4} repeats CF 3"));
+                    Catch::Contains("'" + bad("repeated_cf.json") +
+                                    "' at /cfs/4: PC set {e-f:0:4} repeats CF 3"));
   CHECK_THROWS_WITH(CfGraph::load(bad("repeated_pc.json")),
-                    Catch::Contains("'" + bad("repeated_pc.json") + "' at /cfs/2/pcs/1: PC f-f:2:4 is repeated in this CF"));
+                    Catch::Contains("'" + bad("repeated_pc.json") +
+                                    "' at /cfs/2/pcs/1: PC f-f:2:4 is repeated in this CF"));
 }
 
 TEST_CASE("load: a CF id that is not its position", "[graph][bad]") {
-  CHECK_THROWS_WITH(CfGraph::load(bad("id_mismatch.json")),
-                    Catch::Contains("'" + bad("id_mismatch.json") + "' at /cfs/1/id: id 7 should be 1"));
+  CHECK_THROWS_WITH(
+      CfGraph::load(bad("id_mismatch.json")),
+      Catch::Contains("'" + bad("id_mismatch.json") + "' at /cfs/1/id: id 7 should be 1"));
 }
 
 TEST_CASE("load: a witness that is not a rotation", "[graph][bad]") {
   CHECK_THROWS_WITH(CfGraph::load(bad("not_rotation.json")),
-                    Catch::Contains("'" + bad("not_rotation.json") + "' at /cfs/0/witness/R: not a rotation matrix"));
+                    Catch::Contains("'" + bad("not_rotation.json") +
+                                    "' at /cfs/0/witness/R: not a rotation matrix"));
 }
 
 TEST_CASE("load: a broken model", "[graph][bad]") {
-  CHECK_THROWS_WITH(CfGraph::load(bad("bad_model.json")),
-                    Catch::Contains("'" + bad("bad_model.json") + "' at /models/B/faces/0/loops/0/1: expected a non-negative integer index"));
+  CHECK_THROWS_WITH(
+      CfGraph::load(bad("bad_model.json")),
+      Catch::Contains("'" + bad("bad_model.json") +
+                      "' at /models/B/faces/0/loops/0/1: expected a non-negative integer index"));
 }
 
 TEST_CASE("load: an unknown member in a witness", "[graph][bad]") {
-  CHECK_THROWS_WITH(CfGraph::load(bad("witness_extra_member.json")),
-                    Catch::Contains("'" + bad("witness_extra_member.json") +
-                                    "' at /cfs/2/witness: unexpected member \"q\" (a witness has R and t)"));
+  CHECK_THROWS_WITH(
+      CfGraph::load(bad("witness_extra_member.json")),
+      Catch::Contains("'" + bad("witness_extra_member.json") +
+                      "' at /cfs/2/witness: unexpected member \"q\" (a witness has R and t)"));
 }
 
 TEST_CASE("load: a CF with more than 3 PCs", "[graph][bad]") {
-  CHECK_THROWS_WITH(CfGraph::load(bad("pc_count.json")),
-                    Catch::Contains("'" + bad("pc_count.json") + "' at /cfs/2/pcs: a CF has 1 to 3 PCs, got 4"));
+  CHECK_THROWS_WITH(
+      CfGraph::load(bad("pc_count.json")),
+      Catch::Contains("'" + bad("pc_count.json") + "' at /cfs/2/pcs: a CF has 1 to 3 PCs, got 4"));
 }
 
 TEST_CASE("load: a missing top-level member", "[graph][bad]") {
   CHECK_THROWS_WITH(CfGraph::load(bad("missing_transitions.json")),
-                    Catch::Contains("'" + bad("missing_transitions.json") + "' at /: missing member \"transitions\""));
+                    Catch::Contains("'" + bad("missing_transitions.json") +
+                                    "' at /: missing member \"transitions\""));
 }
 
 TEST_CASE("load: a model that breaks the model schema", "[graph][bad]") {
-  CHECK_THROWS_WITH(CfGraph::load(bad("model_schema_violation.json")),
-                    Catch::Contains("'" + bad("model_schema_violation.json") +
-                                    "' at /models/A/faces/0/area: does not match the cf-graph schema:"));
+  CHECK_THROWS_WITH(
+      CfGraph::load(bad("model_schema_violation.json")),
+      Catch::Contains("'" + bad("model_schema_violation.json") +
+                      "' at /models/A/faces/0/area: does not match the cf-graph schema:"));
 }
 
 TEST_CASE("load: a schema violation the reader itself would let through", "[graph][bad]") {
   CHECK_THROWS_WITH(CfGraph::load(bad("schema_violation.json")),
                     Catch::Contains("'" + bad("schema_violation.json") +
-                                    "' at /stats: does not match the cf-graph schema: Value type not permitted by 'type' constraint."));
+                                    "' at /stats: does not match the cf-graph schema: Value type "
+                                    "not permitted by 'type' constraint."));
 }
 
 // ---- the JSON parser of the reader ----------------------------------------------------
@@ -737,20 +800,26 @@ TEST_CASE("the reader takes every JSON value form in metadata and names", "[grap
   CHECK_THROWS_WITH(CfGraph::from_bytes(text, "m.json", false),
                     Catch::Contains("'m.json': not valid JSON: syntax error at line 6") &&
                         Catch::Contains("number out of the range of a double"));
-  const CfGraph g = CfGraph::from_bytes(fixture_with(R"("stats": {"note":"hand-made test fixture"},)",
-                                                     [&] {
-                                                       std::string m = meta;
-                                                       m.replace(m.find("1e400000"), 8, "1e300");
-                                                       return m;
-                                                     }()),
-                                        "m.json", false);
+  const CfGraph g =
+      CfGraph::from_bytes(fixture_with(R"("stats": {"note":"hand-made test fixture"},)",
+                                       [&] {
+                                         std::string m = meta;
+                                         m.replace(m.find("1e400000"), 8, "1e300");
+                                         return m;
+                                       }()),
+                          "m.json", false);
   CHECK(g.metadata_json() ==
-        "{\"parameters\":{\"epsilon_mm\":1.0},\"stats\":{\"E\":-200.0,\"big\":18446744073709551615,\"e\":0.0015,"
-        "\"huge\":1e+300,\"l\":[true,false,null,{},[]],\"neg\":-9223372036854775808,\"past64\":-1.2345678901234568e+20,"
+        "{\"parameters\":{\"epsilon_mm\":1.0},\"stats\":{\"E\":-200.0,\"big\":18446744073709551615,"
+        "\"e\":0.0015,"
+        "\"huge\":1e+300,\"l\":[true,false,null,{},[]],\"neg\":-9223372036854775808,\"past64\":-1."
+        "2345678901234568e+20,"
         "\"s\":\"tab\\there \\\"q\\\" \\\\ / \xc3\xa9 \xf0\x9f\x98\x80 \xc3\xa9\",\"z\":-0.0}}");
   // A model name with escapes survives the round trip.
-  const CfGraph n = CfGraph::from_bytes(fixture_with(R"("name": "cube")", R"("name": "c\u00fcbe \"1\"")"), "n.json", false);
-  CHECK(n.model_a().name() == "c\xc3\xbc" "be \"1\"");
+  const CfGraph n = CfGraph::from_bytes(
+      fixture_with(R"("name": "cube")", R"("name": "c\u00fcbe \"1\"")"), "n.json", false);
+  CHECK(n.model_a().name() ==
+        "c\xc3\xbc"
+        "be \"1\"");
   check_same(n, CfGraph::from_bytes(n.to_json(), "n2.json", false));
 }
 
@@ -767,36 +836,48 @@ TEST_CASE("the reader rejects malformed JSON with the line and column", "[graph]
       {R"("version": 1,)", R"("version": 1e,)", "line 3, column 13 near '1': invalid number"},
       {R"("version": 1,)", R"("version": -,)", "line 3, column 13 near '-': invalid number"},
       // An integer past 64 bits (read as a double) must still end where the token ends.
-      {R"("version": 1,)", R"("version": 91111111111111111111z1,)", "line 3, column 13 near '9': invalid number"},
+      {R"("version": 1,)", R"("version": 91111111111111111111z1,)",
+       "line 3, column 13 near '9': invalid number"},
       {R"("version": 1,)", R"("version": tru,)", "line 3, column 13 near 't': invalid literal"},
       {R"("version": 1,)", R"("version": nul,)", "line 3, column 13 near 'n': invalid literal"},
-      {R"("version": 1,)", R"("version": 1,,)", "line 3, column 15 near ',': The JSON document has an " + kStructure},
+      {R"("version": 1,)", R"("version": 1,,)",
+       "line 3, column 15 near ',': The JSON document has an " + kStructure},
       {R"("name": "cube")", R"("name": "cu\qbe")", "near '\"': invalid string (an unknown escape"},
       {R"("name": "cube")", R"("name": "cu\ud800be")", "unpaired UTF-16 surrogate"},
-      {"{\n \"format\"", "{\n \"format\" \"x\",", "line 2, column 11 near '\"': The JSON document has an " + kStructure},
+      {"{\n \"format\"", "{\n \"format\" \"x\",",
+       "line 2, column 11 near '\"': The JSON document has an " + kStructure},
       {R"([[1.0,0.0,0.0])", R"([[1.0 0.0,0.0])", kStructure},
   };
   for (const Case& c : cases) {
     INFO(c.to);
     CHECK_THROWS_WITH(CfGraph::from_bytes(fixture_with(c.from, c.to), "x.json", false),
-                      Catch::Contains("reading 'x.json': not valid JSON: syntax error at ") && Catch::Contains(c.message));
+                      Catch::Contains("reading 'x.json': not valid JSON: syntax error at ") &&
+                          Catch::Contains(c.message));
   }
   // Faults of simdjson's first pass over the bytes come without a position.
   const std::vector<Case> first_pass = {
       {R"("name": "cube")", "\"name\": \"cu\tbe\"", "some characters must be escaped"},
-      {R"("name": "cube")", "\"name\": \"cu\xff" "be\"", "not valid UTF-8"},
-      {R"("name": "cube")", "\"name\": \"cu\xc0\xaf" "be\"", "not valid UTF-8"},
+      {R"("name": "cube")",
+       "\"name\": \"cu\xff"
+       "be\"",
+       "not valid UTF-8"},
+      {R"("name": "cube")",
+       "\"name\": \"cu\xc0\xaf"
+       "be\"",
+       "not valid UTF-8"},
       {R"("name": "cube")", R"("name": "cube)", "not valid JSON: "},
   };
   for (const Case& c : first_pass) {
     INFO(c.to);
-    CHECK_THROWS_WITH(CfGraph::from_bytes(fixture_with(c.from, c.to), "x.json", false),
-                      Catch::StartsWith("reading 'x.json': not valid JSON: ") && Catch::Contains(c.message));
+    CHECK_THROWS_WITH(
+        CfGraph::from_bytes(fixture_with(c.from, c.to), "x.json", false),
+        Catch::StartsWith("reading 'x.json': not valid JSON: ") && Catch::Contains(c.message));
   }
   CHECK_THROWS_WITH(CfGraph::from_bytes(slurp(kFixture) + "x", "t.json", false),
                     Catch::Contains("unexpected content after the JSON value"));
-  CHECK_THROWS_WITH(CfGraph::from_bytes(std::string(300, '[') + std::string(300, ']'), "d.json", false),
-                    Catch::Contains("line 1, column 257 near '[': nesting deeper than 256 levels"));
+  CHECK_THROWS_WITH(
+      CfGraph::from_bytes(std::string(300, '[') + std::string(300, ']'), "d.json", false),
+      Catch::Contains("line 1, column 257 near '[': nesting deeper than 256 levels"));
   CHECK_THROWS_WITH(CfGraph::from_bytes(" \n ", "w.json", false),
                     Catch::Contains("line 2, column 2 at the end of the input: empty input"));
 }

@@ -1,7 +1,7 @@
 #include <cf/identifier.hpp>
 
-#include "runtime_models.hpp"
 #include "fixtures.hpp"
+#include "runtime_models.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -72,10 +72,11 @@ struct Fixture {
                                      record({{PcType::kFF, 2, 4}, {PcType::kFF, 5, 5}}),
                                      record({{PcType::kVF, 0, 4}})};
     using K = cf::TransitionKind;
-    std::vector<cf::Transition> tr = {{CfId(0), CfId(1), K::kChange}, {CfId(1), CfId(0), K::kChange},
-                                      {CfId(1), CfId(2), K::kChange}, {CfId(2), CfId(1), K::kChange},
-                                      {CfId(0), CfId(3), K::kGain},   {CfId(3), CfId(0), K::kLose},
-                                      {CfId(1), CfId(4), K::kChange}, {CfId(4), CfId(1), K::kChange}};
+    std::vector<cf::Transition> tr = {
+        {CfId(0), CfId(1), K::kChange}, {CfId(1), CfId(0), K::kChange},
+        {CfId(1), CfId(2), K::kChange}, {CfId(2), CfId(1), K::kChange},
+        {CfId(0), CfId(3), K::kGain},   {CfId(3), CfId(0), K::kLose},
+        {CfId(1), CfId(4), K::kChange}, {CfId(4), CfId(1), K::kChange}};
     graph = cf::CfGraph::from_parts(a, b, cfs, tr);
   }
 };
@@ -85,7 +86,8 @@ const double kEdgeDrop = 15 * std::sqrt(2.0);  // centre height over the lowest 
 
 cf::Pose flat() { return pose(I, {70, 35.3, 40}); }
 cf::Pose on_edge() {
-  return pose(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()).toRotationMatrix(), {70, 20 + kEdgeDrop + 0.2, 40});
+  return pose(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()).toRotationMatrix(),
+              {70, 20 + kEdgeDrop + 0.2, 40});
 }
 // On the same edge, tilted so that its end at z = -15 (vertex 0) is lower (paper Fig. 3).
 // The e-f's angular tolerance is atan(1 mm / 30 mm) = 0.0333 rad; it dominates the v-f of
@@ -99,18 +101,21 @@ cf::Pose corner() { return pose(I, {35.2, 35.4, 40}); }
 cf::Pose far() { return pose(I, {70, 80, 40}); }
 cf::Pose on_vertex0() {
   const Eigen::Matrix3d R =
-      Eigen::Quaterniond::FromTwoVectors(Vec3(-1, -1, -1).normalized(), Vec3(0, -1, 0)).toRotationMatrix();
+      Eigen::Quaterniond::FromTwoVectors(Vec3(-1, -1, -1).normalized(), Vec3(0, -1, 0))
+          .toRotationMatrix();
   return pose(R, Vec3(70, 20.4, 40) - R * Vec3(-15, -15, -15));
 }
 cf::Pose on_vertex6() {  // vertex 6 (15,15,15) down: not in the graph
   const Eigen::Matrix3d R =
-      Eigen::Quaterniond::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3(0, -1, 0)).toRotationMatrix();
+      Eigen::Quaterniond::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3(0, -1, 0))
+          .toRotationMatrix();
   return pose(R, Vec3(70, 20.4, 40) - R * Vec3(15, 15, 15));
 }
 
 }  // namespace
 
-TEST_CASE("identification prefers the previous CF, then a neighbour, else the best fit", "[identifier]") {
+TEST_CASE("identification prefers the previous CF, then a neighbour, else the best fit",
+          "[identifier]") {
   Fixture fx;
   cf::CfIdentifier id(fx.graph);
 
@@ -138,8 +143,9 @@ TEST_CASE("identification prefers the previous CF, then a neighbour, else the be
   CHECK_FALSE(id.previous().valid());
 }
 
-TEST_CASE("a contact farther than the CF's own is apart until it touches; the CF is kept while it leaves",
-          "[identifier]") {
+TEST_CASE(
+    "a contact farther than the CF's own is apart until it touches; the CF is kept while it leaves",
+    "[identifier]") {
   Fixture fx;
   cf::CfIdentifier id(fx.graph);
   // The cube on the slab (its bottom at y = t.y - 15) beside the wall (its side at
@@ -186,10 +192,12 @@ TEST_CASE("a contact farther than the CF's own is apart until it touches; the CF
   cf::CfIdentifier wide(fx.graph, p);
   CHECK(wide.step(at(-0.1, 0.3)).cf == CfId(3));
   p.identification.touch_distance_mm = -1;
-  CHECK_THROWS_WITH(cf::CfIdentifier(fx.graph, p), Catch::Contains("touch_distance_mm must be finite and non-negative"));
+  CHECK_THROWS_WITH(cf::CfIdentifier(fx.graph, p),
+                    Catch::Contains("touch_distance_mm must be finite and non-negative"));
 }
 
-TEST_CASE("the ambiguity of paper Fig. 3: the undominated reading wins, else history", "[identifier]") {
+TEST_CASE("the ambiguity of paper Fig. 3: the undominated reading wins, else history",
+          "[identifier]") {
   Fixture fx;
   cf::CfIdentifier id(fx.graph);
   // The edge tilted by 0.005 rad (0.15 of the angular tolerance): e-f, with the v-f of its
@@ -248,7 +256,8 @@ TEST_CASE("contacts outside the graph and jumps are reported, not hidden", "[ide
 TEST_CASE("identification steps allocate nothing", "[identifier]") {
   Fixture fx;
   cf::CfIdentifier id(fx.graph);
-  const cf::Pose poses[] = {flat(), corner(), on_edge(), tilted_edge(), far(), on_vertex0(), on_vertex6()};
+  const cf::Pose poses[] = {flat(), corner(),     on_edge(),   tilted_edge(),
+                            far(),  on_vertex0(), on_vertex6()};
   id.step(flat());  // warm up (nothing is lazily allocated, but be fair)
   const long before = g_news.load();
   for (int k = 0; k < 50; ++k)

@@ -1,5 +1,5 @@
-// The witness search's small LP solver (tools/cfgen/verify/lp.cpp: a dense simplex, GLPK for what it
-// leaves) against GLPK's primal simplex alone, a solver written apart from the dense one, on
+// The witness search's small LP solver (tools/cfgen/verify/lp.cpp: a dense simplex, GLPK for what
+// it leaves) against GLPK's primal simplex alone, a solver written apart from the dense one, on
 // random programs of the witness search's shapes: up to ten variables, equality rows, bounds,
 // and degenerate vertices where many rows meet.
 #include <catch2/catch.hpp>
@@ -85,8 +85,7 @@ LinearProgram random_program(std::mt19937& rng, bool& bounded_box) {
 
 }  // namespace
 
-TEST_CASE("lp: matches GLPK's optimum on random programs with degenerate vertices",
-          "[lp]") {
+TEST_CASE("lp: matches GLPK's optimum on random programs with degenerate vertices", "[lp]") {
   std::mt19937 rng(20261202);
   int optimal = 0, unbounded = 0, dense_answered = 0;
   for (int trial = 0; trial < 3000; ++trial) {
@@ -95,8 +94,7 @@ TEST_CASE("lp: matches GLPK's optimum on random programs with degenerate vertice
     const Reference ref = glpk_solve(lp);
     const LpResult got = cf::gen::solve(lp);
     const LpResult dense = cf::gen::internal::dense_solve(lp);
-    INFO("trial " << trial << ", " << lp.num_vars << " variables, " << lp.rows.size()
-                  << " rows");
+    INFO("trial " << trial << ", " << lp.num_vars << " variables, " << lp.rows.size() << " rows");
     REQUIRE(ref.status != Status::kInfeasible);  // x is feasible by construction
     REQUIRE(got.status == ref.status);
     // The dense solver answers only with an optimum, never with an unbounded program's.
@@ -199,17 +197,42 @@ TEST_CASE("lp: a touching pose's program, feasible only within tolerance, is sol
   lp.lower[3] = {true, 0};
   lp.upper[3] = {true, 164.92422502470643};
   lp.add({{2, -1}, {4, 7.2164496600635175e-16}}, Rel::kEq, 15.000000612127661);
-  lp.add({{0, -0.70710678118654746}, {1, 0.70710678118654746}, {4, -0.70710681004252163}}, Rel::kGreaterEq, -21.213203002756799);
+  lp.add({{0, -0.70710678118654746}, {1, 0.70710678118654746}, {4, -0.70710681004252163}},
+         Rel::kGreaterEq, -21.213203002756799);
   lp.add({{0, 1}, {4, 0.99999999999999956}, {3, -1}}, Rel::kGreaterEq, 14.999999387872354);
   lp.add({{1, -1}, {4, 4.0808510459733327e-08}, {3, -1}}, Rel::kGreaterEq, -65.000000000000028);
   lp.add({{0, -1}, {4, -0.99999999999999956}, {3, -1}}, Rel::kGreaterEq, -34.99999938787235);
   lp.add({{4, 1}, {3, -1}}, Rel::kGreaterEq, 0);
   lp.add({{4, 1}, {3, 1}}, Rel::kLessEq, 30);
-  lp.add({{0, 1.1379786002407855e-15}, {1, 4.0808510431977751e-08}, {2, -0.99999999999999956}, {5, 1.1379786002407855e-15}}, Rel::kEq, 15.000000816170346);
-  lp.add({{0, -0.99999999999999956}, {1, 4.0808510459733327e-08}, {2, 7.2164496600635175e-16}, {5, -0.99999999999999956}, {3, -1}}, Rel::kGreaterEq, -134.99999918382974);
-  lp.add({{0, -4.0808510459733327e-08}, {1, -0.99999999999999845}, {2, -4.0808510459733327e-08}, {5, -4.0808510459733327e-08}, {3, -1}}, Rel::kGreaterEq, -35.000004897021228);
-  lp.add({{0, 0.99999999999999956}, {1, -4.0808510459733327e-08}, {2, -7.2164496600635175e-16}, {5, 0.99999999999999956}, {3, -1}}, Rel::kGreaterEq, 104.99999918382973);
-  lp.add({{0, 4.0808510459733327e-08}, {1, 0.99999999999999845}, {2, 4.0808510459733327e-08}, {5, 4.0808510459733327e-08}, {3, -1}}, Rel::kGreaterEq, 5.0000048970212241);
+  lp.add({{0, 1.1379786002407855e-15},
+          {1, 4.0808510431977751e-08},
+          {2, -0.99999999999999956},
+          {5, 1.1379786002407855e-15}},
+         Rel::kEq, 15.000000816170346);
+  lp.add({{0, -0.99999999999999956},
+          {1, 4.0808510459733327e-08},
+          {2, 7.2164496600635175e-16},
+          {5, -0.99999999999999956},
+          {3, -1}},
+         Rel::kGreaterEq, -134.99999918382974);
+  lp.add({{0, -4.0808510459733327e-08},
+          {1, -0.99999999999999845},
+          {2, -4.0808510459733327e-08},
+          {5, -4.0808510459733327e-08},
+          {3, -1}},
+         Rel::kGreaterEq, -35.000004897021228);
+  lp.add({{0, 0.99999999999999956},
+          {1, -4.0808510459733327e-08},
+          {2, -7.2164496600635175e-16},
+          {5, 0.99999999999999956},
+          {3, -1}},
+         Rel::kGreaterEq, 104.99999918382973);
+  lp.add({{0, 4.0808510459733327e-08},
+          {1, 0.99999999999999845},
+          {2, 4.0808510459733327e-08},
+          {5, 4.0808510459733327e-08},
+          {3, -1}},
+         Rel::kGreaterEq, 5.0000048970212241);
   lp.add({{5, 1}, {3, -1}}, Rel::kGreaterEq, 0);
   lp.add({{5, 1}, {3, 1}}, Rel::kLessEq, 100);
   lp.add({{0, 1}, {6, -4.0808510459733327e-08}}, Rel::kEq, 34.99999938787235);

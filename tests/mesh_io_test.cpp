@@ -34,7 +34,7 @@ using cf::test::scratch;
 using cf::test::write_file;
 
 // The 10 mm cube of tests/data/models/cube.off as points and quads.
-const std::vector<cf::Vec3> kCubeV = {{0, 0, 0},   {10, 0, 0},  {10, 10, 0}, {0, 10, 0},
+const std::vector<cf::Vec3> kCubeV = {{0, 0, 0},  {10, 0, 0},  {10, 10, 0},  {0, 10, 0},
                                       {0, 0, 10}, {10, 0, 10}, {10, 10, 10}, {0, 10, 10}};
 const std::vector<std::vector<int>> kCubeF = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
                                               {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
@@ -108,15 +108,18 @@ void check_cube(const cf::Polyhedron& m) {
 TEST_CASE("every reader loads the cube", "[mesh_io]") {
   SECTION("OFF, polygonal") { check_cube(load_model(kModels + "cube.off")); }
   SECTION("OFF, triangulated") { check_cube(load_model(kModels + "cube_tri.off")); }
-  SECTION("OBJ with texture and normal references") { check_cube(load_model(kModels + "cube.obj")); }
+  SECTION("OBJ with texture and normal references") {
+    check_cube(load_model(kModels + "cube.obj"));
+  }
   SECTION("STL ascii") { check_cube(load_model(kModels + "cube_ascii.stl")); }
   SECTION("STL binary") {
-    check_cube(load_model(write_file("cube_binary.stl", binary_stl(kCubeV, triangulate(kCubeF), "binary cube"))));
+    check_cube(load_model(
+        write_file("cube_binary.stl", binary_stl(kCubeV, triangulate(kCubeF), "binary cube"))));
   }
   SECTION("STL binary whose header starts with 'solid'") {
     // Some exporters do this; the reader falls back from ascii to binary.
-    check_cube(load_model(
-        write_file("cube_solid_header.stl", binary_stl(kCubeV, triangulate(kCubeF), "solid cube"))));
+    check_cube(load_model(write_file("cube_solid_header.stl",
+                                     binary_stl(kCubeV, triangulate(kCubeF), "solid cube"))));
   }
   SECTION("PLY ascii, polygonal") { check_cube(load_model(kModels + "cube.ply")); }
   SECTION("PLY binary little-endian, polygonal") {
@@ -139,7 +142,8 @@ TEST_CASE("every reader loads the cube", "[mesh_io]") {
     check_cube(load_model(write_file("cube_binary.ply", ply)));
   }
   SECTION("extension in upper case") {
-    fs::copy_file(kModels + "cube.off", scratch() / "CUBE.OFF", fs::copy_options::overwrite_existing);
+    fs::copy_file(kModels + "cube.off", scratch() / "CUBE.OFF",
+                  fs::copy_options::overwrite_existing);
     check_cube(load_model((scratch() / "CUBE.OFF").string()));
   }
 }
@@ -173,57 +177,82 @@ TEST_CASE("files that cannot be read are rejected, naming the file", "[mesh_io]"
   CHECK_THROWS_WITH(load_model(missing),
                     Catch::Contains("loading '" + missing + "': cannot open file: no such file"));
   fs::create_directories(scratch() / "dir.off");
-  CHECK_THROWS_WITH(load_model((scratch() / "dir.off").string()),
-                    Catch::Contains("dir.off': cannot open file: is a directory, not a regular file"));
+  CHECK_THROWS_WITH(
+      load_model((scratch() / "dir.off").string()),
+      Catch::Contains("dir.off': cannot open file: is a directory, not a regular file"));
   const std::string empty = write_file("empty.off", "");
-  CHECK_THROWS_WITH(load_model(empty), Catch::Contains("loading '" + empty + "': the file is empty"));
+  CHECK_THROWS_WITH(load_model(empty),
+                    Catch::Contains("loading '" + empty + "': the file is empty"));
   const std::string xyz = write_file("cube.xyz", off_text(kCubeV, kCubeF));
-  CHECK_THROWS_WITH(load_model(xyz),
-                    Catch::Contains("cube.xyz': unknown file extension '.xyz' (expected .off, .obj, .stl or .ply)"));
+  CHECK_THROWS_WITH(
+      load_model(xyz),
+      Catch::Contains(
+          "cube.xyz': unknown file extension '.xyz' (expected .off, .obj, .stl or .ply)"));
   const std::string noext = write_file("cube", off_text(kCubeV, kCubeF));
   CHECK_THROWS_WITH(load_model(noext), Catch::Contains("unknown file extension ''"));
 }
 
 TEST_CASE("malformed files are parse errors", "[mesh_io]") {
-  CHECK_THROWS_WITH(load_model(write_file("bad.off", "OFF\n3 1 0\n0 0 zero\n1 0 0\n0 1 0\n3 0 1 2\n")),
-                    Catch::Contains("bad.off': parse error: line 3: vertex 0: 'zero' is not a finite number"));
+  CHECK_THROWS_WITH(
+      load_model(write_file("bad.off", "OFF\n3 1 0\n0 0 zero\n1 0 0\n0 1 0\n3 0 1 2\n")),
+      Catch::Contains("bad.off': parse error: line 3: vertex 0: 'zero' is not a finite number"));
   CHECK_THROWS_WITH(load_model(write_file("bad.obj", "v 0 0 0\nbogus line\n")),
                     Catch::Contains("bad.obj': parse error: line 2: unknown OBJ record 'bogus'"));
-  CHECK_THROWS_WITH(load_model(write_file("bad.stl", "solid x\n  facet normal 0 0 1\n    outer loop\n"
-                                                    "      vertex 0 0 nope\n")),
-                    Catch::Contains("bad.stl': parse error: line 4: expected a finite number in a vertex, found 'nope'"));
-  CHECK_THROWS_WITH(load_model(write_file("bad.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
-                                                    "property float x\nend_header\n1\n")),
-                    Catch::Contains("bad.ply': parse error: the header's element counts need at least 6 bytes of data, but the file has 2 after the header"));
+  CHECK_THROWS_WITH(
+      load_model(write_file("bad.stl",
+                            "solid x\n  facet normal 0 0 1\n    outer loop\n"
+                            "      vertex 0 0 nope\n")),
+      Catch::Contains(
+          "bad.stl': parse error: line 4: expected a finite number in a vertex, found 'nope'"));
+  CHECK_THROWS_WITH(load_model(write_file("bad.ply",
+                                          "ply\nformat ascii 1.0\nelement vertex 3\n"
+                                          "property float x\nend_header\n1\n")),
+                    Catch::Contains("bad.ply': parse error: the header's element counts need at "
+                                    "least 6 bytes of data, but the file has 2 after the header"));
   // A facet index beyond the vertex list, in OFF and in OBJ (where it may point forward).
   auto f = kCubeF;
   f[0] = {0, 3, 2, 9};
   CHECK_THROWS_WITH(load_model(write_file("index.off", off_text(kCubeV, f))),
-                    Catch::Contains("index.off': parse error: line 11: facet 0 refers to vertex 9 but the file has 8 vertices (0 to 7)"));
-  CHECK_THROWS_WITH(load_model(write_file("index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n")),
-                    Catch::Contains("index.obj': parse error: facet 0 refers to vertex 3 but the file has 3 vertices"));
+                    Catch::Contains("index.off': parse error: line 11: facet 0 refers to vertex 9 "
+                                    "but the file has 8 vertices (0 to 7)"));
+  CHECK_THROWS_WITH(
+      load_model(write_file("index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n")),
+      Catch::Contains(
+          "index.obj': parse error: facet 0 refers to vertex 3 but the file has 3 vertices"));
 }
 
-TEST_CASE("header counts are checked against the file's size before anything is allocated", "[mesh_io][hostile]") {
+TEST_CASE("header counts are checked against the file's size before anything is allocated",
+          "[mesh_io][hostile]") {
   // Each of these used to allocate gigabytes (CGAL reserves what the header says).
-  CHECK_THROWS_WITH(load_model(write_file("count.off", "OFF\n3 999999999 0\n0 0 0\n1 0 0\n0 1 0\n")),
-                    Catch::Contains("count.off': parse error: the header says 3 vertices and 999999999 facets, more than the "
-                                    "remaining 18 bytes of the file can hold"));
-  CHECK_THROWS_WITH(load_model(write_file("facet.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n1000000000 0 1 2\n")),
-                    Catch::Contains("facet.off': parse error: line 6: facet 0 says it has 1000000000 vertices but its line "
-                                    "lists 3 numbers"));
-  CHECK_THROWS_WITH(load_model(write_file("count.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\n"
-                                                      "property float x\nproperty float y\nproperty float z\nend_header\n")),
-                    Catch::Contains("count.ply': parse error: the header's element counts need at least 48000000000 bytes"));
-  CHECK_THROWS_WITH(load_model(write_file("list.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 0\n"
-                                                     "property float x\nproperty float y\nproperty float z\nelement face 1\n"
-                                                     "property list uint int vertex_indices\nend_header\n\xff\xff\xff\x7f")),
-                    Catch::Contains("list.ply': parse error: item 0 of element 'face' has a list of 2147483647 values, more than "
-                                    "the rest of the file holds"));
+  CHECK_THROWS_WITH(
+      load_model(write_file("count.off", "OFF\n3 999999999 0\n0 0 0\n1 0 0\n0 1 0\n")),
+      Catch::Contains(
+          "count.off': parse error: the header says 3 vertices and 999999999 facets, more than the "
+          "remaining 18 bytes of the file can hold"));
+  CHECK_THROWS_WITH(
+      load_model(write_file("facet.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n1000000000 0 1 2\n")),
+      Catch::Contains(
+          "facet.off': parse error: line 6: facet 0 says it has 1000000000 vertices but its line "
+          "lists 3 numbers"));
+  CHECK_THROWS_WITH(
+      load_model(write_file("count.ply",
+                            "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\n"
+                            "property float x\nproperty float y\nproperty float z\nend_header\n")),
+      Catch::Contains(
+          "count.ply': parse error: the header's element counts need at least 48000000000 bytes"));
+  CHECK_THROWS_WITH(
+      load_model(write_file("list.ply",
+                            "ply\nformat binary_little_endian 1.0\nelement vertex 0\n"
+                            "property float x\nproperty float y\nproperty float z\nelement face 1\n"
+                            "property list uint int vertex_indices\nend_header\n\xff\xff\xff\x7f")),
+      Catch::Contains("list.ply': parse error: item 0 of element 'face' has a list of 2147483647 "
+                      "values, more than "
+                      "the rest of the file holds"));
   std::string stl(80, ' ');
   stl += std::string("\xff\xff\xff\x7f", 4);
   CHECK_THROWS_WITH(load_model(write_file("count.stl", stl)),
-                    Catch::Contains("count.stl': parse error: not an ascii STL (no 'solid'), and as binary STL its header says "
+                    Catch::Contains("count.stl': parse error: not an ascii STL (no 'solid'), and "
+                                    "as binary STL its header says "
                                     "2147483647 triangles"));
 }
 
@@ -232,40 +261,56 @@ TEST_CASE("indices and coordinates out of range get precise messages", "[mesh_io
   std::string text = off_text(kCubeV, f);
   text.replace(text.find("\n4 0 3 2 1\n"), 11, "\n4 99999999999999999999 3 2 1\n");
   CHECK_THROWS_WITH(load_model(write_file("index20.off", text)),
-                    Catch::Contains("index20.off': parse error: line 11: facet 0 refers to vertex 99999999999999999999 but the "
+                    Catch::Contains("index20.off': parse error: line 11: facet 0 refers to vertex "
+                                    "99999999999999999999 but the "
                                     "file has 8 vertices (0 to 7)"));
-  CHECK_THROWS_WITH(load_model(write_file("index20.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n")),
-                    Catch::Contains("index20.obj': parse error: line 4: facet 0 refers to vertex 99999999999999999999, which "
-                                    "does not exist"));
+  CHECK_THROWS_WITH(
+      load_model(
+          write_file("index20.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n")),
+      Catch::Contains(
+          "index20.obj': parse error: line 4: facet 0 refers to vertex 99999999999999999999, which "
+          "does not exist"));
   std::vector<cf::Vec3> v = kCubeV;
   for (auto& p : v) p *= 1e300;
   CHECK_THROWS_WITH(load_model(write_file("huge.off", off_text(v, kCubeF))),
-                    Catch::Contains("huge.off': vertex 1 has the coordinate 1e+301 mm, beyond the largest accepted (|x| <= 1e+09 mm)"));
-  CHECK_THROWS_WITH(load_model(write_file("inf.off", "OFF\n3 1 0\n0 0 0\n1e999 0 0\n0 1 0\n3 0 1 2\n")),
-                    Catch::Contains("inf.off': parse error: line 4: vertex 1: '1e999' is not a finite number"));
+                    Catch::Contains("huge.off': vertex 1 has the coordinate 1e+301 mm, beyond the "
+                                    "largest accepted (|x| <= 1e+09 mm)"));
+  CHECK_THROWS_WITH(
+      load_model(write_file("inf.off", "OFF\n3 1 0\n0 0 0\n1e999 0 0\n0 1 0\n3 0 1 2\n")),
+      Catch::Contains("inf.off': parse error: line 4: vertex 1: '1e999' is not a finite number"));
   // Found by fuzz_ply: an index beyond the range of long long (the message's cast was
   // undefined behaviour), and a NaN in binary PLY (it broke the ordering of the point index).
-  const std::string ply_head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                               "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                               "0 0 0\n1 0 0\n0 1 0\n";
-  CHECK_THROWS_WITH(load_model(write_file("index_huge.ply", ply_head + "3 0 1 1" + std::string(40, '1') + "\n")),
-                    Catch::Contains("index_huge.ply': parse error: facet 0 refers to vertex 1.111111111111111e+40, which does "
-                                    "not exist"));
-  std::string nan_ply = "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-                        "property float z\nend_header\n";
+  const std::string ply_head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n";
+  CHECK_THROWS_WITH(
+      load_model(write_file("index_huge.ply", ply_head + "3 0 1 1" + std::string(40, '1') + "\n")),
+      Catch::Contains("index_huge.ply': parse error: facet 0 refers to vertex "
+                      "1.111111111111111e+40, which does "
+                      "not exist"));
+  std::string nan_ply =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n";
   const float nan_xyz[3] = {std::nanf(""), 0, 0};
   nan_ply.append(reinterpret_cast<const char*>(nan_xyz), sizeof nan_xyz);
-  CHECK_THROWS_WITH(load_model(write_file("nan.ply", nan_ply)),
-                    Catch::Contains("nan.ply': parse error: a property value in the binary data is not a finite number"));
+  CHECK_THROWS_WITH(
+      load_model(write_file("nan.ply", nan_ply)),
+      Catch::Contains(
+          "nan.ply': parse error: a property value in the binary data is not a finite number"));
   // Binary garbage is quoted printable.
-  CHECK_THROWS_WITH(load_model(write_file("garbage.obj", "v 0 0 0\n\x01\x1b[2J\xff x\n")),
-                    Catch::Contains("garbage.obj': parse error: line 2: unknown OBJ record '\\x01\\x1B[2J\\xFF'"));
+  CHECK_THROWS_WITH(
+      load_model(write_file("garbage.obj", "v 0 0 0\n\x01\x1b[2J\xff x\n")),
+      Catch::Contains(
+          "garbage.obj': parse error: line 2: unknown OBJ record '\\x01\\x1B[2J\\xFF'"));
 }
 
 TEST_CASE("a FIFO is refused without blocking", "[mesh_io][hostile]") {
   const std::string fifo = (scratch() / "fifo.off").string();
   REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
-  CHECK_THROWS_WITH(load_model(fifo), Catch::Contains("fifo.off': cannot open file: is a FIFO (named pipe), not a regular file"));
+  CHECK_THROWS_WITH(
+      load_model(fifo),
+      Catch::Contains("fifo.off': cannot open file: is a FIFO (named pipe), not a regular file"));
 }
 
 TEST_CASE("units: the points are converted to mm", "[mesh_io][units]") {
@@ -278,13 +323,16 @@ TEST_CASE("units: the points are converted to mm", "[mesh_io][units]") {
   const cf::Polyhedron raw = load_model(path);
   CHECK(raw.size() == Approx(0.01 * std::sqrt(3.0)));
   CHECK_THAT(cf::tools::size_warning(raw, "A", "--units-a"),
-             Catch::StartsWith("model A 'cube_m' is 0.01732 mm across (bounding-box diagonal), small against the contact "
-                               "threshold epsilon = 1 mm") && Catch::EndsWith("give its unit with --units-a (mm, cm, m or in)"));
+             Catch::StartsWith("model A 'cube_m' is 0.01732 mm across (bounding-box diagonal), "
+                               "small against the contact "
+                               "threshold epsilon = 1 mm") &&
+                 Catch::EndsWith("give its unit with --units-a (mm, cm, m or in)"));
   CHECK(cf::tools::size_warning(load_model(path, opt), "A", "--units-a").empty());
   opt.units = "in";
   CHECK(load_model(path, opt).size() == Approx(0.01 * 25.4 * std::sqrt(3.0)));
   opt.units = "furlong";
-  CHECK_THROWS_WITH(load_model(path, opt), Catch::Contains("unknown unit 'furlong' (expected mm, cm, m or in)"));
+  CHECK_THROWS_WITH(load_model(path, opt),
+                    Catch::Contains("unknown unit 'furlong' (expected mm, cm, m or in)"));
 }
 
 TEST_CASE("a file without facets is rejected", "[mesh_io]") {
@@ -298,8 +346,9 @@ TEST_CASE("broken solids are rejected with the reason", "[mesh_io]") {
   SECTION("open boundary") {
     auto f = kCubeF;
     f.pop_back();  // no x = 0 side
-    CHECK_THROWS_WITH(load_model(write_file("open.off", off_text(kCubeV, f))),
-                      Catch::Contains("open.off': open boundary: edge 0-3 belongs to facet 0 only"));
+    CHECK_THROWS_WITH(
+        load_model(write_file("open.off", off_text(kCubeV, f))),
+        Catch::Contains("open.off': open boundary: edge 0-3 belongs to facet 0 only"));
   }
   SECTION("non-manifold edge: two cubes sharing an edge") {
     // Second cube [10,20] x [10,20] x [0,10] shares the cube's edge 2-6 (x = y = 10).
@@ -313,8 +362,9 @@ TEST_CASE("broken solids are rejected with the reason", "[mesh_io]") {
     // Weld the second cube's corners (10,10,z) = points 8 and 12 onto points 2 and 6.
     for (auto& q : f)
       for (int& i : q) i = i == 8 ? 2 : i == 12 ? 6 : i;
-    CHECK_THROWS_WITH(load_model(write_file("nm_edge.off", off_text(v, f))),
-                      Catch::Contains("nm_edge.off': non-manifold edge: edge 2-6 is shared by 4 facets"));
+    CHECK_THROWS_WITH(
+        load_model(write_file("nm_edge.off", off_text(v, f))),
+        Catch::Contains("nm_edge.off': non-manifold edge: edge 2-6 is shared by 4 facets"));
   }
   SECTION("non-manifold vertex: two cubes sharing a corner") {
     std::vector<cf::Vec3> v = kCubeV;
@@ -324,20 +374,23 @@ TEST_CASE("broken solids are rejected with the reason", "[mesh_io]") {
       for (int& i : q) i = i == 0 ? 6 : i + 8;  // its corner 0 is the cube's corner 6
       f.push_back(q);
     }
-    CHECK_THROWS_WITH(load_model(write_file("nm_vertex.off", off_text(v, f))),
-                      Catch::Contains("nm_vertex.off': non-manifold vertex: vertex 6 joins separate fans"));
+    CHECK_THROWS_WITH(
+        load_model(write_file("nm_vertex.off", off_text(v, f))),
+        Catch::Contains("nm_vertex.off': non-manifold vertex: vertex 6 joins separate fans"));
   }
   SECTION("inconsistent orientation: one facet flipped") {
     auto f = kCubeF;
     std::reverse(f[1].begin(), f[1].end());
-    CHECK_THROWS_WITH(load_model(write_file("flipped.off", off_text(kCubeV, f))),
-                      Catch::Contains("flipped.off': inconsistent orientation: facets 1 and 2 both run edge"));
+    CHECK_THROWS_WITH(
+        load_model(write_file("flipped.off", off_text(kCubeV, f))),
+        Catch::Contains("flipped.off': inconsistent orientation: facets 1 and 2 both run edge"));
   }
   SECTION("inward orientation") {
     auto f = kCubeF;
     for (auto& q : f) std::reverse(q.begin(), q.end());
-    CHECK_THROWS_WITH(load_model(write_file("inward.off", off_text(kCubeV, f))),
-                      Catch::Contains("inward.off': inward orientation: the enclosed volume is -1000 mm^3"));
+    CHECK_THROWS_WITH(
+        load_model(write_file("inward.off", off_text(kCubeV, f))),
+        Catch::Contains("inward.off': inward orientation: the enclosed volume is -1000 mm^3"));
   }
   SECTION("self-intersection") {
     // Triangulated cube with its top corner (10,10,10) pulled down through the bottom.
@@ -349,8 +402,9 @@ TEST_CASE("broken solids are rejected with the reason", "[mesh_io]") {
   SECTION("degenerate facet: repeated vertex") {
     auto f = kCubeF;
     f[0] = {0, 3, 3, 2, 1};
-    CHECK_THROWS_WITH(load_model(write_file("repeat.off", off_text(kCubeV, f))),
-                      Catch::Contains("repeat.off': degenerate facet: facet 0 uses vertex 3 more than once"));
+    CHECK_THROWS_WITH(
+        load_model(write_file("repeat.off", off_text(kCubeV, f))),
+        Catch::Contains("repeat.off': degenerate facet: facet 0 uses vertex 3 more than once"));
   }
   SECTION("degenerate facet: fewer than 3 vertices") {
     auto f = kCubeF;

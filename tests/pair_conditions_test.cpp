@@ -1,7 +1,8 @@
-// Tests of the generator's necessary conditions on two PCs (tools/cfgen/decide/pair_conditions.cpp):
-// spherical distances worked out by hand on a cube's normal cones, rejections on the cube
-// against the L-block that follow from one measurement each, and soundness on every CF of the
-// bundled graphs (their witnesses were verified apart from these conditions).
+// Tests of the generator's necessary conditions on two PCs
+// (tools/cfgen/decide/pair_conditions.cpp): spherical distances worked out by hand on a cube's
+// normal cones, rejections on the cube against the L-block that follow from one measurement each,
+// and soundness on every CF of the bundled graphs (their witnesses were verified apart from these
+// conditions).
 
 #include "cfgen/decide/pair_conditions.hpp"
 #include "analysed_pair.hpp"
@@ -26,15 +27,20 @@ namespace {
 
 // Closed-form angles evaluated with atan2 on unit vectors: rounding only.
 constexpr double kAngle = 1e-12;
-// Widening used by the generator (tools/cfgen/enumerate/levels.cpp): far above rounding, far below its margins.
+// Widening used by the generator (tools/cfgen/enumerate/levels.cpp): far above rounding, far below
+// its margins.
 constexpr double kLengthTol = 1e-9;
 constexpr double kAngleTol = 1e-9;
 
-std::string model(const std::string& name) { return std::string(CF_SOURCE_DIR) + "/data/models/" + name; }
+std::string model(const std::string& name) {
+  return std::string(CF_SOURCE_DIR) + "/data/models/" + name;
+}
 
 using Pair = cf::test::AnalysedPair;
 
-cf::gen::PairConditions exact_conditions(const Pair& p) { return {p.ai, p.bi, kLengthTol, kAngleTol}; }
+cf::gen::PairConditions exact_conditions(const Pair& p) {
+  return {p.ai, p.bi, kLengthTol, kAngleTol};
+}
 
 double bbox_diagonal(const Polyhedron& m) {
   Vec3 lo = m.vertices()[0].p, hi = lo;
@@ -46,7 +52,8 @@ double bbox_diagonal(const Polyhedron& m) {
 
 TEST_CASE("the normal cones of a cube: a face's normal, an edge's arc, a corner's octant") {
   // Cube [-15, 15]^3 (data/models/cube.off).
-  const Pair p(cf::tools::load_model(model("cube.off")), cf::tools::load_model(model("l_block.off")));
+  const Pair p(cf::tools::load_model(model("cube.off")),
+               cf::tools::load_model(model("l_block.off")));
   const auto pc = exact_conditions(p);
   const int corner = cf::test::vertex_at(p.A, Vec3(15, 15, 15));
   REQUIRE(corner >= 0);
@@ -58,7 +65,8 @@ TEST_CASE("the normal cones of a cube: a face's normal, an edge's arc, a corner'
   }
   const Vec3 diag = Vec3(1, 1, 1).normalized();
   CHECK(cf::gen::cone_distance(diag, octant, kAngleTol) == 0);
-  CHECK(cf::gen::cone_distance(Vec3(-1, 0, 0), octant, kAngleTol) == Approx(M_PI / 2).margin(kAngle));
+  CHECK(cf::gen::cone_distance(Vec3(-1, 0, 0), octant, kAngleTol) ==
+        Approx(M_PI / 2).margin(kAngle));
   // (1, 1, -1) is nearest to (1, 1, 0) on the octant's boundary: acos(sqrt(2/3)).
   CHECK(cf::gen::cone_distance(Vec3(1, 1, -1).normalized(), octant, kAngleTol) ==
         Approx(std::acos(std::sqrt(2.0 / 3.0))).margin(kAngle));
@@ -73,7 +81,8 @@ TEST_CASE("the normal cones of a cube: a face's normal, an edge's arc, a corner'
   const NormalCone& arc = pc.cone(true, ElementKind::kEdge, edge);
   REQUIRE(arc.gens.size() == 2);
   CHECK(cf::gen::cone_distance(Vec3(0, 0, 1), arc, kAngleTol) == Approx(M_PI / 2).margin(kAngle));
-  CHECK(cf::gen::cone_distance(diag, arc, kAngleTol) == Approx(std::asin(1 / std::sqrt(3.0))).margin(kAngle));
+  CHECK(cf::gen::cone_distance(diag, arc, kAngleTol) ==
+        Approx(std::asin(1 / std::sqrt(3.0))).margin(kAngle));
   CHECK(cf::gen::cone_distance(Vec3(-1, 0, 0), arc, kAngleTol) == Approx(M_PI / 2).margin(kAngle));
   CHECK(cf::gen::cone_distance(Vec3(-1, -1, 0).normalized(), arc, kAngleTol) ==
         Approx(3 * M_PI / 4).margin(kAngle));
@@ -81,8 +90,8 @@ TEST_CASE("the normal cones of a cube: a face's normal, an edge's arc, a corner'
   // Two opposite corners' octants: u >= 0 and v <= 0 componentwise give u . v <= 0.
   const int opposite = cf::test::vertex_at(p.A, Vec3(-15, -15, -15));
   REQUIRE(opposite >= 0);
-  CHECK(cf::gen::cone_cone_distance(octant, pc.cone(true, ElementKind::kVertex, opposite), kAngleTol) ==
-        Approx(M_PI / 2).margin(kAngle));
+  CHECK(cf::gen::cone_cone_distance(octant, pc.cone(true, ElementKind::kVertex, opposite),
+                                    kAngleTol) == Approx(M_PI / 2).margin(kAngle));
   // An octant and its own edge's arc meet.
   CHECK(cf::gen::cone_cone_distance(octant, arc, kAngleTol) == 0);
 }
@@ -90,7 +99,8 @@ TEST_CASE("the normal cones of a cube: a face's normal, an edge's arc, a corner'
 TEST_CASE("two PCs are rejected when a distance, an angle or a height has no common value") {
   // A: cube [-15, 15]^3. B: the L-block, slab 0 <= y <= 20 over x in [0, 120], wall
   // 0 <= x <= 20 up to y = 80, both 80 deep along z.
-  const Pair p(cf::tools::load_model(model("cube.off")), cf::tools::load_model(model("l_block.off")));
+  const Pair p(cf::tools::load_model(model("cube.off")),
+               cf::tools::load_model(model("l_block.off")));
   const auto pc = exact_conditions(p);
   const int a_bottom = cf::test::face_with_plane(p.A, Vec3(0, -1, 0), 15);
   const int a_top = cf::test::face_with_plane(p.A, Vec3(0, 1, 0), 15);
@@ -105,33 +115,39 @@ TEST_CASE("two PCs are rejected when a distance, an angle or a height has no com
   CHECK(pc.compatible(Pc{PcType::kFF, a_bottom, slab_top}, Pc{PcType::kFF, a_left, wall_side}));
   // Angle: A's bottom and top are antiparallel (pi), the slab's top and the wall's side are
   // at pi/2.
-  CHECK_FALSE(pc.compatible(Pc{PcType::kFF, a_bottom, slab_top}, Pc{PcType::kFF, a_top, wall_side}));
+  CHECK_FALSE(
+      pc.compatible(Pc{PcType::kFF, a_bottom, slab_top}, Pc{PcType::kFF, a_top, wall_side}));
   // Distance: the wall's side (x = 20, y >= 20) and the slab's far end (x = 120, y <= 20)
   // are 100 mm apart, more than the cube's diagonal (52 mm); a corner of A's left face
   // cannot reach the end. (A height over either plane is at most that distance, so the
   // heights reject it too.)
   const int left_corner = cf::test::vertex_at(p.A, Vec3(-15, 15, 15));
   REQUIRE(left_corner >= 0);
-  CHECK_FALSE(pc.compatible(Pc{PcType::kFF, a_left, wall_side}, Pc{PcType::kVF, left_corner, slab_end}));
+  CHECK_FALSE(
+      pc.compatible(Pc{PcType::kFF, a_left, wall_side}, Pc{PcType::kVF, left_corner, slab_end}));
   CHECK(pc.compatible(Pc{PcType::kFF, a_left, wall_side}, Pc{PcType::kVF, left_corner, slab_top}));
   // Height: with the cube's bottom on the slab (y = 20), its top vertices are at y = 50, but
   // the wall's top is at y = 80 (its distance from the slab's top, 60 mm, is within the
   // cube's diagonal, so only the height tells).
   const int top_corner = cf::test::vertex_at(p.A, Vec3(15, 15, 15));
   REQUIRE(top_corner >= 0);
-  CHECK_FALSE(pc.compatible(Pc{PcType::kFF, a_bottom, slab_top}, Pc{PcType::kVF, top_corner, wall_top}));
-  CHECK_FALSE(pc.compatible(Pc{PcType::kVF, top_corner, wall_top}, Pc{PcType::kFF, a_bottom, slab_top}));
+  CHECK_FALSE(
+      pc.compatible(Pc{PcType::kFF, a_bottom, slab_top}, Pc{PcType::kVF, top_corner, wall_top}));
+  CHECK_FALSE(
+      pc.compatible(Pc{PcType::kVF, top_corner, wall_top}, Pc{PcType::kFF, a_bottom, slab_top}));
   // The same corner against the wall's side: heights 0 to 60 over the slab hold 30.
   CHECK(pc.compatible(Pc{PcType::kFF, a_bottom, slab_top}, Pc{PcType::kVF, top_corner, wall_side}));
 }
 
 TEST_CASE("the cones shrunk by the verified slack exclude normals at a cone's boundary") {
-  const Pair p(cf::tools::load_model(model("cube.off")), cf::tools::load_model(model("l_block.off")));
+  const Pair p(cf::tools::load_model(model("cube.off")),
+               cf::tools::load_model(model("l_block.off")));
   constexpr double kMargin = 5e-4;  // rad, about the generator's default (half of 1e-3)
   const cf::gen::PairConditions shrunk(p.ai, p.bi, kLengthTol, kAngleTol, kMargin);
   const double s = std::sin(kMargin);
   // The corner (15, 15, 15): the octant u >= sin(margin) componentwise, corners (s, s, c).
-  const NormalCone& octant = shrunk.cone(true, ElementKind::kVertex, cf::test::vertex_at(p.A, Vec3(15, 15, 15)));
+  const NormalCone& octant =
+      shrunk.cone(true, ElementKind::kVertex, cf::test::vertex_at(p.A, Vec3(15, 15, 15)));
   REQUIRE(octant.gens.size() == 3);
   for (const Vec3& g : octant.gens) {
     CHECK(g.minCoeff() == Approx(s).margin(kAngle));
@@ -165,10 +181,11 @@ TEST_CASE("every pair of PCs of every CF of the bundled graphs passes") {
     INFO(name);
     const cf::CfGraph g = cf::CfGraph::load(std::string(CF_SOURCE_DIR) + "/data/graphs/" + name);
     const Pair p(g.model_a(), g.model_b());
-    // As enumerate/levels.cpp builds them for the default --angle-margin (1e-3 rad) and --min-margin
-    // (2e-4 of the smaller model's bounding-box diagonal).
+    // As enumerate/levels.cpp builds them for the default --angle-margin (1e-3 rad) and
+    // --min-margin (2e-4 of the smaller model's bounding-box diagonal).
     const double diag = std::min(bbox_diagonal(p.A), bbox_diagonal(p.B));
-    const cf::gen::PairConditions pc(p.ai, p.bi, kLengthTol, kAngleTol, std::asin(0.5 * std::sin(1e-3)) - kAngleTol,
+    const cf::gen::PairConditions pc(p.ai, p.bi, kLengthTol, kAngleTol,
+                                     std::asin(0.5 * std::sin(1e-3)) - kAngleTol,
                                      0.5 * 2e-4 * diag);
     std::size_t pairs = 0, rejected = 0;
     for (std::size_t i = 0; i < g.num_cfs(); ++i) {
@@ -187,7 +204,8 @@ TEST_CASE("every pair of PCs of every CF of the bundled graphs passes") {
   }
 }
 
-TEST_CASE("contact points inside their elements: faces that meet only at B's convex edge are rejected") {
+TEST_CASE(
+    "contact points inside their elements: faces that meet only at B's convex edge are rejected") {
   // The cube's top (+z) against the L-block's end (z = 0, outward -z) and its front (+y)
   // against the block's underside (y = 0, outward -y). The end and the underside meet at
   // their common edge, so the two contacts hold at once only on that edge: on the boundary
@@ -195,14 +213,16 @@ TEST_CASE("contact points inside their elements: faces that meet only at B's con
   // faces all allow it; over the points the generator's margin inside the faces, the cube's
   // front lies at heights of at least that margin behind the end's plane, the underside's
   // points at least that margin in front of it.
-  const Pair p(cf::tools::load_model(model("cube.off")), cf::tools::load_model(model("l_block.off")));
+  const Pair p(cf::tools::load_model(model("cube.off")),
+               cf::tools::load_model(model("l_block.off")));
   const int a_top = cf::test::face_with_plane(p.A, Vec3(0, 0, 1), 15);
   const int a_front = cf::test::face_with_plane(p.A, Vec3(0, 1, 0), 15);
   const int b_end = cf::test::face_with_plane(p.B, Vec3(0, 0, -1), 0);
   const int b_under = cf::test::face_with_plane(p.B, Vec3(0, -1, 0), 0);
   REQUIRE(std::min({a_top, a_front, b_end, b_under}) >= 0);
   const Pc x{PcType::kFF, a_top, b_end}, y{PcType::kFF, a_front, b_under};
-  constexpr double kContactMargin = 0.005;  // mm, half the default min_margin for the cube (2e-4 x 52 mm)
+  constexpr double kContactMargin =
+      0.005;  // mm, half the default min_margin for the cube (2e-4 x 52 mm)
   const cf::gen::PairConditions inside(p.ai, p.bi, kLengthTol, kAngleTol, 0, kContactMargin);
   CHECK(exact_conditions(p).compatible(x, y));
   CHECK_FALSE(inside.compatible(x, y));

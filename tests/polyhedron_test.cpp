@@ -1,5 +1,5 @@
-#include "fixtures.hpp"
 #include <cf/polyhedron.hpp>
+#include "fixtures.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -35,7 +35,9 @@ TEST_CASE("a box has the planes, convexity and mass properties of a box", "[poly
 TEST_CASE("a model with an inward orientation is rejected", "[polyhedron]") {
   std::vector<cf::Vec3> v = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   std::vector<std::array<int, 2>> e = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-  std::vector<std::vector<std::vector<int>>> inward = {{{0, 1, 2}}, {{0, 3, 1}}, {{0, 2, 3}}, {{1, 3, 2}}};
-  CHECK_THROWS_WITH(cf::Polyhedron::from_features("t", v, e, inward),
-                    Catch::Contains("model 't': encloses a non-positive volume: faces are oriented inward"));
+  std::vector<std::vector<std::vector<int>>> inward = {
+      {{0, 1, 2}}, {{0, 3, 1}}, {{0, 2, 3}}, {{1, 3, 2}}};
+  CHECK_THROWS_WITH(
+      cf::Polyhedron::from_features("t", v, e, inward),
+      Catch::Contains("model 't': encloses a non-positive volume: faces are oriented inward"));
 }

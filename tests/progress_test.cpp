@@ -1,5 +1,5 @@
-// cfgen's progress display (tools/cfgen/execute/progress.hpp): what a person sees on a terminal and in
-// a log file.
+// cfgen's progress display (tools/cfgen/execute/progress.hpp): what a person sees on a terminal and
+// in a log file.
 #include "cfgen/execute/progress.hpp"
 
 #include <catch2/catch.hpp>
@@ -28,10 +28,12 @@ TEST_CASE("durations read as people write them", "[progress]") {
 
 TEST_CASE("a stage under way shows the rate and the time left", "[progress]") {
   // 250 of 1000 in 2 s: 125/s, 750 left take 6 s.
-  CHECK(cf::gen::progress_line(tick(250, 2.0)) == "level 2: 250/1000 candidate sets, 125/s, 6.0 s left");
+  CHECK(cf::gen::progress_line(tick(250, 2.0)) ==
+        "level 2: 250/1000 candidate sets, 125/s, 6.0 s left");
   // Nothing done yet: no rate to show.
   CHECK(cf::gen::progress_line(tick(0, 0.5)) == "level 2: 0/1000 candidate sets");
-  CHECK(cf::gen::progress_line(end_of_stage()) == "level 2: 1000 candidate sets, 16 valid in 8.0 s");
+  CHECK(cf::gen::progress_line(end_of_stage()) ==
+        "level 2: 1000 candidate sets, 16 valid in 8.0 s");
 }
 
 TEST_CASE("on a terminal, one line is rewritten in place", "[progress]") {

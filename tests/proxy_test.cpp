@@ -197,7 +197,8 @@ TEST_CASE("a region pressed harder and pulled within its new static limit sticks
   CHECK(res.X_WP.t_BA.x() == Approx(70).margin(1e-6));
   CHECK(res.X_WP.t_BA.y() == Approx(35).margin(kDelta));
   bool sliding = false;
-  for (int j = 0; j < res.proxy->num_contacts; ++j) sliding = sliding || res.proxy->contacts[j].sliding;
+  for (int j = 0; j < res.proxy->num_contacts; ++j)
+    sliding = sliding || res.proxy->contacts[j].sliding;
   CHECK_FALSE(sliding);
 }
 
@@ -208,9 +209,9 @@ TEST_CASE("with more point contacts than a solve holds, the nearest are kept and
   // solve's ProxyResult::kMaxContacts. Pressing 6 mm in, the proxy must still not sink into
   // B: the nearest contacts are the ones that bind.
   namespace tm = cf::testmodels;
-  const cf::CfGraph g = cf::CfGraph::from_parts(tm::faceted_sphere(30, 40, 50, cf::Vec3::Zero(), "sphere2000"),
-                                                tm::faceted_sphere(50, 42, 48, cf::Vec3::Zero(), "sphere2016"),
-                                                {}, {});
+  const cf::CfGraph g = cf::CfGraph::from_parts(
+      tm::faceted_sphere(30, 40, 50, cf::Vec3::Zero(), "sphere2000"),
+      tm::faceted_sphere(50, 42, 48, cf::Vec3::Zero(), "sphere2016"), {}, {});
   cf::Params p;
   p.epsilon_mm = p.detection.max_penetration_mm = 4.0;
   cf::HapticRenderer r(g, p);
@@ -225,7 +226,8 @@ TEST_CASE("with more point contacts than a solve holds, the nearest are kept and
     X.t_BA = dir * (80 + 2 - 8.0 * i / 400);  // from 2 mm apart to 6 mm in
     const cf::HapticResult& res = r.step(X, t += 0.001);
     most_dropped = std::max(most_dropped, res.proxy->dropped_contacts);
-    if (res.proxy->dropped_contacts > 0) CHECK(res.proxy->num_contacts == cf::ProxyResult::kMaxContacts);
+    if (res.proxy->dropped_contacts > 0)
+      CHECK(res.proxy->num_contacts == cf::ProxyResult::kMaxContacts);
     det.detect(res.X_WP, cs);
     for (const cf::ContactPc& c : cs) deepest = std::max(deepest, -c.distance);
   }

@@ -10,10 +10,10 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cstdio>
-#include <memory>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <new>
 #include <set>
 
@@ -44,20 +44,43 @@ using cf::test::from_loops;
 
 // data/models/cube.off: 30 mm, centred on its origin.
 cf::Polyhedron cube() {
-  return from_loops("cube",
-                    {{-15, -15, -15}, {15, -15, -15}, {15, 15, -15}, {-15, 15, -15},
-                     {-15, -15, 15}, {15, -15, 15}, {15, 15, 15}, {-15, 15, 15}},
-                    {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}});
+  return from_loops(
+      "cube",
+      {{-15, -15, -15},
+       {15, -15, -15},
+       {15, 15, -15},
+       {-15, 15, -15},
+       {-15, -15, 15},
+       {15, -15, 15},
+       {15, 15, 15},
+       {-15, 15, 15}},
+      {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}});
 }
 
 // data/models/l_block.off: slab y in [0,20] over x in [0,120], wall x in [0,20] up to
 // y = 80, z in [0,80]. Face 4 is the floor (y = 20), face 5 the inner wall (x = 20).
 cf::Polyhedron l_block() {
   return from_loops("l_block",
-                    {{0, 0, 0}, {120, 0, 0}, {120, 20, 0}, {20, 20, 0}, {20, 80, 0}, {0, 80, 0},
-                     {0, 0, 80}, {120, 0, 80}, {120, 20, 80}, {20, 20, 80}, {20, 80, 80}, {0, 80, 80}},
-                    {{5, 4, 3, 2, 1, 0}, {6, 7, 8, 9, 10, 11}, {0, 1, 7, 6}, {1, 2, 8, 7},
-                     {2, 3, 9, 8}, {3, 4, 10, 9}, {4, 5, 11, 10}, {5, 0, 6, 11}});
+                    {{0, 0, 0},
+                     {120, 0, 0},
+                     {120, 20, 0},
+                     {20, 20, 0},
+                     {20, 80, 0},
+                     {0, 80, 0},
+                     {0, 0, 80},
+                     {120, 0, 80},
+                     {120, 20, 80},
+                     {20, 20, 80},
+                     {20, 80, 80},
+                     {0, 80, 80}},
+                    {{5, 4, 3, 2, 1, 0},
+                     {6, 7, 8, 9, 10, 11},
+                     {0, 1, 7, 6},
+                     {1, 2, 8, 7},
+                     {2, 3, 9, 8},
+                     {3, 4, 10, 9},
+                     {4, 5, 11, 10},
+                     {5, 0, 6, 11}});
 }
 
 const cf::Pc kFloor{cf::PcType::kFF, 2, 4};  // cube bottom on the floor
@@ -114,7 +137,7 @@ std::unique_ptr<cf::Identification> identification(int cf, const std::vector<cf:
                                                    const std::vector<cf::ContactPc>& detected) {
   auto id = std::make_unique<cf::Identification>();
   id->cf = cf::CfId(cf);
-  id->status = cf >= 0 ? cf::IdStatus::kMatchedByFit
+  id->status = cf >= 0            ? cf::IdStatus::kMatchedByFit
                : detected.empty() ? cf::IdStatus::kNoContact
                                   : cf::IdStatus::kOutsideGraph;
   for (const cf::ContactPc& c : cf_pcs) {
@@ -131,7 +154,8 @@ TEST_CASE("renderer bookkeeping: CF, motion and status over given identification
   const cf::CfGraph g = corner_graph();
   cf::HapticRenderer r(g);
   double t = 0;
-  auto tick = [&](const cf::Pose& p, int cf, std::vector<cf::ContactPc> pcs) -> const cf::HapticResult& {
+  auto tick = [&](const cf::Pose& p, int cf,
+                  std::vector<cf::ContactPc> pcs) -> const cf::HapticResult& {
     t += 0.001;
     return r.step_identified(p, t, *identification(cf, pcs, pcs));
   };
@@ -169,7 +193,8 @@ TEST_CASE("renderer bookkeeping: CF, motion and status over given identification
   // Contacts that no CF fits.
   std::vector<cf::ContactPc> odd = {floor_pc(at(35.5, 35.5, 40))};
   t += 0.001;
-  const cf::HapticResult& nf = r.step_identified(at(35.5, 35.5, 40), t, *identification(-1, {}, odd));
+  const cf::HapticResult& nf =
+      r.step_identified(at(35.5, 35.5, 40), t, *identification(-1, {}, odd));
   CHECK(nf.status == cf::RenderStatus::kNoFittingCf);
   CHECK(std::string(nf.identification) == "outside-graph");
   CHECK(nf.cf == cf::CfId());
@@ -177,7 +202,8 @@ TEST_CASE("renderer bookkeeping: CF, motion and status over given identification
   CHECK(std::string(cf::to_string(nf.status)) == "no_fitting_cf");
 }
 
-TEST_CASE("full servo step: the cube lands on the L-block floor and slides into the corner", "[renderer]") {
+TEST_CASE("full servo step: the cube lands on the L-block floor and slides into the corner",
+          "[renderer]") {
   const cf::CfGraph g = corner_graph();
   cf::HapticRenderer r(g);
   double t = 0;
@@ -210,7 +236,8 @@ TEST_CASE("full servo step: the cube lands on the L-block floor and slides into 
   CHECK(res->status == cf::RenderStatus::kOk);
 }
 
-TEST_CASE("one parameter tree: epsilon, detection and identification reach the renderer's stages", "[renderer]") {
+TEST_CASE("one parameter tree: epsilon, detection and identification reach the renderer's stages",
+          "[renderer]") {
   const cf::CfGraph g = corner_graph();
   cf::Params P;
   P.epsilon_mm = 0.3;  // one epsilon: the detector's band and eq. (1)
@@ -230,13 +257,18 @@ TEST_CASE("one parameter tree: epsilon, detection and identification reach the r
   // Out-of-range values of the subtrees are refused by the stage that reads them.
   cf::Params bad = P;
   bad.detection.reuse_margin_mm = -1;
-  CHECK_THROWS_WITH(cf::HapticRenderer(g, bad), Catch::Contains("parameter reuse_margin_mm must be non-negative"));
+  CHECK_THROWS_WITH(cf::HapticRenderer(g, bad),
+                    Catch::Contains("parameter reuse_margin_mm must be non-negative"));
   bad = P;
   bad.identification.max_combinations = 0;
-  CHECK_THROWS_WITH(cf::HapticRenderer(g, bad), Catch::Contains("cf::Params: parameter identification.max_combinations must be at least 1, got 0"));
+  CHECK_THROWS_WITH(
+      cf::HapticRenderer(g, bad),
+      Catch::Contains(
+          "cf::Params: parameter identification.max_combinations must be at least 1, got 0"));
 }
 
-TEST_CASE("a second plane's contact pushes from epsilon on, without a step at its gain", "[renderer]") {
+TEST_CASE("a second plane's contact pushes from epsilon on, without a step at its gain",
+          "[renderer]") {
   // The cube resting 0.5 mm into the floor's band slides towards the wall, 10 um per tick,
   // from 3 mm away to 0.2 mm into it. The wall's normal force (of its PC, or of its contact
   // while approaching) must follow eq. (1) tick by tick: at most K * 10 um of change per
@@ -250,7 +282,8 @@ TEST_CASE("a second plane's contact pushes from epsilon on, without a step at it
     for (int k = 0; k < res.force->num_pcs + res.force->num_approaching; ++k) {
       const cf::PcForce& pf = res.force->pcs[k];
       if (pf.R_WT.col(1).x() > 0.99)
-        f += pf.F_cy + (k < res.force->num_pcs ? res.constraint_load_N[static_cast<std::size_t>(k)] : 0.0);
+        f += pf.F_cy +
+             (k < res.force->num_pcs ? res.constraint_load_N[static_cast<std::size_t>(k)] : 0.0);
     }
     return f;
   };
@@ -293,9 +326,12 @@ TEST_CASE("the servo step allocates nothing", "[renderer]") {
   const auto given = identification(0, {floor_pc(at(70, 35.5, 40))}, {floor_pc(at(70, 35.5, 40))});
   const long before = g_allocations.load();
   for (int i = 0; i < 3000; ++i) {
-    if (i < 450) p.t_BA.y() -= 0.01;                   // land
-    else if (p.t_BA.x() > 35.6) p.t_BA.x() -= 0.02;   // slide into the corner
-    else p.t_BA.y() += 0.01;                           // lift off the floor
+    if (i < 450)
+      p.t_BA.y() -= 0.01;  // land
+    else if (p.t_BA.x() > 35.6)
+      p.t_BA.x() -= 0.02;  // slide into the corner
+    else
+      p.t_BA.y() += 0.01;  // lift off the floor
     r.step(p, t += 0.001);
   }
   r.step_identified(at(70, 35.5, 40), t += 0.001, *given);
@@ -308,11 +344,29 @@ namespace {
 // and z = 20 up to y = 80.
 cf::Polyhedron corner_block() {
   return from_loops("corner_block",
-                    {{0, 0, 0}, {120, 0, 0}, {120, 0, 120}, {0, 0, 120}, {0, 80, 0}, {120, 80, 0}, {120, 80, 20},
-                     {20, 80, 20}, {20, 80, 120}, {0, 80, 120}, {20, 20, 20}, {120, 20, 20}, {120, 20, 120},
+                    {{0, 0, 0},
+                     {120, 0, 0},
+                     {120, 0, 120},
+                     {0, 0, 120},
+                     {0, 80, 0},
+                     {120, 80, 0},
+                     {120, 80, 20},
+                     {20, 80, 20},
+                     {20, 80, 120},
+                     {0, 80, 120},
+                     {20, 20, 20},
+                     {120, 20, 20},
+                     {120, 20, 120},
                      {20, 20, 120}},
-                    {{0, 1, 2, 3}, {9, 8, 7, 6, 5, 4}, {13, 12, 11, 10}, {0, 3, 9, 4}, {0, 4, 5, 1},
-                     {1, 5, 6, 11, 12, 2}, {3, 2, 12, 13, 8, 9}, {10, 7, 8, 13}, {10, 11, 6, 7}});
+                    {{0, 1, 2, 3},
+                     {9, 8, 7, 6, 5, 4},
+                     {13, 12, 11, 10},
+                     {0, 3, 9, 4},
+                     {0, 4, 5, 1},
+                     {1, 5, 6, 11, 12, 2},
+                     {3, 2, 12, 13, 8, 9},
+                     {10, 7, 8, 13},
+                     {10, 11, 6, 7}});
 }
 
 // Places A (rotation R) so that its lowest vertex is `gap` above y = 20 and, when walls
@@ -382,7 +436,8 @@ Scenario run_scenario(const cf::Polyhedron& B, const std::vector<cf::Pose>& pose
     prev = id;
   }
   Scenario s;
-  s.graph = std::make_unique<cf::CfGraph>(cf::CfGraph::from_parts(A, B, std::move(cfs), std::move(tr)));
+  s.graph =
+      std::make_unique<cf::CfGraph>(cf::CfGraph::from_parts(A, B, std::move(cfs), std::move(tr)));
   s.renderer = std::make_unique<cf::HapticRenderer>(*s.graph);
   double t = 0;
   for (const cf::Pose& p : poses) {
@@ -403,9 +458,12 @@ std::string types(const cf::HapticResult& r) {
 
 void print_row(const char* name, const cf::HapticResult& r) {
   if (std::getenv("CF_PRINT_PAPER_ROWS") == nullptr) return;
-  std::printf("%-28s %-14s %-6s F = %9.5f %9.5f %9.5f   M = %10.5f %10.5f %10.5f   Fc = %8.5f %8.5f %8.5f  [", name,
-              types(r).c_str(), cf::to_string(r.motion), r.F_W.x(), r.F_W.y(), r.F_W.z(), r.M_W.x(), r.M_W.y(),
-              r.M_W.z(), r.force->F_contact_W.x(), r.force->F_contact_W.y(), r.force->F_contact_W.z());
+  std::printf(
+      "%-28s %-14s %-6s F = %9.5f %9.5f %9.5f   M = %10.5f %10.5f %10.5f   Fc = %8.5f %8.5f %8.5f  "
+      "[",
+      name, types(r).c_str(), cf::to_string(r.motion), r.F_W.x(), r.F_W.y(), r.F_W.z(), r.M_W.x(),
+      r.M_W.y(), r.M_W.z(), r.force->F_contact_W.x(), r.force->F_contact_W.y(),
+      r.force->F_contact_W.z());
   for (int k = 0; k < r.force->num_pcs; ++k)
     std::printf("%s%s", k ? " " : "", cf::to_string(r.force->pcs[k].regime));
   std::printf("]\n");
@@ -419,7 +477,8 @@ cf::Mat3 rot(double ax, double ay, double az) {
 
 }  // namespace
 
-TEST_CASE("the paper's force table rows as scripted cases (docs/force-model.md)", "[renderer][paper]") {
+TEST_CASE("the paper's force table rows as scripted cases (docs/force-model.md)",
+          "[renderer][paper]") {
   SECTION("row 1: {e-f, v-f} by MT4 against the L-block") {
     // An edge of the tilted, turned cube rests on the floor; it moves towards the inner wall
     // 0.1 mm per tick until a vertex touches it.
@@ -427,7 +486,8 @@ TEST_CASE("the paper's force table rows as scripted cases (docs/force-model.md)"
     std::vector<cf::Pose> poses;
     for (int i = 0; i <= 30; ++i) poses.push_back(seat(R, false, false, 0, 40));
     const double x_touch = seat(R, true, false, 0, 40).t_BA.x();
-    for (int i = 0; i < 30; ++i) poses[static_cast<std::size_t>(i)].t_BA.x() = x_touch + 0.1 * (29 - i) + 0.6;
+    for (int i = 0; i < 30; ++i)
+      poses[static_cast<std::size_t>(i)].t_BA.x() = x_touch + 0.1 * (29 - i) + 0.6;
     poses.back().t_BA.x() = x_touch;
     const Scenario s = run_scenario(l_block(), poses, cf::MotionType::kMT4);
     print_row("row 1 (L-block)", *s.last);
@@ -463,7 +523,8 @@ TEST_CASE("the paper's force table rows as scripted cases (docs/force-model.md)"
     const cf::Mat3 R0 = rot(0.25, 0.5, 0.0);
     std::vector<cf::Pose> poses(5, seat(R0, true, true, 0, 0));
     for (int i = 1; i <= 3; ++i)
-      poses.push_back(seat(Eigen::AngleAxisd(0.02 * i, cf::Vec3(1, 0, 1).normalized()) * R0, true, true, 0, 0));
+      poses.push_back(
+          seat(Eigen::AngleAxisd(0.02 * i, cf::Vec3(1, 0, 1).normalized()) * R0, true, true, 0, 0));
     const Scenario s = run_scenario(corner_block(), poses, cf::MotionType::kMT3);
     print_row("row 4 (corner, tipping)", *s.last);
     CHECK(types(*s.last) == "v-f v-f v-f");

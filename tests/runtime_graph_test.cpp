@@ -54,8 +54,12 @@ const cf::CfGraph& graph(const std::string& name) {
   auto it = cache.find(name);
   if (it != cache.end()) return *it->second;
   const char* dir = std::getenv("CF_RUNTIME_GRAPH_DIR");
-  if (dir == nullptr) FAIL("CF_RUNTIME_GRAPH_DIR is not set: run through ctest, whose cfgen fixtures write the graphs");
-  auto g = std::make_unique<cf::CfGraph>(cf::CfGraph::load(std::string(dir) + "/" + name + ".json"));
+  if (dir == nullptr)
+    FAIL(
+        "CF_RUNTIME_GRAPH_DIR is not set: run through ctest, whose cfgen fixtures write the "
+        "graphs");
+  auto g =
+      std::make_unique<cf::CfGraph>(cf::CfGraph::load(std::string(dir) + "/" + name + ".json"));
   return *cache.emplace(name, std::move(g)).first->second;
 }
 
@@ -99,16 +103,23 @@ void pc_heights(const cf::Polyhedron& A, const cf::Polyhedron& B, const Pc& pc, 
     return F.normal.dot(P.inverse_apply(p_B)) - F.offset;
   };
   switch (pc.type) {
-    case PcType::kVF: h.push_back(over_b(pc.b, A.vertices()[static_cast<std::size_t>(pc.a)].p)); break;
-    case PcType::kFV: h.push_back(over_a(pc.a, B.vertices()[static_cast<std::size_t>(pc.b)].p)); break;
+    case PcType::kVF:
+      h.push_back(over_b(pc.b, A.vertices()[static_cast<std::size_t>(pc.a)].p));
+      break;
+    case PcType::kFV:
+      h.push_back(over_a(pc.a, B.vertices()[static_cast<std::size_t>(pc.b)].p));
+      break;
     case PcType::kEF:
-      for (int end = 0; end < 2; ++end) h.push_back(over_b(pc.b, A.edge_point(cf::EdgeId(pc.a), end)));
+      for (int end = 0; end < 2; ++end)
+        h.push_back(over_b(pc.b, A.edge_point(cf::EdgeId(pc.a), end)));
       break;
     case PcType::kFE:
-      for (int end = 0; end < 2; ++end) h.push_back(over_a(pc.a, B.edge_point(cf::EdgeId(pc.b), end)));
+      for (int end = 0; end < 2; ++end)
+        h.push_back(over_a(pc.a, B.edge_point(cf::EdgeId(pc.b), end)));
       break;
     case PcType::kFF:
-      for (cf::VertexId v : A.faces()[static_cast<std::size_t>(pc.a)].vertices) h.push_back(over_b(pc.b, A.vertex(v).p));
+      for (cf::VertexId v : A.faces()[static_cast<std::size_t>(pc.a)].vertices)
+        h.push_back(over_b(pc.b, A.vertex(v).p));
       break;
     case PcType::kEE: {
       // Distance between the two edges' lines along their common normal, which points out
@@ -146,7 +157,8 @@ bool distance_consistent(const cf::CfGraph& g, const cf::ContactPc& c, const Pos
     const cf::Edge& EB = g.model_b().edges()[static_cast<std::size_t>(c.pc.b)];
     const Vec3 p0 = P.apply(g.model_a().vertex(EA.v0).p), uA = P.R_BA * EA.dir;
     const Vec3 q0 = g.model_b().vertex(EB.v0).p;
-    const double b = uA.dot(EB.dir), cA = uA.dot(p0 - q0), fB = EB.dir.dot(p0 - q0), den = 1 - b * b;
+    const double b = uA.dot(EB.dir), cA = uA.dot(p0 - q0), fB = EB.dir.dot(p0 - q0),
+                 den = 1 - b * b;
     const double sA = (b * fB - cA) / den, tB = (fB - b * cA) / den;
     if (sA < 0 || sA > EA.length || tB < 0 || tB > EB.length) return true;
   }
@@ -185,7 +197,8 @@ Vec3 contact_centre(const cf::Identification& r) {
 
 // A random pose near `w` at which every PC of `pcs` stays within [kBandLo, kBandHi]; shrinks
 // the motion until it does (false after 20 tries).
-bool perturb(const cf::CfGraph& g, const PcSet& pcs, const Pose& w, const Vec3& c, std::mt19937& rng, Pose* out) {
+bool perturb(const cf::CfGraph& g, const PcSet& pcs, const Pose& w, const Vec3& c,
+             std::mt19937& rng, Pose* out) {
   double scale = 1;
   for (int tries = 0; tries < 20; ++tries, scale *= 0.7) {
     const Vec3 axis = Vec3(uniform(rng), uniform(rng), uniform(rng)).normalized();
@@ -225,9 +238,11 @@ bool solve_contact(const cf::CfGraph& g, const PcSet& pcs, const Vec3& c, Pose* 
       Eigen::Matrix<double, 6, 1> x = Eigen::Matrix<double, 6, 1>::Zero();
       x[k] = kStep;
       const std::vector<double> r1 = residual(moved(*p, x.head<3>(), x.tail<3>(), c));
-      for (std::size_t i = 0; i < r0.size(); ++i) J(static_cast<Eigen::Index>(i), k) = (r1[i] - r0[i]) / kStep;
+      for (std::size_t i = 0; i < r0.size(); ++i)
+        J(static_cast<Eigen::Index>(i), k) = (r1[i] - r0[i]) / kStep;
     }
-    const Eigen::VectorXd rv = Eigen::Map<const Eigen::VectorXd>(r0.data(), static_cast<Eigen::Index>(r0.size()));
+    const Eigen::VectorXd rv =
+        Eigen::Map<const Eigen::VectorXd>(r0.data(), static_cast<Eigen::Index>(r0.size()));
     const Eigen::Matrix<double, 6, 1> x = -J.completeOrthogonalDecomposition().solve(rv);
     *p = moved(*p, x.head<3>(), x.tail<3>(), c);
   }
@@ -235,12 +250,13 @@ bool solve_contact(const cf::CfGraph& g, const PcSet& pcs, const Vec3& c, Pose* 
 }
 
 std::string describe(const cf::Identification& r) {
-  std::string s = std::string(cf::to_string(r.status)) + " CF " + std::to_string(r.cf.value()) + " {" +
-                  cf::to_string(r.pcs) + "}; contacts:";
+  std::string s = std::string(cf::to_string(r.status)) + " CF " + std::to_string(r.cf.value()) +
+                  " {" + cf::to_string(r.pcs) + "}; contacts:";
   for (const cf::ContactPc& c : r.contacts) {
     char buf[96];
-    std::snprintf(buf, sizeof buf, " %s(d %.4f, misfit %.3f%s, plane %d)", cf::to_string(c.pc).c_str(), c.distance,
-                  c.misfit, c.dominated ? ", dominated" : "", c.plane);
+    std::snprintf(buf, sizeof buf, " %s(d %.4f, misfit %.3f%s, plane %d)",
+                  cf::to_string(c.pc).c_str(), c.distance, c.misfit,
+                  c.dominated ? ", dominated" : "", c.plane);
     s += buf;
   }
   return s;
@@ -261,7 +277,8 @@ TEST_CASE("the witness of every CF identifies exactly that CF", "[runtime_graph]
       id.reset();
       const cf::Identification& r = id.step(g.cf(X).witness);
       bool ok = r.status == IdStatus::kMatchedByFit && r.cf == X;
-      for (int k = 0; k < r.num_cf_pcs && ok; ++k) ok = std::abs(r.cf_pcs[static_cast<std::size_t>(k)].distance) <= kExact;
+      for (int k = 0; k < r.num_cf_pcs && ok; ++k)
+        ok = std::abs(r.cf_pcs[static_cast<std::size_t>(k)].distance) <= kExact;
       if (ok) {
         ++exact;
         // Near pairs in other planes (at least 0.01 mm away at a witness), which a CF holding
@@ -269,28 +286,34 @@ TEST_CASE("the witness of every CF identifies exactly that CF", "[runtime_graph]
         with_apart += r.partial_cover;
         for (const cf::ContactPc& c : r.contacts) {
           bool in_cf_plane = false;
-          for (int k = 0; k < r.num_cf_pcs; ++k) in_cf_plane |= r.cf_pcs[static_cast<std::size_t>(k)].plane == c.plane;
+          for (int k = 0; k < r.num_cf_pcs; ++k)
+            in_cf_plane |= r.cf_pcs[static_cast<std::size_t>(k)].plane == c.plane;
           if (!in_cf_plane) nearest_apart = std::min(nearest_apart, c.distance);
         }
       } else if (shown++ < 10) {
-        notes << name << ": CF " << i << " {" << cf::to_string(g.cf(X).pcs) << "} -> " << describe(r) << "\n";
+        notes << name << ": CF " << i << " {" << cf::to_string(g.cf(X).pcs) << "} -> "
+              << describe(r) << "\n";
       }
       // Staying there: the previous CF.
       const cf::Identification& again = id.step(g.cf(X).witness);
       kept += again.status == IdStatus::kMatchedPrevious && again.cf == X;
     }
-    std::printf("%s: %zu/%zu witnesses identify their CF (matched-by-fit, PCs at |d| <= %g mm), %zu/%zu kept "
-                "(matched-previous); %zu leave out contacts of other planes within epsilon as apart (nearest: %s mm)\n",
-                name, exact, g.num_cfs(), kExact, kept, g.num_cfs(), with_apart,
-                with_apart > 0 ? std::to_string(nearest_apart).c_str() : "-");
+    std::printf(
+        "%s: %zu/%zu witnesses identify their CF (matched-by-fit, PCs at |d| <= %g mm), %zu/%zu "
+        "kept "
+        "(matched-previous); %zu leave out contacts of other planes within epsilon as apart "
+        "(nearest: %s mm)\n",
+        name, exact, g.num_cfs(), kExact, kept, g.num_cfs(), with_apart,
+        with_apart > 0 ? std::to_string(nearest_apart).c_str() : "-");
     INFO(notes.str());
     CHECK(exact == g.num_cfs());
     CHECK(kept == g.num_cfs());
   }
 }
 
-TEST_CASE("perturbed witnesses: a CF of the graph consistent with the geometry, near the previous one",
-          "[runtime_graph]") {
+TEST_CASE(
+    "perturbed witnesses: a CF of the graph consistent with the geometry, near the previous one",
+    "[runtime_graph]") {
   std::mt19937 rng(20240601);
   for (const char* name : kGraphs) {
     const cf::CfGraph& g = graph(name);
@@ -322,11 +345,13 @@ TEST_CASE("perturbed witnesses: a CF of the graph consistent with the geometry, 
         found += ok;
         consistent += ok && geo;
         same_by_fit += r.cf == X;
-        if (!(ok && geo) && shown++ < 10) notes << name << ": near CF " << i << " by fit: " << describe(r) << "\n";
+        if (!(ok && geo) && shown++ < 10)
+          notes << name << ": near CF " << i << " by fit: " << describe(r) << "\n";
         // Coming from X: X, else a neighbour, whenever one of them stands at P (SPEC 6's
         // preference); elsewhere only when none does (the motion changed more than one step).
         bool near_stands = stands(r, rec.pcs);
-        for (const cf::Transition& t : g.out_transitions(X)) near_stands = near_stands || stands(r, g.cf(t.to).pcs);
+        for (const cf::Transition& t : g.out_transitions(X))
+          near_stands = near_stands || stands(r, g.cf(t.to).pcs);
         id.reset();
         id.step(rec.witness);
         const cf::Identification& q = id.step(P);
@@ -340,16 +365,20 @@ TEST_CASE("perturbed witnesses: a CF of the graph consistent with the geometry, 
           ++prev_far;
           if (near_stands) {
             ++wrong_jumps;
-            if (shown++ < 10) notes << name << ": from CF " << i << " {" << cf::to_string(rec.pcs) << "}: " << describe(q) << "\n";
+            if (shown++ < 10)
+              notes << name << ": from CF " << i << " {" << cf::to_string(rec.pcs)
+                    << "}: " << describe(q) << "\n";
           }
         }
       }
     }
-    std::printf("%s: %zu perturbed poses (PCs within [%g, %g] mm); by fit: %zu CFs of the graph, %zu with "
-                "distances matching the geometry, %zu the witness's CF, %zu with its PCs all detected; "
-                "from the witness's CF: %zu kept, %zu neighbours, %zu elsewhere (none of them standing there)\n",
-                name, poses, kBandLo, kBandHi, found, consistent, same_by_fit, own_detected, prev_same, prev_neighbour,
-                prev_far);
+    std::printf(
+        "%s: %zu perturbed poses (PCs within [%g, %g] mm); by fit: %zu CFs of the graph, %zu with "
+        "distances matching the geometry, %zu the witness's CF, %zu with its PCs all detected; "
+        "from the witness's CF: %zu kept, %zu neighbours, %zu elsewhere (none of them standing "
+        "there)\n",
+        name, poses, kBandLo, kBandHi, found, consistent, same_by_fit, own_detected, prev_same,
+        prev_neighbour, prev_far);
     INFO(notes.str());
     CHECK(poses >= 2 * g.num_cfs());
     CHECK(own_detected == poses);  // the detector finds the PCs within tolerance
@@ -377,12 +406,15 @@ TEST_CASE("sequences: the previous CF and its neighbours are preferred", "[runti
       } else if (r.cf == t.from && r.status == IdStatus::kMatchedPrevious) {
         ++kept_prev;  // the previous CF still stands there: allowed
       } else if (wrong++ < 10) {
-        notes << name << ": " << t.from.value() << " -> " << t.to.value() << ": " << describe(r) << "\n";
+        notes << name << ": " << t.from.value() << " -> " << t.to.value() << ": " << describe(r)
+              << "\n";
       }
     }
-    std::printf("%s: %zu transitions, witness to witness: %zu reach the neighbour (matched-neighbour), %zu keep the "
-                "previous CF, %zu other\n",
-                name, g.num_transitions(), to_next, kept_prev, wrong);
+    std::printf(
+        "%s: %zu transitions, witness to witness: %zu reach the neighbour (matched-neighbour), %zu "
+        "keep the "
+        "previous CF, %zu other\n",
+        name, g.num_transitions(), to_next, kept_prev, wrong);
     INFO(notes.str());
     CHECK(wrong == 0);
     notes.str("");
@@ -408,7 +440,8 @@ TEST_CASE("sequences: the previous CF and its neighbours are preferred", "[runti
         if (!all_detected(f, g.cf(X).pcs) || !all_detected(f, g.cf(Y).pcs)) continue;
         // The path can run into other elements: keep the poses without deep contacts.
         bool shallow = true;
-        for (const cf::ContactPc& contact : f.contacts) shallow = shallow && contact.distance >= kBandLo;
+        for (const cf::ContactPc& contact : f.contacts)
+          shallow = shallow && contact.distance >= kBandLo;
         if (!shallow) {
           ++deep;
           continue;
@@ -416,7 +449,8 @@ TEST_CASE("sequences: the previous CF and its neighbours are preferred", "[runti
         ++between;
         fit_valid += f.has_cf();
         if (!f.has_cf() && failed++ < 10)
-          notes << name << ": " << X.value() << " -> " << Y.value() << " at " << s << ", by fit: " << describe(f) << "\n";
+          notes << name << ": " << X.value() << " -> " << Y.value() << " at " << s
+                << ", by fit: " << describe(f) << "\n";
         for (const CfId prev : {X, Y}) {
           if (!stands(f, g.cf(prev).pcs)) continue;
           ++stood;
@@ -426,16 +460,19 @@ TEST_CASE("sequences: the previous CF and its neighbours are preferred", "[runti
           if (r.cf == prev && r.status == IdStatus::kMatchedPrevious) {
             ++kept;
           } else if (failed++ < 10) {
-            notes << name << ": " << X.value() << " -> " << Y.value() << " at " << s << ", previous "
-                               << prev.value() << ": " << describe(r) << "\n";
+            notes << name << ": " << X.value() << " -> " << Y.value() << " at " << s
+                  << ", previous " << prev.value() << ": " << describe(r) << "\n";
           }
         }
       }
     }
-    std::printf("%s: change transitions: %zu with a pose touching both, %zu poses between them with both CFs' PCs "
-                "detected and no contact deeper than %g mm (%zu more skipped), %zu identified by fit; previous CF "
-                "standing there %zu times, kept %zu\n",
-                name, solved, between, -kBandLo, deep, fit_valid, stood, kept);
+    std::printf(
+        "%s: change transitions: %zu with a pose touching both, %zu poses between them with both "
+        "CFs' PCs "
+        "detected and no contact deeper than %g mm (%zu more skipped), %zu identified by fit; "
+        "previous CF "
+        "standing there %zu times, kept %zu\n",
+        name, solved, between, -kBandLo, deep, fit_valid, stood, kept);
     INFO(notes.str());
     CHECK(between > 1000);
     CHECK(fit_valid == between);
@@ -489,11 +526,12 @@ TEST_CASE("an edge rocking onto a face: the hysteresis band of dominance", "[run
   // until the face leaves its tolerance.
   const double kappa = cf::DetectionParams().dominance_fit;
   REQUIRE(kappa == 0.25);
-  const Tick ticks[] = {{1.7, *ef, IdStatus::kMatchedByFit},     {0.85, *ef, IdStatus::kMatchedPrevious},
-                        {0.4, *ef, IdStatus::kMatchedPrevious},  {0.3, *ef, IdStatus::kMatchedPrevious},
-                        {0.2, *ff, IdStatus::kMatchedNeighbour}, {0.0, *ff, IdStatus::kMatchedPrevious},
-                        {0.6, *ff, IdStatus::kMatchedPrevious},  {0.95, *ff, IdStatus::kMatchedPrevious},
-                        {1.05, *ef, IdStatus::kMatchedNeighbour}};
+  const Tick ticks[] = {
+      {1.7, *ef, IdStatus::kMatchedByFit},     {0.85, *ef, IdStatus::kMatchedPrevious},
+      {0.4, *ef, IdStatus::kMatchedPrevious},  {0.3, *ef, IdStatus::kMatchedPrevious},
+      {0.2, *ff, IdStatus::kMatchedNeighbour}, {0.0, *ff, IdStatus::kMatchedPrevious},
+      {0.6, *ff, IdStatus::kMatchedPrevious},  {0.95, *ff, IdStatus::kMatchedPrevious},
+      {1.05, *ef, IdStatus::kMatchedNeighbour}};
   for (const Tick& t : ticks) {
     INFO("tilt " << t.fraction << " x tolerance " << tol << " rad");
     const cf::Identification& r = id.step(tilted(t.fraction));
@@ -513,7 +551,8 @@ TEST_CASE("an edge rocking onto a face: the hysteresis band of dominance", "[run
   }
 }
 
-TEST_CASE("the renderer on the recorded trajectories identifies CFs on contact ticks", "[runtime_graph]") {
+TEST_CASE("the renderer on the recorded trajectories identifies CFs on contact ticks",
+          "[runtime_graph]") {
   struct Case {
     const char* trajectory;
     const char* graph;
@@ -530,8 +569,8 @@ TEST_CASE("the renderer on the recorded trajectories identifies CFs on contact t
   };
   for (const Case& k : cases) {
     const cf::CfGraph& g = graph(k.graph);
-    const std::vector<cf::replay::Sample> samples =
-        cf::replay::read_trajectory(std::string(CF_SOURCE_DIR) + "/data/trajectories/" + k.trajectory + ".csv");
+    const std::vector<cf::replay::Sample> samples = cf::replay::read_trajectory(
+        std::string(CF_SOURCE_DIR) + "/data/trajectories/" + k.trajectory + ".csv");
     const std::vector<cf::replay::Row> rows = cf::replay::run(g, samples, cf::Params());
     std::size_t contact = 0, identified = 0, no_fit = 0, unlisted = 0;
     std::vector<std::string> runs;
@@ -546,9 +585,12 @@ TEST_CASE("the renderer on the recorded trajectories identifies CFs on contact t
       if (runs.empty() || runs.back() != pcs) runs.push_back(pcs);
     }
     std::string seq;
-    for (const std::string& r : runs) seq += (seq.empty() ? "" : " -> ") + (r.empty() ? std::string("none") : r);
-    std::printf("%s on %s: %zu ticks, %zu in contact: %zu with a CF, %zu no_fitting_cf, %zu unlisted_transition; %s\n",
-                k.trajectory, k.graph, rows.size(), contact, identified, no_fit, unlisted, seq.c_str());
+    for (const std::string& r : runs)
+      seq += (seq.empty() ? "" : " -> ") + (r.empty() ? std::string("none") : r);
+    std::printf(
+        "%s on %s: %zu ticks, %zu in contact: %zu with a CF, %zu no_fitting_cf, %zu "
+        "unlisted_transition; %s\n",
+        k.trajectory, k.graph, rows.size(), contact, identified, no_fit, unlisted, seq.c_str());
     INFO(k.trajectory << ": " << seq);
     CHECK(contact > 0);
     CHECK(10 * identified >= 9 * contact);  // a CF on at least 90% of the contact ticks
@@ -559,13 +601,15 @@ TEST_CASE("the renderer on the recorded trajectories identifies CFs on contact t
       CHECK(runs.size() == k.runs.size());
     } else {
       // Seated against the floor and both walls: the three f-f, when the graph holds them.
-      const std::optional<CfId> seat = g.find(
-          PcSet({Pc{PcType::kFF, 0, 8}, Pc{PcType::kFF, 2, 2}, Pc{PcType::kFF, 5, 7}}));
+      const std::optional<CfId> seat =
+          g.find(PcSet({Pc{PcType::kFF, 0, 8}, Pc{PcType::kFF, 2, 2}, Pc{PcType::kFF, 5, 7}}));
       if (seat) {
         CHECK(runs.back() == cf::to_string(g.cf(*seat).pcs));
       } else {
-        WARN("the corner graph lacks the seated CF {f-f:0:8;f-f:2:2;f-f:5:7}: the trajectory ends in {"
-             << runs.back() << "}");
+        WARN(
+            "the corner graph lacks the seated CF {f-f:0:8;f-f:2:2;f-f:5:7}: the trajectory ends "
+            "in {"
+            << runs.back() << "}");
       }
     }
   }

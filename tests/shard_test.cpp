@@ -1,6 +1,7 @@
-// Tests of the text form of cfgen's chunks of tasks and their results (tools/cfgen/execute/shard.cpp),
-// which MPI ranks exchange: every kind of task and result comes back exactly, doubles to
-// the last bit, and text that is not such a chunk is refused with a message naming it.
+// Tests of the text form of cfgen's chunks of tasks and their results
+// (tools/cfgen/execute/shard.cpp), which MPI ranks exchange: every kind of task and result comes
+// back exactly, doubles to the last bit, and text that is not such a chunk is refused with a
+// message naming it.
 
 #include "cfgen/execute/shard.hpp"
 
@@ -26,7 +27,8 @@ namespace {
 // A pose whose numbers have no short decimal form.
 Pose odd_pose(double s) {
   Pose p;
-  p.R_BA = Eigen::AngleAxisd(s * std::sqrt(2.0), Vec3(1, std::sqrt(3.0), -M_PI).normalized()).toRotationMatrix();
+  p.R_BA = Eigen::AngleAxisd(s * std::sqrt(2.0), Vec3(1, std::sqrt(3.0), -M_PI).normalized())
+               .toRotationMatrix();
   p.t_BA = Vec3(s / 3.0, -s * M_E, std::nextafter(s, 10.0));
   return p;
 }
@@ -54,14 +56,16 @@ TEST_CASE("chunks of tasks and their results round-trip exactly") {
   tasks[4].pose = odd_pose(4.1);
 
   std::size_t chunk = 0;
-  const std::vector<Task> back = cf::tools::tasks_from_text(cf::tools::tasks_text(41, tasks), "tasks", chunk);
+  const std::vector<Task> back =
+      cf::tools::tasks_from_text(cf::tools::tasks_text(41, tasks), "tasks", chunk);
   CHECK(chunk == 41);
   REQUIRE(back.size() == tasks.size());
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     CHECK(back[i].kind == tasks[i].kind);
     CHECK(back[i].pcs == tasks[i].pcs);
     REQUIRE(back[i].seeds.size() == tasks[i].seeds.size());
-    for (std::size_t k = 0; k < tasks[i].seeds.size(); ++k) CHECK(back[i].seeds[k] == tasks[i].seeds[k]);
+    for (std::size_t k = 0; k < tasks[i].seeds.size(); ++k)
+      CHECK(back[i].seeds[k] == tasks[i].seeds[k]);
     CHECK(same(back[i].pose, tasks[i].pose));
   }
 
@@ -100,19 +104,23 @@ TEST_CASE("text that is not a chunk is refused with what and why") {
     }
     return std::string("accepted");
   };
-  CHECK_THAT(refused("{\"chunk\": 3"), Catch::Matchers::StartsWith("reading a chunk from rank 0: not JSON"));
-  CHECK(refused("{\"tasks\": []}") == "reading a chunk from rank 0: expected {\"chunk\", \"tasks\"}");
+  CHECK_THAT(refused("{\"chunk\": 3"),
+             Catch::Matchers::StartsWith("reading a chunk from rank 0: not JSON"));
+  CHECK(refused("{\"tasks\": []}") ==
+        "reading a chunk from rank 0: expected {\"chunk\", \"tasks\"}");
   CHECK(refused("{\"chunk\": 1, \"tasks\": [[9, [[0, 1, 2]], [], []]]}") ==
         "reading a chunk from rank 0: expected a task [kind, PCs, seeds, pose]");
   // One past the last kind (kVerify, 4).
   CHECK(refused("{\"chunk\": 1, \"tasks\": [[5, [[0, 1, 2]], [], [1,0,0,0,1,0,0,0,1,0,0,0]]]}") ==
         "reading a chunk from rank 0: expected a task [kind, PCs, seeds, pose]");
-  CHECK(refused("{\"chunk\": 1, \"tasks\": [[0, [[0, 1, 2], [0, 1, 2]], [], " + std::string("[1,0,0,0,1,0,0,0,1,0,0,0]]]}")) ==
+  CHECK(refused("{\"chunk\": 1, \"tasks\": [[0, [[0, 1, 2], [0, 1, 2]], [], " +
+                std::string("[1,0,0,0,1,0,0,0,1,0,0,0]]]}")) ==
         "reading a chunk from rank 0: a PC is repeated");
   CHECK(refused("{\"chunk\": 1, \"tasks\": [[0, [[6, 1, 2]], [], [1,0,0,0,1,0,0,0,1,0,0,0]]]}") ==
         "reading a chunk from rank 0: expected a PC [type, a, b]");
   CHECK(refused("{\"chunk\": 1, \"tasks\": [[0, [[0, 1, 2]], [], [1,0,0,0,1,0,0,0,1,0,0]]]}") ==
         "reading a chunk from rank 0: expected a pose of 12 numbers");
-  CHECK_THROWS_WITH(cf::tools::task_results_from_text("{\"chunk\": 0, \"results\": [[[true], []]]}", "the results of rank 1", chunk),
+  CHECK_THROWS_WITH(cf::tools::task_results_from_text("{\"chunk\": 0, \"results\": [[[true], []]]}",
+                                                      "the results of rank 1", chunk),
                     "reading the results of rank 1: expected [true, pose, clearance, margin]");
 }

@@ -6,8 +6,8 @@
 // plane); the oracle measures every pair. So near contact the clearance verify reports, and
 // its refusal of every penetrating pose, must be the oracle's.
 
-#include "cfgen/generate.hpp"
 #include "cfgen/decide/witness.hpp"
+#include "cfgen/generate.hpp"
 #include "classify.hpp"
 #include "motion.hpp"
 #include "oracle_pair.hpp"

@@ -4,10 +4,10 @@
 // rim hold only in a sliver of orientations, and a rotation a few hundredths of a radian off
 // places the contacts but runs A into another pair of elements.
 
+#include "cfgen/decide/witness.hpp"
 #include "analysed_pair.hpp"
 #include "cfgen/enumerate/enumerate.hpp"
 #include "cfgen/generate.hpp"
-#include "cfgen/decide/witness.hpp"
 #include "mesh/model_loader.hpp"
 #include "ngon_models.hpp"
 #include "scratch.hpp"
@@ -56,7 +56,8 @@ TEST_CASE(
     if (r.pcs.size() != 2) continue;
     bool point_pcs = true;  // no rotational condition: the rotations tried are not projected
     for (const cf::Pc& pc : r.pcs)
-      point_pcs = point_pcs && (pc.type == cf::PcType::kVF || pc.type == cf::PcType::kFV || pc.type == cf::PcType::kEE);
+      point_pcs = point_pcs && (pc.type == cf::PcType::kVF || pc.type == cf::PcType::kFV ||
+                                pc.type == cf::PcType::kEE);
     if (!point_pcs) continue;
     const cf::Mat3 seed = cf::gen::axis_angle(axis, kTurn) * r.witness.R_BA;
     const cf::gen::Witness w = search.find(r.pcs, {seed}, true);

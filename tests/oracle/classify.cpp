@@ -13,22 +13,33 @@ namespace oracle {
 
 const char* type_name(PcType t) {
   switch (t) {
-    case PcType::FF: return "f-f";
-    case PcType::EF: return "e-f";
-    case PcType::FE: return "f-e";
-    case PcType::VF: return "v-f";
-    case PcType::FV: return "f-v";
-    case PcType::EE: return "e-e";
-    case PcType::VV: return "v-v";
-    case PcType::VE: return "v-e";
-    case PcType::EV: return "e-v";
-    case PcType::EEC: return "e-e(collinear)";
+    case PcType::FF:
+      return "f-f";
+    case PcType::EF:
+      return "e-f";
+    case PcType::FE:
+      return "f-e";
+    case PcType::VF:
+      return "v-f";
+    case PcType::FV:
+      return "f-v";
+    case PcType::EE:
+      return "e-e";
+    case PcType::VV:
+      return "v-v";
+    case PcType::VE:
+      return "v-e";
+    case PcType::EV:
+      return "e-v";
+    case PcType::EEC:
+      return "e-e(collinear)";
   }
   return "?";
 }
 
 bool parse_type(const std::string& s, PcType* t) {
-  static const PcType all[] = {PcType::FF, PcType::EF, PcType::FE, PcType::VF, PcType::FV, PcType::EE};
+  static const PcType all[] = {PcType::FF, PcType::EF, PcType::FE,
+                               PcType::VF, PcType::FV, PcType::EE};
   for (PcType x : all)
     if (s == type_name(x)) {
       *t = x;
@@ -39,16 +50,32 @@ bool parse_type(const std::string& s, PcType* t) {
 
 int kind_a(PcType t) {
   switch (t) {
-    case PcType::FF: case PcType::FE: case PcType::FV: return 2;
-    case PcType::EF: case PcType::EE: case PcType::EV: case PcType::EEC: return 1;
-    default: return 0;
+    case PcType::FF:
+    case PcType::FE:
+    case PcType::FV:
+      return 2;
+    case PcType::EF:
+    case PcType::EE:
+    case PcType::EV:
+    case PcType::EEC:
+      return 1;
+    default:
+      return 0;
   }
 }
 int kind_b(PcType t) {
   switch (t) {
-    case PcType::FF: case PcType::EF: case PcType::VF: return 2;
-    case PcType::FE: case PcType::EE: case PcType::VE: case PcType::EEC: return 1;
-    default: return 0;
+    case PcType::FF:
+    case PcType::EF:
+    case PcType::VF:
+      return 2;
+    case PcType::FE:
+    case PcType::EE:
+    case PcType::VE:
+    case PcType::EEC:
+      return 1;
+    default:
+      return 0;
   }
 }
 
@@ -64,11 +91,12 @@ std::string key_string(const CfKey& k) {
 std::string pose_string(const Pose& X) {
   Eigen::Quaterniond q(X.R);
   char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "R=[[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g]] t=[%.17g,%.17g,%.17g] "
-                "(quaternion w,x,y,z = %.12g,%.12g,%.12g,%.12g)",
-                X.R(0, 0), X.R(0, 1), X.R(0, 2), X.R(1, 0), X.R(1, 1), X.R(1, 2), X.R(2, 0), X.R(2, 1), X.R(2, 2),
-                X.t.x(), X.t.y(), X.t.z(), q.w(), q.x(), q.y(), q.z());
+  std::snprintf(
+      buf, sizeof buf,
+      "R=[[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g],[%.17g,%.17g,%.17g]] t=[%.17g,%.17g,%.17g] "
+      "(quaternion w,x,y,z = %.12g,%.12g,%.12g,%.12g)",
+      X.R(0, 0), X.R(0, 1), X.R(0, 2), X.R(1, 0), X.R(1, 1), X.R(1, 2), X.R(2, 0), X.R(2, 1),
+      X.R(2, 2), X.t.x(), X.t.y(), X.t.z(), q.w(), q.x(), q.y(), q.z());
   return buf;
 }
 
@@ -136,7 +164,8 @@ bool quad_le0(double a, double b, double c, Interval* out) {
 }
 
 // Parameters s in R of x(s) = p + s (q - p) within distance r of segment [a, b] (one interval).
-bool capsule_interval(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, double r, Interval* out) {
+bool capsule_interval(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, double r,
+                      Interval* out) {
   Vec3 D = q - p;
   double lo = kInf, hi = -kInf;
   auto take = [&](const Interval& iv) {
@@ -161,8 +190,10 @@ bool capsule_interval(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b
       double k0 = w.dot(e), k1 = D.dot(e);
       Interval slab;
       if (std::abs(k1) < 1e-300) {
-        if (k0 < 0 || k0 > L) slab = {1, 0};
-        else slab = {-kInf, kInf};
+        if (k0 < 0 || k0 > L)
+          slab = {1, 0};
+        else
+          slab = {-kInf, kInf};
       } else {
         double s1 = (0 - k0) / k1, s2 = (L - k0) / k1;
         slab = {std::min(s1, s2), std::max(s1, s2)};
@@ -178,7 +209,8 @@ bool capsule_interval(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b
 double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // Parameters in [0,1] of the 2D segment P->Q that lie inside the loops (even-odd).
-std::vector<Interval> clip_to_loops(const std::vector<std::vector<Vec2>>& loops, const Vec2& P, const Vec2& Q) {
+std::vector<Interval> clip_to_loops(const std::vector<std::vector<Vec2>>& loops, const Vec2& P,
+                                    const Vec2& Q) {
   std::vector<double> ts{0.0, 1.0};
   Vec2 D = Q - P;
   for (const auto& L : loops)
@@ -255,7 +287,8 @@ EFResult edge_face_test(const Poly& P, const Face& f, const Vec3& p, const Vec3&
   double best = -1;
   for (const Interval& iv : rem) {
     double a = iv.first, b = iv.second;
-    if ((b - a) * L <= tol) continue;  // a piece shorter than tol is rounding at a neighbour's contact
+    if ((b - a) * L <= tol)
+      continue;  // a piece shorter than tol is rounding at a neighbour's contact
     double ha = h0 + a * (h1 - h0), hb = h0 + b * (h1 - h0);
     if (std::max(std::abs(ha), std::abs(hb)) <= tol) {
       if (r.kind < 1) r.kind = 1;
@@ -295,7 +328,8 @@ struct EEResult {
   bool near_end = false;
 };
 
-EEResult edge_edge_test(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1, double tol) {
+EEResult edge_edge_test(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1,
+                        double tol) {
   EEResult r;
   double s, t;
   double dist = seg_seg_dist(a0, a1, b0, b1, &s, &t);
@@ -320,7 +354,8 @@ EEResult edge_edge_test(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Ve
   }
   if (r.sin_angle <= 1e-12) return r;
   Vec3 xa = a0 + s * dA, xb = b0 + t * dB;
-  if ((xa - a0).norm() <= tol || (xa - a1).norm() <= tol || (xb - b0).norm() <= tol || (xb - b1).norm() <= tol)
+  if ((xa - a0).norm() <= tol || (xa - a1).norm() <= tol || (xb - b0).norm() <= tol ||
+      (xb - b1).norm() <= tol)
     return r;
   r.kind = 1;
   r.point = 0.5 * (xa + xb);
@@ -356,7 +391,8 @@ double clip_area(std::vector<Vec2> poly, const Vec2 tri[3]) {
 
 // Area of the intersection of two polygon regions (loops with even-odd/orientation), by the
 // signed fan decomposition 1_P = sum_i s_i 1_{T_i}.
-double overlap_area(const std::vector<std::vector<Vec2>>& P, const std::vector<std::vector<Vec2>>& Q) {
+double overlap_area(const std::vector<std::vector<Vec2>>& P,
+                    const std::vector<std::vector<Vec2>>& Q) {
   Vec2 oP = P[0][0], oQ = Q[0][0];
   struct Tri {
     Vec2 v[3];
@@ -372,9 +408,15 @@ double overlap_area(const std::vector<std::vector<Vec2>>& P, const std::vector<s
         if (std::abs(c) <= 1e-300) continue;
         Tri t;
         if (c > 0) {
-          t.v[0] = o; t.v[1] = a; t.v[2] = b; t.s = 1;
+          t.v[0] = o;
+          t.v[1] = a;
+          t.v[2] = b;
+          t.s = 1;
         } else {
-          t.v[0] = o; t.v[1] = b; t.v[2] = a; t.s = -1;
+          t.v[0] = o;
+          t.v[1] = b;
+          t.v[2] = a;
+          t.s = -1;
         }
         T.push_back(t);
       }
@@ -405,9 +447,10 @@ bool seg2_cross(const Vec2& p, const Vec2& q, const Vec2& a, const Vec2& b, Vec2
 // ---------------------------------------------------------------------------------------
 
 bool point_in_solid(const Poly& P, const Vec3& x) {
-  static const Vec3 dirs[] = {Vec3(0.31, 0.77, 0.56).normalized(), Vec3(-0.62, 0.21, 0.75).normalized(),
-                              Vec3(0.13, -0.91, 0.39).normalized(), Vec3(0.83, 0.35, -0.43).normalized(),
-                              Vec3(-0.27, -0.44, -0.86).normalized(), Vec3(0.57, -0.58, 0.59).normalized()};
+  static const Vec3 dirs[] = {
+      Vec3(0.31, 0.77, 0.56).normalized(),    Vec3(-0.62, 0.21, 0.75).normalized(),
+      Vec3(0.13, -0.91, 0.39).normalized(),   Vec3(0.83, 0.35, -0.43).normalized(),
+      Vec3(-0.27, -0.44, -0.86).normalized(), Vec3(0.57, -0.58, 0.59).normalized()};
   const double eps = 1e-9 * P.diag;
   for (const Vec3& w : dirs) {
     int count = 0;
@@ -661,7 +704,8 @@ void Classifier::touches(const Scene& S, Verdict& V) const {
             }
       if (maxabs > tol) continue;  // tilted: touches (if at all) along edges or at points
       if (sliver) {
-        V.uncertain.push_back("f-f:" + std::to_string(fa) + ":" + std::to_string(fb) + " overlap is a sliver");
+        V.uncertain.push_back("f-f:" + std::to_string(fa) + ":" + std::to_string(fb) +
+                              " overlap is a sliver");
         continue;
       }
       Touch t{PcType::FF, (int)fa, (int)fb};
@@ -679,22 +723,31 @@ void Classifier::cone_checks(const Scene& S, Verdict& V) const {
   for (const Touch& t : V.touches) {
     if (t.transversal) {
       V.penetrating = true;
-      V.why = std::string("open ") + (t.type == PcType::EF ? "edge of A through open face of B" : "edge of B through open face of A") +
-              " (" + type_name(t.type) + ":" + std::to_string(t.a) + ":" + std::to_string(t.b) + ")";
+      V.why = std::string("open ") +
+              (t.type == PcType::EF ? "edge of A through open face of B"
+                                    : "edge of B through open face of A") +
+              " (" + type_name(t.type) + ":" + std::to_string(t.a) + ":" + std::to_string(t.b) +
+              ")";
       return;
     }
     Cone ca, cb;
     const int ka = kind_a(t.type), kb = kind_b(t.type);
-    ca = ka == 2 ? face_cone(A_, t.a, R) : ka == 1 ? edge_cone(A_, t.a, R) : vertex_cone(A_, t.a, R);
+    ca = ka == 2   ? face_cone(A_, t.a, R)
+         : ka == 1 ? edge_cone(A_, t.a, R)
+                   : vertex_cone(A_, t.a, R);
     const Mat3 I = Mat3::Identity();
-    cb = kb == 2 ? face_cone(B_, t.b, I) : kb == 1 ? edge_cone(B_, t.b, I) : vertex_cone(B_, t.b, I);
+    cb = kb == 2   ? face_cone(B_, t.b, I)
+         : kb == 1 ? edge_cone(B_, t.b, I)
+                   : vertex_cone(B_, t.b, I);
     double slack = tol_.ang;
-    if ((t.type == PcType::EF || t.type == PcType::FE) && t.extent > 0) slack = std::max(slack, 2 * tol / t.extent);
-    if (t.type == PcType::FF && t.extent > 0) slack = std::max(slack, 4 * tol / std::sqrt(t.extent));
+    if ((t.type == PcType::EF || t.type == PcType::FE) && t.extent > 0)
+      slack = std::max(slack, 2 * tol / t.extent);
+    if (t.type == PcType::FF && t.extent > 0)
+      slack = std::max(slack, 4 * tol / std::sqrt(t.extent));
     if (cones_overlap(ca, cb, slack)) {
       V.penetrating = true;
-      V.why = std::string("tangent cones overlap at ") + type_name(t.type) + ":" + std::to_string(t.a) + ":" +
-              std::to_string(t.b);
+      V.why = std::string("tangent cones overlap at ") + type_name(t.type) + ":" +
+              std::to_string(t.a) + ":" + std::to_string(t.b);
       return;
     }
   }
@@ -731,8 +784,10 @@ void Classifier::pcs_and_planes(const Scene& S, Verdict& V) const {
   for (int i : V.pcs) {
     const Touch& t = V.touches[i];
     if (!nondegenerate(t.type)) V.degenerate = true;
-    if (t.type == PcType::EE && t.near_end) V.uncertain.push_back("e-e crossing close to an edge end or at a small angle");
-    if ((t.type == PcType::EF || t.type == PcType::FE) && t.extent < 10 * tol) V.uncertain.push_back("line contact of tiny length");
+    if (t.type == PcType::EE && t.near_end)
+      V.uncertain.push_back("e-e crossing close to an edge end or at a small angle");
+    if ((t.type == PcType::EF || t.type == PcType::FE) && t.extent < 10 * tol)
+      V.uncertain.push_back("line contact of tiny length");
   }
   if (V.pcs.size() > 3) V.too_many = true;
   if (V.degenerate) return;
@@ -749,7 +804,8 @@ void Classifier::pcs_and_planes(const Scene& S, Verdict& V) const {
   for (std::size_t i = 0; i < pl.size(); ++i)
     for (std::size_t j = i + 1; j < pl.size(); ++j) {
       double s = pl[i].n.cross(pl[j].n).norm();
-      double off = std::max(std::abs(pl[i].n.dot(pl[j].p - pl[i].p)), std::abs(pl[j].n.dot(pl[i].p - pl[j].p)));
+      double off = std::max(std::abs(pl[i].n.dot(pl[j].p - pl[i].p)),
+                            std::abs(pl[j].n.dot(pl[i].p - pl[j].p)));
       if (s <= 1e-6 && off <= 4 * tol)
         V.same_plane = true;
       else if (!(s > 1e-4 || off > 100 * tol))
@@ -768,7 +824,8 @@ void Classifier::clearance(const Scene& S, Verdict& V, const CfKey* outside) con
   auto dominated = [&](int kx, int x, int ky, int y) {
     if (outside == nullptr) return false;
     for (const Pc& pc : *outside)
-      if (A.in_closure(kx, x, kind_a(pc.type), pc.a) && B.in_closure(ky, y, kind_b(pc.type), pc.b)) return true;
+      if (A.in_closure(kx, x, kind_a(pc.type), pc.a) && B.in_closure(ky, y, kind_b(pc.type), pc.b))
+        return true;
     return false;
   };
   for (std::size_t va = 0; va < A.V.size(); ++va)
@@ -795,7 +852,8 @@ void Classifier::clearance(const Scene& S, Verdict& V, const CfKey* outside) con
     for (std::size_t eb = 0; eb < B.E.size(); ++eb) {
       if (S.ae[ea].dist(be_[eb]) >= best) continue;
       if (dominated(1, static_cast<int>(ea), 1, static_cast<int>(eb))) continue;
-      double d = seg_seg_dist(S.pa[A.E[ea].v0], S.pa[A.E[ea].v1], B.V[B.E[eb].v0].p, B.V[B.E[eb].v1].p, nullptr, nullptr);
+      double d = seg_seg_dist(S.pa[A.E[ea].v0], S.pa[A.E[ea].v1], B.V[B.E[eb].v0].p,
+                              B.V[B.E[eb].v1].p, nullptr, nullptr);
       if (d > tol && d < best) {
         best = d;
         what = "e" + std::to_string(ea) + " of A to e" + std::to_string(eb) + " of B";

@@ -29,9 +29,9 @@ struct Pose {
 std::string pose_string(const Pose& X);  // "R=[[..],[..],[..]] t=[..] q=(w,x,y,z)"
 
 struct Tolerances {
-  double len = 1e-6;   // mm: closed elements this close touch
-  double ang = 1e-6;   // rad: slack of the tangent-cone tests
-  double gap = 1e-4;   // mm: the sampler drops poses whose clearance is below this
+  double len = 1e-6;  // mm: closed elements this close touch
+  double ang = 1e-6;  // rad: slack of the tangent-cone tests
+  double gap = 1e-4;  // mm: the sampler drops poses whose clearance is below this
 };
 /// len = 1e-7 x the smaller model's bounding-box diagonal, gap = 100 x len.
 Tolerances default_tolerances(const Poly& A, const Poly& B);
@@ -53,7 +53,7 @@ struct Pc {
   }
   bool operator==(const Pc& o) const { return type == o.type && a == o.a && b == o.b; }
 };
-using CfKey = std::vector<Pc>;  // sorted
+using CfKey = std::vector<Pc>;           // sorted
 std::string key_string(const CfKey& k);  // "f-f:1:2 v-f:3:0"
 
 struct Touch {
@@ -71,16 +71,18 @@ struct Verdict {
   bool penetrating = false;
   std::string why;  // what penetrates
   std::vector<Touch> touches;
-  std::vector<int> pcs;  // indices into touches: the non-dominated ones
-  bool degenerate = false;  // a PC is v-v, v-e, e-v or collinear e-e
-  bool too_many = false;    // more than 3 PCs
-  bool same_plane = false;  // two PCs share a contact plane
+  std::vector<int> pcs;                // indices into touches: the non-dominated ones
+  bool degenerate = false;             // a PC is v-v, v-e, e-v or collinear e-e
+  bool too_many = false;               // more than 3 PCs
+  bool same_plane = false;             // two PCs share a contact plane
   std::vector<std::string> uncertain;  // near-degenerate situations (the sampler drops these)
   double clearance = kInf;
   std::string clearance_what;
 
   bool free() const { return !penetrating && touches.empty(); }
-  bool valid_cf() const { return !penetrating && !pcs.empty() && !degenerate && !too_many && !same_plane; }
+  bool valid_cf() const {
+    return !penetrating && !pcs.empty() && !degenerate && !too_many && !same_plane;
+  }
   CfKey key() const;
   std::string describe() const;  // one line: status, PCs, flags
 };

@@ -124,7 +124,8 @@ bool wedge_wedge_overlap(const Wedge& X, const Wedge& Y, double slack) {
     Vec3 s = c.normalized();
     for (double sg : {1.0, -1.0}) {
       Vec3 p = sg * s;
-      if (p.dot(X.m1) <= slack && p.dot(X.m2) <= slack && p.dot(Y.m1) >= -slack && p.dot(Y.m2) >= -slack)
+      if (p.dot(X.m1) <= slack && p.dot(X.m2) <= slack && p.dot(Y.m1) >= -slack &&
+          p.dot(Y.m2) >= -slack)
         return false;
     }
     return true;

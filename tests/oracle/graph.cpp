@@ -12,7 +12,8 @@ namespace {
 
 Poly poly_from_json(const nlohmann::json& m, const std::string& name) {
   std::vector<Vec3> verts;
-  for (const auto& v : m.at("vertices")) verts.emplace_back(v.at(0).get<double>(), v.at(1).get<double>(), v.at(2).get<double>());
+  for (const auto& v : m.at("vertices"))
+    verts.emplace_back(v.at(0).get<double>(), v.at(1).get<double>(), v.at(2).get<double>());
   std::vector<std::array<int, 2>> edges;
   for (const auto& e : m.at("edges")) edges.push_back({e.at(0).get<int>(), e.at(1).get<int>()});
   std::vector<std::vector<std::vector<int>>> faces;
@@ -47,7 +48,8 @@ Graph read_graph(const std::string& path) {
       cf.id = c.at("id").get<int>();
       for (const auto& p : c.at("pcs")) {
         PcType t;
-        if (!parse_type(p.at("type").get<std::string>(), &t)) throw std::runtime_error("unknown PC type");
+        if (!parse_type(p.at("type").get<std::string>(), &t))
+          throw std::runtime_error("unknown PC type");
         cf.key.push_back(Pc{t, p.at("a").get<int>(), p.at("b").get<int>()});
       }
       std::sort(cf.key.begin(), cf.key.end());
@@ -70,7 +72,9 @@ std::string problem_of(const Verdict& V, const CfKey& want) {
   if (V.touches.empty()) return "A touches nothing at the witness";
   CfKey got = V.key();
   std::string s;
-  if (got != want) s = "PCs at the witness {" + key_string(got) + "} differ from the CF's {" + key_string(want) + "}";
+  if (got != want)
+    s = "PCs at the witness {" + key_string(got) + "} differ from the CF's {" + key_string(want) +
+        "}";
   if (V.degenerate) s += std::string(s.empty() ? "" : "; ") + "a PC is degenerate";
   if (V.too_many) s += std::string(s.empty() ? "" : "; ") + "more than 3 PCs";
   if (V.same_plane) s += std::string(s.empty() ? "" : "; ") + "two PCs share a contact plane";
@@ -78,7 +82,8 @@ std::string problem_of(const Verdict& V, const CfKey& want) {
 }
 }  // namespace
 
-WitnessResult check_witness(const Classifier& nominal, const Classifier& lo, const Classifier& hi, const GraphCf& cf) {
+WitnessResult check_witness(const Classifier& nominal, const Classifier& lo, const Classifier& hi,
+                            const GraphCf& cf) {
   WitnessResult r;
   r.id = cf.id;
   r.key = cf.key;

@@ -42,7 +42,8 @@ struct CheckReport {
 /// Sound: at the witness, with tolerance tol, interiors are disjoint and the PCs that hold
 /// (touching, non-dominated, classified) are exactly the CF's PCs. A witness that fails at tol
 /// but passes at tol/100 or tol*100 is marginal; one that fails at all three is unsound.
-WitnessResult check_witness(const Classifier& nominal, const Classifier& lo, const Classifier& hi, const GraphCf& cf);
+WitnessResult check_witness(const Classifier& nominal, const Classifier& lo, const Classifier& hi,
+                            const GraphCf& cf);
 CheckReport check_graph(const Graph& G, const Tolerances& tol);
 
 }  // namespace oracle

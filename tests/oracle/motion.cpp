@@ -24,7 +24,8 @@ bool in_closed_face(const Face& f, const Vec3& x, double tol) {
   return inside_loops(f.loops2, p) || dist_to_loops(f.loops2, p) <= tol;
 }
 
-double toi_translation(const Poly& A, const Poly& B, const Pose& X0, const Vec3& u, double lam_max, double tol) {
+double toi_translation(const Poly& A, const Poly& B, const Pose& X0, const Vec3& u, double lam_max,
+                       double tol) {
   const double lam_min = 1e-9 * std::min(A.diag, B.diag);
   double best = lam_max;
   bool hit = false;
@@ -118,8 +119,8 @@ void trig_roots(double A, double B, double C, double lo, double hi, std::vector<
   }
 }
 
-double toi_rotation(const Poly& A, const Poly& B, const Pose& X0, const Vec3& c, const Vec3& w, double lam_max,
-                    double tol) {
+double toi_rotation(const Poly& A, const Poly& B, const Pose& X0, const Vec3& c, const Vec3& w,
+                    double lam_max, double tol) {
   const double scale = std::max(A.diag, B.diag);
   const double th_min = 1e-9;
   double best = lam_max;
@@ -132,7 +133,8 @@ double toi_rotation(const Poly& A, const Poly& B, const Pose& X0, const Vec3& c,
     for (const Face& f : B.F) {
       double Ac = f.n.dot(x.P1), Bs = f.n.dot(x.P2), C = f.n.dot(x.P0) - f.d;
       if (std::hypot(Ac, Bs) < 1e-12 * scale) continue;
-      if (std::abs(C + Ac) <= tol && Bs < -1e-9 * scale && in_closed_face(f, x.at(1, 0), tol)) return 0;
+      if (std::abs(C + Ac) <= tol && Bs < -1e-9 * scale && in_closed_face(f, x.at(1, 0), tol))
+        return 0;
       roots.clear();
       trig_roots(Ac, Bs, C, th_min, best, &roots);
       for (double t : roots)
@@ -153,7 +155,9 @@ double toi_rotation(const Poly& A, const Poly& B, const Pose& X0, const Vec3& c,
     for (std::size_t g = 0; g < A.F.size(); ++g) {
       double Ac = an[g].dot(q.P1), Bs = -an[g].dot(q.P2), C = an[g].dot(q.P0) - ad[g];
       if (std::hypot(Ac, Bs) < 1e-12 * scale) continue;
-      if (std::abs(C + Ac) <= tol && Bs < -1e-9 * scale && in_closed_face(A.F[g], X0.inv(q.at(1, 0)), tol)) return 0;
+      if (std::abs(C + Ac) <= tol && Bs < -1e-9 * scale &&
+          in_closed_face(A.F[g], X0.inv(q.at(1, 0)), tol))
+        return 0;
       roots.clear();
       trig_roots(Ac, Bs, C, th_min, best, &roots);
       for (double t : roots) {
@@ -252,7 +256,8 @@ double toi_rotation(const Poly& A, const Poly& B, const Pose& X0, const Vec3& c,
 
 }  // namespace
 
-double time_of_impact(const Poly& A, const Poly& B, const Pose& X0, const Motion& M, double lam_max, double tol) {
+double time_of_impact(const Poly& A, const Poly& B, const Pose& X0, const Motion& M, double lam_max,
+                      double tol) {
   if (!M.rotation) return toi_translation(A, B, X0, M.u, lam_max, tol);
   return toi_rotation(A, B, X0, M.c, M.w, lam_max, tol);
 }

@@ -29,6 +29,7 @@ Pose apply_motion(const Pose& X0, const Motion& M, double lambda);
 /// First contact parameter in (lam_min, lam_max]; kInf when nothing is met; 0 when the motion
 /// at once pushes a vertex that touches a face (within tol) into it. tol: how far outside an
 /// element an event point may lie and still count.
-double time_of_impact(const Poly& A, const Poly& B, const Pose& X0, const Motion& M, double lam_max, double tol);
+double time_of_impact(const Poly& A, const Poly& B, const Pose& X0, const Motion& M, double lam_max,
+                      double tol);
 
 }  // namespace oracle

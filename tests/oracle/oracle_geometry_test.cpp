@@ -11,10 +11,10 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <unistd.h>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 #include <random>
 #include <set>
 
@@ -23,7 +23,8 @@ using namespace oracle;
 namespace {
 
 // A featured polyhedron from maximal polygonal faces (one loop each), edges from the loops.
-Poly poly_from_faces(const std::vector<Vec3>& V, const std::vector<std::vector<int>>& F, const std::string& name) {
+Poly poly_from_faces(const std::vector<Vec3>& V, const std::vector<std::vector<int>>& F,
+                     const std::string& name) {
   std::set<std::pair<int, int>> es;
   for (const auto& f : F)
     for (std::size_t i = 0; i < f.size(); ++i) {
@@ -119,7 +120,8 @@ TEST_CASE("every shape family and every pairing gives closed, outward, manifold 
 TEST_CASE("triangulation of a square with an octagonal hole adds up") {
   std::vector<Vec2> outer{{0, 0}, {10, 0}, {10, 10}, {0, 10}};
   std::vector<Vec2> hole;
-  for (int i = 7; i >= 0; --i) hole.emplace_back(5 + 4.9 * std::cos(0.3 + i * kPi / 4), 5 + 4.9 * std::sin(0.3 + i * kPi / 4));
+  for (int i = 7; i >= 0; --i)
+    hole.emplace_back(5 + 4.9 * std::cos(0.3 + i * kPi / 4), 5 + 4.9 * std::sin(0.3 + i * kPi / 4));
   auto tris = triangulate(outer, {hole});
   CHECK(tris.size() == 4 + 8);  // one bridge: n + h triangles
 }
@@ -175,7 +177,8 @@ TEST_CASE("a cube face-down on a floor is one f-f") {
   CHECK(W.key()[0].type == PcType::EF);
   // tilted about two axes: a single vertex
   Pose Z;
-  Z.R = Eigen::AngleAxisd(0.3, Vec3::UnitX()).toRotationMatrix() * Eigen::AngleAxisd(-0.2, Vec3::UnitY()).toRotationMatrix();
+  Z.R = Eigen::AngleAxisd(0.3, Vec3::UnitX()).toRotationMatrix() *
+        Eigen::AngleAxisd(-0.2, Vec3::UnitY()).toRotationMatrix();
   Verdict U = C.classify(Z);
   INFO(U.describe());
   REQUIRE(U.valid_cf());
@@ -185,7 +188,8 @@ TEST_CASE("a cube face-down on a floor is one f-f") {
 
 TEST_CASE("a cube edge crossing a table edge is e-e") {
   Poly A = cube(10);
-  Poly B = prism({{-50, -50}, {0, -50}, {0, 50}, {-50, 50}}, -20, 0, "table");  // edge along y at x=0, z=0
+  Poly B = prism({{-50, -50}, {0, -50}, {0, 50}, {-50, 50}}, -20, 0,
+                 "table");  // edge along y at x=0, z=0
   Classifier C(A, B, tol_for(A, B));
   Vec3 d = Vec3(1, 0, -1).normalized();
   Vec3 s = d.cross(Vec3(0, 1, 0)).normalized();  // separating plane normal; B on s.x <= 0
@@ -233,7 +237,8 @@ TEST_CASE("the L-foot inside a wall is caught although elements only touch on bo
   int wall = face_with_normal(B, Vec3(1, 0, 0));
   REQUIRE(v >= 0);
   REQUIRE(wall >= 0);
-  CHECK(cones_overlap(vertex_cone(A, v, Mat3::Identity()), face_cone(B, wall, Mat3::Identity()), 1e-6));
+  CHECK(cones_overlap(vertex_cone(A, v, Mat3::Identity()), face_cone(B, wall, Mat3::Identity()),
+                      1e-6));
   // the same part moved out of the wall by 7.8 mm sits in the corner: two f-f on distinct planes
   Pose Y;
   Y.t = Vec3(7.8, 0, 0);
@@ -404,13 +409,14 @@ TEST_CASE("graph reader and witness checker on a hand-written graph") {
   g["models"]["A"] = model(A);
   g["models"]["B"] = model(B);
   const double tol = default_tolerances(A, B).len;
-  g["cfs"] = {cf(0, "f-f", fa, fb, 0.0),          // sound
-              cf(1, "f-f", fa, fb, -0.01),        // sunk 0.01 mm: unsound
-              cf(2, "v-f", 0, fb, 0.0),           // the pose holds an f-f, not this: unsound
-              cf(3, "f-f", fa, fb, 20 * tol)};    // lifted by 20 tol: marginal
+  g["cfs"] = {cf(0, "f-f", fa, fb, 0.0),        // sound
+              cf(1, "f-f", fa, fb, -0.01),      // sunk 0.01 mm: unsound
+              cf(2, "v-f", 0, fb, 0.0),         // the pose holds an f-f, not this: unsound
+              cf(3, "f-f", fa, fb, 20 * tol)};  // lifted by 20 tol: marginal
   g["transitions"] = nlohmann::json::array();
-  const std::string path =
-      (std::filesystem::temp_directory_path() / ("oracle_graph_" + std::to_string(::getpid()) + ".json")).string();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("oracle_graph_" + std::to_string(::getpid()) + ".json"))
+                               .string();
   std::ofstream(path) << g.dump();
   Graph G = read_graph(path);
   std::filesystem::remove(path);

@@ -30,7 +30,8 @@ namespace {
 void usage() {
   std::puts(
       "usage: oracle_recall --seed N [--cfgen PATH] [--budget SECONDS] [--keep DIR] [-j THREADS]\n"
-      "                     [--sampler-seed K] [--rounds K] [--pose R00,..,R22,tx,ty,tz]... [--quiet]\n"
+      "                     [--sampler-seed K] [--rounds K] [--pose R00,..,R22,tx,ty,tz]... "
+      "[--quiet]\n"
       "       oracle_recall A.off B.off [options]\n"
       "Generates the model pair of seed N (or takes A.off, B.off), runs cfgen on it, re-verifies\n"
       "every witness of the graph and samples valid CFs independently; prints the CFs the graph\n"
@@ -66,7 +67,8 @@ int main(int argc, char** argv) {
         o.cfgen = val();
       } else if (a == "--budget") {
         o.budget_s = std::stod(val());
-        if (!(o.budget_s >= 0 && o.budget_s < 1e6)) throw std::runtime_error("--budget out of range");
+        if (!(o.budget_s >= 0 && o.budget_s < 1e6))
+          throw std::runtime_error("--budget out of range");
       } else if (a == "--keep") {
         o.keep_dir = val();
       } else if (a == "-j" || a == "--threads") {
@@ -79,7 +81,8 @@ int main(int argc, char** argv) {
         o.sampler_rounds = std::stol(val());
       } else if (a == "--pose") {
         oracle::Pose X;
-        if (!oracle::parse_pose_arg(val(), &X)) throw std::runtime_error("--pose needs 12 numbers R00,...,R22,tx,ty,tz (R a rotation)");
+        if (!oracle::parse_pose_arg(val(), &X))
+          throw std::runtime_error("--pose needs 12 numbers R00,...,R22,tx,ty,tz (R a rotation)");
         o.check_poses.push_back(X);
       } else if (a == "--quiet" || a == "-q") {
         quiet = true;
@@ -95,8 +98,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "oracle_recall: %s\n", e.what());
     return 2;
   }
-  oracle::RecallResult r =
-      have_seed ? oracle::run_recall_seed(seed, o) : oracle::run_recall_files(files[0], files[1], o);
+  oracle::RecallResult r = have_seed ? oracle::run_recall_seed(seed, o)
+                                     : oracle::run_recall_files(files[0], files[1], o);
   std::cout << r.line() << "\n";
   if (!quiet) {
     std::cout << "  sampler: " << r.sampler_stats.str() << "\n";

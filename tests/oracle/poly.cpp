@@ -23,7 +23,8 @@ double ccw_angle(const Vec3& a, const Vec3& b, const Vec3& n) {
 }
 
 Vec3 any_perp(const Vec3& n) {
-  Vec3 a = std::abs(n.x()) < 0.6 ? Vec3(1, 0, 0) : (std::abs(n.y()) < 0.6 ? Vec3(0, 1, 0) : Vec3(0, 0, 1));
+  Vec3 a = std::abs(n.x()) < 0.6 ? Vec3(1, 0, 0)
+                                 : (std::abs(n.y()) < 0.6 ? Vec3(0, 1, 0) : Vec3(0, 0, 1));
   return n.cross(a).normalized();
 }
 
@@ -53,7 +54,8 @@ static double pt_seg2(const Vec2& p, const Vec2& a, const Vec2& b) {
 double dist_to_loops(const std::vector<std::vector<Vec2>>& loops, const Vec2& p) {
   double best = kInf;
   for (const auto& L : loops)
-    for (std::size_t i = 0; i < L.size(); ++i) best = std::min(best, pt_seg2(p, L[i], L[(i + 1) % L.size()]));
+    for (std::size_t i = 0; i < L.size(); ++i)
+      best = std::min(best, pt_seg2(p, L[i], L[(i + 1) % L.size()]));
   return best;
 }
 
@@ -66,7 +68,8 @@ double point_seg_dist(const Vec3& p, const Vec3& a, const Vec3& b, double* sp) {
 }
 
 // Ericson, Real-Time Collision Detection, 5.1.9.
-double seg_seg_dist(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2, double* sp, double* tp) {
+double seg_seg_dist(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2, double* sp,
+                    double* tp) {
   Vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
   double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
   double s = 0, t = 0;
@@ -154,16 +157,19 @@ Poly build_poly(const std::vector<Vec3>& verts, const std::vector<std::array<int
   for (std::size_t e = 0; e < edges.size(); ++e) {
     int a = edges[e][0], b = edges[e][1];
     if (a < 0 || b < 0 || a >= nv || b >= nv || a == b)
-      throw std::runtime_error(fmt_err(name, "edge " + std::to_string(e) + " has bad vertex indices"));
+      throw std::runtime_error(
+          fmt_err(name, "edge " + std::to_string(e) + " has bad vertex indices"));
     if (P.edge_of.count({std::min(a, b), std::max(a, b)}))
-      throw std::runtime_error(fmt_err(name, "edge " + std::to_string(e) + " repeats another edge"));
+      throw std::runtime_error(
+          fmt_err(name, "edge " + std::to_string(e) + " repeats another edge"));
     P.edge_of[{std::min(a, b), std::max(a, b)}] = static_cast<int>(e);
     Edge& E = P.E[e];
     E.v0 = a;
     E.v1 = b;
     Vec3 d = verts[b] - verts[a];
     E.len = d.norm();
-    if (!(E.len > 0)) throw std::runtime_error(fmt_err(name, "edge " + std::to_string(e) + " has zero length"));
+    if (!(E.len > 0))
+      throw std::runtime_error(fmt_err(name, "edge " + std::to_string(e) + " has zero length"));
     E.dir = d / E.len;
     P.V[a].edges.push_back(static_cast<int>(e));
     P.V[b].edges.push_back(static_cast<int>(e));
@@ -175,25 +181,32 @@ Poly build_poly(const std::vector<Vec3>& verts, const std::vector<std::array<int
   for (std::size_t fi = 0; fi < faces.size(); ++fi) {
     Face& F = P.F[fi];
     F.loops = faces[fi];
-    if (F.loops.empty()) throw std::runtime_error(fmt_err(name, "face " + std::to_string(fi) + " has no loop"));
+    if (F.loops.empty())
+      throw std::runtime_error(fmt_err(name, "face " + std::to_string(fi) + " has no loop"));
     // Newell normal of the outer loop.
     Vec3 nn = Vec3::Zero();
     const auto& outer = F.loops[0];
-    if (outer.size() < 3) throw std::runtime_error(fmt_err(name, "face " + std::to_string(fi) + " outer loop has < 3 vertices"));
+    if (outer.size() < 3)
+      throw std::runtime_error(
+          fmt_err(name, "face " + std::to_string(fi) + " outer loop has < 3 vertices"));
     for (std::size_t i = 0; i < outer.size(); ++i) {
       int a = outer[i], b = outer[(i + 1) % outer.size()];
       if (a < 0 || a >= nv || b < 0 || b >= nv)
-        throw std::runtime_error(fmt_err(name, "face " + std::to_string(fi) + " has a bad vertex index"));
+        throw std::runtime_error(
+            fmt_err(name, "face " + std::to_string(fi) + " has a bad vertex index"));
       nn += verts[a].cross(verts[b]);
     }
-    if (nn.norm() <= 0) throw std::runtime_error(fmt_err(name, "face " + std::to_string(fi) + " has zero area"));
+    if (nn.norm() <= 0)
+      throw std::runtime_error(fmt_err(name, "face " + std::to_string(fi) + " has zero area"));
     F.n = nn.normalized();
     Vec3 c = Vec3::Zero();
     int cnt = 0;
     std::set<int> vs;
     for (const auto& L : F.loops)
       for (int v : L) {
-        if (v < 0 || v >= nv) throw std::runtime_error(fmt_err(name, "face " + std::to_string(fi) + " has a bad vertex index"));
+        if (v < 0 || v >= nv)
+          throw std::runtime_error(
+              fmt_err(name, "face " + std::to_string(fi) + " has a bad vertex index"));
         c += verts[v];
         ++cnt;
         vs.insert(v);
@@ -228,9 +241,11 @@ Poly build_poly(const std::vector<Vec3>& verts, const std::vector<std::array<int
         F.perimeter += (b - a).norm();
       }
       if (li == 0 && la <= 0)
-        throw std::runtime_error(fmt_err(name, "face " + std::to_string(fi) + " outer loop is not counter-clockwise"));
+        throw std::runtime_error(
+            fmt_err(name, "face " + std::to_string(fi) + " outer loop is not counter-clockwise"));
       if (li > 0 && la >= 0)
-        throw std::runtime_error(fmt_err(name, "face " + std::to_string(fi) + " hole loop is not clockwise"));
+        throw std::runtime_error(
+            fmt_err(name, "face " + std::to_string(fi) + " hole loop is not clockwise"));
       area += la;
       F.loops2.push_back(std::move(L2));
     }
@@ -242,12 +257,14 @@ Poly build_poly(const std::vector<Vec3>& verts, const std::vector<std::array<int
         int a = L[i], b = L[(i + 1) % L.size()];
         int e = P.edge_index(a, b);
         if (e < 0)
-          throw std::runtime_error(fmt_err(name, "face " + std::to_string(fi) + " runs " + std::to_string(a) + "-" +
-                                                     std::to_string(b) + " which is not an edge"));
+          throw std::runtime_error(fmt_err(name, "face " + std::to_string(fi) + " runs " +
+                                                     std::to_string(a) + "-" + std::to_string(b) +
+                                                     " which is not an edge"));
         Edge& E = P.E[e];
         int slot = (E.v0 == a) ? 0 : 1;
         if (E.face[slot] >= 0)
-          throw std::runtime_error(fmt_err(name, "edge " + std::to_string(e) + " is run the same way by two faces"));
+          throw std::runtime_error(
+              fmt_err(name, "edge " + std::to_string(e) + " is run the same way by two faces"));
         E.face[slot] = static_cast<int>(fi);
         F.edges.push_back(e);
       }
@@ -255,9 +272,11 @@ Poly build_poly(const std::vector<Vec3>& verts, const std::vector<std::array<int
   for (std::size_t e = 0; e < P.E.size(); ++e) {
     Edge& E = P.E[e];
     if (E.face[0] < 0 || E.face[1] < 0)
-      throw std::runtime_error(fmt_err(name, "edge " + std::to_string(e) + " does not have two faces"));
+      throw std::runtime_error(
+          fmt_err(name, "edge " + std::to_string(e) + " does not have two faces"));
     if (E.face[0] == E.face[1])
-      throw std::runtime_error(fmt_err(name, "edge " + std::to_string(e) + " has the same face on both sides"));
+      throw std::runtime_error(
+          fmt_err(name, "edge " + std::to_string(e) + " has the same face on both sides"));
     const Vec3& n0 = P.F[E.face[0]].n;
     const Vec3& n1 = P.F[E.face[1]].n;
     E.m[0] = n0.cross(E.dir).normalized();
@@ -285,8 +304,10 @@ Poly build_poly(const std::vector<Vec3>& verts, const std::vector<std::array<int
   }
   for (int v = 0; v < nv; ++v)
     if (P.V[v].edges.size() < 3 || P.V[v].corners.size() < 3)
-      throw std::runtime_error(fmt_err(name, "vertex " + std::to_string(v) + " has fewer than 3 edges/faces"));
-  if (P.volume() <= 0) throw std::runtime_error(fmt_err(name, "non-positive volume (inward orientation?)"));
+      throw std::runtime_error(
+          fmt_err(name, "vertex " + std::to_string(v) + " has fewer than 3 edges/faces"));
+  if (P.volume() <= 0)
+    throw std::runtime_error(fmt_err(name, "non-positive volume (inward orientation?)"));
   return P;
 }
 

@@ -120,7 +120,8 @@ bool inside_loops(const std::vector<std::vector<Vec2>>& loops, const Vec2& p);
 double dist_to_loops(const std::vector<std::vector<Vec2>>& loops, const Vec2& p);
 double point_seg_dist(const Vec3& p, const Vec3& a, const Vec3& b, double* s = nullptr);
 /// Closest points of segments [p0,p1], [q0,q1]: returns the distance, parameters in [0,1].
-double seg_seg_dist(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double* s, double* t);
+double seg_seg_dist(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double* s,
+                    double* t);
 /// Distance from a point (in the face's frame) to the closed face polygon.
 double point_face_dist(const Poly& P, const Face& f, const Vec3& x);
 

@@ -26,7 +26,8 @@ namespace fs = std::filesystem;
 
 std::string signature(const CfKey& k) {
   std::string s = std::to_string(k.size()) + ":";
-  for (std::size_t i = 0; i < k.size(); ++i) s += (i ? "+" : "") + std::string(type_name(k[i].type));
+  for (std::size_t i = 0; i < k.size(); ++i)
+    s += (i ? "+" : "") + std::string(type_name(k[i].type));
   return s;
 }
 
@@ -65,16 +66,19 @@ bool parse_pose_arg(const std::string& a, Pose* X) {
     if (!std::isfinite(x)) return false;
   for (int k = 0; k < 9; ++k) X->R(k / 3, k % 3) = v[k];
   X->t = Vec3(v[9], v[10], v[11]);
-  return (X->R.transpose() * X->R - Mat3::Identity()).cwiseAbs().maxCoeff() < 1e-6 && X->R.determinant() > 0;
+  return (X->R.transpose() * X->R - Mat3::Identity()).cwiseAbs().maxCoeff() < 1e-6 &&
+         X->R.determinant() > 0;
 }
 
 std::string RecallResult::line() const {
   char buf[512];
   std::snprintf(buf, sizeof buf,
-                "%s graph=%d sampled=%d misses=%zu recall=%.1f%% unsound=%d marginal=%d dropped=%d cfgen=%.1fs "
+                "%s graph=%d sampled=%d misses=%zu recall=%.1f%% unsound=%d marginal=%d dropped=%d "
+                "cfgen=%.1fs "
                 "sampler=%.1fs",
-                from_seed ? ("seed=" + std::to_string(seed)).c_str() : "files", graph_cfs, sampled, misses.size(),
-                recall(), check.unsound, check.marginal, unstable + suspect, cfgen_s, sampler_s);
+                from_seed ? ("seed=" + std::to_string(seed)).c_str() : "files", graph_cfs, sampled,
+                misses.size(), recall(), check.unsound, check.marginal, unstable + suspect, cfgen_s,
+                sampler_s);
   std::string s = buf;
   if (!ok) s += " ERROR: " + error;
   if (!model_problems.empty()) s += " MODEL-MISMATCH";
@@ -89,8 +93,10 @@ std::string RecallResult::details() const {
   if (ok) {
     char buf[256];
     std::snprintf(buf, sizeof buf,
-                  "  witnesses: %d checked in %.1f s, %d sound (smallest clearance %.4g mm), %d marginal, %d unsound\n",
-                  check.total, check_s, check.sound, check.min_clearance, check.marginal, check.unsound);
+                  "  witnesses: %d checked in %.1f s, %d sound (smallest clearance %.4g mm), %d "
+                  "marginal, %d unsound\n",
+                  check.total, check_s, check.sound, check.min_clearance, check.marginal,
+                  check.unsound);
     o << buf;
   }
   int n = 0;
@@ -99,9 +105,12 @@ std::string RecallResult::details() const {
       o << "  ... " << check.bad.size() - 20 << " more bad witnesses\n";
       break;
     }
-    o << "  " << (w.verdict == 2 ? "UNSOUND" : "MARGINAL") << " witness " << who << " cf " << w.id << " {"
-      << key_string(w.key) << "}: " << w.problem << "\n    pose " << pose_string(w.pose) << "\n";
-    if (from_seed) o << "    recheck: oracle_recall --seed " << seed << " --budget 0 --pose " << pose_arg(w.pose) << "\n";
+    o << "  " << (w.verdict == 2 ? "UNSOUND" : "MARGINAL") << " witness " << who << " cf " << w.id
+      << " {" << key_string(w.key) << "}: " << w.problem << "\n    pose " << pose_string(w.pose)
+      << "\n";
+    if (from_seed)
+      o << "    recheck: oracle_recall --seed " << seed << " --budget 0 --pose " << pose_arg(w.pose)
+        << "\n";
   }
   for (const auto& m : suspects)
     o << "  SUSPECT (not counted: the Monte-Carlo check found points of A inside B) " << who << " {"
@@ -124,9 +133,11 @@ std::string RecallResult::details() const {
     char cl[64];
     std::snprintf(cl, sizeof cl, "%.4g", m.sample.clearance);
     o << "  MISS " << who << " {" << key_string(m.key) << "} clearance " << cl << " mm"
-      << (m.sample.clearance < 0.01 ? " (below cfgen's default --min-clearance 0.01 mm)" : "") << " via " << m.sample.how
-      << "\n    pose " << pose_string(m.sample.pose) << "\n";
-    if (from_seed) o << "    recheck: oracle_recall --seed " << seed << " --budget 0 --pose " << pose_arg(m.sample.pose) << "\n";
+      << (m.sample.clearance < 0.01 ? " (below cfgen's default --min-clearance 0.01 mm)" : "")
+      << " via " << m.sample.how << "\n    pose " << pose_string(m.sample.pose) << "\n";
+    if (from_seed)
+      o << "    recheck: oracle_recall --seed " << seed << " --budget 0 --pose "
+        << pose_arg(m.sample.pose) << "\n";
   }
   return o.str();
 }
@@ -144,8 +155,8 @@ double now_s() {
 }
 
 // Runs cfgen; returns its exit status (-1 when it could not start); output to log.
-int run_cfgen(const std::string& cfgen, const std::string& a, const std::string& b, const std::string& g, int threads,
-              const std::string& log, double timeout_s) {
+int run_cfgen(const std::string& cfgen, const std::string& a, const std::string& b,
+              const std::string& g, int threads, const std::string& log, double timeout_s) {
   pid_t pid = fork();
   if (pid < 0) return -1;
   if (pid == 0) {
@@ -156,8 +167,8 @@ int run_cfgen(const std::string& cfgen, const std::string& a, const std::string&
       close(fd);
     }
     std::string j = std::to_string(threads);
-    execl(cfgen.c_str(), cfgen.c_str(), a.c_str(), b.c_str(), "-o", g.c_str(), "-q", "-j", j.c_str(),
-          static_cast<char*>(nullptr));
+    execl(cfgen.c_str(), cfgen.c_str(), a.c_str(), b.c_str(), "-o", g.c_str(), "-q", "-j",
+          j.c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
   int st = 0;
@@ -192,22 +203,27 @@ void compare_model(const Mesh& m, const Poly& P, const char* which, std::vector<
   double am = mesh_area(m), ap = P.surface_area();
   char buf[256];
   if (std::abs(vm - vp) > 1e-6 * std::abs(vm)) {
-    std::snprintf(buf, sizeof buf, "%s: volume of the graph model %.9g differs from the mesh's %.9g", which, vp, vm);
+    std::snprintf(buf, sizeof buf,
+                  "%s: volume of the graph model %.9g differs from the mesh's %.9g", which, vp, vm);
     out->push_back(buf);
   }
   if (std::abs(am - ap) > 1e-6 * am) {
-    std::snprintf(buf, sizeof buf, "%s: surface area of the graph model %.9g differs from the mesh's %.9g", which, ap, am);
+    std::snprintf(buf, sizeof buf,
+                  "%s: surface area of the graph model %.9g differs from the mesh's %.9g", which,
+                  ap, am);
     out->push_back(buf);
   }
   int nf = count_planar_faces(m);
   if (nf != static_cast<int>(P.F.size())) {
-    std::snprintf(buf, sizeof buf, "%s: the graph model has %zu faces, the mesh %d maximal planar regions", which,
+    std::snprintf(buf, sizeof buf,
+                  "%s: the graph model has %zu faces, the mesh %d maximal planar regions", which,
                   P.F.size(), nf);
     out->push_back(buf);
   }
   int nv = count_corner_vertices(m);
   if (nv != static_cast<int>(P.V.size())) {
-    std::snprintf(buf, sizeof buf, "%s: the graph model has %zu vertices, the mesh %d corners of 3+ faces", which,
+    std::snprintf(buf, sizeof buf,
+                  "%s: the graph model has %zu vertices, the mesh %d corners of 3+ faces", which,
                   P.V.size(), nv);
     out->push_back(buf);
   }
@@ -215,7 +231,8 @@ void compare_model(const Mesh& m, const Poly& P, const char* which, std::vector<
 
 // Points of A (random in A, and near each contact) that lie inside B farther than 10 tol from
 // B's boundary.
-int mc_points_inside(const Poly& A, const Poly& B, const Pose& X, const Verdict& V, double tol, std::uint64_t seed) {
+int mc_points_inside(const Poly& A, const Poly& B, const Pose& X, const Verdict& V, double tol,
+                     std::uint64_t seed) {
   std::mt19937_64 rng(seed ^ 0x5bd1e995ULL);
   std::uniform_real_distribution<double> u01(0, 1);
   std::normal_distribution<double> N(0, 1);
@@ -245,8 +262,8 @@ int mc_points_inside(const Poly& A, const Poly& B, const Pose& X, const Verdict&
   return bad;
 }
 
-RecallResult run_pair(const Mesh& A, const Mesh& B, const std::string& dir, const RecallOptions& o, RecallResult r,
-                      bool write_models) {
+RecallResult run_pair(const Mesh& A, const Mesh& B, const std::string& dir, const RecallOptions& o,
+                      RecallResult r, bool write_models) {
   r.a_path = (fs::path(dir) / "A.off").string();
   r.b_path = (fs::path(dir) / "B.off").string();
   r.graph_path = (fs::path(dir) / "G.json").string();
@@ -257,10 +274,12 @@ RecallResult run_pair(const Mesh& A, const Mesh& B, const std::string& dir, cons
     }
     double t0 = now_s();
     std::string log = (fs::path(dir) / "cfgen.log").string();
-    int rc = run_cfgen(o.cfgen, r.a_path, r.b_path, r.graph_path, o.threads, log, o.cfgen_timeout_s);
+    int rc =
+        run_cfgen(o.cfgen, r.a_path, r.b_path, r.graph_path, o.threads, log, o.cfgen_timeout_s);
     r.cfgen_s = now_s() - t0;
     if (rc == -2) {
-      r.error = "cfgen did not finish within " + std::to_string(static_cast<int>(o.cfgen_timeout_s)) + " s";
+      r.error = "cfgen did not finish within " +
+                std::to_string(static_cast<int>(o.cfgen_timeout_s)) + " s";
       return r;
     }
     if (rc != 0) {
@@ -284,7 +303,8 @@ RecallResult run_pair(const Mesh& A, const Mesh& B, const std::string& dir, cons
       Verdict v = C.classify(X, true);
       std::string rep = "pose " + pose_string(X) + "\n    oracle: " + v.describe();
       if (v.valid_cf() && v.uncertain.empty())
-        rep += in_graph.count(v.key()) ? "\n    the graph holds this CF" : "\n    the graph does NOT hold this CF";
+        rep += in_graph.count(v.key()) ? "\n    the graph holds this CF"
+                                       : "\n    the graph does NOT hold this CF";
       r.pose_reports.push_back(rep);
     }
     SamplerOptions so;
@@ -389,7 +409,8 @@ RecallResult run_recall_seed(std::uint64_t seed, const RecallOptions& o) {
   return r;
 }
 
-RecallResult run_recall_files(const std::string& a_off, const std::string& b_off, const RecallOptions& o) {
+RecallResult run_recall_files(const std::string& a_off, const std::string& b_off,
+                              const RecallOptions& o) {
   RecallResult r;
   r.desc = a_off + " | " + b_off;
   bool tmp = false;

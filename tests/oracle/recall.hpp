@@ -14,15 +14,16 @@
 namespace oracle {
 
 struct RecallOptions {
-  std::string cfgen;         // path of the cfgen binary
-  double budget_s = 3.0;     // sampler time per pair
-  int threads = 2;           // cfgen -j
-  double cfgen_timeout_s = 0;  // >0: kill cfgen after this long and report the run as failed
-  std::string keep_dir;      // keep the models and the graph here ("" = temporary, removed)
+  std::string cfgen;               // path of the cfgen binary
+  double budget_s = 3.0;           // sampler time per pair
+  int threads = 2;                 // cfgen -j
+  double cfgen_timeout_s = 0;      // >0: kill cfgen after this long and report the run as failed
+  std::string keep_dir;            // keep the models and the graph here ("" = temporary, removed)
   std::uint64_t sampler_seed = 0;  // 0: derived from the pair's seed
   int max_printed_misses = 30;
-  long sampler_rounds = 0;         // >0: stop the sampler after this many rounds (deterministic)
-  std::vector<Pose> check_poses;   // classify these poses of A and say whether the graph holds the CF
+  long sampler_rounds = 0;  // >0: stop the sampler after this many rounds (deterministic)
+  std::vector<Pose>
+      check_poses;  // classify these poses of A and say whether the graph holds the CF
 };
 
 struct Miss {
@@ -31,7 +32,7 @@ struct Miss {
 };
 
 struct RecallResult {
-  bool ok = false;            // the run itself worked (cfgen ran, graph read)
+  bool ok = false;  // the run itself worked (cfgen ran, graph read)
   std::string error;
   std::uint64_t seed = 0;
   bool from_seed = false;
@@ -41,8 +42,8 @@ struct RecallResult {
   int sampled = 0;
   int found = 0;  // sampled and in the graph
   std::vector<Miss> misses;
-  int unstable = 0;               // sampled CFs whose PCs change between tol/10 and tol*10 (dropped)
-  int suspect = 0;                // misses the Monte-Carlo check contradicts (dropped, printed)
+  int unstable = 0;  // sampled CFs whose PCs change between tol/10 and tol*10 (dropped)
+  int suspect = 0;   // misses the Monte-Carlo check contradicts (dropped, printed)
   std::vector<Miss> suspects;
   std::vector<std::string> pose_reports;  // for RecallOptions::check_poses
   CheckReport check;
@@ -64,6 +65,7 @@ bool parse_pose_arg(const std::string& a, Pose* X);
 std::string signature(const CfKey& k);
 
 RecallResult run_recall_seed(std::uint64_t seed, const RecallOptions& o);
-RecallResult run_recall_files(const std::string& a_off, const std::string& b_off, const RecallOptions& o);
+RecallResult run_recall_files(const std::string& a_off, const std::string& b_off,
+                              const RecallOptions& o);
 
 }  // namespace oracle

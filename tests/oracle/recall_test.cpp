@@ -29,8 +29,8 @@ constexpr double kMinRecallPercent = 99.5;
 void run_seed(std::uint64_t seed) {
   oracle::RecallOptions o;
   o.cfgen = CF_CFGEN;
-  o.budget_s = 15.0;         // a cap only: the sampler stops after sampler_rounds rounds,
-  o.sampler_rounds = 8000;   // which takes about 3 s and makes the run deterministic
+  o.budget_s = 15.0;        // a cap only: the sampler stops after sampler_rounds rounds,
+  o.sampler_rounds = 8000;  // which takes about 3 s and makes the run deterministic
   o.threads = 2;
 #ifdef CF_ORACLE_KEEP_DIR
   o.keep_dir = CF_ORACLE_KEEP_DIR;  // pair, graph and samples.csv for identify_oracle_test
@@ -39,7 +39,8 @@ void run_seed(std::uint64_t seed) {
   if (const char* k = std::getenv("ORACLE_ROUNDS")) o.sampler_rounds = std::atol(k);
   if (const char* j = std::getenv("ORACLE_THREADS")) o.threads = std::atoi(j);
   oracle::RecallResult r = oracle::run_recall_seed(seed, o);
-  std::cout << r.line() << "\n  sampler: " << r.sampler_stats.str() << "\n" << r.details() << std::flush;
+  std::cout << r.line() << "\n  sampler: " << r.sampler_stats.str() << "\n"
+            << r.details() << std::flush;
   INFO(r.line());
   REQUIRE(r.ok);
   CHECK(r.model_problems.empty());
@@ -58,10 +59,8 @@ void run_seed(std::uint64_t seed) {
 // 1 box in corner block, 14 triangular prism in U-channel. The other pairings (cube in square
 // hole, L-part against U-channel, A wider than the pocket, L-part against corner/stairs) make
 // cfgen run for minutes; scripts/recall-soak.sh covers them.
-#define ORACLE_SEED(N)                                  \
-  TEST_CASE("recall on seed " #N, "[oracle][recall]") { \
-    run_seed(N);                                        \
-  }
+#define ORACLE_SEED(N) \
+  TEST_CASE("recall on seed " #N, "[oracle][recall]") { run_seed(N); }
 
 ORACLE_SEED(127)
 ORACLE_SEED(44)

@@ -9,13 +9,15 @@ namespace oracle {
 
 std::string SamplerStats::str() const {
   std::ostringstream o;
-  o << rounds << " rounds, " << poses << " poses: " << accepted << " accepted, " << penetrating << " penetrating, "
-    << free << " free, " << uncertain << " near-degenerate, " << low_clearance << " low clearance, " << degenerate
-    << " degenerate PC, " << too_many << " >3 PCs, " << same_plane << " shared plane; " << seconds << " s";
+  o << rounds << " rounds, " << poses << " poses: " << accepted << " accepted, " << penetrating
+    << " penetrating, " << free << " free, " << uncertain << " near-degenerate, " << low_clearance
+    << " low clearance, " << degenerate << " degenerate PC, " << too_many << " >3 PCs, "
+    << same_plane << " shared plane; " << seconds << " s";
   return o.str();
 }
 
-Sampler::Sampler(const Classifier& C, SamplerOptions o) : C_(C), A_(C.A()), B_(C.B()), o_(o), rng_(o.seed) {
+Sampler::Sampler(const Classifier& C, SamplerOptions o)
+    : C_(C), A_(C.A()), B_(C.B()), o_(o), rng_(o.seed) {
   for (std::size_t e = 0; e < A_.E.size(); ++e)
     if (A_.E[e].convex) convex_a_.push_back(static_cast<int>(e));
   for (std::size_t e = 0; e < B_.E.size(); ++e)
@@ -76,7 +78,9 @@ Vec3 Sampler::outward_b(int kind, int idx) {
 }
 
 namespace {
-Mat3 align(const Vec3& x, const Vec3& y) { return Eigen::Quaterniond::FromTwoVectors(x, y).toRotationMatrix(); }
+Mat3 align(const Vec3& x, const Vec3& y) {
+  return Eigen::Quaterniond::FromTwoVectors(x, y).toRotationMatrix();
+}
 Mat3 spin(const Vec3& k, double phi) { return Eigen::AngleAxisd(phi, k).toRotationMatrix(); }
 Mat3 expmap(const Vec3& d) {
   double a = d.norm();
@@ -284,7 +288,8 @@ Verdict Sampler::record(const Pose& X, const std::string& how) {
   ++st_.accepted;
   CfKey k = V.key();
   auto it = found_.find(k);
-  if (it == found_.end() || it->second.clearance < V.clearance) found_[k] = Sample{X, V.clearance, how};
+  if (it == found_.end() || it->second.clearance < V.clearance)
+    found_[k] = Sample{X, V.clearance, how};
   return V;
 }
 

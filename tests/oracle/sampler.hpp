@@ -39,8 +39,8 @@ struct Sample {
 };
 
 struct SamplerStats {
-  long rounds = 0, poses = 0, accepted = 0, penetrating = 0, free = 0, uncertain = 0, low_clearance = 0,
-       degenerate = 0, too_many = 0, same_plane = 0;
+  long rounds = 0, poses = 0, accepted = 0, penetrating = 0, free = 0, uncertain = 0,
+       low_clearance = 0, degenerate = 0, too_many = 0, same_plane = 0;
   double seconds = 0;
   std::string str() const;
 };

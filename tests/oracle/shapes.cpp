@@ -79,7 +79,8 @@ static Vec3 facet_area_vec(const Mesh& m, const std::vector<int>& f) {
 double mesh_volume(const Mesh& m) {
   double v = 0;
   for (const auto& f : m.F)
-    for (std::size_t i = 1; i + 1 < f.size(); ++i) v += m.V[f[0]].dot(m.V[f[i]].cross(m.V[f[i + 1]]));
+    for (std::size_t i = 1; i + 1 < f.size(); ++i)
+      v += m.V[f[0]].dot(m.V[f[i]].cross(m.V[f[i + 1]]));
   return v / 6;
 }
 
@@ -108,10 +109,12 @@ std::string check_mesh(const Mesh& m) {
     if (a.norm() <= 1e-12 * diag * diag) return "facet " + std::to_string(fi) + " has zero area";
     Vec3 n = a.normalized();
     for (int v : f)
-      if (std::abs(n.dot(m.V[v] - m.V[f[0]])) > 1e-9 * diag) return "facet " + std::to_string(fi) + " is not planar";
+      if (std::abs(n.dot(m.V[v] - m.V[f[0]])) > 1e-9 * diag)
+        return "facet " + std::to_string(fi) + " is not planar";
     for (std::size_t i = 0; i < f.size(); ++i) {
       int p = f[i], q = f[(i + 1) % f.size()];
-      if (++dir[{p, q}] > 1) return "edge " + std::to_string(p) + "-" + std::to_string(q) + " run twice the same way";
+      if (++dir[{p, q}] > 1)
+        return "edge " + std::to_string(p) + "-" + std::to_string(q) + " run twice the same way";
     }
   }
   for (const auto& [e, c] : dir) {
@@ -135,15 +138,18 @@ std::string check_mesh(const Mesh& m) {
     // corner (prev, next) at v; the facet across edge v->next has its corner with prev == next
     std::map<int, int> by_prev;
     for (const auto& c : corners)
-      if (!by_prev.emplace(c.first, c.second).second) return "vertex " + std::to_string(v) + " is not manifold";
+      if (!by_prev.emplace(c.first, c.second).second)
+        return "vertex " + std::to_string(v) + " is not manifold";
     int s0 = corners[0].first, cur = corners[0].second, steps = 1;
     while (cur != s0) {
       auto it = by_prev.find(cur);
-      if (it == by_prev.end() || steps > static_cast<int>(corners.size())) return "vertex " + std::to_string(v) + " is not manifold";
+      if (it == by_prev.end() || steps > static_cast<int>(corners.size()))
+        return "vertex " + std::to_string(v) + " is not manifold";
       cur = it->second;
       ++steps;
     }
-    if (steps != static_cast<int>(corners.size())) return "vertex " + std::to_string(v) + " joins separate fans";
+    if (steps != static_cast<int>(corners.size()))
+      return "vertex " + std::to_string(v) + " joins separate fans";
   }
   return "";
 }
@@ -228,10 +234,14 @@ Pose random_rigid(std::mt19937_64& rng) {
 // share an edge share both its end points (no T-junctions).
 // ---------------------------------------------------------------------------------------
 
-static Mesh grid_mesh(const std::vector<double>& xs, const std::vector<double>& ys, const std::vector<double>& zs,
-                      const std::function<bool(int, int, int)>& occ, const std::string& name) {
-  const int nx = static_cast<int>(xs.size()) - 1, ny = static_cast<int>(ys.size()) - 1, nz = static_cast<int>(zs.size()) - 1;
-  auto in = [&](int i, int j, int k) { return i >= 0 && j >= 0 && k >= 0 && i < nx && j < ny && k < nz && occ(i, j, k); };
+static Mesh grid_mesh(const std::vector<double>& xs, const std::vector<double>& ys,
+                      const std::vector<double>& zs, const std::function<bool(int, int, int)>& occ,
+                      const std::string& name) {
+  const int nx = static_cast<int>(xs.size()) - 1, ny = static_cast<int>(ys.size()) - 1,
+            nz = static_cast<int>(zs.size()) - 1;
+  auto in = [&](int i, int j, int k) {
+    return i >= 0 && j >= 0 && k >= 0 && i < nx && j < ny && k < nz && occ(i, j, k);
+  };
   Mesh m;
   m.name = name;
   std::map<std::array<int, 3>, int> vid;
@@ -248,49 +258,65 @@ static Mesh grid_mesh(const std::vector<double>& xs, const std::vector<double>& 
     for (int j = 0; j < ny; ++j)
       for (int k = 0; k < nz; ++k) {
         if (!in(i, j, k)) continue;
-        if (!in(i + 1, j, k)) m.F.push_back({V(i + 1, j, k), V(i + 1, j + 1, k), V(i + 1, j + 1, k + 1), V(i + 1, j, k + 1)});
-        if (!in(i - 1, j, k)) m.F.push_back({V(i, j, k), V(i, j, k + 1), V(i, j + 1, k + 1), V(i, j + 1, k)});
-        if (!in(i, j + 1, k)) m.F.push_back({V(i, j + 1, k), V(i, j + 1, k + 1), V(i + 1, j + 1, k + 1), V(i + 1, j + 1, k)});
-        if (!in(i, j - 1, k)) m.F.push_back({V(i, j, k), V(i + 1, j, k), V(i + 1, j, k + 1), V(i, j, k + 1)});
-        if (!in(i, j, k + 1)) m.F.push_back({V(i, j, k + 1), V(i + 1, j, k + 1), V(i + 1, j + 1, k + 1), V(i, j + 1, k + 1)});
-        if (!in(i, j, k - 1)) m.F.push_back({V(i, j, k), V(i, j + 1, k), V(i + 1, j + 1, k), V(i + 1, j, k)});
+        if (!in(i + 1, j, k))
+          m.F.push_back(
+              {V(i + 1, j, k), V(i + 1, j + 1, k), V(i + 1, j + 1, k + 1), V(i + 1, j, k + 1)});
+        if (!in(i - 1, j, k))
+          m.F.push_back({V(i, j, k), V(i, j, k + 1), V(i, j + 1, k + 1), V(i, j + 1, k)});
+        if (!in(i, j + 1, k))
+          m.F.push_back(
+              {V(i, j + 1, k), V(i, j + 1, k + 1), V(i + 1, j + 1, k + 1), V(i + 1, j + 1, k)});
+        if (!in(i, j - 1, k))
+          m.F.push_back({V(i, j, k), V(i + 1, j, k), V(i + 1, j, k + 1), V(i, j, k + 1)});
+        if (!in(i, j, k + 1))
+          m.F.push_back(
+              {V(i, j, k + 1), V(i + 1, j, k + 1), V(i + 1, j + 1, k + 1), V(i, j + 1, k + 1)});
+        if (!in(i, j, k - 1))
+          m.F.push_back({V(i, j, k), V(i, j + 1, k), V(i + 1, j + 1, k), V(i + 1, j, k)});
       }
   return m;
 }
 
 Mesh make_box(double x, double y, double z) {
-  return grid_mesh({0, x}, {0, y}, {0, z}, [](int, int, int) { return true; }, "box");
+  return grid_mesh(
+      {0, x}, {0, y}, {0, z}, [](int, int, int) { return true; }, "box");
 }
 
 Mesh make_l_section(double w, double h, double t1, double t2, double d) {
-  return grid_mesh({0, t2, w}, {0, t1, h}, {0, d}, [](int i, int j, int) { return j == 0 || i == 0; }, "L-section");
+  return grid_mesh(
+      {0, t2, w}, {0, t1, h}, {0, d}, [](int i, int j, int) { return j == 0 || i == 0; },
+      "L-section");
 }
 
 Mesh make_u_channel(double g, double tw, double tb, double h, double d) {
-  return grid_mesh({0, tw, tw + g, 2 * tw + g}, {0, tb, h}, {0, d},
-                   [](int i, int j, int) { return j == 0 || i == 0 || i == 2; }, "U-channel");
+  return grid_mesh(
+      {0, tw, tw + g, 2 * tw + g}, {0, tb, h}, {0, d},
+      [](int i, int j, int) { return j == 0 || i == 0 || i == 2; }, "U-channel");
 }
 
 Mesh make_t_section(double w, double tf, double tw, double h, double d) {
   double a = (w - tw) / 2;
-  return grid_mesh({0, a, a + tw, w}, {0, h - tf, h}, {0, d}, [](int i, int j, int) { return j == 1 || i == 1; },
-                   "T-section");
+  return grid_mesh(
+      {0, a, a + tw, w}, {0, h - tf, h}, {0, d}, [](int i, int j, int) { return j == 1 || i == 1; },
+      "T-section");
 }
 
 Mesh make_t_slot(double w, double h, double d, double nw, double nd, double hw, double hd) {
   double c1 = (w - nw) / 2, c2 = c1 + nw, d1 = (w - hw) / 2, d2 = d1 + hw;
-  return grid_mesh({0, d1, c1, c2, d2, w}, {0, h - nd - hd, h - nd, h}, {0, d},
-                   [](int i, int j, int) {
-                     if (j == 2 && i == 2) return false;
-                     if (j == 1 && i >= 1 && i <= 3) return false;
-                     return true;
-                   },
-                   "T-slot block");
+  return grid_mesh(
+      {0, d1, c1, c2, d2, w}, {0, h - nd - hd, h - nd, h}, {0, d},
+      [](int i, int j, int) {
+        if (j == 2 && i == 2) return false;
+        if (j == 1 && i >= 1 && i <= 3) return false;
+        return true;
+      },
+      "T-slot block");
 }
 
 Mesh make_corner_block(double w, double dd, double tf, double t1, double t2, double h) {
-  return grid_mesh({0, t2, w}, {0, t1, dd}, {0, tf, h}, [](int i, int j, int k) { return k == 0 || j == 0 || i == 0; },
-                   "corner block");
+  return grid_mesh(
+      {0, t2, w}, {0, t1, dd}, {0, tf, h},
+      [](int i, int j, int k) { return k == 0 || j == 0 || i == 0; }, "corner block");
 }
 
 Mesh make_stairs(const std::vector<double>& runs, const std::vector<double>& rises, double d) {
@@ -298,13 +324,15 @@ Mesh make_stairs(const std::vector<double>& runs, const std::vector<double>& ris
   for (double r : runs) xs.push_back(xs.back() + r);
   for (double r : rises) ys.push_back(ys.back() + r);
   const int n = static_cast<int>(runs.size());
-  return grid_mesh(xs, ys, {0, d}, [n](int i, int j, int) { return j < n - i; }, "stairs");
+  return grid_mesh(
+      xs, ys, {0, d}, [n](int i, int j, int) { return j < n - i; }, "stairs");
 }
 
 Mesh make_square_hole_block(double w, double h, double s, double ox, double oy) {
   double a = (w - s) / 2 + ox, b = (w - s) / 2 + oy;
-  return grid_mesh({0, a, a + s, w}, {0, b, b + s, w}, {0, h}, [](int i, int j, int) { return !(i == 1 && j == 1); },
-                   "square-hole block");
+  return grid_mesh(
+      {0, a, a + s, w}, {0, b, b + s, w}, {0, h},
+      [](int i, int j, int) { return !(i == 1 && j == 1); }, "square-hole block");
 }
 
 // ---------------------------------------------------------------------------------------
@@ -328,7 +356,8 @@ bool convex_ccw(const std::vector<Vec2>& L) {
   return true;
 }
 bool segs_cross_properly(const Vec2& p, const Vec2& q, const Vec2& a, const Vec2& b) {
-  double d1 = cross2(q - p, a - p), d2 = cross2(q - p, b - p), d3 = cross2(b - a, p - a), d4 = cross2(b - a, q - a);
+  double d1 = cross2(q - p, a - p), d2 = cross2(q - p, b - p), d3 = cross2(b - a, p - a),
+         d4 = cross2(b - a, q - a);
   return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
 }
 bool point_in_tri(const Vec2& p, const Vec2& a, const Vec2& b, const Vec2& c) {
@@ -337,7 +366,8 @@ bool point_in_tri(const Vec2& p, const Vec2& a, const Vec2& b, const Vec2& c) {
 }
 }  // namespace
 
-std::vector<std::array<int, 3>> triangulate(const std::vector<Vec2>& outer, const std::vector<std::vector<Vec2>>& holes) {
+std::vector<std::array<int, 3>> triangulate(const std::vector<Vec2>& outer,
+                                            const std::vector<std::vector<Vec2>>& holes) {
   std::vector<Vec2> P = outer;
   std::vector<int> poly(outer.size());
   std::iota(poly.begin(), poly.end(), 0);
@@ -366,7 +396,8 @@ std::vector<std::array<int, 3>> triangulate(const std::vector<Vec2>& outer, cons
     // candidate vertices of the current polygon, nearest first
     std::vector<int> cand(poly.size());
     std::iota(cand.begin(), cand.end(), 0);
-    std::sort(cand.begin(), cand.end(), [&](int a, int b) { return (P[poly[a]] - M).norm() < (P[poly[b]] - M).norm(); });
+    std::sort(cand.begin(), cand.end(),
+              [&](int a, int b) { return (P[poly[a]] - M).norm() < (P[poly[b]] - M).norm(); });
     int pick = -1;
     for (int ci : cand) {
       const Vec2 Q = P[poly[ci]];
@@ -414,7 +445,8 @@ std::vector<std::array<int, 3>> triangulate(const std::vector<Vec2>& outer, cons
         int v = cur[j];
         if (v == a || v == b || v == c) continue;
         const Vec2& p = P[v];
-        if ((p - P[a]).norm() < 1e-12 || (p - P[b]).norm() < 1e-12 || (p - P[c]).norm() < 1e-12) continue;
+        if ((p - P[a]).norm() < 1e-12 || (p - P[b]).norm() < 1e-12 || (p - P[c]).norm() < 1e-12)
+          continue;
         if (point_in_tri(p, P[a], P[b], P[c])) empty = false;
       }
       if (!empty) continue;
@@ -435,12 +467,15 @@ std::vector<std::array<int, 3>> triangulate(const std::vector<Vec2>& outer, cons
     if (a <= 0) throw std::runtime_error("triangulate: inverted triangle");
     got += a;
   }
-  if (std::abs(got - want) > 1e-9 * std::abs(want)) throw std::runtime_error("triangulate: areas do not add up");
+  if (std::abs(got - want) > 1e-9 * std::abs(want))
+    throw std::runtime_error("triangulate: areas do not add up");
   return tris;
 }
 
-Mesh extrude(const std::vector<Vec2>& outer, const std::vector<std::vector<Vec2>>& holes, double d) {
-  if (loop_area(outer) <= 0) throw std::runtime_error("extrude: outer loop must be counter-clockwise");
+Mesh extrude(const std::vector<Vec2>& outer, const std::vector<std::vector<Vec2>>& holes,
+             double d) {
+  if (loop_area(outer) <= 0)
+    throw std::runtime_error("extrude: outer loop must be counter-clockwise");
   for (const auto& h : holes)
     if (loop_area(h) >= 0) throw std::runtime_error("extrude: holes must be clockwise");
   Mesh m;
@@ -510,11 +545,18 @@ Mesh make_wedge(double a, double b, double c, double d) {
 // ---------------------------------------------------------------------------------------
 
 const char* pairing_name(int p) {
-  static const char* names[kPairings] = {"n-gon peg in n-gon hole", "box in corner block", "prism in U-channel",
-                                         "box on stairs", "cube in square hole", "L-part against U-channel",
-                                         "box against T-section / T-slot", "wedge against L-section",
-                                         "tiny A against big B", "box larger than the U pocket",
-                                         "L-part against corner block / stairs", "box against L-section"};
+  static const char* names[kPairings] = {"n-gon peg in n-gon hole",
+                                         "box in corner block",
+                                         "prism in U-channel",
+                                         "box on stairs",
+                                         "cube in square hole",
+                                         "L-part against U-channel",
+                                         "box against T-section / T-slot",
+                                         "wedge against L-section",
+                                         "tiny A against big B",
+                                         "box larger than the U pocket",
+                                         "L-part against corner block / stairs",
+                                         "box against L-section"};
   return names[((p % kPairings) + kPairings) % kPairings];
 }
 
@@ -557,14 +599,17 @@ Made l_part_r(Rng& r, double lo, double hi) {
 Made u_channel_r(Rng& r, double gap, double depth_over_floor) {
   double tw = r.U(0.1, 0.6) * gap, tb = r.U(0.1, 0.6) * gap, d = r.U(20, 60);
   double h = tb + depth_over_floor;
-  return {make_u_channel(gap, tw, tb, h, d),
-          "U-channel gap " + f1(gap) + " walls " + f1(tw) + " base " + f1(tb) + " height " + f1(h) + " length " + f1(d)};
+  return {make_u_channel(gap, tw, tb, h, d), "U-channel gap " + f1(gap) + " walls " + f1(tw) +
+                                                 " base " + f1(tb) + " height " + f1(h) +
+                                                 " length " + f1(d)};
 }
 Made corner_r(Rng& r) {
   double w = r.U(20, 60), dd = r.U(20, 60), m = std::min(w, dd);
-  double tf = r.U(0.1, 0.35) * m, t1 = r.U(0.1, 0.35) * m, t2 = r.U(0.1, 0.35) * m, h = tf + r.U(8, 40);
-  return {make_corner_block(w, dd, tf, t1, t2, h),
-          "corner block " + f1(w) + "x" + f1(dd) + " floor " + f1(tf) + " walls " + f1(t1) + "/" + f1(t2) + " height " + f1(h)};
+  double tf = r.U(0.1, 0.35) * m, t1 = r.U(0.1, 0.35) * m, t2 = r.U(0.1, 0.35) * m,
+         h = tf + r.U(8, 40);
+  return {make_corner_block(w, dd, tf, t1, t2, h), "corner block " + f1(w) + "x" + f1(dd) +
+                                                       " floor " + f1(tf) + " walls " + f1(t1) +
+                                                       "/" + f1(t2) + " height " + f1(h)};
 }
 Made stairs_r(Rng& r) {
   int n = r.I(2, 3);
@@ -579,16 +624,19 @@ Made stairs_r(Rng& r) {
   return {make_stairs(runs, rises, d), s + " width " + f1(d)};
 }
 Made t_section_r(Rng& r) {
-  double w = r.U(20, 60), h = r.U(15, 50), tf = r.U(0.1, 0.4) * h, tw = r.U(0.1, 0.4) * w, d = r.U(15, 50);
-  return {make_t_section(w, tf, tw, h, d),
-          "T-section " + f1(w) + "x" + f1(h) + " flange " + f1(tf) + " web " + f1(tw) + " length " + f1(d)};
+  double w = r.U(20, 60), h = r.U(15, 50), tf = r.U(0.1, 0.4) * h, tw = r.U(0.1, 0.4) * w,
+         d = r.U(15, 50);
+  return {make_t_section(w, tf, tw, h, d), "T-section " + f1(w) + "x" + f1(h) + " flange " +
+                                               f1(tf) + " web " + f1(tw) + " length " + f1(d)};
 }
 Made ngon_prism_r(Rng& r, int n, double rad, double len) {
-  return {make_ngon_prism(n, rad, len, r.U(0, 2 * kPi)), std::to_string(n) + "-gon prism r=" + f1(rad) + " L=" + f1(len)};
+  return {make_ngon_prism(n, rad, len, r.U(0, 2 * kPi)),
+          std::to_string(n) + "-gon prism r=" + f1(rad) + " L=" + f1(len)};
 }
 Made wedge_r(Rng& r, double lo, double hi) {
   double a = r.U(lo, hi), b = r.U(lo, hi), c = r.U(0, 1) * a, d = r.U(lo, hi);
-  return {make_wedge(a, b, c, d), "wedge " + f1(a) + "x" + f1(b) + " apex " + f1(c) + " depth " + f1(d)};
+  return {make_wedge(a, b, c, d),
+          "wedge " + f1(a) + "x" + f1(b) + " apex " + f1(c) + " depth " + f1(d)};
 }
 }  // namespace
 
@@ -603,9 +651,9 @@ ShapePair make_pair(std::uint64_t seed) {
       double rp = r.U(4, 10), lp = r.U(8, 30), k = r.U(1.02, 1.2), rh = k * rp;
       double w = 2 * rh * r.U(1.15, 2.0), h = r.U(5, 30), ph = r.U(0, 2 * kPi);
       a = ngon_prism_r(r, n, rp, lp);
-      b = {make_ngon_hole_block(w, h, n, rh, ph), "block " + f1(w) + "x" + f1(w) + "x" + f1(h) + " with " +
-                                                       std::to_string(n) + "-gon hole r=" + f1(rh) + " (+" +
-                                                       f1(100 * (k - 1)) + "%)"};
+      b = {make_ngon_hole_block(w, h, n, rh, ph),
+           "block " + f1(w) + "x" + f1(w) + "x" + f1(h) + " with " + std::to_string(n) +
+               "-gon hole r=" + f1(rh) + " (+" + f1(100 * (k - 1)) + "%)"};
       break;
     }
     case 1:
@@ -632,12 +680,14 @@ ShapePair make_pair(std::uint64_t seed) {
       b = stairs_r(r);
       break;
     case 4: {
-      double s = r.U(5, 20), k = r.U(1.02, 1.2), hole = s * k, wall = r.U(0.1, 0.6) * hole, h = r.U(5, 30);
+      double s = r.U(5, 20), k = r.U(1.02, 1.2), hole = s * k, wall = r.U(0.1, 0.6) * hole,
+             h = r.U(5, 30);
       double w = hole + 2 * wall;
       a = {make_box(s, s, s), "cube " + f1(s)};
       double ox = r.U(-0.5, 0.5) * wall * 0.8, oy = r.U(-0.5, 0.5) * wall * 0.8;
-      b = {make_square_hole_block(w, h, hole, ox, oy),
-           "block " + f1(w) + "x" + f1(w) + "x" + f1(h) + " square hole " + f1(hole) + " (+" + f1(100 * (k - 1)) + "%)"};
+      b = {make_square_hole_block(w, h, hole, ox, oy), "block " + f1(w) + "x" + f1(w) + "x" +
+                                                           f1(h) + " square hole " + f1(hole) +
+                                                           " (+" + f1(100 * (k - 1)) + "%)"};
       break;
     }
     case 5: {
@@ -653,8 +703,9 @@ ShapePair make_pair(std::uint64_t seed) {
       } else {
         double nw = x * r.U(1.02, 1.3), nd = r.U(2, 10), hw = nw + r.U(4, 20), hd = r.U(3, 15);
         double w = hw + 2 * r.U(3, 15), h = nd + hd + r.U(3, 15), d = r.U(20, 50);
-        b = {make_t_slot(w, h, d, nw, nd, hw, hd), "T-slot block " + f1(w) + "x" + f1(h) + "x" + f1(d) + " neck " + f1(nw) +
-                                                       "x" + f1(nd) + " head " + f1(hw) + "x" + f1(hd)};
+        b = {make_t_slot(w, h, d, nw, nd, hw, hd), "T-slot block " + f1(w) + "x" + f1(h) + "x" +
+                                                       f1(d) + " neck " + f1(nw) + "x" + f1(nd) +
+                                                       " head " + f1(hw) + "x" + f1(hd)};
       }
       break;
     }
@@ -664,13 +715,18 @@ ShapePair make_pair(std::uint64_t seed) {
       break;
     case 8: {  // tiny A against big B
       int kind = r.I(0, 4);
-      Made big = kind == 0 ? l_section_r(r, 30, 60) : kind == 1 ? u_channel_r(r, r.U(10, 30), r.U(5, 25))
-               : kind == 2 ? corner_r(r) : kind == 3 ? stairs_r(r) : t_section_r(r);
+      Made big = kind == 0   ? l_section_r(r, 30, 60)
+                 : kind == 1 ? u_channel_r(r, r.U(10, 30), r.U(5, 25))
+                 : kind == 2 ? corner_r(r)
+                 : kind == 3 ? stairs_r(r)
+                             : t_section_r(r);
       Box3 bb;
       for (const auto& v : big.m.V) bb.add(v);
       double s = bb.diag() * r.U(0.02, 0.1);
       int ak = r.I(0, 2);
-      a = ak == 0 ? box_r(r, 0.5 * s, s) : ak == 1 ? wedge_r(r, 0.5 * s, s) : ngon_prism_r(r, r.I(3, 6), 0.5 * s, s);
+      a = ak == 0   ? box_r(r, 0.5 * s, s)
+          : ak == 1 ? wedge_r(r, 0.5 * s, s)
+                    : ngon_prism_r(r, r.I(3, 6), 0.5 * s, s);
       a.d = "tiny " + a.d;
       b = big;
       break;
@@ -678,7 +734,8 @@ ShapePair make_pair(std::uint64_t seed) {
     case 9: {  // A larger than the pocket
       double gap = r.U(5, 20);
       double x = gap * r.U(1.1, 2.0), y = r.U(5, 25), z = r.U(5, 25);
-      a = {make_box(x, y, z), "box " + f1(x) + "x" + f1(y) + "x" + f1(z) + " (wider than the pocket)"};
+      a = {make_box(x, y, z),
+           "box " + f1(x) + "x" + f1(y) + "x" + f1(z) + " (wider than the pocket)"};
       b = u_channel_r(r, gap, r.U(3, 25));
       break;
     }

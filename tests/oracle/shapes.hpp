@@ -63,7 +63,8 @@ Mesh make_wedge(double a, double b, double c, double d);
 /// Extrusion of a polygon (outer CCW, holes CW) along z by d; caps triangulated when needed.
 Mesh extrude(const std::vector<Vec2>& outer, const std::vector<std::vector<Vec2>>& holes, double d);
 /// Ear clipping of a polygon with holes; triangles index into the concatenation of the loops.
-std::vector<std::array<int, 3>> triangulate(const std::vector<Vec2>& outer, const std::vector<std::vector<Vec2>>& holes);
+std::vector<std::array<int, 3>> triangulate(const std::vector<Vec2>& outer,
+                                            const std::vector<std::vector<Vec2>>& holes);
 
 struct ShapePair {
   Mesh A, B;  // transformed (random rigid motion each)

@@ -23,7 +23,8 @@ inline std::string ngon_off(int n, double r, double r_in, double y0, double y1) 
   for (int ring = 0; ring < (tube ? 4 : 2); ++ring) {
     const double rad = ring < 2 ? r : r_in, y = ring % 2 == 0 ? y0 : y1;
     for (int i = 0; i < n; ++i)
-      os << rad * std::cos(2 * M_PI * i / n) << ' ' << y << ' ' << rad * std::sin(2 * M_PI * i / n) << '\n';
+      os << rad * std::cos(2 * M_PI * i / n) << ' ' << y << ' ' << rad * std::sin(2 * M_PI * i / n)
+         << '\n';
   }
   for (int i = 0, j = 1; i < n; ++i, j = (i + 1) % n)
     os << "4 " << i << ' ' << n + i << ' ' << n + j << ' ' << j << '\n';

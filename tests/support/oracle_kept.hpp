@@ -22,7 +22,8 @@ inline std::vector<std::filesystem::path> kept_oracle_pairs(const std::filesyste
   std::vector<fs::path> dirs;
   if (fs::is_directory(kept))
     for (const auto& e : fs::directory_iterator(kept))
-      if (fs::exists(e.path() / "samples.csv") && fs::exists(e.path() / "G.json")) dirs.push_back(e.path());
+      if (fs::exists(e.path() / "samples.csv") && fs::exists(e.path() / "G.json"))
+        dirs.push_back(e.path());
   std::sort(dirs.begin(), dirs.end());
   return dirs;
 }

@@ -36,10 +36,17 @@ inline Polyhedron from_loops(const std::string& name, const std::vector<Vec3>& v
 /// data/models/cube.off: a cube of side `s` centred on its origin.
 inline Polyhedron cube(double s = 30) {
   const double h = s / 2;
-  return from_loops("cube",
-                    {{-h, -h, -h}, {h, -h, -h}, {h, h, -h}, {-h, h, -h},
-                     {-h, -h, h}, {h, -h, h}, {h, h, h}, {-h, h, h}},
-                    {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}});
+  return from_loops(
+      "cube",
+      {{-h, -h, -h},
+       {h, -h, -h},
+       {h, h, -h},
+       {-h, h, -h},
+       {-h, -h, h},
+       {h, -h, h},
+       {h, h, h},
+       {-h, h, h}},
+      {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}});
 }
 
 /// data/models/l_block.off: 120 x 80 x 80, slab (y in [0, 20]) and wall (x in [0, 20]).
@@ -47,10 +54,26 @@ inline Polyhedron cube(double s = 30) {
 /// 6 y=80 (wall top), 7 x=0.
 inline Polyhedron l_block() {
   return from_loops("l_block",
-                    {{0, 0, 0}, {120, 0, 0}, {120, 20, 0}, {20, 20, 0}, {20, 80, 0}, {0, 80, 0},
-                     {0, 0, 80}, {120, 0, 80}, {120, 20, 80}, {20, 20, 80}, {20, 80, 80}, {0, 80, 80}},
-                    {{5, 4, 3, 2, 1, 0}, {6, 7, 8, 9, 10, 11}, {0, 1, 7, 6}, {1, 2, 8, 7},
-                     {2, 3, 9, 8}, {3, 4, 10, 9}, {4, 5, 11, 10}, {5, 0, 6, 11}});
+                    {{0, 0, 0},
+                     {120, 0, 0},
+                     {120, 20, 0},
+                     {20, 20, 0},
+                     {20, 80, 0},
+                     {0, 80, 0},
+                     {0, 0, 80},
+                     {120, 0, 80},
+                     {120, 20, 80},
+                     {20, 20, 80},
+                     {20, 80, 80},
+                     {0, 80, 80}},
+                    {{5, 4, 3, 2, 1, 0},
+                     {6, 7, 8, 9, 10, 11},
+                     {0, 1, 7, 6},
+                     {1, 2, 8, 7},
+                     {2, 3, 9, 8},
+                     {3, 4, 10, 9},
+                     {4, 5, 11, 10},
+                     {5, 0, 6, 11}});
 }
 
 /// A UV sphere of radius r centred at c: `rings` latitude bands of `sectors` faces (planar
@@ -63,7 +86,8 @@ inline Polyhedron faceted_sphere(double r, int rings, int sectors, const Vec3& c
     const double th = M_PI * i / rings - M_PI / 2;
     for (int j = 0; j < sectors; ++j) {
       const double ph = 2 * M_PI * j / sectors;
-      v.push_back(c + r * Vec3(std::cos(th) * std::cos(ph), std::sin(th), -std::cos(th) * std::sin(ph)));
+      v.push_back(
+          c + r * Vec3(std::cos(th) * std::cos(ph), std::sin(th), -std::cos(th) * std::sin(ph)));
     }
   }
   v.push_back(c + Vec3(0, r, 0));  // north pole
@@ -72,7 +96,8 @@ inline Polyhedron faceted_sphere(double r, int rings, int sectors, const Vec3& c
   std::vector<std::vector<int>> f;
   for (int j = 0; j < sectors; ++j) f.push_back({0, at(1, j + 1), at(1, j)});
   for (int i = 1; i + 1 < rings; ++i)
-    for (int j = 0; j < sectors; ++j) f.push_back({at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)});
+    for (int j = 0; j < sectors; ++j)
+      f.push_back({at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)});
   for (int j = 0; j < sectors; ++j) f.push_back({north, at(rings - 1, j), at(rings - 1, j + 1)});
   return from_loops(name, v, f);
 }

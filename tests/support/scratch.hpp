@@ -14,7 +14,8 @@ namespace cf::test {
 inline std::filesystem::path scratch() {
   namespace fs = std::filesystem;
   static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("cf_test_" + std::to_string(static_cast<long>(::getpid())));
+    fs::path d =
+        fs::temp_directory_path() / ("cf_test_" + std::to_string(static_cast<long>(::getpid())));
     fs::create_directories(d);
     return d;
   }();

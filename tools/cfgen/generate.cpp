@@ -2,8 +2,8 @@
 
 #include "cfgen/enumerate/enumerate.hpp"
 #include "cfgen/execute/progress.hpp"
-#include "cfgen/execute/stop.hpp"
 #include "cfgen/execute/shard.hpp"
+#include "cfgen/execute/stop.hpp"
 #include "mesh/model_loader.hpp"
 
 #include <cf/file_io.hpp>
@@ -30,8 +30,8 @@ double length_scale(const Polyhedron& A, const Polyhedron& B) {
   return std::min((A.bbox_max() - A.bbox_min()).norm(), (B.bbox_max() - B.bbox_min()).norm());
 }
 
-gen::SearchParams scaled_search(const Polyhedron& A, const Polyhedron& B, const RelativeLengths& rel,
-                                gen::SearchParams base) {
+gen::SearchParams scaled_search(const Polyhedron& A, const Polyhedron& B,
+                                const RelativeLengths& rel, gen::SearchParams base) {
   const double D = length_scale(A, B);
   base.touch_tol = rel.touch_tol * D;
   base.min_clearance = rel.min_clearance * D;
@@ -45,11 +45,16 @@ namespace {
 // The exit status of a run stopped on request, after saying what was kept.
 int stopped_status(const GenerateArgs& args, const std::string& checkpoint_dir) {
   const int sig = gen::stop_signal();
-  std::cerr << "cfgen: stopped" << (sig == SIGTERM ? " (SIGTERM)" : sig == SIGINT ? " (SIGINT)" : "") << "; ";
+  std::cerr << "cfgen: stopped"
+            << (sig == SIGTERM  ? " (SIGTERM)"
+                : sig == SIGINT ? " (SIGINT)"
+                                : "")
+            << "; ";
   if (args.estimate)
     std::cerr << "no estimate printed\n";
   else if (checkpoint_dir.empty())
-    std::cerr << "nothing kept (--checkpoint DIR keeps finished work); '" << args.out_path << "' not written\n";
+    std::cerr << "nothing kept (--checkpoint DIR keeps finished work); '" << args.out_path
+              << "' not written\n";
   else
     std::cerr << "finished chunks are kept in '" << checkpoint_dir
               << "': the same command resumes from them\n";
@@ -58,13 +63,15 @@ int stopped_status(const GenerateArgs& args, const std::string& checkpoint_dir) 
 }
 
 // The graph's "meta" record: statistics, the parameters and the generator (docs/graph-format.md).
-nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args, const gen::SearchParams& s,
-                          const gen::EnumerateOptions& opt, double diag) {
+nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args,
+                          const gen::SearchParams& s, const gen::EnumerateOptions& opt,
+                          double diag) {
   nlohmann::json meta;
   nlohmann::json by_count = nlohmann::json::object(), by_type = nlohmann::json::object();
   for (const CfRecord& r : e.cfs) {
     by_count[std::to_string(r.pcs.size())] = by_count.value(std::to_string(r.pcs.size()), 0) + 1;
-    for (const Pc& pc : r.pcs) by_type[to_string(pc.type)] = by_type.value(to_string(pc.type), 0) + 1;
+    for (const Pc& pc : r.pcs)
+      by_type[to_string(pc.type)] = by_type.value(to_string(pc.type), 0) + 1;
   }
   nlohmann::json by_kind = nlohmann::json::object();
   for (const Transition& t : e.transitions)
@@ -108,10 +115,9 @@ nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args, c
                         {"max_rotations", s.max_rotations},
                         {"max_pcs", opt.max_pcs},
                         {"symmetry", opt.use_symmetry}};
-  if (args.thorough) meta["parameters"]["thorough"] = true;  // absent otherwise: the same bytes as before
-  meta["generator"] = {{"name", "cfgen"},
-                       {"a_model", args.a_path},
-                       {"b_model", args.b_path}};
+  if (args.thorough)
+    meta["parameters"]["thorough"] = true;  // absent otherwise: the same bytes as before
+  meta["generator"] = {{"name", "cfgen"}, {"a_model", args.a_path}, {"b_model", args.b_path}};
   // Coordinates are stored in mm; the unit each model file was read in (SPEC section 2).
   meta["source_units"] = {{"A", args.load_a.units}, {"B", args.load_b.units}};
 
@@ -124,7 +130,8 @@ std::string about(double x, bool exact = false) {
   if (x < 10) return "~" + std::to_string(std::llround(x));
   const double p = std::pow(10.0, std::floor(std::log10(x)) - 1);
   std::string digits = std::to_string(std::llround(std::round(x / p) * p));
-  for (int i = static_cast<int>(digits.size()) - 3; i > 0; i -= 3) digits.insert(static_cast<std::size_t>(i), ",");
+  for (int i = static_cast<int>(digits.size()) - 3; i > 0; i -= 3)
+    digits.insert(static_cast<std::size_t>(i), ",");
   return "~" + digits;
 }
 
@@ -134,19 +141,20 @@ void print_estimate(std::ostream& os, const gen::RunEstimate& e, int max_pcs) {
     const gen::LevelEstimate& v = e.levels[l];
     decided += v.sampled;
     os << "level " << l + 1 << ": " << about(v.candidates, v.exact) << " candidate sets in "
-       << about(v.orbits, v.exact) << " orbits" << (v.exact ? " (counted)" : "") << ", " << about(v.valid)
-       << " valid, " << about(v.tasks) << " searches\n";
+       << about(v.orbits, v.exact) << " orbits" << (v.exact ? " (counted)" : "") << ", "
+       << about(v.valid) << " valid, " << about(v.tasks) << " searches\n";
   }
   os << "graph: " << about(e.cfs) << " CFs, " << about(e.transitions) << " transitions\n";
-  os << "time: " << gen::human_duration(e.seconds) << " on " << e.threads << " thread" << (e.threads == 1 ? "" : "s")
-     << " (" << gen::human_duration(e.cpu_seconds) << " on one)\n";
+  os << "time: " << gen::human_duration(e.seconds) << " on " << e.threads << " thread"
+     << (e.threads == 1 ? "" : "s") << " (" << gen::human_duration(e.cpu_seconds) << " on one)\n";
   os << "peak memory: " << about(e.peak_bytes / 1e6) << " MB\n";
   os << "predicted from " << decided << " sets decided in " << gen::human_duration(e.sample_seconds)
      << "; its errors on the pairs measured: docs/performance.md, \"Estimates\"\n";
 }
 
 // The run predicted with the search and options of the run, on its threads.
-gen::RunEstimate predict(const gen::WitnessSearch& ws, const gen::EnumerateOptions& opt, const GenerateArgs& args) {
+gen::RunEstimate predict(const gen::WitnessSearch& ws, const gen::EnumerateOptions& opt,
+                         const GenerateArgs& args) {
   gen::ExecuteOptions exec;
   exec.threads = args.threads;
   exec.stop = args.stop;
@@ -165,18 +173,20 @@ struct RunPlan {
 // run of the same command is taken up whatever the prediction. The prediction also gives
 // the progress line the time left of the whole run.
 // @throws gen::Stopped when a signal stops the prediction.
-RunPlan plan_run(const gen::WitnessSearch& ws, const gen::EnumerateOptions& opt, const GenerateArgs& args,
-                 bool writes) {
+RunPlan plan_run(const gen::WitnessSearch& ws, const gen::EnumerateOptions& opt,
+                 const GenerateArgs& args, bool writes) {
   RunPlan plan;
   plan.checkpoint_dir = args.checkpoint_dir;
-  const bool may_keep = writes && !args.distribute && plan.checkpoint_dir.empty() && !args.no_checkpoint &&
-                        args.shard.count == 0;
-  if (writes && !args.distribute && (may_keep || !args.quiet)) plan.predicted = predict(ws, opt, args).seconds;
+  const bool may_keep = writes && !args.distribute && plan.checkpoint_dir.empty() &&
+                        !args.no_checkpoint && args.shard.count == 0;
+  if (writes && !args.distribute && (may_keep || !args.quiet))
+    plan.predicted = predict(ws, opt, args).seconds;
   if (!may_keep) return plan;
   const std::string dir = args.out_path + ".ckpt";
   std::error_code ec;
   const bool left = std::filesystem::exists(std::filesystem::path(dir) / "checkpoint.json", ec);
-  if (left || plan.predicted > kDefaultCheckpointSeconds) plan.checkpoint_dir = dir, plan.default_checkpoint = true;
+  if (left || plan.predicted > kDefaultCheckpointSeconds)
+    plan.checkpoint_dir = dir, plan.default_checkpoint = true;
   return plan;
 }
 
@@ -193,11 +203,15 @@ int run_generate(const GenerateArgs& args) {
   const Polyhedron A = load_model(args.a_path, args.load_a);
   const Polyhedron B = load_model(args.b_path, args.load_b);
   if (!args.serve)
-    for (const auto& [m, which, option] : {std::tuple{&A, "A", "--units-a"}, std::tuple{&B, "B", "--units-b"}})
-      if (const std::string w = size_warning(*m, which, option); !w.empty()) std::cerr << "cfgen: warning: " << w << '\n';
+    for (const auto& [m, which, option] :
+         {std::tuple{&A, "A", "--units-a"}, std::tuple{&B, "B", "--units-b"}})
+      if (const std::string w = size_warning(*m, which, option); !w.empty())
+        std::cerr << "cfgen: warning: " << w << '\n';
   const gen::ModelInfo ai = gen::analyse_model(A);
   const gen::ModelInfo bi = gen::analyse_model(B);
-  if (args.serve) return args.serve(gen::WitnessSearch(ai, bi, scaled_search(A, B, args.rel, args.search)), args.threads);
+  if (args.serve)
+    return args.serve(gen::WitnessSearch(ai, bi, scaled_search(A, B, args.rel, args.search)),
+                      args.threads);
 
   gen::EnumerateOptions opt;
   // Lengths scale with the smaller model (RelativeLengths).
@@ -231,7 +245,8 @@ int run_generate(const GenerateArgs& args) {
   exec.threads = args.threads;
   exec.shard = args.shard;
   exec.shard_patience = args.shard_patience;
-  if (!checkpoint_dir.empty()) exec.checkpoint = open_checkpoint(checkpoint_dir, run_fingerprint(args), inputs);
+  if (!checkpoint_dir.empty())
+    exec.checkpoint = open_checkpoint(checkpoint_dir, run_fingerprint(args), inputs);
   exec.distribute = args.distribute;
   exec.stop = args.stop;
   const bool terminal = isatty(STDERR_FILENO) != 0;
@@ -243,8 +258,9 @@ int run_generate(const GenerateArgs& args) {
       printer(ev);
     };
   if (!args.quiet && default_checkpoint)
-    std::cerr << "cfgen: predicted " << gen::human_duration(predicted) << "; finished work is kept in '"
-              << checkpoint_dir << "' until the graph is written (--no-checkpoint: not kept)\n";
+    std::cerr << "cfgen: predicted " << gen::human_duration(predicted)
+              << "; finished work is kept in '" << checkpoint_dir
+              << "' until the graph is written (--no-checkpoint: not kept)\n";
   printer.set_run(predicted);
   gen::Executor executor([&ws](const gen::Task& t) { return gen::decide(ws, t); }, exec);
   gen::Enumeration e;
@@ -256,26 +272,31 @@ int run_generate(const GenerateArgs& args) {
   }
   printer.finish();
   if (executor.resumed_chunks() > 0 && !args.quiet)
-    std::cerr << "cfgen: checkpoint '" << checkpoint_dir << "': resumed " << executor.resumed_chunks()
-              << " finished chunks\n";
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::cerr << "cfgen: checkpoint '" << checkpoint_dir << "': resumed "
+              << executor.resumed_chunks() << " finished chunks\n";
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (args.shard.count > 0 && !args.quiet)
     std::cerr << "cfgen: shard " << args.shard.index << "/" << args.shard.count << ": took "
-              << executor.shared_chunks() << " chunks from the other shards, waited " << executor.waited_seconds()
-              << " s for them, computed " << executor.taken_over_chunks() << " of theirs that did not come"
+              << executor.shared_chunks() << " chunks from the other shards, waited "
+              << executor.waited_seconds() << " s for them, computed "
+              << executor.taken_over_chunks() << " of theirs that did not come"
               << (writes ? "" : "; shard 0 writes the graph") << '\n';
   if (!writes) return 0;
 
   const nlohmann::json meta = graph_meta(e, args, search, opt, diag);
   const std::size_t n_cfs = e.cfs.size(), n_tr = e.transitions.size();
   // Moved, not copied: a large graph's records and transitions are hundreds of MB.
-  const CfGraph graph = CfGraph::from_parts(A, B, std::move(e.cfs), std::move(e.transitions), meta.dump());
+  const CfGraph graph =
+      CfGraph::from_parts(A, B, std::move(e.cfs), std::move(e.transitions), meta.dump());
   check_output_path(args.out_path, inputs, "writing graph");
   graph.save(args.out_path);
   if (default_checkpoint) remove_checkpoint(checkpoint_dir);
   if (n_cfs == 0)
-    std::cerr << "cfgen: warning: the graph has no CF: A (" << A.size() << " mm across) and B (" << B.size()
-              << " mm across) never touch in a valid contact formation; are the models' units right (--units)?\n";
+    std::cerr << "cfgen: warning: the graph has no CF: A (" << A.size() << " mm across) and B ("
+              << B.size()
+              << " mm across) never touch in a valid contact formation; are the models' units "
+                 "right (--units)?\n";
   if (!args.quiet)
     std::cerr << "cfgen: " << n_cfs << " CFs (" << e.levels[0].valid << " + " << e.levels[1].valid
               << " + " << e.levels[2].valid << "), " << n_tr << " transitions, " << seconds

@@ -22,8 +22,9 @@ namespace cf::tools {
 /// graph of a pair scaled by any factor is the same up to that scale. Defaults give about
 /// the SearchParams defaults (in mm) for a 30 mm cube (D = 52 mm).
 struct RelativeLengths {
-  double touch_tol = 2e-11;      ///< element pairs closer than this touch
-  double min_clearance = 2e-4;   ///< every pair not part of a PC at least this far apart at a witness
+  double touch_tol = 2e-11;  ///< element pairs closer than this touch
+  double min_clearance =
+      2e-4;  ///< every pair not part of a PC at least this far apart at a witness
   double good_clearance = 2e-2;  ///< a witness this clear ends the search
   double min_margin = 2e-4;      ///< contact points at least this far inside their elements
 };
@@ -32,8 +33,8 @@ struct RelativeLengths {
 double length_scale(const Polyhedron& A, const Polyhedron& B);
 
 /// `base` with its lengths set to `rel` times length_scale(A, B): the search cfgen runs.
-gen::SearchParams scaled_search(const Polyhedron& A, const Polyhedron& B, const RelativeLengths& rel,
-                                gen::SearchParams base = {});
+gen::SearchParams scaled_search(const Polyhedron& A, const Polyhedron& B,
+                                const RelativeLengths& rel, gen::SearchParams base = {});
 
 /// Parsed arguments of `cfgen A_MODEL B_MODEL -o GRAPH.json [options]`.
 struct GenerateArgs {
@@ -43,8 +44,9 @@ struct GenerateArgs {
   int threads = 0;       ///< worker threads; 0 = hardware concurrency
   bool quiet = false;    ///< no progress on stderr
   int max_pcs = 3;       ///< largest CFs to enumerate (1..3)
-  bool thorough = false;  ///< search every set, then add every image of each CF found (enumerate.hpp)
-  bool symmetry = true;  ///< search one set per orbit of the models' symmetries (symmetry.hpp)
+  bool thorough =
+      false;  ///< search every set, then add every image of each CF found (enumerate.hpp)
+  bool symmetry = true;      ///< search one set per orbit of the models' symmetries (symmetry.hpp)
   gen::SearchParams search;  ///< angular tolerances and search limits (lengths: `rel`)
   RelativeLengths rel;       ///< lengths of the search, relative to the models' size
   LoadOptions load_a, load_b;  ///< units and coplanarity tolerance of each model

@@ -4,14 +4,14 @@
 //   cfgen A_MODEL B_MODEL -o GRAPH.json    the CF graph of A against B
 //   cfgen A_MODEL B_MODEL -o GRAPH.json --checkpoint DIR --shard i/K   one of K processes
 
+#include "cfgen/execute/shard.hpp"
 #include "cfgen/execute/stop.hpp"
 #include "cfgen/generate.hpp"
-#include "cfgen/execute/shard.hpp"
 #ifdef CF_HAVE_MPI
 #include "cfgen/execute/mpi_run.hpp"
 #endif
-#include "mesh/model_loader.hpp"
 #include "cli_checks.hpp"
+#include "mesh/model_loader.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -34,71 +34,79 @@ int print_features(const std::string& path, const cf::tools::LoadOptions& opt) {
 
 // The witness search's tolerances and limits (docs/generator.md explains each), added to
 // `added`.
-void add_search_options(CLI::App& app, cf::tools::GenerateArgs& gen, std::vector<CLI::Option*>& added) {
+void add_search_options(CLI::App& app, cf::tools::GenerateArgs& gen,
+                        std::vector<CLI::Option*>& added) {
   auto& sp = gen.search;
   // Lengths of the search are relative to the smaller model's bounding-box diagonal D, so
   // that a pair scaled by any factor gives the same graph up to scale.
   added.push_back(app.add_option("--touch-tol", gen.rel.touch_tol,
-                                    "x D: element pairs closer than this touch (D: the smaller model's bounding-box diagonal)")
-                         ->check(cf::cli::finite_range(1e-15, 1e-5))
-                         ->capture_default_str());
-  added.push_back(app.add_option("--min-clearance", gen.rel.min_clearance,
-                                    "x D: at a witness, every pair not part of a PC is at least this far apart")
-                         ->check(cf::cli::finite_range(1e-9, 0.1))
-                         ->capture_default_str());
+                                 "x D: element pairs closer than this touch (D: the smaller "
+                                 "model's bounding-box diagonal)")
+                      ->check(cf::cli::finite_range(1e-15, 1e-5))
+                      ->capture_default_str());
+  added.push_back(
+      app.add_option("--min-clearance", gen.rel.min_clearance,
+                     "x D: at a witness, every pair not part of a PC is at least this far apart")
+          ->check(cf::cli::finite_range(1e-9, 0.1))
+          ->capture_default_str());
   added.push_back(app.add_option("--good-clearance", gen.rel.good_clearance,
-                                    "x D: stop searching a CF's witness once it is this clear")
-                         ->check(cf::cli::finite_range(1e-9, 1.0))
-                         ->capture_default_str());
+                                 "x D: stop searching a CF's witness once it is this clear")
+                      ->check(cf::cli::finite_range(1e-9, 1.0))
+                      ->capture_default_str());
   added.push_back(app.add_option("--min-margin", gen.rel.min_margin,
-                                    "x D: contact point at least this far inside its elements")
-                         ->check(cf::cli::finite_range(1e-9, 0.1))
-                         ->capture_default_str());
+                                 "x D: contact point at least this far inside its elements")
+                      ->check(cf::cli::finite_range(1e-9, 0.1))
+                      ->capture_default_str());
   added.push_back(app.add_option("--angle-margin", sp.angle_margin,
-                                    "rad: local non-penetration slack at each PC")
-                         ->check(cf::cli::finite_range(1e-9, 0.5))
-                         ->capture_default_str());
+                                 "rad: local non-penetration slack at each PC")
+                      ->check(cf::cli::finite_range(1e-9, 0.5))
+                      ->capture_default_str());
   added.push_back(app.add_option("--theta-samples", sp.theta_samples,
-                                    "samples of a one-parameter rotation family")
-                         ->check(CLI::Range(1, 1000))
-                         ->capture_default_str());
+                                 "samples of a one-parameter rotation family")
+                      ->check(CLI::Range(1, 1000))
+                      ->capture_default_str());
   added.push_back(app.add_option("--max-rotations", sp.max_rotations,
-                                    "rotations tried per candidate set before it is declared invalid")
-                         ->check(CLI::Range(1, 10000))
-                         ->capture_default_str());
+                                 "rotations tried per candidate set before it is declared invalid")
+                      ->check(CLI::Range(1, 10000))
+                      ->capture_default_str());
 }
 
 // How the run's work is kept and shared (--shard, --checkpoint, --shard-patience,
 // --no-checkpoint) and --estimate, added to `added`.
-void add_run_options(CLI::App& app, cf::tools::GenerateArgs& gen, std::string& shard_text, CLI::Option* out,
-                     std::vector<CLI::Option*>& added) {
-  auto* shard = app.add_option("--shard", shard_text,
-                               "compute shard i of K of every stage, taking the other shards' work from "
-                               "the --checkpoint DIR they share; shard 0 writes the graph")
-                    ->type_name("i/K");
-  auto* checkpoint = app.add_option("--checkpoint", gen.checkpoint_dir,
-                                    "keep finished work in DIR; a rerun with the same models and options "
-                                    "resumes from it")
-                         ->type_name("DIR");
+void add_run_options(CLI::App& app, cf::tools::GenerateArgs& gen, std::string& shard_text,
+                     CLI::Option* out, std::vector<CLI::Option*>& added) {
+  auto* shard =
+      app.add_option("--shard", shard_text,
+                     "compute shard i of K of every stage, taking the other shards' work from "
+                     "the --checkpoint DIR they share; shard 0 writes the graph")
+          ->type_name("i/K");
+  auto* checkpoint =
+      app.add_option("--checkpoint", gen.checkpoint_dir,
+                     "keep finished work in DIR; a rerun with the same models and options "
+                     "resumes from it")
+          ->type_name("DIR");
   shard->needs(checkpoint);
-  auto* no_checkpoint = app.add_flag("--no-checkpoint", gen.no_checkpoint,
-                                     "keep no checkpoint (by default a run predicted to take over 2 minutes "
-                                     "keeps one in GRAPH.json.ckpt/ until the graph is written)")
-                            ->excludes(checkpoint);
-  auto* estimate = app.add_flag("--estimate", gen.estimate,
-                                "print the candidate sets per level, the CFs, time and peak memory predicted "
-                                "for a run (from a few sets decided), and stop")
-                       ->excludes(out)
-                       ->excludes(checkpoint)
-                       ->excludes(no_checkpoint)
-                       ->excludes(shard);
-  auto* patience = app.add_option("--shard-patience", gen.shard_patience,
-                                  "seconds a shard waits at least for another shard's chunk before "
-                                  "computing it itself (raise it where new files take long to be seen, "
-                                  "e.g. NFS)")
-                       ->check(cf::cli::finite_range(0, 1e6))
-                       ->capture_default_str()
-                       ->needs(shard);
+  auto* no_checkpoint =
+      app.add_flag("--no-checkpoint", gen.no_checkpoint,
+                   "keep no checkpoint (by default a run predicted to take over 2 minutes "
+                   "keeps one in GRAPH.json.ckpt/ until the graph is written)")
+          ->excludes(checkpoint);
+  auto* estimate =
+      app.add_flag("--estimate", gen.estimate,
+                   "print the candidate sets per level, the CFs, time and peak memory predicted "
+                   "for a run (from a few sets decided), and stop")
+          ->excludes(out)
+          ->excludes(checkpoint)
+          ->excludes(no_checkpoint)
+          ->excludes(shard);
+  auto* patience =
+      app.add_option("--shard-patience", gen.shard_patience,
+                     "seconds a shard waits at least for another shard's chunk before "
+                     "computing it itself (raise it where new files take long to be seen, "
+                     "e.g. NFS)")
+          ->check(cf::cli::finite_range(0, 1e6))
+          ->capture_default_str()
+          ->needs(shard);
   for (CLI::Option* o : {shard, checkpoint, patience, no_checkpoint, estimate}) added.push_back(o);
 }
 
@@ -127,7 +135,8 @@ int main(int argc, char** argv) {
   auto* pos = app.add_option("models", models, "A_MODEL B_MODEL: the moving and the fixed object")
                   ->expected(2)
                   ->type_name("MODEL");
-  auto* out = app.add_option("-o,--output", gen.out_path, "graph file to write")->type_name("GRAPH.json");
+  auto* out =
+      app.add_option("-o,--output", gen.out_path, "graph file to write")->type_name("GRAPH.json");
   auto* threads = app.add_option("-j,--threads", gen.threads, "worker threads (0: all cores)")
                       ->check(CLI::Range(0, 1024));
   auto* quiet = app.add_flag("-q,--quiet", gen.quiet, "no progress messages");
@@ -138,24 +147,32 @@ int main(int argc, char** argv) {
                          ->check(CLI::Range(1, 3))
                          ->capture_default_str());
   bool no_symmetry = false, thorough = false;
-  CLI::Option* no_sym_opt = app.add_flag("--no-symmetry", no_symmetry,
-                                         "search every candidate set, not one per orbit of the models' symmetries");
+  CLI::Option* no_sym_opt =
+      app.add_flag("--no-symmetry", no_symmetry,
+                   "search every candidate set, not one per orbit of the models' symmetries");
   gen_opts.push_back(no_sym_opt);
-  gen_opts.push_back(app.add_flag("--thorough", thorough,
-                                  "search every candidate set as --no-symmetry does, then add every image of each CF "
-                                  "found under the models' symmetries: the most complete graph, at --no-symmetry's cost")
-                         ->excludes(no_sym_opt));
+  gen_opts.push_back(
+      app.add_flag(
+             "--thorough", thorough,
+             "search every candidate set as --no-symmetry does, then add every image of each CF "
+             "found under the models' symmetries: the most complete graph, at --no-symmetry's cost")
+          ->excludes(no_sym_opt));
   add_search_options(app, gen, gen_opts);
   app.add_option("--coplanar-tol", coplanar_tol,
                  "coplanarity tolerance relative to the model's bounding-box diagonal")
       ->check(cf::cli::finite_range(cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol));
   // Model units (SPEC section 2): files carry none; mm unless said otherwise.
   const auto unit_names = CLI::IsMember({"mm", "cm", "m", "in"});
-  app.add_option("--units", units, "length unit of every model file: mm, cm, m or in (the graph stores mm)")
+  app.add_option("--units", units,
+                 "length unit of every model file: mm, cm, m or in (the graph stores mm)")
       ->check(unit_names)
       ->capture_default_str();
-  gen_opts.push_back(app.add_option("--units-a", units_a, "length unit of A_MODEL (overrides --units)")->check(unit_names));
-  gen_opts.push_back(app.add_option("--units-b", units_b, "length unit of B_MODEL (overrides --units)")->check(unit_names));
+  gen_opts.push_back(
+      app.add_option("--units-a", units_a, "length unit of A_MODEL (overrides --units)")
+          ->check(unit_names));
+  gen_opts.push_back(
+      app.add_option("--units-b", units_b, "length unit of B_MODEL (overrides --units)")
+          ->check(unit_names));
   features->excludes(pos)->excludes(out);
   for (CLI::Option* o : gen_opts) features->excludes(o);
 
@@ -176,7 +193,8 @@ int main(int argc, char** argv) {
     load.units = units;
     if (!features_path.empty()) return print_features(features_path, load);
     if (models.size() != 2) {
-      std::cerr << "cfgen: expected A_MODEL B_MODEL -o GRAPH.json or --features MODEL (see cfgen --help)\n";
+      std::cerr << "cfgen: expected A_MODEL B_MODEL -o GRAPH.json or --features MODEL (see cfgen "
+                   "--help)\n";
       return 2;
     }
     if (gen.out_path.empty() && !gen.estimate) {
@@ -199,7 +217,8 @@ int main(int argc, char** argv) {
 #ifdef CF_HAVE_MPI
     if (cf::tools::launched_by_mpi()) {
       if (gen.shard.count > 0) {
-        std::cerr << "cfgen: --shard is for runs outside mpirun (mpirun shares every stage itself)\n";
+        std::cerr
+            << "cfgen: --shard is for runs outside mpirun (mpirun shares every stage itself)\n";
         return 2;
       }
       return cf::tools::run_generate_mpi(gen);
@@ -224,3 +243,4 @@ int main(int argc, char** argv) {
     return 3;
   }
 }
+int x;

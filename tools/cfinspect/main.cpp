@@ -38,9 +38,9 @@ struct Failure {
 };
 
 struct Summary {
-  std::array<std::size_t, 4> cfs_by_size{};        // index = number of PCs
-  std::array<std::size_t, 6> pcs_by_type{};        // PCs over all CFs
-  std::array<std::size_t, 6> cfs_with_type{};      // CFs holding at least one PC of a type
+  std::array<std::size_t, 4> cfs_by_size{};    // index = number of PCs
+  std::array<std::size_t, 6> pcs_by_type{};    // PCs over all CFs
+  std::array<std::size_t, 6> cfs_with_type{};  // CFs holding at least one PC of a type
   std::array<std::size_t, 3> transitions_by_kind{};
   std::size_t unpaired = 0;  // transitions whose reverse is not in the graph
   std::size_t min_out = 0, max_out = 0;
@@ -49,8 +49,8 @@ struct Summary {
 };
 
 std::size_t reflex_edges(const cf::Polyhedron& m) {
-  return static_cast<std::size_t>(
-      std::count_if(m.edges().begin(), m.edges().end(), [](const cf::Edge& e) { return !e.convex; }));
+  return static_cast<std::size_t>(std::count_if(m.edges().begin(), m.edges().end(),
+                                                [](const cf::Edge& e) { return !e.convex; }));
 }
 
 Summary summarise(const cf::CfGraph& g) {
@@ -107,7 +107,8 @@ ojson model_json(const cf::Polyhedron& m) {
   return j;
 }
 
-ojson summary_json(const std::string& path, const cf::CfGraph& g, const Summary& s, bool full_check) {
+ojson summary_json(const std::string& path, const cf::CfGraph& g, const Summary& s,
+                   bool full_check) {
   ojson j = ojson::object();
   j["file"] = path;
   j["valid"] = true;
@@ -120,38 +121,45 @@ ojson summary_json(const std::string& path, const cf::CfGraph& g, const Summary&
     by_type[kTypeNames[t]] = s.pcs_by_type[t];
     with_type[kTypeNames[t]] = s.cfs_with_type[t];
   }
-  j["cfs"] = {{"count", g.num_cfs()}, {"by_num_pcs", by_size}, {"pcs_by_type", by_type}, {"cfs_with_type", with_type}};
+  j["cfs"] = {{"count", g.num_cfs()},
+              {"by_num_pcs", by_size},
+              {"pcs_by_type", by_type},
+              {"cfs_with_type", with_type}};
   ojson by_kind = ojson::object();
   for (std::size_t k = 0; k < 3; ++k) by_kind[kKindNames[k]] = s.transitions_by_kind[k];
-  j["transitions"] = {{"count", g.num_transitions()}, {"by_kind", by_kind}, {"without_reverse", s.unpaired}};
+  j["transitions"] = {
+      {"count", g.num_transitions()}, {"by_kind", by_kind}, {"without_reverse", s.unpaired}};
   j["out_degree"] = {{"min", s.min_out}, {"mean", s.mean_out}, {"max", s.max_out}};
-  j["components"] = {{"count", s.components}, {"largest", s.largest_component}, {"isolated_cfs", s.isolated}};
+  j["components"] = {
+      {"count", s.components}, {"largest", s.largest_component}, {"isolated_cfs", s.isolated}};
   j["metadata"] = ojson::parse(g.metadata_json());
   return j;
 }
 
-void print_summary(std::ostream& out, const std::string& path, const cf::CfGraph& g, const Summary& s,
-                   bool full_check) {
+void print_summary(std::ostream& out, const std::string& path, const cf::CfGraph& g,
+                   const Summary& s, bool full_check) {
   auto model_line = [&](const char* which, const cf::Polyhedron& m) {
     out << "model " << which << " '" << cf::printable(m.name()) << "': " << m.num_vertices()
         << " vertices, " << m.num_edges() << " edges (" << reflex_edges(m) << " reflex), "
         << m.num_faces() << " faces\n";
   };
-  out << path << ": valid cf-graph v1 (" << (full_check ? "full schema check" : "schema check of the skeleton")
-      << ")\n";
+  out << path << ": valid cf-graph v1 ("
+      << (full_check ? "full schema check" : "schema check of the skeleton") << ")\n";
   model_line("A", g.model_a());
   model_line("B", g.model_b());
   out << "CFs: " << g.num_cfs() << "\n";
   out << "  by number of PCs:";
-  for (std::size_t k = 1; k <= 3; ++k) out << " " << k << ": " << s.cfs_by_size[k] << (k < 3 ? "," : "\n");
+  for (std::size_t k = 1; k <= 3; ++k)
+    out << " " << k << ": " << s.cfs_by_size[k] << (k < 3 ? "," : "\n");
   out << "  PCs by type (CFs holding one):";
   for (std::size_t t = 0; t < 6; ++t)
-    out << " " << kTypeNames[t] << " " << s.pcs_by_type[t] << " (" << s.cfs_with_type[t] << ")" << (t < 5 ? "," : "\n");
-  out << "transitions: " << g.num_transitions() << " (gain " << s.transitions_by_kind[0] << ", lose "
-      << s.transitions_by_kind[1] << ", change " << s.transitions_by_kind[2] << "), " << s.unpaired
-      << " without their reverse\n";
-  out << "out-degree: min " << s.min_out << ", mean " << std::fixed << std::setprecision(2) << s.mean_out
-      << ", max " << s.max_out << "\n";
+    out << " " << kTypeNames[t] << " " << s.pcs_by_type[t] << " (" << s.cfs_with_type[t] << ")"
+        << (t < 5 ? "," : "\n");
+  out << "transitions: " << g.num_transitions() << " (gain " << s.transitions_by_kind[0]
+      << ", lose " << s.transitions_by_kind[1] << ", change " << s.transitions_by_kind[2] << "), "
+      << s.unpaired << " without their reverse\n";
+  out << "out-degree: min " << s.min_out << ", mean " << std::fixed << std::setprecision(2)
+      << s.mean_out << ", max " << s.max_out << "\n";
   out.unsetf(std::ios::floatfield);
   out << "connected components: " << s.components << " (largest " << s.largest_component << " CFs, "
       << s.isolated << " isolated CFs)\n";
@@ -192,7 +200,8 @@ ojson cf_json(const cf::CfGraph& g, cf::CfId id) {
   if (r.dof >= 0 || r.translation_dof >= 0) j["pure_rotation"] = r.pure_rotation;
   ojson out = ojson::array();
   for (const cf::Transition& t : g.out_transitions(id))
-    out.push_back({{"to", t.to.value()}, {"kind", cf::to_string(t.kind)}, {"pcs", pcs_json(g.cf(t.to).pcs)}});
+    out.push_back(
+        {{"to", t.to.value()}, {"kind", cf::to_string(t.kind)}, {"pcs", pcs_json(g.cf(t.to).pcs)}});
   j["transitions"] = out;
   return j;
 }
@@ -202,24 +211,30 @@ void print_cf(std::ostream& out, const cf::CfGraph& g, cf::CfId id) {
   out << "CF " << id.value() << ": " << cf::to_string(r.pcs) << "\n";
   const Eigen::IOFormat fmt(Eigen::FullPrecision, 0, ", ", "\n", "    [", "]");
   out << "  witness R (rows):\n" << r.witness.R_BA.format(fmt) << "\n";
-  out << "  witness t (mm): " << r.witness.t_BA.transpose().format(Eigen::IOFormat(Eigen::FullPrecision, 0, ", ", "", "", "", "[", "]")) << "\n";
+  out << "  witness t (mm): "
+      << r.witness.t_BA.transpose().format(
+             Eigen::IOFormat(Eigen::FullPrecision, 0, ", ", "", "", "", "[", "]"))
+      << "\n";
   if (r.dof >= 0 || r.translation_dof >= 0)
-    out << "  freedoms: dof " << r.dof << ", translation dof " << r.translation_dof << ", pure rotation "
-        << (r.pure_rotation ? "yes" : "no") << "\n";
+    out << "  freedoms: dof " << r.dof << ", translation dof " << r.translation_dof
+        << ", pure rotation " << (r.pure_rotation ? "yes" : "no") << "\n";
   out << "  transitions out: " << g.out_transitions(id).size() << "\n";
 }
 
 void print_neighbours(std::ostream& out, const cf::CfGraph& g, cf::CfId id) {
   const auto& list = g.out_transitions(id);
-  out << "CF " << id.value() << " {" << cf::to_string(g.cf(id).pcs) << "}: " << list.size() << " transitions\n";
+  out << "CF " << id.value() << " {" << cf::to_string(g.cf(id).pcs) << "}: " << list.size()
+      << " transitions\n";
   for (const cf::Transition& t : list)
-    out << "  -> CF " << t.to.value() << " " << cf::to_string(t.kind) << " {" << cf::to_string(g.cf(t.to).pcs) << "}\n";
+    out << "  -> CF " << t.to.value() << " " << cf::to_string(t.kind) << " {"
+        << cf::to_string(g.cf(t.to).pcs) << "}\n";
 }
 
 std::vector<cf::CfId> holding(const cf::CfGraph& g, const cf::Pc& pc) {
   std::vector<cf::CfId> ids;
   for (std::size_t i = 0; i < g.num_cfs(); ++i)
-    if (g.cf(cf::CfId(static_cast<int>(i))).pcs.contains(pc)) ids.push_back(cf::CfId(static_cast<int>(i)));
+    if (g.cf(cf::CfId(static_cast<int>(i))).pcs.contains(pc))
+      ids.push_back(cf::CfId(static_cast<int>(i)));
   return ids;
 }
 
@@ -236,11 +251,14 @@ std::string dot_text(const cf::CfGraph& g) {
   }
   std::ostringstream dot;
   auto vertex_label = [&g](std::ostream& os, std::size_t v) {
-    os << "[label=\"" << v << ": " << cf::to_string(g.cf(cf::CfId(static_cast<int>(v))).pcs) << "\"]";
+    os << "[label=\"" << v << ": " << cf::to_string(g.cf(cf::CfId(static_cast<int>(v))).pcs)
+       << "\"]";
   };
   auto edge_label = [&bg](std::ostream& os, const DotGraph::edge_descriptor& e) {
     const cf::TransitionKind k = bg[e];
-    const char* style = k == cf::TransitionKind::kGain ? "solid" : k == cf::TransitionKind::kLose ? "dashed" : "dotted";
+    const char* style = k == cf::TransitionKind::kGain   ? "solid"
+                        : k == cf::TransitionKind::kLose ? "dashed"
+                                                         : "dotted";
     os << "[label=\"" << cf::to_string(k) << "\", style=" << style << "]";
   };
   auto graph_attrs = [](std::ostream& os) { os << "node [shape=box, fontname=\"monospace\"];\n"; };
@@ -281,27 +299,39 @@ cf::Pose parse_pose(const std::string& text) {
 }
 
 int run(int argc, char** argv) {
-  CLI::App app{"cfinspect: validate a CF graph file against the schema, summarise it, answer queries, export DOT"};
+  CLI::App app{
+      "cfinspect: validate a CF graph file against the schema, summarise it, answer queries, "
+      "export DOT"};
   app.set_version_flag("--version", "cfinspect 0.1 (cf-graph format version 1)");
   std::string path, holding_text, dot_path, pose_text, html_path, replay_path, trajectory_path;
   long long neighbours_id = -1, cf_id = -1;
   bool as_json = false, fast = false, print_schema = false;
   double epsilon = 1.0;
   app.add_option("graph", path, "CF graph file (.json, or .cbor)");
-  app.add_option("--holding", holding_text, "list the CFs that hold this PC, TYPE:A:B (e.g. v-f:3:5)");
+  app.add_option("--holding", holding_text,
+                 "list the CFs that hold this PC, TYPE:A:B (e.g. v-f:3:5)");
   app.add_option("--neighbours,--neighbors", neighbours_id, "list the transitions leaving CF ID");
   app.add_option("--cf", cf_id, "print CF ID with its witness pose and freedoms");
-  app.add_option("--dot", dot_path, "write the graph as Graphviz DOT (labels: PC lists; edges: kinds)");
+  app.add_option("--dot", dot_path,
+                 "write the graph as Graphviz DOT (labels: PC lists; edges: kinds)");
   app.add_option("--pose", pose_text,
-                 "identify the CF at the pose tx,ty,tz,qw,qx,qy,qz of A (mm, unit quaternion; as in POSES.csv)");
-  app.add_option("--epsilon", epsilon, "contact threshold for --pose, mm (default 1.0, the paper's)")
+                 "identify the CF at the pose tx,ty,tz,qw,qx,qy,qz of A (mm, unit quaternion; as "
+                 "in POSES.csv)");
+  app.add_option("--epsilon", epsilon,
+                 "contact threshold for --pose, mm (default 1.0, the paper's)")
       ->check(cf::cli::finite_range(1e-6, 1e3));
-  app.add_option("--html", html_path, "write the browser viewer of the graph: one self-contained HTML file");
-  app.add_option("--replay", replay_path, "with --html: a cfreplay output CSV for the page to animate");
-  app.add_option("--trajectory", trajectory_path, "with --replay: the POSES.csv it was replayed from (moves A)");
+  app.add_option("--html", html_path,
+                 "write the browser viewer of the graph: one self-contained HTML file");
+  app.add_option("--replay", replay_path,
+                 "with --html: a cfreplay output CSV for the page to animate");
+  app.add_option("--trajectory", trajectory_path,
+                 "with --replay: the POSES.csv it was replayed from (moves A)");
   app.add_flag("--json", as_json, "machine-readable output (the summary or the query's answer)");
-  app.add_flag("--fast", fast, "check the items of cfs/transitions with the reader's rules instead of the full schema");
-  app.add_flag("--print-schema", print_schema, "print the JSON Schema of graph files (schemas/cf-graph.schema.json) and exit");
+  app.add_flag(
+      "--fast", fast,
+      "check the items of cfs/transitions with the reader's rules instead of the full schema");
+  app.add_flag("--print-schema", print_schema,
+               "print the JSON Schema of graph files (schemas/cf-graph.schema.json) and exit");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -324,7 +354,8 @@ int run(int argc, char** argv) {
   std::optional<cf::Pc> holding_pc;
   if (!holding_text.empty()) {
     holding_pc = cf::pc_from_string(holding_text);
-    if (!holding_pc) throw Failure{"--holding '" + holding_text + "': expected TYPE:A:B such as v-f:3:5"};
+    if (!holding_pc)
+      throw Failure{"--holding '" + holding_text + "': expected TYPE:A:B such as v-f:3:5"};
   }
   std::optional<cf::Pose> pose;
   if (!pose_text.empty()) pose = parse_pose(pose_text);
@@ -350,8 +381,9 @@ int run(int argc, char** argv) {
   // Warnings (stderr, exit status 0): nothing to identify, or models whose size suggests a
   // unit mistake.
   if (g.num_cfs() == 0)
-    std::cerr << "cfinspect: warning: the graph has no CF (A " << g.model_a().size() << " mm across, B "
-              << g.model_b().size() << " mm across): nothing can be identified; were the models' units right?\n";
+    std::cerr << "cfinspect: warning: the graph has no CF (A " << g.model_a().size()
+              << " mm across, B " << g.model_b().size()
+              << " mm across): nothing can be identified; were the models' units right?\n";
   for (const auto& [m, which] : {std::pair{&g.model_a(), "A"}, std::pair{&g.model_b(), "B"}})
     if (const std::string w = cf::size_warning(*m, which, epsilon); !w.empty())
       std::cerr << "cfinspect: warning: " << w << "\n";
@@ -371,20 +403,25 @@ int run(int argc, char** argv) {
       answer["holding"] = {{"pc", cf::to_string(pc)}, {"cfs", list}};
     } else {
       std::cout << ids.size() << " CFs hold " << cf::to_string(pc) << "\n";
-      for (cf::CfId id : ids) std::cout << "  CF " << id.value() << ": " << cf::to_string(g.cf(id).pcs) << "\n";
+      for (cf::CfId id : ids)
+        std::cout << "  CF " << id.value() << ": " << cf::to_string(g.cf(id).pcs) << "\n";
     }
   }
   if (neighbours_id != -1 || app.count("--neighbours")) {
     queried = true;
     const cf::CfId id = parse_cf_id(g, path, neighbours_id);
-    if (as_json) answer["neighbours"] = cf_json(g, id)["transitions"];
-    else print_neighbours(std::cout, g, id);
+    if (as_json)
+      answer["neighbours"] = cf_json(g, id)["transitions"];
+    else
+      print_neighbours(std::cout, g, id);
   }
   if (cf_id != -1 || app.count("--cf")) {
     queried = true;
     const cf::CfId id = parse_cf_id(g, path, cf_id);
-    if (as_json) answer["cf"] = cf_json(g, id);
-    else print_cf(std::cout, g, id);
+    if (as_json)
+      answer["cf"] = cf_json(g, id);
+    else
+      print_cf(std::cout, g, id);
   }
   if (pose) {
     queried = true;
@@ -403,27 +440,40 @@ int run(int argc, char** argv) {
                         {"pcs", pcs_json(r.pcs)},
                         {"candidates", candidates}};
     } else {
-      std::cout << "pose: " << cf::to_string(r.status) << ", CF " << (r.has_cf() ? r.cf.value() : -1);
+      std::cout << "pose: " << cf::to_string(r.status) << ", CF "
+                << (r.has_cf() ? r.cf.value() : -1);
       if (r.has_cf()) std::cout << " {" << cf::to_string(r.pcs) << "}";
       std::cout << ", " << r.contacts.size() << " candidate PCs within " << epsilon << " mm\n";
       for (int i = 0; i < r.contacts.size(); ++i)
-        std::cout << "  " << cf::to_string(r.contacts[i].pc) << " at " << r.contacts[i].distance << " mm\n";
+        std::cout << "  " << cf::to_string(r.contacts[i].pc) << " at " << r.contacts[i].distance
+                  << " mm\n";
     }
   }
   if (!dot_path.empty()) {
     cf::write_outputs({{dot_path, dot_text(g)}}, {path}, "writing DOT");
-    if (!as_json) std::cout << "wrote " << dot_path << " (" << g.num_cfs() << " nodes, " << g.num_transitions() << " edges)\n";
-    else answer["dot"] = dot_path;
+    if (!as_json)
+      std::cout << "wrote " << dot_path << " (" << g.num_cfs() << " nodes, " << g.num_transitions()
+                << " edges)\n";
+    else
+      answer["dot"] = dot_path;
   }
   if (!html_path.empty()) {
     // The graph file's own text when it is JSON (with cfgen's contact planes, which the
     // loaded graph does not keep); the re-serialised graph for CBOR.
     const bool cbor = path.size() >= 5 && path.compare(path.size() - 5, 5, ".cbor") == 0;
-    cf::inspect::ViewerInputs in{path, cbor ? g.to_json(-1) : cf::inspect::read_text_file(path, "reading"),
-                                 g.num_cfs(), replay_path, trajectory_path, cf_id};
+    cf::inspect::ViewerInputs in{
+        path,
+        cbor ? g.to_json(-1) : cf::inspect::read_text_file(path, "reading"),
+        g.num_cfs(),
+        replay_path,
+        trajectory_path,
+        cf_id};
     cf::write_outputs({{html_path, cf::inspect::viewer_html(in)}}, html_inputs, "writing HTML");
-    if (!as_json) std::cout << "wrote " << html_path << " (viewer of " << g.num_cfs() << " CFs" << (replay_path.empty() ? "" : ", with the replay") << ")\n";
-    else answer["html"] = html_path;
+    if (!as_json)
+      std::cout << "wrote " << html_path << " (viewer of " << g.num_cfs() << " CFs"
+                << (replay_path.empty() ? "" : ", with the replay") << ")\n";
+    else
+      answer["html"] = html_path;
   }
   if (!queried) {  // no query: the summary (also after --dot, --html)
     const Summary s = summarise(g);

@@ -8,8 +8,8 @@
 #include <cf/graph.hpp>
 #include <cf/params.hpp>
 
-#include "cli_checks.hpp"
 #include <cf/file_io.hpp>
+#include "cli_checks.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -38,35 +38,48 @@ int main(int argc, char** argv) {
   std::string graph_path, traj_path, out_path, plot_path;
   cf::Params P;
   std::string friction = "anchor", moment_ref = "origin", centroid = "vertex", proxy = "on";
-  app.add_option("--graph", graph_path, "CF graph file (cfgen's output)")->required()->type_name("GRAPH.json");
+  app.add_option("--graph", graph_path, "CF graph file (cfgen's output)")
+      ->required()
+      ->type_name("GRAPH.json");
   app.add_option("--trajectory", traj_path, "poses of A, one row per servo tick")
       ->required()
       ->type_name("POSES.csv");
-  app.add_option("-o,--output", out_path, "force and moment per tick")->required()->type_name("OUT.csv");
+  app.add_option("-o,--output", out_path, "force and moment per tick")
+      ->required()
+      ->type_name("OUT.csv");
   app.add_option("--plot", plot_path, "also write an SVG plot of force and moment against time")
       ->type_name("OUT.svg");
-  app.add_option("--friction", friction,
-                 "s_pj reading: 'anchor' (displacement since sticking, rate independent) or 'per-tick' "
-                 "(the paper's literal one-tick displacement)")
+  app.add_option(
+         "--friction", friction,
+         "s_pj reading: 'anchor' (displacement since sticking, rate independent) or 'per-tick' "
+         "(the paper's literal one-tick displacement)")
       ->check(CLI::IsMember({"anchor", "per-tick"}));
-  app.add_option("--proxy", proxy,
-                 "'on': the trajectory is the device and A is rendered at a proxy that stays out of B, "
-                 "felt through a spring (SPEC 6b); 'off': A's pose is the trajectory (the paper's literal model)")
+  app.add_option(
+         "--proxy", proxy,
+         "'on': the trajectory is the device and A is rendered at a proxy that stays out of B, "
+         "felt through a spring (SPEC 6b); 'off': A's pose is the trajectory (the paper's literal "
+         "model)")
       ->check(CLI::IsMember({"on", "off"}));
-  app.add_option("--proxy-stiffness", P.proxy.stiffness_N_per_mm, "the proxy coupling's stiffness, N/mm")
+  app.add_option("--proxy-stiffness", P.proxy.stiffness_N_per_mm,
+                 "the proxy coupling's stiffness, N/mm")
       ->check(finite_range(1e-9, 1e9));
-  app.add_option("--proxy-damping", P.proxy.damping_N_s_per_mm, "the proxy coupling's damping, N s/mm")
+  app.add_option("--proxy-damping", P.proxy.damping_N_s_per_mm,
+                 "the proxy coupling's damping, N s/mm")
       ->check(finite_range(0, 1e9));
-  app.add_option("--hold", P.hold_fcy_threshold_N, "hold F_cy while it changes by less than this (N); 0: off")
+  app.add_option("--hold", P.hold_fcy_threshold_N,
+                 "hold F_cy while it changes by less than this (N); 0: off")
       ->check(finite_range(0, 1e6));
   app.add_option("--tau", P.interpolation_time_constant_s,
                  "low-pass time constant of the total contact force and moment (s); 0: off")
       ->check(finite_range(0, 1e3));
   app.add_option("--moment-ref", moment_ref,
-                 "moment about A's 'origin' (paper eq. (9)), its 'centroid', or the 'point' given by --moment-point")
+                 "moment about A's 'origin' (paper eq. (9)), its 'centroid', or the 'point' given "
+                 "by --moment-point")
       ->check(CLI::IsMember({"origin", "centroid", "point"}));
   std::vector<double> moment_point;
-  app.add_option("--moment-point", moment_point, "X Y Z: the moment's reference point, mm in A's frame (implies --moment-ref point)")
+  app.add_option(
+         "--moment-point", moment_point,
+         "X Y Z: the moment's reference point, mm in A's frame (implies --moment-ref point)")
       ->expected(3)
       ->check(finite_range(-1e9, 1e9));
   app.add_option("--centroid", centroid, "mass centre: 'vertex' mean (paper) or 'volume' centroid")
@@ -75,8 +88,10 @@ int main(int argc, char** argv) {
   app.add_option("--stiffness", P.stiffness_N_per_mm, "K, N/mm")->check(finite_range(1e-9, 1e9));
   app.add_option("--kp", P.kp_N_per_mm, "K_p, N/mm")->check(finite_range(1e-9, 1e9));
   app.add_option("--mu", P.mu_static, "static friction coefficient")->check(finite_range(0, 100));
-  app.add_option("--mu-d", P.mu_kinetic, "kinetic friction coefficient")->check(finite_range(0, 100));
-  app.add_option("--epsilon", P.epsilon_mm, "contact threshold, mm")->check(finite_range(1e-6, 1e3));
+  app.add_option("--mu-d", P.mu_kinetic, "kinetic friction coefficient")
+      ->check(finite_range(0, 100));
+  app.add_option("--epsilon", P.epsilon_mm, "contact threshold, mm")
+      ->check(finite_range(1e-6, 1e3));
 
   try {
     app.parse(argc, argv);
@@ -87,9 +102,10 @@ int main(int argc, char** argv) {
     return 2;
   }
   P.proxy.enabled = proxy == "on";
-  P.friction_displacement =
-      friction == "per-tick" ? cf::FrictionDisplacement::kPerTick : cf::FrictionDisplacement::kStickAnchor;
-  P.moment_reference = moment_ref == "centroid" ? cf::MomentReference::kACentroid : cf::MomentReference::kAOrigin;
+  P.friction_displacement = friction == "per-tick" ? cf::FrictionDisplacement::kPerTick
+                                                   : cf::FrictionDisplacement::kStickAnchor;
+  P.moment_reference =
+      moment_ref == "centroid" ? cf::MomentReference::kACentroid : cf::MomentReference::kAOrigin;
   if (!moment_point.empty()) {
     P.moment_reference = cf::MomentReference::kAPoint;
     P.moment_point_A = cf::Vec3(moment_point[0], moment_point[1], moment_point[2]);
@@ -105,7 +121,8 @@ int main(int argc, char** argv) {
     cf::check_output_path(out_path, inputs, "writing");
     if (!plot_path.empty()) cf::check_output_path(plot_path, inputs, "writing");
     const cf::CfGraph graph = cf::CfGraph::load(graph_path);
-    for (const auto& [m, which] : {std::pair{&graph.model_a(), "A"}, std::pair{&graph.model_b(), "B"}})
+    for (const auto& [m, which] :
+         {std::pair{&graph.model_a(), "A"}, std::pair{&graph.model_b(), "B"}})
       if (const std::string w = cf::size_warning(*m, which, P.epsilon_mm); !w.empty())
         std::cerr << "cfreplay: warning: " << w << "\n";
     const std::vector<cf::replay::Sample> samples = cf::replay::read_trajectory(traj_path);
@@ -122,7 +139,8 @@ int main(int argc, char** argv) {
     // Both files or neither: a plot that cannot be written leaves no CSV behind.
     std::vector<cf::OutputFile> files{{out_path, std::move(text)}};
     if (!plot_path.empty())
-      files.push_back({plot_path, cf::replay::svg_plot(rows, traj_path + " against " + graph_path)});
+      files.push_back(
+          {plot_path, cf::replay::svg_plot(rows, traj_path + " against " + graph_path)});
     cf::write_outputs(files, inputs, "writing");
     std::cerr << "cfreplay: " << rows.size() << " ticks ->" << ' ' << out_path << " (";
     bool first = true;

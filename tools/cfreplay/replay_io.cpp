@@ -33,7 +33,8 @@ std::vector<std::string> split(const std::string& line) {
   std::size_t start = 0;
   while (true) {
     const std::size_t comma = line.find(',', start);
-    out.push_back(trim(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
+    out.push_back(
+        trim(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
@@ -50,7 +51,8 @@ double number(const std::string& field, const char* column, const std::string& s
   char* end = nullptr;
   const double v = std::strtod(field.c_str(), &end);
   if (end != field.c_str() + field.size() || errno == ERANGE || !std::isfinite(v))
-    fail(source, line, std::string("column '") + column + "' is not a finite number: '" + printable(field) + "'");
+    fail(source, line,
+         std::string("column '") + column + "' is not a finite number: '" + printable(field) + "'");
   return v;
 }
 
@@ -72,17 +74,22 @@ std::vector<Sample> parse_trajectory(const std::string& text, const std::string&
       std::string joined;
       for (std::size_t i = 0; i < f.size(); ++i) joined += (i ? "," : "") + f[i];
       if (joined != kInputHeader)
-        fail(source, line, std::string("expected the header '") + kInputHeader + "', found '" +
-                               printable(s) + "'");
+        fail(source, line,
+             std::string("expected the header '") + kInputHeader + "', found '" + printable(s) +
+                 "'");
       header = true;
       continue;
     }
     if (f.size() != 8)
-      fail(source, line, "expected 8 columns (" + std::string(kInputHeader) + "), found " + std::to_string(f.size()));
+      fail(source, line,
+           "expected 8 columns (" + std::string(kInputHeader) + "), found " +
+               std::to_string(f.size()));
     double v[8];
-    for (int i = 0; i < 8; ++i) v[i] = number(f[static_cast<std::size_t>(i)], kColumns[i], source, line);
+    for (int i = 0; i < 8; ++i)
+      v[i] = number(f[static_cast<std::size_t>(i)], kColumns[i], source, line);
     Eigen::Quaterniond q(v[4], v[5], v[6], v[7]);
-    if (std::string why = quaternion_problem(v[4], v[5], v[6], v[7]); !why.empty()) fail(source, line, why);
+    if (std::string why = quaternion_problem(v[4], v[5], v[6], v[7]); !why.empty())
+      fail(source, line, why);
     q.normalize();
     Sample smp;
     smp.t = v[0];
@@ -91,13 +98,16 @@ std::vector<Sample> parse_trajectory(const std::string& text, const std::string&
     smp.line = line;
     if (!out.empty() && !(smp.t > out.back().t)) {
       char buf[160];
-      std::snprintf(buf, sizeof buf, "time %.9g s does not increase (previous row, line %d: %.9g s)", smp.t,
+      std::snprintf(buf, sizeof buf,
+                    "time %.9g s does not increase (previous row, line %d: %.9g s)", smp.t,
                     out.back().line, out.back().t);
       fail(source, line, buf);
     }
     out.push_back(smp);
   }
-  if (!header) fail(source, std::max(line, 1), std::string("empty file: expected the header '") + kInputHeader + "'");
+  if (!header)
+    fail(source, std::max(line, 1),
+         std::string("empty file: expected the header '") + kInputHeader + "'");
   if (out.empty()) fail(source, line, "no pose rows after the header");
   return out;
 }
@@ -122,14 +132,16 @@ std::string format_row(const Row& r) {
   std::snprintf(buf, sizeof buf,
                 "%.6f,%d,%s,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%s,%s,"
                 "%.9g,%.9g,%.9g,%.12f,%.12f,%.12f,%.12f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g",
-                r.t, r.cf, r.pcs.c_str(), r.motion.c_str(), r.F_W.x(), r.F_W.y(), r.F_W.z(), r.M_W.x(), r.M_W.y(),
-                r.M_W.z(), r.F_A.x(), r.F_A.y(), r.F_A.z(), r.M_A.x(), r.M_A.y(), r.M_A.z(), r.status.c_str(),
-                r.regimes.c_str(), r.X_WP.t_BA.x(), r.X_WP.t_BA.y(), r.X_WP.t_BA.z(), q.w(), q.x(), q.y(), q.z(),
-                r.Fc_W.x(), r.Fc_W.y(), r.Fc_W.z(), r.Mc_W.x(), r.Mc_W.y(), r.Mc_W.z());
+                r.t, r.cf, r.pcs.c_str(), r.motion.c_str(), r.F_W.x(), r.F_W.y(), r.F_W.z(),
+                r.M_W.x(), r.M_W.y(), r.M_W.z(), r.F_A.x(), r.F_A.y(), r.F_A.z(), r.M_A.x(),
+                r.M_A.y(), r.M_A.z(), r.status.c_str(), r.regimes.c_str(), r.X_WP.t_BA.x(),
+                r.X_WP.t_BA.y(), r.X_WP.t_BA.z(), q.w(), q.x(), q.y(), q.z(), r.Fc_W.x(),
+                r.Fc_W.y(), r.Fc_W.z(), r.Mc_W.x(), r.Mc_W.y(), r.Mc_W.z());
   return buf;
 }
 
-void write_file_atomic(const std::string& path, const std::string& text, const std::vector<std::string>& inputs) {
+void write_file_atomic(const std::string& path, const std::string& text,
+                       const std::vector<std::string>& inputs) {
   write_outputs({OutputFile{path, text}}, inputs, "writing");
 }
 
@@ -138,11 +150,16 @@ namespace {
 std::string esc(const std::string& s) {
   std::string o;
   for (char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else if (c == '"') o += "&quot;";
-    else o += c;
+    if (c == '<')
+      o += "&lt;";
+    else if (c == '>')
+      o += "&gt;";
+    else if (c == '&')
+      o += "&amp;";
+    else if (c == '"')
+      o += "&quot;";
+    else
+      o += c;
   }
   return o;
 }
@@ -195,7 +212,8 @@ std::string svg_plot(const std::vector<Row>& rows, const std::string& title) {
   };
   std::vector<Band> bands;
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    if (bands.empty() || rows[i].cf != rows[bands.back().a].cf || rows[i].motion != rows[bands.back().a].motion)
+    if (bands.empty() || rows[i].cf != rows[bands.back().a].cf ||
+        rows[i].motion != rows[bands.back().a].motion)
       bands.push_back({i, i});
     bands.back().b = i;
   }
@@ -222,33 +240,36 @@ std::string svg_plot(const std::vector<Row>& rows, const std::string& title) {
       const Band& b = bands[k];
       const double xa = X(rows[b.a].t);
       const double xb = b.b + 1 < rows.size() ? X(rows[b.b + 1].t) : X(rows[b.b].t);
-      const std::string label = (rows[b.a].cf >= 0 ? "CF " + std::to_string(rows[b.a].cf) : std::string("no CF")) +
-                                " " + rows[b.a].motion;
-      o << "<rect x=\"" << fmt(xa) << "\" y=\"" << fmt(y0) << "\" width=\"" << fmt(std::max(xb - xa, 0.5))
-        << "\" height=\"" << fmt(panel_h) << "\" fill=\"" << kBand[k % 4] << "\"><title>" << esc(label)
-        << " (" << fmt_tick(rows[b.a].t) << "-" << fmt_tick(rows[b.b].t) << " s)</title></rect>\n";
+      const std::string label =
+          (rows[b.a].cf >= 0 ? "CF " + std::to_string(rows[b.a].cf) : std::string("no CF")) + " " +
+          rows[b.a].motion;
+      o << "<rect x=\"" << fmt(xa) << "\" y=\"" << fmt(y0) << "\" width=\""
+        << fmt(std::max(xb - xa, 0.5)) << "\" height=\"" << fmt(panel_h) << "\" fill=\""
+        << kBand[k % 4] << "\"><title>" << esc(label) << " (" << fmt_tick(rows[b.a].t) << "-"
+        << fmt_tick(rows[b.b].t) << " s)</title></rect>\n";
       if (xb - xa > 12) {
         const double ty = y0 + 4;
-        o << "<text transform=\"translate(" << fmt(xa + 10) << "," << fmt(ty) << ") rotate(90)\" fill=\"#666\">"
-          << esc(label) << "</text>\n";
+        o << "<text transform=\"translate(" << fmt(xa + 10) << "," << fmt(ty)
+          << ") rotate(90)\" fill=\"#666\">" << esc(label) << "</text>\n";
       }
     }
     // Axes and grid.
-    o << "<rect x=\"" << left << "\" y=\"" << fmt(y0) << "\" width=\"" << plot_w << "\" height=\"" << panel_h
-      << "\" fill=\"none\" stroke=\"#444\"/>\n";
+    o << "<rect x=\"" << left << "\" y=\"" << fmt(y0) << "\" width=\"" << plot_w << "\" height=\""
+      << panel_h << "\" fill=\"none\" stroke=\"#444\"/>\n";
     const double ys = nice_step(hi - lo);
     for (double v = std::ceil(lo / ys) * ys; v <= hi; v += ys) {
-      o << "<line x1=\"" << left << "\" x2=\"" << left + plot_w << "\" y1=\"" << fmt(Y(v)) << "\" y2=\""
-        << fmt(Y(v)) << "\" stroke=\"#ccc\" stroke-dasharray=\"2,3\"/>\n";
-      o << "<text x=\"" << left - 5 << "\" y=\"" << fmt(Y(v) + 4) << "\" text-anchor=\"end\">" << fmt_tick(v)
-        << "</text>\n";
+      o << "<line x1=\"" << left << "\" x2=\"" << left + plot_w << "\" y1=\"" << fmt(Y(v))
+        << "\" y2=\"" << fmt(Y(v)) << "\" stroke=\"#ccc\" stroke-dasharray=\"2,3\"/>\n";
+      o << "<text x=\"" << left - 5 << "\" y=\"" << fmt(Y(v) + 4) << "\" text-anchor=\"end\">"
+        << fmt_tick(v) << "</text>\n";
     }
     const double xs = nice_step(t1 - t0);
     for (double t = std::ceil(t0 / xs) * xs; t <= t1 + 1e-12; t += xs) {
-      o << "<text x=\"" << fmt(X(t)) << "\" y=\"" << fmt(y0 + panel_h + 14) << "\" text-anchor=\"middle\">"
-        << fmt_tick(t) << "</text>\n";
+      o << "<text x=\"" << fmt(X(t)) << "\" y=\"" << fmt(y0 + panel_h + 14)
+        << "\" text-anchor=\"middle\">" << fmt_tick(t) << "</text>\n";
     }
-    o << "<text transform=\"translate(15," << fmt(y0 + panel_h / 2) << ") rotate(-90)\" text-anchor=\"middle\">"
+    o << "<text transform=\"translate(15," << fmt(y0 + panel_h / 2)
+      << ") rotate(-90)\" text-anchor=\"middle\">"
       << (panel == 0 ? "force F (N, world)" : "moment M (N mm, world)") << "</text>\n";
 
     // Series, with min/max per pixel column so that spikes survive: the rendered wrench (full),
@@ -264,11 +285,12 @@ std::string svg_plot(const std::vector<Row>& rows, const std::string& title) {
       auto flush = [&]() {
         if (col < 0) return;
         const double x = left + col;
-        o << fmt(x) << "," << fmt(Y(mx)) << " " << fmt(x) << "," << fmt(Y(mn)) << " " << fmt(x) << ","
-          << fmt(Y(last)) << " ";
+        o << fmt(x) << "," << fmt(Y(mx)) << " " << fmt(x) << "," << fmt(Y(mn)) << " " << fmt(x)
+          << "," << fmt(Y(last)) << " ";
       };
       for (const Row& r : rows) {
-        const double v = (contact ? (panel == 0 ? r.Fc_W : r.Mc_W) : (panel == 0 ? r.F_W : r.M_W))(c);
+        const double v =
+            (contact ? (panel == 0 ? r.Fc_W : r.Mc_W) : (panel == 0 ? r.F_W : r.M_W))(c);
         const int cc = std::min(cols - 1, static_cast<int>((X(r.t) - left)));
         if (cc != col) {
           flush();
@@ -281,12 +303,15 @@ std::string svg_plot(const std::vector<Row>& rows, const std::string& title) {
       }
       flush();
       o << "\"/>\n";
-      const char* names[2][2][3] = {{{"Fx", "Fy", "Fz"}, {"Mx", "My", "Mz"}}, {{"Fcx", "Fcy", "Fcz"}, {"Mcx", "Mcy", "Mcz"}}};
-      o << "<text x=\"" << fmt(left + plot_w - 260 + 45 * series) << "\" y=\"" << fmt(y0 - 6) << "\" fill=\""
-        << colors[c] << "\">" << names[contact ? 1 : 0][panel][c] << (contact ? " (dashed)" : "") << "</text>\n";
+      const char* names[2][2][3] = {{{"Fx", "Fy", "Fz"}, {"Mx", "My", "Mz"}},
+                                    {{"Fcx", "Fcy", "Fcz"}, {"Mcx", "Mcy", "Mcz"}}};
+      o << "<text x=\"" << fmt(left + plot_w - 260 + 45 * series) << "\" y=\"" << fmt(y0 - 6)
+        << "\" fill=\"" << colors[c] << "\">" << names[contact ? 1 : 0][panel][c]
+        << (contact ? " (dashed)" : "") << "</text>\n";
     }
   }
-  o << "<text x=\"" << fmt(left + plot_w / 2) << "\" y=\"" << fmt(H - 10) << "\" text-anchor=\"middle\">time (s)"
+  o << "<text x=\"" << fmt(left + plot_w / 2) << "\" y=\"" << fmt(H - 10)
+    << "\" text-anchor=\"middle\">time (s)"
     << "</text>\n";
   o << "</svg>\n";
   return o.str();

@@ -10,7 +10,8 @@ Row make_row(const HapticResult& r) {
     row.pcs = to_string(r.pcs);
   } else if (r.force != nullptr) {
     // No CF fits: list the contacts that were rendered conservatively.
-    for (int k = 0; k < r.force->num_pcs; ++k) row.pcs += (k ? ";" : "") + to_string(r.force->pcs[k].pc);
+    for (int k = 0; k < r.force->num_pcs; ++k)
+      row.pcs += (k ? ";" : "") + to_string(r.force->pcs[k].pc);
   }
   row.motion = to_string(r.motion);
   row.F_W = r.F_W;
@@ -22,7 +23,8 @@ Row make_row(const HapticResult& r) {
   row.Fc_W = r.F_contact_W;
   row.Mc_W = r.M_contact_W;
   if (r.force != nullptr) {
-    for (int k = 0; k < r.force->num_pcs; ++k) row.regimes += (k ? ";" : "") + std::string(to_string(r.force->pcs[k].regime));
+    for (int k = 0; k < r.force->num_pcs; ++k)
+      row.regimes += (k ? ";" : "") + std::string(to_string(r.force->pcs[k].regime));
     // Approaching contacts (eq. (1) only) follow, named, as they are not among the pcs.
     for (int k = r.force->num_pcs; k < r.force->num_pcs + r.force->num_approaching; ++k)
       row.regimes += (k ? ";" : "") + std::string("approaching:") + to_string(r.force->pcs[k].pc);

@@ -110,8 +110,8 @@ void check_soup(const PolygonSoup& s, const std::string& src, const LoadOptions&
   for (std::size_t f = 0; f < F.size(); ++f) {
     const std::string fs = "facet " + std::to_string(f);
     if (F[f].size() < 3)
-      fail(src, "degenerate facet: " + fs + " has only " + std::to_string(F[f].size()) +
-                    " vertices");
+      fail(src,
+           "degenerate facet: " + fs + " has only " + std::to_string(F[f].size()) + " vertices");
     for (int i : F[f])
       if (i < 0 || i >= np)
         fail(src, "parse error: " + fs + " refers to vertex " + std::to_string(i) +
@@ -120,8 +120,8 @@ void check_soup(const PolygonSoup& s, const std::string& src, const LoadOptions&
     std::sort(sorted.begin(), sorted.end());
     const auto dup = std::adjacent_find(sorted.begin(), sorted.end());
     if (dup != sorted.end())
-      fail(src, "degenerate facet: " + fs + " uses vertex " + std::to_string(*dup) +
-                    " more than once");
+      fail(src,
+           "degenerate facet: " + fs + " uses vertex " + std::to_string(*dup) + " more than once");
     for (int i : F[f])
       if (!P[i].allFinite()) fail(src, "vertex " + std::to_string(i) + " is not finite");
   }
@@ -169,7 +169,7 @@ void check_soup(const PolygonSoup& s, const std::string& src, const LoadOptions&
     do {
       ++walked;
       const int next = F[f][(k + 1) % F[f].size()];  // facet f runs v -> next
-      const auto [g, j] = he.at(key(next, v));        // its twin runs next -> v, v at j + 1
+      const auto [g, j] = he.at(key(next, v));       // its twin runs next -> v, v at j + 1
       f = g;
       k = static_cast<int>((j + 1) % F[g].size());
     } while (!(f == corners[v][0].first && k == corners[v][0].second) &&
@@ -199,8 +199,8 @@ void check_soup(const PolygonSoup& s, const std::string& src, const LoadOptions&
         const double d = std::abs(n.dot(P[i] - c));
         if (d > tol)
           fail(src, "non-planar facet: vertex " + std::to_string(i) + " of facet " +
-                        std::to_string(f) + " lies " + num(d) + " mm off the facet's plane (tolerance " +
-                        num(tol) + " mm)");
+                        std::to_string(f) + " lies " + num(d) +
+                        " mm off the facet's plane (tolerance " + num(tol) + " mm)");
       }
     }
   }
@@ -208,7 +208,8 @@ void check_soup(const PolygonSoup& s, const std::string& src, const LoadOptions&
   UnionFind uf(F.size());
   for (const auto& [e, u] : uses) uf.unite(u[0].first, u[1].first);
   int solids = 0;
-  for (std::size_t f = 0; f < F.size(); ++f) solids += uf.find(static_cast<int>(f)) == static_cast<int>(f);
+  for (std::size_t f = 0; f < F.size(); ++f)
+    solids += uf.find(static_cast<int>(f)) == static_cast<int>(f);
   if (solids > 1)
     fail(src, "the file holds " + std::to_string(solids) +
                   " separate solids (facet groups not connected by edges); one solid is expected");
@@ -368,7 +369,8 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
       if (corners.size() < 3)
         fail(src, "a boundary loop of " + face_desc(r) + " has " + std::to_string(corners.size()) +
                       " corners; a curved boundary tessellated finer than the collinearity "
-                      "tolerance (" + num(tol) + " mm) is not a polyhedron");
+                      "tolerance (" +
+                      num(tol) + " mm) is not a polyhedron");
       // Every run of non-feature vertices between two corners must be one straight edge.
       const std::size_t m = mesh_loop.size();
       for (std::size_t c = 0; c < corners.size(); ++c) {

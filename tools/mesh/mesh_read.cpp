@@ -24,8 +24,8 @@
 namespace cf::tools {
 namespace {
 
-using detail::fail;
 using cf::printable;
+using detail::fail;
 
 std::string quoted(std::string_view t) { return "'" + printable(std::string(t), 40) + "'"; }
 
@@ -33,12 +33,16 @@ std::string quoted(std::string_view t) { return "'" + printable(std::string(t), 
 /// (A cast of a double beyond the range of long long is undefined: fuzz_ply found one.)
 std::string number_text(double v) {
   char buf[40];
-  if (std::abs(v) < 9e18 && v == std::floor(v)) std::snprintf(buf, sizeof buf, "%lld", static_cast<long long>(v));
-  else std::snprintf(buf, sizeof buf, "%.17g", v);
+  if (std::abs(v) < 9e18 && v == std::floor(v))
+    std::snprintf(buf, sizeof buf, "%lld", static_cast<long long>(v));
+  else
+    std::snprintf(buf, sizeof buf, "%.17g", v);
   return buf;
 }
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v'; }
+bool is_space(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v';
+}
 
 std::string lower(std::string_view s) {
   std::string o(s);
@@ -134,59 +138,69 @@ RawSoup read_off(std::string_view text, const std::string& src) {
     if (!off) parse_fail(src, in.line(), "expected the keyword OFF, found " + quoted(tok[0]));
     const std::string prefix = kw.substr(0, kw.size() - 3);
     if (prefix.find('4') != std::string::npos || prefix.find('n') != std::string::npos)
-      parse_fail(src, in.line(), "the " + kw + " variant (homogeneous or n-dimensional) is not supported");
+      parse_fail(src, in.line(),
+                 "the " + kw + " variant (homogeneous or n-dimensional) is not supported");
     for (char c : prefix)
       if (c != 'S' && c != 'T' && c != 'C' && c != 'N')
         parse_fail(src, in.line(), "expected the keyword OFF, found " + quoted(tok[0]));
     k = 1;
     if (tok.size() > 1 && lower(tok[1]) == "binary")
-      parse_fail(src, in.line(), "binary OFF is not supported (write the model as text OFF, or as PLY or STL)");
+      parse_fail(src, in.line(),
+                 "binary OFF is not supported (write the model as text OFF, or as PLY or STL)");
   }
   // The counts: on the keyword's line or the next.
   if (k >= tok.size()) {
-    if (!in.next(tok)) fail(src, "parse error: the file ends before the counts (vertices facets edges)");
+    if (!in.next(tok))
+      fail(src, "parse error: the file ends before the counts (vertices facets edges)");
     k = 0;
   }
   if (tok.size() - k < 2) parse_fail(src, in.line(), "expected the counts 'vertices facets edges'");
   long long nv = 0, nf = 0;
   bool overflow = false;
   if (!parse_int(tok[k], nv, overflow) || nv < 0)
-    parse_fail(src, in.line(), "the vertex count " + quoted(tok[k]) + " is not a non-negative integer");
+    parse_fail(src, in.line(),
+               "the vertex count " + quoted(tok[k]) + " is not a non-negative integer");
   if (!parse_int(tok[k + 1], nf, overflow) || nf < 0)
-    parse_fail(src, in.line(), "the facet count " + quoted(tok[k + 1]) + " is not a non-negative integer");
+    parse_fail(src, in.line(),
+               "the facet count " + quoted(tok[k + 1]) + " is not a non-negative integer");
   // Every vertex takes at least "x y z\n" (6 bytes), every facet at least "3 i j k\n" (8).
-  const long double need = 6.0L * static_cast<long double>(nv) + 8.0L * static_cast<long double>(nf) - 1;
+  const long double need =
+      6.0L * static_cast<long double>(nv) + 8.0L * static_cast<long double>(nf) - 1;
   if (need > static_cast<long double>(in.remaining()))
-    fail(src, "parse error: the header says " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
-                  " facets, more than the remaining " + std::to_string(in.remaining()) +
-                  " bytes of the file can hold");
+    fail(src, "parse error: the header says " + std::to_string(nv) + " vertices and " +
+                  std::to_string(nf) + " facets, more than the remaining " +
+                  std::to_string(in.remaining()) + " bytes of the file can hold");
   s.points.reserve(static_cast<std::size_t>(nv));
   for (long long i = 0; i < nv; ++i) {
     if (!in.next(tok))
-      fail(src, "parse error: the file ends after " + std::to_string(i) + " of its " + std::to_string(nv) +
-                    " vertices");
+      fail(src, "parse error: the file ends after " + std::to_string(i) + " of its " +
+                    std::to_string(nv) + " vertices");
     if (tok.size() < 3)
-      parse_fail(src, in.line(), "vertex " + std::to_string(i) + " has " + std::to_string(tok.size()) +
-                                     " numbers, expected x y z");
+      parse_fail(src, in.line(),
+                 "vertex " + std::to_string(i) + " has " + std::to_string(tok.size()) +
+                     " numbers, expected x y z");
     double c[3];
     for (int a = 0; a < 3; ++a)
       if (!parse_double(tok[static_cast<std::size_t>(a)], c[a]))
-        parse_fail(src, in.line(), "vertex " + std::to_string(i) + ": " + quoted(tok[static_cast<std::size_t>(a)]) +
-                                       " is not a finite number");
+        parse_fail(src, in.line(),
+                   "vertex " + std::to_string(i) + ": " + quoted(tok[static_cast<std::size_t>(a)]) +
+                       " is not a finite number");
     s.points.emplace_back(c[0], c[1], c[2]);
   }
   s.polygons.reserve(static_cast<std::size_t>(nf));
   for (long long f = 0; f < nf; ++f) {
     if (!in.next(tok))
-      fail(src, "parse error: the file ends after " + std::to_string(f) + " of its " + std::to_string(nf) +
-                    " facets");
+      fail(src, "parse error: the file ends after " + std::to_string(f) + " of its " +
+                    std::to_string(nf) + " facets");
     long long n = 0;
     if (!parse_int(tok[0], n, overflow) || n < 0)
-      parse_fail(src, in.line(), "facet " + std::to_string(f) + ": the vertex count " + quoted(tok[0]) +
-                                     " is not a non-negative integer");
+      parse_fail(src, in.line(),
+                 "facet " + std::to_string(f) + ": the vertex count " + quoted(tok[0]) +
+                     " is not a non-negative integer");
     if (static_cast<unsigned long long>(n) > tok.size() - 1)
-      parse_fail(src, in.line(), "facet " + std::to_string(f) + " says it has " + std::to_string(n) +
-                                     " vertices but its line lists " + std::to_string(tok.size() - 1) + " numbers");
+      parse_fail(src, in.line(),
+                 "facet " + std::to_string(f) + " says it has " + std::to_string(n) +
+                     " vertices but its line lists " + std::to_string(tok.size() - 1) + " numbers");
     std::vector<std::size_t> poly;
     poly.reserve(static_cast<std::size_t>(n));
     for (long long j = 1; j <= n; ++j) {
@@ -194,12 +208,14 @@ RawSoup read_off(std::string_view text, const std::string& src) {
       long long v = 0;
       const bool ok = parse_int(t, v, overflow);
       if (!ok && !overflow)
-        parse_fail(src, in.line(), "facet " + std::to_string(f) + ": vertex index " + quoted(t) +
-                                       " is not an integer");
+        parse_fail(
+            src, in.line(),
+            "facet " + std::to_string(f) + ": vertex index " + quoted(t) + " is not an integer");
       if (overflow || v < 0 || v >= nv)
-        parse_fail(src, in.line(), "facet " + std::to_string(f) + " refers to vertex " + printable(std::string(t), 40) +
-                                       " but the file has " + std::to_string(nv) + " vertices (0 to " +
-                                       std::to_string(nv - 1) + ")");
+        parse_fail(src, in.line(),
+                   "facet " + std::to_string(f) + " refers to vertex " +
+                       printable(std::string(t), 40) + " but the file has " + std::to_string(nv) +
+                       " vertices (0 to " + std::to_string(nv - 1) + ")");
       poly.push_back(static_cast<std::size_t>(v));
     }
     s.polygons.push_back(std::move(poly));
@@ -213,22 +229,25 @@ RawSoup read_obj(std::string_view text, const std::string& src) {
   RawSoup s;
   Lines in(text, true);
   std::vector<std::string_view> tok;
-  static const char* const kIgnored[] = {"vt", "vn", "vp", "o", "g", "s", "usemtl", "mtllib", "l", "p",
-                                         "cstype", "deg", "bmat", "step", "curv", "curv2", "surf", "parm",
-                                         "trim", "hole", "scrv", "sp", "end", "con", "mg", "lod", "usemap",
-                                         "maplib", "shadow_obj", "trace_obj", "ctech", "stech", "bevel",
-                                         "c_interp", "d_interp"};
+  static const char* const kIgnored[] = {
+      "vt",         "vn",        "vp",    "o",      "g",     "s",        "usemtl",
+      "mtllib",     "l",         "p",     "cstype", "deg",   "bmat",     "step",
+      "curv",       "curv2",     "surf",  "parm",   "trim",  "hole",     "scrv",
+      "sp",         "end",       "con",   "mg",     "lod",   "usemap",   "maplib",
+      "shadow_obj", "trace_obj", "ctech", "stech",  "bevel", "c_interp", "d_interp"};
   while (in.next(tok)) {
     const std::string_view kw = tok[0];
     if (kw == "v") {
       if (tok.size() < 4)
-        parse_fail(src, in.line(), "vertex " + std::to_string(s.points.size()) + " has " +
-                                       std::to_string(tok.size() - 1) + " numbers, expected x y z");
+        parse_fail(src, in.line(),
+                   "vertex " + std::to_string(s.points.size()) + " has " +
+                       std::to_string(tok.size() - 1) + " numbers, expected x y z");
       double c[3];
       for (std::size_t a = 0; a < 3; ++a)
         if (!parse_double(tok[a + 1], c[a]))
-          parse_fail(src, in.line(), "vertex " + std::to_string(s.points.size()) + ": " + quoted(tok[a + 1]) +
-                                         " is not a finite number");
+          parse_fail(src, in.line(),
+                     "vertex " + std::to_string(s.points.size()) + ": " + quoted(tok[a + 1]) +
+                         " is not a finite number");
       s.points.emplace_back(c[0], c[1], c[2]);
     } else if (kw == "f" || kw == "fo") {
       std::vector<std::size_t> poly;
@@ -239,14 +258,16 @@ RawSoup read_obj(std::string_view text, const std::string& src) {
         bool overflow = false;
         const bool ok = parse_int(ref, v, overflow);
         if (!ok && !overflow)
-          parse_fail(src, in.line(), "facet " + std::to_string(s.polygons.size()) + ": vertex reference " +
-                                         quoted(tok[j]) + " is not an integer");
+          parse_fail(src, in.line(),
+                     "facet " + std::to_string(s.polygons.size()) + ": vertex reference " +
+                         quoted(tok[j]) + " is not an integer");
         const auto n = static_cast<long long>(s.points.size());
         if (overflow || v == 0 || v < -n || v > std::numeric_limits<int>::max())
-          parse_fail(src, in.line(), "facet " + std::to_string(s.polygons.size()) + " refers to vertex " +
-                                         printable(std::string(ref), 40) + (v < 0 ? " (relative)" : "") +
-                                         ", which does not exist (OBJ counts vertices from 1; " +
-                                         std::to_string(n) + " so far)");
+          parse_fail(src, in.line(),
+                     "facet " + std::to_string(s.polygons.size()) + " refers to vertex " +
+                         printable(std::string(ref), 40) + (v < 0 ? " (relative)" : "") +
+                         ", which does not exist (OBJ counts vertices from 1; " +
+                         std::to_string(n) + " so far)");
         // Positive references may point forward (checked once all vertices are read).
         poly.push_back(static_cast<std::size_t>(v > 0 ? v - 1 : n + v));
       }
@@ -304,14 +325,17 @@ RawSoup read_stl_ascii(std::string_view text, const std::string& src) {
   Tokens in(text);
   std::string_view tok;
   auto expect = [&](const char* word) {
-    if (!in.next(tok)) fail(src, std::string("parse error: the file ends where '") + word + "' was expected");
-    if (lower(tok) != word) parse_fail(src, in.line(), std::string("expected '") + word + "', found " + quoted(tok));
+    if (!in.next(tok))
+      fail(src, std::string("parse error: the file ends where '") + word + "' was expected");
+    if (lower(tok) != word)
+      parse_fail(src, in.line(), std::string("expected '") + word + "', found " + quoted(tok));
   };
   auto number = [&](const char* what) {
     if (!in.next(tok)) fail(src, std::string("parse error: the file ends inside a ") + what);
     double v = 0;
     if (!parse_double(tok, v))
-      parse_fail(src, in.line(), std::string("expected a finite number in a ") + what + ", found " + quoted(tok));
+      parse_fail(src, in.line(),
+                 std::string("expected a finite number in a ") + what + ", found " + quoted(tok));
     return v;
   };
   expect("solid");
@@ -322,11 +346,13 @@ RawSoup read_stl_ascii(std::string_view text, const std::string& src) {
     if (kw == "endsolid") {
       in.skip_line();
       if (!in.next(tok)) break;  // done; another solid may follow
-      if (lower(tok) != "solid") parse_fail(src, in.line(), "expected 'solid' or the end, found " + quoted(tok));
+      if (lower(tok) != "solid")
+        parse_fail(src, in.line(), "expected 'solid' or the end, found " + quoted(tok));
       in.skip_line();
       continue;
     }
-    if (kw != "facet") parse_fail(src, in.line(), "expected 'facet' or 'endsolid', found " + quoted(tok));
+    if (kw != "facet")
+      parse_fail(src, in.line(), "expected 'facet' or 'endsolid', found " + quoted(tok));
     expect("normal");
     for (int a = 0; a < 3; ++a) number("facet normal");
     expect("outer");
@@ -370,7 +396,8 @@ RawSoup read_stl_binary(std::string_view bytes, const std::string& src) {
     for (int c = 0; c < 3; ++c, q += 12) {
       const double x = lef(q), y = lef(q + 4), z = lef(q + 8);
       if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
-        fail(src, "parse error: triangle " + std::to_string(t) + " of the binary STL has a corner that is not finite");
+        fail(src, "parse error: triangle " + std::to_string(t) +
+                      " of the binary STL has a corner that is not finite");
       tri.push_back(index.add(x, y, z));
     }
     s.polygons.push_back(std::move(tri));
@@ -379,10 +406,11 @@ RawSoup read_stl_binary(std::string_view bytes, const std::string& src) {
 }
 
 RawSoup read_stl(std::string_view bytes, const std::string& src) {
-  const bool binary_size = bytes.size() >= 84 &&
-                           84 + 50 * static_cast<unsigned long long>(
-                                         le32(reinterpret_cast<const unsigned char*>(bytes.data()) + 80)) ==
-                               bytes.size();
+  const bool binary_size =
+      bytes.size() >= 84 &&
+      84 + 50 * static_cast<unsigned long long>(
+                    le32(reinterpret_cast<const unsigned char*>(bytes.data()) + 80)) ==
+          bytes.size();
   std::size_t b = 0;
   while (b < bytes.size() && is_space(bytes[b])) ++b;
   if (b == bytes.size()) fail(src, "the file contains no facets");
@@ -399,12 +427,13 @@ RawSoup read_stl(std::string_view bytes, const std::string& src) {
   if (binary_size) return read_stl_binary(bytes, src);
   if (bytes.size() >= 84) {
     const unsigned long long n = le32(reinterpret_cast<const unsigned char*>(bytes.data()) + 80);
-    fail(src, "parse error: not an ascii STL (no 'solid'), and as binary STL its header says " + std::to_string(n) +
-                  " triangles (" + std::to_string(84 + 50 * n) + " bytes) but the file has " +
-                  std::to_string(bytes.size()) + " bytes");
+    fail(src, "parse error: not an ascii STL (no 'solid'), and as binary STL its header says " +
+                  std::to_string(n) + " triangles (" + std::to_string(84 + 50 * n) +
+                  " bytes) but the file has " + std::to_string(bytes.size()) + " bytes");
   }
-  fail(src, "parse error: not a readable STL file: no 'solid' keyword and too short for binary STL (" +
-                std::to_string(bytes.size()) + " bytes, at least 84 needed)");
+  fail(src,
+       "parse error: not a readable STL file: no 'solid' keyword and too short for binary STL (" +
+           std::to_string(bytes.size()) + " bytes, at least 84 needed)");
 }
 
 // --- PLY ---------------------------------------------------------------------------------
@@ -413,10 +442,12 @@ enum class PlyType : std::uint8_t { kI8, kU8, kI16, kU16, kI32, kU32, kF32, kF64
 
 bool ply_type(std::string_view name, PlyType& t) {
   static const std::pair<const char*, PlyType> kNames[] = {
-      {"char", PlyType::kI8},     {"int8", PlyType::kI8},     {"uchar", PlyType::kU8},   {"uint8", PlyType::kU8},
-      {"short", PlyType::kI16},   {"int16", PlyType::kI16},   {"ushort", PlyType::kU16}, {"uint16", PlyType::kU16},
-      {"int", PlyType::kI32},     {"int32", PlyType::kI32},   {"uint", PlyType::kU32},   {"uint32", PlyType::kU32},
-      {"float", PlyType::kF32},   {"float32", PlyType::kF32}, {"double", PlyType::kF64}, {"float64", PlyType::kF64}};
+      {"char", PlyType::kI8},    {"int8", PlyType::kI8},     {"uchar", PlyType::kU8},
+      {"uint8", PlyType::kU8},   {"short", PlyType::kI16},   {"int16", PlyType::kI16},
+      {"ushort", PlyType::kU16}, {"uint16", PlyType::kU16},  {"int", PlyType::kI32},
+      {"int32", PlyType::kI32},  {"uint", PlyType::kU32},    {"uint32", PlyType::kU32},
+      {"float", PlyType::kF32},  {"float32", PlyType::kF32}, {"double", PlyType::kF64},
+      {"float64", PlyType::kF64}};
   for (const auto& [n, v] : kNames)
     if (name == n) {
       t = v;
@@ -427,10 +458,18 @@ bool ply_type(std::string_view name, PlyType& t) {
 
 std::size_t ply_size(PlyType t) {
   switch (t) {
-    case PlyType::kI8: case PlyType::kU8: return 1;
-    case PlyType::kI16: case PlyType::kU16: return 2;
-    case PlyType::kI32: case PlyType::kU32: case PlyType::kF32: return 4;
-    default: return 8;
+    case PlyType::kI8:
+    case PlyType::kU8:
+      return 1;
+    case PlyType::kI16:
+    case PlyType::kU16:
+      return 2;
+    case PlyType::kI32:
+    case PlyType::kU32:
+    case PlyType::kF32:
+      return 4;
+    default:
+      return 8;
   }
 }
 
@@ -462,38 +501,70 @@ class PlyData {
         if (d_[p_] == '\n') ++line_;
         ++p_;
       }
-      if (p_ >= d_.size()) fail(src_, std::string("parse error: the file ends inside the data, reading ") + what);
+      if (p_ >= d_.size())
+        fail(src_, std::string("parse error: the file ends inside the data, reading ") + what);
       const std::size_t b = p_;
       while (p_ < d_.size() && !is_space(d_[p_])) ++p_;
       const std::string_view tok = d_.substr(b, p_ - b);
       double v = 0;
       if (!parse_double(tok, v))
-        parse_fail(src_, line_, std::string("expected a finite number for ") + what + ", found " + quoted(tok));
+        parse_fail(src_, line_,
+                   std::string("expected a finite number for ") + what + ", found " + quoted(tok));
       if (ply_integer(t) && v != std::floor(v))
-        parse_fail(src_, line_, std::string("expected an integer for ") + what + ", found " + quoted(tok));
+        parse_fail(src_, line_,
+                   std::string("expected an integer for ") + what + ", found " + quoted(tok));
       return v;
     }
     const std::size_t n = ply_size(t);
-    if (d_.size() - p_ < n) fail(src_, std::string("parse error: the file ends inside the data, reading ") + what);
+    if (d_.size() - p_ < n)
+      fail(src_, std::string("parse error: the file ends inside the data, reading ") + what);
     unsigned char b[8];
     std::memcpy(b, d_.data() + p_, n);
     p_ += n;
     if (format_ == 2) std::reverse(b, b + n);  // big endian to little endian
     switch (t) {
-      case PlyType::kI8: return static_cast<double>(static_cast<std::int8_t>(b[0]));
-      case PlyType::kU8: return b[0];
-      case PlyType::kI16: { std::int16_t v; std::memcpy(&v, b, 2); return v; }
-      case PlyType::kU16: { std::uint16_t v; std::memcpy(&v, b, 2); return v; }
-      case PlyType::kI32: { std::int32_t v; std::memcpy(&v, b, 4); return v; }
-      case PlyType::kU32: { std::uint32_t v; std::memcpy(&v, b, 4); return v; }
-      case PlyType::kF32: { float v; std::memcpy(&v, b, 4); return finite(v, what); }
-      default: { double v; std::memcpy(&v, b, 8); return finite(v, what); }
+      case PlyType::kI8:
+        return static_cast<double>(static_cast<std::int8_t>(b[0]));
+      case PlyType::kU8:
+        return b[0];
+      case PlyType::kI16: {
+        std::int16_t v;
+        std::memcpy(&v, b, 2);
+        return v;
+      }
+      case PlyType::kU16: {
+        std::uint16_t v;
+        std::memcpy(&v, b, 2);
+        return v;
+      }
+      case PlyType::kI32: {
+        std::int32_t v;
+        std::memcpy(&v, b, 4);
+        return v;
+      }
+      case PlyType::kU32: {
+        std::uint32_t v;
+        std::memcpy(&v, b, 4);
+        return v;
+      }
+      case PlyType::kF32: {
+        float v;
+        std::memcpy(&v, b, 4);
+        return finite(v, what);
+      }
+      default: {
+        double v;
+        std::memcpy(&v, b, 8);
+        return finite(v, what);
+      }
     }
   }
   /// Binary floats may be NaN or infinite: refused like the text "nan" (and a NaN would
   /// break the ordering of the point index).
   double finite(double v, const char* what) const {
-    if (!std::isfinite(v)) fail(src_, std::string("parse error: ") + what + " in the binary data is not a finite number");
+    if (!std::isfinite(v))
+      fail(src_,
+           std::string("parse error: ") + what + " in the binary data is not a finite number");
     return v;
   }
   /// Bytes left; in ascii a value takes at least 2 (a digit and a separator).
@@ -524,7 +595,8 @@ RawSoup read_ply(std::string_view bytes, const std::string& src) {
     return true;
   };
   std::string_view l;
-  if (!next_line(l) || l != "ply") parse_fail(src, 1, "expected 'ply' on the first line, found " + quoted(l));
+  if (!next_line(l) || l != "ply")
+    parse_fail(src, 1, "expected 'ply' on the first line, found " + quoted(l));
   int format = -1;
   std::vector<PlyElement> elements;
   bool ended = false;
@@ -543,16 +615,22 @@ RawSoup read_ply(std::string_view bytes, const std::string& src) {
       break;
     }
     if (t[0] == "format") {
-      if (t.size() < 2) parse_fail(src, line, "expected 'format ascii|binary_little_endian|binary_big_endian 1.0'");
-      if (t[1] == "ascii") format = 0;
-      else if (t[1] == "binary_little_endian") format = 1;
-      else if (t[1] == "binary_big_endian") format = 2;
-      else parse_fail(src, line, "unknown PLY format " + quoted(t[1]));
+      if (t.size() < 2)
+        parse_fail(src, line, "expected 'format ascii|binary_little_endian|binary_big_endian 1.0'");
+      if (t[1] == "ascii")
+        format = 0;
+      else if (t[1] == "binary_little_endian")
+        format = 1;
+      else if (t[1] == "binary_big_endian")
+        format = 2;
+      else
+        parse_fail(src, line, "unknown PLY format " + quoted(t[1]));
     } else if (t[0] == "element") {
       long long n = 0;
       bool overflow = false;
       if (t.size() != 3 || !parse_int(t[2], n, overflow) || n < 0)
-        parse_fail(src, line, "expected 'element NAME COUNT' with a non-negative count, found " + quoted(l));
+        parse_fail(src, line,
+                   "expected 'element NAME COUNT' with a non-negative count, found " + quoted(l));
       elements.push_back({std::string(t[1]), static_cast<unsigned long long>(n), {}});
     } else if (t[0] == "property") {
       if (elements.empty()) parse_fail(src, line, "a property before any element");
@@ -561,14 +639,16 @@ RawSoup read_ply(std::string_view bytes, const std::string& src) {
         p.list = true;
         if (!ply_type(t[2], p.count_type) || !ply_type(t[3], p.type))
           parse_fail(src, line, "unknown type in " + quoted(l));
-        if (!ply_integer(p.count_type)) parse_fail(src, line, "a list's count type must be an integer type");
+        if (!ply_integer(p.count_type))
+          parse_fail(src, line, "a list's count type must be an integer type");
         p.name = std::string(t[4]);
       } else if (t.size() == 3) {
         if (!ply_type(t[1], p.type)) parse_fail(src, line, "unknown type " + quoted(t[1]));
         p.name = std::string(t[2]);
       } else {
-        parse_fail(src, line, "expected 'property TYPE NAME' or 'property list COUNT_TYPE TYPE NAME', found " +
-                                  quoted(l));
+        parse_fail(src, line,
+                   "expected 'property TYPE NAME' or 'property list COUNT_TYPE TYPE NAME', found " +
+                       quoted(l));
       }
       elements.back().props.push_back(p);
     } else {
@@ -583,8 +663,8 @@ RawSoup read_ply(std::string_view bytes, const std::string& src) {
   long double need = 0;
   for (const PlyElement& e : elements) {
     if (e.count > 0 && e.props.empty())
-      fail(src, "parse error: element '" + printable(e.name, 40) + "' has " + std::to_string(e.count) +
-                    " items but no properties");
+      fail(src, "parse error: element '" + printable(e.name, 40) + "' has " +
+                    std::to_string(e.count) + " items but no properties");
     std::size_t per = 0;
     for (const PlyProperty& p : e.props) per += data.min_bytes(p.list ? p.count_type : p.type);
     need += static_cast<long double>(e.count) * static_cast<long double>(per);
@@ -592,7 +672,8 @@ RawSoup read_ply(std::string_view bytes, const std::string& src) {
   if (need > static_cast<long double>(data.remaining()) + 1)
     fail(src, "parse error: the header's element counts need at least " +
                   std::to_string(static_cast<unsigned long long>(std::min(need, 1e19L))) +
-                  " bytes of data, but the file has " + std::to_string(data.remaining()) + " after the header");
+                  " bytes of data, but the file has " + std::to_string(data.remaining()) +
+                  " after the header");
 
   RawSoup s;
   bool have_vertices = false;
@@ -606,15 +687,18 @@ RawSoup read_ply(std::string_view bytes, const std::string& src) {
         if (p.name == "y") iy = static_cast<int>(k);
         if (p.name == "z") iz = static_cast<int>(k);
       }
-      if (is_face && p.list && (p.name == "vertex_indices" || p.name == "vertex_index")) ilist = static_cast<int>(k);
+      if (is_face && p.list && (p.name == "vertex_indices" || p.name == "vertex_index"))
+        ilist = static_cast<int>(k);
     }
     if (is_vertex) {
-      if (ix < 0 || iy < 0 || iz < 0) fail(src, "parse error: the PLY element 'vertex' lacks a property x, y or z");
+      if (ix < 0 || iy < 0 || iz < 0)
+        fail(src, "parse error: the PLY element 'vertex' lacks a property x, y or z");
       have_vertices = true;
       s.points.reserve(static_cast<std::size_t>(e.count));
     }
     if (is_face) {
-      if (ilist < 0) fail(src, "parse error: the PLY element 'face' has no list property 'vertex_indices'");
+      if (ilist < 0)
+        fail(src, "parse error: the PLY element 'face' has no list property 'vertex_indices'");
       s.polygons.reserve(static_cast<std::size_t>(e.count));
     }
     for (unsigned long long i = 0; i < e.count; ++i) {
@@ -630,9 +714,10 @@ RawSoup read_ply(std::string_view bytes, const std::string& src) {
           continue;
         }
         const double nd = data.value(p.count_type, "a list count");
-        if (nd < 0 || nd * static_cast<double>(data.min_bytes(p.type)) > static_cast<double>(data.remaining()) + 1)
-          fail(src, "parse error: item " + std::to_string(i) + " of element '" + printable(e.name, 40) +
-                        "' has a list of " + number_text(nd) +
+        if (nd < 0 || nd * static_cast<double>(data.min_bytes(p.type)) >
+                          static_cast<double>(data.remaining()) + 1)
+          fail(src, "parse error: item " + std::to_string(i) + " of element '" +
+                        printable(e.name, 40) + "' has a list of " + number_text(nd) +
                         " values, more than the rest of the file holds");
         const auto n = static_cast<std::size_t>(nd);
         const bool keep = static_cast<int>(k) == ilist;
@@ -641,8 +726,8 @@ RawSoup read_ply(std::string_view bytes, const std::string& src) {
           const double v = data.value(p.type, "a list value");
           if (!keep) continue;
           if (!ply_integer(p.type) && v != std::floor(v))
-            fail(src, "parse error: facet " + std::to_string(i) + ": vertex index " + number_text(v) +
-                          " is not an integer");
+            fail(src, "parse error: facet " + std::to_string(i) + ": vertex index " +
+                          number_text(v) + " is not an integer");
           if (v < 0 || v > static_cast<double>(std::numeric_limits<int>::max()))
             fail(src, "parse error: facet " + std::to_string(i) + " refers to vertex " +
                           number_text(v) + ", which does not exist");
@@ -665,18 +750,28 @@ MeshFormat mesh_format_of(const std::string& path) {
   if (ext == ".obj") return MeshFormat::kObj;
   if (ext == ".stl") return MeshFormat::kStl;
   if (ext == ".ply") return MeshFormat::kPly;
-  fail(path, "unknown file extension '" + printable(std::filesystem::path(path).extension().string(), 40) +
+  fail(path, "unknown file extension '" +
+                 printable(std::filesystem::path(path).extension().string(), 40) +
                  "' (expected .off, .obj, .stl or .ply)");
 }
 
-PolygonSoup parse_polygon_soup(std::string_view bytes, MeshFormat format, const std::string& source) {
+PolygonSoup parse_polygon_soup(std::string_view bytes, MeshFormat format,
+                               const std::string& source) {
   if (bytes.empty()) fail(source, "the file is empty");
   RawSoup raw;
   switch (format) {
-    case MeshFormat::kOff: raw = read_off(bytes, source); break;
-    case MeshFormat::kObj: raw = read_obj(bytes, source); break;
-    case MeshFormat::kStl: raw = read_stl(bytes, source); break;
-    case MeshFormat::kPly: raw = read_ply(bytes, source); break;
+    case MeshFormat::kOff:
+      raw = read_off(bytes, source);
+      break;
+    case MeshFormat::kObj:
+      raw = read_obj(bytes, source);
+      break;
+    case MeshFormat::kStl:
+      raw = read_stl(bytes, source);
+      break;
+    case MeshFormat::kPly:
+      raw = read_ply(bytes, source);
+      break;
   }
   if (raw.points.empty() || raw.polygons.empty()) fail(source, "the file contains no facets");
   if (raw.points.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
@@ -691,7 +786,8 @@ PolygonSoup parse_polygon_soup(std::string_view bytes, MeshFormat format, const 
   for (std::size_t i = 0; i < raw.points.size(); ++i) {
     const Vec3& p = raw.points[i];
     soup.points.push_back(p);
-    remap[i] = first.emplace(std::array<double, 3>{p.x(), p.y(), p.z()}, static_cast<int>(i)).first->second;
+    remap[i] = first.emplace(std::array<double, 3>{p.x(), p.y(), p.z()}, static_cast<int>(i))
+                   .first->second;
   }
   soup.polygons.reserve(raw.polygons.size());
   for (std::size_t f = 0; f < raw.polygons.size(); ++f) {
@@ -699,8 +795,9 @@ PolygonSoup parse_polygon_soup(std::string_view bytes, MeshFormat format, const 
     poly.reserve(raw.polygons[f].size());
     for (std::size_t i : raw.polygons[f]) {
       if (i >= raw.points.size())
-        fail(source, "parse error: facet " + std::to_string(f) + " refers to vertex " + std::to_string(i) +
-                         " but the file has " + std::to_string(raw.points.size()) + " vertices");
+        fail(source, "parse error: facet " + std::to_string(f) + " refers to vertex " +
+                         std::to_string(i) + " but the file has " +
+                         std::to_string(raw.points.size()) + " vertices");
       poly.push_back(remap[i]);
     }
     soup.polygons.push_back(std::move(poly));

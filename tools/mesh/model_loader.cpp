@@ -74,10 +74,11 @@ void check_self_intersection(const PolygonSoup& s, const std::string& src) {
 
 cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& source,
                                const LoadOptions& options) {
-  if (!(options.coplanar_rel_tol >= kMinCoplanarTol && options.coplanar_rel_tol <= kMaxCoplanarTol)) {
+  if (!(options.coplanar_rel_tol >= kMinCoplanarTol &&
+        options.coplanar_rel_tol <= kMaxCoplanarTol)) {
     char buf[160];
-    std::snprintf(buf, sizeof buf, "coplanarity tolerance %g is outside [%g, %g]", options.coplanar_rel_tol,
-                  kMinCoplanarTol, kMaxCoplanarTol);
+    std::snprintf(buf, sizeof buf, "coplanarity tolerance %g is outside [%g, %g]",
+                  options.coplanar_rel_tol, kMinCoplanarTol, kMaxCoplanarTol);
     fail(source, buf);
   }
   for (std::size_t i = 0; i < soup.points.size(); ++i) {
@@ -85,23 +86,24 @@ cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& sourc
     for (int k = 0; k < 3; ++k)
       if (!std::isfinite(p[k]) || std::abs(p[k]) > kMaxCoordinateMm) {
         char buf[200];
-        std::snprintf(buf, sizeof buf,
-                      "vertex %zu has the coordinate %g mm, beyond the largest accepted (|x| <= %g mm)", i, p[k],
-                      kMaxCoordinateMm);
+        std::snprintf(
+            buf, sizeof buf,
+            "vertex %zu has the coordinate %g mm, beyond the largest accepted (|x| <= %g mm)", i,
+            p[k], kMaxCoordinateMm);
         fail(source, buf);
       }
   }
   detail::check_soup(soup, source, options);
   if (options.check_self_intersection) check_self_intersection(soup, source);
-  const std::string name =
-      options.name.empty() ? fs::path(source).stem().string() : options.name;
+  const std::string name = options.name.empty() ? fs::path(source).stem().string() : options.name;
   return detail::extract_features(soup, source, name, options);
 }
 
-std::string size_warning(const cf::Polyhedron& model, const std::string& which, const std::string& unit_option,
-                         double epsilon_mm) {
+std::string size_warning(const cf::Polyhedron& model, const std::string& which,
+                         const std::string& unit_option, double epsilon_mm) {
   std::string w = cf::size_warning(model, which, epsilon_mm);
-  if (!w.empty()) w += "; if the file is not in mm, give its unit with " + unit_option + " (mm, cm, m or in)";
+  if (!w.empty())
+    w += "; if the file is not in mm, give its unit with " + unit_option + " (mm, cm, m or in)";
   return w;
 }
 

@@ -58,7 +58,8 @@ MeshFormat mesh_format_of(const std::string& path);
 /// are rewritten accordingly. Counts in headers are checked against the bytes that follow
 /// before anything is allocated; indices against their range; numbers must be finite.
 /// @throws cf::Error "loading '<source>': ..." (empty, parse error with the line, no facets).
-PolygonSoup parse_polygon_soup(std::string_view bytes, MeshFormat format, const std::string& source);
+PolygonSoup parse_polygon_soup(std::string_view bytes, MeshFormat format,
+                               const std::string& source);
 
 /// Reads the raw polygon soup of a mesh file (the format from the extension), without
 /// blocking on a FIFO or reading anything that is not a regular file.
@@ -78,8 +79,8 @@ cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& sourc
 /// Empty when `model` is a reasonable size against the contact threshold `epsilon_mm` (the
 /// paper's 1 mm by default), else a warning naming the sizes and `unit_option`, the option
 /// that gives the file's unit (SPEC section 2).
-std::string size_warning(const cf::Polyhedron& model, const std::string& which, const std::string& unit_option,
-                         double epsilon_mm = 1.0);
+std::string size_warning(const cf::Polyhedron& model, const std::string& which,
+                         const std::string& unit_option, double epsilon_mm = 1.0);
 
 /// read_polygon_soup, the points converted from options.units to mm, then model_from_soup.
 /// @throws cf::Error with a one-line message that names the file and the problem.

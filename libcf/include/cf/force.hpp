@@ -33,18 +33,18 @@ const char* to_string(Regime regime);
 struct PcForce {
   Pc pc;
   PcExtent extent = PcExtent::kPoint;
-  Mat3 R_WT = Mat3::Identity();   ///< task frame axes in the world (y: normal into A)
-  Vec3 origin_W = Vec3::Zero();   ///< task frame origin, mm
-  Vec3 p_W = Vec3::Zero();        ///< point of action p_j, mm
-  double distance = 0;            ///< d_j, mm
-  double F_cy = 0;                ///< N, eq. (1) (after the hold of section 4.5)
-  double s_mm = 0;                ///< s_pj as used in eq. (3)
-  double s_bound_mm = 0;          ///< mu F_cy / K_p, the eq. (3) bound
-  Vec3 u_T = Vec3::Zero();        ///< [a b c]: unit direction of p_j's motion this tick
+  Mat3 R_WT = Mat3::Identity();  ///< task frame axes in the world (y: normal into A)
+  Vec3 origin_W = Vec3::Zero();  ///< task frame origin, mm
+  Vec3 p_W = Vec3::Zero();       ///< point of action p_j, mm
+  double distance = 0;           ///< d_j, mm
+  double F_cy = 0;               ///< N, eq. (1) (after the hold of section 4.5)
+  double s_mm = 0;               ///< s_pj as used in eq. (3)
+  double s_bound_mm = 0;         ///< mu F_cy / K_p, the eq. (3) bound
+  Vec3 u_T = Vec3::Zero();       ///< [a b c]: unit direction of p_j's motion this tick
   Regime regime = Regime::kNone;
-  Vec3 F_T = Vec3::Zero();        ///< N, contact force in the task frame [F_cx F_cy F_cz]
-  Vec3 F_W = Vec3::Zero();        ///< N, the same in the world
-  bool gained = false;            ///< the PC MT4 gained
+  Vec3 F_T = Vec3::Zero();  ///< N, contact force in the task frame [F_cx F_cy F_cz]
+  Vec3 F_W = Vec3::Zero();  ///< N, the same in the world
+  bool gained = false;      ///< the PC MT4 gained
 };
 
 /// Result of one force evaluation. Fixed capacity: no heap.
@@ -54,7 +54,7 @@ struct ForceResult {
   std::array<PcForce, kMaxPcs> pcs{};
   int num_pcs = 0;
   int num_approaching = 0;  ///< entries after the PCs; num_pcs + num_approaching <= kMaxPcs
-  bool truncated = false;  ///< more contacts than kMaxPcs were given; the rest are ignored
+  bool truncated = false;   ///< more contacts than kMaxPcs were given; the rest are ignored
   MotionType motion = MotionType::kNone;
   /// Rendered with the conservative laws (normal force eq. (1) + kinetic friction eq. (5)
   /// on the non-dominated contacts) because no CF or transition of the graph fits.
@@ -62,7 +62,7 @@ struct ForceResult {
   /// Of the current PCs; computed for MT3, and for MT2 when some PC fails eq. (3) (with all
   /// PCs static the case is MT2.a whatever the freedoms). Default (6 dof) otherwise.
   Freedoms freedoms;
-  MotionCheck check;  ///< pose change against the freedoms (MT2, when computed)
+  MotionCheck check;                ///< pose change against the freedoms (MT2, when computed)
   Vec3 reference_W = Vec3::Zero();  ///< moment reference point, mm
   Vec3 centroid_W = Vec3::Zero();   ///< p_g, mm
   Vec3 F_contact_W = Vec3::Zero();  ///< eq. (7) in the world (after interpolation)

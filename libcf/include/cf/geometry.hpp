@@ -24,10 +24,10 @@ struct ClosestPoints {
 
 /// Where a 2D point lies relative to a face region (in the face's (u, v) frame).
 struct FaceLocation {
-  bool inside = false;      ///< in the open region (not on the boundary, not in a hole)
+  bool inside = false;  ///< in the open region (not on the boundary, not in a hole)
   double boundary_distance = std::numeric_limits<double>::infinity();  ///< mm, >= 0
   Eigen::Vector2d closest = Eigen::Vector2d::Zero();  ///< nearest boundary point, (u, v)
-  int loop = -1;     ///< loop holding the nearest boundary segment
+  int loop = -1;                                      ///< loop holding the nearest boundary segment
   int segment = -1;  ///< that segment: from loops_2d[loop][segment] to the next point
   /// Signed in-plane distance to the boundary: > 0 inside, < 0 outside (as face_inset).
   double inset() const { return inside ? boundary_distance : -boundary_distance; }

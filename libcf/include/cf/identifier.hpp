@@ -24,8 +24,8 @@ enum class IdStatus : std::uint8_t {
   /// A CF of the graph fits, but it is neither the previous CF nor its neighbour (a jump,
   /// e.g. fast motion). `cf` is set to the best fit; callers may treat it with caution.
   kNonNeighbourJump,
-  kOutsideGraph,      ///< contacts detected, but no interpretation is a CF of the graph
-  kTooManyPlanes,     ///< more than 3 contact planes and no subset explains them
+  kOutsideGraph,   ///< contacts detected, but no interpretation is a CF of the graph
+  kTooManyPlanes,  ///< more than 3 contact planes and no subset explains them
 };
 /// "matched-previous", "matched-neighbour", "matched-by-fit", "no-contact",
 /// "non-neighbour-jump", "outside-graph", "too-many-planes".
@@ -34,16 +34,16 @@ const char* to_string(IdStatus status);
 /// Result of CfIdentifier::step. Fixed capacity; lives inside the identifier.
 struct Identification {
   IdStatus status = IdStatus::kNoContact;
-  CfId cf;        ///< the identified CF; invalid when none fits or no contact
-  PcSet pcs;      ///< its PCs (canonical order); empty when cf is invalid
+  CfId cf;    ///< the identified CF; invalid when none fits or no contact
+  PcSet pcs;  ///< its PCs (canonical order); empty when cf is invalid
   /// The CF's PCs with geometry, in the order of `pcs`; num_cf_pcs entries are valid.
   std::array<ContactPc, PcSet::kMaxPcs> cf_pcs{};
   int num_cf_pcs = 0;
   /// Every candidate detected at this pose (capacity ContactSet::kCapacity, overflow flagged).
   ContactSet contacts;
-  double misfit = 0;         ///< total misfit of the chosen interpretation
-  int combinations = 0;      ///< interpretations examined
-  bool capped = false;       ///< the enumeration hit max_combinations
+  double misfit = 0;     ///< total misfit of the chosen interpretation
+  int combinations = 0;  ///< interpretations examined
+  bool capped = false;   ///< the enumeration hit max_combinations
   /// True when the chosen CF does not cover every contact plane: the other planes' contacts
   /// are apart (farther than every PC of the CF, and than touch_distance_mm) or alternative
   /// readings of the chosen PCs (degenerate touches).

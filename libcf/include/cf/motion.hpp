@@ -42,19 +42,19 @@ struct Freedoms {
   /// Whether some twist with w != 0 and v . w = 0 (a screw of zero pitch: a pure rotation
   /// about some axis) keeps the CF.
   bool pure_rotation = true;
-  Vec3 rotation_axis_W = Vec3::UnitZ();   ///< unit; one such axis when pure_rotation
-  Vec3 rotation_point_W = Vec3::Zero();   ///< mm; a point on that axis
+  Vec3 rotation_axis_W = Vec3::UnitZ();  ///< unit; one such axis when pure_rotation
+  Vec3 rotation_point_W = Vec3::Zero();  ///< mm; a point on that axis
   /// Orthonormal basis of the free twists (v, L w) in its first `dof` columns, with v the
   /// velocity of A's origin in world axes.
   Eigen::Matrix<double, 6, 6> basis = Eigen::Matrix<double, 6, 6>::Identity();
-  double length_scale = 1;  ///< L, mm
+  double length_scale = 1;          ///< L, mm
   Vec3 reference_W = Vec3::Zero();  ///< A's origin at this pose: the twists' reference point
 };
 
 /// A point of A whose velocity along a contact normal must stay zero while a CF holds.
 struct ConstraintPoint {
-  Vec3 p_W = Vec3::Zero();  ///< mm, world frame
-  Vec3 n_W = Vec3::UnitY(); ///< unit contact normal, world frame
+  Vec3 p_W = Vec3::Zero();   ///< mm, world frame
+  Vec3 n_W = Vec3::UnitY();  ///< unit contact normal, world frame
 };
 
 /// The freedoms left by constraint points: the null space of the rows
@@ -77,11 +77,11 @@ Freedoms compute_freedoms(const ContactPc* pcs, int n, const Polyhedron& A, cons
 
 /// Result of comparing a pose change with the freedoms (paper Fig. 10).
 struct MotionCheck {
-  bool moved = false;      ///< some point of A moved more than Params::motion_noise_mm
-  bool along = true;       ///< the change is approximately along a possible motion
-  double twist_angle_rad = 0;     ///< angle between the twist and the space of freedoms
-  double rotation_angle_rad = 0;  ///< angle between the rotation axis and possible axes
-  double rotation_rad = 0;        ///< size of the rotation
+  bool moved = false;                 ///< some point of A moved more than Params::motion_noise_mm
+  bool along = true;                  ///< the change is approximately along a possible motion
+  double twist_angle_rad = 0;         ///< angle between the twist and the space of freedoms
+  double rotation_angle_rad = 0;      ///< angle between the rotation axis and possible axes
+  double rotation_rad = 0;            ///< size of the rotation
   Vec3 translation_W = Vec3::Zero();  ///< mm, displacement of A's origin
 };
 
@@ -94,7 +94,7 @@ MotionCheck check_motion(const Freedoms& f, const Pose& prev, const Pose& cur,
 /// The base prior motion from the previous and the current PC sets and the graph.
 struct PriorMotion {
   MotionType type = MotionType::kNone;  ///< MT1, MT2a (to be refined), MT3, MT4, MT5, none
-  bool transition_in_graph = true;  ///< false when the CF pair is not a graph transition
+  bool transition_in_graph = true;      ///< false when the CF pair is not a graph transition
   /// Index in the current PC set of the PC that MT4 gained, -1 otherwise.
   int gained = -1;
 };

@@ -34,18 +34,18 @@ struct Edge {
 /// A maximal connected region of coplanar facets: a polygon, possibly non-convex, possibly
 /// with holes.
 struct Face {
-  Vec3 normal;     ///< unit, outward
-  double offset;   ///< mm; the plane is { x : normal . x == offset }
+  Vec3 normal;    ///< unit, outward
+  double offset;  ///< mm; the plane is { x : normal . x == offset }
   /// loops[0] is the outer boundary, counter-clockwise seen from outside (against the
   /// normal); loops[1..] are the holes, clockwise seen from outside. Every loop starts at
   /// its smallest vertex index.
   std::vector<std::vector<VertexId>> loops;
-  std::vector<EdgeId> edges;        ///< edges that bound this face, ascending
-  std::vector<VertexId> vertices;   ///< vertices on its boundary, ascending
-  Vec3 u, v;                        ///< unit tangent axes, u x v = normal (2D frame below)
+  std::vector<EdgeId> edges;       ///< edges that bound this face, ascending
+  std::vector<VertexId> vertices;  ///< vertices on its boundary, ascending
+  Vec3 u, v;                       ///< unit tangent axes, u x v = normal (2D frame below)
   std::vector<std::vector<Eigen::Vector2d>> loops_2d;  ///< mm, loops in the (u, v) frame
-  Vec3 centroid;                    ///< mm, area centroid of the region
-  double area = 0;                  ///< mm^2, holes excluded
+  Vec3 centroid;                                       ///< mm, area centroid of the region
+  double area = 0;                                     ///< mm^2, holes excluded
 };
 
 /// An immutable featured polyhedron.

@@ -59,5 +59,7 @@ class Error : public std::runtime_error {
 
 template <class Tag>
 struct std::hash<cf::Id<Tag>> {
-  std::size_t operator()(cf::Id<Tag> id) const noexcept { return std::hash<std::int32_t>()(id.value()); }
+  std::size_t operator()(cf::Id<Tag> id) const noexcept {
+    return std::hash<std::int32_t>()(id.value());
+  }
 };

@@ -23,7 +23,8 @@ cf::CfId checked_id(const cf::CfGraph& g, long id, const char* where) {
 
 template <class T>
 py::array_t<T> array2(std::size_t rows, std::size_t cols) {
-  return py::array_t<T>(std::vector<py::ssize_t>{static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(cols)});
+  return py::array_t<T>(
+      std::vector<py::ssize_t>{static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(cols)});
 }
 
 py::array_t<double> vec3s(std::size_t n, const std::function<cf::Vec3(std::size_t)>& get) {
@@ -52,16 +53,19 @@ py::object optional_int(int v) { return v < 0 ? py::object(py::none()) : py::obj
 
 void bind_graph(py::module_& m) {
   using cf::Polyhedron;
-  py::class_<Polyhedron>(m, "Polyhedron",
-                         "A featured polyhedron (cf::Polyhedron): faces, edges and vertices in mm, indexed as "
-                         "in the graph's PCs (docs/features.md).")
+  py::class_<Polyhedron>(
+      m, "Polyhedron",
+      "A featured polyhedron (cf::Polyhedron): faces, edges and vertices in mm, indexed as "
+      "in the graph's PCs (docs/features.md).")
       .def_property_readonly("name", &Polyhedron::name)
       .def_property_readonly("num_vertices", &Polyhedron::num_vertices)
       .def_property_readonly("num_edges", &Polyhedron::num_edges)
       .def_property_readonly("num_faces", &Polyhedron::num_faces)
       .def_property_readonly(
           "vertices",
-          [](const Polyhedron& P) { return vec3s(P.num_vertices(), [&](std::size_t i) { return P.vertices()[i].p; }); },
+          [](const Polyhedron& P) {
+            return vec3s(P.num_vertices(), [&](std::size_t i) { return P.vertices()[i].p; });
+          },
           "(V, 3) float64: the feature vertices, mm, model frame.")
       .def_property_readonly(
           "edges",
@@ -84,7 +88,8 @@ void bind_graph(py::module_& m) {
               for (const auto& loop : f.loops) {
                 py::array_t<std::int32_t> a(static_cast<py::ssize_t>(loop.size()));
                 auto r = a.mutable_unchecked<1>();
-                for (std::size_t k = 0; k < loop.size(); ++k) r(static_cast<py::ssize_t>(k)) = loop[k].value();
+                for (std::size_t k = 0; k < loop.size(); ++k)
+                  r(static_cast<py::ssize_t>(k)) = loop[k].value();
                 loops.append(a);
               }
               faces.append(loops);
@@ -109,7 +114,8 @@ void bind_graph(py::module_& m) {
           "edge_convex",
           [](const Polyhedron& P) {
             py::array_t<bool> a(static_cast<py::ssize_t>(P.num_edges()));
-            for (std::size_t i = 0; i < P.num_edges(); ++i) a.mutable_at(static_cast<py::ssize_t>(i)) = P.edges()[i].convex;
+            for (std::size_t i = 0; i < P.num_edges(); ++i)
+              a.mutable_at(static_cast<py::ssize_t>(i)) = P.edges()[i].convex;
             return a;
           },
           "(E,) bool: interior dihedral angle below pi.")
@@ -117,19 +123,23 @@ void bind_graph(py::module_& m) {
           "edge_dihedral",
           [](const Polyhedron& P) {
             py::array_t<double> a(static_cast<py::ssize_t>(P.num_edges()));
-            for (std::size_t i = 0; i < P.num_edges(); ++i) a.mutable_at(static_cast<py::ssize_t>(i)) = P.edges()[i].dihedral;
+            for (std::size_t i = 0; i < P.num_edges(); ++i)
+              a.mutable_at(static_cast<py::ssize_t>(i)) = P.edges()[i].dihedral;
             return a;
           },
           "(E,) float64: interior dihedral angles, rad.")
       .def_property_readonly(
           "face_normals",
-          [](const Polyhedron& P) { return vec3s(P.num_faces(), [&](std::size_t i) { return P.faces()[i].normal; }); },
+          [](const Polyhedron& P) {
+            return vec3s(P.num_faces(), [&](std::size_t i) { return P.faces()[i].normal; });
+          },
           "(F, 3) float64: outward unit normals.")
       .def_property_readonly(
           "face_offsets",
           [](const Polyhedron& P) {
             py::array_t<double> a(static_cast<py::ssize_t>(P.num_faces()));
-            for (std::size_t i = 0; i < P.num_faces(); ++i) a.mutable_at(static_cast<py::ssize_t>(i)) = P.faces()[i].offset;
+            for (std::size_t i = 0; i < P.num_faces(); ++i)
+              a.mutable_at(static_cast<py::ssize_t>(i)) = P.faces()[i].offset;
             return a;
           },
           "(F,) float64: plane offsets, mm (normal . x == offset).")
@@ -137,80 +147,109 @@ void bind_graph(py::module_& m) {
           "face_areas",
           [](const Polyhedron& P) {
             py::array_t<double> a(static_cast<py::ssize_t>(P.num_faces()));
-            for (std::size_t i = 0; i < P.num_faces(); ++i) a.mutable_at(static_cast<py::ssize_t>(i)) = P.faces()[i].area;
+            for (std::size_t i = 0; i < P.num_faces(); ++i)
+              a.mutable_at(static_cast<py::ssize_t>(i)) = P.faces()[i].area;
             return a;
           },
           "(F,) float64: areas, mm^2, holes excluded.")
       .def_property_readonly(
           "face_centroids",
-          [](const Polyhedron& P) { return vec3s(P.num_faces(), [&](std::size_t i) { return P.faces()[i].centroid; }); },
+          [](const Polyhedron& P) {
+            return vec3s(P.num_faces(), [&](std::size_t i) { return P.faces()[i].centroid; });
+          },
           "(F, 3) float64: area centroids, mm.")
       .def_property_readonly("volume", &Polyhedron::volume, "mm^3")
       .def_property_readonly("size", &Polyhedron::size, "mm, the bounding box's diagonal")
-      .def_property_readonly("vertex_centroid", [](const Polyhedron& P) { return vec(P.vertex_centroid()); },
-                             "mm, the mean of the vertices (the paper's centroid)")
-      .def_property_readonly("volume_centroid", [](const Polyhedron& P) { return vec(P.volume_centroid()); },
-                             "mm, the centroid of the uniform solid")
+      .def_property_readonly(
+          "vertex_centroid", [](const Polyhedron& P) { return vec(P.vertex_centroid()); },
+          "mm, the mean of the vertices (the paper's centroid)")
+      .def_property_readonly(
+          "volume_centroid", [](const Polyhedron& P) { return vec(P.volume_centroid()); },
+          "mm, the centroid of the uniform solid")
       .def_property_readonly("bbox_min", [](const Polyhedron& P) { return vec(P.bbox_min()); })
       .def_property_readonly("bbox_max", [](const Polyhedron& P) { return vec(P.bbox_max()); })
-      .def("to_json", [](const Polyhedron& P, int indent) { return cf::to_json(P, indent); }, py::arg("indent") = 2,
-           "The model object of the graph file (SPEC section 5), as cfgen --features prints it.")
+      .def(
+          "to_json", [](const Polyhedron& P, int indent) { return cf::to_json(P, indent); },
+          py::arg("indent") = 2,
+          "The model object of the graph file (SPEC section 5), as cfgen --features prints it.")
       .def("__repr__", [](const Polyhedron& P) {
-        return "<cf.Polyhedron '" + P.name() + "': " + std::to_string(P.num_vertices()) + " vertices, " +
-               std::to_string(P.num_edges()) + " edges, " + std::to_string(P.num_faces()) + " faces>";
+        return "<cf.Polyhedron '" + P.name() + "': " + std::to_string(P.num_vertices()) +
+               " vertices, " + std::to_string(P.num_edges()) + " edges, " +
+               std::to_string(P.num_faces()) + " faces>";
       });
 
   py::class_<CfEntry>(m, "Cf", "One contact formation of a graph (cf::CfRecord) with its id.")
       .def_readonly("id", &CfEntry::id)
-      .def_property_readonly("pcs", [](const CfEntry& e) { return pcs_to_py(e.rec.pcs); },
-                             "The PCs (1 to 3 cf.Pc) in canonical order.")
-      .def_property_readonly("pcs_string", [](const CfEntry& e) { return cf::to_string(e.rec.pcs); },
-                             "The PCs as 'type:a:b;...' (cfreplay's pcs column).")
-      .def_property_readonly("witness_R", [](const CfEntry& e) { return cf::Mat3(e.rec.witness.R_BA); },
-                             "(3, 3): the witness pose's rotation R (x_B = R x_A + t).")
-      .def_property_readonly("witness_t", [](const CfEntry& e) { return vec(e.rec.witness.t_BA); },
-                             "(3,): the witness pose's translation t, mm.")
-      .def_property_readonly("witness_q", [](const CfEntry& e) { return quaternion_wxyz(e.rec.witness.R_BA); },
-                             "(4,): the witness rotation as a unit quaternion w, x, y, z (w >= 0).")
-      .def_property_readonly("dof", [](const CfEntry& e) { return optional_int(e.rec.dof); },
-                             "Freedoms at the witness (0..6), None when the file does not store them.")
-      .def_property_readonly("translation_dof", [](const CfEntry& e) { return optional_int(e.rec.translation_dof); },
-                             "Pure translations among the freedoms (0..3), None when not stored.")
-      .def_property_readonly("pure_rotation", [](const CfEntry& e) {
-        return e.rec.dof < 0 ? py::object(py::none()) : py::object(py::bool_(e.rec.pure_rotation));
-      }, "Whether some pure rotation keeps the CF; None when the freedoms are not stored.")
+      .def_property_readonly(
+          "pcs", [](const CfEntry& e) { return pcs_to_py(e.rec.pcs); },
+          "The PCs (1 to 3 cf.Pc) in canonical order.")
+      .def_property_readonly(
+          "pcs_string", [](const CfEntry& e) { return cf::to_string(e.rec.pcs); },
+          "The PCs as 'type:a:b;...' (cfreplay's pcs column).")
+      .def_property_readonly(
+          "witness_R", [](const CfEntry& e) { return cf::Mat3(e.rec.witness.R_BA); },
+          "(3, 3): the witness pose's rotation R (x_B = R x_A + t).")
+      .def_property_readonly(
+          "witness_t", [](const CfEntry& e) { return vec(e.rec.witness.t_BA); },
+          "(3,): the witness pose's translation t, mm.")
+      .def_property_readonly(
+          "witness_q", [](const CfEntry& e) { return quaternion_wxyz(e.rec.witness.R_BA); },
+          "(4,): the witness rotation as a unit quaternion w, x, y, z (w >= 0).")
+      .def_property_readonly(
+          "dof", [](const CfEntry& e) { return optional_int(e.rec.dof); },
+          "Freedoms at the witness (0..6), None when the file does not store them.")
+      .def_property_readonly(
+          "translation_dof", [](const CfEntry& e) { return optional_int(e.rec.translation_dof); },
+          "Pure translations among the freedoms (0..3), None when not stored.")
+      .def_property_readonly(
+          "pure_rotation",
+          [](const CfEntry& e) {
+            return e.rec.dof < 0 ? py::object(py::none())
+                                 : py::object(py::bool_(e.rec.pure_rotation));
+          },
+          "Whether some pure rotation keeps the CF; None when the freedoms are not stored.")
       .def_property_readonly(
           "planes",
           [](const CfEntry& e) {
             auto a = array2<double>(static_cast<std::size_t>(e.rec.num_planes), 4);
             auto r = a.mutable_unchecked<2>();
             for (int i = 0; i < e.rec.num_planes; ++i)
-              for (int k = 0; k < 4; ++k) r(i, k) = e.rec.planes[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)];
+              for (int k = 0; k < 4; ++k)
+                r(i, k) = e.rec.planes[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)];
             return a;
           },
-          "(n, 4): each PC's contact plane at the witness (n_x, n_y, n_z, d), n into A; (0, 4) when not stored.")
-      .def("__repr__", [](const CfEntry& e) { return "<cf.Cf " + std::to_string(e.id) + ": " + cf::to_string(e.rec.pcs) + ">"; });
+          "(n, 4): each PC's contact plane at the witness (n_x, n_y, n_z, d), n into A; (0, 4) "
+          "when not stored.")
+      .def("__repr__", [](const CfEntry& e) {
+        return "<cf.Cf " + std::to_string(e.id) + ": " + cf::to_string(e.rec.pcs) + ">";
+      });
 
-  py::class_<cf::CfGraph>(m, "CfGraph",
-                          "The CF graph of a model pair (cf::CfGraph): CFs, transitions and the two models. "
-                          "Immutable; load it with cf.load_graph or make it with cf.generate.")
-      .def_property_readonly("model_a", &cf::CfGraph::model_a, py::return_value_policy::reference_internal,
+  py::class_<cf::CfGraph>(
+      m, "CfGraph",
+      "The CF graph of a model pair (cf::CfGraph): CFs, transitions and the two models. "
+      "Immutable; load it with cf.load_graph or make it with cf.generate.")
+      .def_property_readonly("model_a", &cf::CfGraph::model_a,
+                             py::return_value_policy::reference_internal,
                              "A, the moving polyhedron.")
-      .def_property_readonly("model_b", &cf::CfGraph::model_b, py::return_value_policy::reference_internal,
+      .def_property_readonly("model_b", &cf::CfGraph::model_b,
+                             py::return_value_policy::reference_internal,
                              "B, the fixed polyhedron (world frame).")
       .def_property_readonly("num_cfs", &cf::CfGraph::num_cfs)
       .def_property_readonly("num_transitions", &cf::CfGraph::num_transitions)
       .def("__len__", &cf::CfGraph::num_cfs)
       .def(
           "cf",
-          [](const cf::CfGraph& g, long id) { return CfEntry{static_cast<int>(id), g.cf(checked_id(g, id, "cf"))}; },
+          [](const cf::CfGraph& g, long id) {
+            return CfEntry{static_cast<int>(id), g.cf(checked_id(g, id, "cf"))};
+          },
           py::arg("id"), "The CF with this id (cf.Error when there is none).")
       .def_property_readonly(
           "cfs",
           [](const cf::CfGraph& g) {
             py::list out;
             for (std::size_t i = 0; i < g.num_cfs(); ++i)
-              out.append(CfEntry{static_cast<int>(i), g.cf(cf::CfId(static_cast<std::int32_t>(i)))});
+              out.append(
+                  CfEntry{static_cast<int>(i), g.cf(cf::CfId(static_cast<std::int32_t>(i)))});
             return out;
           },
           "Every CF, in id order.")
@@ -221,10 +260,13 @@ void bind_graph(py::module_& m) {
             return id ? py::object(py::int_(id->value())) : py::object(py::none());
           },
           py::arg("pcs"),
-          "The id of the CF with exactly these PCs ('type:a:b;...', or a list of PCs in any order), "
+          "The id of the CF with exactly these PCs ('type:a:b;...', or a list of PCs in any "
+          "order), "
           "None when the graph has none.")
-      .def("holds", [](const cf::CfGraph& g, const py::object& pc) { return g.holds(pc_from_py(pc)); }, py::arg("pc"),
-           "True when some CF of the graph holds this PC.")
+      .def(
+          "holds",
+          [](const cf::CfGraph& g, const py::object& pc) { return g.holds(pc_from_py(pc)); },
+          py::arg("pc"), "True when some CF of the graph holds this PC.")
       .def(
           "neighbours",
           [](const cf::CfGraph& g, long id, const std::optional<std::string>& kind) {
@@ -232,7 +274,8 @@ void bind_graph(py::module_& m) {
             std::optional<cf::TransitionKind> k;
             if (kind) {
               k = cf::transition_kind_from_string(*kind);
-              if (!k) fail("neighbours: kind must be 'gain', 'lose' or 'change', got '" + *kind + "'");
+              if (!k)
+                fail("neighbours: kind must be 'gain', 'lose' or 'change', got '" + *kind + "'");
             }
             std::vector<int> out;
             for (const cf::Transition& t : g.out_transitions(c))
@@ -251,11 +294,14 @@ void bind_graph(py::module_& m) {
             return out;
           },
           py::arg("id"), "The transitions leaving `id` as (to, kind) pairs, sorted by target.")
-      .def("adjacent",
-           [](const cf::CfGraph& g, long from, long to) {
-             return g.adjacent(cf::CfId(static_cast<std::int32_t>(from)), cf::CfId(static_cast<std::int32_t>(to)));
-           },
-           py::arg("from_id"), py::arg("to_id"), "True when the graph has a transition from one to the other.")
+      .def(
+          "adjacent",
+          [](const cf::CfGraph& g, long from, long to) {
+            return g.adjacent(cf::CfId(static_cast<std::int32_t>(from)),
+                              cf::CfId(static_cast<std::int32_t>(to)));
+          },
+          py::arg("from_id"), py::arg("to_id"),
+          "True when the graph has a transition from one to the other.")
       .def(
           "transition_arrays",
           [](const cf::CfGraph& g) {
@@ -271,14 +317,16 @@ void bind_graph(py::module_& m) {
             return py::make_tuple(from, to, py::module_::import("numpy").attr("array")(kinds));
           },
           "Every transition in file order as three arrays: from (int32), to (int32), kind (str).")
-      .def_property_readonly("metadata_json", &cf::CfGraph::metadata_json,
-                             "The file's extra top-level members (statistics, parameters) as JSON text.")
+      .def_property_readonly(
+          "metadata_json", &cf::CfGraph::metadata_json,
+          "The file's extra top-level members (statistics, parameters) as JSON text.")
       .def("to_json", &cf::CfGraph::to_json, py::arg("indent") = -1, "The graph file's JSON text.")
       .def("_save", &cf::CfGraph::save, py::arg("path"),
            "Writes the graph (JSON, or CBOR when the name ends in .cbor), whole or not at all.")
       .def("__repr__", [](const cf::CfGraph& g) {
-        return "<cf.CfGraph '" + g.model_a().name() + "' against '" + g.model_b().name() + "': " +
-               std::to_string(g.num_cfs()) + " CFs, " + std::to_string(g.num_transitions()) + " transitions>";
+        return "<cf.CfGraph '" + g.model_a().name() + "' against '" + g.model_b().name() +
+               "': " + std::to_string(g.num_cfs()) + " CFs, " +
+               std::to_string(g.num_transitions()) + " transitions>";
       });
 
   m.def(

@@ -24,7 +24,8 @@ py::array_t<double> vec(const cf::Vec3& v) { return py::array_t<double>(3, v.dat
 
 Array as_array(const py::handle& h, const char* name, const std::string& where) {
   Array a = Array::ensure(h);
-  if (!a) fail(where + ": " + name + " must be an array of numbers, got " + std::string(py::repr(h)));
+  if (!a)
+    fail(where + ": " + name + " must be an array of numbers, got " + std::string(py::repr(h)));
   return a;
 }
 
@@ -112,10 +113,11 @@ cf::Params params_arg(const py::object& params, const py::kwargs& kw, const std:
 }  // namespace
 
 void bind_render(py::module_& m) {
-  py::class_<Renderer>(m, "Renderer",
-                       "The haptic renderer (cf::HapticRenderer) of one graph: Renderer(graph, params=None, "
-                       "**params). step() runs one servo tick: detect, identify the CF, classify the prior "
-                       "motion, compute the force and moment.")
+  py::class_<Renderer>(
+      m, "Renderer",
+      "The haptic renderer (cf::HapticRenderer) of one graph: Renderer(graph, params=None, "
+      "**params). step() runs one servo tick: detect, identify the CF, classify the prior "
+      "motion, compute the force and moment.")
       .def(py::init([](const cf::CfGraph& g, const py::object& params, const py::kwargs& kw) {
              return std::make_unique<Renderer>(g, params_arg(params, kw, "Renderer"));
            }),
@@ -124,12 +126,15 @@ void bind_render(py::module_& m) {
           "step",
           [](Renderer& self, double t_s, const py::object& p, const py::object& q) {
             const Array pa = as_array(p, "p", "step"), qa = as_array(q, "q", "step");
-            if (pa.ndim() != 1 || pa.shape(0) != 3) fail("step: p must have shape (3,), got " + shape_of(pa));
-            if (qa.ndim() != 1 || qa.shape(0) != 4) fail("step: q must have shape (4,) (w, x, y, z), got " + shape_of(qa));
+            if (pa.ndim() != 1 || pa.shape(0) != 3)
+              fail("step: p must have shape (3,), got " + shape_of(pa));
+            if (qa.ndim() != 1 || qa.shape(0) != 4)
+              fail("step: q must have shape (4,) (w, x, y, z), got " + shape_of(qa));
             if (!std::isfinite(t_s)) fail("step: t is not finite");
             if (self.stepped && !(t_s > self.last_t)) {
               char buf[160];
-              std::snprintf(buf, sizeof buf, "step: time %.9g s does not increase (previous step: %.9g s)", t_s,
+              std::snprintf(buf, sizeof buf,
+                            "step: time %.9g s does not increase (previous step: %.9g s)", t_s,
                             self.last_t);
               fail(buf);
             }
@@ -139,43 +144,55 @@ void bind_render(py::module_& m) {
             return step_dict(self.r.step(pose, t_s));
           },
           py::arg("t"), py::arg("p"), py::arg("q"),
-          "One servo tick at time t (s, increasing), A's translation p (3, mm) and rotation q (4, unit "
-          "quaternion w, x, y, z; x_B = R x_A + p). Returns a dict named like cf::HapticResult's fields: "
-          "t_s, cf (-1 for none), pcs, motion, status, identification, num_detected, F_W, M_W, F_A, "
+          "One servo tick at time t (s, increasing), A's translation p (3, mm) and rotation q (4, "
+          "unit "
+          "quaternion w, x, y, z; x_B = R x_A + p). Returns a dict named like cf::HapticResult's "
+          "fields: "
+          "t_s, cf (-1 for none), pcs, motion, status, identification, num_detected, F_W, M_W, "
+          "F_A, "
           "M_A, and the force model's F_contact_W, F_gravity_W, dof, pc_forces (per PC: regime, "
           "distance, F_cy, task frame R_WT, ...).")
-      .def("reset", [](Renderer& self) { self.r.reset(); self.stepped = false; }, "Forgets the history (previous CF, anchors, filters).")
+      .def(
+          "reset",
+          [](Renderer& self) {
+            self.r.reset();
+            self.stepped = false;
+          },
+          "Forgets the history (previous CF, anchors, filters).")
       .def_property_readonly("params", [](const Renderer& self) { return self.r.params(); });
 
   py::class_<ReplayRows>(m, "_ReplayRows")
       .def("__len__", [](const ReplayRows& r) { return r.rows.size(); })
-      .def("csv",
-           [](const ReplayRows& r) {
-             std::string text = cf::replay::output_header();
-             text += '\n';
-             for (const cf::replay::Row& row : r.rows) {
-               text += cf::replay::format_row(row);
-               text += '\n';
-             }
-             return text;
-           },
-           "The rows as cfreplay writes them (header first).");
+      .def(
+          "csv",
+          [](const ReplayRows& r) {
+            std::string text = cf::replay::output_header();
+            text += '\n';
+            for (const cf::replay::Row& row : r.rows) {
+              text += cf::replay::format_row(row);
+              text += '\n';
+            }
+            return text;
+          },
+          "The rows as cfreplay writes them (header first).");
 
   m.def(
       "replay",
-      [](const cf::CfGraph& g, const py::object& t, const py::object& p, const py::object& q, const py::object& params,
-         const py::kwargs& kw) {
+      [](const cf::CfGraph& g, const py::object& t, const py::object& p, const py::object& q,
+         const py::object& params, const py::kwargs& kw) {
         const std::string where = "replay";
         const cf::Params P = params_arg(params, kw, where);
-        const Array ta = as_array(t, "t", where), pa = as_array(p, "p", where), qa = as_array(q, "q", where);
+        const Array ta = as_array(t, "t", where), pa = as_array(p, "p", where),
+                    qa = as_array(q, "q", where);
         if (ta.ndim() != 1) fail(where + ": t must have shape (N,), got " + shape_of(ta));
         const py::ssize_t n = ta.shape(0);
         if (n == 0) fail(where + ": no poses (t is empty)");
         if (pa.ndim() != 2 || pa.shape(0) != n || pa.shape(1) != 3)
-          fail(where + ": p must have shape (N, 3) with N = len(t) = " + std::to_string(n) + ", got " + shape_of(pa));
+          fail(where + ": p must have shape (N, 3) with N = len(t) = " + std::to_string(n) +
+               ", got " + shape_of(pa));
         if (qa.ndim() != 2 || qa.shape(0) != n || qa.shape(1) != 4)
-          fail(where + ": q must have shape (N, 4) (w, x, y, z) with N = len(t) = " + std::to_string(n) + ", got " +
-               shape_of(qa));
+          fail(where + ": q must have shape (N, 4) (w, x, y, z) with N = len(t) = " +
+               std::to_string(n) + ", got " + shape_of(qa));
         std::vector<cf::replay::Sample> samples(static_cast<std::size_t>(n));
         const double* T = ta.data();
         for (py::ssize_t i = 0; i < n; ++i) {
@@ -183,7 +200,8 @@ void bind_render(py::module_& m) {
           if (!std::isfinite(T[i])) fail(row + ": time is not finite");
           if (i > 0 && !(T[i] > T[i - 1])) {
             char buf[160];
-            std::snprintf(buf, sizeof buf, ": time %.9g s does not increase (previous row: %.9g s)", T[i], T[i - 1]);
+            std::snprintf(buf, sizeof buf, ": time %.9g s does not increase (previous row: %.9g s)",
+                          T[i], T[i - 1]);
             fail(row + buf);
           }
           cf::replay::Sample& s = samples[static_cast<std::size_t>(i)];
@@ -202,26 +220,28 @@ void bind_render(py::module_& m) {
         {
           py::gil_scoped_release release;
           std::size_t i = 0;
-          rows->rows = cf::replay::run(g, samples, P, [&](const cf::replay::Sample&, const cf::HapticResult& r) {
-            num_detected[i] = r.num_detected;
-            identification[i] = r.identification;
-            for (int k = 0; k < 3; ++k) {
-              Fc[3 * i + static_cast<std::size_t>(k)] = r.F_contact_W[k];
-              Mc[3 * i + static_cast<std::size_t>(k)] = r.M_contact_W[k];
-            }
-            if (r.force != nullptr) {
-              for (int k = 0; k < 3; ++k) Fg[3 * i + static_cast<std::size_t>(k)] = r.force->F_gravity_W[k];
-              conservative[i] = r.force->conservative;
-              dof[i] = r.force->freedoms.dof;
-            }
-            ++i;
-          });
+          rows->rows = cf::replay::run(
+              g, samples, P, [&](const cf::replay::Sample&, const cf::HapticResult& r) {
+                num_detected[i] = r.num_detected;
+                identification[i] = r.identification;
+                for (int k = 0; k < 3; ++k) {
+                  Fc[3 * i + static_cast<std::size_t>(k)] = r.F_contact_W[k];
+                  Mc[3 * i + static_cast<std::size_t>(k)] = r.M_contact_W[k];
+                }
+                if (r.force != nullptr) {
+                  for (int k = 0; k < 3; ++k)
+                    Fg[3 * i + static_cast<std::size_t>(k)] = r.force->F_gravity_W[k];
+                  conservative[i] = r.force->conservative;
+                  dof[i] = r.force->freedoms.dof;
+                }
+                ++i;
+              });
         }
 
         py::dict d;
         const std::vector<py::ssize_t> shape3{n, 3};
-        py::array_t<double> tt(n), FW(shape3), MW(shape3), FA(shape3), MA(shape3), FC(shape3), MC(shape3), FG(shape3),
-            PP(shape3), PQ(std::vector<py::ssize_t>{n, 4});
+        py::array_t<double> tt(n), FW(shape3), MW(shape3), FA(shape3), MA(shape3), FC(shape3),
+            MC(shape3), FG(shape3), PP(shape3), PQ(std::vector<py::ssize_t>{n, 4});
         py::array_t<std::int32_t> cfa(n), nd(n), dofa(n);
         py::array_t<bool> cons(n);
         py::list pcs, motion, status, regimes, ident;

@@ -30,15 +30,16 @@ void check_units(const std::string& units, const char* name, const std::string& 
 void check_range(double v, double lo, double hi, const char* name, const std::string& where) {
   if (!std::isfinite(v) || v < lo || v > hi) {
     char buf[160];
-    std::snprintf(buf, sizeof buf, ": %s must be a finite number in [%g, %g], got %.17g", name, lo, hi, v);
+    std::snprintf(buf, sizeof buf, ": %s must be a finite number in [%g, %g], got %.17g", name, lo,
+                  hi, v);
     fail(where + buf);
   }
 }
 
 void check_int(int v, int lo, int hi, const char* name, const std::string& where) {
   if (v < lo || v > hi)
-    fail(where + ": " + name + " must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-         "], got " + std::to_string(v));
+    fail(where + ": " + name + " must be an integer in [" + std::to_string(lo) + ", " +
+         std::to_string(hi) + "], got " + std::to_string(v));
 }
 
 // run_generate on a thread of its own while this one, the caller's, checks Python's signals:
@@ -90,11 +91,11 @@ void bind_tools(py::module_& m) {
   m.attr("HAVE_TOOLS") = true;
   m.def(
       "load_model",
-      [](const std::string& path, const std::string& units, double coplanar_rel_tol, bool check_self_intersection,
-         const std::string& name) {
+      [](const std::string& path, const std::string& units, double coplanar_rel_tol,
+         bool check_self_intersection, const std::string& name) {
         check_units(units, "units", "load_model");
-        check_range(coplanar_rel_tol, cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol, "coplanar_rel_tol",
-                    "load_model");
+        check_range(coplanar_rel_tol, cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol,
+                    "coplanar_rel_tol", "load_model");
         cf::tools::LoadOptions o;
         o.units = units;
         o.coplanar_rel_tol = coplanar_rel_tol;
@@ -103,11 +104,14 @@ void bind_tools(py::module_& m) {
         py::gil_scoped_release release;
         return cf::tools::load_model(path, o);
       },
-      py::arg("path"), py::arg("units") = "mm", py::arg("coplanar_rel_tol") = cf::tools::LoadOptions{}.coplanar_rel_tol,
+      py::arg("path"), py::arg("units") = "mm",
+      py::arg("coplanar_rel_tol") = cf::tools::LoadOptions{}.coplanar_rel_tol,
       py::arg("check_self_intersection") = true, py::arg("name") = "",
       "Reads a closed, outward-oriented polyhedral model (OFF, OBJ, STL or PLY), validates it and "
-      "extracts its features (cf::tools::load_model, as cfgen --features). units: the file's length "
-      "unit ('mm', 'cm', 'm', 'in'); the model is in mm. Raises cf.Error naming the file and the problem.");
+      "extracts its features (cf::tools::load_model, as cfgen --features). units: the file's "
+      "length "
+      "unit ('mm', 'cm', 'm', 'in'); the model is in mm. Raises cf.Error naming the file and the "
+      "problem.");
 
   m.def(
       "generate",
@@ -128,7 +132,8 @@ void bind_tools(py::module_& m) {
         check_range(angle_margin, 1e-9, 0.5, "angle_margin", where);
         check_int(theta_samples, 1, 1000, "theta_samples", where);
         check_int(max_rotations, 1, 10000, "max_rotations", where);
-        check_range(coplanar_rel_tol, cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol, "coplanar_rel_tol", where);
+        check_range(coplanar_rel_tol, cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol,
+                    "coplanar_rel_tol", where);
         check_units(units, "units", where);
         cf::tools::GenerateArgs g;
         g.a_path = a_path;

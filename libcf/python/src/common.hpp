@@ -28,7 +28,8 @@ cf::Pose pose_from(const double* p, const double* q, const std::string& where);
 
 /// Params from keyword arguments (names and units of cf::Params' fields), starting from
 /// `base`. Unknown names and values out of range raise cf.Error naming the function.
-cf::Params params_from_kwargs(const cf::Params& base, const py::kwargs& kwargs, const std::string& where);
+cf::Params params_from_kwargs(const cf::Params& base, const py::kwargs& kwargs,
+                              const std::string& where);
 
 /// A PC from "type:a:b", a (type, a, b) tuple or a cf.Pc.
 cf::Pc pc_from_py(const py::handle& h);

@@ -17,7 +17,8 @@ cf::Pose pose_from(const double* p, const double* q, const std::string& where) {
   for (int i = 0; i < 3; ++i)
     if (!std::isfinite(p[i])) fail(where + ": the translation is not finite");
   // The check and message every tool applies to a quaternion it reads (cf/file_io.hpp).
-  if (const std::string why = cf::quaternion_problem(q[0], q[1], q[2], q[3]); !why.empty()) fail(where + ": " + why);
+  if (const std::string why = cf::quaternion_problem(q[0], q[1], q[2], q[3]); !why.empty())
+    fail(where + ": " + why);
   // As cfreplay reads a row: normalised, then the rotation matrix.
   Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
   quat.normalize();
@@ -55,7 +56,8 @@ const std::vector<DoubleField>& double_fields() {
        "relative singular-value tolerance of the freedoms' null space"},
       {"motion_angle_tolerance_rad", CF_FIELD(motion_angle_tolerance_rad), 0, M_PI,
        "'approximately along' angle of paper Fig. 10 (rad)"},
-      {"motion_noise_mm", CF_FIELD(motion_noise_mm), 0, 1e3, "pose changes below this are no motion (mm)"},
+      {"motion_noise_mm", CF_FIELD(motion_noise_mm), 0, 1e3,
+       "pose changes below this are no motion (mm)"},
       {"hold_fcy_threshold_N", CF_FIELD(hold_fcy_threshold_N), 0, 1e6,
        "hold F_cy while it changes by less than this (N); 0: off"},
       {"interpolation_time_constant_s", CF_FIELD(interpolation_time_constant_s), 0, 1e3,
@@ -97,9 +99,11 @@ struct EnumField {
 
 const EnumField<cf::FrictionDisplacement> kFriction{
     "friction_displacement",
-    {{"stick_anchor", cf::FrictionDisplacement::kStickAnchor}, {"per_tick", cf::FrictionDisplacement::kPerTick}}};
+    {{"stick_anchor", cf::FrictionDisplacement::kStickAnchor},
+     {"per_tick", cf::FrictionDisplacement::kPerTick}}};
 const EnumField<cf::CentroidChoice> kCentroid{
-    "centroid", {{"vertex_mean", cf::CentroidChoice::kVertexMean}, {"volume", cf::CentroidChoice::kVolume}}};
+    "centroid",
+    {{"vertex_mean", cf::CentroidChoice::kVertexMean}, {"volume", cf::CentroidChoice::kVolume}}};
 const EnumField<cf::MomentReference> kMomentRef{"moment_reference",
                                                 {{"a_origin", cf::MomentReference::kAOrigin},
                                                  {"a_centroid", cf::MomentReference::kACentroid},
@@ -115,9 +119,11 @@ std::string enum_name(const EnumField<E>& f, E v) {
 template <class E>
 E enum_value(const EnumField<E>& f, const py::handle& h, const std::string& where) {
   std::string allowed;
-  for (const auto& [n, e] : f.values) allowed += std::string(allowed.empty() ? "" : ", ") + "'" + n + "'";
+  for (const auto& [n, e] : f.values)
+    allowed += std::string(allowed.empty() ? "" : ", ") + "'" + n + "'";
   if (!py::isinstance<py::str>(h))
-    fail(where + ": " + f.name + " must be one of " + allowed + ", got " + std::string(py::repr(h)));
+    fail(where + ": " + f.name + " must be one of " + allowed + ", got " +
+         std::string(py::repr(h)));
   const std::string s = h.cast<std::string>();
   for (const auto& [n, e] : f.values)
     if (s == n) return e;
@@ -136,7 +142,8 @@ double double_value(const DoubleField& f, const py::handle& h, const std::string
   }
   if (!std::isfinite(v) || v < f.lo || v > f.hi) {
     char buf[120];
-    std::snprintf(buf, sizeof buf, " must be a finite number in [%g, %g], got %.17g", f.lo, f.hi, v);
+    std::snprintf(buf, sizeof buf, " must be a finite number in [%g, %g], got %.17g", f.lo, f.hi,
+                  v);
     fail(where + ": " + f.name + buf);
   }
   return v;
@@ -155,7 +162,8 @@ cf::Vec3 vec3_value(const char* name, const py::handle& h, const std::string& wh
   return v;
 }
 
-void set_param(cf::Params& P, const std::string& key, const py::handle& value, const std::string& where) {
+void set_param(cf::Params& P, const std::string& key, const py::handle& value,
+               const std::string& where) {
   for (const DoubleField& f : double_fields())
     if (key == f.name) {
       f.ref(P) = double_value(f, value, where);
@@ -171,25 +179,29 @@ void set_param(cf::Params& P, const std::string& key, const py::handle& value, c
     P.moment_point_A = vec3_value("moment_point_A", value, where);
   } else if (key == "proxy_grip_point_A") {
     P.proxy.grip_point_A = vec3_value("proxy_grip_point_A", value, where);
-  } else if (key == "render_approaching" || key == "use_bvh" || key == "proxy" || key == "proxy_friction") {
+  } else if (key == "render_approaching" || key == "use_bvh" || key == "proxy" ||
+             key == "proxy_friction") {
     if (!py::isinstance<py::bool_>(value))
       fail(where + ": " + key + " must be True or False, got " + std::string(py::repr(value)));
-    bool& field = key == "use_bvh"     ? P.detection.use_bvh
-                  : key == "proxy"     ? P.proxy.enabled
+    bool& field = key == "use_bvh"          ? P.detection.use_bvh
+                  : key == "proxy"          ? P.proxy.enabled
                   : key == "proxy_friction" ? P.proxy.friction
-                                       : P.render_approaching;
+                                            : P.render_approaching;
     field = value.cast<bool>();
   } else if (key == "max_combinations") {
-    if (!py::isinstance<py::int_>(value) || py::isinstance<py::bool_>(value) || value.cast<long long>() < 1 ||
-        value.cast<long long>() > 1000000000)
-      fail(where + ": max_combinations must be an integer in [1, 1000000000], got " + std::string(py::repr(value)));
+    if (!py::isinstance<py::int_>(value) || py::isinstance<py::bool_>(value) ||
+        value.cast<long long>() < 1 || value.cast<long long>() > 1000000000)
+      fail(where + ": max_combinations must be an integer in [1, 1000000000], got " +
+           std::string(py::repr(value)));
     P.identification.max_combinations = value.cast<int>();
   } else {
     std::string names;
-    for (const DoubleField& f : double_fields()) names += std::string(names.empty() ? "" : ", ") + f.name;
-    names += std::string(", ") + kFriction.name + ", " + kCentroid.name + ", " + kMomentRef.name +
-             ", moment_point_A, render_approaching, use_bvh, max_combinations, proxy, proxy_friction, "
-             "proxy_grip_point_A";
+    for (const DoubleField& f : double_fields())
+      names += std::string(names.empty() ? "" : ", ") + f.name;
+    names +=
+        std::string(", ") + kFriction.name + ", " + kCentroid.name + ", " + kMomentRef.name +
+        ", moment_point_A, render_approaching, use_bvh, max_combinations, proxy, proxy_friction, "
+        "proxy_grip_point_A";
     fail(where + ": unknown parameter '" + key + "' (parameters: " + names + ")");
   }
 }
@@ -212,7 +224,8 @@ py::dict params_to_dict(const cf::Params& P) {
 
 }  // namespace
 
-cf::Params params_from_kwargs(const cf::Params& base, const py::kwargs& kwargs, const std::string& where) {
+cf::Params params_from_kwargs(const cf::Params& base, const py::kwargs& kwargs,
+                              const std::string& where) {
   cf::Params P = base;
   for (const auto& [k, v] : kwargs) set_param(P, k.cast<std::string>(), v, where);
   return P;
@@ -223,21 +236,24 @@ cf::Pc pc_from_py(const py::handle& h) {
   if (py::isinstance<py::str>(h)) {
     const std::string s = h.cast<std::string>();
     const std::optional<cf::Pc> pc = cf::pc_from_string(s);
-    if (!pc) fail("not a PC: '" + s + "' (expected 'type:a:b' with type f-f, e-f, f-e, v-f, f-v or e-e)");
+    if (!pc)
+      fail("not a PC: '" + s + "' (expected 'type:a:b' with type f-f, e-f, f-e, v-f, f-v or e-e)");
     return *pc;
   }
   if (py::isinstance<py::tuple>(h) && py::len(h) == 3) {
     const py::tuple t = py::reinterpret_borrow<py::tuple>(h);
     if (py::isinstance<py::str>(t[0])) {
       const std::optional<cf::PcType> type = cf::pc_type_from_string(t[0].cast<std::string>());
-      if (!type) fail("not a PC type: '" + t[0].cast<std::string>() + "' (f-f, e-f, f-e, v-f, f-v or e-e)");
+      if (!type)
+        fail("not a PC type: '" + t[0].cast<std::string>() + "' (f-f, e-f, f-e, v-f, f-v or e-e)");
       try {
         return cf::Pc{*type, t[1].cast<std::int32_t>(), t[2].cast<std::int32_t>()};
       } catch (const py::cast_error&) {
       }
     }
   }
-  fail("not a PC: " + std::string(py::repr(h)) + " (expected 'type:a:b', a (type, a, b) tuple or a cf.Pc)");
+  fail("not a PC: " + std::string(py::repr(h)) +
+       " (expected 'type:a:b', a (type, a, b) tuple or a cf.Pc)");
 }
 
 cf::PcSet pcset_from_py(const py::handle& h) {
@@ -247,13 +263,15 @@ cf::PcSet pcset_from_py(const py::handle& h) {
     std::size_t start = 0;
     while (start <= s.size() && !s.empty()) {
       const std::size_t semi = s.find(';', start);
-      pcs.push_back(pc_from_py(py::str(s.substr(start, semi == std::string::npos ? std::string::npos : semi - start))));
+      pcs.push_back(pc_from_py(
+          py::str(s.substr(start, semi == std::string::npos ? std::string::npos : semi - start))));
       if (semi == std::string::npos) break;
       start = semi + 1;
     }
   } else if (py::isinstance<cf::Pc>(h) || py::isinstance<py::tuple>(h)) {
     // A single PC given alone, or a (type, a, b) tuple.
-    if (py::isinstance<py::tuple>(h) && py::len(h) == 3 && py::isinstance<py::str>(py::reinterpret_borrow<py::tuple>(h)[0]))
+    if (py::isinstance<py::tuple>(h) && py::len(h) == 3 &&
+        py::isinstance<py::str>(py::reinterpret_borrow<py::tuple>(h)[0]))
       pcs.push_back(pc_from_py(h));
     else if (py::isinstance<cf::Pc>(h))
       pcs.push_back(pc_from_py(h));
@@ -262,7 +280,8 @@ cf::PcSet pcset_from_py(const py::handle& h) {
   } else if (py::isinstance<py::sequence>(h)) {
     for (const py::handle& x : h) pcs.push_back(pc_from_py(x));
   } else {
-    fail("not a set of PCs: " + std::string(py::repr(h)) + " (expected 'type:a:b;...' or a list of PCs)");
+    fail("not a set of PCs: " + std::string(py::repr(h)) +
+         " (expected 'type:a:b;...' or a list of PCs)");
   }
   if (pcs.empty()) fail("a set of PCs needs 1 to 3 PCs, got none");
   return cf::PcSet(pcs);  // throws cf::Error for more than 3 or a repeat
@@ -279,46 +298,61 @@ py::list pcs_to_py(const cf::PcSet& pcs) {
 PYBIND11_MODULE(_cf, m) {
   namespace py = pybind11;
   using namespace cfpy;
-  m.doc() = "cf: contact formations of two rigid polyhedra (libcf), the C++ extension of the package cf.";
+  m.doc() =
+      "cf: contact formations of two rigid polyhedra (libcf), the C++ extension of the package cf.";
 
   py::register_exception<cf::Error>(m, "Error", PyExc_ValueError).doc() =
-      "Bad input (a file, a model, a graph, a trajectory, a parameter): a ValueError whose message is libcf's.";
+      "Bad input (a file, a model, a graph, a trajectory, a parameter): a ValueError whose message "
+      "is libcf's.";
 
-  py::class_<cf::Pc>(m, "Pc", "A principal contact: a PC type and the indices of A's and B's elements.")
+  py::class_<cf::Pc>(m, "Pc",
+                     "A principal contact: a PC type and the indices of A's and B's elements.")
       .def(py::init([](const py::object& spec) { return pc_from_py(spec); }), py::arg("spec"),
            "From 'type:a:b' (e.g. 'e-f:4:4') or a (type, a, b) tuple.")
-      .def(py::init([](const std::string& type, int a, int b) { return pc_from_py(py::make_tuple(type, a, b)); }),
+      .def(py::init([](const std::string& type, int a, int b) {
+             return pc_from_py(py::make_tuple(type, a, b));
+           }),
            py::arg("type"), py::arg("a"), py::arg("b"))
-      .def_property_readonly("type", [](const cf::Pc& pc) { return std::string(cf::to_string(pc.type)); },
-                             "'f-f', 'e-f', 'f-e', 'v-f', 'f-v' or 'e-e' (A's element kind, then B's)")
+      .def_property_readonly(
+          "type", [](const cf::Pc& pc) { return std::string(cf::to_string(pc.type)); },
+          "'f-f', 'e-f', 'f-e', 'v-f', 'f-v' or 'e-e' (A's element kind, then B's)")
       .def_readonly("a", &cf::Pc::a, "index of A's element (of the kind the type names)")
       .def_readonly("b", &cf::Pc::b, "index of B's element")
       .def("__str__", [](const cf::Pc& pc) { return cf::to_string(pc); })
       .def("__repr__", [](const cf::Pc& pc) { return "cf.Pc('" + cf::to_string(pc) + "')"; })
-      .def("__eq__", [](const cf::Pc& x, const py::object& y) {
-        try {
-          return x == pc_from_py(y);
-        } catch (const cf::Error&) {
-          return false;
-        }
-      })
+      .def("__eq__",
+           [](const cf::Pc& x, const py::object& y) {
+             try {
+               return x == pc_from_py(y);
+             } catch (const cf::Error&) {
+               return false;
+             }
+           })
       .def("__lt__", [](const cf::Pc& x, const cf::Pc& y) { return x < y; })
       .def("__hash__", [](const cf::Pc& pc) { return py::hash(py::str(cf::to_string(pc))); })
       .def(py::pickle([](const cf::Pc& pc) { return cf::to_string(pc); },
                       [](const std::string& s) { return pc_from_py(py::str(s)); }));
 
-  py::class_<cf::Params>(m, "Params",
-                         "Parameters of the renderer (cf::Params): the same names and units as in C++. "
-                         "Params(**kwargs) starts from the defaults (the paper's values).")
-      .def(py::init([](const py::kwargs& kw) { return params_from_kwargs(cf::Params(), kw, "Params"); }))
-      .def("replace", [](const cf::Params& P, const py::kwargs& kw) { return params_from_kwargs(P, kw, "Params.replace"); },
-           "A copy with the given fields changed.")
-      .def("to_dict", &params_to_dict, "Every field by name (enums as strings, moment_point_A as an array).")
-      .def("__getattr__", [](const cf::Params& P, const std::string& name) -> py::object {
-        py::dict d = params_to_dict(P);
-        if (d.contains(name)) return d[py::str(name)];
-        throw py::attribute_error("cf.Params has no field '" + name + "'");
-      })
+  py::class_<cf::Params>(
+      m, "Params",
+      "Parameters of the renderer (cf::Params): the same names and units as in C++. "
+      "Params(**kwargs) starts from the defaults (the paper's values).")
+      .def(py::init(
+          [](const py::kwargs& kw) { return params_from_kwargs(cf::Params(), kw, "Params"); }))
+      .def(
+          "replace",
+          [](const cf::Params& P, const py::kwargs& kw) {
+            return params_from_kwargs(P, kw, "Params.replace");
+          },
+          "A copy with the given fields changed.")
+      .def("to_dict", &params_to_dict,
+           "Every field by name (enums as strings, moment_point_A as an array).")
+      .def("__getattr__",
+           [](const cf::Params& P, const std::string& name) -> py::object {
+             py::dict d = params_to_dict(P);
+             if (d.contains(name)) return d[py::str(name)];
+             throw py::attribute_error("cf.Params has no field '" + name + "'");
+           })
       .def("__repr__", [](const cf::Params& P) {
         std::string s = "cf.Params(";
         bool first = true;

@@ -23,7 +23,8 @@ int main(int argc, char** argv) {
     const std::vector<cf::replay::Row> rows = cf::replay::run(graph, samples, cf::Params());
     std::printf("t,cf,pcs,motion,status,Fx,Fy,Fz,Mx,My,Mz,FAx,FAy,FAz,MAx,MAy,MAz\n");
     for (const cf::replay::Row& r : rows) {
-      std::printf("%.17g,%d,%s,%s,%s", r.t, r.cf, r.pcs.c_str(), r.motion.c_str(), r.status.c_str());
+      std::printf("%.17g,%d,%s,%s,%s", r.t, r.cf, r.pcs.c_str(), r.motion.c_str(),
+                  r.status.c_str());
       for (const cf::Vec3* v : {&r.F_W, &r.M_W, &r.F_A, &r.M_A})
         for (int k = 0; k < 3; ++k) std::printf(",%.17g", (*v)[k]);
       std::printf("\n");

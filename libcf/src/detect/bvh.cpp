@@ -66,7 +66,8 @@ void obb_of(const std::vector<Vec3>& pts, double inflate, const Vec3& origin, No
   const Vec3 centre_local = 0.5 * (lo + hi);
   const double reach = (0.5 * (hi - lo)).norm() + 1.0;
   Eigen::Vector3f c, h;
-  round_out(axes * centre_local - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate + 1e-6 * reach), c, h);
+  round_out(axes * centre_local - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate + 1e-6 * reach),
+            c, h);
   o.oc = lanes4(c);
   o.oh = lanes4(h);
 }
@@ -90,7 +91,8 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin,
     const auto end = static_cast<std::int32_t>(members.size());
     if (end == first) return;
     pts.clear();
-    for (std::int32_t i = first; i < end; ++i) points_of(m, members[static_cast<std::size_t>(i)], pts);
+    for (std::int32_t i = first; i < end; ++i)
+      points_of(m, members[static_cast<std::size_t>(i)], pts);
     Vec3 lo, hi;
     bounds_of(pts, lo, hi);
     items.push_back({first, end - first, lo, hi});
@@ -108,11 +110,14 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin,
     std::vector<std::vector<BvhElement>> owned(m.num_faces());
     std::vector<std::int32_t> faceless;  // vertices on no face: items of their own
     for (std::size_t e = 0; e < m.num_edges(); ++e)
-      owned[m.edges()[e].left.index()].push_back({ElementKind::kEdge, static_cast<std::int32_t>(e)});
+      owned[m.edges()[e].left.index()].push_back(
+          {ElementKind::kEdge, static_cast<std::int32_t>(e)});
     for (std::size_t v = 0; v < m.num_vertices(); ++v) {
       const auto iv = static_cast<std::int32_t>(v);
-      if (m.vertices()[v].faces.empty()) faceless.push_back(iv);
-      else owned[m.vertices()[v].faces.front().index()].push_back({ElementKind::kVertex, iv});
+      if (m.vertices()[v].faces.empty())
+        faceless.push_back(iv);
+      else
+        owned[m.vertices()[v].faces.front().index()].push_back({ElementKind::kVertex, iv});
     }
     for (std::size_t f = 0; f < m.num_faces(); ++f) {
       auto first = static_cast<std::int32_t>(members.size());
@@ -226,11 +231,13 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin,
     if (n.leaf()) {
       const std::int32_t b = ~n.child, e = b + n.count;
       n.child = ~offset[static_cast<std::size_t>(b)];
-      n.count = static_cast<std::uint8_t>(offset[static_cast<std::size_t>(e)] - offset[static_cast<std::size_t>(b)]);
+      n.count = static_cast<std::uint8_t>(offset[static_cast<std::size_t>(e)] -
+                                          offset[static_cast<std::size_t>(b)]);
       if (!lanes) continue;
       // One group: at most kMaxGroup == LeafBoxes::kLanes elements.
       static_assert(kMaxGroup <= LeafBoxes::kLanes);
-      leaf_of_element_[static_cast<std::size_t>(n.element())] = static_cast<std::int32_t>(leaf_boxes_.size());
+      leaf_of_element_[static_cast<std::size_t>(n.element())] =
+          static_cast<std::int32_t>(leaf_boxes_.size());
       LeafBoxes& L = leaf_boxes_.emplace_back();
       for (int i = 0; i < 3; ++i) {
         L.c[i].setZero();
@@ -264,8 +271,10 @@ std::int32_t Bvh::add_wide(const std::int32_t* members, int count) {
       W.node[j] = n;
       W.box.set_lane(j, boxes_[static_cast<std::size_t>(n)]);
       for (unsigned mask = 1; mask < 8; ++mask) {
-        if (N.kinds & mask) W.lanes_holding[mask] = static_cast<std::uint8_t>(W.lanes_holding[mask] | (1u << j));
-        if (N.touchable & mask) W.lanes_touching[mask] = static_cast<std::uint8_t>(W.lanes_touching[mask] | (1u << j));
+        if (N.kinds & mask)
+          W.lanes_holding[mask] = static_cast<std::uint8_t>(W.lanes_holding[mask] | (1u << j));
+        if (N.touchable & mask)
+          W.lanes_touching[mask] = static_cast<std::uint8_t>(W.lanes_touching[mask] | (1u << j));
       }
     }
   }

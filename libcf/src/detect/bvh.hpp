@@ -26,7 +26,9 @@ namespace cf::detail {
 
 /// A 3-vector in the first three of four float lanes, the fourth 0. Written out because
 /// Eigen's comma initialiser from a Vector3f made GCC 12 -O3 warn of a 16-byte load from it.
-inline Eigen::Array4f lanes4(const Eigen::Ref<const Eigen::Vector3f>& v) { return {v.x(), v.y(), v.z(), 0.0f}; }
+inline Eigen::Array4f lanes4(const Eigen::Ref<const Eigen::Vector3f>& v) {
+  return {v.x(), v.y(), v.z(), 0.0f};
+}
 
 struct BvhElement {
   ElementKind kind;
@@ -42,12 +44,12 @@ inline std::uint8_t kind_bit(ElementKind k) {
 /// elements; 32 bytes so that descents stay in cache) and either two children (`child`,
 /// `child + 1`) or a few elements (leaf).
 struct BvhNode {
-  Eigen::Vector3f center;  // mm, model frame
-  Eigen::Vector3f half;    // mm, half extents, >= 0
-  std::int32_t child = 0;  // inner: index of the first child; leaf: ~(first element index)
-  std::uint8_t kinds = 0;  // kind_bit of every element below
+  Eigen::Vector3f center;      // mm, model frame
+  Eigen::Vector3f half;        // mm, half extents, >= 0
+  std::int32_t child = 0;      // inner: index of the first child; leaf: ~(first element index)
+  std::uint8_t kinds = 0;      // kind_bit of every element below
   std::uint8_t touchable = 0;  // touchable_by_a(kinds), for the descent
-  std::uint8_t count = 0;  // leaf: number of elements
+  std::uint8_t count = 0;      // leaf: number of elements
   bool leaf() const { return child < 0; }
   std::int32_t left() const { return child; }
   std::int32_t right() const { return child + 1; }
@@ -84,16 +86,19 @@ struct alignas(16) ElemBox {
 /// never overlap anything.
 struct alignas(16) LeafBoxes {
   static constexpr int kLanes = 4;
-  Eigen::Array4f c[3], h[3];  // mm: centres (relative to the tree's origin) and half extents, per axis
+  Eigen::Array4f c[3],
+      h[3];  // mm: centres (relative to the tree's origin) and half extents, per axis
   /// Per kind of an element of the other model (posed as A): the lanes whose elements it
   /// can form a PC type with (bit j for lane j).
   std::uint8_t touchable_by[3] = {0, 0, 0};
 };
 
 /// Bit j set where lane j of x is greater than y's.
-__attribute__((always_inline)) inline unsigned greater_mask4(const Eigen::Array4f& x, const Eigen::Array4f& y) {
+__attribute__((always_inline)) inline unsigned greater_mask4(const Eigen::Array4f& x,
+                                                             const Eigen::Array4f& y) {
 #if defined(CF_SSE)
-  return static_cast<unsigned>(_mm_movemask_ps(_mm_cmpgt_ps(_mm_load_ps(x.data()), _mm_load_ps(y.data()))));
+  return static_cast<unsigned>(
+      _mm_movemask_ps(_mm_cmpgt_ps(_mm_load_ps(x.data()), _mm_load_ps(y.data()))));
 #else
   unsigned m = 0;
   for (int j = 0; j < 4; ++j) m |= (x[j] > y[j] ? 1u : 0u) << j;
@@ -102,20 +107,24 @@ __attribute__((always_inline)) inline unsigned greater_mask4(const Eigen::Array4
 }
 
 /// Is some lane of x greater than y's?
-__attribute__((always_inline)) inline bool any_greater(const Eigen::Array4f& x, const Eigen::Array4f& y) {
+__attribute__((always_inline)) inline bool any_greater(const Eigen::Array4f& x,
+                                                       const Eigen::Array4f& y) {
   return greater_mask4(x, y) != 0;
 }
 
 /// The lanes of leaf boxes q whose boxes overlap box p (same frame), as bits.
-__attribute__((always_inline)) inline unsigned overlapping_lanes(const ElemBox& p, const LeafBoxes& q) {
+__attribute__((always_inline)) inline unsigned overlapping_lanes(const ElemBox& p,
+                                                                 const LeafBoxes& q) {
 #if defined(CF_SSE)
   // On SSE registers, unrolled (as the wide nodes' test below).
   const __m128 sign = _mm_set1_ps(-0.0f);
   __m128 apart = _mm_setzero_ps();
   CF_UNROLL3
   for (int i = 0; i < 3; ++i)
-    apart = _mm_or_ps(apart, _mm_cmpgt_ps(_mm_andnot_ps(sign, _mm_sub_ps(_mm_load_ps(q.c[i].data()), _mm_set1_ps(p.c[i]))),
-                                          _mm_add_ps(_mm_load_ps(q.h[i].data()), _mm_set1_ps(p.h[i]))));
+    apart = _mm_or_ps(
+        apart, _mm_cmpgt_ps(
+                   _mm_andnot_ps(sign, _mm_sub_ps(_mm_load_ps(q.c[i].data()), _mm_set1_ps(p.c[i]))),
+                   _mm_add_ps(_mm_load_ps(q.h[i].data()), _mm_set1_ps(p.h[i]))));
   return ~static_cast<unsigned>(_mm_movemask_ps(apart)) & 0xFu;
 #else
   unsigned apart = 0;
@@ -161,9 +170,10 @@ struct alignas(16) Box4 {
 /// A node of the 4-wide tree: up to four nodes of the binary tree (children or
 /// grandchildren of one node), tested at once.
 struct WideNode {
-  Box4 box;                       // lane j: binary node node[j]'s boxes
+  Box4 box;                                 // lane j: binary node node[j]'s boxes
   std::int32_t node[4] = {-1, -1, -1, -1};  // binary node per lane; -1 for an unused lane
-  std::int32_t wide[4] = {-1, -1, -1, -1};  // its wide node when inner; -1 for a leaf or an unused lane
+  std::int32_t wide[4] = {-1, -1, -1,
+                          -1};  // its wide node when inner; -1 for a leaf or an unused lane
   /// By a mask of element kinds (kind_bit bits): the lanes holding some of those kinds, and
   /// the lanes holding elements that can touch some of them (empty for unused lanes).
   std::uint8_t lanes_holding[8] = {};
@@ -175,7 +185,8 @@ struct WideNode {
 /// normal), each box projected on the other's. The other four face axes and the nine cross
 /// axes cull less than they cost (on 2,000-face spheres 10% more instructions with all six
 /// face axes). Unused lanes of q give any answer: the caller masks them.
-__attribute__((always_inline)) inline unsigned overlapping_lanes(const Box4& p, int s, const Box4& q) {
+__attribute__((always_inline)) inline unsigned overlapping_lanes(const Box4& p, int s,
+                                                                 const Box4& q) {
 #if defined(CF_SSE)
   // Written on SSE registers and unrolled: GCC at -O2, which an embedding application may
   // use, keeps loops of 3 and spills Eigen's 4-float temporaries to memory here.
@@ -189,7 +200,8 @@ __attribute__((always_inline)) inline unsigned overlapping_lanes(const Box4& p, 
   __m128 apart = _mm_setzero_ps();
   CF_UNROLL3
   for (int i = 0; i < 3; ++i)
-    apart = _mm_or_ps(apart, _mm_cmpgt_ps(abs(_mm_sub_ps(ld(q.c[i]), bc(p.c[i]))), _mm_add_ps(ld(q.h[i]), bc(p.h[i]))));
+    apart = _mm_or_ps(apart, _mm_cmpgt_ps(abs(_mm_sub_ps(ld(q.c[i]), bc(p.c[i]))),
+                                          _mm_add_ps(ld(q.h[i]), bc(p.h[i]))));
   if (_mm_movemask_ps(apart) == 0xF) return 0;
   const __m128 d0 = _mm_sub_ps(ld(q.oc[0]), bc(p.oc[0])), d1 = _mm_sub_ps(ld(q.oc[1]), bc(p.oc[1])),
                d2 = _mm_sub_ps(ld(q.oc[2]), bc(p.oc[2]));
@@ -199,29 +211,37 @@ __attribute__((always_inline)) inline unsigned overlapping_lanes(const Box4& p, 
   __m128 r = _mm_add_ps(ld(q.oh[0]), _mm_mul_ps(abs(dot(n0, n1, n2, m0, m1, m2)), bc(p.oh[0])));
   CF_UNROLL3
   for (int j = 1; j < 3; ++j)
-    r = _mm_add_ps(r, _mm_mul_ps(abs(dot(n0, n1, n2, bc(p.ax[j][0]), bc(p.ax[j][1]), bc(p.ax[j][2]))), bc(p.oh[j])));
+    r = _mm_add_ps(r,
+                   _mm_mul_ps(abs(dot(n0, n1, n2, bc(p.ax[j][0]), bc(p.ax[j][1]), bc(p.ax[j][2]))),
+                              bc(p.oh[j])));
   apart = _mm_or_ps(apart, _mm_cmpgt_ps(abs(dot(n0, n1, n2, d0, d1, d2)), r));
   // On p's normal: q's oriented box projects to sum_j |m . q.ax[j]| q.oh[j].
   r = _mm_add_ps(bc(p.oh[0]), _mm_mul_ps(abs(dot(n0, n1, n2, m0, m1, m2)), ld(q.oh[0])));
   CF_UNROLL3
   for (int j = 1; j < 3; ++j)
-    r = _mm_add_ps(r, _mm_mul_ps(abs(dot(ld(q.ax[j][0]), ld(q.ax[j][1]), ld(q.ax[j][2]), m0, m1, m2)), ld(q.oh[j])));
+    r = _mm_add_ps(r,
+                   _mm_mul_ps(abs(dot(ld(q.ax[j][0]), ld(q.ax[j][1]), ld(q.ax[j][2]), m0, m1, m2)),
+                              ld(q.oh[j])));
   apart = _mm_or_ps(apart, _mm_cmpgt_ps(abs(dot(m0, m1, m2, d0, d1, d2)), r));
   return ~static_cast<unsigned>(_mm_movemask_ps(apart)) & 0xFu;
 #else
   using V = Eigen::Array4f;
   unsigned apart = 0;
-  for (int i = 0; i < 3; ++i) apart |= greater_mask4((q.c[i] - p.c[i][s]).abs(), q.h[i] + p.h[i][s]);
+  for (int i = 0; i < 3; ++i)
+    apart |= greater_mask4((q.c[i] - p.c[i][s]).abs(), q.h[i] + p.h[i][s]);
   if (apart == 0xFu) return 0;
   const V d[3] = {q.oc[0] - p.oc[0][s], q.oc[1] - p.oc[1][s], q.oc[2] - p.oc[2][s]};
   // |q's axis k . p's axis j|
   const auto c = [&](int k, int j) {
-    return (q.ax[k][0] * p.ax[j][0][s] + q.ax[k][1] * p.ax[j][1][s] + q.ax[k][2] * p.ax[j][2][s]).abs();
+    return (q.ax[k][0] * p.ax[j][0][s] + q.ax[k][1] * p.ax[j][1][s] + q.ax[k][2] * p.ax[j][2][s])
+        .abs();
   };
   const V tq = q.ax[0][0] * d[0] + q.ax[0][1] * d[1] + q.ax[0][2] * d[2];
-  apart |= greater_mask4(tq.abs(), q.oh[0] + c(0, 0) * p.oh[0][s] + c(0, 1) * p.oh[1][s] + c(0, 2) * p.oh[2][s]);
+  apart |= greater_mask4(
+      tq.abs(), q.oh[0] + c(0, 0) * p.oh[0][s] + c(0, 1) * p.oh[1][s] + c(0, 2) * p.oh[2][s]);
   const V tp = d[0] * p.ax[0][0][s] + d[1] * p.ax[0][1][s] + d[2] * p.ax[0][2][s];
-  apart |= greater_mask4(tp.abs(), c(0, 0) * q.oh[0] + c(1, 0) * q.oh[1] + c(2, 0) * q.oh[2] + p.oh[0][s]);
+  apart |= greater_mask4(tp.abs(),
+                         c(0, 0) * q.oh[0] + c(1, 0) * q.oh[1] + c(2, 0) * q.oh[2] + p.oh[0][s]);
   return ~apart & 0xFu;
 #endif
 }
@@ -248,7 +268,9 @@ class Bvh {
   /// Face-group trees with leaves of one group: per leaf, its elements' boxes on lanes
   /// (empty otherwise); leaf_boxes()[leaf_index(n)] for leaf node n.
   const std::vector<LeafBoxes>& leaf_boxes() const { return leaf_boxes_; }
-  std::int32_t leaf_index(const BvhNode& n) const { return leaf_of_element_[static_cast<std::size_t>(n.element())]; }
+  std::int32_t leaf_index(const BvhNode& n) const {
+    return leaf_of_element_[static_cast<std::size_t>(n.element())];
+  }
   const std::vector<BvhNode>& nodes() const { return nodes_; }
   /// Per node, its axis-aligned and oriented boxes (inflated alike), centres relative to
   /// origin().
@@ -270,7 +292,8 @@ class Bvh {
   std::vector<BvhElement> elements_;
   std::vector<ElemBox> elem_boxes_;
   std::vector<LeafBoxes> leaf_boxes_;
-  std::vector<std::int32_t> leaf_of_element_;  // leaf_boxes_ index of the leaf starting at an element
+  std::vector<std::int32_t>
+      leaf_of_element_;  // leaf_boxes_ index of the leaf starting at an element
   int depth_ = 0;
 };
 
@@ -286,11 +309,14 @@ inline std::size_t stack_capacity(const Bvh& a, const Bvh& b) {
 inline std::uint8_t touchable_by_a(std::uint8_t ka) {
   const std::uint8_t V = kind_bit(ElementKind::kVertex), E = kind_bit(ElementKind::kEdge),
                      F = kind_bit(ElementKind::kFace);
-  return static_cast<std::uint8_t>(((ka & V) ? F : 0) | ((ka & E) ? (E | F) : 0) | ((ka & F) ? (V | E | F) : 0));
+  return static_cast<std::uint8_t>(((ka & V) ? F : 0) | ((ka & E) ? (E | F) : 0) |
+                                   ((ka & F) ? (V | E | F) : 0));
 }
 
 /// Can an element of a kind in mask `ka` (of A) and one in mask `kb` (of B) form a PC type?
-inline bool kinds_can_touch(std::uint8_t ka, std::uint8_t kb) { return (touchable_by_a(ka) & kb) != 0; }
+inline bool kinds_can_touch(std::uint8_t ka, std::uint8_t kb) {
+  return (touchable_by_a(ka) & kb) != 0;
+}
 
 /// Calls leaves(const BvhNode& a, const BvhNode& b) for every pair of leaves whose bounding
 /// volumes overlap and whose kinds can touch, where tree `a` is posed into tree `b`'s frame:
@@ -345,7 +371,8 @@ bool descend_wide(const Bvh& ta, const Bvh& tb, PosedA&& posed_a, NodePair* stac
   const auto& na = ta.nodes();
   const auto& nb = tb.nodes();
   // Stack entries are lanes, 4 * wide node + lane; the roots are lane 0 of wide node 0.
-  if (!(wb[0].lanes_holding[na[0].touchable] & overlapping_lanes(posed_a(0), 0, wb[0].box) & 1u)) return true;
+  if (!(wb[0].lanes_holding[na[0].touchable] & overlapping_lanes(posed_a(0), 0, wb[0].box) & 1u))
+    return true;
   std::size_t top = 0;
   stack[top++] = {0, 0};
   bool ok = true;

@@ -2,10 +2,10 @@
 
 #include "detect.hpp"
 
-#include "bvh.hpp"
-#include "check.hpp"
 #include "all_pairs.hpp"
+#include "bvh.hpp"
 #include "cheap.hpp"
+#include "check.hpp"
 #include "coherence.hpp"
 #include "exact.hpp"
 #include "finish.hpp"
@@ -18,7 +18,6 @@
 
 namespace cf::detail {
 
-
 // BVH leaves of a model: one element for small models (with bigger leaves, leaf boxes of the
 // paper's cube and L-block overlap everything), posed like inner nodes (cheaper than exact
 // boxes there: 2.4 against 2.8 us per tick). Big models' nodes are also tested as oriented
@@ -29,7 +28,9 @@ namespace cf::detail {
 // leaf (on 2,000-face spheres 7% fewer instructions than leaves of 2 elements of any kind,
 // 15% fewer at the paper's epsilon). docs/performance.md has the figures.
 constexpr std::size_t kBigModelElements = 256;
-static bool is_big(const Polyhedron& m) { return m.num_vertices() + m.num_edges() + m.num_faces() >= kBigModelElements; }
+static bool is_big(const Polyhedron& m) {
+  return m.num_vertices() + m.num_edges() + m.num_faces() >= kBigModelElements;
+}
 static detail::Leaves leaves_for(const Polyhedron& m) {
   return is_big(m) ? detail::Leaves::kFaceGroups : detail::Leaves::kElements;
 }
@@ -45,7 +46,7 @@ struct DetectModel {
   // tested in the leaf, and nodes tested as oriented boxes too.
   bool big = false;
   std::vector<Eigen::Array4f> a_vert;  // mm, A's vertices relative to bvh_a.origin(), A's frame
-  FinishContext finishing;  // what finish_contacts reads (finish.hpp)
+  FinishContext finishing;             // what finish_contacts reads (finish.hpp)
 
   DetectModel(const Polyhedron& ma, const Polyhedron& mb, const Params& params_in)
       : a(ma), b(mb), all(params_in), tab(a, b, params_in, 0.5 * (ma.bbox_min() + ma.bbox_max())) {
@@ -58,11 +59,12 @@ struct DetectModel {
     // exact tests could accept has overlapping boxes.
     // A pair the tests accept is within max(eps, depth) across the plane and in_plane along
     // it, so within max(eps, depth, hypot(eps, in_plane)) of B's element.
-    bvh_b = Bvh(b, std::max({eps, depth, std::hypot(eps, in_plane)}) + tab.geo_tol + float_slack, 1, Vec3::Zero(),
-                leaves_for(b));
+    bvh_b = Bvh(b, std::max({eps, depth, std::hypot(eps, in_plane)}) + tab.geo_tol + float_slack, 1,
+                Vec3::Zero(), leaves_for(b));
     big = is_big(a) || is_big(b);
     if (big)
-      for (const Vertex& v : a.vertices()) a_vert.emplace_back() << (v.p - bvh_a.origin()).cast<float>(), 0.0f;
+      for (const Vertex& v : a.vertices())
+        a_vert.emplace_back() << (v.p - bvh_a.origin()).cast<float>(), 0.0f;
     constexpr std::size_t kKeyIndices = std::size_t{1} << 24;
     finishing.a = &a;
     finishing.b = &b;
@@ -70,8 +72,9 @@ struct DetectModel {
     finishing.dominance_fit = tab.prm.dominance_fit;
     finishing.dominance_penalty = tab.prm.dominance_penalty;
     finishing.cos_plane_tolerance = tab.cos_max_tol;
-    finishing.small_indices = std::max({a.num_vertices(), a.num_edges(), a.num_faces(), b.num_vertices(),
-                                        b.num_edges(), b.num_faces()}) < kKeyIndices;
+    finishing.small_indices =
+        std::max({a.num_vertices(), a.num_edges(), a.num_faces(), b.num_vertices(), b.num_edges(),
+                  b.num_faces()}) < kKeyIndices;
   }
   DetectModel(const DetectModel&) = delete;  // tab and finishing point into a and b
   DetectModel& operator=(const DetectModel&) = delete;
@@ -89,7 +92,7 @@ struct DetectState {
     std::uint64_t stamp = 0;
   };
   std::vector<PosedBox> a_box;
-  struct PosedWide {  // big models: a wide node's four boxes
+  struct PosedWide {   // big models: a wide node's four boxes
     detail::Box4 box;  // B's frame
     std::uint64_t stamp = 0;
   };
@@ -108,8 +111,8 @@ struct DetectState {
   Mat3 absR = Mat3::Identity();
   detail::CheapRejections cheap;  // cheap.hpp
   Eigen::Matrix3f Rf = Eigen::Matrix3f::Identity(), absRf = Eigen::Matrix3f::Identity();
-  Eigen::Array4f Rcol[3];  // R_BA's columns, lane 3 zero (A's vertices' posing)
-  Eigen::Array4f a_origin;              // mm, bvh_a's origin posed, B's frame
+  Eigen::Array4f Rcol[3];   // R_BA's columns, lane 3 zero (A's vertices' posing)
+  Eigen::Array4f a_origin;  // mm, bvh_a's origin posed, B's frame
   // The same on all four lanes (for the wide nodes' posing): R_BA(i, k), |R_BA(i, k)|, and
   // a_origin[i].
   Eigen::Array4f Rb[3][3], absRb[3][3], ob[3];
@@ -124,7 +127,7 @@ struct DetectState {
   using Cert = detail::Cert;
   detail::KeptPairs kept;
   bool recording = false, reused = false;
-  float grow = 0;    // mm, added to A's posed boxes in this call
+  float grow = 0;                        // mm, added to A's posed boxes in this call
   detail::FinishScratch finish_scratch;  // finish.hpp
 
   explicit DetectState(const DetectModel& m) : cheap(m.tab), scratch(m.tab), posed(m.a) {
@@ -141,7 +144,8 @@ struct DetectState {
 
   // Small models: does A's BVH node `ia` (posed) overlap B's node? The axis-aligned boxes
   // in B's frame, then, for inner nodes, B's box on A's node's own axes.
-  __attribute__((always_inline)) bool overlap(std::int32_t ia, const detail::BvhNode& A, const detail::BvhNode& B) {
+  __attribute__((always_inline)) bool overlap(std::int32_t ia, const detail::BvhNode& A,
+                                              const detail::BvhNode& B) {
     PosedBox& P = a_box[static_cast<std::size_t>(ia)];
     if (P.stamp != posed.stamp) pose_box(P, A);
     const Eigen::Vector3f d = P.c - B.center;
@@ -152,7 +156,8 @@ struct DetectState {
     // B's box on A's axes: centre offset R^T d, half extents |R^T| B.half.
     for (int k = 0; k < 3; ++k) {
       const float dk = Rf(0, k) * d.x() + Rf(1, k) * d.y() + Rf(2, k) * d.z();
-      const float hk = absRf(0, k) * B.half.x() + absRf(1, k) * B.half.y() + absRf(2, k) * B.half.z();
+      const float hk =
+          absRf(0, k) * B.half.x() + absRf(1, k) * B.half.y() + absRf(2, k) * B.half.z();
       if (std::abs(dk) > A.half[k] + hk) return false;
     }
     return true;
@@ -194,7 +199,8 @@ struct DetectState {
         break;
     }
     P.box.c = 0.5f * (lo + hi);
-    P.box.h = (0.5f * (hi - lo) + 2.4e-7f * P.box.c.abs()) * 1.0000003f + Eigen::Array4f(grow, grow, grow, 0.0f);
+    P.box.h = (0.5f * (hi - lo) + 2.4e-7f * P.box.c.abs()) * 1.0000003f +
+              Eigen::Array4f(grow, grow, grow, 0.0f);
   }
 
   // Does A's element at position ia of its BVH (posed) overlap B's element at ib?
@@ -208,7 +214,8 @@ struct DetectState {
   // A's node at the current pose: its box in B's frame.
   __attribute__((noinline)) void pose_box(PosedBox& P, const detail::BvhNode& N) {
     P.stamp = posed.stamp;
-    detail::round_out(posed.pose.apply(N.center.cast<double>()), absR * N.half.cast<double>(), P.c, P.h);
+    detail::round_out(posed.pose.apply(N.center.cast<double>()), absR * N.half.cast<double>(), P.c,
+                      P.h);
   }
 
   // A big model's wide node w at the current pose, in B's frame, in single precision. Its
@@ -230,15 +237,16 @@ struct DetectState {
     detail::Box4& Q = P.box;
     // Unrolled: at -O2 GCC keeps these loops of 3 and spills the temporaries.
     CF_UNROLL3
-    for (int k = 0; k < 3; ++k)
-      CF_UNROLL3
-      for (int i = 0; i < 3; ++i) Q.ax[k][i] = N.ax[k][0] * Rb[i][0] + N.ax[k][1] * Rb[i][1] + N.ax[k][2] * Rb[i][2];
+    for (int k = 0; k < 3; ++k) CF_UNROLL3
+    for (int i = 0; i < 3; ++i)
+      Q.ax[k][i] = N.ax[k][0] * Rb[i][0] + N.ax[k][1] * Rb[i][1] + N.ax[k][2] * Rb[i][2];
     CF_UNROLL3
     for (int i = 0; i < 3; ++i) {
       const V c = N.c[0] * Rb[i][0] + N.c[1] * Rb[i][1] + N.c[2] * Rb[i][2] + ob[i];
       const V oc = N.oc[0] * Rb[i][0] + N.oc[1] * Rb[i][1] + N.oc[2] * Rb[i][2] + ob[i];
       const V h = N.h[0] * absRb[i][0] + N.h[1] * absRb[i][1] + N.h[2] * absRb[i][2];
-      const V oh = Q.ax[0][i].abs() * N.oh[0] + Q.ax[1][i].abs() * N.oh[1] + Q.ax[2][i].abs() * N.oh[2];
+      const V oh =
+          Q.ax[0][i].abs() * N.oh[0] + Q.ax[1][i].abs() * N.oh[1] + Q.ax[2][i].abs() * N.oh[2];
       const V lo = (c - h).max(oc - oh), hi = (c + h).min(oc + oh);
       Q.c[i] = 0.5f * (lo + hi);
       // Widened by the rounding of the midpoint and of the half difference.
@@ -260,7 +268,8 @@ struct DetectState {
 
   // The cheap rejection and the exact test of a pair, for kept pairs: the certificate of
   // whichever turned it away (none when it passed both).
-  __attribute__((always_inline)) Cert certified_test(const detail::BvhElement& x, const detail::BvhElement& y) {
+  __attribute__((always_inline)) Cert certified_test(const detail::BvhElement& x,
+                                                     const detail::BvhElement& y) {
     const DetectModel& M = *mp;
     Cert c;
     if (cheap.may_touch<true>(M.tab, posed, x.kind, x.index, y.kind, y.index, &c)) c = exact(x, y);
@@ -277,7 +286,8 @@ struct DetectState {
         for (int j = 0; j < B.count; ++j) pair(A.element() + i, B.element() + j);
       return;
     }
-    const detail::LeafBoxes& L = M.bvh_b.leaf_boxes()[static_cast<std::size_t>(M.bvh_b.leaf_index(B))];
+    const detail::LeafBoxes& L =
+        M.bvh_b.leaf_boxes()[static_cast<std::size_t>(M.bvh_b.leaf_index(B))];
     for (int i = 0; i < A.count; ++i) {
       const int ia = A.element() + i;
       const detail::BvhElement& x = M.bvh_a.elements()[static_cast<std::size_t>(ia)];
@@ -300,7 +310,8 @@ struct DetectState {
     const DetectModel& M = *mp;
     ++pairs;
     if (!recording) {
-      if (cheap.may_touch<false>(M.tab, posed, x.kind, x.index, y.kind, y.index, nullptr)) exact(x, y);
+      if (cheap.may_touch<false>(M.tab, posed, x.kind, x.index, y.kind, y.index, nullptr))
+        exact(x, y);
       return;
     }
     kept.record(ia, ib, certified_test(x, y));
@@ -308,9 +319,11 @@ struct DetectState {
 
   // The exact test of a pair (exact.hpp): its contact goes to the output; returns the
   // certificate of a pair turned away.
-  __attribute__((always_inline)) Cert exact(const detail::BvhElement& x, const detail::BvhElement& y) {
+  __attribute__((always_inline)) Cert exact(const detail::BvhElement& x,
+                                            const detail::BvhElement& y) {
     const DetectModel& M = *mp;
-    detail::PairOutcome o = detail::exact_test(M.tab, posed, scratch, x.kind, x.index, y.kind, y.index);
+    detail::PairOutcome o =
+        detail::exact_test(M.tab, posed, scratch, x.kind, x.index, y.kind, y.index);
     if (o.contact) out->push(*o.contact);
     return o.cert;
   }
@@ -372,17 +385,19 @@ struct DetectState {
       }
     }
     // The stack is sized for the trees' depths, so the descents cannot overflow it.
-    const auto leaves = [this](const detail::BvhNode& A, const detail::BvhNode& B) { leaf_pair(A, B); };
+    const auto leaves = [this](const detail::BvhNode& A, const detail::BvhNode& B) {
+      leaf_pair(A, B);
+    };
     const bool complete =
         M.big ? detail::descend_wide(
-                  M.bvh_a, M.bvh_b,
-                  [this](std::int32_t w) -> const detail::Box4& { return posed_wide(w); },
-                  stack.data(), stack.size(), leaves)
-            : detail::descend(
-                  M.bvh_a, M.bvh_b,
-                  [this](std::int32_t ia, std::int32_t, const detail::BvhNode& A,
-                         const detail::BvhNode& B) { return overlap(ia, A, B); },
-                  stack.data(), stack.size(), leaves);
+                    M.bvh_a, M.bvh_b,
+                    [this](std::int32_t w) -> const detail::Box4& { return posed_wide(w); },
+                    stack.data(), stack.size(), leaves)
+              : detail::descend(
+                    M.bvh_a, M.bvh_b,
+                    [this](std::int32_t ia, std::int32_t, const detail::BvhNode& A,
+                           const detail::BvhNode& B) { return overlap(ia, A, B); },
+                    stack.data(), stack.size(), leaves);
     CF_DEMAND(complete);
     if (recording) kept.finish_recording(pose);
     recording = posed.certifying = false;
@@ -396,8 +411,12 @@ void DetectStateDelete::operator()(DetectState* s) const { delete s; }
 DetectModelPtr make_detect_model(const Polyhedron& a, const Polyhedron& b, const Params& params) {
   return DetectModelPtr(new DetectModel(a, b, params));
 }
-DetectStatePtr make_detect_state(const DetectModel& m) { return DetectStatePtr(new DetectState(m)); }
-void detect(const DetectModel& m, DetectState& s, const Pose& pose, ContactSet& out) { s.detect(m, pose, out); }
+DetectStatePtr make_detect_state(const DetectModel& m) {
+  return DetectStatePtr(new DetectState(m));
+}
+void detect(const DetectModel& m, DetectState& s, const Pose& pose, ContactSet& out) {
+  s.detect(m, pose, out);
+}
 const Params& params_of(const DetectModel& m) { return m.all; }
 const Polyhedron& model_a_of(const DetectModel& m) { return m.a; }
 const Polyhedron& model_b_of(const DetectModel& m) { return m.b; }
@@ -422,11 +441,15 @@ ContactDetector::~ContactDetector() = default;
 ContactDetector::ContactDetector(ContactDetector&&) noexcept = default;
 ContactDetector& ContactDetector::operator=(ContactDetector&&) noexcept = default;
 
-void ContactDetector::detect(const Pose& pose, ContactSet& out) { detail::detect(*impl_->model, *impl_->state, pose, out); }
+void ContactDetector::detect(const Pose& pose, ContactSet& out) {
+  detail::detect(*impl_->model, *impl_->state, pose, out);
+}
 const Params& ContactDetector::params() const { return detail::params_of(*impl_->model); }
 const Polyhedron& ContactDetector::model_a() const { return detail::model_a_of(*impl_->model); }
 const Polyhedron& ContactDetector::model_b() const { return detail::model_b_of(*impl_->model); }
-std::size_t ContactDetector::last_pairs_tested() const { return detail::pairs_tested(*impl_->state); }
+std::size_t ContactDetector::last_pairs_tested() const {
+  return detail::pairs_tested(*impl_->state);
+}
 bool ContactDetector::last_reused_pairs() const { return detail::reused_pairs(*impl_->state); }
 
 }  // namespace cf

@@ -28,7 +28,7 @@ struct Poly2 {
 };
 
 struct Loc2 {
-  bool inside = false;   // even-odd over all loops
+  bool inside = false;                                    // even-odd over all loops
   double dist = std::numeric_limits<double>::infinity();  // to the boundary
   Vec2 closest = Vec2::Zero();
   Vec2 seg_dir = Vec2::Zero();  // direction (not normalised) of the nearest boundary segment
@@ -171,7 +171,8 @@ Overlap2 overlap(const Poly2& P, const Poly2& Q, double tol, double* params, Vis
 /// clockwise): the piece [*t0, *t1] of segment a->b within tol of P, cut by each edge's
 /// line moved out by tol (Cyrus-Beck). False when it is no longer than the general
 /// routine's shortest piece (1e-12).
-inline bool clip_segment_convex(const Vec2& a, const Vec2& b, const Poly2& P, double tol, double* t0, double* t1) {
+inline bool clip_segment_convex(const Vec2& a, const Vec2& b, const Poly2& P, double tol,
+                                double* t0, double* t1) {
   const Vec2 r = b - a;
   double lo = 0, hi = 1;
   const int lb = P.lb[0], le = P.lb[1];
@@ -181,9 +182,12 @@ inline bool clip_segment_convex(const Vec2& a, const Vec2& b, const Poly2& P, do
     // Inside the moved line: f0 + t * fr >= 0 at a + t r.
     const double f0 = cross2(s, a - c) + tol * s.norm();
     const double fr = cross2(s, r);
-    if (fr > 0) lo = std::max(lo, -f0 / fr);
-    else if (fr < 0) hi = std::min(hi, -f0 / fr);
-    else if (f0 < 0) return false;
+    if (fr > 0)
+      lo = std::max(lo, -f0 / fr);
+    else if (fr < 0)
+      hi = std::min(hi, -f0 / fr);
+    else if (f0 < 0)
+      return false;
     if (hi - lo <= 1e-12) return false;
   }
   *t0 = lo;
@@ -210,7 +214,8 @@ inline bool is_convex(const Poly2& P) {
 /// `buf` is scratch of 2 * cap points, cap >= |P| + |Q|. Returns false, having visited
 /// nothing, if rounding on a near-degenerate input would overflow it (then use overlap()).
 template <class Visit>
-bool overlap_convex(const Poly2& P, const Poly2& Q, Vec2* buf, int cap, Overlap2& o, Visit&& visit) {
+bool overlap_convex(const Poly2& P, const Poly2& Q, Vec2* buf, int cap, Overlap2& o,
+                    Visit&& visit) {
   const int pb = P.lb[0], np = P.lb[1] - pb;
   const int qb = Q.lb[0], nq = Q.lb[1] - qb;
   if (np + nq > cap) return false;
@@ -229,7 +234,8 @@ bool overlap_convex(const Poly2& P, const Poly2& Q, Vec2* buf, int cap, Overlap2
       const Vec2& prev = in[i == 0 ? n - 1 : i - 1];
       const Vec2& cur = in[i];
       const double s_cur = cross2(edge, cur - c);  // >= 0: on the inner side of the edge
-      if ((s_prev >= 0) != (s_cur >= 0)) out[m++] = prev + (s_prev / (s_prev - s_cur)) * (cur - prev);
+      if ((s_prev >= 0) != (s_cur >= 0))
+        out[m++] = prev + (s_prev / (s_prev - s_cur)) * (cur - prev);
       if (s_cur >= 0) out[m++] = cur;
       s_prev = s_cur;
     }

@@ -13,12 +13,18 @@ namespace cf {
 
 const char* to_string(Regime regime) {
   switch (regime) {
-    case Regime::kNone: return "none";
-    case Regime::kImpactStatic: return "impact_static";
-    case Regime::kStick: return "stick";
-    case Regime::kMaxStatic: return "max_static";
-    case Regime::kKinetic: return "kinetic";
-    case Regime::kApproaching: return "approaching";
+    case Regime::kNone:
+      return "none";
+    case Regime::kImpactStatic:
+      return "impact_static";
+    case Regime::kStick:
+      return "stick";
+    case Regime::kMaxStatic:
+      return "max_static";
+    case Regime::kKinetic:
+      return "kinetic";
+    case Regime::kApproaching:
+      return "approaching";
   }
   return "none";
 }
@@ -44,7 +50,8 @@ bool compliant(MotionType m) {
 
 ForceModel::ForceModel(const Polyhedron& A, const Polyhedron& B, const Params& params)
     : A_(&A), B_(&B), params_(params) {
-  centroid_A_ = params_.centroid == CentroidChoice::kVolume ? A.volume_centroid() : A.vertex_centroid();
+  centroid_A_ =
+      params_.centroid == CentroidChoice::kVolume ? A.volume_centroid() : A.vertex_centroid();
 }
 
 void ForceModel::reset() {
@@ -199,7 +206,8 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
   auto rotation_rule = [&]() {
     int i_min = 0;
     for (int k = 1; k < m; ++k)
-      if (r.pcs[static_cast<std::size_t>(k)].s_mm < r.pcs[static_cast<std::size_t>(i_min)].s_mm) i_min = k;
+      if (r.pcs[static_cast<std::size_t>(k)].s_mm < r.pcs[static_cast<std::size_t>(i_min)].s_mm)
+        i_min = k;
     set_all(Regime::kKinetic);
     if (m > 0 && sticks(i_min)) r.pcs[static_cast<std::size_t>(i_min)].regime = Regime::kStick;
   };
@@ -215,7 +223,8 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
       switch (r.motion) {
         case MotionType::kMT1:
           for (int k = 0; k < m; ++k)
-            r.pcs[static_cast<std::size_t>(k)].regime = inside_cone(k) ? Regime::kImpactStatic : Regime::kKinetic;
+            r.pcs[static_cast<std::size_t>(k)].regime =
+                inside_cone(k) ? Regime::kImpactStatic : Regime::kKinetic;
           break;
         case MotionType::kMT2a:
         case MotionType::kMT2b:
@@ -231,7 +240,8 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
             set_all(Regime::kStick);
           } else if (!r.check.along) {
             r.motion = MotionType::kMT2a;  // second situation: not a possible motion
-            for (int k = 0; k < m; ++k) r.pcs[static_cast<std::size_t>(k)].regime = static_or_max(k);
+            for (int k = 0; k < m; ++k)
+              r.pcs[static_cast<std::size_t>(k)].regime = static_or_max(k);
           } else if (!r.freedoms.pure_rotation) {
             r.motion = MotionType::kMT2b;
             set_all(Regime::kKinetic);
@@ -243,22 +253,29 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
         }
         case MotionType::kMT3:
           freedoms();
-          if (!r.freedoms.pure_rotation) set_all(Regime::kKinetic);
-          else rotation_rule();
+          if (!r.freedoms.pure_rotation)
+            set_all(Regime::kKinetic);
+          else
+            rotation_rule();
           break;
         case MotionType::kMT4: {
           const int g = prior.gained;
           if (g >= 0 && g < m && inside_cone(g)) {
             for (int k = 0; k < m; ++k)
-              r.pcs[static_cast<std::size_t>(k)].regime = k == g ? Regime::kImpactStatic : static_or_max(k);
+              r.pcs[static_cast<std::size_t>(k)].regime =
+                  k == g ? Regime::kImpactStatic : static_or_max(k);
           } else {
             set_all(Regime::kKinetic);
           }
           if (g >= 0 && g < m) r.pcs[static_cast<std::size_t>(g)].gained = true;
           break;
         }
-        case MotionType::kMT5: rotation_rule(); break;
-        case MotionType::kNone: set_all(Regime::kKinetic); break;
+        case MotionType::kMT5:
+          rotation_rule();
+          break;
+        case MotionType::kNone:
+          set_all(Regime::kKinetic);
+          break;
       }
     }
   }
@@ -268,9 +285,15 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
   Vec3 M_c = Vec3::Zero();
   r.centroid_W = pose.apply(centroid_A_);
   switch (P.moment_reference) {
-    case MomentReference::kAOrigin: r.reference_W = pose.t_BA; break;
-    case MomentReference::kACentroid: r.reference_W = r.centroid_W; break;
-    case MomentReference::kAPoint: r.reference_W = pose.apply(P.moment_point_A); break;
+    case MomentReference::kAOrigin:
+      r.reference_W = pose.t_BA;
+      break;
+    case MomentReference::kACentroid:
+      r.reference_W = r.centroid_W;
+      break;
+    case MomentReference::kAPoint:
+      r.reference_W = pose.apply(P.moment_point_A);
+      break;
   }
   for (int k = 0; k < m; ++k) {
     PcForce& f = r.pcs[static_cast<std::size_t>(k)];
@@ -285,10 +308,15 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
       case Regime::kStick:  // eq. (4); min() only trims the round-off slack of eq. (3)
         Ff = -P.kp_N_per_mm * std::min(f.s_mm, f.s_bound_mm) * task_dir(dir_static[k]);
         break;
-      case Regime::kMaxStatic: Ff = -P.mu_static * f.F_cy * task_dir(dir_static[k]); break;  // eq. (6)
-      case Regime::kKinetic: Ff = -P.mu_kinetic * f.F_cy * task_dir(dir_kinetic[k]); break;  // eq. (5)
+      case Regime::kMaxStatic:
+        Ff = -P.mu_static * f.F_cy * task_dir(dir_static[k]);
+        break;  // eq. (6)
+      case Regime::kKinetic:
+        Ff = -P.mu_kinetic * f.F_cy * task_dir(dir_kinetic[k]);
+        break;  // eq. (5)
       case Regime::kNone:
-      case Regime::kApproaching: break;
+      case Regime::kApproaching:
+        break;
     }
     f.F_T = Vec3(Ff.x(), f.F_cy, Ff.z());
     f.F_W = f.R_WT * f.F_T;

@@ -1,7 +1,7 @@
 #include <cf/identifier.hpp>
 
-#include "identify.hpp"
 #include "../check.hpp"
+#include "identify.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,13 +12,20 @@ namespace cf {
 
 const char* to_string(IdStatus status) {
   switch (status) {
-    case IdStatus::kMatchedPrevious: return "matched-previous";
-    case IdStatus::kMatchedNeighbour: return "matched-neighbour";
-    case IdStatus::kMatchedByFit: return "matched-by-fit";
-    case IdStatus::kNoContact: return "no-contact";
-    case IdStatus::kNonNeighbourJump: return "non-neighbour-jump";
-    case IdStatus::kOutsideGraph: return "outside-graph";
-    case IdStatus::kTooManyPlanes: return "too-many-planes";
+    case IdStatus::kMatchedPrevious:
+      return "matched-previous";
+    case IdStatus::kMatchedNeighbour:
+      return "matched-neighbour";
+    case IdStatus::kMatchedByFit:
+      return "matched-by-fit";
+    case IdStatus::kNoContact:
+      return "no-contact";
+    case IdStatus::kNonNeighbourJump:
+      return "non-neighbour-jump";
+    case IdStatus::kOutsideGraph:
+      return "outside-graph";
+    case IdStatus::kTooManyPlanes:
+      return "too-many-planes";
   }
   return "?";
 }
@@ -66,8 +73,10 @@ bool closures_meet(const Polyhedron& m, ElementKind ki, int i, ElementKind kj, i
   int p = 0, q = 0;  // both ascending
   while (p < x.n && q < y.n) {
     if (x.v[p] == y.v[q]) return true;
-    if (x.v[p] < y.v[q]) ++p;
-    else ++q;
+    if (x.v[p] < y.v[q])
+      ++p;
+    else
+      ++q;
   }
   return false;
 }
@@ -85,7 +94,8 @@ struct IdentifyScratch {
   CfId prev;
   // Per step scratch (fixed size).
   std::array<std::array<std::int16_t, ContactSet::kCapacity>, kMaxGroups> members{};
-  std::array<std::pair<double, std::int16_t>, ContactSet::kCapacity> by_fit{};  // scratch: (misfit, position)
+  std::array<std::pair<double, std::int16_t>, ContactSet::kCapacity>
+      by_fit{};  // scratch: (misfit, position)
   std::array<int, kMaxGroups> count{};
   // The members some CF of the graph holds (best fit first): only these can be chosen.
   std::array<std::array<std::int16_t, ContactSet::kCapacity>, kMaxGroups> choosable{};
@@ -104,7 +114,8 @@ struct IdentifyScratch {
     const std::uint64_t k = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(pc.a)) << 34) ^
                             (static_cast<std::uint64_t>(static_cast<std::uint32_t>(pc.b)) << 3) ^
                             static_cast<std::uint64_t>(pc.type);
-    HeldEntry& e = held_memo[static_cast<std::size_t>((k * 0x9E3779B97F4A7C15ull) >> 54) % kHeldMemo];
+    HeldEntry& e =
+        held_memo[static_cast<std::size_t>((k * 0x9E3779B97F4A7C15ull) >> 54) % kHeldMemo];
     if (e.pc != pc) {
       e.pc = pc;
       e.held = graph->holds(pc);
@@ -155,10 +166,10 @@ struct IdentifyScratch {
 
   // An interpretation that is a CF, with its rank keys (docs/runtime.md, Identification).
   struct Ranked {
-    int tier = 2;    // 0: every skipped plane apart; 1: some explained
-    int dom = 4;     // dominated PCs chosen
-    int left = 64;   // skipped planes holding an exact, undominated touch (another reading)
-    int cat = 3;     // 0 previous CF, 1 its neighbour, 2 other
+    int tier = 2;   // 0: every skipped plane apart; 1: some explained
+    int dom = 4;    // dominated PCs chosen
+    int left = 64;  // skipped planes holding an exact, undominated touch (another reading)
+    int cat = 3;    // 0 previous CF, 1 its neighbour, 2 other
     double misfit = 0;
     CfId id;
     int n = 0;
@@ -180,7 +191,8 @@ struct IdentifyScratch {
   // Ranks the interpretation `chosen` (contact indices; taken[g]: plane g has one of them).
   // False when a skipped plane is not accounted for, when it ranks below `bound` on the
   // first two keys (dominated PCs, then tier), or when no CF has this PC set.
-  bool rank(const int* chosen, int n, const bool* taken, int G, const Ranked& bound, Ranked& r) const {
+  bool rank(const int* chosen, int n, const bool* taken, int G, const Ranked& bound,
+            Ranked& r) const {
     const ContactSet& cs = res->contacts;
     r.partial = n < G;
     r.dom = 0;
@@ -205,7 +217,9 @@ struct IdentifyScratch {
     const std::optional<CfId> id = graph->find(key);
     if (!id) return false;
     r.id = *id;
-    r.cat = (prev.valid() && *id == prev) ? 0 : (prev.valid() && graph->adjacent(prev, *id)) ? 1 : 2;
+    r.cat = (prev.valid() && *id == prev)                  ? 0
+            : (prev.valid() && graph->adjacent(prev, *id)) ? 1
+                                                           : 2;
     r.misfit = 0;
     for (int i = 0; i < n; ++i) r.misfit += cs[chosen[i]].misfit;
     r.n = n;
@@ -253,7 +267,9 @@ struct IdentifyScratch {
     }
     res->num_approaching = 0;
     for (int g = 0; g < cs.num_planes() && partial; ++g) {
-      if (held[static_cast<std::size_t>(g)] || accounted(g, chosen, n, farthest + prm.touch_distance_mm) != 0) continue;
+      if (held[static_cast<std::size_t>(g)] ||
+          accounted(g, chosen, n, farthest + prm.touch_distance_mm) != 0)
+        continue;
       int best = -1;
       for (int k = 0; k < count[static_cast<std::size_t>(g)]; ++k) {
         const int i = members[static_cast<std::size_t>(g)][static_cast<std::size_t>(k)];
@@ -271,7 +287,8 @@ struct IdentifyScratch {
     res->num_cf_pcs = 0;
     for (const Pc& pc : res->pcs)
       for (int i = 0; i < n; ++i)
-        if (res->contacts[chosen[i]].pc == pc) res->cf_pcs[static_cast<std::size_t>(res->num_cf_pcs++)] = res->contacts[chosen[i]];
+        if (res->contacts[chosen[i]].pc == pc)
+          res->cf_pcs[static_cast<std::size_t>(res->num_cf_pcs++)] = res->contacts[chosen[i]];
   }
 
   void run() {
@@ -310,12 +327,14 @@ struct IdentifyScratch {
         by_fit[static_cast<std::size_t>(i)] = {cs[v].misfit, v};
       }
       std::sort(by_fit.begin(), by_fit.begin() + n);
-      for (int i = 0; i < n; ++i) m[static_cast<std::size_t>(i)] = by_fit[static_cast<std::size_t>(i)].second;
+      for (int i = 0; i < n; ++i)
+        m[static_cast<std::size_t>(i)] = by_fit[static_cast<std::size_t>(i)].second;
       auto& c = choosable[static_cast<std::size_t>(g)];
       int& nc = nchoose[static_cast<std::size_t>(g)];
       nc = 0;
       for (int i = 0; i < count[static_cast<std::size_t>(g)]; ++i)
-        if (holds(cs[m[static_cast<std::size_t>(i)]].pc)) c[static_cast<std::size_t>(nc++)] = m[static_cast<std::size_t>(i)];
+        if (holds(cs[m[static_cast<std::size_t>(i)]].pc))
+          c[static_cast<std::size_t>(nc++)] = m[static_cast<std::size_t>(i)];
     }
     if (try_previous(G)) return;
 
@@ -346,8 +365,10 @@ struct IdentifyScratch {
         const int d = digit[static_cast<std::size_t>(g)];
         taken[static_cast<std::size_t>(g)] = d < nchoose[static_cast<std::size_t>(g)];
         if (taken[static_cast<std::size_t>(g)]) {
-          if (n == 3) too_many = true;
-          else chosen[n++] = choosable[static_cast<std::size_t>(g)][static_cast<std::size_t>(d)];
+          if (n == 3)
+            too_many = true;
+          else
+            chosen[n++] = choosable[static_cast<std::size_t>(g)][static_cast<std::size_t>(d)];
         }
       }
       if (!too_many && n > 0) {
@@ -365,7 +386,8 @@ struct IdentifyScratch {
       }
       // Next combination (mixed radix, last plane fastest).
       int g = G - 1;
-      while (g >= 0 && ++digit[static_cast<std::size_t>(g)] > nchoose[static_cast<std::size_t>(g)]) digit[static_cast<std::size_t>(g--)] = 0;
+      while (g >= 0 && ++digit[static_cast<std::size_t>(g)] > nchoose[static_cast<std::size_t>(g)])
+        digit[static_cast<std::size_t>(g--)] = 0;
       if (g < 0) break;
     }
     const CfId best_id = best.id;
@@ -385,12 +407,11 @@ struct IdentifyScratch {
   }
 };
 
-
 void IdentifyScratchDelete::operator()(IdentifyScratch* s) const { delete s; }
 IdentifyScratchPtr make_identify_scratch() { return IdentifyScratchPtr(new IdentifyScratch()); }
 
-void identify(const CfGraph& graph, const IdentificationParams& params, double epsilon_mm, CfId previous,
-              IdentifyScratch& s, Identification& id) {
+void identify(const CfGraph& graph, const IdentificationParams& params, double epsilon_mm,
+              CfId previous, IdentifyScratch& s, Identification& id) {
   s.graph = &graph;
   s.prm = params;
   s.eps_mm = epsilon_mm;
@@ -405,8 +426,10 @@ void check_identification_params(const IdentificationParams& params) {
     throw Error("cf::Params: parameter identification.max_combinations must be at least 1, got " +
                 std::to_string(params.max_combinations));
   if (!std::isfinite(params.touch_distance_mm) || params.touch_distance_mm < 0)
-    throw Error("cf::Params: parameter identification.touch_distance_mm must be finite and non-negative, got " +
-                std::to_string(params.touch_distance_mm));
+    throw Error(
+        "cf::Params: parameter identification.touch_distance_mm must be finite and non-negative, "
+        "got " +
+        std::to_string(params.touch_distance_mm));
 }
 
 }  // namespace detail

@@ -20,8 +20,8 @@ IdentifyScratchPtr make_identify_scratch();
 
 /// Identifies the CF among `id.contacts` (as detected: canonical order, planes set),
 /// preferring `previous` and its neighbours; fills the rest of `id`. No heap allocation.
-void identify(const CfGraph& graph, const IdentificationParams& params, double epsilon_mm, CfId previous,
-              IdentifyScratch& s, Identification& id);
+void identify(const CfGraph& graph, const IdentificationParams& params, double epsilon_mm,
+              CfId previous, IdentifyScratch& s, Identification& id);
 
 /// @throws cf::Error naming an identification parameter out of range.
 void check_identification_params(const IdentificationParams& params);

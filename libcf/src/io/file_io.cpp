@@ -93,9 +93,13 @@ std::string checked_target(const std::string& path, const std::vector<std::strin
   const std::string dir = dir_of(target);
   struct stat sd {};
   if (::stat(dir.c_str(), &sd) != 0)
-    refuse(what, path, "the directory '" + dir + "' " + (errno == ENOENT ? std::string("does not exist") : "cannot be checked: " + errno_text(errno)));
+    refuse(what, path,
+           "the directory '" + dir + "' " +
+               (errno == ENOENT ? std::string("does not exist")
+                                : "cannot be checked: " + errno_text(errno)));
   if (!S_ISDIR(sd.st_mode)) refuse(what, path, "'" + dir + "' is not a directory");
-  if (::access(dir.c_str(), W_OK) != 0) refuse(what, path, "the directory '" + dir + "' is not writable: " + errno_text(errno));
+  if (::access(dir.c_str(), W_OK) != 0)
+    refuse(what, path, "the directory '" + dir + "' is not writable: " + errno_text(errno));
   return target;
 }
 
@@ -107,7 +111,8 @@ std::string canonical_key(const std::string& target) {
 
 }  // namespace
 
-bool read_input_file(const std::string& path, std::string& bytes, std::string& why, std::size_t max_bytes) {
+bool read_input_file(const std::string& path, std::string& bytes, std::string& why,
+                     std::size_t max_bytes) {
   bytes.clear();
   if (path.empty()) {
     why = "empty file name";
@@ -165,7 +170,8 @@ bool read_input_file(const std::string& path, std::string& bytes, std::string& w
   return true;
 }
 
-void check_output_path(const std::string& path, const std::vector<std::string>& inputs, const char* what) {
+void check_output_path(const std::string& path, const std::vector<std::string>& inputs,
+                       const char* what) {
   checked_target(path, inputs, what);
 }
 
@@ -173,21 +179,23 @@ void write_outputs(const std::vector<OutputFile>& files, const std::vector<std::
                    const char* what) {
   std::vector<detail::StreamedOutput> streamed;
   for (const OutputFile& f : files)
-    streamed.push_back({f.path, [&f](const detail::ByteSink& sink) { sink(f.bytes.data(), f.bytes.size()); }});
+    streamed.push_back(
+        {f.path, [&f](const detail::ByteSink& sink) { sink(f.bytes.data(), f.bytes.size()); }});
   detail::write_streamed_outputs(streamed, inputs, what);
 }
 
 namespace detail {
 
-void write_streamed_outputs(const std::vector<StreamedOutput>& files, const std::vector<std::string>& inputs,
-                            const char* what) {
+void write_streamed_outputs(const std::vector<StreamedOutput>& files,
+                            const std::vector<std::string>& inputs, const char* what) {
   std::vector<std::string> targets, keys;
   for (const StreamedOutput& f : files) {
     targets.push_back(checked_target(f.path, inputs, what));
     keys.push_back(canonical_key(targets.back()));
     for (std::size_t k = 0; k + 1 < keys.size(); ++k)
       if (keys[k] == keys.back())
-        refuse(what, f.path, "is also the output '" + files[k].path + "'; each output needs its own file");
+        refuse(what, f.path,
+               "is also the output '" + files[k].path + "'; each output needs its own file");
   }
   std::vector<std::string> temps;
   auto discard = [&temps] {
@@ -202,7 +210,8 @@ void write_streamed_outputs(const std::vector<StreamedOutput>& files, const std:
     if (fd < 0) {
       const int e = errno;
       discard();
-      refuse(what, files[i].path, "cannot create a temporary file in '" + dir_of(target) + "': " + errno_text(e));
+      refuse(what, files[i].path,
+             "cannot create a temporary file in '" + dir_of(target) + "': " + errno_text(e));
     }
     temps.push_back(tmp);
     int err = 0;
@@ -269,21 +278,24 @@ std::string quaternion_problem(double w, double x, double y, double z) {
   const double norm = std::sqrt(w * w + x * x + y * y + z * z);
   if (std::isfinite(norm) && std::abs(norm - 1) <= kUnitQuaternionTolerance) return {};
   char buf[160];
-  std::snprintf(buf, sizeof buf, "the quaternion (qw,qx,qy,qz) has norm %.9g, not 1 within %g", norm,
-                kUnitQuaternionTolerance);
+  std::snprintf(buf, sizeof buf, "the quaternion (qw,qx,qy,qz) has norm %.9g, not 1 within %g",
+                norm, kUnitQuaternionTolerance);
   return buf;
 }
 
 std::string size_warning(const Polyhedron& model, const std::string& which, double epsilon_mm) {
   if (model.num_vertices() == 0 || !(epsilon_mm > 0)) return {};
   const double diag = (model.bbox_max() - model.bbox_min()).norm();
-  const bool small = diag < kSmallModel * epsilon_mm, large = diag > kLargeModel * epsilon_mm;
+  const bool small = diag<kSmallModel * epsilon_mm, large = diag> kLargeModel * epsilon_mm;
   if (!small && !large) return {};
   char buf[160];
-  std::snprintf(buf, sizeof buf, " is %.4g mm across (bounding-box diagonal), %s against the contact threshold "
-                "epsilon = %g mm (%s %g epsilon)", diag, small ? "small" : "large", epsilon_mm,
-                small ? "below" : "above", small ? kSmallModel : kLargeModel);
-  return "model " + (which.empty() ? "" : which + " ") + "'" + printable(model.name(), 40) + "'" + buf;
+  std::snprintf(buf, sizeof buf,
+                " is %.4g mm across (bounding-box diagonal), %s against the contact threshold "
+                "epsilon = %g mm (%s %g epsilon)",
+                diag, small ? "small" : "large", epsilon_mm, small ? "below" : "above",
+                small ? kSmallModel : kLargeModel);
+  return "model " + (which.empty() ? "" : which + " ") + "'" + printable(model.name(), 40) + "'" +
+         buf;
 }
 
 }  // namespace cf

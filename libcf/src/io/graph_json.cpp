@@ -1,9 +1,9 @@
 // The CF graph file (SPEC section 5): writing (deterministic, whole-or-nothing) and reading
 // (JSON or CBOR, schema-validated, every fault named by file and JSON pointer).
 
-#include "model/graph_impl.hpp"
 #include "graph_schema.hpp"
 #include "json_util.hpp"
+#include "model/graph_impl.hpp"
 #include "polyhedron_json.hpp"
 #include "streamed_output.hpp"
 
@@ -26,10 +26,13 @@ using detail::JsonWhere;
 using ojson = nlohmann::ordered_json;
 
 bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-bool is_cbor_path(const std::string& path) { return ends_with(path, ".cbor") || ends_with(path, ".CBOR"); }
+bool is_cbor_path(const std::string& path) {
+  return ends_with(path, ".cbor") || ends_with(path, ".CBOR");
+}
 
 // --- writing ----------------------------------------------------------------------------
 
@@ -251,8 +254,10 @@ void append_items(std::string& out, const CfGraph::Impl& g, bool cfs, const std:
   const std::size_t n = cfs ? g.cfs.size() : g.transitions.size();
   for (std::size_t i = 0; i < n; ++i) {
     out += i == 0 ? before : sep;
-    if (cfs) append_cf(out, i, g.cfs[i]);
-    else append_transition(out, g.transitions[i]);
+    if (cfs)
+      append_cf(out, i, g.cfs[i]);
+    else
+      append_transition(out, g.transitions[i]);
     if (flush && out.size() >= kFlushBytes) (*flush)(out);
   }
 }
@@ -306,9 +311,9 @@ void print(const ojson& v, int indent, int level, bool items_inline, std::string
       print(*it, indent, level + 1, false, out);
     }
   }
-  out += "\n" + std::string(static_cast<std::size_t>(indent * level), ' ') + (v.is_object() ? "}" : "]");
+  out += "\n" + std::string(static_cast<std::size_t>(indent * level), ' ') +
+         (v.is_object() ? "}" : "]");
 }
-
 
 /// The graph's JSON text (CfGraph::to_json) appended to `out`, handed to `flush` in pieces
 /// when it is set (the rest stays in `out`).
@@ -389,7 +394,8 @@ CfGraph CfGraph::load(const std::string& path) { return load(path, GraphLoadOpti
 CfGraph CfGraph::load(const std::string& path, const GraphLoadOptions& options) {
   // Never blocks on a FIFO; a directory, a device or a FIFO is refused before reading.
   std::string bytes, why;
-  if (!read_input_file(path, bytes, why)) throw Error("reading '" + path + "': cannot open: " + why);
+  if (!read_input_file(path, bytes, why))
+    throw Error("reading '" + path + "': cannot open: " + why);
   CfGraph g;
   g.impl_ = detail::read_graph(bytes, path, is_cbor_path(path), options);
   return g;

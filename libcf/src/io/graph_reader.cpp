@@ -8,9 +8,9 @@
 // members, types, ranges, no unknown members in PCs and witnesses); GraphLoadOptions::
 // full_schema_check runs valijson over the whole document as well.
 
-#include "model/graph_impl.hpp"
 #include "graph_schema.hpp"
 #include "json_util.hpp"
+#include "model/graph_impl.hpp"
 #include "polyhedron_json.hpp"
 
 #include <cf/file_io.hpp>
@@ -18,9 +18,9 @@
 #include <array>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <cmath>
 #include <string_view>
 #include <utility>
 
@@ -53,44 +53,69 @@ struct Scalar {
 
   bool is_number() const { return type == kInt || type == kUint || type == kFloat; }
   bool is_integer() const { return type == kInt || type == kUint; }
-  double number() const { return type == kInt ? static_cast<double>(i) : type == kUint ? static_cast<double>(u) : d; }
+  double number() const {
+    return type == kInt ? static_cast<double>(i) : type == kUint ? static_cast<double>(u) : d;
+  }
   json to_json() const {
     switch (type) {
-      case kNull: return json(nullptr);
-      case kBool: return json(b);
-      case kInt: return json(i);
-      case kUint: return json(u);
-      case kFloat: return json(d);
-      default: return json(*s);
+      case kNull:
+        return json(nullptr);
+      case kBool:
+        return json(b);
+      case kInt:
+        return json(i);
+      case kUint:
+        return json(u);
+      case kFloat:
+        return json(d);
+      default:
+        return json(*s);
     }
   }
   std::string shown() const { return json_short(to_json()); }
 };
 
 enum class Ctx : std::uint8_t {
-  kDocument,    // expecting the root value
-  kRoot,        // in the root object
-  kCapture,     // inside a DOM-captured container (models, metadata)
-  kSkip,        // inside a container whose content is ignored
-  kCfs,         // in the cfs array
-  kCf,          // in a CF object
-  kPcs,         // in a CF's pcs array
-  kPc,          // in a PC object
-  kWitness,     // in a witness object
-  kR,           // in witness.R
-  kRRow,        // in a row of witness.R
-  kT,           // in witness.t
-  kTransitions, // in the transitions array
-  kTransition,  // in a transition object
+  kDocument,     // expecting the root value
+  kRoot,         // in the root object
+  kCapture,      // inside a DOM-captured container (models, metadata)
+  kSkip,         // inside a container whose content is ignored
+  kCfs,          // in the cfs array
+  kCf,           // in a CF object
+  kPcs,          // in a CF's pcs array
+  kPc,           // in a PC object
+  kWitness,      // in a witness object
+  kR,            // in witness.R
+  kRRow,         // in a row of witness.R
+  kT,            // in witness.t
+  kTransitions,  // in the transitions array
+  kTransition,   // in a transition object
 };
 
 /// What the next value is, set by the preceding key.
 enum class Field : std::uint8_t {
-  kNone, kRootOther, kRootCfs, kRootTransitions,
-  kCfId, kCfPcs, kCfWitness, kCfDof, kCfTdof, kCfPure, kCfOther,
-  kPcType, kPcA, kPcB, kPcOther,
-  kWR, kWT, kWOther,
-  kTrFrom, kTrTo, kTrKind, kTrOther,
+  kNone,
+  kRootOther,
+  kRootCfs,
+  kRootTransitions,
+  kCfId,
+  kCfPcs,
+  kCfWitness,
+  kCfDof,
+  kCfTdof,
+  kCfPure,
+  kCfOther,
+  kPcType,
+  kPcA,
+  kPcB,
+  kPcOther,
+  kWR,
+  kWT,
+  kWOther,
+  kTrFrom,
+  kTrTo,
+  kTrKind,
+  kTrOther,
 };
 
 class GraphSax {
@@ -101,12 +126,41 @@ class GraphSax {
   }
 
   // --- nlohmann SAX interface -----------------------------------------------------------
-  bool null() { Scalar s; s.type = Scalar::kNull; return scalar(s); }
-  bool boolean(bool v) { Scalar s; s.type = Scalar::kBool; s.b = v; return scalar(s); }
-  bool number_integer(std::int64_t v) { Scalar s; s.type = Scalar::kInt; s.i = v; return scalar(s); }
-  bool number_unsigned(std::uint64_t v) { Scalar s; s.type = Scalar::kUint; s.u = v; return scalar(s); }
-  bool number_float(double v, const std::string&) { Scalar s; s.type = Scalar::kFloat; s.d = v; return scalar(s); }
-  bool string(std::string& v) { Scalar s; s.type = Scalar::kString; s.s = &v; return scalar(s); }
+  bool null() {
+    Scalar s;
+    s.type = Scalar::kNull;
+    return scalar(s);
+  }
+  bool boolean(bool v) {
+    Scalar s;
+    s.type = Scalar::kBool;
+    s.b = v;
+    return scalar(s);
+  }
+  bool number_integer(std::int64_t v) {
+    Scalar s;
+    s.type = Scalar::kInt;
+    s.i = v;
+    return scalar(s);
+  }
+  bool number_unsigned(std::uint64_t v) {
+    Scalar s;
+    s.type = Scalar::kUint;
+    s.u = v;
+    return scalar(s);
+  }
+  bool number_float(double v, const std::string&) {
+    Scalar s;
+    s.type = Scalar::kFloat;
+    s.d = v;
+    return scalar(s);
+  }
+  bool string(std::string& v) {
+    Scalar s;
+    s.type = Scalar::kString;
+    s.s = &v;
+    return scalar(s);
+  }
   bool binary(json::binary_t&) {
     Scalar s;
     s.type = Scalar::kNull;
@@ -118,12 +172,13 @@ class GraphSax {
   bool end_array() { return end(); }
   bool key(std::string& k);
   bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) {
-    throw Error("reading '" + source_ + "': not valid " + (cbor_ ? "CBOR" : "JSON") + ": " + e.what());
+    throw Error("reading '" + source_ + "': not valid " + (cbor_ ? "CBOR" : "JSON") + ": " +
+                e.what());
   }
 
   // --- results --------------------------------------------------------------------------
   json skeleton = json::object();  ///< every root member except the cfs and transitions items
-  std::vector<CfRecord> cfs;  ///< PC sets still empty: filled from raw_pcs after the parse
+  std::vector<CfRecord> cfs;       ///< PC sets still empty: filled from raw_pcs after the parse
   std::vector<RawPcs> raw_pcs;
   std::vector<Transition> transitions;
   bool have_cfs = false, have_transitions = false;
@@ -150,7 +205,9 @@ class GraphSax {
   static const char* container_name(bool object) { return object ? "an object" : "an array"; }
 
   void capture_value(json value);
-  bool item_context(Ctx c) const { return c != Ctx::kDocument && c != Ctx::kRoot && c != Ctx::kCapture; }
+  bool item_context(Ctx c) const {
+    return c != Ctx::kDocument && c != Ctx::kRoot && c != Ctx::kCapture;
+  }
 
   const std::string& source_;
   bool cbor_;
@@ -170,23 +227,40 @@ class GraphSax {
 
 std::string GraphSax::field_ptr() const {
   switch (field_) {
-    case Field::kCfId: return cf_ptr() + "/id";
-    case Field::kCfPcs: return cf_ptr() + "/pcs";
-    case Field::kCfWitness: return cf_ptr() + "/witness";
-    case Field::kCfDof: return cf_ptr() + "/dof";
-    case Field::kCfTdof: return cf_ptr() + "/translation_dof";
-    case Field::kCfPure: return cf_ptr() + "/pure_rotation";
-    case Field::kPcType: return pc_ptr() + "/type";
-    case Field::kPcA: return pc_ptr() + "/a";
-    case Field::kPcB: return pc_ptr() + "/b";
-    case Field::kWR: return cf_ptr() + "/witness/R";
-    case Field::kWT: return cf_ptr() + "/witness/t";
-    case Field::kTrFrom: return tr_ptr() + "/from";
-    case Field::kTrTo: return tr_ptr() + "/to";
-    case Field::kTrKind: return tr_ptr() + "/kind";
-    case Field::kRootCfs: return "/cfs";
-    case Field::kRootTransitions: return "/transitions";
-    default: return "/";
+    case Field::kCfId:
+      return cf_ptr() + "/id";
+    case Field::kCfPcs:
+      return cf_ptr() + "/pcs";
+    case Field::kCfWitness:
+      return cf_ptr() + "/witness";
+    case Field::kCfDof:
+      return cf_ptr() + "/dof";
+    case Field::kCfTdof:
+      return cf_ptr() + "/translation_dof";
+    case Field::kCfPure:
+      return cf_ptr() + "/pure_rotation";
+    case Field::kPcType:
+      return pc_ptr() + "/type";
+    case Field::kPcA:
+      return pc_ptr() + "/a";
+    case Field::kPcB:
+      return pc_ptr() + "/b";
+    case Field::kWR:
+      return cf_ptr() + "/witness/R";
+    case Field::kWT:
+      return cf_ptr() + "/witness/t";
+    case Field::kTrFrom:
+      return tr_ptr() + "/from";
+    case Field::kTrTo:
+      return tr_ptr() + "/to";
+    case Field::kTrKind:
+      return tr_ptr() + "/kind";
+    case Field::kRootCfs:
+      return "/cfs";
+    case Field::kRootTransitions:
+      return "/transitions";
+    default:
+      return "/";
   }
 }
 
@@ -203,31 +277,44 @@ bool GraphSax::key(std::string& k) {
   switch (stack_.back()) {
     case Ctx::kRoot:
       root_key_ = k;
-      field_ = k == "cfs" ? Field::kRootCfs : k == "transitions" ? Field::kRootTransitions : Field::kRootOther;
+      field_ = k == "cfs"           ? Field::kRootCfs
+               : k == "transitions" ? Field::kRootTransitions
+                                    : Field::kRootOther;
       break;
-    case Ctx::kCapture: capture_key_ = k; break;
+    case Ctx::kCapture:
+      capture_key_ = k;
+      break;
     case Ctx::kCf:
-      field_ = k == "id" ? Field::kCfId
-               : k == "pcs" ? Field::kCfPcs
-               : k == "witness" ? Field::kCfWitness
-               : k == "dof" ? Field::kCfDof
+      field_ = k == "id"                ? Field::kCfId
+               : k == "pcs"             ? Field::kCfPcs
+               : k == "witness"         ? Field::kCfWitness
+               : k == "dof"             ? Field::kCfDof
                : k == "translation_dof" ? Field::kCfTdof
-               : k == "pure_rotation" ? Field::kCfPure
-                                      : Field::kCfOther;  // CFs may carry extra members
+               : k == "pure_rotation"   ? Field::kCfPure
+                                        : Field::kCfOther;  // CFs may carry extra members
       break;
     case Ctx::kPc:
-      field_ = k == "type" ? Field::kPcType : k == "a" ? Field::kPcA : k == "b" ? Field::kPcB : Field::kPcOther;
-      if (field_ == Field::kPcOther) fault(pc_ptr(), "unexpected member \"" + printable(k) + "\" (a PC has type, a and b)");
+      field_ = k == "type" ? Field::kPcType
+               : k == "a"  ? Field::kPcA
+               : k == "b"  ? Field::kPcB
+                           : Field::kPcOther;
+      if (field_ == Field::kPcOther)
+        fault(pc_ptr(), "unexpected member \"" + printable(k) + "\" (a PC has type, a and b)");
       break;
     case Ctx::kWitness:
       field_ = k == "R" ? Field::kWR : k == "t" ? Field::kWT : Field::kWOther;
       if (field_ == Field::kWOther)
-        fault(cf_ptr() + "/witness", "unexpected member \"" + printable(k) + "\" (a witness has R and t)");
+        fault(cf_ptr() + "/witness",
+              "unexpected member \"" + printable(k) + "\" (a witness has R and t)");
       break;
     case Ctx::kTransition:
-      field_ = k == "from" ? Field::kTrFrom : k == "to" ? Field::kTrTo : k == "kind" ? Field::kTrKind : Field::kTrOther;
+      field_ = k == "from"   ? Field::kTrFrom
+               : k == "to"   ? Field::kTrTo
+               : k == "kind" ? Field::kTrKind
+                             : Field::kTrOther;
       break;
-    default: break;  // kSkip
+    default:
+      break;  // kSkip
   }
   return true;
 }
@@ -239,8 +326,10 @@ bool GraphSax::scalar(const Scalar& s) {
     return true;
   }
   if (c == Ctx::kRoot) {
-    if (field_ == Field::kRootOther) skeleton[root_key_] = s.to_json();
-    else fault(field_ptr(), std::string("expected an array, got ") + s.shown());
+    if (field_ == Field::kRootOther)
+      skeleton[root_key_] = s.to_json();
+    else
+      fault(field_ptr(), std::string("expected an array, got ") + s.shown());
     return true;
   }
   if (c == Ctx::kCapture) {
@@ -250,18 +339,22 @@ bool GraphSax::scalar(const Scalar& s) {
   if (faulted() || c == Ctx::kSkip) return true;
 
   auto index = [&](std::int32_t& out) {
-    if (s.is_integer() && (s.type == Scalar::kUint ? s.u <= 2147483647ULL : (s.i >= 0 && s.i <= 2147483647LL))) {
-      out = static_cast<std::int32_t>(s.type == Scalar::kUint ? s.u : static_cast<std::uint64_t>(s.i));
+    if (s.is_integer() &&
+        (s.type == Scalar::kUint ? s.u <= 2147483647ULL : (s.i >= 0 && s.i <= 2147483647LL))) {
+      out = static_cast<std::int32_t>(s.type == Scalar::kUint ? s.u
+                                                              : static_cast<std::uint64_t>(s.i));
       return true;
     }
     fault(field_ptr(), "expected a non-negative integer index, got " + s.shown());
     return false;
   };
   auto small_int = [&](int lo, int hi, int& out) {
-    const bool ok = s.is_integer() && (s.type == Scalar::kUint ? s.u <= static_cast<std::uint64_t>(hi)
-                                                               : (s.i >= lo && s.i <= hi));
+    const bool ok =
+        s.is_integer() && (s.type == Scalar::kUint ? s.u <= static_cast<std::uint64_t>(hi)
+                                                   : (s.i >= lo && s.i <= hi));
     if (!ok) {
-      fault(field_ptr(), "expected an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + s.shown());
+      fault(field_ptr(), "expected an integer in " + std::to_string(lo) + ".." +
+                             std::to_string(hi) + ", got " + s.shown());
       return;
     }
     out = static_cast<int>(s.type == Scalar::kUint ? static_cast<std::int64_t>(s.u) : s.i);
@@ -279,20 +372,34 @@ bool GraphSax::scalar(const Scalar& s) {
         case Field::kCfId: {
           has_id_ = true;
           const auto expected = static_cast<std::int64_t>(cfs.size() - 1);
-          if (!s.is_integer() || (s.type == Scalar::kInt ? s.i : static_cast<std::int64_t>(s.u)) != expected)
+          if (!s.is_integer() ||
+              (s.type == Scalar::kInt ? s.i : static_cast<std::int64_t>(s.u)) != expected)
             fault(field_ptr(), "id " + s.shown() + " should be " + std::to_string(expected) +
                                    " (CF ids are the array positions)");
           break;
         }
-        case Field::kCfPcs: has_pcs_ = true; fault(field_ptr(), "expected an array, got " + s.shown()); break;
-        case Field::kCfWitness: has_witness_ = true; fault(field_ptr(), "expected an object, got " + s.shown()); break;
-        case Field::kCfDof: small_int(0, 6, r.dof); break;
-        case Field::kCfTdof: small_int(0, 3, r.translation_dof); break;
-        case Field::kCfPure:
-          if (s.type != Scalar::kBool) fault(field_ptr(), "expected true or false, got " + s.shown());
-          else r.pure_rotation = s.b;
+        case Field::kCfPcs:
+          has_pcs_ = true;
+          fault(field_ptr(), "expected an array, got " + s.shown());
           break;
-        default: break;
+        case Field::kCfWitness:
+          has_witness_ = true;
+          fault(field_ptr(), "expected an object, got " + s.shown());
+          break;
+        case Field::kCfDof:
+          small_int(0, 6, r.dof);
+          break;
+        case Field::kCfTdof:
+          small_int(0, 3, r.translation_dof);
+          break;
+        case Field::kCfPure:
+          if (s.type != Scalar::kBool)
+            fault(field_ptr(), "expected true or false, got " + s.shown());
+          else
+            r.pure_rotation = s.b;
+          break;
+        default:
+          break;
       }
       break;
     }
@@ -310,14 +417,22 @@ bool GraphSax::scalar(const Scalar& s) {
           }
           const auto type = pc_type_from_string(*s.s);
           if (!type)
-            fault(field_ptr(), "unknown PC type \"" + *s.s + "\" (expected one of f-f, e-f, f-e, v-f, f-v, e-e)");
+            fault(field_ptr(), "unknown PC type \"" + *s.s +
+                                   "\" (expected one of f-f, e-f, f-e, v-f, f-v, e-e)");
           else
             pc_.type = *type;
           break;
         }
-        case Field::kPcA: has_a_ = true; index(pc_.a); break;
-        case Field::kPcB: has_b_ = true; index(pc_.b); break;
-        default: break;
+        case Field::kPcA:
+          has_a_ = true;
+          index(pc_.a);
+          break;
+        case Field::kPcB:
+          has_b_ = true;
+          index(pc_.b);
+          break;
+        default:
+          break;
       }
       break;
     case Ctx::kWitness:
@@ -326,20 +441,25 @@ bool GraphSax::scalar(const Scalar& s) {
       fault(field_ptr(), "expected an array, got " + s.shown());
       break;
     case Ctx::kR:
-      fault(cf_ptr() + "/witness/R/" + std::to_string(row_), "expected a row of 3 numbers, got " + s.shown());
+      fault(cf_ptr() + "/witness/R/" + std::to_string(row_),
+            "expected a row of 3 numbers, got " + s.shown());
       ++row_;
       break;
     case Ctx::kRRow: {
       if (!s.is_number())
         fault(cf_ptr() + "/witness/R/" + std::to_string(row_ - 1) + "/" + std::to_string(col_),
               "expected a number, got " + s.shown());
-      else if (col_ < 3) cfs.back().witness.R_BA(row_ - 1, col_) = s.number();
+      else if (col_ < 3)
+        cfs.back().witness.R_BA(row_ - 1, col_) = s.number();
       ++col_;
       break;
     }
     case Ctx::kT:
-      if (!s.is_number()) fault(cf_ptr() + "/witness/t/" + std::to_string(t_count_), "expected a number, got " + s.shown());
-      else if (t_count_ < 3) cfs.back().witness.t_BA(t_count_) = s.number();
+      if (!s.is_number())
+        fault(cf_ptr() + "/witness/t/" + std::to_string(t_count_),
+              "expected a number, got " + s.shown());
+      else if (t_count_ < 3)
+        cfs.back().witness.t_BA(t_count_) = s.number();
       ++t_count_;
       break;
     case Ctx::kTransitions:
@@ -350,8 +470,14 @@ bool GraphSax::scalar(const Scalar& s) {
       Transition& t = transitions.back();
       std::int32_t v = -1;
       switch (field_) {
-        case Field::kTrFrom: has_from_ = true; if (index(v)) t.from = CfId(v); break;
-        case Field::kTrTo: has_to_ = true; if (index(v)) t.to = CfId(v); break;
+        case Field::kTrFrom:
+          has_from_ = true;
+          if (index(v)) t.from = CfId(v);
+          break;
+        case Field::kTrTo:
+          has_to_ = true;
+          if (index(v)) t.to = CfId(v);
+          break;
         case Field::kTrKind: {
           has_kind_ = true;
           if (s.type != Scalar::kString) {
@@ -359,15 +485,20 @@ bool GraphSax::scalar(const Scalar& s) {
             break;
           }
           const auto kind = transition_kind_from_string(*s.s);
-          if (!kind) fault(field_ptr(), "unknown transition kind \"" + *s.s + "\" (expected gain, lose or change)");
-          else t.kind = *kind;
+          if (!kind)
+            fault(field_ptr(),
+                  "unknown transition kind \"" + *s.s + "\" (expected gain, lose or change)");
+          else
+            t.kind = *kind;
           break;
         }
-        default: break;
+        default:
+          break;
       }
       break;
     }
-    default: break;
+    default:
+      break;
   }
   return true;
 }
@@ -376,8 +507,8 @@ bool GraphSax::start(bool object) {
   // nlohmann's CBOR reader recurses once per level: without a cap, a few hundred thousand
   // nested arrays overflow the stack. JSON is capped by JsonWalker at the same depth.
   if (cbor_ && stack_.size() > kMaxNesting)
-    throw Error("reading '" + source_ + "': not valid CBOR: nesting deeper than " + std::to_string(kMaxNesting) +
-                " levels");
+    throw Error("reading '" + source_ + "': not valid CBOR: nesting deeper than " +
+                std::to_string(kMaxNesting) + " levels");
   const Ctx c = stack_.back();
   if (c == Ctx::kDocument) {
     if (!object) {
@@ -401,8 +532,10 @@ bool GraphSax::start(bool object) {
       have_transitions = true;
       stack_.push_back(Ctx::kTransitions);
     } else {
-      if (field_ == Field::kRootCfs) have_cfs = true;
-      else have_transitions = true;
+      if (field_ == Field::kRootCfs)
+        have_cfs = true;
+      else
+        have_transitions = true;
       fault(field_ptr(), std::string("expected an array, got ") + container_name(object));
       stack_.push_back(Ctx::kSkip);
     }
@@ -454,7 +587,9 @@ bool GraphSax::start(bool object) {
       } else {
         if (field_ == Field::kCfPcs) has_pcs_ = true;
         if (field_ == Field::kCfWitness) has_witness_ = true;
-        const char* want = field_ == Field::kCfPcs ? "an array" : field_ == Field::kCfWitness ? "an object" : "a scalar";
+        const char* want = field_ == Field::kCfPcs       ? "an array"
+                           : field_ == Field::kCfWitness ? "an object"
+                                                         : "a scalar";
         fault(field_ptr(), std::string("expected ") + want + ", got " + container_name(object));
       }
       break;
@@ -490,7 +625,8 @@ bool GraphSax::start(bool object) {
         col_ = 0;
         next = Ctx::kRRow;
       } else if (object) {
-        fault(cf_ptr() + "/witness/R/" + std::to_string(row_ - 1), "expected a row of 3 numbers, got an object");
+        fault(cf_ptr() + "/witness/R/" + std::to_string(row_ - 1),
+              "expected a row of 3 numbers, got an object");
       }
       break;
     case Ctx::kRRow:
@@ -498,7 +634,8 @@ bool GraphSax::start(bool object) {
             std::string("expected a number, got ") + container_name(object));
       break;
     case Ctx::kT:
-      fault(cf_ptr() + "/witness/t/" + std::to_string(t_count_), std::string("expected a number, got ") + container_name(object));
+      fault(cf_ptr() + "/witness/t/" + std::to_string(t_count_),
+            std::string("expected a number, got ") + container_name(object));
       break;
     case Ctx::kTransitions:
       transitions.emplace_back();
@@ -513,7 +650,8 @@ bool GraphSax::start(bool object) {
       if (field_ == Field::kTrOther) break;  // extra members allowed, skipped
       fault(field_ptr(), std::string("expected a scalar, got ") + container_name(object));
       break;
-    default: break;
+    default:
+      break;
   }
   stack_.push_back(next);
   return true;
@@ -568,17 +706,20 @@ bool GraphSax::end() {
       break;
     case Ctx::kRRow:
       if (col_ != 3)
-        fault(cf_ptr() + "/witness/R/" + std::to_string(row_ - 1), "expected 3 numbers, got " + std::to_string(col_));
+        fault(cf_ptr() + "/witness/R/" + std::to_string(row_ - 1),
+              "expected 3 numbers, got " + std::to_string(col_));
       break;
     case Ctx::kT:
-      if (t_count_ != 3) fault(cf_ptr() + "/witness/t", "expected 3 numbers, got " + std::to_string(t_count_));
+      if (t_count_ != 3)
+        fault(cf_ptr() + "/witness/t", "expected 3 numbers, got " + std::to_string(t_count_));
       break;
     case Ctx::kTransition:
       missing(at_tr, has_from_, "from");
       missing(at_tr, has_to_, "to");
       missing(at_tr, has_kind_, "kind");
       break;
-    default: break;
+    default:
+      break;
   }
   return true;
 }
@@ -590,7 +731,8 @@ bool GraphSax::end() {
 class JsonWalker {
  public:
   JsonWalker(const std::string& bytes, const std::string& source) : source_(source) {
-    static_assert(kReadSlack >= simdjson::SIMDJSON_PADDING, "read_input_file's slack must cover simdjson's padding");
+    static_assert(kReadSlack >= simdjson::SIMDJSON_PADDING,
+                  "read_input_file's slack must cover simdjson's padding");
     if (bytes.capacity() - bytes.size() >= simdjson::SIMDJSON_PADDING) {
       text_ = simdjson::padded_string_view(bytes);  // reads into the string's spare capacity
     } else {
@@ -604,7 +746,8 @@ class JsonWalker {
     // An empty or blank document is refused before simdjson sees it, to say so plainly.
     const char* first = text_.data();
     const char* const end = first + text_.size();
-    while (first < end && (*first == ' ' || *first == '\n' || *first == '\r' || *first == '\t')) ++first;
+    while (first < end && (*first == ' ' || *first == '\n' || *first == '\r' || *first == '\t'))
+      ++first;
     if (first == end) fail_at(end, "empty input, expected a JSON value");
     // Errors of simdjson's first pass (invalid UTF-8, an unclosed string, a raw control
     // character) come before there is a document to ask for a position.
@@ -613,7 +756,8 @@ class JsonWalker {
     iterating_ = true;
     simdjson::ondemand::json_type type{};
     check(doc_.type().get(type), first);
-    if (type == simdjson::ondemand::json_type::object || type == simdjson::ondemand::json_type::array) {
+    if (type == simdjson::ondemand::json_type::object ||
+        type == simdjson::ondemand::json_type::array) {
       simdjson::ondemand::value root;
       check(doc_.get_value().get(root), first);
       value(root, sax, 0);
@@ -643,12 +787,13 @@ class JsonWalker {
     std::string near;
     if (at < end) {
       const unsigned char c = static_cast<unsigned char>(*at);
-      near = c >= 0x20 && c < 0x7f ? std::string(" near '") + *at + "'" : " near byte " + std::to_string(c);
+      near = c >= 0x20 && c < 0x7f ? std::string(" near '") + *at + "'"
+                                   : " near byte " + std::to_string(c);
     } else {
       near = " at the end of the input";
     }
-    throw Error("reading '" + source_ + "': not valid JSON: syntax error at line " + std::to_string(line) +
-                ", column " + std::to_string(col) + near + ": " + what);
+    throw Error("reading '" + source_ + "': not valid JSON: syntax error at line " +
+                std::to_string(line) + ", column " + std::to_string(col) + near + ": " + what);
   }
 
   /// Where the parser stopped; `fallback` when it cannot say.
@@ -670,10 +815,14 @@ class JsonWalker {
     switch (e) {
       case simdjson::T_ATOM_ERROR:
       case simdjson::F_ATOM_ERROR:
-      case simdjson::N_ATOM_ERROR: return "invalid literal";
-      case simdjson::STRING_ERROR: return "invalid string (an unknown escape or an unpaired UTF-16 surrogate)";
-      case simdjson::NUMBER_ERROR: return "invalid number";
-      default: return simdjson::error_message(e);
+      case simdjson::N_ATOM_ERROR:
+        return "invalid literal";
+      case simdjson::STRING_ERROR:
+        return "invalid string (an unknown escape or an unpaired UTF-16 surrogate)";
+      case simdjson::NUMBER_ERROR:
+        return "invalid number";
+      default:
+        return simdjson::error_message(e);
     }
   }
 
@@ -685,7 +834,8 @@ class JsonWalker {
     check(v.type().get(type), at);
     switch (type) {
       case json_type::object: {
-        if (depth >= kMaxNesting) fail_at(at, "nesting deeper than " + std::to_string(kMaxNesting) + " levels");
+        if (depth >= kMaxNesting)
+          fail_at(at, "nesting deeper than " + std::to_string(kMaxNesting) + " levels");
         simdjson::ondemand::object object;
         check(v.get_object().get(object), at);
         sax.start_object(static_cast<std::size_t>(-1));
@@ -704,7 +854,8 @@ class JsonWalker {
         return;
       }
       case json_type::array: {
-        if (depth >= kMaxNesting) fail_at(at, "nesting deeper than " + std::to_string(kMaxNesting) + " levels");
+        if (depth >= kMaxNesting)
+          fail_at(at, "nesting deeper than " + std::to_string(kMaxNesting) + " levels");
         simdjson::ondemand::array array;
         check(v.get_array().get(array), at);
         sax.start_array(static_cast<std::size_t>(-1));
@@ -729,7 +880,8 @@ class JsonWalker {
     switch (type) {
       case json_type::number: {
         simdjson::ondemand::number n;
-        if (node.get_number().get(n) != simdjson::SUCCESS) return number_fallback(node.raw_json_token(), sax, at);
+        if (node.get_number().get(n) != simdjson::SUCCESS)
+          return number_fallback(node.raw_json_token(), sax, at);
         return emit_number(n, sax);
       }
       case json_type::string: {
@@ -747,27 +899,36 @@ class JsonWalker {
       }
       case json_type::null: {
         bool is_null = false;
-        if (node.is_null().get(is_null) != simdjson::SUCCESS || !is_null) fail_at(at, "invalid literal");
+        if (node.is_null().get(is_null) != simdjson::SUCCESS || !is_null)
+          fail_at(at, "invalid literal");
         sax.null();
         return;
       }
-      default: fail_at(at, "expected a value");
+      default:
+        fail_at(at, "expected a value");
     }
   }
 
   template <class Sax>
   void emit_number(simdjson::ondemand::number n, Sax& sax) {
     switch (n.get_number_type()) {
-      case simdjson::ondemand::number_type::signed_integer: sax.number_integer(n.get_int64()); return;
-      case simdjson::ondemand::number_type::unsigned_integer: sax.number_unsigned(n.get_uint64()); return;
-      default: sax.number_float(n.get_double(), kEmpty); return;
+      case simdjson::ondemand::number_type::signed_integer:
+        sax.number_integer(n.get_int64());
+        return;
+      case simdjson::ondemand::number_type::unsigned_integer:
+        sax.number_unsigned(n.get_uint64());
+        return;
+      default:
+        sax.number_float(n.get_double(), kEmpty);
+        return;
     }
   }
 
   /// simdjson refuses integers past 64 bits, which JSON allows and nlohmann reads as doubles;
   /// any other number it refuses is reported with its position.
   template <class Sax>
-  void number_fallback(simdjson::simdjson_result<std::string_view> token, Sax& sax, const char* at) {
+  void number_fallback(simdjson::simdjson_result<std::string_view> token, Sax& sax,
+                       const char* at) {
     std::string_view raw;
     if (std::move(token).get(raw) != simdjson::SUCCESS) fail_at(at, "invalid number");
     // The token runs to the next structural character: the number, then at most white space
@@ -792,9 +953,10 @@ class JsonWalker {
 
   inline static const std::string kEmpty;
   static constexpr const char* kInvalidNumber =
-      "invalid number (RFC 8259: an optional minus, digits without leading zeros, an optional fraction and "
+      "invalid number (RFC 8259: an optional minus, digits without leading zeros, an optional "
+      "fraction and "
       "exponent)";
-  simdjson::padded_string copy_;     // when the caller's bytes have no padding
+  simdjson::padded_string copy_;       // when the caller's bytes have no padding
   simdjson::padded_string_view text_;  // simdjson reads up to SIMDJSON_PADDING bytes past the end
   const std::string& source_;
   simdjson::ondemand::parser parser_;
@@ -813,10 +975,13 @@ class JsonLocator final : public FaultLocator {
                              const std::string& what) const override {
     json_fail(root_ / "cfs" / cf / "pcs" / pc / field, what);
   }
-  [[noreturn]] void transition_fault(std::size_t t, const char* field, const std::string& what) const override {
+  [[noreturn]] void transition_fault(std::size_t t, const char* field,
+                                     const std::string& what) const override {
     json_fail(root_ / "transitions" / t / field, what);
   }
-  [[noreturn]] void metadata_fault(const std::string& what) const override { json_fail(root_, what); }
+  [[noreturn]] void metadata_fault(const std::string& what) const override {
+    json_fail(root_, what);
+  }
 
  private:
   const JsonWhere& root_;
@@ -829,8 +994,8 @@ bool is_reserved(const std::string& key) {
 
 }  // namespace
 
-std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::string& source, bool cbor,
-                                          const GraphLoadOptions& options) {
+std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::string& source,
+                                          bool cbor, const GraphLoadOptions& options) {
   const char* const data = bytes.data();
   const std::size_t size = bytes.size();
   GraphSax sax(source, cbor);
@@ -849,12 +1014,14 @@ std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::s
       json_fail(root / "format", "format is " + json_short(*it) + ", expected \"cf-graph\"");
     const json& v = json_member(j, "version", root);
     if (!v.is_number_integer() || v.get<long long>() != 1)
-      json_fail(root / "version", "version " + json_short(v) + " is not supported (this library reads version 1)");
+      json_fail(root / "version",
+                "version " + json_short(v) + " is not supported (this library reads version 1)");
     const json& u = json_member(j, "units", root);
     if (!u.is_string() || u.get<std::string>() != "mm")
       json_fail(root / "units", "units " + json_short(u) + " are not supported, expected \"mm\"");
   }
-  if (sax.faulted()) throw Error("reading '" + source + "' at " + sax.fault_pointer + ": " + sax.fault_what);
+  if (sax.faulted())
+    throw Error("reading '" + source + "' at " + sax.fault_pointer + ": " + sax.fault_what);
   const JsonWhere wm = root / "models";
   const json& jm = json_member(j, "models", root);
   if (!sax.have_cfs) json_fail(root, "missing member \"cfs\"");
@@ -874,14 +1041,16 @@ std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::s
       if (std::string why = check_pc(pc, impl->a, impl->b, &field); !why.empty())
         where.pc_fault(i, static_cast<std::size_t>(k), field, why);
       if (!set.insert(pc))
-        json_fail(root / "cfs" / i / "pcs" / static_cast<std::size_t>(k), "PC " + to_string(pc) + " is repeated in this CF");
+        json_fail(root / "cfs" / i / "pcs" / static_cast<std::size_t>(k),
+                  "PC " + to_string(pc) + " is repeated in this CF");
     }
   }
   sax.raw_pcs = {};
 
   if (options.validate_schema) {
     if (options.full_schema_check) {
-      validate_graph_schema(cbor ? json::from_cbor(data, data + size) : json::parse(data, data + size), source);
+      validate_graph_schema(
+          cbor ? json::from_cbor(data, data + size) : json::parse(data, data + size), source);
     } else {
       json skeleton = j;
       skeleton["cfs"] = json::array();

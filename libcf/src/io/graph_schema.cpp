@@ -28,7 +28,8 @@ const valijson::Schema& graph_schema() {
     // The only external reference is the model schema, embedded next to this one.
     const auto fetch = [](const std::string& uri) -> const nlohmann::json* {
       const std::string name = "model.schema.json";
-      if (uri.size() >= name.size() && uri.compare(uri.size() - name.size(), name.size(), name) == 0)
+      if (uri.size() >= name.size() &&
+          uri.compare(uri.size() - name.size(), name.size(), name) == 0)
         return new nlohmann::json(nlohmann::json::parse(model_schema_text()));
       return nullptr;
     };
@@ -51,9 +52,12 @@ std::string pointer_of(const std::vector<std::string>& context) {
       token = token.substr(1, token.size() - 2);
     std::string escaped;  // RFC 6901
     for (char ch : token) {
-      if (ch == '~') escaped += "~0";
-      else if (ch == '/') escaped += "~1";
-      else escaped += ch;
+      if (ch == '~')
+        escaped += "~0";
+      else if (ch == '/')
+        escaped += "~1";
+      else
+        escaped += ch;
     }
     p += "/" + escaped;
   }

@@ -53,13 +53,15 @@ Polyhedron polyhedron_from_json(const json& j, const JsonWhere& w) {
   const json& jf = json_array(json_member(j, "faces", w), w / "faces");
   std::vector<Vec3> vertices;
   vertices.reserve(jv.size());
-  for (std::size_t i = 0; i < jv.size(); ++i) vertices.push_back(json_vec3(jv[i], w / "vertices" / i));
+  for (std::size_t i = 0; i < jv.size(); ++i)
+    vertices.push_back(json_vec3(jv[i], w / "vertices" / i));
   std::vector<std::array<int, 2>> edges;
   edges.reserve(je.size());
   for (std::size_t i = 0; i < je.size(); ++i) {
     const JsonWhere we = w / "edges" / i;
     json_array(je[i], we);
-    if (je[i].size() != 2) json_fail(we, "expected a pair of vertex indices, got " + json_short(je[i]));
+    if (je[i].size() != 2)
+      json_fail(we, "expected a pair of vertex indices, got " + json_short(je[i]));
     edges.push_back({json_index(je[i][0], we / 0), json_index(je[i][1], we / 1)});
   }
   std::vector<std::vector<std::vector<int>>> faces(jf.size());

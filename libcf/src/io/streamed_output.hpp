@@ -23,7 +23,7 @@ struct StreamedOutput {
 /// `inputs`, each output written to a temporary file beside it, then all renamed into place.
 /// A producer that throws leaves every target untouched (its exception goes on).
 /// @throws cf::Error "<what> '<path>': <reason>".
-void write_streamed_outputs(const std::vector<StreamedOutput>& files, const std::vector<std::string>& inputs,
-                            const char* what);
+void write_streamed_outputs(const std::vector<StreamedOutput>& files,
+                            const std::vector<std::string>& inputs, const char* what);
 
 }  // namespace cf::detail

@@ -168,9 +168,9 @@ ClosestPoints element_distance(const Polyhedron& A, const Pose& pose, ElementKin
       return swapped(to_world(point_face(q, A, f), pose));
     }
     const EdgeId e(b);
-    return swapped(to_world(
-        segment_face(pose.inverse_apply(B.edge_point(e, 0)), pose.inverse_apply(B.edge_point(e, 1)), A, f),
-        pose));
+    return swapped(to_world(segment_face(pose.inverse_apply(B.edge_point(e, 0)),
+                                         pose.inverse_apply(B.edge_point(e, 1)), A, f),
+                            pose));
   }
   if (kb == K::kFace) {
     const FaceId f(b);

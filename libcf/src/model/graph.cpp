@@ -2,8 +2,8 @@
 // Reading and writing the file is in io/graph_reader.cpp and io/graph_json.cpp.
 
 #include "check.hpp"
-#include "model/graph_impl.hpp"
 #include "io/json_util.hpp"
+#include "model/graph_impl.hpp"
 
 #include <algorithm>
 #include <array>
@@ -47,7 +47,8 @@ std::string check_witness(const Pose& pose, const char** field) {
     return "translation is not finite";
   }
   const Mat3& R = pose.R_BA;
-  const double ortho = R.allFinite() ? (R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff() : HUGE_VAL;
+  const double ortho =
+      R.allFinite() ? (R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff() : HUGE_VAL;
   const double det = R.determinant();
   if (!(ortho <= kRotationTol) || !(det > 0)) {
     *field = "R";
@@ -88,7 +89,8 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
     for (const Pc& pc : pcs) held.insert(pc);
     const auto [it, inserted] = index.emplace(pcs, CfId(static_cast<std::int32_t>(i)));
     if (!inserted)
-      where.cf_fault(i, "PC set {" + to_string(pcs) + "} repeats CF " + std::to_string(it->second.value()));
+      where.cf_fault(
+          i, "PC set {" + to_string(pcs) + "} repeats CF " + std::to_string(it->second.value()));
   }
 
   // `change` (SPEC section 4, MT3), as cfgen builds it: the target is the source with each
@@ -118,15 +120,15 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
     const Transition& tr = transitions[t];
     const auto in_range = [&](CfId id, const char* field) {
       if (!id.valid() || id.index() >= n)
-        where.transition_fault(t, field, std::string(field) + " = " + std::to_string(id.value()) +
-                                             " is not a CF id (the graph has " + std::to_string(n) +
-                                             " CFs)");
+        where.transition_fault(t, field,
+                               std::string(field) + " = " + std::to_string(id.value()) +
+                                   " is not a CF id (the graph has " + std::to_string(n) + " CFs)");
     };
     in_range(tr.from, "from");
     in_range(tr.to, "to");
     if (tr.from == tr.to)
-      where.transition_fault(t, "to", "a transition from CF " + std::to_string(tr.from.value()) +
-                                          " to itself");
+      where.transition_fault(
+          t, "to", "a transition from CF " + std::to_string(tr.from.value()) + " to itself");
     const PcSet& f = cfs[tr.from.index()].pcs;
     const PcSet& g = cfs[tr.to.index()].pcs;
     const auto superset = [](const PcSet& big, const PcSet& small) {
@@ -158,10 +160,11 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
         break;
     }
     if (!ok)
-      where.transition_fault(t, "kind", std::string("kind ") + rule + ": CF " +
-                                            std::to_string(tr.from.value()) + " {" + to_string(f) +
-                                            "} -> CF " + std::to_string(tr.to.value()) + " {" +
-                                            to_string(g) + "}");
+      where.transition_fault(t, "kind",
+                             std::string("kind ") + rule + ": CF " +
+                                 std::to_string(tr.from.value()) + " {" + to_string(f) +
+                                 "} -> CF " + std::to_string(tr.to.value()) + " {" + to_string(g) +
+                                 "}");
     out[tr.from.index()].push_back(tr);
   }
   for (std::size_t i = 0; i < n; ++i) {
@@ -173,10 +176,11 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
         // Find the later of the two in file order, to point at it.
         std::size_t seen = 0, t = 0;
         for (; t < transitions.size(); ++t)
-          if (transitions[t].from == list[k].from && transitions[t].to == list[k].to && seen++ == 1) break;
-        where.transition_fault(t, "to", "transition CF " + std::to_string(list[k].from.value()) +
-                                            " -> CF " + std::to_string(list[k].to.value()) +
-                                            " is listed twice");
+          if (transitions[t].from == list[k].from && transitions[t].to == list[k].to && seen++ == 1)
+            break;
+        where.transition_fault(t, "to",
+                               "transition CF " + std::to_string(list[k].from.value()) + " -> CF " +
+                                   std::to_string(list[k].to.value()) + " is listed twice");
       }
   }
 }
@@ -190,10 +194,11 @@ class PartsLocator final : public detail::FaultLocator {
   }
   [[noreturn]] void pc_fault(std::size_t cf, std::size_t pc, const char*,
                              const std::string& what) const override {
-    throw Error("CfGraph::from_parts: CF " + std::to_string(cf) + ", PC " + std::to_string(pc) + ": " +
-                what);
+    throw Error("CfGraph::from_parts: CF " + std::to_string(cf) + ", PC " + std::to_string(pc) +
+                ": " + what);
   }
-  [[noreturn]] void transition_fault(std::size_t t, const char*, const std::string& what) const override {
+  [[noreturn]] void transition_fault(std::size_t t, const char*,
+                                     const std::string& what) const override {
     throw Error("CfGraph::from_parts: transition " + std::to_string(t) + ": " + what);
   }
   [[noreturn]] void metadata_fault(const std::string& what) const override {
@@ -204,7 +209,8 @@ class PartsLocator final : public detail::FaultLocator {
 }  // namespace
 
 std::string detail::check_metadata(const json& meta) {
-  static const char* const kReserved[] = {"format", "version", "units", "models", "cfs", "transitions"};
+  static const char* const kReserved[] = {"format", "version", "units",
+                                          "models", "cfs",     "transitions"};
   if (!meta.is_object()) return "expected a JSON object, got " + json_short(meta);
   for (const char* key : kReserved)
     if (meta.contains(key))
@@ -236,9 +242,11 @@ CfGraph CfGraph::from_parts(Polyhedron a, Polyhedron b, std::vector<CfRecord> cf
       if (std::string why = detail::check_witness(r.witness, &field); !why.empty())
         where.cf_fault(i, std::string("witness ") + field + ": " + why);
     }
-    if (r.dof < -1 || r.dof > 6) where.cf_fault(i, "dof = " + std::to_string(r.dof) + " is not in 0..6");
+    if (r.dof < -1 || r.dof > 6)
+      where.cf_fault(i, "dof = " + std::to_string(r.dof) + " is not in 0..6");
     if (r.translation_dof < -1 || r.translation_dof > 3)
-      where.cf_fault(i, "translation_dof = " + std::to_string(r.translation_dof) + " is not in 0..3");
+      where.cf_fault(i,
+                     "translation_dof = " + std::to_string(r.translation_dof) + " is not in 0..3");
   }
   impl->a = std::move(a);
   impl->b = std::move(b);

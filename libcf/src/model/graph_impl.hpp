@@ -18,7 +18,8 @@ struct PcHash {
   std::size_t operator()(const Pc& pc) const noexcept {
     const std::uint64_t k = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(pc.a)) << 32) |
                             static_cast<std::uint32_t>(pc.b);
-    return std::hash<std::uint64_t>()(k * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint64_t>(pc.type));
+    return std::hash<std::uint64_t>()(k * 0x9E3779B97F4A7C15ull ^
+                                      static_cast<std::uint64_t>(pc.type));
   }
 };
 
@@ -48,10 +49,10 @@ struct CfGraph::Impl {
   Polyhedron a, b;
   std::vector<CfRecord> cfs;
   std::vector<Transition> transitions;
-  std::unordered_map<PcSet, CfId> index;          ///< PC set -> CF, for constant-time find
-  std::unordered_set<Pc, detail::PcHash> held;    ///< every PC some CF holds
-  std::vector<std::vector<Transition>> out;       ///< per CF, sorted by target id
-  std::string metadata;                           ///< JSON object text, canonical dump
+  std::unordered_map<PcSet, CfId> index;        ///< PC set -> CF, for constant-time find
+  std::unordered_set<Pc, detail::PcHash> held;  ///< every PC some CF holds
+  std::vector<std::vector<Transition>> out;     ///< per CF, sorted by target id
+  std::string metadata;                         ///< JSON object text, canonical dump
 
   /// Checks everything that does not need the original PC order (repeated PC sets, PCs
   /// sharing a contact plane, transitions) and builds the index and the out lists. PC index ranges
@@ -75,6 +76,6 @@ namespace cf::detail {
 /// is read in place when `bytes` has kReadSlack bytes of capacity past its end (as
 /// read_input_file leaves), else from a padded copy.
 /// @throws cf::Error naming `source`, the JSON pointer and the problem.
-std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::string& source, bool cbor,
-                                          const GraphLoadOptions& options);
+std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::string& source,
+                                          bool cbor, const GraphLoadOptions& options);
 }  // namespace cf::detail

@@ -29,7 +29,6 @@ double signed_area_2d(const std::vector<Eigen::Vector2d>& loop) {
   return 0.5 * a;
 }
 
-
 }  // namespace
 
 Polyhedron Polyhedron::from_features(std::string name, std::vector<Vec3> vertices,
@@ -99,8 +98,9 @@ Polyhedron Polyhedron::from_features(std::string name, std::vector<Vec3> vertice
         Edge& E = m.edges_[it->second];
         FaceId& slot = (E.v0.value() == a) ? E.left : E.right;
         if (slot.valid())
-          fail(nm, "edge " + std::to_string(it->second) + " is run in the same direction by faces " +
-                       std::to_string(slot.value()) + " and " + std::to_string(f) +
+          fail(nm, "edge " + std::to_string(it->second) +
+                       " is run in the same direction by faces " + std::to_string(slot.value()) +
+                       " and " + std::to_string(f) +
                        " (non-manifold edge or inconsistent orientation)");
         slot = FaceId(static_cast<int>(f));
         F.edges.push_back(EdgeId(it->second));
@@ -212,8 +212,7 @@ Polyhedron Polyhedron::from_features(std::string name, std::vector<Vec3> vertice
       }
   }
   m.volume_ = vol / 6.0;
-  if (!(m.volume_ > 0))
-    fail(nm, "encloses a non-positive volume: faces are oriented inward");
+  if (!(m.volume_ > 0)) fail(nm, "encloses a non-positive volume: faces are oriented inward");
   m.volume_centroid_ = moment / (4.0 * vol);
   Vec3 sum = Vec3::Zero();
   for (const Vec3& p : vertices) sum += p;

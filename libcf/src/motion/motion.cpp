@@ -16,14 +16,22 @@ namespace cf {
 
 const char* to_string(MotionType type) {
   switch (type) {
-    case MotionType::kNone: return "none";
-    case MotionType::kMT1: return "MT1";
-    case MotionType::kMT2a: return "MT2.a";
-    case MotionType::kMT2b: return "MT2.b";
-    case MotionType::kMT2c: return "MT2.c";
-    case MotionType::kMT3: return "MT3";
-    case MotionType::kMT4: return "MT4";
-    case MotionType::kMT5: return "MT5";
+    case MotionType::kNone:
+      return "none";
+    case MotionType::kMT1:
+      return "MT1";
+    case MotionType::kMT2a:
+      return "MT2.a";
+    case MotionType::kMT2b:
+      return "MT2.b";
+    case MotionType::kMT2c:
+      return "MT2.c";
+    case MotionType::kMT3:
+      return "MT3";
+    case MotionType::kMT4:
+      return "MT4";
+    case MotionType::kMT5:
+      return "MT5";
   }
   return "none";
 }
@@ -34,7 +42,8 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 
 // Unit direction of the contact line of a line PC in the world.
-Vec3 line_direction(const ContactPc& c, const Polyhedron& A, const Polyhedron& B, const Pose& pose) {
+Vec3 line_direction(const ContactPc& c, const Polyhedron& A, const Polyhedron& B,
+                    const Pose& pose) {
   if (c.pc.type == PcType::kEF) return pose.R_BA * A.edge(EdgeId(c.pc.a)).dir;
   return B.edge(EdgeId(c.pc.b)).dir;  // f-e
 }
@@ -54,8 +63,11 @@ Freedoms compute_freedoms(const ContactPc* pcs, int n, const Polyhedron& A, cons
     const Vec3 nrm = c.R_WT.col(1);
     add(c.p_W, nrm);
     switch (extent(c.pc.type)) {
-      case PcExtent::kPoint: break;
-      case PcExtent::kLine: add(c.p_W + L * line_direction(c, A, B, pose), nrm); break;
+      case PcExtent::kPoint:
+        break;
+      case PcExtent::kLine:
+        add(c.p_W + L * line_direction(c, A, B, pose), nrm);
+        break;
       case PcExtent::kPlane:
         // Any three non-collinear points of the plane span the same constraints as the
         // corners of the contact region (the constraint is affine in the point).
@@ -69,17 +81,19 @@ Freedoms compute_freedoms(const ContactPc* pcs, int n, const Polyhedron& A, cons
 
 Freedoms freedoms_from_points(const ConstraintPoint* pts, int n, const Vec3& reference_W,
                               double length_scale, const Params& params) {
-  CF_REQUIRE(n >= 0 && n <= Freedoms::kMaxRows,
-             "computing freedoms: at most " + std::to_string(Freedoms::kMaxRows) + " constraint points, got " +
-                 std::to_string(n));
-  CF_REQUIRE(length_scale > 0, "computing freedoms: the length scale must be positive, got " + std::to_string(length_scale));
+  CF_REQUIRE(n >= 0 && n <= Freedoms::kMaxRows, "computing freedoms: at most " +
+                                                    std::to_string(Freedoms::kMaxRows) +
+                                                    " constraint points, got " + std::to_string(n));
+  CF_REQUIRE(length_scale > 0, "computing freedoms: the length scale must be positive, got " +
+                                   std::to_string(length_scale));
   Freedoms f;
   const double L = length_scale;
   f.length_scale = L;
   f.reference_W = reference_W;
 
   // Rows n . v + ((q - ref) x n / L) . (L w) = 0, one per constraint point q.
-  Eigen::Matrix<double, Freedoms::kMaxRows, 6> J = Eigen::Matrix<double, Freedoms::kMaxRows, 6>::Zero();
+  Eigen::Matrix<double, Freedoms::kMaxRows, 6> J =
+      Eigen::Matrix<double, Freedoms::kMaxRows, 6>::Zero();
   int rows = 0;
   for (int i = 0; i < n; ++i, ++rows) {
     J.row(rows).head<3>() = pts[i].n_W.transpose();
@@ -162,7 +176,8 @@ Freedoms freedoms_from_points(const ConstraintPoint* pts, int n, const Vec3& ref
   return f;
 }
 
-MotionCheck check_motion(const Freedoms& f, const Pose& prev, const Pose& cur, const Params& params) {
+MotionCheck check_motion(const Freedoms& f, const Pose& prev, const Pose& cur,
+                         const Params& params) {
   MotionCheck m;
   const Eigen::AngleAxisd aa(Mat3(cur.R_BA * prev.R_BA.transpose()));
   const Vec3 rot = aa.axis() * aa.angle();
@@ -231,8 +246,8 @@ PriorMotion classify_prior_motion(const PcSet& prev, const PcSet& cur, const CfG
     pm.type = MotionType::kMT2a;  // the case is refined by the force model
     return pm;
   }
-  if (graph != nullptr && prev_id.valid() && cur_id.valid() &&
-      prev_id.index() < graph->num_cfs() && cur_id.index() < graph->num_cfs()) {
+  if (graph != nullptr && prev_id.valid() && cur_id.valid() && prev_id.index() < graph->num_cfs() &&
+      cur_id.index() < graph->num_cfs()) {
     for (const Transition& tr : graph->out_transitions(prev_id)) {
       if (tr.to != cur_id) continue;
       switch (tr.kind) {
@@ -240,8 +255,12 @@ PriorMotion classify_prior_motion(const PcSet& prev, const PcSet& cur, const CfG
           pm.type = MotionType::kMT4;
           pm.gained = first_not_in(cur, prev);
           break;
-        case TransitionKind::kLose: pm.type = MotionType::kMT5; break;
-        case TransitionKind::kChange: pm.type = MotionType::kMT3; break;
+        case TransitionKind::kLose:
+          pm.type = MotionType::kMT5;
+          break;
+        case TransitionKind::kChange:
+          pm.type = MotionType::kMT3;
+          break;
       }
       return pm;
     }

@@ -64,8 +64,9 @@ bool at_friction_bound(double l1, double l2, double mu, double ln) {
 // One constraint row: a . xi >= lo (normal) or = 0 (tangent), xi = (v, w) about the grip.
 struct Row {
   Vec6 a, Wa;    // the row and the inverse metric times it
-  double G = 1;      // a . W a
-  double inv_G = 1;  // 1 / G: Gauss-Seidel multiplies (a division is on each update's critical path)
+  double G = 1;  // a . W a
+  double inv_G =
+      1;  // 1 / G: Gauss-Seidel multiplies (a division is on each update's critical path)
 };
 
 // Grip point of a pose, world frame.
@@ -291,7 +292,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
   std::array<int, ProxyResult::kMaxContacts> group{};       // contact plane, numbered per pass
   std::array<bool, ProxyResult::kMaxContacts> slides{};     // by group, from the last polish
   std::array<ContactPc, ProxyResult::kMaxContacts> used{};  // copies: detection reuses its set
-  std::array<int, ContactSet::kCapacity> pick{};             // the point contacts used, by index
+  std::array<int, ContactSet::kCapacity> pick{};            // the point contacts used, by index
   std::array<std::int16_t, ContactSet::kCapacity> plane_group{};  // detection's plane -> group
   int m = 0;  // point contacts used as constraints in the last solve
   // The loaded contacts' constraint forces, by PC: a later solve starts from them.
@@ -328,9 +329,11 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
       // Equally near contacts (the corners of a flat region) by index, so the choice is
       // the same from pass to pass.
       const auto nearer = [&](int x, int y) {
-        return contacts[x].distance < contacts[y].distance || (contacts[x].distance == contacts[y].distance && x < y);
+        return contacts[x].distance < contacts[y].distance ||
+               (contacts[x].distance == contacts[y].distance && x < y);
       };
-      std::nth_element(pick.begin(), pick.begin() + ProxyResult::kMaxContacts, pick.begin() + n_point, nearer);
+      std::nth_element(pick.begin(), pick.begin() + ProxyResult::kMaxContacts,
+                       pick.begin() + n_point, nearer);
       for (int i = ProxyResult::kMaxContacts; i < n_point; ++i)
         blocking = blocking || blocks(contacts[pick[static_cast<std::size_t>(i)]]);
       std::sort(pick.begin(), pick.begin() + ProxyResult::kMaxContacts);  // detection's order
@@ -402,7 +405,8 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
           if (ln <= 0) continue;
           loaded[g] = true;
           load[g] += ln;
-          if (!(mu[J] == pm.mu_static && at_friction_bound(lambda[3 * J + 1], lambda[3 * J + 2], mu[J], ln)))
+          if (!(mu[J] == pm.mu_static &&
+                at_friction_bound(lambda[3 * J + 1], lambda[3 * J + 2], mu[J], ln)))
             held[g] = false;
         }
         // And its load settled (the group's total within kSettledLoad of a sweep ago): while
@@ -423,7 +427,8 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
           const auto J = static_cast<std::size_t>(j);
           if (!breaks[static_cast<std::size_t>(group[J])]) continue;
           mu[J] = pm.mu_kinetic;
-          x += rows[3 * J + 1].Wa * (lambda[3 * J + 1] * (sc - 1)) + rows[3 * J + 2].Wa * (lambda[3 * J + 2] * (sc - 1));
+          x += rows[3 * J + 1].Wa * (lambda[3 * J + 1] * (sc - 1)) +
+               rows[3 * J + 2].Wa * (lambda[3 * J + 2] * (sc - 1));
           lambda[3 * J + 1] *= sc;
           lambda[3 * J + 2] *= sc;
         }

@@ -42,7 +42,7 @@ struct ProxyState {
   std::array<std::array<double, 3>, ProxyResult::kMaxContacts> warm_lambda{};
   int num_warm = 0;
   ProxyResult result;
-  DetectStatePtr look;     // for ProxyModel::look
+  DetectStatePtr look;  // for ProxyModel::look
   ContactSet look_contacts;
 };
 

@@ -17,8 +17,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Point p moving along unit d meets the closed segment [q0, q1] first at s; kInf when never.
 // Pairs that already touch (s <= s_min) are ignored.
-double point_segment_hit(const Vec3& p, const Vec3& d, const Vec3& q0, const Vec3& q1,
-                         double s_min, double tol) {
+double point_segment_hit(const Vec3& p, const Vec3& d, const Vec3& q0, const Vec3& q1, double s_min,
+                         double tol) {
   const Vec3 e = q1 - q0;
   const double len = e.norm();
   if (len == 0) return kInf;
@@ -47,7 +47,8 @@ double point_segment_hit(const Vec3& p, const Vec3& d, const Vec3& q0, const Vec
 std::vector<Vec3> null_space(const std::vector<Vec3>& rows) {
   if (rows.empty()) return {Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
   Eigen::MatrixXd N(static_cast<Eigen::Index>(rows.size()), 3);
-  for (std::size_t i = 0; i < rows.size(); ++i) N.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    N.row(static_cast<Eigen::Index>(i)) = rows[i].transpose();
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(N, Eigen::ComputeFullV);
   int rank = 0;
   for (Eigen::Index i = 0; i < svd.singularValues().size(); ++i)
@@ -63,7 +64,9 @@ double first_contact_translation(const Polyhedron& A, const Polyhedron& B, const
                                  const Vec3& d, double s_min, double s_max, double tol,
                                  const PcSet& kept) {
   // Events between elements that the kept PCs dominate do not change the contact set.
-  auto dominated = [&](ElementKind ka, int a, ElementKind kb, int b) { return covered_by(A, B, kept, ka, a, kb, b); };
+  auto dominated = [&](ElementKind ka, int a, ElementKind kb, int b) {
+    return covered_by(A, B, kept, ka, a, kb, b);
+  };
   double best = s_max;
   bool hit = false;
   auto take = [&](double s) {
@@ -128,7 +131,8 @@ double first_contact_translation(const Polyhedron& A, const Polyhedron& B, const
     double lo[3], hi[3];  // along e1, e2, d
   };
   // An edge's box from its ends: their coordinates across d (computed above) and along d.
-  auto box_of = [&](const Eigen::Vector2d& c0, const Eigen::Vector2d& c1, const Vec3& a, const Vec3& b) {
+  auto box_of = [&](const Eigen::Vector2d& c0, const Eigen::Vector2d& c1, const Vec3& a,
+                    const Vec3& b) {
     Box x;
     const double u[3] = {c0[0], c0[1], d.dot(a)}, w[3] = {c1[0], c1[1], d.dot(b)};
     for (int k = 0; k < 3; ++k) {
@@ -150,8 +154,9 @@ double first_contact_translation(const Polyhedron& A, const Polyhedron& B, const
     const Box ba = box_of(ca[A.edges()[ea].v0.index()], ca[A.edges()[ea].v1.index()], p0, p1);
     for (std::size_t eb = 0; eb < B.num_edges(); ++eb) {
       const Box& bb = b_boxes[eb];
-      if (bb.lo[0] > ba.hi[0] + slack || ba.lo[0] > bb.hi[0] + slack || bb.lo[1] > ba.hi[1] + slack ||
-          ba.lo[1] > bb.hi[1] + slack || bb.hi[2] - ba.lo[2] < s_min - slack || bb.lo[2] - ba.hi[2] > best + slack)
+      if (bb.lo[0] > ba.hi[0] + slack || ba.lo[0] > bb.hi[0] + slack ||
+          bb.lo[1] > ba.hi[1] + slack || ba.lo[1] > bb.hi[1] + slack ||
+          bb.hi[2] - ba.lo[2] < s_min - slack || bb.lo[2] - ba.hi[2] > best + slack)
         continue;
       if (dominated(ElementKind::kEdge, int(ea), ElementKind::kEdge, int(eb))) continue;
       const Vec3& q0 = B.edge_point(EdgeId(int(eb)), 0);
@@ -178,16 +183,23 @@ double first_contact_translation(const Polyhedron& A, const Polyhedron& B, const
   return hit ? best : kInf;
 }
 
-std::vector<Pose> turned_witnesses(const WitnessSearch& search, const PcSet& pcs, const Pose& witness) {
+std::vector<Pose> turned_witnesses(const WitnessSearch& search, const PcSet& pcs,
+                                   const Pose& witness) {
   const Polyhedron& A = *search.a().model;
   const Polyhedron& B = *search.b().model;
   std::vector<Vec3> points;
   for (const Pc& pc : pcs) {
     switch (pc.type) {
-      case PcType::kVF: points.push_back(witness.apply(A.vertices()[pc.a].p)); break;
-      case PcType::kFV: points.push_back(B.vertices()[pc.b].p); break;
+      case PcType::kVF:
+        points.push_back(witness.apply(A.vertices()[pc.a].p));
+        break;
+      case PcType::kFV:
+        points.push_back(B.vertices()[pc.b].p);
+        break;
       case PcType::kEE:
-        points.push_back(element_distance(A, witness, ElementKind::kEdge, pc.a, B, ElementKind::kEdge, pc.b).p_b);
+        points.push_back(
+            element_distance(A, witness, ElementKind::kEdge, pc.a, B, ElementKind::kEdge, pc.b)
+                .p_b);
         break;
       default:
         return {};  // line and plane PCs leave no rotation about a point free
@@ -197,8 +209,12 @@ std::vector<Pose> turned_witnesses(const WitnessSearch& search, const PcSet& pcs
   // the line through two.
   std::vector<std::pair<Vec3, double>> turns;
   if (points.size() == 1) {
-    static const Vec3 kAxes[] = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1),
-                                 Vec3(1, 1, 0).normalized(), Vec3(0, 1, -1).normalized(), Vec3(-1, 0, 1).normalized()};
+    static const Vec3 kAxes[] = {Vec3(1, 0, 0),
+                                 Vec3(0, 1, 0),
+                                 Vec3(0, 0, 1),
+                                 Vec3(1, 1, 0).normalized(),
+                                 Vec3(0, 1, -1).normalized(),
+                                 Vec3(-1, 0, 1).normalized()};
     for (const Vec3& ax : kAxes)
       for (double ang : {0.25, -0.25, 0.6, -0.6}) turns.push_back({ax, ang});
   } else if (points.size() == 2 && (points[1] - points[0]).norm() > 1e-6 * search.scale()) {
@@ -212,7 +228,8 @@ std::vector<Pose> turned_witnesses(const WitnessSearch& search, const PcSet& pcs
     q.R_BA = Q * witness.R_BA;
     q.t_BA = Q * (witness.t_BA - points[0]) + points[0];
     PcSet now;
-    if (search.contacts_at(q, now) && now == pcs && search.verify(pcs, q) >= search.params().min_clearance)
+    if (search.contacts_at(q, now) && now == pcs &&
+        search.verify(pcs, q) >= search.params().min_clearance)
       out.push_back(q);
   }
   return out;
@@ -231,7 +248,8 @@ std::vector<Discovery> explore_translations(const WitnessSearch& search, const P
   std::vector<Discovery> out;
   auto record = [&](const Pose& pose) {
     PcSet found;
-    if (search.contacts_at(pose, found) && !found.empty() && found != pcs) out.push_back({found, pose});
+    if (search.contacts_at(pose, found) && !found.empty() && found != pcs)
+      out.push_back({found, pose});
   };
   // Follows d from the witness keeping `kept`: the pose just clear of the broken PCs (when
   // some break), then the first contact.
@@ -239,7 +257,8 @@ std::vector<Discovery> explore_translations(const WitnessSearch& search, const P
     const double s_hit = first_contact_translation(A, B, witness, d, s_min, s_max, tol, kept);
     if (break_rate > 0) {
       // Far enough that the broken PCs clear min_clearance, at most halfway to the next contact.
-      const double s = std::min(0.5 * s_hit, std::max(10 * p.min_clearance, p.good_clearance) / break_rate);
+      const double s =
+          std::min(0.5 * s_hit, std::max(10 * p.min_clearance, p.good_clearance) / break_rate);
       if (std::isfinite(s)) {
         Pose q = witness;
         q.t_BA += s * d;
@@ -290,7 +309,8 @@ std::vector<Discovery> explore_translations(const WitnessSearch& search, const P
     if (g_proj.norm() > 1e-9) dirs.push_back(g_proj.normalized());
     if (basis.size() == 2 && !dirs.empty()) {
       const Vec3 side = dirs[0].cross(basis[0].cross(basis[1])).normalized();
-      for (double a : {-1.2, -0.6, 0.6, 1.2}) dirs.push_back((std::cos(a) * dirs[0] + std::sin(a) * side).normalized());
+      for (double a : {-1.2, -0.6, 0.6, 1.2})
+        dirs.push_back((std::cos(a) * dirs[0] + std::sin(a) * side).normalized());
     }
     if (basis.size() == 1) {
       dirs.push_back(basis[0]);
@@ -303,6 +323,5 @@ std::vector<Discovery> explore_translations(const WitnessSearch& search, const P
   }
   return out;
 }
-
 
 }  // namespace cf::gen

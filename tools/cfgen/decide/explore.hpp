@@ -33,8 +33,9 @@ double first_contact_translation(const Polyhedron& A, const Polyhedron& B, const
 /// vertex meets a face (solved in closed form) or two edges meet (sign changes of the lines'
 /// meeting condition on 192 samples, refined by bisection). Pairs a PC of `kept` dominates
 /// are ignored. Returns +infinity when none.
-double first_contact_rotation(const Polyhedron& A, const Polyhedron& B, const Pose& pose, const Vec3& p,
-                              const Vec3& u, double phi_min, double phi_max, double tol, const PcSet& kept);
+double first_contact_rotation(const Polyhedron& A, const Polyhedron& B, const Pose& pose,
+                              const Vec3& p, const Vec3& u, double phi_min, double phi_max,
+                              double tol, const PcSet& kept);
 
 /// Contact sets reached from the CF `pcs`, realised at `witness`, by rotations about axes
 /// that keep some PCs (through a point PC's contact point, along a line PC's edge, or along a
@@ -42,14 +43,16 @@ double first_contact_rotation(const Polyhedron& A, const Polyhedron& B, const Po
 /// plane PC about one of its boundary elements into the neighbouring PC that element makes
 /// (an f-f about an edge of either face, an e-f or f-e about an end of its edge), the other
 /// PCs kept. Deterministic.
-std::vector<Discovery> explore_rotations(const WitnessSearch& search, const PcSet& pcs, const Pose& witness);
+std::vector<Discovery> explore_rotations(const WitnessSearch& search, const PcSet& pcs,
+                                         const Pose& witness);
 
 /// Other witnesses of a CF of point PCs (v-f, f-v, e-e), turned about its contact point (one
 /// PC: 24 turns about six axes) or about the line through its two contact points (two PCs:
 /// four turns), kept when the same PCs still hold and verify. A CF of point PCs holds over a
 /// range of orientations; the translations from one witness alone reach only the CFs that
 /// orientation allows. Empty for other CFs.
-std::vector<Pose> turned_witnesses(const WitnessSearch& search, const PcSet& pcs, const Pose& witness);
+std::vector<Pose> turned_witnesses(const WitnessSearch& search, const PcSet& pcs,
+                                   const Pose& witness);
 
 /// Contact sets reached from the CF `pcs`, realised at `witness`, by translations that keep
 /// every PC (sliding) and by those that break some PCs and keep the others. Deterministic.

@@ -36,7 +36,8 @@ double arc_arc(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const Vec3 x = n1.cross(n2);
   if (n1.norm() > 1e-12 && n2.norm() > 1e-12 && x.norm() > 1e-12) {
     const Vec3 s = x.normalized();
-    if ((in_arc(s, a, b, n1) && in_arc(s, c, d, n2)) || (in_arc(-s, a, b, n1) && in_arc(-s, c, d, n2)))
+    if ((in_arc(s, a, b, n1) && in_arc(s, c, d, n2)) ||
+        (in_arc(-s, a, b, n1) && in_arc(-s, c, d, n2)))
       return 0;
   }
   return std::min({point_arc(a, c, d), point_arc(b, c, d), point_arc(c, a, b), point_arc(d, a, b)});
@@ -77,7 +78,9 @@ NormalCone shrink(const NormalCone& c, double margin) {
     if (len <= 2 * margin) return {};
     const Vec3 w = (b - a.dot(b) * a).normalized();  // unit tangent at a towards b
     const Vec3 v = (a - b.dot(a) * b).normalized();  // unit tangent at b towards a
-    return {{std::cos(margin) * a + std::sin(margin) * w, std::cos(margin) * b + std::sin(margin) * v}, {}};
+    return {
+        {std::cos(margin) * a + std::sin(margin) * w, std::cos(margin) * b + std::sin(margin) * v},
+        {}};
   }
   const double s = std::sin(margin);
   NormalCone out;
@@ -113,10 +116,12 @@ std::array<std::vector<NormalCone>, 3> cones_of(const ModelInfo& info, double ma
   auto& edges = out[static_cast<int>(ElementKind::kEdge)];
   auto& faces = out[static_cast<int>(ElementKind::kFace)];
   for (std::size_t v = 0; v < m.num_vertices(); ++v)
-    verts.push_back(info.cones[v].pointed ? shrink(polar_cone(info.cones[v].rays), margin) : NormalCone{});
+    verts.push_back(info.cones[v].pointed ? shrink(polar_cone(info.cones[v].rays), margin)
+                                          : NormalCone{});
   for (const Edge& e : m.edges())
-    edges.push_back(e.convex ? shrink(NormalCone{{m.face(e.left).normal, m.face(e.right).normal}, {}}, margin)
-                             : NormalCone{});
+    edges.push_back(
+        e.convex ? shrink(NormalCone{{m.face(e.left).normal, m.face(e.right).normal}, {}}, margin)
+                 : NormalCone{});
   for (const Face& f : m.faces()) faces.push_back(point_cone(f.normal));
   return out;
 }
@@ -191,8 +196,8 @@ double cone_cone_distance(const NormalCone& p, const NormalCone& q, double tol) 
   return d;
 }
 
-PairConditions::Side PairConditions::build(const ModelInfo& info, double cone_margin, double angle_tol,
-                                           double contact_margin) {
+PairConditions::Side PairConditions::build(const ModelInfo& info, double cone_margin,
+                                           double angle_tol, double contact_margin) {
   const Polyhedron& m = *info.model;
   Side side;
   side.cones = cones_of(info, cone_margin);
@@ -202,7 +207,8 @@ PairConditions::Side PairConditions::build(const ModelInfo& info, double cone_ma
     side.offset[static_cast<std::size_t>(k)] = static_cast<int>(elems.size());
     for (std::size_t i = 0; i < side.cones[static_cast<std::size_t>(k)].size(); ++i) {
       elems.push_back({static_cast<ElementKind>(k), static_cast<int>(i)});
-      points.push_back(inset_closure_points(m, static_cast<ElementKind>(k), static_cast<int>(i), contact_margin));
+      points.push_back(inset_closure_points(m, static_cast<ElementKind>(k), static_cast<int>(i),
+                                            contact_margin));
     }
   }
   side.n = static_cast<int>(elems.size());
@@ -219,10 +225,12 @@ PairConditions::Side PairConditions::build(const ModelInfo& info, double cone_ma
       if (y < x) {
         // Distances and angles are symmetric: copied from (y, x), computed first.
         const Allowed& yx = side.table[y * elems.size() + x];
-        al.dist_lo = yx.dist_lo, al.dist_hi = yx.dist_hi, al.angle_lo = yx.angle_lo, al.angle_hi = yx.angle_hi;
+        al.dist_lo = yx.dist_lo, al.dist_hi = yx.dist_hi, al.angle_lo = yx.angle_lo,
+        al.angle_hi = yx.angle_hi;
       } else {
         al.dist_lo = element_distance(m, Pose(), elems[x].first, elems[x].second, m, elems[y].first,
-                                      elems[y].second).distance;
+                                      elems[y].second)
+                         .distance;
         for (const Vec3& p : points[x])
           for (const Vec3& q : points[y]) al.dist_hi = std::max(al.dist_hi, (p - q).norm());
         NormalCone neg_y = cy;
@@ -237,9 +245,10 @@ PairConditions::Side PairConditions::build(const ModelInfo& info, double cone_ma
   return side;
 }
 
-PairConditions::PairConditions(const ModelInfo& A, const ModelInfo& B, double length_tol, double angle_tol,
-                               double cone_margin, double contact_margin)
-    : a_(build(A, cone_margin, angle_tol, contact_margin)), b_(build(B, cone_margin, angle_tol, contact_margin)),
+PairConditions::PairConditions(const ModelInfo& A, const ModelInfo& B, double length_tol,
+                               double angle_tol, double cone_margin, double contact_margin)
+    : a_(build(A, cone_margin, angle_tol, contact_margin)),
+      b_(build(B, cone_margin, angle_tol, contact_margin)),
       length_tol_(length_tol),
       angle_tol_(angle_tol) {}
 
@@ -248,7 +257,8 @@ const NormalCone& PairConditions::cone(bool of_a, ElementKind k, int i) const {
 }
 
 bool PairConditions::compatible(const Pc& x, const Pc& y) const {
-  const ElementKind kax = a_kind(x.type), kay = a_kind(y.type), kbx = b_kind(x.type), kby = b_kind(y.type);
+  const ElementKind kax = a_kind(x.type), kay = a_kind(y.type), kbx = b_kind(x.type),
+                    kby = b_kind(y.type);
   const Allowed& a = a_.at(kax, x.a, kay, y.a);
   const Allowed& b = b_.at(kbx, x.b, kby, y.b);
   // An element with no direction inside its cone cannot take part in a verified contact.
@@ -258,12 +268,14 @@ bool PairConditions::compatible(const Pc& x, const Pc& y) const {
   // Angle between the contact normals: R maps A's outward normal u at each contact onto
   // -m, m B's outward normal there, so the angle between u_x and u_y equals that between m_x
   // and m_y.
-  if (a.angle_lo > b.angle_hi + 2 * angle_tol_ || b.angle_lo > a.angle_hi + 2 * angle_tol_) return false;
+  if (a.angle_lo > b.angle_hi + 2 * angle_tol_ || b.angle_lo > a.angle_hi + 2 * angle_tol_)
+    return false;
   // Height of one contact point over the other's contact plane: with q = R p + t on both
   // contacts, (q_y - q_x) . m_x = -(p_y - p_x) . u_x, so B's range must meet minus A's; and
   // the same over y's plane.
   auto heights_meet = [&](const Allowed& ha, const Allowed& hb) {
-    return !(hb.height_lo > -ha.height_lo + length_tol_ || -ha.height_hi > hb.height_hi + length_tol_);
+    return !(hb.height_lo > -ha.height_lo + length_tol_ ||
+             -ha.height_hi > hb.height_hi + length_tol_);
   };
   return heights_meet(a, b) && heights_meet(a_.at(kay, y.a, kax, x.a), b_.at(kby, y.b, kbx, x.b));
 }

@@ -20,9 +20,9 @@ namespace cf::gen {
 /// normals of a convex edge, the polar of the tangent cone of a pointed vertex. Spherically
 /// convex, inside an open hemisphere.
 struct NormalCone {
-  std::vector<Vec3> gens;     // unit generators (extreme rays)
-  std::vector<Vec3> facets;   // unit h: the cone is { u : h . u >= shift } (three or more gens)
-  double shift = 0;           // sin of the margin the cone was shrunk by
+  std::vector<Vec3> gens;    // unit generators (extreme rays)
+  std::vector<Vec3> facets;  // unit h: the cone is { u : h . u >= shift } (three or more gens)
+  double shift = 0;          // sin of the margin the cone was shrunk by
 };
 
 class PairConditions {
@@ -53,10 +53,10 @@ class PairConditions {
 
   /// What one model allows for two of its elements x and y touched by two PCs (mm, rad).
   struct Allowed {
-    double dist_lo = 0, dist_hi = 0;    // distance between a point of x and a point of y
-    double angle_lo = 0, angle_hi = 0;  // angle between a normal of x's cone and one of y's
+    double dist_lo = 0, dist_hi = 0;      // distance between a point of x and a point of y
+    double angle_lo = 0, angle_hi = 0;    // angle between a normal of x's cone and one of y's
     double height_lo = 0, height_hi = 0;  // (point of y - point of x) . (normal of x's cone)
-    bool usable = false;                // both cones have directions
+    bool usable = false;                  // both cones have directions
   };
 
  private:
@@ -66,11 +66,13 @@ class PairConditions {
     int n = 0;                                     // elements of all kinds
     std::vector<Allowed> table;                    // n x n, ordered pairs
     const Allowed& at(ElementKind kx, int x, ElementKind ky, int y) const {
-      return table[static_cast<std::size_t>(offset[static_cast<int>(kx)] + x) * static_cast<std::size_t>(n) +
+      return table[static_cast<std::size_t>(offset[static_cast<int>(kx)] + x) *
+                       static_cast<std::size_t>(n) +
                    static_cast<std::size_t>(offset[static_cast<int>(ky)] + y)];
     }
   };
-  static Side build(const ModelInfo& m, double cone_margin, double angle_tol, double contact_margin);
+  static Side build(const ModelInfo& m, double cone_margin, double angle_tol,
+                    double contact_margin);
 
   Side a_, b_;
   double length_tol_, angle_tol_;

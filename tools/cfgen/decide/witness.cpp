@@ -49,9 +49,11 @@ bool WitnessSearch::plausible(const PcSet& pcs) const {
            in_closure(B, b_kind(y.type), y.b, b_kind(x.type), x.b)))
         return false;
       // Two PCs on one plane of B, or one plane of A, share their contact plane.
-      const bool xb = b_kind(x.type) == ElementKind::kFace, yb = b_kind(y.type) == ElementKind::kFace;
+      const bool xb = b_kind(x.type) == ElementKind::kFace,
+                 yb = b_kind(y.type) == ElementKind::kFace;
       if (xb && yb && B_.face_plane[x.b] == B_.face_plane[y.b]) return false;
-      const bool xa = a_kind(x.type) == ElementKind::kFace, ya = a_kind(y.type) == ElementKind::kFace;
+      const bool xa = a_kind(x.type) == ElementKind::kFace,
+                 ya = a_kind(y.type) == ElementKind::kFace;
       if (xa && ya && A_.face_plane[x.a] == A_.face_plane[y.a]) return false;
     }
   // Heights over a face-face contact: while faces a and b lie against each other, a point's
@@ -66,7 +68,8 @@ bool WitnessSearch::plausible(const PcSet& pcs) const {
     const Face& fb = B_.model->faces()[ff.b];
     for (const Pc& pc : pcs) {
       if (pc == ff) continue;
-      double a_lo = std::numeric_limits<double>::infinity(), a_hi = -a_lo, b_lo = a_lo, b_hi = -a_lo;
+      double a_lo = std::numeric_limits<double>::infinity(), a_hi = -a_lo, b_lo = a_lo,
+             b_hi = -a_lo;
       for (const Vec3& p : closure_points(*A_.model, a_kind(pc.type), pc.a)) {
         const double h = fa.offset - fa.normal.dot(p);
         a_lo = std::min(a_lo, h);
@@ -81,10 +84,14 @@ bool WitnessSearch::plausible(const PcSet& pcs) const {
       // element parallel to the plane.
       const bool a_flat = a_hi - a_lo <= tol, b_flat = b_hi - b_lo <= tol;
       bool meet;
-      if (a_flat && b_flat) meet = std::abs(a_lo - b_lo) <= 2 * tol;
-      else if (a_flat) meet = a_lo > b_lo + tol && a_lo < b_hi - tol;
-      else if (b_flat) meet = b_lo > a_lo + tol && b_lo < a_hi - tol;
-      else meet = std::max(a_lo, b_lo) < std::min(a_hi, b_hi) - tol;
+      if (a_flat && b_flat)
+        meet = std::abs(a_lo - b_lo) <= 2 * tol;
+      else if (a_flat)
+        meet = a_lo > b_lo + tol && a_lo < b_hi - tol;
+      else if (b_flat)
+        meet = b_lo > a_lo + tol && b_lo < a_hi - tol;
+      else
+        meet = std::max(a_lo, b_lo) < std::min(a_hi, b_hi) - tol;
       if (!meet) return false;
     }
   }
@@ -125,13 +132,20 @@ std::vector<int> WitnessSearch::piece_slots(const PcSet& pcs) const {
   std::vector<int> slot_sizes;
   for (const Pc& pc : pcs) {
     switch (pc.type) {
-      case PcType::kVF: case PcType::kEF: slot_sizes.push_back(int(B_.pieces[pc.b].size())); break;
-      case PcType::kFV: case PcType::kFE: slot_sizes.push_back(int(A_.pieces[pc.a].size())); break;
+      case PcType::kVF:
+      case PcType::kEF:
+        slot_sizes.push_back(int(B_.pieces[pc.b].size()));
+        break;
+      case PcType::kFV:
+      case PcType::kFE:
+        slot_sizes.push_back(int(A_.pieces[pc.a].size()));
+        break;
       case PcType::kFF:
         slot_sizes.push_back(int(B_.pieces[pc.b].size()));
         slot_sizes.push_back(int(A_.pieces[pc.a].size()));
         break;
-      case PcType::kEE: break;
+      case PcType::kEE:
+        break;
     }
   }
   return slot_sizes;

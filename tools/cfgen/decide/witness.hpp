@@ -25,8 +25,9 @@ class FindRun;
 struct Witness {
   bool found = false;
   Pose pose;
-  double clearance = 0;  // mm, smallest distance between elements not part of a PC, <= good_clearance
-  double margin = 0;     // mm, the LP margin of the contacts inside their elements
+  double clearance =
+      0;              // mm, smallest distance between elements not part of a PC, <= good_clearance
+  double margin = 0;  // mm, the LP margin of the contacts inside their elements
 };
 
 /// The search for witnesses (docs/generator.md, "Layers", decide): rotations from the PCs'
@@ -63,7 +64,8 @@ class WitnessSearch : public Verifier {
                                         bool generic_seeds = true) const;
   // Rotations satisfying the PCs' rotational conditions: the seeds projected onto them, and
   // `samples` spins when one face alignment leaves the spin free.
-  std::vector<Mat3> family_samples(const PcSet& pcs, const std::vector<Mat3>& seeds, int samples) const;
+  std::vector<Mat3> family_samples(const PcSet& pcs, const std::vector<Mat3>& seeds,
+                                   int samples) const;
   // The seeds, each PC's preferred rotations and a fixed spread over SO(3).
   std::vector<Mat3> spread_rotations(const PcSet& pcs, const std::vector<Mat3>& seeds) const;
   // For a set with two point PCs (v-f, f-v, e-e): rotations that place both contacts at
@@ -104,7 +106,8 @@ class WitnessSearch : public Verifier {
   // rotated by R, are separated by at least min_clearance: the separating axis (face normals,
   // edge cross products, edge-vertex and vertex-vertex directions of their closures) that
   // needs the smallest move from t. False when no axis separates them.
-  bool separating_cut(const Mat3& R, const Vec3& t, const Obstacle& o, LinearProgram::Row& cut) const;
+  bool separating_cut(const Mat3& R, const Vec3& t, const Obstacle& o,
+                      LinearProgram::Row& cut) const;
   // The largest s such that, at rotation R, the contacts sit s inside their elements and each
   // obstacle's two elements are s - min_margin farther apart than its separating cuts ask:
   // s >= min_margin places the contacts and clears every obstacle. An obstacle's face that

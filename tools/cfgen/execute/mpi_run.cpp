@@ -37,7 +37,8 @@ std::string receive_text(const MPI_Status& st) {
   int count = 0;
   MPI_Get_count(&st, MPI_CHAR, &count);
   std::string text(static_cast<std::size_t>(count), '\0');
-  MPI_Recv(text.data(), count, MPI_CHAR, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  MPI_Recv(text.data(), count, MPI_CHAR, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD,
+           MPI_STATUS_IGNORE);
   return text;
 }
 
@@ -71,7 +72,11 @@ int run_generate_mpi(GenerateArgs args) {
           if (st.MPI_TAG == kStop) return 0;
           std::size_t chunk = 0;
           const std::vector<gen::Task> tasks = tasks_from_text(text, "a chunk from rank 0", chunk);
-          send_text(task_results_text(chunk, gen::decide_all([&search](const gen::Task& t) { return gen::decide(search, t); }, tasks, threads)), 0, kResult);
+          send_text(task_results_text(
+                        chunk, gen::decide_all(
+                                   [&search](const gen::Task& t) { return gen::decide(search, t); },
+                                   tasks, threads)),
+                    0, kResult);
         }
       };
       return run_generate(args);
@@ -85,90 +90,92 @@ int run_generate_mpi(GenerateArgs args) {
     std::vector<int> idle;  // one entry per free slot
     for (int k = 0; k < kInFlight; ++k)
       for (int r = 1; r < size; ++r) idle.push_back(r);
-    args.distribute = [&](const std::vector<std::vector<gen::Task>>& chunks, const std::vector<std::size_t>& todo,
-                          const std::function<std::vector<gen::TaskResult>(std::size_t)>& compute,
-                          const std::function<void(std::size_t, std::vector<gen::TaskResult>&&)>& done) {
-      std::deque<std::size_t> queue(todo.begin(), todo.end());
-      int outstanding = 0;
-      auto receive = [&] {
-        for (;;) {
-          MPI_Status st;
-          int flag = 0;
-          MPI_Iprobe(MPI_ANY_SOURCE, kResult, MPI_COMM_WORLD, &flag, &st);
-          if (!flag) return;
-          const std::string text = receive_text(st);
-          std::size_t chunk = 0;
-          std::vector<gen::TaskResult> r =
-              task_results_from_text(text, "the results of rank " + std::to_string(st.MPI_SOURCE), chunk);
-          if (chunk >= chunks.size())
-            throw Error("rank " + std::to_string(st.MPI_SOURCE) + " answered for chunk " + std::to_string(chunk) +
-                        ", which this stage does not have");
-          done(chunk, std::move(r));
-          idle.push_back(st.MPI_SOURCE);
-          --outstanding;
-        }
-      };
-      // Chunks go out without blocking: a worker may be sending a result (which waits for rank 0
-      // to take it) when its next chunk is sent.
-      std::deque<std::pair<MPI_Request, std::string>> sending;
-      auto hand_out = [&] {
-        while (!sending.empty()) {
-          int complete = 0;
-          MPI_Test(&sending.front().first, &complete, MPI_STATUS_IGNORE);
-          if (!complete) break;
-          sending.pop_front();
-        }
-        while (!idle.empty() && !queue.empty()) {
-          sending.emplace_back(MPI_REQUEST_NULL, tasks_text(queue.front(), chunks[queue.front()]));
-          std::string& text = sending.back().second;
-          MPI_Isend(text.data(), static_cast<int>(text.size()), MPI_CHAR, idle.back(), kAssign, MPI_COMM_WORLD,
-                    &sending.back().first);
-          queue.pop_front();
-          idle.pop_back();
-          ++outstanding;
-        }
-      };
-      // Rank 0 computes chunks from the back of the queue on a thread of its own, while this
-      // thread (the only one that calls MPI) keeps the workers fed.
-      std::thread local;
-      std::atomic<bool> local_done{false};
-      std::size_t local_chunk = 0;
-      std::vector<gen::TaskResult> local_result;
-      std::exception_ptr local_error;
-      // An error on this thread waits for the chunk in hand (declared last: it must go first,
-      // while what the computing thread writes to still exists), then propagates.
-      struct JoinOnExit {
-        std::thread& t;
-        ~JoinOnExit() {
-          if (t.joinable()) t.join();
-        }
-      } join_on_exit{local};
-      for (;;) {
-        receive();
-        hand_out();
-        if (local.joinable() && local_done) {
-          local.join();
-          if (local_error) std::rethrow_exception(local_error);
-          done(local_chunk, std::move(local_result));
-        }
-        if (!local.joinable() && !queue.empty()) {
-          local_chunk = queue.back();
-          queue.pop_back();
-          local_done = false;
-          local = std::thread([&] {
-            try {
-              local_result = compute(local_chunk);
-            } catch (...) {
-              local_error = std::current_exception();
+    args.distribute =
+        [&](const std::vector<std::vector<gen::Task>>& chunks, const std::vector<std::size_t>& todo,
+            const std::function<std::vector<gen::TaskResult>(std::size_t)>& compute,
+            const std::function<void(std::size_t, std::vector<gen::TaskResult> &&)>& done) {
+          std::deque<std::size_t> queue(todo.begin(), todo.end());
+          int outstanding = 0;
+          auto receive = [&] {
+            for (;;) {
+              MPI_Status st;
+              int flag = 0;
+              MPI_Iprobe(MPI_ANY_SOURCE, kResult, MPI_COMM_WORLD, &flag, &st);
+              if (!flag) return;
+              const std::string text = receive_text(st);
+              std::size_t chunk = 0;
+              std::vector<gen::TaskResult> r = task_results_from_text(
+                  text, "the results of rank " + std::to_string(st.MPI_SOURCE), chunk);
+              if (chunk >= chunks.size())
+                throw Error("rank " + std::to_string(st.MPI_SOURCE) + " answered for chunk " +
+                            std::to_string(chunk) + ", which this stage does not have");
+              done(chunk, std::move(r));
+              idle.push_back(st.MPI_SOURCE);
+              --outstanding;
             }
-            local_done = true;
-          });
-        }
-        if (queue.empty() && outstanding == 0 && !local.joinable()) break;
-        std::this_thread::sleep_for(std::chrono::microseconds(500));
-      }
-      for (auto& [request, text] : sending) MPI_Wait(&request, MPI_STATUS_IGNORE);
-    };
+          };
+          // Chunks go out without blocking: a worker may be sending a result (which waits for rank
+          // 0 to take it) when its next chunk is sent.
+          std::deque<std::pair<MPI_Request, std::string>> sending;
+          auto hand_out = [&] {
+            while (!sending.empty()) {
+              int complete = 0;
+              MPI_Test(&sending.front().first, &complete, MPI_STATUS_IGNORE);
+              if (!complete) break;
+              sending.pop_front();
+            }
+            while (!idle.empty() && !queue.empty()) {
+              sending.emplace_back(MPI_REQUEST_NULL,
+                                   tasks_text(queue.front(), chunks[queue.front()]));
+              std::string& text = sending.back().second;
+              MPI_Isend(text.data(), static_cast<int>(text.size()), MPI_CHAR, idle.back(), kAssign,
+                        MPI_COMM_WORLD, &sending.back().first);
+              queue.pop_front();
+              idle.pop_back();
+              ++outstanding;
+            }
+          };
+          // Rank 0 computes chunks from the back of the queue on a thread of its own, while this
+          // thread (the only one that calls MPI) keeps the workers fed.
+          std::thread local;
+          std::atomic<bool> local_done{false};
+          std::size_t local_chunk = 0;
+          std::vector<gen::TaskResult> local_result;
+          std::exception_ptr local_error;
+          // An error on this thread waits for the chunk in hand (declared last: it must go first,
+          // while what the computing thread writes to still exists), then propagates.
+          struct JoinOnExit {
+            std::thread& t;
+            ~JoinOnExit() {
+              if (t.joinable()) t.join();
+            }
+          } join_on_exit{local};
+          for (;;) {
+            receive();
+            hand_out();
+            if (local.joinable() && local_done) {
+              local.join();
+              if (local_error) std::rethrow_exception(local_error);
+              done(local_chunk, std::move(local_result));
+            }
+            if (!local.joinable() && !queue.empty()) {
+              local_chunk = queue.back();
+              queue.pop_back();
+              local_done = false;
+              local = std::thread([&] {
+                try {
+                  local_result = compute(local_chunk);
+                } catch (...) {
+                  local_error = std::current_exception();
+                }
+                local_done = true;
+              });
+            }
+            if (queue.empty() && outstanding == 0 && !local.joinable()) break;
+            std::this_thread::sleep_for(std::chrono::microseconds(500));
+          }
+          for (auto& [request, text] : sending) MPI_Wait(&request, MPI_STATUS_IGNORE);
+        };
     const int status = run_generate(args);
     for (int r = 1; r < size; ++r) send_text(std::string(), r, kStop);
     return status;

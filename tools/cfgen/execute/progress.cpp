@@ -25,7 +25,8 @@ std::string human_duration(double s) {
 double stage_seconds_left(const ProgressEvent& e) {
   if (e.finished) return 0;
   if (e.done == 0 || e.seconds <= 0) return -1;
-  return static_cast<double>(e.total - std::min(e.done, e.total)) * e.seconds / static_cast<double>(e.done);
+  return static_cast<double>(e.total - std::min(e.done, e.total)) * e.seconds /
+         static_cast<double>(e.done);
 }
 
 std::string progress_line(const ProgressEvent& e) {
@@ -59,7 +60,8 @@ void ProgressPrinter::operator()(const ProgressEvent& e) {
     line += left > 0 ? "; run: about " + human_duration(left) + " left" : "; run: finishing";
   }
   // Pad over the rest of a longer previous line.
-  os_ << '\r' << line << std::string(shown_ > line.size() ? shown_ - line.size() : 0, ' ') << std::flush;
+  os_ << '\r' << line << std::string(shown_ > line.size() ? shown_ - line.size() : 0, ' ')
+      << std::flush;
   shown_ = line.size();
 }
 

@@ -45,7 +45,8 @@ nlohmann::json options_json(const GenerateArgs& a) {
 }
 
 // The JSON document in file `path`; errors read "<what> '<path>': <reason><hint>".
-nlohmann::json read_json_file(const std::string& path, const std::string& what, const std::string& hint = "") {
+nlohmann::json read_json_file(const std::string& path, const std::string& what,
+                              const std::string& hint = "") {
   std::string bytes, why;
   if (!read_input_file(path, bytes, why)) throw Error(what + " '" + path + "': " + why);
   try {
@@ -93,17 +94,21 @@ struct Reader {
     for (int k = 0; k < 12; ++k) {
       if (!j[k].is_number()) bad("a pose holds a non-number");
       const double v = j[k].get<double>();
-      if (k < 9) p.R_BA(k / 3, k % 3) = v;
-      else p.t_BA(k - 9) = v;
+      if (k < 9)
+        p.R_BA(k / 3, k % 3) = v;
+      else
+        p.t_BA(k - 9) = v;
     }
     return p;
   }
   PcSet pcs(const nlohmann::json& j) const {
-    if (!j.is_array() || j.empty() || j.size() > PcSet::kMaxPcs) bad("expected a set of 1 to 3 PCs");
+    if (!j.is_array() || j.empty() || j.size() > PcSet::kMaxPcs)
+      bad("expected a set of 1 to 3 PCs");
     PcSet s;
     for (const nlohmann::json& pc : j) {
-      if (!pc.is_array() || pc.size() != 3 || !pc[0].is_number_unsigned() || !pc[1].is_number_unsigned() ||
-          !pc[2].is_number_unsigned() || pc[0].get<unsigned>() > static_cast<unsigned>(PcType::kEE))
+      if (!pc.is_array() || pc.size() != 3 || !pc[0].is_number_unsigned() ||
+          !pc[1].is_number_unsigned() || !pc[2].is_number_unsigned() ||
+          pc[0].get<unsigned>() > static_cast<unsigned>(PcType::kEE))
         bad("expected a PC [type, a, b]");
       if (!s.insert(Pc{static_cast<PcType>(pc[0].get<int>()), pc[1].get<int>(), pc[2].get<int>()}))
         bad("a PC is repeated");
@@ -115,7 +120,8 @@ struct Reader {
     if (!j.is_array() || j.empty() || !j[0].is_boolean()) bad("expected a witness [found, ...]");
     w.found = j[0].get<bool>();
     if (!w.found) return w;
-    if (j.size() != 4 || !j[2].is_number() || !j[3].is_number()) bad("expected [true, pose, clearance, margin]");
+    if (j.size() != 4 || !j[2].is_number() || !j[3].is_number())
+      bad("expected [true, pose, clearance, margin]");
     w.pose = pose(j[1]);
     w.clearance = j[2].get<double>();
     w.margin = j[3].get<double>();
@@ -147,8 +153,7 @@ std::vector<gen::Task> parse_tasks(const nlohmann::json& j, const Reader& rd) {
   std::vector<gen::Task> out;
   for (const nlohmann::json& t : j) {
     if (!t.is_array() || t.size() != 4 || !t[0].is_number_unsigned() ||
-        t[0].get<unsigned>() > static_cast<unsigned>(gen::Task::Kind::kVerify) ||
-        !t[2].is_array())
+        t[0].get<unsigned>() > static_cast<unsigned>(gen::Task::Kind::kVerify) || !t[2].is_array())
       rd.bad("expected a task [kind, PCs, seeds, pose]");
     gen::Task task;
     task.kind = static_cast<gen::Task::Kind>(t[0].get<int>());
@@ -174,7 +179,8 @@ std::vector<gen::TaskResult> parse_task_results(const nlohmann::json& j, const R
   if (!j.is_array()) rd.bad("expected an array of results");
   std::vector<gen::TaskResult> out;
   for (const nlohmann::json& r : j) {
-    if (!r.is_array() || r.size() != 2 || !r[1].is_array()) rd.bad("expected a result [witness, met]");
+    if (!r.is_array() || r.size() != 2 || !r[1].is_array())
+      rd.bad("expected a result [witness, met]");
     gen::TaskResult res;
     res.witness = rd.witness(r[0]);
     for (const nlohmann::json& d : r[1]) {
@@ -197,21 +203,24 @@ std::string hex64(std::uint64_t h) {
 namespace {
 
 // {"chunk": N, key: ...} as sent between ranks; `what` names it in errors.
-const nlohmann::json& chunk_message(const std::string& text, const char* key, const Reader& rd, nlohmann::json& j,
-                                    std::size_t& chunk) {
+const nlohmann::json& chunk_message(const std::string& text, const char* key, const Reader& rd,
+                                    nlohmann::json& j, std::size_t& chunk) {
   try {
     j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     rd.bad(std::string("not JSON (") + e.what() + ")");
   }
-  if (!j.is_object() || !j.contains("chunk") || !j.at("chunk").is_number_unsigned() || !j.contains(key))
+  if (!j.is_object() || !j.contains("chunk") || !j.at("chunk").is_number_unsigned() ||
+      !j.contains(key))
     rd.bad(std::string("expected {\"chunk\", \"") + key + "\"}");
   chunk = j.at("chunk").get<std::size_t>();
   return j.at(key);
 }
 
 Reader message_reader(const std::string& what) {
-  return Reader{[what](const std::string& problem) -> void { throw Error("reading " + what + ": " + problem); }};
+  return Reader{[what](const std::string& problem) -> void {
+    throw Error("reading " + what + ": " + problem);
+  }};
 }
 
 }  // namespace
@@ -220,7 +229,8 @@ std::string tasks_text(std::size_t chunk, const std::vector<gen::Task>& tasks) {
   return nlohmann::json{{"chunk", chunk}, {"tasks", tasks_json(tasks)}}.dump();
 }
 
-std::vector<gen::Task> tasks_from_text(const std::string& text, const std::string& what, std::size_t& chunk) {
+std::vector<gen::Task> tasks_from_text(const std::string& text, const std::string& what,
+                                       std::size_t& chunk) {
   const Reader rd = message_reader(what);
   nlohmann::json j;
   return parse_tasks(chunk_message(text, "tasks", rd, j, chunk), rd);
@@ -230,8 +240,8 @@ std::string task_results_text(std::size_t chunk, const std::vector<gen::TaskResu
   return nlohmann::json{{"chunk", chunk}, {"results", task_results_json(results)}}.dump();
 }
 
-std::vector<gen::TaskResult> task_results_from_text(const std::string& text, const std::string& what,
-                                                    std::size_t& chunk) {
+std::vector<gen::TaskResult> task_results_from_text(const std::string& text,
+                                                    const std::string& what, std::size_t& chunk) {
   const Reader rd = message_reader(what);
   nlohmann::json j;
   return parse_task_results(chunk_message(text, "results", rd, j, chunk), rd);
@@ -244,7 +254,8 @@ gen::ShardSpec parse_shard(const std::string& text) {
     throw Error("--shard '" + printable(text) + "': expected i/K, e.g. 0/4");
   if (k < 1 || k > kMaxShards)
     throw Error("--shard '" + printable(text) + "': K must be in 1.." + std::to_string(kMaxShards));
-  if (i < 0 || i >= k) throw Error("--shard '" + printable(text) + "': i must be in 0.." + std::to_string(k - 1));
+  if (i < 0 || i >= k)
+    throw Error("--shard '" + printable(text) + "': i must be in 0.." + std::to_string(k - 1));
   gen::ShardSpec spec;
   spec.index = i;
   spec.count = k;
@@ -266,13 +277,14 @@ std::string run_fingerprint(const GenerateArgs& args) {
 }
 
 gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& fingerprint,
-                               const std::vector<std::string>& inputs) {
+                                const std::vector<std::string>& inputs) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
     throw Error("checkpoint '" + dir + "': exists and is not a directory");
   fs::create_directories(dir, ec);
-  if (ec) throw Error("checkpoint '" + dir + "': cannot create the directory (" + ec.message() + ")");
+  if (ec)
+    throw Error("checkpoint '" + dir + "': cannot create the directory (" + ec.message() + ")");
   const std::string manifest = (fs::path(dir) / "checkpoint.json").string();
   if (fs::exists(manifest, ec)) {
     const nlohmann::json j = read_json_file(manifest, "checkpoint", "; not a cfgen checkpoint");
@@ -280,9 +292,11 @@ gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& finge
       throw Error("checkpoint '" + manifest + "': not a cfgen checkpoint");
     if (j.value("fingerprint", std::string()) != fingerprint)
       throw Error("checkpoint '" + dir +
-                  "' was made from other models or options; use another directory, or remove it to start over");
+                  "' was made from other models or options; use another directory, or remove it to "
+                  "start over");
   } else {
-    const nlohmann::json j = {{"format", "cfgen checkpoint"}, {"version", kVersion}, {"fingerprint", fingerprint}};
+    const nlohmann::json j = {
+        {"format", "cfgen checkpoint"}, {"version", kVersion}, {"fingerprint", fingerprint}};
     write_outputs({{manifest, j.dump() + "\n"}}, inputs, "writing checkpoint");
   }
   gen::ChunkStore store;
@@ -292,7 +306,9 @@ gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& finge
     return (fs::path(dir) / name).string();
   };
   // A chunk is kept with a digest of its tasks: a resumed run must be asking for the same work.
-  auto digest = [](const std::vector<gen::Task>& tasks) { return hex64(fnv1a(0xcbf29ce484222325ULL, tasks_json(tasks).dump())); };
+  auto digest = [](const std::vector<gen::Task>& tasks) {
+    return hex64(fnv1a(0xcbf29ce484222325ULL, tasks_json(tasks).dump()));
+  };
   store.load = [=](std::size_t stage, std::size_t chunk, const std::vector<gen::Task>& tasks,
                    std::vector<gen::TaskResult>& out) {
     const std::string path = chunk_path(stage, chunk);
@@ -303,20 +319,26 @@ gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& finge
     if (!j.is_object() || j.value("fingerprint", std::string()) != fingerprint ||
         j.value("stage", std::size_t{0}) != stage || j.value("chunk", std::size_t{0}) != chunk ||
         j.value("tasks", std::string()) != digest(tasks))
-      throw Error("reading checkpoint chunk '" + path + "': made by another run (remove it to compute the chunk again)");
+      throw Error("reading checkpoint chunk '" + path +
+                  "': made by another run (remove it to compute the chunk again)");
     const Reader rd{[&](const std::string& problem) -> void {
-      throw Error("reading checkpoint chunk '" + path + "': " + problem + " (remove it to compute the chunk again)");
+      throw Error("reading checkpoint chunk '" + path + "': " + problem +
+                  " (remove it to compute the chunk again)");
     }};
     if (!j.contains("results")) rd.bad("missing \"results\"");
     out = parse_task_results(j.at("results"), rd);
     if (out.size() != tasks.size())
-      rd.bad(std::to_string(out.size()) + " results for " + std::to_string(tasks.size()) + " tasks");
+      rd.bad(std::to_string(out.size()) + " results for " + std::to_string(tasks.size()) +
+             " tasks");
     return true;
   };
   store.save = [=](std::size_t stage, std::size_t chunk, const std::vector<gen::Task>& tasks,
                    const std::vector<gen::TaskResult>& res) {
-    const nlohmann::json j = {{"fingerprint", fingerprint}, {"stage", stage}, {"chunk", chunk},
-                              {"tasks", digest(tasks)}, {"results", task_results_json(res)}};
+    const nlohmann::json j = {{"fingerprint", fingerprint},
+                              {"stage", stage},
+                              {"chunk", chunk},
+                              {"tasks", digest(tasks)},
+                              {"results", task_results_json(res)}};
     write_outputs({{chunk_path(stage, chunk), j.dump() + "\n"}}, inputs, "writing checkpoint");
   };
   return store;

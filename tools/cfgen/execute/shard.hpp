@@ -4,9 +4,9 @@
 /// `cfgen A B -o G.json --checkpoint DIR` keeps every finished chunk in DIR and resumes from
 /// it; `--shard i/K` with a DIR that K processes share splits every stage between them.
 
-#include "cfgen/generate.hpp"
 #include "cfgen/decide/witness.hpp"
 #include "cfgen/execute/executor.hpp"
+#include "cfgen/generate.hpp"
 
 #include <cstddef>
 #include <string>
@@ -30,7 +30,7 @@ std::string run_fingerprint(const GenerateArgs& args);
 /// @throws cf::Error when DIR is not a directory or holds another run's checkpoint; the store
 /// throws when a kept chunk is damaged or was made for other tasks.
 gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& fingerprint,
-                               const std::vector<std::string>& inputs);
+                                const std::vector<std::string>& inputs);
 
 /// Removes a checkpoint directory that open_checkpoint made: its manifest and chunk files,
 /// then the directory if nothing else is in it. Errors are ignored (the graph is written).
@@ -40,9 +40,10 @@ void remove_checkpoint(const std::string& dir);
 /// processes this way); doubles round-trip exactly.
 /// @throws cf::Error "reading <what>: <problem>" when the text is not such a chunk.
 std::string tasks_text(std::size_t chunk, const std::vector<gen::Task>& tasks);
-std::vector<gen::Task> tasks_from_text(const std::string& text, const std::string& what, std::size_t& chunk);
+std::vector<gen::Task> tasks_from_text(const std::string& text, const std::string& what,
+                                       std::size_t& chunk);
 std::string task_results_text(std::size_t chunk, const std::vector<gen::TaskResult>& results);
-std::vector<gen::TaskResult> task_results_from_text(const std::string& text, const std::string& what,
-                                                    std::size_t& chunk);
+std::vector<gen::TaskResult> task_results_from_text(const std::string& text,
+                                                    const std::string& what, std::size_t& chunk);
 
 }  // namespace cf::tools

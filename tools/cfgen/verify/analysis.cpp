@@ -72,8 +72,10 @@ bool point_inside(const Polyhedron& m, const Vec3& p, double boundary_tol) {
       const double s = -dist / dn;
       if (s <= 0) continue;
       const double inset = m.face_inset(FaceId(static_cast<int>(f)), p + s * d);
-      if (std::abs(inset) <= boundary_tol) ambiguous = true;
-      else if (inset > 0) ++crossings;
+      if (std::abs(inset) <= boundary_tol)
+        ambiguous = true;
+      else if (inset > 0)
+        ++crossings;
     }
     if (!ambiguous) return crossings % 2 == 1;
   }
@@ -99,25 +101,30 @@ BoxIndex::BoxIndex(const std::vector<Vec3>& lo, const std::vector<Vec3>& hi)
   const auto n = static_cast<std::size_t>(n_), w = static_cast<std::size_t>(words_);
   std::vector<int> order(n);
   for (int ax = 0; ax < 3; ++ax) {
-    auto build = [&](const std::vector<Vec3>& end, SortedEnds& ends, std::vector<std::uint64_t>& sets,
-                     bool prefix) {
+    auto build = [&](const std::vector<Vec3>& end, SortedEnds& ends,
+                     std::vector<std::uint64_t>& sets, bool prefix) {
       for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<int>(i);
-      std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return end[a][ax] < end[b][ax]; });
+      std::stable_sort(order.begin(), order.end(),
+                       [&](int a, int b) { return end[a][ax] < end[b][ax]; });
       std::vector<double> sorted(n);
       for (std::size_t r = 0; r < n; ++r) sorted[r] = end[static_cast<std::size_t>(order[r])][ax];
       ends.build(std::move(sorted));
       sets.assign((n + 1) * w, 0);
       // prefix: set r holds order[0, r); suffix: set r holds order[r, n). Each set is the
       // one before it (prefix) or after it (suffix) and one element more.
-      auto bit = [&](std::size_t r, int e) { sets[r * w + static_cast<std::size_t>(e / 64)] |= std::uint64_t{1} << (e % 64); };
+      auto bit = [&](std::size_t r, int e) {
+        sets[r * w + static_cast<std::size_t>(e / 64)] |= std::uint64_t{1} << (e % 64);
+      };
       if (prefix) {
         for (std::size_t r = 1; r <= n; ++r) {
-          std::copy_n(sets.begin() + static_cast<std::ptrdiff_t>((r - 1) * w), w, sets.begin() + static_cast<std::ptrdiff_t>(r * w));
+          std::copy_n(sets.begin() + static_cast<std::ptrdiff_t>((r - 1) * w), w,
+                      sets.begin() + static_cast<std::ptrdiff_t>(r * w));
           bit(r, order[r - 1]);
         }
       } else {
         for (std::size_t r = n; r-- > 0;) {
-          std::copy_n(sets.begin() + static_cast<std::ptrdiff_t>((r + 1) * w), w, sets.begin() + static_cast<std::ptrdiff_t>(r * w));
+          std::copy_n(sets.begin() + static_cast<std::ptrdiff_t>((r + 1) * w), w,
+                      sets.begin() + static_cast<std::ptrdiff_t>(r * w));
           bit(r, order[r]);
         }
       }
@@ -234,7 +241,8 @@ ModelInfo analyse_model(const Polyhedron& m) {
     Vec3 lo = m.vertices()[0].p, hi = lo;
     for (const Vertex& V : m.vertices()) lo = lo.cwiseMin(V.p), hi = hi.cwiseMax(V.p);
     info.bound.first = 0.5 * (lo + hi);
-    for (const Vertex& V : m.vertices()) info.bound.second = std::max(info.bound.second, (V.p - info.bound.first).norm());
+    for (const Vertex& V : m.vertices())
+      info.bound.second = std::max(info.bound.second, (V.p - info.bound.first).norm());
   }
   info.face_plane.assign(m.num_faces(), -1);
   int next = 0;
@@ -255,7 +263,8 @@ ModelInfo analyse_model(const Polyhedron& m) {
 
 std::vector<Vec3> closure_points(const Polyhedron& m, ElementKind k, int i) {
   std::vector<Vec3> out;
-  if (k == ElementKind::kVertex) out.push_back(m.vertices()[i].p);
+  if (k == ElementKind::kVertex)
+    out.push_back(m.vertices()[i].p);
   else if (k == ElementKind::kEdge) {
     out.push_back(m.edge_point(EdgeId(i), 0));
     out.push_back(m.edge_point(EdgeId(i), 1));
@@ -276,7 +285,8 @@ std::vector<Vec3> inset_closure_points(const Polyhedron& m, ElementKind k, int i
   if (f.loops.size() != 1) return whole;
   const std::vector<VertexId>& loop = f.loops[0];
   const std::size_t n = loop.size();
-  std::vector<Vec3> p(n), into(n);  // corners; unit in-plane normals of side k (p[k] to p[k+1]), inwards
+  std::vector<Vec3> p(n),
+      into(n);  // corners; unit in-plane normals of side k (p[k] to p[k+1]), inwards
   for (std::size_t c = 0; c < n; ++c) p[c] = m.vertex(loop[c]).p;
   for (std::size_t c = 0; c < n; ++c) {
     const Vec3 d = p[(c + 1) % n] - p[c];
@@ -307,7 +317,8 @@ std::vector<Vec3> inset_closure_points(const Polyhedron& m, ElementKind k, int i
 
 std::vector<Vec3> closure_directions(const Polyhedron& m, ElementKind k, int i) {
   std::vector<Vec3> out;
-  if (k == ElementKind::kEdge) out.push_back(m.edges()[i].dir);
+  if (k == ElementKind::kEdge)
+    out.push_back(m.edges()[i].dir);
   else if (k == ElementKind::kFace)
     for (EdgeId e : m.faces()[i].edges) out.push_back(m.edge(e).dir);
   return out;

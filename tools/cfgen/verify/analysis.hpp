@@ -16,14 +16,14 @@
 namespace cf::gen {
 
 struct VertexCone {
-  std::vector<Vec3> rays;   // unit, model frame, along each incident edge away from the vertex
-  bool pointed = false;     // the solid's tangent cone lies in an open half-space (v-f / f-v able)
+  std::vector<Vec3> rays;  // unit, model frame, along each incident edge away from the vertex
+  bool pointed = false;    // the solid's tangent cone lies in an open half-space (v-f / f-v able)
   Vec3 center = Vec3::Zero();  // unit m maximising min_i m . ray_i: points into the solid
   double center_margin = 0;    // that minimum (cosine)
 };
 
 struct EdgeWedge {
-  Vec3 into_left, into_right;  // unit, perpendicular to the edge, in each face, pointing into it
+  Vec3 into_left, into_right;    // unit, perpendicular to the edge, in each face, pointing into it
   Vec3 bisector = Vec3::Zero();  // unit bisector of the two outward normals (convex edges)
 };
 
@@ -66,11 +66,13 @@ class BoxIndex {
     }
     std::size_t upper_bound(double q) const {  // ends <= q
       const auto b = static_cast<std::size_t>(bucket(q));
-      return static_cast<std::size_t>(std::upper_bound(x.begin() + first[b], x.begin() + first[b + 1], q) - x.begin());
+      return static_cast<std::size_t>(
+          std::upper_bound(x.begin() + first[b], x.begin() + first[b + 1], q) - x.begin());
     }
     std::size_t lower_bound(double q) const {  // ends < q
       const auto b = static_cast<std::size_t>(bucket(q));
-      return static_cast<std::size_t>(std::lower_bound(x.begin() + first[b], x.begin() + first[b + 1], q) - x.begin());
+      return static_cast<std::size_t>(
+          std::lower_bound(x.begin() + first[b], x.begin() + first[b + 1], q) - x.begin());
     }
   };
   int n_ = 0, words_ = 0;

@@ -117,7 +117,8 @@ std::vector<ConvexPiece> convex_partition(const std::vector<std::vector<Eigen::V
         const std::size_t ib = (k + 1) % P.size();
         for (std::size_t i = 0; i < P.size(); ++i) m.push_back(P[(ib + i) % P.size()]);
         m.pop_back();  // drop a; Q supplies it
-        const std::size_t qa = static_cast<std::size_t>(std::find(Q.begin(), Q.end(), a) - Q.begin());
+        const std::size_t qa =
+            static_cast<std::size_t>(std::find(Q.begin(), Q.end(), a) - Q.begin());
         for (std::size_t i = 0; i + 1 < Q.size(); ++i) m.push_back(Q[(qa + i) % Q.size()]);
         if (!is_convex(m, pts)) continue;
         const int q = it->second;

@@ -1,7 +1,7 @@
 #include "cfgen/verify/lp.hpp"
 
-#include <Eigen/Dense>
 #include <glpk.h>
+#include <Eigen/Dense>
 
 #include <cmath>
 #include <cstring>
@@ -36,7 +36,8 @@ using EqMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxEqs, 
 using EqMatT = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxVars, kMaxEqs>;
 using EqVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxEqs, 1>;
 using MatMap = Eigen::Map<MatrixXd>;
-using RowMatMap = Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
+using RowMatMap =
+    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
 using VecMap = Eigen::Map<VectorXd>;
 
 // Per-thread storage for the matrices whose size follows the number of rows, grown and
@@ -56,8 +57,10 @@ struct Workspace {
     VarMat N;
     bool same(const EqMat& e, const EqVec& g) const {
       return set && e.rows() == E.rows() && e.cols() == E.cols() &&
-             std::memcmp(e.data(), E.data(), sizeof(double) * static_cast<std::size_t>(e.size())) == 0 &&
-             std::memcmp(g.data(), f.data(), sizeof(double) * static_cast<std::size_t>(g.size())) == 0;
+             std::memcmp(e.data(), E.data(), sizeof(double) * static_cast<std::size_t>(e.size())) ==
+                 0 &&
+             std::memcmp(g.data(), f.data(), sizeof(double) * static_cast<std::size_t>(g.size())) ==
+                 0;
     }
   } eq;
 };
@@ -98,8 +101,8 @@ struct DualSimplex {
   // d constraint rows, then the cost row; m columns, then the right side. Phase 1's
   // artificial columns are not stored: they never enter the basis and nothing reads them.
   RowMatMap T;
-  std::vector<int>& basic;  // basic column of each row; m + i: row i's artificial (not stored)
-  std::vector<char>& live;  // rows not removed as redundant
+  std::vector<int>& basic;   // basic column of each row; m + i: row i's artificial (not stored)
+  std::vector<char>& live;   // rows not removed as redundant
   std::vector<double>& tol;  // per column: reduced costs above -tol are non-negative
 
   DualSimplex(const MatMap& A, const VarVec& b, Workspace& w)
@@ -201,7 +204,8 @@ bool meets_rows(const LinearProgram& lp, const Vec& x) {
   for (int j = 0; j < lp.num_vars; ++j) {
     const auto [lf, lv] = lp.lower[j];
     const auto [uf, uv] = lp.upper[j];
-    if ((lf && x[j] < lv - 1e-7 * (1 + std::abs(lv))) || (uf && x[j] > uv + 1e-7 * (1 + std::abs(uv))))
+    if ((lf && x[j] < lv - 1e-7 * (1 + std::abs(lv))) ||
+        (uf && x[j] > uv + 1e-7 * (1 + std::abs(uv))))
       return false;
   }
   return true;
@@ -357,7 +361,7 @@ LpResult internal::glpk_solve(const LinearProgram& lp) {
   std::vector<double> ar{0.0};
   for (int i = 0; i < m; ++i) {
     const auto& r = lp.rows[i];
-    const int type = r.rel == LinearProgram::Rel::kEq        ? GLP_FX
+    const int type = r.rel == LinearProgram::Rel::kEq       ? GLP_FX
                      : r.rel == LinearProgram::Rel::kLessEq ? GLP_UP
                                                             : GLP_LO;
     glp_set_row_bnds(P, i + 1, type, r.b, r.b);

@@ -32,7 +32,8 @@ struct LinearProgram {
     }
     /// Throws std::length_error past kMaxVars entries.
     void push_back(const std::pair<int, double>& x) {
-      if (n_ == kMaxVars) throw std::length_error("LinearProgram row with more than kMaxVars coefficients");
+      if (n_ == kMaxVars)
+        throw std::length_error("LinearProgram row with more than kMaxVars coefficients");
       v_[n_++] = x;
     }
     std::size_t size() const { return n_; }
@@ -51,7 +52,7 @@ struct LinearProgram {
   };
   int num_vars = 0;
   std::vector<Row> rows;
-  std::vector<double> c;                  // objective, size num_vars
+  std::vector<double> c;                              // objective, size num_vars
   std::vector<std::pair<bool, double>> lower, upper;  // (finite?, value) per variable
 
   /// Throws std::length_error when n > kMaxVars.

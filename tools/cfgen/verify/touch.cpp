@@ -52,13 +52,15 @@ Poly face_polygon(const std::vector<std::vector<Eigen::Vector2d>>& loops) {
 
 }  // namespace
 
-std::optional<Vec3> face_overlap_centroid(const Polyhedron& A, const Pose& pose, int a, const Polyhedron& B, int b) {
+std::optional<Vec3> face_overlap_centroid(const Polyhedron& A, const Pose& pose, int a,
+                                          const Polyhedron& B, int b) {
   const Face& fa = A.face(FaceId(a));
   const Face& fb = B.face(FaceId(b));
   std::vector<std::vector<Eigen::Vector2d>> loops_a;
   for (const auto& loop : fa.loops) {
     loops_a.emplace_back();
-    for (VertexId v : loop) loops_a.back().push_back(B.face_coords(FaceId(b), pose.apply(A.vertex(v).p)));
+    for (VertexId v : loop)
+      loops_a.back().push_back(B.face_coords(FaceId(b), pose.apply(A.vertex(v).p)));
   }
   const Poly pa = face_polygon(loops_a), pb = face_polygon(fb.loops_2d);
   std::vector<Poly> inter;
@@ -95,7 +97,8 @@ bool open_touch(const Polyhedron& A, const Pose& pose, ElementKind ka, int a, co
   if (ka == K::kFace && kb == K::kVertex)
     return A.face_inset(FaceId(a), pose.inverse_apply(B.vertices()[b].p)) > tol;
   if (ka == K::kEdge && kb == K::kEdge) {
-    const Vec3 p0 = pose.apply(A.edge_point(EdgeId(a), 0)), p1 = pose.apply(A.edge_point(EdgeId(a), 1));
+    const Vec3 p0 = pose.apply(A.edge_point(EdgeId(a), 0)),
+               p1 = pose.apply(A.edge_point(EdgeId(a), 1));
     const Vec3 q0 = B.edge_point(EdgeId(b), 0), q1 = B.edge_point(EdgeId(b), 1);
     const Vec3 da = (p1 - p0).normalized(), db = (q1 - q0).normalized();
     if (da.cross(db).norm() > 1e-9) {

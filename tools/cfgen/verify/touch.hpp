@@ -17,6 +17,7 @@ bool open_touch(const Polyhedron& A, const Pose& pose, ElementKind ka, int a, co
 
 /// Centroid (B's frame) of the largest piece of the overlap of A's face a, posed, with B's
 /// face b, the two lying in one plane; nullopt when they do not overlap.
-std::optional<Vec3> face_overlap_centroid(const Polyhedron& A, const Pose& pose, int a, const Polyhedron& B, int b);
+std::optional<Vec3> face_overlap_centroid(const Polyhedron& A, const Pose& pose, int a,
+                                          const Polyhedron& B, int b);
 
 }  // namespace cf::gen
