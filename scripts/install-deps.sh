@@ -26,6 +26,8 @@ CF_APT_PACKAGES=(
   # the sanitizer and fuzz build (scripts/sanitize.sh, scripts/fuzz.sh): clang, its
   # ASan/UBSan runtimes and libFuzzer (clang is only a recommendation of clang-14)
   clang clang-14 libclang-rt-14-dev libfuzzer-14-dev
+  # the formatting check of every C++ source (scripts/format-check.sh, the ctest test format)
+  clang-format-14
   # cfinspect --html: the browser test of the viewer (tools/cfinspect/viewer, headless)
   chromium
   # libcf/python: the Python package cf (pybind11 against Debian's /usr/bin/python3), its
