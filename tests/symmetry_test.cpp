@@ -199,13 +199,17 @@ TEST_CASE("symmetry: canonical is the least image, the same for every member of 
                            true);
   REQUIRE(sym.size() == 96);
   const cf::Polyhedron B = cf::test::small_l_block();
-  // Sets of one to three PCs of mixed types spread over both models' elements.
+  // Sets of one to three PCs of mixed types spread over both models' elements (canonical
+  // tries only the maps of A that reach the least element; this checks it against all).
   std::vector<cf::PcSet> sets;
   for (int i = 0; i < 40; ++i) {
     std::vector<cf::Pc> pcs{{cf::PcType::kVF, i % 8, i % static_cast<int>(B.num_faces())}};
     if (i % 3 > 0)
       pcs.push_back({cf::PcType::kEE, (i * 5) % 12, (i * 7) % static_cast<int>(B.num_edges())});
     if (i % 3 > 1) pcs.push_back({cf::PcType::kFV, (i * 3) % 6, (i * 11) % 12});
+    // Two PCs of the least type: the least image's first PC may come from either.
+    if (i % 4 == 3 && pcs.size() < 3)
+      pcs.push_back({cf::PcType::kVF, (i + 4) % 8, (i * 5) % static_cast<int>(B.num_faces())});
     sets.emplace_back(pcs);
   }
   for (const cf::PcSet& s : sets) {

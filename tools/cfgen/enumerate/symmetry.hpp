@@ -47,7 +47,8 @@ class PairSymmetries {
 
  private:
   std::vector<Symmetry> a_, b_;
-  std::vector<std::pair<int, int>> pairs_;
+  std::vector<std::pair<int, int>> pairs_;  // (map of A, map of B), by map of A
+  std::vector<std::size_t> a_first_;        // pairs_[a_first_[i], a_first_[i + 1]): h = a_[i]
 };
 
 /// Lexicographic order of PC sets of one size (then by size).
