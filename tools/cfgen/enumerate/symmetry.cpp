@@ -203,10 +203,10 @@ bool pcset_less(const PcSet& x, const PcSet& y) {
 
 PcSet PairSymmetries::canonical(const PcSet& s) const {
   if (s.size() == 0 || pairs_.size() == 1) return s;
-  // The least image's first PC is the least PC of any image: of s's least type (a map keeps
-  // types), with the least image of A's element. Only the maps h of A that reach that element
-  // can give the least image, so only their pairs are tried (on a hexagonal peg and hole, 4
-  // of 24 maps of A: 48 pairs of 288).
+  // The least image's first PC is the least PC of any image: of s's least type (maps keep
+  // types), with the least element of A that a map takes one of those PCs' elements to. Only
+  // the maps of A that do can give the least image (a few of A's maps for most sets), so only
+  // their pairs are tried.
   const PcType t0 = s[0].type;
   const ElementKind ka = a_kind(t0);
   auto least_a = [&](const Symmetry& h) {
