@@ -79,13 +79,22 @@ fi
 if [[ -n $mpiexec ]]; then
   check "mpirun -n 2" 0 "" env -C "$src" "$mpiexec" -n 2 --oversubscribe --allow-run-as-root "$cfgen" \
     data/models/cube.off data/models/l_block.off -o "$work/mpi.json" -q -j 1
-  # With a checkpoint, then resumed by one process: every stage's chunks are kept by rank 0.
+  # With a checkpoint, then resumed by one process: every rank keeps its chunks of every stage,
+  # the neighbour rounds' screening too, which one process computes again (it is not worth
+  # keeping for one process): the rerun resumes the chunks a run of one process keeps.
   check "mpirun -n 2 --checkpoint" 0 "" env -C "$src" "$mpiexec" -n 2 --oversubscribe --allow-run-as-root "$cfgen" \
     data/models/cube.off data/models/l_block.off --checkpoint "$work/mpick" -o "$work/mpi_ck.json" -q -j 1
+  check "one process, --checkpoint" 0 "" env -C "$src" "$cfgen" \
+    data/models/cube.off data/models/l_block.off --checkpoint "$work/oneck" -o "$work/one_ck.json" -q -j 1
   mpichunks=$(ls mpick/stage*_chunk*.json 2>/dev/null | wc -l)
-  check "resumed from mpirun's checkpoint" 0 "resumed $mpichunks finished chunks" \
+  onechunks=$(ls oneck/stage*_chunk*.json 2>/dev/null | wc -l)
+  if [[ $mpichunks -le $onechunks || $onechunks -lt 50 ]]; then
+    echo "FAIL mpirun kept $mpichunks chunks, one process $onechunks (want more than 50, and more for mpirun)"
+    fail=1
+  fi
+  check "resumed from mpirun's checkpoint" 0 "resumed $onechunks finished chunks" \
     env -C "$src" "$cfgen" data/models/cube.off data/models/l_block.off --checkpoint "$work/mpick" -o "$work/mpi_ck2.json" -j 2
-  same_as_golden mpi.json mpi_ck.json mpi_ck2.json
+  same_as_golden mpi.json mpi_ck.json one_ck.json mpi_ck2.json
 else
   echo "skip mpirun (cfgen built without MPI)"
 fi

@@ -174,27 +174,73 @@ TEST_CASE("a checkpoint keeps every chunk of every stage, and a rerun takes them
   CHECK(again.calls == 16);
 }
 
-TEST_CASE("chunks handed to other processes are taken by index, in any order of return",
-          "[execute]") {
-  StandIn d;
-  ExecuteOptions o;
-  o.threads = 1;
-  std::size_t windows = 0;
-  // Stand-in for MPI: computes the chunks to do in reverse order and returns them so.
-  o.distribute = [&](const std::vector<std::vector<Task>>& chunks,
-                     const std::vector<std::size_t>& todo,
-                     const std::function<std::vector<TaskResult>(std::size_t)>& compute,
-                     const std::function<void(std::size_t, std::vector<TaskResult> &&)>& done) {
-    ++windows;
-    CHECK(chunks.size() <= 256);  // a window of chunks at a time
-    for (auto it = todo.rbegin(); it != todo.rend(); ++it) done(*it, compute(*it));
+// A stage of the enumeration's own items: item i's result names i; `who` records the shard
+// (index + 1) that computed each item.
+Stage own_items(std::size_t n, std::vector<std::size_t>& seen, std::vector<std::atomic<int>>& who,
+                int shard) {
+  Stage s;
+  s.size = n;
+  s.make = task_for;
+  s.compute = [&who, shard](std::size_t i) {
+    who[i] = shard + 1;
+    TaskResult r;
+    r.sets.push_back(task_for(i).pcs);
+    return r;
   };
-  Executor ex(d.decide(), o);
-  std::vector<std::size_t> order;
-  // 300,000 tasks: 1024 a chunk, 293 chunks, two windows.
-  check_results(run_stage(ex, 300000, &order));
-  CHECK(windows == 2);
-  for (std::size_t i = 0; i < order.size(); ++i) REQUIRE(order[i] == i);
+  s.take = [&seen](std::size_t i, TaskResult&& r) {
+    if (r.sets.size() == 1 && r.sets[0] == task_for(i).pcs) seen.push_back(i);
+  };
+  s.chunk = 100;
+  s.owner_key = 7;
+  return s;
+}
+
+TEST_CASE(
+    "the enumeration's own items are computed here, never decided; shards split them in chunks "
+    "that keep their shard from stage to stage",
+    "[execute][shard]") {
+  {
+    // One process with a checkpoint: computed on its threads, in order, nothing kept.
+    MemoryStore mem;
+    StandIn d;
+    ExecuteOptions o;
+    o.threads = 3;
+    o.checkpoint = mem.store();
+    Executor ex(d.decide(), o);
+    std::vector<std::size_t> seen;
+    std::vector<std::atomic<int>> who(1000);
+    ex.run(own_items(1000, seen, who, 0));
+    REQUIRE(seen.size() == 1000);
+    for (std::size_t i = 0; i < seen.size(); ++i) REQUIRE(seen[i] == i);
+    CHECK(d.calls == 0);
+    CHECK(mem.kept.empty());
+  }
+  // Two shards, two stages of the same owner key, the second larger (a list that grew): chunk
+  // k (items 100 k to 100 k + 99) is shard (k + 7) mod 2's in both.
+  MemoryStore mem;
+  const std::size_t sizes[] = {1000, 1550};
+  std::vector<std::atomic<int>> who[2] = {std::vector<std::atomic<int>>(1000),
+                                          std::vector<std::atomic<int>>(1550)};
+  std::vector<std::size_t> seen[2][2];
+  std::vector<std::thread> shards;
+  for (int k = 0; k < 2; ++k)
+    shards.emplace_back([&, k] {
+      StandIn d;
+      ExecuteOptions o;
+      o.threads = 1;
+      o.checkpoint = mem.store();
+      o.shard = {k, 2};
+      Executor ex(d.decide(), o);
+      for (int st = 0; st < 2; ++st) ex.run(own_items(sizes[st], seen[k][st], who[st], k));
+    });
+  for (auto& t : shards) t.join();
+  for (int st = 0; st < 2; ++st) {
+    for (int k = 0; k < 2; ++k) CHECK(seen[k][st].size() == sizes[st]);  // each sees all
+    for (std::size_t i = 0; i < sizes[st]; ++i) {
+      INFO("stage " << st << ", item " << i);
+      REQUIRE(who[st][i] == static_cast<int>((i / 100 + 7) % 2) + 1);
+    }
+  }
 }
 
 TEST_CASE(

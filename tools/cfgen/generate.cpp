@@ -177,10 +177,9 @@ RunPlan plan_run(const gen::WitnessSearch& ws, const gen::EnumerateOptions& opt,
                  const GenerateArgs& args, bool writes) {
   RunPlan plan;
   plan.checkpoint_dir = args.checkpoint_dir;
-  const bool may_keep = writes && !args.distribute && plan.checkpoint_dir.empty() &&
-                        !args.no_checkpoint && args.shard.count == 0;
-  if (writes && !args.distribute && (may_keep || !args.quiet))
-    plan.predicted = predict(ws, opt, args).seconds;
+  const bool may_keep =
+      writes && plan.checkpoint_dir.empty() && !args.no_checkpoint && args.shard.count == 0;
+  if (writes && (may_keep || !args.quiet)) plan.predicted = predict(ws, opt, args).seconds;
   if (!may_keep) return plan;
   const std::string dir = args.out_path + ".ckpt";
   std::error_code ec;
@@ -198,20 +197,18 @@ int run_generate(const GenerateArgs& args) {
   // the models (SPEC section 5b).
   const std::vector<std::string> inputs{args.a_path, args.b_path};
   // Of K shards, shard 0 writes the graph.
-  const bool writes = !args.serve && !args.estimate && args.shard.index == 0;
+  const bool writes = !args.estimate && args.shard.index == 0;
   if (writes) check_output_path(args.out_path, inputs, "writing graph");
   const Polyhedron A = load_model(args.a_path, args.load_a);
   const Polyhedron B = load_model(args.b_path, args.load_b);
-  if (!args.serve)
+  // The other ranks of an MPI run say nothing that rank 0 says.
+  if (!args.share.load || args.shard.index == 0)
     for (const auto& [m, which, option] :
          {std::tuple{&A, "A", "--units-a"}, std::tuple{&B, "B", "--units-b"}})
       if (const std::string w = size_warning(*m, which, option); !w.empty())
         std::cerr << "cfgen: warning: " << w << '\n';
   const gen::ModelInfo ai = gen::analyse_model(A);
   const gen::ModelInfo bi = gen::analyse_model(B);
-  if (args.serve)
-    return args.serve(gen::WitnessSearch(ai, bi, scaled_search(A, B, args.rel, args.search)),
-                      args.threads);
 
   gen::EnumerateOptions opt;
   // Lengths scale with the smaller model (RelativeLengths).
@@ -247,7 +244,7 @@ int run_generate(const GenerateArgs& args) {
   exec.shard_patience = args.shard_patience;
   if (!checkpoint_dir.empty())
     exec.checkpoint = open_checkpoint(checkpoint_dir, run_fingerprint(args), inputs);
-  exec.distribute = args.distribute;
+  exec.checkpoint = gen::either(exec.checkpoint, args.share);
   exec.stop = args.stop;
   const bool terminal = isatty(STDERR_FILENO) != 0;
   gen::ProgressPrinter printer(std::cerr, terminal);
@@ -276,7 +273,11 @@ int run_generate(const GenerateArgs& args) {
               << executor.resumed_chunks() << " finished chunks\n";
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (args.shard.count > 0 && !args.quiet)
+  if (args.share.load && !args.quiet)
+    std::cerr << "cfgen: rank " << args.shard.index << " of " << args.shard.count << ": took "
+              << executor.shared_chunks() << " chunks from the other ranks, waited "
+              << executor.waited_seconds() << " s for them\n";
+  else if (args.shard.count > 0 && !args.quiet)
     std::cerr << "cfgen: shard " << args.shard.index << "/" << args.shard.count << ": took "
               << executor.shared_chunks() << " chunks from the other shards, waited "
               << executor.waited_seconds() << " s for them, computed "

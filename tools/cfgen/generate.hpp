@@ -50,18 +50,16 @@ struct GenerateArgs {
   gen::SearchParams search;  ///< angular tolerances and search limits (lengths: `rel`)
   RelativeLengths rel;       ///< lengths of the search, relative to the models' size
   LoadOptions load_a, load_b;  ///< units and coplanarity tolerance of each model
-  /// With shard.count > 0 (checkpoint_dir required, on storage every shard sees): compute this
-  /// shard's chunks of every stage and take the others' from the checkpoint; shard 0 writes
-  /// the graph, the others nothing (docs/generator.md, "Shards").
+  /// With shard.count > 0 (checkpoint_dir or share required, a directory on storage every
+  /// shard sees): compute this shard's chunks of every stage and take the others' from the
+  /// checkpoint or the share; shard 0 writes the graph, the others nothing
+  /// (docs/generator.md, "Shards").
   gen::ShardSpec shard;
   /// s: the least a shard waits for another shard's chunk before computing it itself.
   double shard_patience = 10;
-  /// Empty, or how the run's chunks are shared with other processes (rank 0 of an MPI run).
-  gen::Distribute distribute;
-  /// When set, the models are read and analysed as for a run, and then this serves tasks
-  /// with the run's search instead of enumerating (the other ranks of an MPI run); its
-  /// value is the exit status.
-  std::function<int(const gen::WitnessSearch&, int threads)> serve;
+  /// Empty, or how the shards share chunks besides a checkpoint (the ranks of an MPI run,
+  /// by messages).
+  gen::ChunkStore share;
   /// Null, or a flag read between tasks: once set, the run stops, keeps the chunks it
   /// finished when checkpoint_dir is set, writes nothing else and returns 128 + the signal
   /// that set it (cfgen/execute/stop.hpp).

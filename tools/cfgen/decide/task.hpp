@@ -31,6 +31,7 @@ struct Task {
 struct TaskResult {
   Witness witness;             // kFind, kFindOrRefine, kFindNear, kVerify (pose and clearance)
   std::vector<Discovery> met;  // kExplore: the contact sets met, in a fixed order
+  std::vector<PcSet> sets;     // the enumeration's own items (Stage::compute), not a search's
 };
 
 /// Answers one task with `search`.

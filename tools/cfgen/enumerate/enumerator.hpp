@@ -123,6 +123,13 @@ class Enumerator {
                      std::vector<Kept>& kept);
   void screen_cf(int level, std::size_t i, const PcSetMap<std::vector<Pc>>& new_by_rest,
                  std::vector<Kept>& kept);
+  // A neighbour round's tasks as its screening takes them (neighbours.cpp).
+  struct RoundTake {
+    std::vector<Task> tasks;
+    PcSetSet searched;  // the sets of `tasks`
+    PcSetSet orbits;    // their orbits
+  };
+  void take_near(const PcSet& s, const PcSet& orbit, RoundTake& round) const;
   std::vector<Task> neighbour_tasks();
   std::size_t neighbour_round();
   void release_neighbour_rounds();

@@ -20,6 +20,8 @@ namespace {
 
 // Witnesses of neighbouring CFs a failed set is searched again from.
 constexpr std::size_t kNeighbourSeeds = 16;
+// Sets or CFs a chunk of a round's screening: a few milliseconds of work.
+constexpr std::size_t kScreenChunk = 4096;
 
 }  // namespace
 
@@ -166,8 +168,8 @@ void Enumerator::screen_cf(int level, std::size_t i, const PcSetMap<std::vector<
 }
 
 // The sets of a neighbour round, in order: the failed candidates, then the changes of the CFs
-// (screen_cf). Screened on all threads a block at a time, then taken in order on this
-// thread: one member of an orbit a round.
+// (screen_cf). Screened in stages of the runner (on all threads; split between shards), taken
+// in order on this thread: one member of an orbit a round.
 std::vector<Task> Enumerator::neighbour_tasks() {
   // The PCs of the failed sets and of the CFs new since the last round, then those of the
   // new CFs' changes.
@@ -184,55 +186,67 @@ std::vector<Task> Enumerator::neighbour_tasks() {
   know_neighbours(next);
   const PcSetMap<std::vector<Pc>> new_by_rest = new_cfs_by_rest();
   near_screened_none_ = near_screened_cfs_[0] + near_screened_cfs_[1] + near_screened_cfs_[2] == 0;
-  // Failed sets (level -1) and CFs not marked dead by earlier rounds.
   failed_dead_.resize(failed_.size(), 0);
   failed_near_.resize(failed_.size());
-  std::vector<std::pair<int, std::size_t>> from;
-  for (std::size_t i = 0; i < failed_.size(); ++i)
-    if (!failed_dead_[i]) from.emplace_back(-1, i);
   for (int l = 0; l < 3; ++l) {
     cf_dead_[l].resize(valid_[l].size(), 0);
     cf_screened_[l].resize(valid_[l].size(), 0);
     cf_near_[l].resize(valid_[l].size());
     near_screened_cfs_[l] = valid_[l].size();
-    for (std::size_t i = 0; i < valid_[l].size(); ++i)
-      if (!cf_dead_[l][i]) from.emplace_back(l, i);
   }
-  std::vector<Task> tasks;
-  PcSetSet round_orbits;
-  constexpr std::size_t kBlock = 4096;
-  std::vector<std::vector<Kept>> kept;  // per item: (candidate, its orbit)
-  for (std::size_t b = 0; b < from.size(); b += kBlock) {
-    const std::size_t e = std::min(from.size(), b + kBlock);
-    kept.assign(e - b, {});
-    runner_.for_each(e - b, [&](std::size_t k) {
-      const auto [level, i] = from[b + k];
-      if (level < 0)
-        screen_failed(i, new_by_rest, kept[k]);
-      else
-        screen_cf(level, i, new_by_rest, kept[k]);
-    });
-    for (const auto& list : kept)
-      for (const auto& [s, orbit] : list) {
-        // Taken earlier this round, as itself or by another member of its orbit.
-        if (near_searched_.count(s) || round_orbits.count(orbit) ||
-            near_tries_[orbit] >= kOrbitTries)
-          continue;
-        round_orbits.insert(orbit);
-        ++near_tries_[orbit];
-        near_searched_.insert(s);
-        Task t;
-        t.kind = Task::Kind::kFindNear;
-        t.pcs = s;
-        changes_of(s, [&](const PcSet& n, int, const Pc&) {
-          if (auto it = witness_rot_.find(n);
-              it != witness_rot_.end() && t.seeds.size() < kNeighbourSeeds)
-            t.seeds.push_back(it->second);
-        });
-        tasks.push_back(std::move(t));
-      }
+  // The failed sets (list -1), then each level's CFs, each list a stage whose items keep their
+  // chunk, and so their shard, from round to round. Screening reads only what the round
+  // starts with; the sets taken go to `round` and count as searched once every list is done.
+  RoundTake round;
+  for (int list = -1; list < 3; ++list) {
+    Stage st;
+    st.size = list < 0 ? failed_.size() : valid_[list].size();
+    st.chunk = kScreenChunk;
+    st.owner_key = static_cast<std::size_t>(list + 1);
+    st.make = [&, list](std::size_t i) {
+      Task t;
+      t.pcs = list < 0 ? failed_[i] : valid_[list][i].first;
+      return t;
+    };
+    st.compute = [&, list](std::size_t i) {
+      std::vector<Kept> kept;
+      if (list < 0 && !failed_dead_[i])
+        screen_failed(i, new_by_rest, kept);
+      else if (list >= 0 && !cf_dead_[list][i])
+        screen_cf(list, i, new_by_rest, kept);
+      TaskResult r;
+      for (const Kept& k : kept) r.sets.insert(r.sets.end(), {k.set, k.orbit});
+      return r;
+    };
+    st.take = [&](std::size_t, TaskResult&& r) {
+      for (std::size_t k = 0; k + 1 < r.sets.size(); k += 2)
+        take_near(r.sets[k], r.sets[k + 1], round);
+    };
+    runner_.run(st);
   }
-  return tasks;
+  for (const PcSet& orbit : round.orbits) ++near_tries_[orbit];
+  near_searched_.insert(round.searched.begin(), round.searched.end());
+  return std::move(round.tasks);
+}
+
+// A set the screening kept, made a task of the round unless it or another member of its orbit
+// was taken this round or the orbit has had its tries.
+void Enumerator::take_near(const PcSet& s, const PcSet& orbit, RoundTake& round) const {
+  const auto tries = near_tries_.find(orbit);
+  if (near_searched_.count(s) || round.orbits.count(orbit) ||
+      (tries != near_tries_.end() && tries->second >= kOrbitTries))
+    return;
+  round.orbits.insert(orbit);
+  round.searched.insert(s);
+  Task t;
+  t.kind = Task::Kind::kFindNear;
+  t.pcs = s;
+  changes_of(s, [&](const PcSet& n, int, const Pc&) {
+    if (auto it = witness_rot_.find(n);
+        it != witness_rot_.end() && t.seeds.size() < kNeighbourSeeds)
+      t.seeds.push_back(it->second);
+  });
+  round.tasks.push_back(std::move(t));
 }
 
 // The rounds' memory, once they are over: the records and the transitions need it more.

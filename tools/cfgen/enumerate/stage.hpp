@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,17 @@ struct Stage {
   std::function<void(std::size_t, TaskResult&&)> take;
   ProgressEvent* progress = nullptr;  ///< where this stage's progress goes; null: quiet
   Clock::time_point started;          ///< when the step the stage belongs to began
+  /// Set for work that is the enumeration's own, not a search (the neighbour rounds'
+  /// screening): item i's result is compute(i), called on any thread (distinct items at
+  /// once), and make(i) only names the item, for the checkpoint. Like compute, it must not
+  /// depend on what take has seen in the same stage. Shared between shards like tasks; run
+  /// here on threads otherwise, never kept in a checkpoint or sent to another process.
+  std::function<TaskResult(std::size_t)> compute;
+  /// Items a chunk; 0: chunk_size(size).
+  std::size_t chunk = 0;
+  /// Set: chunk k belongs to the same shard in every stage with the same key (a shard keeps
+  /// what it learned of its items between rounds); else chunks are dealt out afresh.
+  std::optional<std::size_t> owner_key;
 };
 
 /// Runs stages. Implemented by the execute layer (cfgen/execute/executor.hpp).

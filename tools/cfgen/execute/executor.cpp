@@ -13,8 +13,8 @@ namespace {
 
 // Tasks a slice holds in a stage without checkpoint or other processes.
 constexpr std::size_t kSliceTasks = std::size_t{1} << 15;
-// Under MPI, windows of chunks are handed out in turn (their results taken between windows,
-// on this thread): every chunk of a window is made at once.
+// Shards take a window of chunks at a time (their results taken between windows, on this
+// thread): every chunk of a window is made at once.
 constexpr std::size_t kWindowChunks = 256;
 
 }  // namespace
@@ -24,6 +24,22 @@ std::size_t chunk_size(std::size_t tasks) {
   // few enough files; at most 1024 tasks (about a minute of the slowest searches) a chunk.
   constexpr std::size_t kChunks = 64, kMin = 8, kMax = 1024;
   return std::clamp<std::size_t>((tasks + kChunks - 1) / kChunks, kMin, kMax);
+}
+
+ChunkStore either(ChunkStore first, ChunkStore second) {
+  if (!first.load) return second;
+  if (!second.load) return first;
+  ChunkStore out;
+  out.load = [first, second](std::size_t stage, std::size_t chunk, const std::vector<Task>& tasks,
+                             std::vector<TaskResult>& res) {
+    return first.load(stage, chunk, tasks, res) || second.load(stage, chunk, tasks, res);
+  };
+  out.save = [first, second](std::size_t stage, std::size_t chunk, const std::vector<Task>& tasks,
+                             const std::vector<TaskResult>& res) {
+    first.save(stage, chunk, tasks, res);
+    second.save(stage, chunk, tasks, res);
+  };
+  return out;
 }
 
 std::vector<TaskResult> decide_all(const Decide& decide, const std::vector<Task>& tasks,
@@ -67,44 +83,70 @@ std::vector<Task> Executor::make_range(const Stage& stage, std::size_t begin,
   return tasks;
 }
 
+std::vector<TaskResult> Executor::compute_range(
+    const Stage& stage, std::size_t begin, std::size_t end,
+    const std::function<void(std::size_t)>& ticks) const {
+  std::vector<TaskResult> out(end - begin);
+  if (!parallel_for(
+          end - begin, threads_, [&](std::size_t i) { out[i] = stage.compute(begin + i); }, ticks,
+          opt_.stop))
+    throw Stopped("stopped on request");
+  return out;
+}
+
 void Executor::run(const Stage& stage) {
   const std::size_t number = stages_++;
   throw_if_stopped();
-  if (!opt_.checkpoint.load && !opt_.distribute)
-    run_slices(stage);
-  else
+  // The enumeration's own work is shared between shards, not worth keeping in a checkpoint
+  // of one process.
+  const bool shared =
+      stage.compute ? opt_.shard.count > 0 : static_cast<bool>(opt_.checkpoint.load);
+  if (shared)
     run_chunks(stage, number);
+  else
+    run_slices(stage);
 }
 
 void Executor::run_slices(const Stage& stage) {
   const bool report = stage.progress && opt_.progress;
-  for (std::size_t b = 0; b < stage.size; b += kSliceTasks) {
-    const std::size_t e = std::min(stage.size, b + kSliceTasks);
+  // A stage with chunks of its own size is taken a chunk at a time: its results are many.
+  const std::size_t slice = stage.chunk ? stage.chunk : kSliceTasks;
+  for (std::size_t b = 0; b < stage.size; b += slice) {
+    const std::size_t e = std::min(stage.size, b + slice);
     std::function<void(std::size_t)> ticks;
     if (report) ticks = [&, b](std::size_t d) { tick(stage, b + d); };
     std::vector<TaskResult> r =
-        decide_all(decide_, make_range(stage, b, e), threads_, ticks, opt_.stop);
+        stage.compute ? compute_range(stage, b, e, ticks)
+                      : decide_all(decide_, make_range(stage, b, e), threads_, ticks, opt_.stop);
     for (std::size_t i = 0; i < r.size(); ++i) stage.take(b + i, std::move(r[i]));
   }
 }
 
 void Executor::run_chunks(const Stage& stage, std::size_t number) {
-  const std::size_t n = stage.size, size = chunk_size(n), count = (n + size - 1) / size;
+  const std::size_t n = stage.size, size = stage.chunk ? stage.chunk : chunk_size(n),
+                    count = (n + size - 1) / size;
+  const std::size_t key = stage.owner_key.value_or(number);
   const bool report = stage.progress && opt_.progress;
   std::size_t done = 0;  // tasks finished, for the progress
-  // Chunks handed to other processes, or shared with other shards, go a window at a time.
-  const std::size_t window = opt_.distribute || opt_.shard.count > 0 ? kWindowChunks : 1;
+  // Chunks shared with other shards go a window at a time.
+  const std::size_t window = opt_.shard.count > 0 ? kWindowChunks : 1;
   for (std::size_t w0 = 0; w0 < count; w0 += window) {
     const std::size_t w1 = std::min(count, w0 + window);
     std::vector<std::vector<Task>> chunks;
     for (std::size_t k = w0; k < w1; ++k)
       chunks.push_back(make_range(stage, k * size, std::min(n, (k + 1) * size)));
+    // Chunk j of the window computed here: tasks decided, or the enumeration's items.
+    auto compute = [&](std::size_t j, const std::function<void(std::size_t)>& ticks) {
+      const std::size_t b = (w0 + j) * size;
+      return stage.compute ? compute_range(stage, b, b + chunks[j].size(), ticks)
+                           : decide_all(decide_, chunks[j], threads_, ticks, opt_.stop);
+    };
     std::vector<std::vector<TaskResult>> res(chunks.size());
     std::vector<std::size_t> todo;  // within the window
     for (std::size_t j = 0; j < chunks.size(); ++j) {
       if (opt_.checkpoint.load && opt_.checkpoint.load(number, w0 + j, chunks[j], res[j])) {
         done += chunks[j].size();
-        ++(mine(number, w0 + j) ? resumed_ : shared_);
+        ++(mine(key, w0 + j) ? resumed_ : shared_);
       } else {
         todo.push_back(j);
       }
@@ -125,64 +167,61 @@ void Executor::run_chunks(const Stage& stage, std::size_t number) {
     std::vector<std::size_t> theirs;
     if (opt_.shard.count > 0) {
       std::vector<std::size_t> own;
-      for (std::size_t j : todo) (mine(number, w0 + j) ? own : theirs).push_back(j);
+      for (std::size_t j : todo) (mine(key, w0 + j) ? own : theirs).push_back(j);
       todo.swap(own);
     }
-    if (opt_.distribute) {
-      // Progress then moves chunk by chunk, from the thread that takes them.
-      if (!todo.empty())
-        opt_.distribute(
-            chunks, todo,
-            [&](std::size_t j) { return decide_all(decide_, chunks[j], threads_, {}, opt_.stop); },
-            finish);
-    } else {
-      for (std::size_t j : todo) {
-        std::function<void(std::size_t)> ticks;
-        if (report) ticks = [&](std::size_t d) { tick(stage, done + d); };
-        const auto c0 = Clock::now();
-        finish(j, decide_all(decide_, chunks[j], threads_, ticks, opt_.stop));
-        slowest_chunk_ =
-            std::max(slowest_chunk_, std::chrono::duration<double>(Clock::now() - c0).count());
-      }
+    for (std::size_t j : todo) {
+      std::function<void(std::size_t)> ticks;
+      if (report) ticks = [&](std::size_t d) { tick(stage, done + d); };
+      const auto c0 = Clock::now();
+      finish(j, compute(j, ticks));
+      slowest_chunk_ =
+          std::max(slowest_chunk_, std::chrono::duration<double>(Clock::now() - c0).count());
     }
     if (!theirs.empty())
-      take_theirs(number, w0, chunks, theirs, res, finish, [&](std::size_t j) {
-        done += chunks[j].size();
-        tick(stage, done);
-      });
+      take_theirs(
+          number, key, w0, chunks, theirs, res, [&](std::size_t j) { finish(j, compute(j, {})); },
+          [&](std::size_t j) {
+            done += chunks[j].size();
+            tick(stage, done);
+          });
     for (std::size_t j = 0; j < chunks.size(); ++j)
       for (std::size_t i = 0; i < res[j].size(); ++i)
         stage.take((w0 + j) * size + i, std::move(res[j][i]));
   }
 }
 
-bool Executor::mine(std::size_t stage, std::size_t chunk) const {
-  const auto count = static_cast<std::size_t>(opt_.shard.count);
-  // Shifted by the stage, so that the many stages of a chunk or two spread over the shards.
-  return count == 0 || (chunk + stage) % count == static_cast<std::size_t>(opt_.shard.index);
+std::size_t Executor::owner(std::size_t key, std::size_t chunk) const {
+  // Shifted by the key (the stage's number unless it pins its chunks), so that the many
+  // stages of a chunk or two spread over the shards.
+  return (chunk + key) % static_cast<std::size_t>(opt_.shard.count);
 }
 
-void Executor::take_theirs(std::size_t number, std::size_t w0,
+bool Executor::mine(std::size_t key, std::size_t chunk) const {
+  return opt_.shard.count == 0 || owner(key, chunk) == static_cast<std::size_t>(opt_.shard.index);
+}
+
+void Executor::take_theirs(std::size_t number, std::size_t key, std::size_t w0,
                            const std::vector<std::vector<Task>>& chunks,
                            std::vector<std::size_t> outstanding,
-                           std::vector<std::vector<TaskResult>>& res, const Finish& finish,
+                           std::vector<std::vector<TaskResult>>& res,
+                           const std::function<void(std::size_t)>& compute_here,
                            const std::function<void(std::size_t)>& arrived) {
   // Polled together against one deadline: a chunk takes milliseconds to seconds, so the first
   // looks come quickly, then one every 100 ms (a stat of one file a chunk).
   const auto t0 = Clock::now();
   const double deadline = patience();
-  const auto k_shards = static_cast<std::size_t>(opt_.shard.count);
   for (int k = 0; !outstanding.empty(); ++k) {
     std::vector<std::size_t> still;
     for (std::size_t j : outstanding) {
-      const std::size_t owner = (w0 + j + number) % k_shards;
+      const std::size_t who = owner(key, w0 + j);
       if (opt_.checkpoint.load(number, w0 + j, chunks[j], res[j])) {
-        gone_[owner] = 0;  // it is back
+        gone_[who] = 0;  // it is back
         ++shared_;
         arrived(j);
-      } else if (gone_[owner]) {
+      } else if (gone_[who]) {
         ++taken_over_;
-        finish(j, decide_all(decide_, chunks[j], threads_, {}, opt_.stop));
+        compute_here(j);
       } else {
         still.push_back(j);
       }
@@ -193,7 +232,7 @@ void Executor::take_theirs(std::size_t number, std::size_t w0,
     if (std::chrono::duration<double>(Clock::now() - t0).count() >= deadline) {
       // Their shards are taken as gone until a chunk of theirs appears: the next pass
       // computes these chunks, and later stages compute their chunks without waiting.
-      for (std::size_t j : outstanding) gone_[(w0 + j + number) % k_shards] = 1;
+      for (std::size_t j : outstanding) gone_[owner(key, w0 + j)] = 1;
       continue;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(std::min(100, 1 << std::min(k, 7))));

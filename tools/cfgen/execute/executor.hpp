@@ -32,19 +32,14 @@ struct ChunkStore {
       save;
 };
 
-/// Hands a stage's chunks to other processes (an MPI run). Called with every chunk of a
-/// window and the indices of those still to do; compute(k) returns the results of chunk k
-/// computed here (callable from any one thread), done(k, r) takes the results of chunk k
-/// (computed here or elsewhere; call it from the calling thread). Returns when every chunk
-/// in `todo` is done.
-using Distribute = std::function<void(
-    const std::vector<std::vector<Task>>& chunks, const std::vector<std::size_t>& todo,
-    const std::function<std::vector<TaskResult>(std::size_t)>& compute,
-    const std::function<void(std::size_t, std::vector<TaskResult>&&)>& done)>;
+/// A store that finds chunks in `first`, else in `second`, and keeps them in both (an MPI
+/// run's checkpoint directory and its messages); either may be empty.
+ChunkStore either(ChunkStore first, ChunkStore second);
 
 /// One of K processes that share a run through a checkpoint directory they all see
-/// (cfgen --shard i/K --checkpoint DIR): chunk k of stage s is this process's when
-/// (k + s) mod count == index; the others' are read from the checkpoint as they appear. A
+/// (cfgen --shard i/K --checkpoint DIR) or messages (the ranks of an MPI run): chunk k of
+/// stage s is this process's when (k + s) mod count == index (s: Stage::owner_key when set);
+/// the others' are read from the checkpoint as they appear. A
 /// chunk that does not appear within the patience (three times the slowest chunk computed
 /// here on one thread, at least ExecuteOptions::shard_patience) is computed here, and its
 /// shard is taken as gone (its chunks computed here without waiting) until a chunk of its
@@ -62,10 +57,9 @@ struct ExecuteOptions {
   ShardSpec shard;
   /// s: the least a shard waits for another's chunk before computing it itself.
   double shard_patience = 10;
-  /// Empty, or where every stage's finished chunks are kept and found again.
+  /// Empty, or where every stage's finished chunks are kept and found again (with shards:
+  /// where they find each other's).
   ChunkStore checkpoint;
-  /// Empty, or how chunks are shared with other processes.
-  Distribute distribute;
   /// Called now and then while a stage runs, and once when it ends (ProgressEvent::finished);
   /// from one thread at a time. Empty to stay quiet.
   std::function<void(const ProgressEvent&)> progress;
@@ -107,15 +101,21 @@ class Executor final : public StageRunner {
   // kept when done.
   void run_chunks(const Stage& stage, std::size_t number);
   std::vector<Task> make_range(const Stage& stage, std::size_t begin, std::size_t end) const;
+  // Items [begin, end) of a stage with Stage::compute, on every thread.
+  std::vector<TaskResult> compute_range(const Stage& stage, std::size_t begin, std::size_t end,
+                                        const std::function<void(std::size_t)>& ticks) const;
   void tick(const Stage& stage, std::size_t done) const;
-  bool mine(std::size_t stage, std::size_t chunk) const;
-  using Finish = std::function<void(std::size_t, std::vector<TaskResult>&&)>;
-  // The other shards' chunks `outstanding` of the window at w0: read into res as they appear
-  // in the checkpoint (then arrived(j)), or, when their shard is gone or lets them wait past
-  // the patience, computed here and passed to finish.
-  void take_theirs(std::size_t number, std::size_t w0, const std::vector<std::vector<Task>>& chunks,
+  // The shard chunk `chunk` of a stage with owner key `key` belongs to, and whether it is this.
+  std::size_t owner(std::size_t key, std::size_t chunk) const;
+  bool mine(std::size_t key, std::size_t chunk) const;
+  // The other shards' chunks `outstanding` of the window at w0 of stage `number`: read into
+  // res as they appear in the checkpoint (then arrived(j)), or, when their shard is gone or
+  // lets them wait past the patience, computed here (compute_here(j)).
+  void take_theirs(std::size_t number, std::size_t key, std::size_t w0,
+                   const std::vector<std::vector<Task>>& chunks,
                    std::vector<std::size_t> outstanding, std::vector<std::vector<TaskResult>>& res,
-                   const Finish& finish, const std::function<void(std::size_t)>& arrived);
+                   const std::function<void(std::size_t)>& compute_here,
+                   const std::function<void(std::size_t)>& arrived);
   // s: how long to wait for another shard's chunk before computing it here.
   double patience() const;
   void throw_if_stopped() const;

@@ -11,8 +11,9 @@
 #include <chrono>
 #include <cstdlib>
 #include <deque>
-#include <exception>
 #include <iostream>
+#include <limits>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -20,27 +21,117 @@
 namespace cf::tools {
 namespace {
 
-enum Tag : int { kAssign = 2, kResult = 3, kStop = 4 };
+constexpr int kChunk = 5;  // the message tag of a chunk's results
 
-[[noreturn]] void abort_job(int rank, const std::string& message) {
+[[noreturn]] void abort_job(int rank, const std::string& message, int status = 1) {
   std::cerr << "cfgen (MPI rank " << rank << "): " << message << '\n';
-  MPI_Abort(MPI_COMM_WORLD, 1);
-  std::exit(1);
+  MPI_Abort(MPI_COMM_WORLD, status);
+  std::exit(status);
 }
 
-void send_text(const std::string& text, int to, int tag) {
-  MPI_Send(text.data(), static_cast<int>(text.size()), MPI_CHAR, to, tag, MPI_COMM_WORLD);
-}
+// The chunks of every stage between the ranks of the job: each rank sends the chunks it
+// computes to every other rank and takes theirs as they arrive. Every MPI call is made from
+// the thread that runs the stages (MPI_THREAD_FUNNELED).
+class MpiShare {
+ public:
+  MpiShare(int rank, int size) : rank_(rank), size_(size) {}
 
-// The message `st` announced, as text.
-std::string receive_text(const MPI_Status& st) {
-  int count = 0;
-  MPI_Get_count(&st, MPI_CHAR, &count);
-  std::string text(static_cast<std::size_t>(count), '\0');
-  MPI_Recv(text.data(), count, MPI_CHAR, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD,
-           MPI_STATUS_IGNORE);
-  return text;
-}
+  gen::ChunkStore store() {
+    gen::ChunkStore s;
+    s.load = [this](std::size_t stage, std::size_t chunk, const std::vector<gen::Task>& tasks,
+                    std::vector<gen::TaskResult>& out) { return take(stage, chunk, tasks, out); };
+    s.save = [this](std::size_t stage, std::size_t chunk, const std::vector<gen::Task>&,
+                    const std::vector<gen::TaskResult>& results) { send(stage, chunk, results); };
+    return s;
+  }
+
+  // Returns once every rank has called it: by then every chunk sent has left, and messages
+  // that nobody needs (a chunk a rank found in its checkpoint) are received and dropped.
+  void finish() {
+    MPI_Request barrier = MPI_REQUEST_NULL;
+    for (bool entered = false;;) {
+      receive();
+      arrived_.clear();
+      reap();
+      if (!entered && sending_.empty()) {
+        MPI_Ibarrier(MPI_COMM_WORLD, &barrier);
+        entered = true;
+      }
+      int done = 0;
+      if (entered) MPI_Test(&barrier, &done, MPI_STATUS_IGNORE);
+      if (done) return;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
+
+ private:
+  struct Sending {
+    std::string text;
+    std::vector<MPI_Request> requests;
+  };
+
+  void send(std::size_t stage, std::size_t chunk, const std::vector<gen::TaskResult>& results) {
+    reap();
+    sending_.push_back({chunk_text(stage, chunk, results), {}});
+    Sending& s = sending_.back();
+    for (int r = 0; r < size_; ++r) {
+      if (r == rank_) continue;
+      s.requests.emplace_back();
+      MPI_Isend(s.text.data(), static_cast<int>(s.text.size()), MPI_CHAR, r, kChunk, MPI_COMM_WORLD,
+                &s.requests.back());
+    }
+  }
+
+  // Sends whose every copy has left, from the oldest.
+  void reap() {
+    while (!sending_.empty()) {
+      int done = 0;
+      Sending& s = sending_.front();
+      MPI_Testall(static_cast<int>(s.requests.size()), s.requests.data(), &done,
+                  MPI_STATUSES_IGNORE);
+      if (!done) return;
+      sending_.pop_front();
+    }
+  }
+
+  // Every chunk that has come, kept by (stage, chunk) until a stage asks for it.
+  void receive() {
+    for (;;) {
+      MPI_Status st;
+      int flag = 0;
+      MPI_Iprobe(MPI_ANY_SOURCE, kChunk, MPI_COMM_WORLD, &flag, &st);
+      if (!flag) return;
+      int count = 0;
+      MPI_Get_count(&st, MPI_CHAR, &count);
+      std::string text(static_cast<std::size_t>(count), '\0');
+      MPI_Recv(text.data(), count, MPI_CHAR, st.MPI_SOURCE, kChunk, MPI_COMM_WORLD,
+               MPI_STATUS_IGNORE);
+      std::size_t stage = 0, chunk = 0;
+      std::vector<gen::TaskResult> r =
+          chunk_from_text(text, "a chunk from rank " + std::to_string(st.MPI_SOURCE), stage, chunk);
+      arrived_[{stage, chunk}] = std::move(r);
+    }
+  }
+
+  bool take(std::size_t stage, std::size_t chunk, const std::vector<gen::Task>& tasks,
+            std::vector<gen::TaskResult>& out) {
+    reap();
+    receive();
+    const auto it = arrived_.find({stage, chunk});
+    if (it == arrived_.end()) return false;
+    if (it->second.size() != tasks.size())
+      throw Error("stage " + std::to_string(stage) + ", chunk " + std::to_string(chunk) + ": " +
+                  std::to_string(it->second.size()) + " results from another rank for " +
+                  std::to_string(tasks.size()) + " tasks");
+    out = std::move(it->second);
+    arrived_.erase(it);
+    return true;
+  }
+
+  int rank_, size_;
+  std::map<std::pair<std::size_t, std::size_t>, std::vector<gen::TaskResult>> arrived_;
+  std::deque<Sending> sending_;
+};
 
 }  // namespace
 
@@ -61,123 +152,19 @@ int run_generate_mpi(GenerateArgs args) {
   } finalize;
   try {
     if (size == 1) return rank == 0 ? run_generate(args) : 0;
-    if (rank != 0) {
-      // A worker: chunks of tasks in, their results out, until rank 0 says stop.
-      args.quiet = true;
-      args.serve = [](const gen::WitnessSearch& search, int threads) {
-        for (;;) {
-          MPI_Status st;
-          MPI_Probe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &st);
-          const std::string text = receive_text(st);
-          if (st.MPI_TAG == kStop) return 0;
-          std::size_t chunk = 0;
-          const std::vector<gen::Task> tasks = tasks_from_text(text, "a chunk from rank 0", chunk);
-          send_text(task_results_text(
-                        chunk, gen::decide_all(
-                                   [&search](const gen::Task& t) { return gen::decide(search, t); },
-                                   tasks, threads)),
-                    0, kResult);
-        }
-      };
-      return run_generate(args);
-    }
-    // Rank 0 runs the enumeration; each stage's chunks go to idle workers while it computes
-    // others itself, and the results are taken by chunk index, so the graph is the one a
-    // single process writes.
-    // Two chunks in flight per worker: one to compute while rank 0, busy with a chunk of its
-    // own, cannot answer; a worker answers in order, so its second chunk starts at once.
-    constexpr int kInFlight = 2;
-    std::vector<int> idle;  // one entry per free slot
-    for (int k = 0; k < kInFlight; ++k)
-      for (int r = 1; r < size; ++r) idle.push_back(r);
-    args.distribute =
-        [&](const std::vector<std::vector<gen::Task>>& chunks, const std::vector<std::size_t>& todo,
-            const std::function<std::vector<gen::TaskResult>(std::size_t)>& compute,
-            const std::function<void(std::size_t, std::vector<gen::TaskResult> &&)>& done) {
-          std::deque<std::size_t> queue(todo.begin(), todo.end());
-          int outstanding = 0;
-          auto receive = [&] {
-            for (;;) {
-              MPI_Status st;
-              int flag = 0;
-              MPI_Iprobe(MPI_ANY_SOURCE, kResult, MPI_COMM_WORLD, &flag, &st);
-              if (!flag) return;
-              const std::string text = receive_text(st);
-              std::size_t chunk = 0;
-              std::vector<gen::TaskResult> r = task_results_from_text(
-                  text, "the results of rank " + std::to_string(st.MPI_SOURCE), chunk);
-              if (chunk >= chunks.size())
-                throw Error("rank " + std::to_string(st.MPI_SOURCE) + " answered for chunk " +
-                            std::to_string(chunk) + ", which this stage does not have");
-              done(chunk, std::move(r));
-              idle.push_back(st.MPI_SOURCE);
-              --outstanding;
-            }
-          };
-          // Chunks go out without blocking: a worker may be sending a result (which waits for rank
-          // 0 to take it) when its next chunk is sent.
-          std::deque<std::pair<MPI_Request, std::string>> sending;
-          auto hand_out = [&] {
-            while (!sending.empty()) {
-              int complete = 0;
-              MPI_Test(&sending.front().first, &complete, MPI_STATUS_IGNORE);
-              if (!complete) break;
-              sending.pop_front();
-            }
-            while (!idle.empty() && !queue.empty()) {
-              sending.emplace_back(MPI_REQUEST_NULL,
-                                   tasks_text(queue.front(), chunks[queue.front()]));
-              std::string& text = sending.back().second;
-              MPI_Isend(text.data(), static_cast<int>(text.size()), MPI_CHAR, idle.back(), kAssign,
-                        MPI_COMM_WORLD, &sending.back().first);
-              queue.pop_front();
-              idle.pop_back();
-              ++outstanding;
-            }
-          };
-          // Rank 0 computes chunks from the back of the queue on a thread of its own, while this
-          // thread (the only one that calls MPI) keeps the workers fed.
-          std::thread local;
-          std::atomic<bool> local_done{false};
-          std::size_t local_chunk = 0;
-          std::vector<gen::TaskResult> local_result;
-          std::exception_ptr local_error;
-          // An error on this thread waits for the chunk in hand (declared last: it must go first,
-          // while what the computing thread writes to still exists), then propagates.
-          struct JoinOnExit {
-            std::thread& t;
-            ~JoinOnExit() {
-              if (t.joinable()) t.join();
-            }
-          } join_on_exit{local};
-          for (;;) {
-            receive();
-            hand_out();
-            if (local.joinable() && local_done) {
-              local.join();
-              if (local_error) std::rethrow_exception(local_error);
-              done(local_chunk, std::move(local_result));
-            }
-            if (!local.joinable() && !queue.empty()) {
-              local_chunk = queue.back();
-              queue.pop_back();
-              local_done = false;
-              local = std::thread([&] {
-                try {
-                  local_result = compute(local_chunk);
-                } catch (...) {
-                  local_error = std::current_exception();
-                }
-                local_done = true;
-              });
-            }
-            if (queue.empty() && outstanding == 0 && !local.joinable()) break;
-            std::this_thread::sleep_for(std::chrono::microseconds(500));
-          }
-          for (auto& [request, text] : sending) MPI_Wait(&request, MPI_STATUS_IGNORE);
-        };
+    // Every rank runs the enumeration as shard `rank` of `size`: its own chunks of every stage
+    // computed here and sent to the others, theirs taken as they come; rank 0 writes the graph.
+    // A rank does not leave the job before it ends, so none is waited for with a patience.
+    MpiShare share(rank, size);
+    args.shard.index = rank;
+    args.shard.count = size;
+    args.shard_patience = std::numeric_limits<double>::infinity();
+    args.share = share.store();
+    if (rank != 0) args.quiet = true;
     const int status = run_generate(args);
-    for (int r = 1; r < size; ++r) send_text(std::string(), r, kStop);
+    // A rank stopped by a signal ends the job: the others would wait for its chunks.
+    if (status != 0) abort_job(rank, "stopped (status " + std::to_string(status) + ")", status);
+    share.finish();
     return status;
   } catch (const Error& e) {
     abort_job(rank, e.what());

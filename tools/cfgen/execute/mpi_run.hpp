@@ -11,12 +11,12 @@ namespace cf::tools {
 /// variables); a plain `cfgen` run never initialises MPI.
 bool launched_by_mpi();
 
-/// Every process of the MPI job runs this with the same arguments. Rank 0 runs the
-/// enumeration: every stage's chunks (levels, motion rounds) go to idle ranks while it
-/// computes others, and their results are taken by chunk index, so the graph is byte for
-/// byte the one a single-process run writes, and --checkpoint works as in one process. The
-/// other ranks read the models, then compute the chunks they are sent with their threads
-/// and write nothing. A failing rank aborts the job.
+/// Every process of the MPI job runs this with the same arguments. Each rank runs the
+/// enumeration as one of the job's shards (docs/generator.md, "MPI"): it computes its own
+/// chunks of every stage with its threads, sends them to the other ranks and takes theirs
+/// as they come, so the graph is byte for byte the one a single-process run writes, and
+/// --checkpoint keeps every rank's chunks as shards do. Rank 0 writes the graph and reports
+/// progress; the others write nothing. A failing or stopped rank aborts the job.
 /// @returns the process exit status.
 int run_generate_mpi(GenerateArgs args);
 

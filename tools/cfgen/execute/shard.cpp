@@ -18,8 +18,8 @@ namespace {
 // (12), clearance, margin]; 3: the witness search climbs past obstacles and the neighbour
 // rounds' tasks (the same tasks give other results, so checkpoints of version 2 are refused);
 // 4: the images of each batch of CFs found verified as a stage of kVerify tasks (the stages
-// are numbered differently).
-constexpr int kVersion = 4;
+// are numbered differently); 5: the neighbour rounds' screening in stages of its own.
+constexpr int kVersion = 5;
 constexpr int kMaxShards = 4096;
 
 // The options that shape the graph, in a fixed order (not the thread count, the output or
@@ -148,29 +148,18 @@ nlohmann::json tasks_json(const std::vector<gen::Task>& tasks) {
   return out;
 }
 
-std::vector<gen::Task> parse_tasks(const nlohmann::json& j, const Reader& rd) {
-  if (!j.is_array()) rd.bad("expected an array of tasks");
-  std::vector<gen::Task> out;
-  for (const nlohmann::json& t : j) {
-    if (!t.is_array() || t.size() != 4 || !t[0].is_number_unsigned() ||
-        t[0].get<unsigned>() > static_cast<unsigned>(gen::Task::Kind::kVerify) || !t[2].is_array())
-      rd.bad("expected a task [kind, PCs, seeds, pose]");
-    gen::Task task;
-    task.kind = static_cast<gen::Task::Kind>(t[0].get<int>());
-    task.pcs = rd.pcs(t[1]);
-    for (const nlohmann::json& seed : t[2]) task.seeds.push_back(rd.pose(seed).R_BA);
-    task.pose = rd.pose(t[3]);
-    out.push_back(std::move(task));
-  }
-  return out;
-}
-
 nlohmann::json task_results_json(const std::vector<gen::TaskResult>& results) {
   nlohmann::json out = nlohmann::json::array();
   for (const gen::TaskResult& r : results) {
     nlohmann::json met = nlohmann::json::array();
     for (const gen::Discovery& d : r.met) met.push_back({pcs_json(d.pcs), pose_json(d.pose)});
-    out.push_back({witness_json(r.witness), met});
+    nlohmann::json one = {witness_json(r.witness), met};
+    if (!r.sets.empty()) {
+      nlohmann::json sets = nlohmann::json::array();
+      for (const PcSet& x : r.sets) sets.push_back(pcs_json(x));
+      one.push_back(std::move(sets));
+    }
+    out.push_back(std::move(one));
   }
   return out;
 }
@@ -179,14 +168,17 @@ std::vector<gen::TaskResult> parse_task_results(const nlohmann::json& j, const R
   if (!j.is_array()) rd.bad("expected an array of results");
   std::vector<gen::TaskResult> out;
   for (const nlohmann::json& r : j) {
-    if (!r.is_array() || r.size() != 2 || !r[1].is_array())
-      rd.bad("expected a result [witness, met]");
+    if (!r.is_array() || r.size() < 2 || r.size() > 3 || !r[1].is_array() ||
+        (r.size() == 3 && !r[2].is_array()))
+      rd.bad("expected a result [witness, met] or [witness, met, sets]");
     gen::TaskResult res;
     res.witness = rd.witness(r[0]);
     for (const nlohmann::json& d : r[1]) {
       if (!d.is_array() || d.size() != 2) rd.bad("expected a discovery [PCs, pose]");
       res.met.push_back({rd.pcs(d[0]), rd.pose(d[1])});
     }
+    if (r.size() == 3)
+      for (const nlohmann::json& x : r[2]) res.sets.push_back(rd.pcs(x));
     out.push_back(std::move(res));
   }
   return out;
@@ -200,51 +192,33 @@ std::string hex64(std::uint64_t h) {
 
 }  // namespace
 
-namespace {
+std::string chunk_text(std::size_t stage, std::size_t chunk,
+                       const std::vector<gen::TaskResult>& results) {
+  return nlohmann::json{{"stage", stage}, {"chunk", chunk}, {"results", task_results_json(results)}}
+      .dump();
+}
 
-// {"chunk": N, key: ...} as sent between ranks; `what` names it in errors.
-const nlohmann::json& chunk_message(const std::string& text, const char* key, const Reader& rd,
-                                    nlohmann::json& j, std::size_t& chunk) {
+std::vector<gen::TaskResult> chunk_from_text(const std::string& text, const std::string& what,
+                                             std::size_t& stage, std::size_t& chunk) {
+  const Reader rd{[what](const std::string& problem) -> void {
+    throw Error("reading " + what + ": " + problem);
+  }};
+  nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     rd.bad(std::string("not JSON (") + e.what() + ")");
   }
-  if (!j.is_object() || !j.contains("chunk") || !j.at("chunk").is_number_unsigned() ||
-      !j.contains(key))
-    rd.bad(std::string("expected {\"chunk\", \"") + key + "\"}");
-  chunk = j.at("chunk").get<std::size_t>();
-  return j.at(key);
-}
-
-Reader message_reader(const std::string& what) {
-  return Reader{[what](const std::string& problem) -> void {
-    throw Error("reading " + what + ": " + problem);
-  }};
-}
-
-}  // namespace
-
-std::string tasks_text(std::size_t chunk, const std::vector<gen::Task>& tasks) {
-  return nlohmann::json{{"chunk", chunk}, {"tasks", tasks_json(tasks)}}.dump();
-}
-
-std::vector<gen::Task> tasks_from_text(const std::string& text, const std::string& what,
-                                       std::size_t& chunk) {
-  const Reader rd = message_reader(what);
-  nlohmann::json j;
-  return parse_tasks(chunk_message(text, "tasks", rd, j, chunk), rd);
-}
-
-std::string task_results_text(std::size_t chunk, const std::vector<gen::TaskResult>& results) {
-  return nlohmann::json{{"chunk", chunk}, {"results", task_results_json(results)}}.dump();
-}
-
-std::vector<gen::TaskResult> task_results_from_text(const std::string& text,
-                                                    const std::string& what, std::size_t& chunk) {
-  const Reader rd = message_reader(what);
-  nlohmann::json j;
-  return parse_task_results(chunk_message(text, "results", rd, j, chunk), rd);
+  auto count = [&](const char* key) {
+    if (!j.contains(key) || !j.at(key).is_number_unsigned())
+      rd.bad("expected {\"stage\", \"chunk\", \"results\"}");
+    return j.at(key).get<std::size_t>();
+  };
+  if (!j.is_object() || !j.contains("results"))
+    rd.bad("expected {\"stage\", \"chunk\", \"results\"}");
+  stage = count("stage");
+  chunk = count("chunk");
+  return parse_task_results(j.at("results"), rd);
 }
 
 gen::ShardSpec parse_shard(const std::string& text) {

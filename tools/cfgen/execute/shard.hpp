@@ -36,14 +36,12 @@ gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& finge
 /// then the directory if nothing else is in it. Errors are ignored (the graph is written).
 void remove_checkpoint(const std::string& dir);
 
-/// A chunk of tasks, and its results, as text and back (an MPI run sends them between
-/// processes this way); doubles round-trip exactly.
+/// The results of chunk `chunk` of stage `stage` as text and back (the ranks of an MPI run
+/// send each other their chunks this way); doubles round-trip exactly.
 /// @throws cf::Error "reading <what>: <problem>" when the text is not such a chunk.
-std::string tasks_text(std::size_t chunk, const std::vector<gen::Task>& tasks);
-std::vector<gen::Task> tasks_from_text(const std::string& text, const std::string& what,
-                                       std::size_t& chunk);
-std::string task_results_text(std::size_t chunk, const std::vector<gen::TaskResult>& results);
-std::vector<gen::TaskResult> task_results_from_text(const std::string& text,
-                                                    const std::string& what, std::size_t& chunk);
+std::string chunk_text(std::size_t stage, std::size_t chunk,
+                       const std::vector<gen::TaskResult>& results);
+std::vector<gen::TaskResult> chunk_from_text(const std::string& text, const std::string& what,
+                                             std::size_t& stage, std::size_t& chunk);
 
 }  // namespace cf::tools
