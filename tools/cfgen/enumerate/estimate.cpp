@@ -10,7 +10,8 @@
 // scales them to the level's candidates, and a sample of those, searched, gives the fraction
 // valid and the cost. What follows the levels (motion, neighbour rounds, the work done per
 // set rather than per orbit, records, transitions) is not sampled: it is taken from the sets
-// the levels find and fail, with constants measured on the pairs in docs/performance.md.
+// the levels find and fail and the cost of their searches, with constants measured on the
+// pairs in docs/performance.md.
 
 #include "cfgen/enumerate/enumerator.hpp"
 
@@ -35,26 +36,28 @@ constexpr std::size_t kRows = 256;
 // candidates to sample.
 constexpr std::size_t kGrowRounds = 8;
 
-// Constants that turn the levels into a run, fitted (least worst ratio) on the bundled pairs
-// and the n-gon pegs and holes n = 3..10 at one thread (scripts/estimate-errors.sh);
-// docs/performance.md ("Estimates") gives the errors that remain.
+// Constants that turn the levels into a run, fitted (least worst ratio) on the bundled pairs,
+// the n-gon pegs and holes n = 3..12 and CGAL's star against its cross at one thread
+// (scripts/estimate-errors.sh); docs/performance.md ("Estimates") gives the errors that remain.
 //
-// CFs in the graph per CF the levels find: the rounds after them (motion, neighbours, the
-// images of sets found there) add most of as many again.
-constexpr double kCfsPerLevelCf = 1.8;
-// CPU time after the levels' searches: the rounds after them and the work done per set, not
-// per orbit (images, the neighbour rounds' screening, records, transitions), per CF the
-// levels find and per candidate they fail, the latter weighing kFailedWeight times as much
-// (each is screened, and some searched again, in every neighbour round).
-constexpr double kMemberSeconds = 80e-6;  // s, on the machine of docs/performance.md
-constexpr double kFailedWeight = 4;
+// CFs in the graph per CF the levels find, and per candidate they fail: the rounds after the
+// levels (motion, neighbours, the images of sets found there) find CFs among the sets the
+// levels' searches missed, more where more failed (a peg tilted across a hole's rim).
+constexpr double kCfsPerLevelCf = 0.85;
+constexpr double kCfsPerFailed = 0.4;
+// CPU time after the levels' searches: per CF the levels find (its images verified, its
+// changes screened, its record and transitions), and per candidate they fail, searches of
+// the levels' mean cost (a failed set is screened in every neighbour round and some are
+// searched again).
+constexpr double kFoundSeconds = 195e-6;  // s, on the machine of docs/performance.md
+constexpr double kSearchesPerFailed = 0.05;
 // Of a run's time on one thread, the part that runs on one thread whatever the count.
 constexpr double kSerial = 0.25;
 // Transitions per CF: 15.5-25 on the pairs measured.
 constexpr double kTransitionsPerCf = 18;
 // Resident bytes per CF at the run's peak (records, the search's sets, the transitions built
-// and sorted), above what the models take: 1.8-9.5 kB per CF in all on the pairs measured.
-constexpr double kBytesPerCf = 2000;
+// and sorted), above what the models take.
+constexpr double kBytesPerCf = 1750;
 
 // k indices spread evenly over [0, n).
 std::vector<std::size_t> spread(std::size_t n, std::size_t k) {
@@ -290,20 +293,23 @@ RunEstimate Enumerator::estimate(int threads) {
     const Sample sample = sample_sets(level, pool, subsets, kSamples, kOrbitTries);
     extrapolate(l, sample, false);
   }
-  double level_cpu = 0, found = 0, failed = 0;
+  double level_cpu = 0, found = 0, failed = 0, searches = 0;
   for (const LevelEstimate& l : e.levels) {
     level_cpu += l.cpu_seconds;
     found += l.valid;
     failed += std::max(0.0, l.candidates - l.valid);
+    searches += l.tasks;
   }
-  e.cfs = found * kCfsPerLevelCf;
+  // s of CPU a search takes, on the mean over the levels' searches.
+  const double search_seconds = searches > 0 ? level_cpu / searches : 0;
+  e.cfs = kCfsPerLevelCf * found + kCfsPerFailed * failed;
   e.transitions = e.cfs * kTransitionsPerCf;
-  e.cpu_seconds = level_cpu + kMemberSeconds * (found + kFailedWeight * failed);
+  e.cpu_seconds = level_cpu + kFoundSeconds * found + kSearchesPerFailed * search_seconds * failed;
   e.seconds = e.cpu_seconds * (kSerial + (1 - kSerial) / e.threads);
   e.peak_bytes = base_bytes + kBytesPerCf * e.cfs;
   if (std::getenv("CF_ESTIMATE_DEBUG"))
-    std::fprintf(stderr, "CAL level_cpu %g found %g failed %g base %g\n", level_cpu, found, failed,
-                 base_bytes);
+    std::fprintf(stderr, "CAL level_cpu %g found %g failed %g search_s %g base %g\n", level_cpu,
+                 found, failed, search_seconds, base_bytes);
   e.sample_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return e;
 }
