@@ -112,6 +112,15 @@ struct MemoryStore {
   }
 };
 
+// Options of a run on `threads` threads that keeps its chunks in `mem`, as shard `shard`.
+ExecuteOptions kept_in(MemoryStore& mem, int threads, cf::gen::ShardSpec shard = {}) {
+  ExecuteOptions o;
+  o.threads = threads;
+  o.checkpoint = mem.store();
+  o.shard = shard;
+  return o;
+}
+
 }  // namespace
 
 TEST_CASE("chunks: about 64 a stage, 8 to 1024 tasks each, fixed by the stage's size",
@@ -144,9 +153,7 @@ TEST_CASE("a stage's results come by index and in task order, whatever the threa
 TEST_CASE("a checkpoint keeps every chunk of every stage, and a rerun takes them without deciding",
           "[execute]") {
   MemoryStore mem;
-  ExecuteOptions o;
-  o.threads = 2;
-  o.checkpoint = mem.store();
+  ExecuteOptions o = kept_in(mem, 2);
   {
     StandIn d;
     Executor ex(d.decide(), o);
@@ -203,9 +210,7 @@ TEST_CASE(
     // One process with a checkpoint: computed on its threads, in order, nothing kept.
     MemoryStore mem;
     StandIn d;
-    ExecuteOptions o;
-    o.threads = 3;
-    o.checkpoint = mem.store();
+    ExecuteOptions o = kept_in(mem, 3);
     Executor ex(d.decide(), o);
     std::vector<std::size_t> seen;
     std::vector<std::atomic<int>> who(1000);
@@ -226,10 +231,7 @@ TEST_CASE(
   for (int k = 0; k < 2; ++k)
     shards.emplace_back([&, k] {
       StandIn d;
-      ExecuteOptions o;
-      o.threads = 1;
-      o.checkpoint = mem.store();
-      o.shard = {k, 2};
+      ExecuteOptions o = kept_in(mem, 1, {k, 2});
       Executor ex(d.decide(), o);
       for (int st = 0; st < 2; ++st) ex.run(own_items(sizes[st], seen[k][st], who[st], k));
     });
@@ -248,9 +250,7 @@ TEST_CASE(
     "[execute]") {
   MemoryStore mem;
   cf::gen::StopFlag stop{false};
-  ExecuteOptions o;
-  o.threads = 2;
-  o.checkpoint = mem.store();
+  ExecuteOptions o = kept_in(mem, 2);
   o.stop = &stop;
   // The stand-in asks to stop in the middle of the stage (its 500th task).
   std::atomic<std::size_t> calls{0};
@@ -308,9 +308,7 @@ TEST_CASE("progress: ticks count the stage's finished tasks, chunk by chunk with
           "[execute]") {
   MemoryStore mem;
   std::vector<cf::gen::ProgressEvent> seen;
-  ExecuteOptions o;
-  o.threads = 1;
-  o.checkpoint = mem.store();
+  ExecuteOptions o = kept_in(mem, 1);
   o.progress = [&](const cf::gen::ProgressEvent& e) { seen.push_back(e); };
   StandIn d;
   Executor ex(d.decide(), o);
@@ -382,10 +380,7 @@ TEST_CASE("shards that share a checkpoint split every stage and each sees every 
   for (int i = 0; i < kShards; ++i)
     shards.emplace_back([&, i] {
       StandIn d;
-      ExecuteOptions o;
-      o.threads = 1;
-      o.checkpoint = mem.store();
-      o.shard = {i, kShards};
+      ExecuteOptions o = kept_in(mem, 1, {i, kShards});
       Executor ex(d.decide(), o);
       for (std::size_t n : sizes) got[i].push_back(run_stage(ex, n));
       calls[i] = d.calls;
@@ -413,10 +408,7 @@ TEST_CASE(
     "[execute][shard]") {
   MemoryStore mem;
   StandIn d;
-  ExecuteOptions o;
-  o.threads = 1;
-  o.checkpoint = mem.store();
-  o.shard = {0, 2};
+  ExecuteOptions o = kept_in(mem, 1, {0, 2});
   o.shard_patience = 0.05;  // s
   Executor ex(d.decide(), o);
   check_results(run_stage(ex, 100));  // 13 chunks, 6 of them shard 1's
