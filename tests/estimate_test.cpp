@@ -32,7 +32,10 @@ TEST_CASE("estimate: two convex boxes, level 1 counted and all valid, nothing ab
   // No pair of PCs holds at once on convex boxes.
   CHECK(e.levels[1].valid == 0);
   CHECK(e.levels[2].valid == 0);
-  CHECK(e.cfs >= 420);
+  // The graph has 420 CFs; an estimate promises to be within 2x (docs/generator.md).
+  constexpr double kPromised = 2;
+  CHECK(e.cfs >= 420 / kPromised);
+  CHECK(e.cfs <= 420 * kPromised);
   CHECK(e.cpu_seconds > 0);
   CHECK(e.threads == 2);
   CHECK(e.seconds < e.cpu_seconds);  // two threads are faster than one

@@ -93,10 +93,17 @@ TEST_CASE("text that is not a chunk is refused with what and why") {
         "reading a chunk from rank 1: expected a result [witness, met] or [witness, met, sets]");
   CHECK(refused(head + "[[[false], [[[[0, 1, 2]], [1,0,0]]]]]}") ==
         "reading a chunk from rank 1: expected a pose of 12 numbers");
-  CHECK(refused(head + "[[[false], [], [[[0, 1, 2], [0, 1, 2]]]]]}") ==
+  // Sets: "t.a.b,t.a.b t.a.b", PCs by ',', sets by ' '.
+  CHECK(refused(head + "[[[false], [], \"0.1.2,0.1.2\"]]}") ==
         "reading a chunk from rank 1: a PC is repeated");
-  CHECK(refused(head + "[[[false], [], [[[6, 1, 2]]]]]}") ==
-        "reading a chunk from rank 1: expected a PC [type, a, b]");
+  const std::string form = "reading a chunk from rank 1: expected sets as \"t.a.b,t.a.b t.a.b\"";
+  CHECK(refused(head + "[[[false], [], \"6.1.2\"]]}") == form);  // no PC type 6
+  CHECK(refused(head + "[[[false], [], \"0.1\"]]}") == form);
+  CHECK(refused(head + "[[[false], [], \"0.1.2 \"]]}") == form);
+  CHECK(refused(head + "[[[false], [], \"0.1.2,1.1.2,2.1.2,3.1.2\"]]}") == form);  // 4 PCs
+  CHECK(refused(head + "[[[false], [], \"0.1.99999999999\"]]}") == form);
+  CHECK(refused(head + "[[[false], [], [[0, 1, 2]]]]}") ==
+        "reading a chunk from rank 1: expected a result [witness, met] or [witness, met, sets]");
   CHECK(refused(head + "[[[true, " + pose + ", 0.5, 0.1], []]]}") == "accepted");
   CHECK(stage == 2);
 }

@@ -242,6 +242,8 @@ int run_generate(const GenerateArgs& args) {
   exec.threads = args.threads;
   exec.shard = args.shard;
   exec.shard_patience = args.shard_patience;
+  // Another shard's chunk is a file to look for (a stat each), another rank's a message.
+  exec.shard_poll = args.share.load ? 0.005 : 0.05;  // s
   if (!checkpoint_dir.empty())
     exec.checkpoint = open_checkpoint(checkpoint_dir, run_fingerprint(args), inputs);
   exec.checkpoint = gen::either(exec.checkpoint, args.share);

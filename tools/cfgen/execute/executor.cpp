@@ -207,8 +207,10 @@ void Executor::take_theirs(std::size_t number, std::size_t key, std::size_t w0,
                            std::vector<std::vector<TaskResult>>& res,
                            const std::function<void(std::size_t)>& compute_here,
                            const std::function<void(std::size_t)>& arrived) {
-  // Polled together against one deadline: a chunk takes milliseconds to seconds, so the first
-  // looks come quickly, then one every 100 ms (a stat of one file a chunk).
+  // Polled together against one deadline: a chunk takes milliseconds to seconds, and a run
+  // has hundreds of stages, each waited for, so the looks come every 0.1 ms at first, then
+  // less and less often up to ExecuteOptions::shard_poll (each a stat of one file a chunk,
+  // or a probe for messages).
   const auto t0 = Clock::now();
   const double deadline = patience();
   for (int k = 0; !outstanding.empty(); ++k) {
@@ -235,7 +237,8 @@ void Executor::take_theirs(std::size_t number, std::size_t key, std::size_t w0,
       for (std::size_t j : outstanding) gone_[owner(key, w0 + j)] = 1;
       continue;
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(std::min(100, 1 << std::min(k, 7))));
+    const double wait = std::min(opt_.shard_poll, 1e-4 * (1 << std::min(k, 20)));  // s
+    std::this_thread::sleep_for(std::chrono::duration<double>(wait));
   }
   waited_ += std::chrono::duration<double>(Clock::now() - t0).count();
 }

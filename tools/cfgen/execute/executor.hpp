@@ -57,6 +57,9 @@ struct ExecuteOptions {
   ShardSpec shard;
   /// s: the least a shard waits for another's chunk before computing it itself.
   double shard_patience = 10;
+  /// s: the longest wait between looks for the other shards' chunks (the first looks come
+  /// every 0.1 ms, then less and less often up to this).
+  double shard_poll = 0.005;
   /// Empty, or where every stage's finished chunks are kept and found again (with shards:
   /// where they find each other's).
   ChunkStore checkpoint;

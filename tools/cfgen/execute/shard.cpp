@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <limits>
 
 namespace cf::tools {
 namespace {
@@ -115,6 +116,39 @@ struct Reader {
     }
     return s;
   }
+  // What sets_text writes: "t.a.b,t.a.b t.a.b" (PCs by ',', sets by ' ').
+  std::vector<PcSet> sets(const std::string& text) const {
+    const char* p = text.c_str();
+    auto form = [&] { bad("expected sets as \"t.a.b,t.a.b t.a.b\""); };
+    auto number = [&](long long most) {
+      long long v = 0;
+      if (*p < '0' || *p > '9') form();
+      for (; *p >= '0' && *p <= '9'; ++p)
+        if ((v = 10 * v + (*p - '0')) > most) form();
+      return static_cast<int>(v);
+    };
+    std::vector<PcSet> out;
+    while (*p) {
+      PcSet set;
+      for (;;) {
+        const int t = number(static_cast<int>(PcType::kEE));
+        if (*p++ != '.') form();
+        const int a = number(std::numeric_limits<int>::max());
+        if (*p++ != '.') form();
+        const int b = number(std::numeric_limits<int>::max());
+        if (set.size() == PcSet::kMaxPcs) form();
+        if (!set.insert(Pc{static_cast<PcType>(t), a, b})) bad("a PC is repeated");
+        if (*p != ',') break;
+        ++p;
+      }
+      out.push_back(set);
+      if (*p == ' ' && p[1])
+        ++p;
+      else if (*p)
+        form();
+    }
+    return out;
+  }
   gen::Witness witness(const nlohmann::json& j) const {
     gen::Witness w;
     if (!j.is_array() || j.empty() || !j[0].is_boolean()) bad("expected a witness [found, ...]");
@@ -134,16 +168,18 @@ nlohmann::json witness_json(const gen::Witness& w) {
   return {true, pose_json(w.pose), w.clearance, w.margin};
 }
 
-nlohmann::json tasks_json(const std::vector<gen::Task>& tasks) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const gen::Task& t : tasks) {
-    nlohmann::json seeds = nlohmann::json::array();
-    for (const Mat3& R : t.seeds) {
-      Pose p;
-      p.R_BA = R;
-      seeds.push_back(pose_json(p));
+// Sets as one string: a chunk of screening holds thousands, and a JSON value each would cost
+// more than the screening.
+std::string sets_text(const std::vector<PcSet>& sets) {
+  std::string out;
+  char buf[48];
+  for (const PcSet& s : sets) {
+    if (!out.empty()) out += ' ';
+    for (int k = 0; k < s.size(); ++k) {
+      std::snprintf(buf, sizeof buf, "%s%d.%d.%d", k ? "," : "", static_cast<int>(s[k].type),
+                    s[k].a, s[k].b);
+      out += buf;
     }
-    out.push_back({static_cast<int>(t.kind), pcs_json(t.pcs), seeds, pose_json(t.pose)});
   }
   return out;
 }
@@ -154,11 +190,7 @@ nlohmann::json task_results_json(const std::vector<gen::TaskResult>& results) {
     nlohmann::json met = nlohmann::json::array();
     for (const gen::Discovery& d : r.met) met.push_back({pcs_json(d.pcs), pose_json(d.pose)});
     nlohmann::json one = {witness_json(r.witness), met};
-    if (!r.sets.empty()) {
-      nlohmann::json sets = nlohmann::json::array();
-      for (const PcSet& x : r.sets) sets.push_back(pcs_json(x));
-      one.push_back(std::move(sets));
-    }
+    if (!r.sets.empty()) one.push_back(sets_text(r.sets));
     out.push_back(std::move(one));
   }
   return out;
@@ -169,7 +201,7 @@ std::vector<gen::TaskResult> parse_task_results(const nlohmann::json& j, const R
   std::vector<gen::TaskResult> out;
   for (const nlohmann::json& r : j) {
     if (!r.is_array() || r.size() < 2 || r.size() > 3 || !r[1].is_array() ||
-        (r.size() == 3 && !r[2].is_array()))
+        (r.size() == 3 && !r[2].is_string()))
       rd.bad("expected a result [witness, met] or [witness, met, sets]");
     gen::TaskResult res;
     res.witness = rd.witness(r[0]);
@@ -177,11 +209,28 @@ std::vector<gen::TaskResult> parse_task_results(const nlohmann::json& j, const R
       if (!d.is_array() || d.size() != 2) rd.bad("expected a discovery [PCs, pose]");
       res.met.push_back({rd.pcs(d[0]), rd.pose(d[1])});
     }
-    if (r.size() == 3)
-      for (const nlohmann::json& x : r[2]) res.sets.push_back(rd.pcs(x));
+    if (r.size() == 3) res.sets = rd.sets(r[2].get_ref<const std::string&>());
     out.push_back(std::move(res));
   }
   return out;
+}
+
+// A digest of tasks: every field's bytes (little-endian machines alike), not their JSON, which
+// would cost more than a chunk of screening itself.
+std::uint64_t tasks_digest(const std::vector<gen::Task>& tasks) {
+  std::string bytes;
+  auto put = [&bytes](const auto& v) { bytes.append(reinterpret_cast<const char*>(&v), sizeof v); };
+  for (const gen::Task& t : tasks) {
+    put(static_cast<std::uint8_t>(t.kind));
+    put(static_cast<std::uint8_t>(t.pcs.size()));
+    for (const Pc& pc : t.pcs) put(pc.type), put(pc.a), put(pc.b);
+    put(static_cast<std::uint32_t>(t.seeds.size()));
+    for (const Mat3& R : t.seeds)
+      for (int k = 0; k < 9; ++k) put(R(k / 3, k % 3));
+    for (int k = 0; k < 9; ++k) put(t.pose.R_BA(k / 3, k % 3));
+    for (int k = 0; k < 3; ++k) put(t.pose.t_BA(k));
+  }
+  return fnv1a(0xcbf29ce484222325ULL, bytes);
 }
 
 std::string hex64(std::uint64_t h) {
@@ -280,9 +329,7 @@ gen::ChunkStore open_checkpoint(const std::string& dir, const std::string& finge
     return (fs::path(dir) / name).string();
   };
   // A chunk is kept with a digest of its tasks: a resumed run must be asking for the same work.
-  auto digest = [](const std::vector<gen::Task>& tasks) {
-    return hex64(fnv1a(0xcbf29ce484222325ULL, tasks_json(tasks).dump()));
-  };
+  auto digest = [](const std::vector<gen::Task>& tasks) { return hex64(tasks_digest(tasks)); };
   store.load = [=](std::size_t stage, std::size_t chunk, const std::vector<gen::Task>& tasks,
                    std::vector<gen::TaskResult>& out) {
     const std::string path = chunk_path(stage, chunk);
