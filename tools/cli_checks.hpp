@@ -1,8 +1,10 @@
 #pragma once
 /// @file
 /// CLI11 validators shared by the tools (SPEC section 5b: an option value must be a finite
-/// number in range). CLI::Range lets NaN through (every comparison with NaN is false) and
-/// says nothing about infinity; these do not. The range shows in --help.
+/// number in range), and their --version text. CLI::Range lets NaN through (every comparison with
+/// NaN is false) and says nothing about infinity; these do not. The range shows in --help.
+
+#include <cf/version.hpp>
 
 #include <CLI/CLI.hpp>
 
@@ -34,6 +36,11 @@ inline CLI::Validator finite_range(double lo, double hi) {
         return {};
       },
       range);
+}
+
+/// What `TOOL --version` prints: "cfgen 0.1.0 (graph format 1)".
+inline std::string version_text(const std::string& tool) {
+  return tool + " " + kVersion + " (graph format " + std::to_string(kGraphFormatVersion) + ")";
 }
 
 }  // namespace cf::cli

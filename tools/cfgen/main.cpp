@@ -123,6 +123,7 @@ int main(int argc, char** argv) {
       "                                        DIR; shard 0 writes the graph\n"
       "Models: closed, outward-oriented polyhedra in OFF, OBJ, STL or PLY (mm).",
       "cfgen"};
+  app.set_version_flag("--version", cf::cli::version_text("cfgen"));
   std::string features_path;
   std::vector<std::string> models;
   cf::tools::GenerateArgs gen;

@@ -6,7 +6,7 @@
 #include <cf/graph.hpp>
 #include <cf/identifier.hpp>
 
-#include "cli_checks.hpp"  // finite_range
+#include "cli_checks.hpp"  // finite_range, version_text
 #include "html.hpp"        // --html: the browser viewer
 
 #include <CLI/CLI.hpp>
@@ -302,7 +302,7 @@ int run(int argc, char** argv) {
   CLI::App app{
       "cfinspect: validate a CF graph file against the schema, summarise it, answer queries, "
       "export DOT"};
-  app.set_version_flag("--version", "cfinspect 0.1 (cf-graph format version 1)");
+  app.set_version_flag("--version", cf::cli::version_text("cfinspect"));
   std::string path, holding_text, dot_path, pose_text, html_path, replay_path, trajectory_path;
   long long neighbours_id = -1, cf_id = -1;
   bool as_json = false, fast = false, print_schema = false;

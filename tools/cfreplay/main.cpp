@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
       "Defaults are the paper's: m 0.5 kg, g 9.8 N/kg along -y, K 2.3 N/mm, K_p 1.6 N/mm,\n"
       "mu 0.7, mu_D 0.08, epsilon 1 mm (docs/force-model.md).",
       "cfreplay"};
+  app.set_version_flag("--version", cf::cli::version_text("cfreplay"));
   std::string graph_path, traj_path, out_path, plot_path;
   cf::Params P;
   std::string friction = "anchor", moment_ref = "origin", centroid = "vertex", proxy = "on";

@@ -8,6 +8,7 @@
 #include "streamed_output.hpp"
 
 #include <cf/file_io.hpp>
+#include <cf/version.hpp>
 
 #include <algorithm>
 #include <charconv>
@@ -86,7 +87,7 @@ ojson transition_json(const Transition& t) {
 ojson graph_json(const CfGraph::Impl& g, bool with_items = true) {
   ojson root = ojson::object();
   root["format"] = "cf-graph";
-  root["version"] = 1;
+  root["version"] = kGraphFormatVersion;
   root["units"] = "mm";
   const json meta = json::parse(g.metadata);
   for (auto it = meta.begin(); it != meta.end(); ++it) root[it.key()] = ojson(it.value());

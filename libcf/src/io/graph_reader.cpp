@@ -14,6 +14,7 @@
 #include "polyhedron_json.hpp"
 
 #include <cf/file_io.hpp>
+#include <cf/version.hpp>
 
 #include <array>
 #include <cctype>
@@ -1013,9 +1014,10 @@ std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::s
     if (!it->is_string() || it->get<std::string>() != "cf-graph")
       json_fail(root / "format", "format is " + json_short(*it) + ", expected \"cf-graph\"");
     const json& v = json_member(j, "version", root);
-    if (!v.is_number_integer() || v.get<long long>() != 1)
-      json_fail(root / "version",
-                "version " + json_short(v) + " is not supported (this library reads version 1)");
+    if (!v.is_number_integer() || v.get<long long>() != kGraphFormatVersion)
+      json_fail(root / "version", "version " + json_short(v) +
+                                      " is not supported (this library reads version " +
+                                      std::to_string(kGraphFormatVersion) + ")");
     const json& u = json_member(j, "units", root);
     if (!u.is_string() || u.get<std::string>() != "mm")
       json_fail(root / "units", "units " + json_short(u) + " are not supported, expected \"mm\"");
