@@ -7,6 +7,7 @@
 #include <cf/renderer.hpp>
 
 #include "fixtures.hpp"
+#include "runtime_models.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -32,27 +33,7 @@ cf::CfGraph corner_graph() {
   const cf::Polyhedron cube = from_loops(
       "cube", kCubeVertices,
       {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}});
-  const cf::Polyhedron l = from_loops("l_block",
-                                      {{0, 0, 0},
-                                       {120, 0, 0},
-                                       {120, 20, 0},
-                                       {20, 20, 0},
-                                       {20, 80, 0},
-                                       {0, 80, 0},
-                                       {0, 0, 80},
-                                       {120, 0, 80},
-                                       {120, 20, 80},
-                                       {20, 20, 80},
-                                       {20, 80, 80},
-                                       {0, 80, 80}},
-                                      {{5, 4, 3, 2, 1, 0},
-                                       {6, 7, 8, 9, 10, 11},
-                                       {0, 1, 7, 6},
-                                       {1, 2, 8, 7},
-                                       {2, 3, 9, 8},
-                                       {3, 4, 10, 9},
-                                       {4, 5, 11, 10},
-                                       {5, 0, 6, 11}});
+  const cf::Polyhedron l = cf::testmodels::l_block();
   const cf::Pc floor{cf::PcType::kFF, 2, 4}, wall{cf::PcType::kFF, 5, 5};
   std::vector<cf::CfRecord> cfs(3);
   cfs[0].pcs = cf::PcSet({floor});

@@ -5,6 +5,7 @@
 #include <cf/renderer.hpp>
 
 #include "fixtures.hpp"
+#include "runtime_models.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -42,46 +43,10 @@ constexpr double kTol = 1e-9;
 
 using cf::test::from_loops;
 
-// data/models/cube.off: 30 mm, centred on its origin.
-cf::Polyhedron cube() {
-  return from_loops(
-      "cube",
-      {{-15, -15, -15},
-       {15, -15, -15},
-       {15, 15, -15},
-       {-15, 15, -15},
-       {-15, -15, 15},
-       {15, -15, 15},
-       {15, 15, 15},
-       {-15, 15, 15}},
-      {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}});
-}
-
-// data/models/l_block.off: slab y in [0,20] over x in [0,120], wall x in [0,20] up to
-// y = 80, z in [0,80]. Face 4 is the floor (y = 20), face 5 the inner wall (x = 20).
-cf::Polyhedron l_block() {
-  return from_loops("l_block",
-                    {{0, 0, 0},
-                     {120, 0, 0},
-                     {120, 20, 0},
-                     {20, 20, 0},
-                     {20, 80, 0},
-                     {0, 80, 0},
-                     {0, 0, 80},
-                     {120, 0, 80},
-                     {120, 20, 80},
-                     {20, 20, 80},
-                     {20, 80, 80},
-                     {0, 80, 80}},
-                    {{5, 4, 3, 2, 1, 0},
-                     {6, 7, 8, 9, 10, 11},
-                     {0, 1, 7, 6},
-                     {1, 2, 8, 7},
-                     {2, 3, 9, 8},
-                     {3, 4, 10, 9},
-                     {4, 5, 11, 10},
-                     {5, 0, 6, 11}});
-}
+// data/models/cube.off (30 mm, centred on its origin) and data/models/l_block.off: face 4
+// of the L-block is the floor (y = 20), face 5 the inner wall (x = 20).
+using cf::testmodels::cube;
+using cf::testmodels::l_block;
 
 const cf::Pc kFloor{cf::PcType::kFF, 2, 4};  // cube bottom on the floor
 const cf::Pc kWall{cf::PcType::kFF, 5, 5};   // cube -x face on the inner wall
