@@ -4,6 +4,7 @@
 // and degenerate vertices where many rows meet.
 #include <catch2/catch.hpp>
 
+#include <limits>
 #include <random>
 
 #include "cfgen/verify/lp.hpp"
@@ -265,4 +266,59 @@ TEST_CASE("lp: programs beyond the fixed capacity are refused with a message") {
   const LpResult r = cf::gen::internal::dense_solve(lp);
   REQUIRE(r.status == Status::kOptimal);
   for (int j = 0; j < kMax; ++j) CHECK(r.x[j] == Approx(1.0).margin(1e-9));
+}
+
+// Farkas certificates (cf::gen::farkas): multipliers of the rows that prove a program has no
+// solution in its box, checked here by summing the rows by hand.
+TEST_CASE("farkas: an infeasible program gets multipliers whose combined row no point meets",
+          "[lp][farkas]") {
+  // x + y <= 1, -x <= -1, -y <= -1 (x >= 1, y >= 1): infeasible; box [-5, 5]^2.
+  LinearProgram lp(2);
+  lp.add({{0, 1.0}, {1, 1.0}}, Rel::kLessEq, 1.0);
+  lp.add({{0, -1.0}}, Rel::kLessEq, -1.0);
+  lp.add({{1, -1.0}}, Rel::kLessEq, -1.0);
+  for (int j = 0; j < 2; ++j) {
+    lp.lower[j] = {true, -5.0};
+    lp.upper[j] = {true, 5.0};
+  }
+  const auto proof = cf::gen::farkas(lp);
+  REQUIRE(proof);
+  REQUIRE(proof->y.size() == 3);
+  for (double y : proof->y) CHECK(y >= 0);
+  // The combined row y1 (x + y) - y2 x - y3 y <= y1 - y2 - y3: its left side is 0 only when
+  // y1 = y2 = y3, and then the right side is -y1 < 0 (0 <= negative: no point meets it).
+  CHECK(proof->y[0] == Approx(proof->y[1]).epsilon(1e-9));
+  CHECK(proof->y[0] == Approx(proof->y[2]).epsilon(1e-9));
+  CHECK(proof->gap < 0);
+  CHECK(cf::gen::farkas_gap(lp, proof->y) == proof->gap);
+  // Weights that prove nothing: a row alone, or a negative weight.
+  CHECK(cf::gen::farkas_gap(lp, {1.0, 0.0, 0.0}) > 0);
+  CHECK(cf::gen::farkas_gap(lp, {1.0, -1.0, 1.0}) == std::numeric_limits<double>::infinity());
+}
+
+TEST_CASE("farkas: a feasible program has none; the box alone can refute", "[lp][farkas]") {
+  LinearProgram lp(1);
+  lp.add({{0, 1.0}}, Rel::kLessEq, 2.0);  // x <= 2
+  lp.lower[0] = {true, 0.0};
+  lp.upper[0] = {true, 1.0};
+  CHECK_FALSE(cf::gen::farkas(lp));
+  lp.add({{0, -1.0}}, Rel::kLessEq, -3.0);  // x >= 3, outside the box [0, 1]
+  const auto proof = cf::gen::farkas(lp);
+  REQUIRE(proof);
+  CHECK(proof->y[1] > 0);  // x >= 3 with x <= 1 from the box
+  CHECK(proof->gap < 0);
+}
+
+TEST_CASE("farkas: its preconditions are refused with the reason", "[lp][farkas]") {
+  LinearProgram lp(1);
+  lp.add({{0, 1.0}}, Rel::kGreaterEq, 2.0);
+  lp.lower[0] = {true, 0.0};
+  lp.upper[0] = {true, 1.0};
+  CHECK_THROWS_WITH(cf::gen::farkas(lp), "farkas: a row that is not a.x <= b");
+  LinearProgram open(1);
+  open.add({{0, 1.0}}, Rel::kLessEq, 2.0);
+  CHECK_THROWS_WITH(cf::gen::farkas(open), "farkas: variable 0 without finite bounds");
+  open.lower[0] = {true, 0.0};
+  open.upper[0] = {true, 1.0};
+  CHECK_THROWS_WITH(cf::gen::farkas_gap(open, {1.0, 2.0}), "farkas_gap: 2 multipliers for 1 rows");
 }

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace cf::gen {
 
@@ -443,6 +445,98 @@ LpResult solve(const LinearProgram& lp) {
   LpResult r = internal::dense_solve(lp);
   if (r.status == LpResult::Status::kOptimal || surely_infeasible(lp)) return r;
   return internal::glpk_solve(lp);
+}
+
+}  // namespace cf::gen
+
+namespace cf::gen {
+namespace {
+
+void require_box_form(const LinearProgram& lp) {
+  for (const auto& r : lp.rows)
+    if (r.rel != LinearProgram::Rel::kLessEq)
+      throw std::invalid_argument("farkas: a row that is not a.x <= b");
+  for (int j = 0; j < lp.num_vars; ++j)
+    if (!lp.lower[j].first || !lp.upper[j].first || !std::isfinite(lp.lower[j].second) ||
+        !std::isfinite(lp.upper[j].second))
+      throw std::invalid_argument("farkas: variable " + std::to_string(j) +
+                                  " without finite bounds");
+}
+
+}  // namespace
+
+double farkas_gap(const LinearProgram& lp, const std::vector<double>& y) {
+  require_box_form(lp);
+  if (y.size() != lp.rows.size())
+    throw std::invalid_argument("farkas_gap: " + std::to_string(y.size()) + " multipliers for " +
+                                std::to_string(lp.rows.size()) + " rows");
+  std::vector<double> r(static_cast<std::size_t>(lp.num_vars), 0.0);
+  double gap = 0, size = 0;  // size: sum of the magnitudes of every term, for the rounding bound
+  for (std::size_t i = 0; i < y.size(); ++i) {
+    if (!(y[i] >= 0)) return std::numeric_limits<double>::infinity();
+    gap += y[i] * lp.rows[i].b;
+    size += y[i] * std::abs(lp.rows[i].b);
+    for (const auto& [j, v] : lp.rows[i].a) {
+      r[static_cast<std::size_t>(j)] += y[i] * v;
+      size +=
+          y[i] * std::abs(v) * std::max(std::abs(lp.lower[j].second), std::abs(lp.upper[j].second));
+    }
+  }
+  for (int j = 0; j < lp.num_vars; ++j)
+    gap -= std::min(r[j] * lp.lower[j].second, r[j] * lp.upper[j].second);
+  // Each term is rounded a few times and each sum adds at most (number of terms) units of
+  // roundoff of its largest partial sum: 1e-12 of the terms' magnitude covers programs of
+  // thousands of terms with a wide margin (double's unit roundoff is 1.1e-16).
+  return gap + 1e-12 * size;
+}
+
+std::optional<FarkasCertificate> farkas(const LinearProgram& lp) {
+  require_box_form(lp);
+  glp_term_out(GLP_OFF);
+  glp_prob* P = glp_create_prob();
+  glp_set_obj_dir(P, GLP_MIN);
+  const int m = static_cast<int>(lp.rows.size()), n = lp.num_vars;
+  if (m > 0) glp_add_rows(P, m);
+  glp_add_cols(P, n + 1);
+  for (int j = 0; j < n; ++j) {
+    const double lo = lp.lower[j].second, hi = lp.upper[j].second;
+    glp_set_col_bnds(P, j + 1, lo == hi ? GLP_FX : GLP_DB, lo, hi);
+  }
+  glp_set_col_bnds(P, n + 1, GLP_LO, -1.0, 0.0);  // s, the least violation
+  glp_set_obj_coef(P, n + 1, 1.0);
+  std::vector<int> ia{0}, ja{0};
+  std::vector<double> ar{0.0};
+  for (int i = 0; i < m; ++i) {
+    const auto& row = lp.rows[static_cast<std::size_t>(i)];
+    glp_set_row_bnds(P, i + 1, GLP_UP, 0.0, row.b);
+    for (const auto& [j, v] : row.a) {
+      if (v == 0.0) continue;
+      ia.push_back(i + 1);
+      ja.push_back(j + 1);
+      ar.push_back(v);
+    }
+    ia.push_back(i + 1);
+    ja.push_back(n + 1);
+    ar.push_back(-(1 + std::abs(row.b)));
+  }
+  glp_load_matrix(P, static_cast<int>(ar.size()) - 1, ia.data(), ja.data(), ar.data());
+  glp_smcp parm;
+  glp_init_smcp(&parm);
+  parm.msg_lev = GLP_MSG_OFF;
+  parm.it_lim = 5000;
+  std::optional<FarkasCertificate> out;
+  if (glp_simplex(P, &parm) == 0 && glp_get_status(P) == GLP_OPT && glp_get_obj_val(P) > 0) {
+    FarkasCertificate c;
+    c.y.resize(static_cast<std::size_t>(m));
+    // A row's dual is the objective's rate as its right side grows: <= 0 for a binding a.x <= b
+    // of a minimisation; its negation is the row's weight.
+    for (int i = 0; i < m; ++i)
+      c.y[static_cast<std::size_t>(i)] = std::max(0.0, -glp_get_row_dual(P, i + 1));
+    c.gap = farkas_gap(lp, c.y);
+    if (c.gap < 0) out = std::move(c);
+  }
+  glp_delete_prob(P);
+  return out;
 }
 
 }  // namespace cf::gen

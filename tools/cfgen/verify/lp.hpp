@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <initializer_list>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -76,6 +77,30 @@ struct LpResult {
 /// is verified on its own before it is accepted, and every solution meets each row within
 /// 1e-7 (1 + |b|).
 LpResult solve(const LinearProgram& lp);
+
+/// A proof that a program has no solution (Farkas' lemma over a box): multipliers y >= 0, one
+/// per row a_i . x <= b_i, with y . b < min over the variables' box of (A^T y) . x. Summing
+/// the rows with these weights gives a row no point of the box meets.
+struct FarkasCertificate {
+  std::vector<double> y;  // per row, >= 0
+  /// y . b - min over the box of (A^T y) . x, computed in double with the rounding bound
+  /// below added: negative when the certificate holds.
+  double gap = 0;
+};
+
+/// The multipliers of an infeasible program, read from the duals of its least-violation
+/// program (min s subject to a_i . x - (1 + |b_i|) s <= b_i, GLPK's simplex); std::nullopt when
+/// that program's optimum is not above 0 or its multipliers do not prove infeasibility once
+/// rounding is accounted for (farkas_gap). The checker in tests/oracle rechecks a certificate
+/// in exact arithmetic.
+/// Preconditions: every row is Rel::kLessEq and every variable has finite lower and upper
+/// bounds; @throws std::invalid_argument otherwise.
+std::optional<FarkasCertificate> farkas(const LinearProgram& lp);
+
+/// y . b - min over the box of (A^T y) . x plus a bound on its rounding error in double:
+/// negative proves the program (kLessEq rows, finite bounds) has no solution.
+/// Preconditions: y.size() == lp.rows.size(); @throws std::invalid_argument otherwise.
+double farkas_gap(const LinearProgram& lp, const std::vector<double>& y);
 
 namespace internal {
 /// The dense solver alone (for its tests): kOptimal with a solution, or kInfeasible meaning

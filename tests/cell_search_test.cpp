@@ -1,0 +1,177 @@
+// The decision's branch and bound over rotation space (tools/cfgen/decide/rotation_cells,
+// cell_relaxation, cell_search): the cells' turn bound, their tiling, and the relaxation's
+// soundness (a cell holding a witness's rotation is never refuted) on a cube against a small
+// L-block; sets refuted with evidence that tiles the whole space.
+
+#include "cfgen/decide/cell_search.hpp"
+#include "analysed_pair.hpp"
+#include "cfgen/decide/witness.hpp"
+#include "fixtures.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <random>
+
+namespace {
+
+using cf::Mat3;
+using cf::Pc;
+using cf::PcSet;
+using cf::PcType;
+using cf::Vec3;
+using cf::gen::CellRelaxation;
+using cf::gen::CellSearchResult;
+using cf::gen::RotationCell;
+
+Vec3 axis_angle_of(const Mat3& R) {
+  const Eigen::AngleAxisd aa(R);
+  return aa.angle() * aa.axis();
+}
+
+Vec3 random_in(std::mt19937& rng, const RotationCell& c) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  return c.centre + c.half * Vec3(u(rng), u(rng), u(rng));
+}
+
+// Every single PC of the two models, of every type.
+std::vector<Pc> all_pcs(const cf::Polyhedron& A, const cf::Polyhedron& B) {
+  std::vector<Pc> out;
+  for (int t = 0; t <= static_cast<int>(PcType::kEE); ++t) {
+    const auto type = static_cast<PcType>(t);
+    const int na = static_cast<int>(A.num_elements(cf::a_kind(type)));
+    const int nb = static_cast<int>(B.num_elements(cf::b_kind(type)));
+    for (int a = 0; a < na; ++a)
+      for (int b = 0; b < nb; ++b) out.push_back(Pc{type, a, b});
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("rotation cells: every rotation of a cell is within the turn bound of the centre's",
+          "[cells]") {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (double half : {1.5, 0.3, 1e-2, 1e-5}) {
+    for (int trial = 0; trial < 200; ++trial) {
+      const RotationCell cell{Vec3(u(rng), u(rng), u(rng)) * 2.0, half};
+      const Mat3 R_c = cf::gen::rotation_at(cell.centre);
+      const Mat3 R = cf::gen::rotation_at(random_in(rng, cell));
+      const Vec3 x = Vec3(u(rng), u(rng), u(rng)) * 50.0;  // mm
+      // 1e-12 relative: rounding of the two rotations' products.
+      CHECK((R * x - R_c * x).norm() <= cf::gen::turn_bound(cell) * x.norm() * (1 + 1e-12));
+    }
+  }
+  // Rodrigues agrees with the generator's axis-angle rotation.
+  const Vec3 r(0.3, -1.2, 2.0);
+  CHECK((cf::gen::rotation_at(r) - cf::gen::axis_angle(r.normalized(), r.norm())).norm() < 1e-14);
+  CHECK(cf::gen::turn_bound({Vec3::Zero(), 10.0}) == 2.0);  // no chord is longer than 2
+}
+
+TEST_CASE("rotation cells: split tiles a cell; cells beyond the ball of radius pi are skipped",
+          "[cells]") {
+  std::mt19937 rng(11);
+  const RotationCell parent{Vec3(0.5, -0.25, 1.0), 0.5};
+  const auto kids = cf::gen::split(parent);
+  double volume = 0;
+  for (const RotationCell& k : kids) volume += std::pow(2 * k.half, 3);
+  CHECK(volume == Approx(std::pow(2 * parent.half, 3)));
+  for (int trial = 0; trial < 1000; ++trial) {
+    const Vec3 p = random_in(rng, parent);
+    int holding = 0;
+    for (const RotationCell& k : kids)
+      holding += ((p - k.centre).cwiseAbs().maxCoeff() <= k.half) ? 1 : 0;
+    CHECK(holding >= 1);
+  }
+  CHECK_FALSE(cf::gen::outside_rotation_ball(cf::gen::whole_rotation_space()));
+  CHECK(cf::gen::outside_rotation_ball({Vec3(3, 3, 3), 0.5}));          // nearest point 2.5 sqrt(3)
+  CHECK_FALSE(cf::gen::outside_rotation_ball({Vec3(3.5, 0, 0), 0.5}));  // touches r = (3, 0, 0)
+}
+
+TEST_CASE("cell relaxation: a cell holding a witness's rotation is never refuted", "[cells]") {
+  cf::test::AnalysedPair p(cf::test::box(10, 10, 10, "A"), cf::test::small_l_block());
+  const cf::gen::WitnessSearch search(p.ai, p.bi, {});
+  std::mt19937 rng(3);
+  std::vector<std::pair<PcSet, cf::Pose>> witnesses;
+  std::vector<Pc> valid;
+  for (const Pc& pc : all_pcs(p.A, p.B)) {
+    const PcSet s({pc});
+    const cf::gen::Witness w = search.find(s, {});
+    if (!w.found) continue;
+    witnesses.push_back({s, w.pose});
+    valid.push_back(pc);
+  }
+  REQUIRE(witnesses.size() > 100);
+  // Pairs of valid PCs, a spread of them: those with a witness join the list.
+  std::uniform_int_distribution<std::size_t> pick(0, valid.size() - 1);
+  for (int trial = 0; trial < 400; ++trial) {
+    PcSet s({valid[pick(rng)]});
+    if (!s.insert(valid[pick(rng)])) continue;
+    const cf::gen::Witness w = search.find(s, {});
+    if (w.found) witnesses.push_back({s, w.pose});
+  }
+  INFO(witnesses.size() << " witnesses");
+  std::size_t checked = 0;
+  for (const auto& [s, pose] : witnesses) {
+    const CellRelaxation relaxation(p.ai, p.bi, s);
+    const Vec3 r = axis_angle_of(pose.R_BA);
+    CHECK(relaxation.holds_at(pose.R_BA));
+    for (double half : {1.0, 0.1, 1e-2, 1e-4}) {
+      // A cell of this size with r somewhere inside it.
+      std::uniform_real_distribution<double> u(-half, half);
+      const RotationCell cell{r + Vec3(u(rng), u(rng), u(rng)), half};
+      const CellRelaxation::Refutation ref = relaxation.refute(cell, false);
+      INFO(cf::to_string(s) << " half " << half);
+      CHECK(ref.verdict == CellRelaxation::Verdict::kOpen);
+      ++checked;
+    }
+    const CellSearchResult found = cf::gen::search_cells(p.ai, p.bi, s, {});
+    CHECK(found.outcome != CellSearchResult::Outcome::kRefuted);
+  }
+  CHECK(checked >= 4 * 100);
+}
+
+TEST_CASE(
+    "cell search: sets whose contacts cannot hold together are refuted, the refuted cells "
+    "tiling the rotation space",
+    "[cells]") {
+  cf::test::AnalysedPair p(cf::test::box(10, 10, 10, "A"), cf::test::box(40, 40, 10, "B"));
+  constexpr int kBottom = 0, kTop = 1;  // faces of cf::test::box
+  const cf::Polyhedron& A = p.A;
+  // A's bottom and top faces both on B's top face: their normals cannot both be opposite to it.
+  // A's bottom face on B's top face with A's top vertex on B's top face too: the vertex's
+  // edges would point into B. With that vertex on B's bottom face instead: its edges are
+  // clear of that face, but the vertex stands 10 mm above B's top face, 20 mm above the
+  // bottom face (the translation programs).
+  const int top_vertex = cf::test::vertex_at(A, Vec3(10, 10, 10));
+  for (const PcSet& s :
+       {PcSet({Pc{PcType::kFF, kBottom, kTop}, Pc{PcType::kFF, kTop, kTop}}),
+        PcSet({Pc{PcType::kFF, kBottom, kTop}, Pc{PcType::kVF, top_vertex, kTop}}),
+        PcSet({Pc{PcType::kFF, kBottom, kTop}, Pc{PcType::kVF, top_vertex, kBottom}})}) {
+    INFO(cf::to_string(s));
+    std::vector<cf::gen::CellEvidence> evidence;
+    const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, {}, &evidence);
+    REQUIRE(r.outcome == CellSearchResult::Outcome::kRefuted);
+    CHECK(evidence.size() < r.cells);  // the leaves; the cells split are not evidence
+    double volume = 0;
+    std::size_t programs = 0;
+    for (const auto& e : evidence) {
+      volume += std::pow(2 * e.cell.half, 3);
+      if (e.refutation.verdict == CellRelaxation::Verdict::kProgram) {
+        ++programs;
+        // One certificate per choice of pieces (convex faces: one), each rechecked.
+        REQUIRE(e.refutation.certificates.size() == 1);
+        const CellRelaxation relaxation(p.ai, p.bi, s);
+        const cf::gen::LinearProgram lp =
+            relaxation.program(cf::gen::rotation_at(e.cell.centre), cf::gen::turn_bound(e.cell),
+                               std::vector<int>(relaxation.slot_sizes().size(), 0));
+        CHECK(cf::gen::farkas_gap(lp, e.refutation.certificates[0].y) < 0);
+      }
+    }
+    CHECK(volume == Approx(std::pow(2 * M_PI, 3)));  // the whole cube [-pi, pi]^3
+    if (s[1] == Pc{PcType::kVF, top_vertex, kBottom}) CHECK(programs > 0);
+  }
+}

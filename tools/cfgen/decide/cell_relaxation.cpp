@@ -1,0 +1,264 @@
+#include "cfgen/decide/cell_relaxation.hpp"
+
+#include "cfgen/verify/rotation_conditions.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace cf::gen {
+namespace {
+
+using Rel = LinearProgram::Rel;
+
+// Parameters a PC's contact point takes on each side: a point of A's edge (1) or face (2),
+// of B's edge (1); B's faces are met by rows on the image point, vertices are fixed.
+int params_of(PcType type) {
+  int n = 0;
+  if (a_kind(type) == ElementKind::kEdge) n += 1;
+  if (a_kind(type) == ElementKind::kFace) n += 2;
+  if (b_kind(type) == ElementKind::kEdge) n += 1;
+  return n;
+}
+
+int num_vars(const PcSet& pcs) {
+  int n = 3;
+  for (const Pc& pc : pcs) n += params_of(pc.type);
+  return n;
+}
+
+// Unit outward normal (2D) of side k of a counter-clockwise convex piece, and its offset:
+// the piece is { q : o . q <= o . P_k } over its sides.
+std::pair<Eigen::Vector2d, double> side_row(const ConvexPiece& piece, std::size_t k) {
+  const Eigen::Vector2d& p = piece.points[k];
+  const Eigen::Vector2d& q = piece.points[(k + 1) % piece.points.size()];
+  Eigen::Vector2d o(q.y() - p.y(), p.x() - q.x());
+  o.normalize();
+  return {o, o.dot(p)};
+}
+
+Vec3 face_point(const Face& f, const Eigen::Vector2d& q) {
+  return f.offset * f.normal + q.x() * f.u + q.y() * f.v;
+}
+
+}  // namespace
+
+CellRelaxation::CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs)
+    : A_(a), B_(b), pcs_(pcs) {
+  if (pcs.empty() || num_vars(pcs) > LinearProgram::kMaxVars)
+    throw std::invalid_argument("CellRelaxation: a set of 1 to 3 PCs");
+  const Polyhedron& mA = *A_.model;
+  const Polyhedron& mB = *B_.model;
+  std::vector<Vec3> pts;
+  for (const Pc& pc : pcs) {
+    const std::vector<Vec3> p = closure_points(mA, a_kind(pc.type), pc.a);
+    pts.insert(pts.end(), p.begin(), p.end());
+    if (a_kind(pc.type) == ElementKind::kFace)
+      slot_sizes_.push_back(static_cast<int>(A_.pieces[static_cast<std::size_t>(pc.a)].size()));
+    if (b_kind(pc.type) == ElementKind::kFace)
+      slot_sizes_.push_back(static_cast<int>(B_.pieces[static_cast<std::size_t>(pc.b)].size()));
+  }
+  for (const Vec3& p : pts) pivot_ += p;
+  pivot_ /= static_cast<double>(pts.size());
+  // The translation t puts the pivot at t: a contact point x of A goes to R (x - pivot) + t,
+  // which must be a point y of B's element, so t = y - R (x - pivot) lies in the box of B's
+  // element grown by the largest |x - pivot|.
+  t_lo_ = Vec3::Constant(-HUGE_VAL);
+  t_hi_ = Vec3::Constant(HUGE_VAL);
+  for (const Pc& pc : pcs) {
+    double reach = 0;
+    for (const Vec3& x : closure_points(mA, a_kind(pc.type), pc.a))
+      reach = std::max(reach, (x - pivot_).norm());
+    Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
+    for (const Vec3& y : closure_points(mB, b_kind(pc.type), pc.b)) {
+      lo = lo.cwiseMin(y);
+      hi = hi.cwiseMax(y);
+    }
+    t_lo_ = t_lo_.cwiseMax(lo - Vec3::Constant(reach));
+    t_hi_ = t_hi_.cwiseMin(hi + Vec3::Constant(reach));
+  }
+  for (int k = 0; k < 3; ++k) empty_ = empty_ || t_lo_[k] > t_hi_[k];
+}
+
+CellRelaxation::Verdict CellRelaxation::rotation_test(const Mat3& R_c, double beta, int& pc) const {
+  const Polyhedron& mA = *A_.model;
+  const Polyhedron& mB = *B_.model;
+  for (pc = 0; pc < pcs_.size(); ++pc) {
+    const Pc& x = pcs_[pc];
+    const ElementKind ka = a_kind(x.type), kb = b_kind(x.type);
+    // Opposite normals (f-f), an edge parallel to the face (e-f, f-e): each side moves by at
+    // most beta per unit length over the cell.
+    if (x.type == PcType::kFF &&
+        (R_c * mA.face(FaceId(x.a)).normal + mB.face(FaceId(x.b)).normal).norm() > beta)
+      return Verdict::kRotation;
+    if (x.type == PcType::kEF &&
+        std::abs((R_c * mA.edge(EdgeId(x.a)).dir).dot(mB.face(FaceId(x.b)).normal)) > beta)
+      return Verdict::kRotation;
+    if (x.type == PcType::kFE &&
+        std::abs((R_c * mA.face(FaceId(x.a)).normal).dot(mB.edge(EdgeId(x.b)).dir)) > beta)
+      return Verdict::kRotation;
+    // Local non-penetration against a face: the other solid's tangent directions at the
+    // contact (a vertex's edge rays, an edge's wedge sides) lie on the face's outer side.
+    std::vector<Vec3> dirs;  // tangent directions of the non-face side, in its own frame
+    Vec3 n = Vec3::Zero();   // the face's outward normal, in that same frame's image
+    bool a_dirs = false;
+    if (kb == ElementKind::kFace && ka != ElementKind::kFace) {
+      n = mB.face(FaceId(x.b)).normal;
+      a_dirs = true;
+      if (ka == ElementKind::kVertex)
+        dirs = A_.cones[static_cast<std::size_t>(x.a)].rays;
+      else
+        dirs = {A_.wedges[static_cast<std::size_t>(x.a)].into_left,
+                A_.wedges[static_cast<std::size_t>(x.a)].into_right};
+    } else if (ka == ElementKind::kFace && kb != ElementKind::kFace) {
+      n = R_c * mA.face(FaceId(x.a)).normal;
+      if (kb == ElementKind::kVertex)
+        dirs = B_.cones[static_cast<std::size_t>(x.b)].rays;
+      else
+        dirs = {B_.wedges[static_cast<std::size_t>(x.b)].into_left,
+                B_.wedges[static_cast<std::size_t>(x.b)].into_right};
+    }
+    for (const Vec3& d : dirs)
+      if (n.dot(a_dirs ? Vec3(R_c * d) : d) < -beta) return Verdict::kCone;
+  }
+  pc = -1;
+  return Verdict::kOpen;
+}
+
+void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, double beta, int& slot,
+                                 const std::vector<int>& choice) const {
+  const Pc& pc = pcs_[i];
+  const Polyhedron& mA = *A_.model;
+  const Polyhedron& mB = *B_.model;
+  int var = 3;
+  for (int k = 0; k < i; ++k) var += params_of(pcs_[k].type);
+  // A's contact point x(s) = x0 + g0 s0 + g1 s1 (A's frame) and the points it ranges over.
+  Vec3 x0;
+  std::vector<Vec3> g, pts;
+  if (a_kind(pc.type) == ElementKind::kVertex) {
+    x0 = mA.vertex(VertexId(pc.a)).p;
+    pts = {x0};
+  } else if (a_kind(pc.type) == ElementKind::kEdge) {
+    x0 = mA.edge_point(EdgeId(pc.a), 0);
+    g = {mA.edge_point(EdgeId(pc.a), 1) - x0};
+    pts = {x0, x0 + g[0]};
+    lp.lower[var] = {true, 0.0};
+    lp.upper[var] = {true, 1.0};
+  } else {
+    const Face& f = mA.face(FaceId(pc.a));
+    const ConvexPiece& piece =
+        A_.pieces[static_cast<std::size_t>(pc.a)]
+                 [static_cast<std::size_t>(choice[static_cast<std::size_t>(slot++)])];
+    x0 = f.offset * f.normal;
+    g = {f.u, f.v};
+    Eigen::Vector2d lo = piece.points[0], hi = piece.points[0];
+    for (std::size_t k = 0; k < piece.points.size(); ++k) {
+      lo = lo.cwiseMin(piece.points[k]);
+      hi = hi.cwiseMax(piece.points[k]);
+      pts.push_back(face_point(f, piece.points[k]));
+      const auto [o, off] = side_row(piece, k);
+      lp.add({{var, o.x()}, {var + 1, o.y()}}, Rel::kLessEq, off);
+    }
+    for (int k = 0; k < 2; ++k) {
+      lp.lower[var + k] = {true, lo[k]};
+      lp.upper[var + k] = {true, hi[k]};
+    }
+  }
+  double reach = 0;
+  for (const Vec3& x : pts) reach = std::max(reach, (x - pivot_).norm());
+  const double widen = beta * reach;
+  const Vec3 p0 = R_c * (x0 - pivot_);
+  std::vector<Vec3> Rg;
+  for (const Vec3& d : g) Rg.push_back(R_c * d);
+  // a . (image of x(s)) <= b, the image R (x(s) - pivot) + t known within `widen` of
+  // R_c (x(s) - pivot) + t; `extra`: one more term (a B edge's parameter).
+  auto row = [&](const Vec3& a, double b, int extra_var = -1, double extra = 0) {
+    LinearProgram::Coefs c;
+    for (int j = 0; j < 3; ++j) c.push_back({j, a[j]});
+    for (std::size_t k = 0; k < Rg.size(); ++k) c.push_back({var + int(k), a.dot(Rg[k])});
+    if (extra_var >= 0) c.push_back({extra_var, extra});
+    lp.add(c, Rel::kLessEq, b + a.norm() * widen - a.dot(p0));
+  };
+  const int b_var = var + static_cast<int>(g.size());
+  if (b_kind(pc.type) == ElementKind::kVertex) {
+    const Vec3 w = mB.vertex(VertexId(pc.b)).p;
+    for (int j = 0; j < 3; ++j) {
+      row(Vec3::Unit(j), w[j]);
+      row(-Vec3::Unit(j), -w[j]);
+    }
+  } else if (b_kind(pc.type) == ElementKind::kEdge) {
+    const Vec3 b0 = mB.edge_point(EdgeId(pc.b), 0);
+    const Vec3 d = mB.edge_point(EdgeId(pc.b), 1) - b0;
+    lp.lower[b_var] = {true, 0.0};
+    lp.upper[b_var] = {true, 1.0};
+    for (int j = 0; j < 3; ++j) {
+      row(Vec3::Unit(j), b0[j], b_var, -d[j]);
+      row(-Vec3::Unit(j), -b0[j], b_var, d[j]);
+    }
+  } else {
+    const Face& f = mB.face(FaceId(pc.b));
+    const ConvexPiece& piece =
+        B_.pieces[static_cast<std::size_t>(pc.b)]
+                 [static_cast<std::size_t>(choice[static_cast<std::size_t>(slot++)])];
+    row(f.normal, f.offset);
+    row(-f.normal, -f.offset);
+    for (std::size_t k = 0; k < piece.points.size(); ++k) {
+      const auto [o, off] = side_row(piece, k);
+      row(o.x() * f.u + o.y() * f.v, off);
+    }
+  }
+}
+
+LinearProgram CellRelaxation::program(const Mat3& R_c, double beta,
+                                      const std::vector<int>& choice) const {
+  LinearProgram lp(num_vars(pcs_));
+  for (int j = 0; j < 3; ++j) {
+    lp.lower[j] = {true, t_lo_[j]};
+    lp.upper[j] = {true, std::max(t_lo_[j], t_hi_[j])};
+  }
+  int slot = 0;
+  for (int i = 0; i < pcs_.size(); ++i) add_contact(lp, i, R_c, beta, slot, choice);
+  return lp;
+}
+
+CellRelaxation::Refutation CellRelaxation::refute(const RotationCell& cell, bool with_certificates,
+                                                  std::size_t max_choices) const {
+  Refutation out;
+  if (empty_) {
+    out.verdict = Verdict::kBounds;
+    return out;
+  }
+  const Mat3 R_c = rotation_at(cell.centre);
+  const double beta = turn_bound(cell);
+  out.verdict = rotation_test(R_c, beta, out.pc);
+  if (out.verdict != Verdict::kOpen) return out;
+  std::size_t choices = 1;
+  for (int n : slot_sizes_) choices *= static_cast<std::size_t>(std::max(n, 1));
+  if (choices > max_choices) return out;
+  std::vector<int> choice(slot_sizes_.size(), 0);
+  for (std::size_t c = 0; c < choices; ++c) {
+    const LinearProgram lp = program(R_c, beta, choice);
+    if (solve(lp).status == LpResult::Status::kOptimal) return out;
+    std::optional<FarkasCertificate> proof = farkas(lp);
+    if (!proof) return out;  // not solved, and not proven infeasible either
+    if (with_certificates) out.certificates.push_back(std::move(*proof));
+    for (std::size_t k = 0; k < choice.size() && ++choice[k] == slot_sizes_[k]; ++k) choice[k] = 0;
+  }
+  out.verdict = Verdict::kProgram;
+  return out;
+}
+
+bool CellRelaxation::holds_at(const Mat3& R) const {
+  int pc = -1;
+  if (empty_ || rotation_test(R, 10 * kRotTol, pc) != Verdict::kOpen) return false;
+  std::size_t choices = 1;
+  for (int n : slot_sizes_) choices *= static_cast<std::size_t>(std::max(n, 1));
+  std::vector<int> choice(slot_sizes_.size(), 0);
+  for (std::size_t c = 0; c < choices; ++c) {
+    if (solve(program(R, 0.0, choice)).status == LpResult::Status::kOptimal) return true;
+    for (std::size_t k = 0; k < choice.size() && ++choice[k] == slot_sizes_[k]; ++k) choice[k] = 0;
+  }
+  return false;
+}
+
+}  // namespace cf::gen
