@@ -5,6 +5,7 @@
 
 #include "cfgen/decide/cell_search.hpp"
 #include "analysed_pair.hpp"
+#include "cfgen/decide/deep_points.hpp"
 #include "cfgen/decide/witness.hpp"
 #include "fixtures.hpp"
 
@@ -13,6 +14,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <iostream>
 #include <random>
 
 namespace {
@@ -94,6 +96,7 @@ TEST_CASE("rotation cells: split tiles a cell; cells beyond the ball of radius p
 TEST_CASE("cell relaxation: a cell holding a witness's rotation is never refuted", "[cells]") {
   cf::test::AnalysedPair p(cf::test::box(10, 10, 10, "A"), cf::test::small_l_block());
   const cf::gen::WitnessSearch search(p.ai, p.bi, {});
+  const cf::gen::DeepPoints deep(p.ai, p.bi);
   std::mt19937 rng(3);
   std::vector<std::pair<PcSet, cf::Pose>> witnesses;
   std::vector<Pc> valid;
@@ -116,20 +119,36 @@ TEST_CASE("cell relaxation: a cell holding a witness's rotation is never refuted
   INFO(witnesses.size() << " witnesses");
   std::size_t checked = 0;
   for (const auto& [s, pose] : witnesses) {
-    const CellRelaxation relaxation(p.ai, p.bi, s);
+    const CellRelaxation relaxation(p.ai, p.bi, s, search.params().touch_tol);
     const Vec3 r = axis_angle_of(pose.R_BA);
     CHECK(relaxation.holds_at(pose.R_BA));
     for (double half : {1.0, 0.1, 1e-2, 1e-4}) {
       // A cell of this size with r somewhere inside it.
       std::uniform_real_distribution<double> u(-half, half);
       const RotationCell cell{r + Vec3(u(rng), u(rng), u(rng)), half};
-      const CellRelaxation::Refutation ref = relaxation.refute(cell, false);
+      cf::Vec3 lo = relaxation.t_lo(), hi = relaxation.t_hi();
+      const CellRelaxation::Refutation ref = relaxation.refute(cell, lo, hi, false);
       INFO(cf::to_string(s) << " half " << half);
       CHECK(ref.verdict == CellRelaxation::Verdict::kOpen);
+      // The narrowed translations still hold the witness's, and no point of either solid is
+      // deep inside the other over the cell.
+      const Vec3 t = pose.t_BA + pose.R_BA * relaxation.pivot();
+      CHECK(((t - lo).array() >= 0).all());
+      CHECK(((hi - t).array() >= 0).all());
+      if (!((hi - t).array() >= 0).all())
+        std::cerr << "lo " << lo.transpose() << " hi " << hi.transpose() << " t " << t.transpose()
+                  << " T " << relaxation.t_lo().transpose() << " / "
+                  << relaxation.t_hi().transpose() << "\n";
+      CHECK_FALSE(deep.find({cf::gen::rotation_at(cell.centre), cf::gen::turn_bound(cell),
+                             relaxation.pivot(), lo, hi}));
       ++checked;
     }
-    const CellSearchResult found = cf::gen::search_cells(p.ai, p.bi, s, {});
+    cf::gen::CellSearchLimits limits;
+    limits.max_cells = 500;  // enough to find most witnesses again; never a refutation
+    const CellSearchResult found = cf::gen::search_cells(p.ai, p.bi, s, limits, &search);
     CHECK(found.outcome != CellSearchResult::Outcome::kRefuted);
+    if (found.outcome == CellSearchResult::Outcome::kWitness)
+      CHECK(search.verify(s, found.witness) >= 0);
   }
   CHECK(checked >= 4 * 100);
 }
@@ -153,25 +172,69 @@ TEST_CASE(
         PcSet({Pc{PcType::kFF, kBottom, kTop}, Pc{PcType::kVF, top_vertex, kBottom}})}) {
     INFO(cf::to_string(s));
     std::vector<cf::gen::CellEvidence> evidence;
-    const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, {}, &evidence);
+    const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, {}, nullptr, &evidence);
     REQUIRE(r.outcome == CellSearchResult::Outcome::kRefuted);
     CHECK(evidence.size() < r.cells);  // the leaves; the cells split are not evidence
-    double volume = 0;
     std::size_t programs = 0;
     for (const auto& e : evidence) {
-      volume += std::pow(2 * e.cell.half, 3);
       if (e.refutation.verdict == CellRelaxation::Verdict::kProgram) {
         ++programs;
         // One certificate per choice of pieces (convex faces: one), each rechecked.
         REQUIRE(e.refutation.certificates.size() == 1);
-        const CellRelaxation relaxation(p.ai, p.bi, s);
+        const CellRelaxation relaxation(p.ai, p.bi, s, 1e-9);
         const cf::gen::LinearProgram lp =
             relaxation.program(cf::gen::rotation_at(e.cell.centre), cf::gen::turn_bound(e.cell),
-                               std::vector<int>(relaxation.slot_sizes().size(), 0));
+                               std::vector<int>(relaxation.slot_sizes().size(), 0), e.t_lo, e.t_hi);
         CHECK(cf::gen::farkas_gap(lp, e.refutation.certificates[0].y) < 0);
       }
     }
-    CHECK(volume == Approx(std::pow(2 * M_PI, 3)));  // the whole cube [-pi, pi]^3
+    // The refuted cells cover the rotations: each random one lies in one of them.
+    std::mt19937 rng(5);
+    for (int trial = 0; trial < 500; ++trial) {
+      const Vec3 r = random_in(rng, cf::gen::whole_rotation_space());
+      bool covered = false;
+      for (const auto& e : evidence)
+        covered = covered || (r - e.cell.centre).cwiseAbs().maxCoeff() <= e.cell.half;
+      CHECK(covered);
+    }
     if (s[1] == Pc{PcType::kVF, top_vertex, kBottom}) CHECK(programs > 0);
   }
+}
+
+TEST_CASE(
+    "deep points: a point inside the other solid by more than the cell moves it refutes "
+    "the cell",
+    "[cells]") {
+  // A: 10 mm cube; B: 40 x 40 x 10 mm slab.
+  cf::test::AnalysedPair p(cf::test::box(10, 10, 10, "A"), cf::test::box(40, 40, 10, "B"));
+  CHECK(cf::gen::depth_inside(p.B, Vec3(20, 20, 5)) == Approx(5));  // the slab's mid-plane
+  CHECK(cf::gen::depth_inside(p.B, Vec3(1, 20, 5)) == Approx(1));   // 1 mm from the side x = 0
+  CHECK(cf::gen::depth_inside(p.B, Vec3(20, 20, 10)) == 0);         // on the top face
+  CHECK(cf::gen::depth_inside(p.B, Vec3(20, 20, 12)) == 0);         // above it
+  const cf::gen::DeepPoints deep(p.ai, p.bi);
+  // A's centre (5, 5, 5) as the pivot, put at (20, 20, 8): A's bottom reaches z = 3, inside B.
+  cf::gen::PoseCell cell;
+  cell.pivot = Vec3(5, 5, 5);
+  cell.t_lo = cell.t_hi = Vec3(20, 20, 8);
+  auto hit = deep.find(cell);
+  REQUIRE(hit);
+  CHECK(hit->depth > hit->reach);
+  // The same with the pivot anywhere in a 2 x 2 x 1 mm box and rotations within 0.05 rad:
+  // the centroid of A's bottom face, 5 mm below the pivot, is 3 mm deep at the centre pose
+  // and moves at most 0.05 sqrt(3) 5 + 1.5 < 2 mm.
+  cell.beta = cf::gen::turn_bound({Vec3::Zero(), 0.05});
+  cell.t_lo = Vec3(19, 19, 7.5);
+  cell.t_hi = Vec3(21, 21, 8.5);
+  hit = deep.find(cell);
+  REQUIRE(hit);
+  CHECK(hit->depth > hit->reach);
+  // Lifted so that A's bottom is 1 mm above B's top: nothing inside B.
+  cell.beta = 0;
+  cell.t_lo = cell.t_hi = Vec3(20, 20, 16);
+  CHECK_FALSE(deep.find(cell));
+  // Half sunk at the centre pose, but with a box of translations 12 mm high: no point is
+  // surely inside (the deepest, 5 mm, can move 6 mm).
+  cell.t_lo = Vec3(20, 20, 4);
+  cell.t_hi = Vec3(20, 20, 16);
+  CHECK_FALSE(deep.find(cell));
 }

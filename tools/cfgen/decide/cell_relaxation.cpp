@@ -43,12 +43,14 @@ Vec3 face_point(const Face& f, const Eigen::Vector2d& q) {
 
 }  // namespace
 
-CellRelaxation::CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs)
-    : A_(a), B_(b), pcs_(pcs) {
+CellRelaxation::CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs,
+                               double touch_tol, double margin)
+    : A_(a), B_(b), pcs_(pcs), touch_tol_(touch_tol), margin_(margin) {
   if (pcs.empty() || num_vars(pcs) > LinearProgram::kMaxVars)
     throw std::invalid_argument("CellRelaxation: a set of 1 to 3 PCs");
   const Polyhedron& mA = *A_.model;
   const Polyhedron& mB = *B_.model;
+  size_ = std::max((mA.bbox_max() - mA.bbox_min()).norm(), (mB.bbox_max() - mB.bbox_min()).norm());
   std::vector<Vec3> pts;
   for (const Pc& pc : pcs) {
     const std::vector<Vec3> p = closure_points(mA, a_kind(pc.type), pc.a);
@@ -74,10 +76,19 @@ CellRelaxation::CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcS
       lo = lo.cwiseMin(y);
       hi = hi.cwiseMax(y);
     }
-    t_lo_ = t_lo_.cwiseMax(lo - Vec3::Constant(reach));
-    t_hi_ = t_hi_.cwiseMin(hi + Vec3::Constant(reach));
+    // Touching within touch_tol, and the rounding of the points' coordinates.
+    const double slack = reach + touch_tol_ + 1e-12 * size_;
+    t_lo_ = t_lo_.cwiseMax(lo - Vec3::Constant(slack));
+    t_hi_ = t_hi_.cwiseMin(hi + Vec3::Constant(slack));
   }
   for (int k = 0; k < 3; ++k) empty_ = empty_ || t_lo_[k] > t_hi_[k];
+  // An edge shorter than twice the margin has no point that far from both ends.
+  for (const Pc& pc : pcs) {
+    if (a_kind(pc.type) == ElementKind::kEdge)
+      empty_ = empty_ || mA.edge(EdgeId(pc.a)).length < 2 * margin_;
+    if (b_kind(pc.type) == ElementKind::kEdge)
+      empty_ = empty_ || mB.edge(EdgeId(pc.b)).length < 2 * margin_;
+  }
 }
 
 CellRelaxation::Verdict CellRelaxation::rotation_test(const Mat3& R_c, double beta, int& pc) const {
@@ -142,8 +153,9 @@ void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, doub
     x0 = mA.edge_point(EdgeId(pc.a), 0);
     g = {mA.edge_point(EdgeId(pc.a), 1) - x0};
     pts = {x0, x0 + g[0]};
-    lp.lower[var] = {true, 0.0};
-    lp.upper[var] = {true, 1.0};
+    const double inset = margin_ / g[0].norm();
+    lp.lower[var] = {true, inset};
+    lp.upper[var] = {true, 1.0 - inset};
   } else {
     const Face& f = mA.face(FaceId(pc.a));
     const ConvexPiece& piece =
@@ -157,7 +169,10 @@ void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, doub
       hi = hi.cwiseMax(piece.points[k]);
       pts.push_back(face_point(f, piece.points[k]));
       const auto [o, off] = side_row(piece, k);
-      lp.add({{var, o.x()}, {var + 1, o.y()}}, Rel::kLessEq, off);
+      // A side on the face's boundary keeps the point the margin inside; a diagonal of the
+      // partition does not bound the face.
+      lp.add({{var, o.x()}, {var + 1, o.y()}}, Rel::kLessEq,
+             piece.boundary[k] ? off - margin_ : off);
     }
     for (int k = 0; k < 2; ++k) {
       lp.lower[var + k] = {true, lo[k]};
@@ -166,7 +181,7 @@ void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, doub
   }
   double reach = 0;
   for (const Vec3& x : pts) reach = std::max(reach, (x - pivot_).norm());
-  const double widen = beta * reach;
+  const double widen = beta * reach + touch_tol_ + 1e-12 * size_;
   const Vec3 p0 = R_c * (x0 - pivot_);
   std::vector<Vec3> Rg;
   for (const Vec3& d : g) Rg.push_back(R_c * d);
@@ -189,8 +204,9 @@ void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, doub
   } else if (b_kind(pc.type) == ElementKind::kEdge) {
     const Vec3 b0 = mB.edge_point(EdgeId(pc.b), 0);
     const Vec3 d = mB.edge_point(EdgeId(pc.b), 1) - b0;
-    lp.lower[b_var] = {true, 0.0};
-    lp.upper[b_var] = {true, 1.0};
+    const double inset = margin_ / d.norm();
+    lp.lower[b_var] = {true, inset};
+    lp.upper[b_var] = {true, 1.0 - inset};
     for (int j = 0; j < 3; ++j) {
       row(Vec3::Unit(j), b0[j], b_var, -d[j]);
       row(-Vec3::Unit(j), -b0[j], b_var, d[j]);
@@ -204,24 +220,25 @@ void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, doub
     row(-f.normal, -f.offset);
     for (std::size_t k = 0; k < piece.points.size(); ++k) {
       const auto [o, off] = side_row(piece, k);
-      row(o.x() * f.u + o.y() * f.v, off);
+      row(o.x() * f.u + o.y() * f.v, piece.boundary[k] ? off - margin_ : off);
     }
   }
 }
 
-LinearProgram CellRelaxation::program(const Mat3& R_c, double beta,
-                                      const std::vector<int>& choice) const {
+LinearProgram CellRelaxation::program(const Mat3& R_c, double beta, const std::vector<int>& choice,
+                                      const Vec3& t_lo, const Vec3& t_hi) const {
   LinearProgram lp(num_vars(pcs_));
   for (int j = 0; j < 3; ++j) {
-    lp.lower[j] = {true, t_lo_[j]};
-    lp.upper[j] = {true, std::max(t_lo_[j], t_hi_[j])};
+    lp.lower[j] = {true, t_lo[j]};
+    lp.upper[j] = {true, std::max(t_lo[j], t_hi[j])};
   }
   int slot = 0;
   for (int i = 0; i < pcs_.size(); ++i) add_contact(lp, i, R_c, beta, slot, choice);
   return lp;
 }
 
-CellRelaxation::Refutation CellRelaxation::refute(const RotationCell& cell, bool with_certificates,
+CellRelaxation::Refutation CellRelaxation::refute(const RotationCell& cell, Vec3& t_lo, Vec3& t_hi,
+                                                  bool with_certificates,
                                                   std::size_t max_choices) const {
   Refutation out;
   if (empty_) {
@@ -236,15 +253,44 @@ CellRelaxation::Refutation CellRelaxation::refute(const RotationCell& cell, bool
   for (int n : slot_sizes_) choices *= static_cast<std::size_t>(std::max(n, 1));
   if (choices > max_choices) return out;
   std::vector<int> choice(slot_sizes_.size(), 0);
+  Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
+  bool open = false;
   for (std::size_t c = 0; c < choices; ++c) {
-    const LinearProgram lp = program(R_c, beta, choice);
-    if (solve(lp).status == LpResult::Status::kOptimal) return out;
-    std::optional<FarkasCertificate> proof = farkas(lp);
-    if (!proof) return out;  // not solved, and not proven infeasible either
-    if (with_certificates) out.certificates.push_back(std::move(*proof));
+    LinearProgram lp = program(R_c, beta, choice, t_lo, t_hi);
+    if (solve(lp).status == LpResult::Status::kOptimal) {
+      open = true;
+      // The translations this choice allows: each coordinate's least and greatest value.
+      for (int j = 0; j < 3; ++j)
+        for (double sign : {1.0, -1.0}) {
+          std::fill(lp.c.begin(), lp.c.end(), 0.0);
+          lp.c[static_cast<std::size_t>(j)] = sign;
+          const LpResult r = solve(lp);
+          // Unsolved: keep the bound given.
+          const double v = r.status == LpResult::Status::kOptimal ? r.x[j]
+                           : sign > 0                             ? t_lo[j]
+                                                                  : t_hi[j];
+          if (sign > 0)
+            lo[j] = std::min(lo[j], v);
+          else
+            hi[j] = std::max(hi[j], v);
+        }
+    } else {
+      std::optional<FarkasCertificate> proof = farkas(lp);
+      if (!proof) return out;  // not solved, and not proven infeasible either
+      if (with_certificates) out.certificates.push_back(std::move(*proof));
+    }
     for (std::size_t k = 0; k < choice.size() && ++choice[k] == slot_sizes_[k]; ++k) choice[k] = 0;
   }
-  out.verdict = Verdict::kProgram;
+  if (!open) {
+    out.verdict = Verdict::kProgram;
+    return out;
+  }
+  // The programs' optima are within the solver's tolerances (reduced costs 1e-9, rows 1e-7
+  // (1 + |b|)) of the true ones: grow the range by more than those.
+  const Vec3 slack = Vec3::Constant(1e-7 * (1 + size_));
+  t_lo = t_lo.cwiseMax(lo - slack);
+  t_hi = t_hi.cwiseMin(hi + slack);
+  out.certificates.clear();
   return out;
 }
 
@@ -255,7 +301,8 @@ bool CellRelaxation::holds_at(const Mat3& R) const {
   for (int n : slot_sizes_) choices *= static_cast<std::size_t>(std::max(n, 1));
   std::vector<int> choice(slot_sizes_.size(), 0);
   for (std::size_t c = 0; c < choices; ++c) {
-    if (solve(program(R, 0.0, choice)).status == LpResult::Status::kOptimal) return true;
+    if (solve(program(R, 0.0, choice, t_lo_, t_hi_)).status == LpResult::Status::kOptimal)
+      return true;
     for (std::size_t k = 0; k < choice.size() && ++choice[k] == slot_sizes_[k]; ++k) choice[k] = 0;
   }
   return false;

@@ -22,7 +22,15 @@ namespace cf::gen {
 class CellRelaxation {
  public:
   /// a, b: the analyses of A and B, which must outlive this object. At most 3 PCs.
-  CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs);
+  /// touch_tol (mm): elements this close touch (SearchParams::touch_tol); every contact row
+  /// is widened by it, so poses the verifier counts as touching stay in the relaxation.
+  /// margin (mm): each contact point at least this far inside its elements (from an edge's
+  /// ends, from a face's boundary within its plane); 0 for the closed elements. With the
+  /// verifier's min_margin, a refutation shows that no witness exists (every witness has
+  /// its contacts that far inside, Verifier::contact_margin), not that no pose realises
+  /// the set.
+  CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs, double touch_tol,
+                 double margin = 0);
 
   /// Why a cell holds no pose of the set.
   enum class Verdict {
@@ -31,6 +39,7 @@ class CellRelaxation {
     kRotation,  // a PC's rotational condition misses by more than the turn bound (pc)
     kCone,      // a PC is locally penetrating for every rotation of the cell (pc)
     kProgram,   // the translation programs of every choice of convex pieces are infeasible
+    kDeep,      // a point of one solid lies inside the other at every pose (DeepPoints)
   };
   struct Refutation {
     Verdict verdict = Verdict::kOpen;
@@ -38,9 +47,12 @@ class CellRelaxation {
     /// kProgram with certificates asked for: one per choice of pieces, in choice order.
     std::vector<FarkasCertificate> certificates;
   };
-  /// Whether the cell holds a rotation at which the relaxation can hold. Choices of convex
-  /// pieces beyond max_choices leave the cell open.
-  Refutation refute(const RotationCell& cell, bool with_certificates,
+  /// Whether some pose with its rotation in the cell and A's pivot at a translation in
+  /// [t_lo, t_hi] (mm, B's frame) can meet the relaxation. When the cell stays open, t_lo and
+  /// t_hi are narrowed to the translations the feasible programs allow (grown by 1e-7 of the
+  /// models' size for the solver's tolerances). Choices of convex pieces beyond max_choices leave
+  /// the cell open.
+  Refutation refute(const RotationCell& cell, Vec3& t_lo, Vec3& t_hi, bool with_certificates,
                     std::size_t max_choices = 4096) const;
 
   /// True when at rotation R (meeting the rotational conditions to 10 kRotTol) the contacts
@@ -51,7 +63,13 @@ class CellRelaxation {
   /// The program over the translation and the contacts' parameters at the centre rotation R_c
   /// of a cell with turn bound beta, for one choice of convex pieces (an index per face slot,
   /// slot_sizes() order): rows a . x <= b, every variable bounded.
-  LinearProgram program(const Mat3& R_c, double beta, const std::vector<int>& choice) const;
+  /// The translation of the pivot is bounded by [t_lo, t_hi].
+  LinearProgram program(const Mat3& R_c, double beta, const std::vector<int>& choice,
+                        const Vec3& t_lo, const Vec3& t_hi) const;
+  /// mm, B's frame: the translations of the pivot any pose of the set can have (each PC's
+  /// element of B grown by how far its element of A reaches from the pivot).
+  const Vec3& t_lo() const { return t_lo_; }
+  const Vec3& t_hi() const { return t_hi_; }
   /// Convex pieces of each face slot: A's face then B's face of each PC that has them.
   const std::vector<int>& slot_sizes() const { return slot_sizes_; }
   /// mm, A's frame: the point the cell's rotations turn A about (the centroid of the PCs'
@@ -72,7 +90,10 @@ class CellRelaxation {
   PcSet pcs_;
   Vec3 pivot_ = Vec3::Zero();
   std::vector<int> slot_sizes_;
-  Vec3 t_lo_, t_hi_;  // mm: bounds of the translation every PC allows
+  double size_ = 0;       // mm, the larger model's bounding-box diagonal
+  double touch_tol_ = 0;  // mm
+  double margin_ = 0;     // mm
+  Vec3 t_lo_, t_hi_;      // mm: bounds of the translation every PC allows
   bool empty_ = false;
 };
 

@@ -1,12 +1,13 @@
 #pragma once
 /// @file
-/// Branch and bound over rotation space for one candidate set (docs/generator.md, "Deciding
-/// a set"): cells of axis-angle coordinates are refuted by the set's relaxation
-/// (cell_relaxation.hpp) or split, until every cell is refuted, a rotation is found at which
-/// the relaxation holds, or the cells reach the resolution or the budget.
+/// Branch and bound over poses for one candidate set (docs/generator.md, "Refuting a set over
+/// cells of rotation space"): cells of axis-angle coordinates, each with a box of translations,
+/// are refuted by the set's relaxation (cell_relaxation.hpp) or by a point of one solid deep
+/// inside the other (deep_points.hpp), or split, until every cell is refuted, a witness is
+/// found, or the cells reach the resolution or the budget.
 
 #include "cfgen/decide/cell_relaxation.hpp"
-#include "cfgen/verify/rotation_conditions.hpp"
+#include "cfgen/decide/witness.hpp"
 
 #include <cstddef>
 #include <vector>
@@ -14,31 +15,42 @@
 namespace cf::gen {
 
 struct CellSearchLimits {
-  double resolution = 1.5e-5;     // rad: cells of a smaller half-width are not split
+  double resolution = 1.5e-5;     // rad, and times the models' size in mm: cells are not split
+                                  // below this in rotation and in translation
   std::size_t max_cells = 20000;  // cells examined before the search gives up
+  double touch_tol = 1e-9;        // mm: elements this close touch (SearchParams::touch_tol)
+  double margin = 0;  // mm: contacts at least this far inside their elements (CellRelaxation)
+  double search_below = 0.05;  // rad: open rotation cells this small are searched for a witness
 };
 
-/// A refuted cell and why (CellRelaxation::refute), for the certificate file.
+/// A refuted cell and why, for the certificate file.
 struct CellEvidence {
   RotationCell cell;
-  CellRelaxation::Refutation refutation;
+  Vec3 t_lo = Vec3::Zero(), t_hi = Vec3::Zero();  // mm: the translations of A's pivot
+  CellRelaxation::Refutation refutation;          // kDeep: `deep` says which point
   bool outside_ball = false;  // the cell holds no axis-angle vector of length <= pi
+  bool deep_of_a = true;      // kDeep: a point of A inside B, else of B inside A
+  int deep_point = -1;        // kDeep: its index in DeepPoints::points
 };
 
 struct CellSearchResult {
   enum class Outcome {
-    kRefuted,    // every cell refuted: no pose makes the set's PCs hold
-    kRealised,   // the relaxation holds at some rotation: the cells cannot refute the set
+    kRefuted,    // every cell refuted: no pose makes the set's PCs hold without penetration
+    kWitness,    // a witness was found near a cell's centre (`witness`)
     kUndecided,  // a cell at the resolution, or the budget, was left open
   } outcome = Outcome::kUndecided;
+  Pose witness;
   std::size_t cells = 0;     // cells examined
-  double smallest_half = 0;  // rad: the half-width of the smallest cell examined
+  double smallest_half = 0;  // rad: the half-width of the smallest rotation cell examined
 };
 
-/// Searches the rotation space for `pcs`. evidence: when given, receives every refuted cell
-/// (the cells tile the whole space when the outcome is kRefuted).
+/// Searches the poses of `pcs`. search: when given, each open rotation cell below
+/// limits.search_below is searched for a witness near its centre's rotation (projected onto
+/// the rotational conditions; WitnessSearch::find with seeds_only), and a witness ends the
+/// search. evidence: when given, receives every refuted
+/// cell (they tile the whole space when the outcome is kRefuted).
 CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs,
-                              const CellSearchLimits& limits,
+                              const CellSearchLimits& limits, const WitnessSearch* search = nullptr,
                               std::vector<CellEvidence>* evidence = nullptr);
 
 }  // namespace cf::gen

@@ -1,0 +1,74 @@
+#include "cfgen/decide/deep_points.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cf::gen {
+namespace {
+
+std::vector<Vec3> boundary_points(const ModelInfo& info) {
+  const Polyhedron& m = *info.model;
+  std::vector<Vec3> out;
+  for (const Vertex& v : m.vertices()) out.push_back(v.p);
+  for (std::size_t e = 0; e < m.num_edges(); ++e)
+    out.push_back(0.5 * (m.edge_point(EdgeId(static_cast<int>(e)), 0) +
+                         m.edge_point(EdgeId(static_cast<int>(e)), 1)));
+  for (std::size_t f = 0; f < m.num_faces(); ++f) {
+    const Face& F = m.faces()[f];
+    for (const ConvexPiece& piece : info.pieces[f]) {
+      Eigen::Vector2d c = Eigen::Vector2d::Zero();
+      for (const auto& q : piece.points) c += q;
+      c /= static_cast<double>(piece.points.size());
+      out.push_back(F.offset * F.normal + c.x() * F.u + c.y() * F.v);
+    }
+  }
+  return out;
+}
+
+bool in_box(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  return (p.array() > lo.array()).all() && (p.array() < hi.array()).all();
+}
+
+}  // namespace
+
+double depth_inside(const Polyhedron& m, const Vec3& p) {
+  if (!in_box(p, m.bbox_min(), m.bbox_max()) || !point_inside(m, p, 0.0)) return 0;
+  double d2 = HUGE_VAL;
+  for (std::size_t f = 0; f < m.num_faces(); ++f) {
+    const Face& F = m.faces()[f];
+    const double h = F.normal.dot(p) - F.offset;
+    const double out = std::max(0.0, -m.face_inset(FaceId(static_cast<int>(f)), p));
+    d2 = std::min(d2, h * h + out * out);
+  }
+  return std::sqrt(d2);
+}
+
+DeepPoints::DeepPoints(const ModelInfo& a, const ModelInfo& b)
+    : A_(a), B_(b), a_points_(boundary_points(a)), b_points_(boundary_points(b)) {}
+
+std::optional<DeepPoints::Hit> DeepPoints::find(const PoseCell& c) const {
+  const Vec3 t_mid = 0.5 * (c.t_lo + c.t_hi);
+  const double spread = 0.5 * (c.t_hi - c.t_lo).norm();  // |t - t_mid| over the box
+  // A's points in B: R (x - pivot) + t is within beta |x - pivot| + spread of its image at
+  // the centre pose.
+  for (std::size_t i = 0; i < a_points_.size(); ++i) {
+    const Vec3 arm = a_points_[i] - c.pivot;
+    const Vec3 y = c.R_c * arm + t_mid;
+    const double reach = c.beta * arm.norm() + spread;
+    const double depth = depth_inside(*B_.model, y);
+    if (depth > reach) return Hit{true, static_cast<int>(i), depth, reach};
+  }
+  // B's points in A: R^T (w - t) + pivot moves by at most beta |w - t| + |t - t_mid|, with
+  // |w - t| <= |w - t_mid| + spread.
+  const Mat3 Rt = c.R_c.transpose();
+  for (std::size_t i = 0; i < b_points_.size(); ++i) {
+    const Vec3 arm = b_points_[i] - t_mid;
+    const Vec3 x = Rt * arm + c.pivot;
+    const double reach = c.beta * (arm.norm() + spread) + spread;
+    const double depth = depth_inside(*A_.model, x);
+    if (depth > reach) return Hit{false, static_cast<int>(i), depth, reach};
+  }
+  return std::nullopt;
+}
+
+}  // namespace cf::gen
