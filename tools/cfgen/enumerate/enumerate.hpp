@@ -59,6 +59,8 @@ struct LevelEstimate {
   double orbits = 0;
   double valid = 0;  ///< CFs the level finds, images included
   double tasks = 0;
+  double explored = 0;      ///< witnesses of the level's CFs the closure by motion explores
+  double failed_tries = 0;  ///< members of the failed orbits a neighbour round may search
   double cpu_seconds = 0;   ///< s on one thread of this machine
   std::size_t sampled = 0;  ///< sets of the level decided to predict it
 };

@@ -8,10 +8,11 @@
 // images), each with every level-1 candidate the necessary conditions allow, give the sets
 // one PC larger; the share of those whose subsets are all valid (decided for a few hundred)
 // scales them to the level's candidates, and a sample of those, searched, gives the fraction
-// valid and the cost. What follows the levels (motion, neighbour rounds, the work done per
-// set rather than per orbit, records, transitions) is not sampled: it is taken from the sets
-// the levels find and fail and the cost of their searches, with constants measured on the
-// pairs in docs/performance.md.
+// valid and the cost. The closure by motion's cost per witness explored is sampled on the
+// CFs the samples found. The rest of what follows the levels (neighbour rounds, the work done
+// per set rather than per orbit, records, transitions) is not sampled: it is taken from the
+// sets the levels find and fail, their orbits and the cost of their searches, with constants
+// measured on the pairs in docs/performance.md.
 
 #include "cfgen/enumerate/enumerator.hpp"
 
@@ -27,9 +28,10 @@
 namespace cf::gen::internal {
 namespace {
 
-// Sets decided per level: enough for the fraction valid to about +-15% (binomial at 32), a
-// second or two on the slowest pairs measured.
-constexpr std::size_t kSamples = 32;
+// Sets decided per level: enough for the fraction valid to about +-9% (binomial at 96); 32
+// predicted a quarter of the valid pairs of CGAL's cross and U. 0.2-18 s on the pairs
+// measured.
+constexpr std::size_t kSamples = 96;
 // Sets whose partners are counted to predict the next level's candidates.
 constexpr std::size_t kRows = 256;
 // Batches of kSamples sets, at most, whose unknown subsets are decided to find a level's
@@ -37,20 +39,28 @@ constexpr std::size_t kRows = 256;
 constexpr std::size_t kGrowRounds = 8;
 
 // Constants that turn the levels into a run, fitted (least worst ratio) on the bundled pairs,
-// the n-gon pegs and holes n = 3..12 and CGAL's star against its cross at one thread
-// (scripts/estimate-errors.sh); docs/performance.md ("Estimates") gives the errors that remain.
+// the n-gon pegs and holes n = 3..12 and CGAL's star, cross and U (star against cross and
+// against itself, cross against U) at one thread (scripts/estimate-errors.sh);
+// docs/performance.md ("Estimates") gives the errors that remain.
 //
 // CFs in the graph per CF the levels find, and per candidate they fail: the rounds after the
 // levels (motion, neighbours, the images of sets found there) find CFs among the sets the
 // levels' searches missed, more where more failed (a peg tilted across a hole's rim).
-constexpr double kCfsPerLevelCf = 0.85;
-constexpr double kCfsPerFailed = 0.4;
-// CPU time after the levels' searches: per CF the levels find (its images verified, its
-// changes screened, its record and transitions), and per candidate they fail, searches of
-// the levels' mean cost (a failed set is screened in every neighbour round and some are
-// searched again).
-constexpr double kFoundSeconds = 195e-6;  // s, on the machine of docs/performance.md
-constexpr double kSearchesPerFailed = 0.05;
+constexpr double kCfsPerLevelCf = 0.55;
+constexpr double kCfsPerFailed = 0.40;
+// CPU time after the levels' searches: the closure by motion, per witness it explores (up to
+// kWitnessesPerOrbit an orbit found), as long as the sampled exploration (explore_seconds);
+// per CF the levels find (its images verified, its changes screened, its record and
+// transitions); per candidate they fail, searches of the levels' mean cost (a failed set is
+// screened in every neighbour round); and per member of a failed orbit a neighbour round may
+// search again (up to kOrbitTries an orbit), searches of that cost. The last two are
+// fitted apart because pairs with few symmetries (CGAL's cross and U) have many more failed
+// orbits per failed set than the symmetric n-gon pairs. The cross and U's run was not
+// measured to its end: its constants assume 100 min of CPU (docs/performance.md).
+constexpr double kExploresPerWitness = 1.0;
+constexpr double kFoundSeconds = 85e-6;  // s, on the machine of docs/performance.md
+constexpr double kSearchesPerFailed = 0.02;
+constexpr double kSearchesPerFailedTry = 1.0;
 // Of a run's time on one thread, the part that runs on one thread whatever the count.
 constexpr double kSerial = 0.25;
 // Transitions per CF: 15.5-25 on the pairs measured.
@@ -87,8 +97,10 @@ struct Enumerator::Sample {
   std::size_t found = 0;                  // of them, found at one of up to kOrbitTries members
   double inv_orbit = 0;                   // mean of 1 / orbit size
   double members = 0, found_members = 0;  // orbit sizes summed over those sampled, the found
-  double searches = 0;                    // mean searches an orbit took
-  double seconds = 0;                     // s of CPU, mean an orbit took (all its searches)
+  double found_explored = 0;              // witnesses motion explores, summed over the found orbits
+  double failed_tries = 0;  // members a failed orbit can have searched, summed over them
+  double searches = 0;      // mean searches an orbit took
+  double seconds = 0;       // s of CPU, mean an orbit took (all its searches)
   double valid_fraction() const { return decided ? double(found) / double(decided) : 0; }
 };
 
@@ -165,7 +177,12 @@ Enumerator::Sample Enumerator::sample_sets(int level, const std::vector<PcSet>& 
     s.members += size;
     s.searches += double(o.tried);
     s.seconds += o.seconds;
-    if (o.found) ++s.found, s.found_members += size;
+    if (o.found) {
+      ++s.found, s.found_members += size;
+      s.found_explored += std::min(double(kWitnessesPerOrbit), size);
+    } else {
+      s.failed_tries += std::min(double(kOrbitTries), size);
+    }
   }
   if (s.decided) {
     const auto n = double(s.decided);
@@ -244,6 +261,35 @@ std::vector<PcSet> Enumerator::with_valid_subsets(const std::vector<PcSet>& pool
   return out;
 }
 
+// s of CPU the closure by motion takes to explore one CF, on the mean over up to `count`
+// of the CFs the samples found (spread over the levels' lists): it varies with the models
+// far more than a search does, as it follows the first contact of every element pair along
+// each direction tried.
+double Enumerator::explore_seconds(std::size_t count) {
+  std::vector<Task> tasks;
+  std::size_t total = 0;
+  for (const auto& v : valid_) total += v.size();
+  for (std::size_t i : spread(total, count)) {
+    std::size_t level = 0;
+    while (i >= valid_[level].size()) i -= valid_[level++].size();
+    Task t;
+    t.kind = Task::Kind::kExplore;
+    t.pcs = valid_[level][i].first;
+    t.pose = valid_[level][i].second.pose;
+    tasks.push_back(t);
+  }
+  if (tasks.empty()) return 0;
+  std::vector<double> sec(tasks.size());
+  runner_.for_each(tasks.size(), [&](std::size_t j) {
+    const double c0 = thread_cpu_seconds();
+    decide(search_, tasks[j]);
+    sec[j] = thread_cpu_seconds() - c0;
+  });
+  double sum = 0;
+  for (double x : sec) sum += x;
+  return sum / double(tasks.size());
+}
+
 namespace {
 
 // A level's size and cost from its candidates and its sample. `by_orbit`: the sample took
@@ -256,6 +302,10 @@ void extrapolate(LevelEstimate& l, const Sample& s, bool by_orbit) {
   const double q =
       by_orbit ? (s.members > 0 ? s.found_members / s.members : 0) : s.valid_fraction();
   l.valid = l.candidates * q;
+  l.explored = s.found_members > 0 ? l.valid * s.found_explored / s.found_members : 0;
+  const double failed_members = s.members - s.found_members;
+  l.failed_tries =
+      failed_members > 0 ? (l.candidates - l.valid) * s.failed_tries / failed_members : 0;
   l.tasks = l.orbits * s.searches;
   l.cpu_seconds = l.orbits * s.seconds;
 }
@@ -293,8 +343,10 @@ RunEstimate Enumerator::estimate(int threads) {
     const Sample sample = sample_sets(level, pool, subsets, kSamples, kOrbitTries);
     extrapolate(l, sample, false);
   }
-  double level_cpu = 0, found = 0, failed = 0, searches = 0;
+  double level_cpu = 0, found = 0, failed = 0, searches = 0, explored = 0, failed_tries = 0;
   for (const LevelEstimate& l : e.levels) {
+    explored += l.explored;
+    failed_tries += l.failed_tries;
     level_cpu += l.cpu_seconds;
     found += l.valid;
     failed += std::max(0.0, l.candidates - l.valid);
@@ -302,14 +354,25 @@ RunEstimate Enumerator::estimate(int threads) {
   }
   // s of CPU a search takes, on the mean over the levels' searches.
   const double search_seconds = searches > 0 ? level_cpu / searches : 0;
+  const double explore_s = explore_seconds(kSamples);
   e.cfs = kCfsPerLevelCf * found + kCfsPerFailed * failed;
   e.transitions = e.cfs * kTransitionsPerCf;
-  e.cpu_seconds = level_cpu + kFoundSeconds * found + kSearchesPerFailed * search_seconds * failed;
+  e.cpu_seconds =
+      level_cpu + kExploresPerWitness * explore_s * explored + kFoundSeconds * found +
+      search_seconds * (kSearchesPerFailed * failed + kSearchesPerFailedTry * failed_tries);
   e.seconds = e.cpu_seconds * (kSerial + (1 - kSerial) / e.threads);
   e.peak_bytes = base_bytes + kBytesPerCf * e.cfs;
   if (std::getenv("CF_ESTIMATE_DEBUG"))
-    std::fprintf(stderr, "CAL level_cpu %g found %g failed %g search_s %g base %g\n", level_cpu,
-                 found, failed, search_seconds, base_bytes);
+    for (const LevelEstimate& l : e.levels)
+      std::fprintf(stderr,
+                   "CAL level candidates %g orbits %g valid %g tasks %g cpu %g sampled %zu\n",
+                   l.candidates, l.orbits, l.valid, l.tasks, l.cpu_seconds, l.sampled);
+  if (std::getenv("CF_ESTIMATE_DEBUG"))
+    std::fprintf(stderr,
+                 "CAL level_cpu %g found %g failed %g search_s %g base %g explore_s %g explored %g "
+                 "failed_tries %g\n",
+                 level_cpu, found, failed, search_seconds, base_bytes, explore_s, explored,
+                 failed_tries);
   e.sample_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return e;
 }

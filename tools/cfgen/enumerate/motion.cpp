@@ -9,17 +9,6 @@
 #include <string>
 
 namespace cf::gen::internal {
-namespace {
-
-// Witnesses explored by motion per orbit a round adds: the one found, and those found by
-// their own searches for up to three more members, spread over the orbit. Motion from one
-// witness reaches what its place in the CF's region allows; the images of that witness reach
-// the images of the same. On the hexagonal pair 4 find 13 orbits more than 1 at 17% more
-// time, 16 one more than 4.
-constexpr std::size_t kWitnessesPerOrbit = 4;
-
-}  // namespace
-
 // More witnesses of each new orbit of the frontier, each found by its own search
 // (kWitnessesPerOrbit), added to the frontier.
 void Enumerator::more_witnesses(Clock::time_point t0) {
