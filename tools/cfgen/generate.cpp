@@ -152,14 +152,15 @@ void print_estimate(std::ostream& os, const gen::RunEstimate& e, int max_pcs) {
      << "; its errors on the pairs measured: docs/performance.md, \"Estimates\"\n";
 }
 
-// The run predicted with the search and options of the run, on its threads.
+// The run predicted with the search and options of the run, on its threads, from `samples`
+// orbits a level.
 gen::RunEstimate predict(const gen::WitnessSearch& ws, const gen::EnumerateOptions& opt,
-                         const GenerateArgs& args) {
+                         const GenerateArgs& args, std::size_t samples) {
   gen::ExecuteOptions exec;
   exec.threads = args.threads;
   exec.stop = args.stop;
   gen::Executor executor([&ws](const gen::Task& t) { return gen::decide(ws, t); }, exec);
-  return gen::estimate(ws, opt, executor, executor.threads());
+  return gen::estimate(ws, opt, executor, executor.threads(), samples);
 }
 
 // Where a run keeps its checkpoint, and how long it is predicted to take.
@@ -179,7 +180,8 @@ RunPlan plan_run(const gen::WitnessSearch& ws, const gen::EnumerateOptions& opt,
   plan.checkpoint_dir = args.checkpoint_dir;
   const bool may_keep =
       writes && plan.checkpoint_dir.empty() && !args.no_checkpoint && args.shard.count == 0;
-  if (writes && (may_keep || !args.quiet)) plan.predicted = predict(ws, opt, args).seconds;
+  if (writes && (may_keep || !args.quiet))
+    plan.predicted = predict(ws, opt, args, gen::kRunPredictionSamples).seconds;
   if (!may_keep) return plan;
   const std::string dir = args.out_path + ".ckpt";
   std::error_code ec;
@@ -221,7 +223,7 @@ int run_generate(const GenerateArgs& args) {
   const gen::WitnessSearch ws(ai, bi, search);
   if (args.estimate) {
     try {
-      print_estimate(std::cout, predict(ws, opt, args), opt.max_pcs);
+      print_estimate(std::cout, predict(ws, opt, args, gen::kEstimateSamples), opt.max_pcs);
     } catch (const gen::Stopped&) {
       return stopped_status(args, "");
     }

@@ -63,8 +63,8 @@ Enumeration enumerate(const WitnessSearch& search, const EnumerateOptions& opt,
 }
 
 RunEstimate estimate(const WitnessSearch& search, const EnumerateOptions& opt, StageRunner& runner,
-                     int threads) {
-  return internal::Enumerator(search, opt, runner).estimate(threads);
+                     int threads, std::size_t samples) {
+  return internal::Enumerator(search, opt, runner).estimate(threads, samples);
 }
 
 std::vector<TaskResult> run_tasks(StageRunner& runner, const std::vector<Task>& tasks,

@@ -80,11 +80,20 @@ struct RunEstimate {
   double sample_seconds = 0;  ///< s the estimate itself took
 };
 
+/// Orbits searched per level by `cfgen --estimate`: the fraction valid to about +-9%
+/// (binomial at 96); 32 predicted a quarter of the valid pairs of CGAL's cross and U.
+constexpr std::size_t kEstimateSamples = 96;
+/// Orbits searched per level by a run's own prediction (its default checkpoint and the time
+/// left in its progress line), which every run pays for before it starts: a third of
+/// --estimate's cost.
+constexpr std::size_t kRunPredictionSamples = 32;
+
 /// Predicts a run of enumerate() with `opt` on `threads` threads, without running it: the
-/// sets it decides go to `runner`'s threads (for_each), never as stages.
+/// sets it decides go to `runner`'s threads (for_each), never as stages. samples: orbits
+/// searched per level, and CFs explored.
 /// @throws Stopped when the runner was asked to stop.
 RunEstimate estimate(const WitnessSearch& search, const EnumerateOptions& opt, StageRunner& runner,
-                     int threads);
+                     int threads, std::size_t samples = kEstimateSamples);
 
 /// The CFs of the pair `search` was made for, and their transitions; every stage of the
 /// work goes to `runner`.

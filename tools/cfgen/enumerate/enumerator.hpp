@@ -66,7 +66,7 @@ class Enumerator {
   Enumerator(const WitnessSearch& search, const EnumerateOptions& opt, StageRunner& runner);
   Enumeration run();
   /// The run's size and cost predicted from samples (estimate.cpp); the enumerator is spent.
-  RunEstimate estimate(int threads);
+  RunEstimate estimate(int threads, std::size_t samples);
 
  private:
   // levels.cpp
@@ -189,6 +189,7 @@ class Enumerator {
   PcSetMap<std::pair<Pose, std::vector<double>>> prefetched_;
   // The estimate's sets searched and not found (estimate.cpp).
   PcSetSet known_invalid_;
+  std::size_t samples_ = kEstimateSamples;  // estimate(): orbits searched per level
 };
 
 }  // namespace cf::gen::internal

@@ -28,13 +28,9 @@
 namespace cf::gen::internal {
 namespace {
 
-// Sets decided per level: enough for the fraction valid to about +-9% (binomial at 96); 32
-// predicted a quarter of the valid pairs of CGAL's cross and U. 0.2-18 s on the pairs
-// measured.
-constexpr std::size_t kSamples = 96;
 // Sets whose partners are counted to predict the next level's candidates.
 constexpr std::size_t kRows = 256;
-// Batches of kSamples sets, at most, whose unknown subsets are decided to find a level's
+// Batches of samples_ sets, at most, whose unknown subsets are decided to find a level's
 // candidates to sample.
 constexpr std::size_t kGrowRounds = 8;
 
@@ -224,7 +220,7 @@ std::vector<PcSet> Enumerator::grown_sets(int level, const std::vector<PcSet>& s
 
 // Of `pool`, the sets whose subsets one PC smaller are all valid, as the run's candidates
 // are: their unknown subsets searched once each (a candidate is not worth a level's retries),
-// kSamples sets at a time, until kSamples such sets are found or kGrowRounds batches have
+// samples_ sets at a time, until samples_ such sets are found or kGrowRounds batches have
 // been tried. fraction: the share of the sets tried that have them all valid.
 std::vector<PcSet> Enumerator::with_valid_subsets(const std::vector<PcSet>& pool,
                                                   double& fraction) {
@@ -235,9 +231,9 @@ std::vector<PcSet> Enumerator::with_valid_subsets(const std::vector<PcSet>& pool
     for (int k = 0; k < s.size(); ++k) subs.push_back(without(s, k));
     return subs;
   };
-  for (std::size_t b = 0; b < pool.size() && b < kGrowRounds * kSamples && out.size() < kSamples;
-       b += kSamples) {
-    const std::size_t e = std::min(pool.size(), b + kSamples);
+  for (std::size_t b = 0; b < pool.size() && b < kGrowRounds * samples_ && out.size() < samples_;
+       b += samples_) {
+    const std::size_t e = std::min(pool.size(), b + samples_);
     std::vector<PcSet> unknown;
     for (std::size_t i = b; i < e; ++i)
       for (const PcSet& sub : subsets(pool[i]))
@@ -312,7 +308,8 @@ void extrapolate(LevelEstimate& l, const Sample& s, bool by_orbit) {
 
 }  // namespace
 
-RunEstimate Enumerator::estimate(int threads) {
+RunEstimate Enumerator::estimate(int threads, std::size_t samples) {
+  samples_ = std::max<std::size_t>(1, samples);
   const auto t0 = Clock::now();
   RunEstimate e;
   e.threads = std::max(1, threads);
@@ -329,7 +326,7 @@ RunEstimate Enumerator::estimate(int threads) {
   std::vector<PcSet> firsts;
   for (std::size_t o = 0; o < g1.size(); ++o) firsts.push_back(g1.member(o, 0));
   const Sample s1 = sample_sets(
-      0, firsts, [](const PcSet&) { return std::vector<Mat3>{}; }, kSamples, kOrbitTries);
+      0, firsts, [](const PcSet&) { return std::vector<Mat3>{}; }, samples_, kOrbitTries);
   extrapolate(l1, s1, true);
   // Levels 2 and 3: a valid set of the level below and a level-1 candidate the necessary
   // conditions allow with it make a candidate when its subsets one PC smaller are valid.
@@ -340,7 +337,7 @@ RunEstimate Enumerator::estimate(int threads) {
     const std::vector<PcSet> pool = with_valid_subsets(grown_sets(level, c1, added), fraction);
     LevelEstimate& l = e.levels[level];
     l.candidates = below.valid * added * fraction / (level + 1);  // each counted by its PCs
-    const Sample sample = sample_sets(level, pool, subsets, kSamples, kOrbitTries);
+    const Sample sample = sample_sets(level, pool, subsets, samples_, kOrbitTries);
     extrapolate(l, sample, false);
   }
   double level_cpu = 0, found = 0, failed = 0, searches = 0, explored = 0, failed_tries = 0;
@@ -354,7 +351,7 @@ RunEstimate Enumerator::estimate(int threads) {
   }
   // s of CPU a search takes, on the mean over the levels' searches.
   const double search_seconds = searches > 0 ? level_cpu / searches : 0;
-  const double explore_s = explore_seconds(kSamples);
+  const double explore_s = explore_seconds(samples_);
   e.cfs = kCfsPerLevelCf * found + kCfsPerFailed * failed;
   e.transitions = e.cfs * kTransitionsPerCf;
   e.cpu_seconds =
