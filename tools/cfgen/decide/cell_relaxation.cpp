@@ -41,7 +41,18 @@ Vec3 face_point(const Face& f, const Eigen::Vector2d& q) {
   return f.offset * f.normal + q.x() * f.u + q.y() * f.v;
 }
 
+// The next choice of convex pieces (an index per face slot, the first slot counting fastest).
+void next_choice(std::vector<int>& choice, const std::vector<int>& slot_sizes) {
+  for (std::size_t k = 0; k < choice.size() && ++choice[k] == slot_sizes[k]; ++k) choice[k] = 0;
+}
+
 }  // namespace
+
+std::size_t CellRelaxation::choices() const {
+  std::size_t n = 1;
+  for (int s : slot_sizes_) n *= static_cast<std::size_t>(std::max(s, 1));
+  return n;
+}
 
 CellRelaxation::CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs,
                                double touch_tol, double margin)
@@ -110,27 +121,22 @@ CellRelaxation::Verdict CellRelaxation::rotation_test(const Mat3& R_c, double be
       return Verdict::kRotation;
     // Local non-penetration against a face: the other solid's tangent directions at the
     // contact (a vertex's edge rays, an edge's wedge sides) lie on the face's outer side.
-    std::vector<Vec3> dirs;  // tangent directions of the non-face side, in its own frame
-    Vec3 n = Vec3::Zero();   // the face's outward normal, in that same frame's image
-    bool a_dirs = false;
-    if (kb == ElementKind::kFace && ka != ElementKind::kFace) {
-      n = mB.face(FaceId(x.b)).normal;
-      a_dirs = true;
-      if (ka == ElementKind::kVertex)
-        dirs = A_.cones[static_cast<std::size_t>(x.a)].rays;
-      else
-        dirs = {A_.wedges[static_cast<std::size_t>(x.a)].into_left,
-                A_.wedges[static_cast<std::size_t>(x.a)].into_right};
-    } else if (ka == ElementKind::kFace && kb != ElementKind::kFace) {
-      n = R_c * mA.face(FaceId(x.a)).normal;
-      if (kb == ElementKind::kVertex)
-        dirs = B_.cones[static_cast<std::size_t>(x.b)].rays;
-      else
-        dirs = {B_.wedges[static_cast<std::size_t>(x.b)].into_left,
-                B_.wedges[static_cast<std::size_t>(x.b)].into_right};
-    }
-    for (const Vec3& d : dirs)
-      if (n.dot(a_dirs ? Vec3(R_c * d) : d) < -beta) return Verdict::kCone;
+    // n: the face's outward normal in B's frame; R: what turns the directions into it.
+    auto penetrates = [&](const ModelInfo& m, ElementKind k, int i, const Vec3& n, const Mat3& R) {
+      const auto below = [&](const Vec3& d) { return n.dot(R * d) < -beta; };
+      if (k == ElementKind::kVertex) {
+        const auto& rays = m.cones[static_cast<std::size_t>(i)].rays;
+        return std::any_of(rays.begin(), rays.end(), below);
+      }
+      const EdgeWedge& w = m.wedges[static_cast<std::size_t>(i)];
+      return below(w.into_left) || below(w.into_right);
+    };
+    if (kb == ElementKind::kFace && ka != ElementKind::kFace &&
+        penetrates(A_, ka, x.a, mB.face(FaceId(x.b)).normal, R_c))
+      return Verdict::kCone;
+    if (ka == ElementKind::kFace && kb != ElementKind::kFace &&
+        penetrates(B_, kb, x.b, R_c * mA.face(FaceId(x.a)).normal, Mat3::Identity()))
+      return Verdict::kCone;
   }
   pc = -1;
   return Verdict::kOpen;
@@ -249,8 +255,7 @@ CellRelaxation::Refutation CellRelaxation::refute(const RotationCell& cell, Vec3
   const double beta = turn_bound(cell);
   out.verdict = rotation_test(R_c, beta, out.pc);
   if (out.verdict != Verdict::kOpen) return out;
-  std::size_t choices = 1;
-  for (int n : slot_sizes_) choices *= static_cast<std::size_t>(std::max(n, 1));
+  const std::size_t choices = this->choices();
   if (choices > max_choices) return out;
   std::vector<int> choice(slot_sizes_.size(), 0);
   Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
@@ -279,7 +284,7 @@ CellRelaxation::Refutation CellRelaxation::refute(const RotationCell& cell, Vec3
       if (!proof) return out;  // not solved, and not proven infeasible either
       if (with_certificates) out.certificates.push_back(std::move(*proof));
     }
-    for (std::size_t k = 0; k < choice.size() && ++choice[k] == slot_sizes_[k]; ++k) choice[k] = 0;
+    next_choice(choice, slot_sizes_);
   }
   if (!open) {
     out.verdict = Verdict::kProgram;
@@ -297,13 +302,11 @@ CellRelaxation::Refutation CellRelaxation::refute(const RotationCell& cell, Vec3
 bool CellRelaxation::holds_at(const Mat3& R) const {
   int pc = -1;
   if (empty_ || rotation_test(R, 10 * kRotTol, pc) != Verdict::kOpen) return false;
-  std::size_t choices = 1;
-  for (int n : slot_sizes_) choices *= static_cast<std::size_t>(std::max(n, 1));
   std::vector<int> choice(slot_sizes_.size(), 0);
-  for (std::size_t c = 0; c < choices; ++c) {
+  for (std::size_t c = 0; c < choices(); ++c) {
     if (solve(program(R, 0.0, choice, t_lo_, t_hi_)).status == LpResult::Status::kOptimal)
       return true;
-    for (std::size_t k = 0; k < choice.size() && ++choice[k] == slot_sizes_[k]; ++k) choice[k] = 0;
+    next_choice(choice, slot_sizes_);
   }
   return false;
 }

@@ -72,6 +72,8 @@ class CellRelaxation {
   const Vec3& t_hi() const { return t_hi_; }
   /// Convex pieces of each face slot: A's face then B's face of each PC that has them.
   const std::vector<int>& slot_sizes() const { return slot_sizes_; }
+  /// Choices of convex pieces: the product of slot_sizes().
+  std::size_t choices() const;
   /// mm, A's frame: the point the cell's rotations turn A about (the centroid of the PCs'
   /// elements of A); the program's translation is where it goes.
   const Vec3& pivot() const { return pivot_; }
