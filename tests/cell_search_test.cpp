@@ -13,6 +13,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <random>
@@ -143,19 +144,71 @@ TEST_CASE("cell relaxation: a cell holding a witness's rotation is never refuted
                              relaxation.pivot(), lo, hi}));
       ++checked;
     }
+    // With the verifier's margins, as runs decide sets: the witnesses keep them.
     cf::gen::CellSearchLimits limits;
     limits.max_cells = 500;  // enough to find most witnesses again; never a refutation
+    limits.touch_tol = search.params().touch_tol;
+    limits.margin = search.params().min_margin;
+    limits.local_slack = search.verified_local_slack();
     const CellSearchResult found = cf::gen::search_cells(p.ai, p.bi, s, limits, &search);
     CHECK(found.outcome != CellSearchResult::Outcome::kRefuted);
     if (found.outcome == CellSearchResult::Outcome::kWitness)
-      CHECK(search.verify(s, found.witness) >= 0);
+      CHECK(search.verify(s, found.witness.pose) >= 0);
   }
   CHECK(checked >= 4 * 100);
 }
 
+namespace {
+
+// Each refuted program's certificate, rechecked on the program rebuilt from the cell's
+// evidence; the number of such cells.
+std::size_t check_certificates(const cf::test::AnalysedPair& p, const PcSet& s,
+                               const std::vector<cf::gen::CellEvidence>& evidence) {
+  std::size_t programs = 0;
+  const CellRelaxation relaxation(p.ai, p.bi, s, 1e-9);
+  for (const auto& e : evidence) {
+    if (e.refutation.verdict != CellRelaxation::Verdict::kProgram) continue;
+    ++programs;
+    // One certificate per choice of pieces (convex faces: one).
+    REQUIRE(e.refutation.certificates.size() == 1);
+    const cf::gen::LinearProgram lp = relaxation.program(
+        e.R_c, e.turn, std::vector<int>(relaxation.slot_sizes().size(), 0), e.t_lo, e.t_hi);
+    CHECK(cf::gen::farkas_gap(lp, e.refutation.certificates[0].y) < 0);
+  }
+  return programs;
+}
+
+// The refuted cubes cover the rotations: each random one lies in one of them.
+void check_cubes_cover(const std::vector<cf::gen::CellEvidence>& evidence) {
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 500; ++trial) {
+    const Vec3 r = random_in(rng, cf::gen::whole_rotation_space());
+    bool covered = false;
+    for (const auto& e : evidence)
+      covered = covered || (r - e.cell.centre).cwiseAbs().maxCoeff() <= e.cell.half;
+    CHECK(covered);
+  }
+}
+
+// The refuted arcs tile the circle's angles [-pi, pi].
+void check_arcs_cover(const std::vector<cf::gen::CellEvidence>& evidence) {
+  std::vector<std::pair<double, double>> arcs;
+  for (const auto& e : evidence) {
+    REQUIRE(e.arc.half > 0);
+    arcs.push_back({e.arc.centre - e.arc.half, e.arc.centre + e.arc.half});
+  }
+  std::sort(arcs.begin(), arcs.end());
+  REQUIRE(!arcs.empty());
+  CHECK(arcs.front().first <= -M_PI);
+  CHECK(arcs.back().second >= M_PI);
+  for (std::size_t k = 1; k < arcs.size(); ++k) CHECK(arcs[k].first <= arcs[k - 1].second);
+}
+
+}  // namespace
+
 TEST_CASE(
     "cell search: sets whose contacts cannot hold together are refuted, the refuted cells "
-    "tiling the rotation space",
+    "tiling the rotation space or the f-f's circle",
     "[cells]") {
   cf::test::AnalysedPair p(cf::test::box(10, 10, 10, "A"), cf::test::box(40, 40, 10, "B"));
   constexpr int kBottom = 0, kTop = 1;  // faces of cf::test::box
@@ -164,7 +217,7 @@ TEST_CASE(
   // A's bottom face on B's top face with A's top vertex on B's top face too: the vertex's
   // edges would point into B. With that vertex on B's bottom face instead: its edges are
   // clear of that face, but the vertex stands 10 mm above B's top face, 20 mm above the
-  // bottom face (the translation programs).
+  // bottom face (the translation programs). These have an f-f: arcs of its circle.
   const int top_vertex = cf::test::vertex_at(A, Vec3(10, 10, 10));
   for (const PcSet& s :
        {PcSet({Pc{PcType::kFF, kBottom, kTop}, Pc{PcType::kFF, kTop, kTop}}),
@@ -174,31 +227,23 @@ TEST_CASE(
     std::vector<cf::gen::CellEvidence> evidence;
     const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, {}, nullptr, &evidence);
     REQUIRE(r.outcome == CellSearchResult::Outcome::kRefuted);
-    CHECK(evidence.size() < r.cells);  // the leaves; the cells split are not evidence
-    std::size_t programs = 0;
-    for (const auto& e : evidence) {
-      if (e.refutation.verdict == CellRelaxation::Verdict::kProgram) {
-        ++programs;
-        // One certificate per choice of pieces (convex faces: one), each rechecked.
-        REQUIRE(e.refutation.certificates.size() == 1);
-        const CellRelaxation relaxation(p.ai, p.bi, s, 1e-9);
-        const cf::gen::LinearProgram lp =
-            relaxation.program(cf::gen::rotation_at(e.cell.centre), cf::gen::turn_bound(e.cell),
-                               std::vector<int>(relaxation.slot_sizes().size(), 0), e.t_lo, e.t_hi);
-        CHECK(cf::gen::farkas_gap(lp, e.refutation.certificates[0].y) < 0);
-      }
-    }
-    // The refuted cells cover the rotations: each random one lies in one of them.
-    std::mt19937 rng(5);
-    for (int trial = 0; trial < 500; ++trial) {
-      const Vec3 r = random_in(rng, cf::gen::whole_rotation_space());
-      bool covered = false;
-      for (const auto& e : evidence)
-        covered = covered || (r - e.cell.centre).cwiseAbs().maxCoeff() <= e.cell.half;
-      CHECK(covered);
-    }
+    CHECK(evidence.size() <= r.cells);  // the leaves; the cells split are not evidence
+    const std::size_t programs = check_certificates(p, s, evidence);
+    check_arcs_cover(evidence);
     if (s[1] == Pc{PcType::kVF, top_vertex, kBottom}) CHECK(programs > 0);
   }
+  // Without an f-f, cubes of rotation space: A's top vertex on B's top face and the vertex
+  // below it on B's bottom face, from below. Local non-penetration turns the edge between
+  // them upwards from the first, so the second lies above B's top face, not on its bottom.
+  const int below = cf::test::vertex_at(A, Vec3(10, 10, 0));
+  const PcSet s({Pc{PcType::kVF, top_vertex, kTop}, Pc{PcType::kVF, below, kBottom}});
+  INFO(cf::to_string(s));
+  std::vector<cf::gen::CellEvidence> evidence;
+  const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, {}, nullptr, &evidence);
+  REQUIRE(r.outcome == CellSearchResult::Outcome::kRefuted);
+  CHECK(evidence.size() < r.cells);
+  CHECK(check_certificates(p, s, evidence) > 0);
+  check_cubes_cover(evidence);
 }
 
 TEST_CASE(
@@ -237,4 +282,48 @@ TEST_CASE(
   cell.t_lo = Vec3(20, 20, 4);
   cell.t_hi = Vec3(20, 20, 16);
   CHECK_FALSE(deep.find(cell));
+}
+
+TEST_CASE(
+    "cell search: on an f-f's circle, an e-e whose edges stay parallel is refuted over arcs "
+    "tiling the circle, by the verifier's local slack",
+    "[cells]") {
+  cf::test::AnalysedPair p(cf::test::box(10, 10, 10, "A"), cf::test::box(40, 40, 10, "B"));
+  constexpr int kBottom = 0, kTop = 1;  // faces of cf::test::box
+  const cf::gen::WitnessSearch search(p.ai, p.bi, {});
+  // A's vertical edge at its origin and B's at its origin: both along z, so parallel for
+  // every turn of A about the normal of the faces in contact.
+  const int ea = cf::test::edge_between(p.A, cf::test::vertex_at(p.A, Vec3(0, 0, 0)),
+                                        cf::test::vertex_at(p.A, Vec3(0, 0, 10)));
+  const int eb = cf::test::edge_between(p.B, cf::test::vertex_at(p.B, Vec3(0, 0, 0)),
+                                        cf::test::vertex_at(p.B, Vec3(0, 0, 10)));
+  const PcSet s({Pc{PcType::kFF, kBottom, kTop}, Pc{PcType::kEE, ea, eb}});
+  cf::gen::CellSearchLimits limits;
+  limits.max_cells = 200;
+  limits.margin = search.params().min_margin;
+  // Without the slack a degenerate touch is not ruled out: the cells stay open.
+  CHECK(cf::gen::search_cells(p.ai, p.bi, s, limits).outcome !=
+        CellSearchResult::Outcome::kRefuted);
+  limits.local_slack = search.verified_local_slack();
+  std::vector<cf::gen::CellEvidence> evidence;
+  const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, limits, &search, &evidence);
+  REQUIRE(r.outcome == CellSearchResult::Outcome::kRefuted);
+  // The arcs refuted tile [-pi, pi]; the e-e (index 1) is the PC below the slack.
+  std::vector<std::pair<double, double>> arcs;
+  for (const auto& e : evidence) {
+    REQUIRE(e.arc.half > 0);
+    CHECK(e.refutation.verdict == CellRelaxation::Verdict::kCone);
+    CHECK(e.refutation.pc == 1);
+    arcs.push_back({e.arc.centre - e.arc.half, e.arc.centre + e.arc.half});
+  }
+  std::sort(arcs.begin(), arcs.end());
+  REQUIRE(!arcs.empty());
+  CHECK(arcs.front().first <= -M_PI);
+  CHECK(arcs.back().second >= M_PI);
+  for (std::size_t k = 1; k < arcs.size(); ++k) CHECK(arcs[k].first <= arcs[k - 1].second);
+  // The same set with the faces apart (no f-f) is not refuted by this argument: A's edge can
+  // turn away from B's.
+  const PcSet apart({Pc{PcType::kEE, ea, eb}});
+  CHECK(cf::gen::search_cells(p.ai, p.bi, apart, limits, &search).outcome !=
+        CellSearchResult::Outcome::kRefuted);
 }

@@ -9,7 +9,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <Eigen/Geometry>
+
 #include <cmath>
+#include <random>
 #include <string>
 
 namespace {
@@ -101,4 +104,50 @@ TEST_CASE("neither solid inside the other: a cube deep inside a large box is ref
   CHECK(held.empty());
   // Beside the box, 5 mm off its side: not a contact, but a pose with no PC at all.
   CHECK(v.verify(PcSet(), at({105, 45, 45}), &why) == kParams.good_clearance);
+}
+
+TEST_CASE(
+    "local margin bound: over a cube of rotations or an arc about an axis, no rotation has a "
+    "larger local margin than the bound at the centre",
+    "[verify]") {
+  cf::test::AnalysedPair p(cf::test::box(10, 10, 10, "A"), cf::test::small_l_block());
+  const cf::gen::Verifier v(p.ai, p.bi, kParams);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto random_unit = [&] { return Vec3(u(rng), u(rng), u(rng)).normalized(); };
+  auto random_pc = [&] {
+    const auto type = static_cast<PcType>(std::uniform_int_distribution<int>(0, 5)(rng));
+    const auto na = static_cast<int>(p.A.num_elements(cf::a_kind(type)));
+    const auto nb = static_cast<int>(p.B.num_elements(cf::b_kind(type)));
+    return Pc{type, std::uniform_int_distribution<int>(0, na - 1)(rng),
+              std::uniform_int_distribution<int>(0, nb - 1)(rng)};
+  };
+  std::size_t bounded = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    PcSet s({random_pc()});
+    s.insert(random_pc());
+    const cf::Mat3 R_c = Eigen::AngleAxisd(3 * u(rng), random_unit()).toRotationMatrix();
+    // The bound with nothing turned is the margin itself.
+    CHECK(cf::gen::local_margin_bound(p.ai, p.bi, s, R_c, {}) == v.local_margin(s, R_c));
+    const double half = std::pow(10.0, -3 + 3 * (u(rng) + 1) / 2);  // 1e-3 .. 1 rad
+    const bool arc = trial % 2 == 1;
+    const Vec3 axis = random_unit();
+    const cf::gen::TurnBound turn =
+        arc ? cf::gen::TurnBound{0, half, axis} : cf::gen::TurnBound{std::sqrt(3.0) * half};
+    const double bound = cf::gen::local_margin_bound(p.ai, p.bi, s, R_c, turn);
+    for (int k = 0; k < 20; ++k) {
+      // A rotation of the cube of axis-angle offsets (any turn of angle <= sqrt(3) half), or
+      // of the arc R_c Rot(axis, d).
+      const cf::Mat3 R =
+          arc ? cf::Mat3(R_c * Eigen::AngleAxisd(half * u(rng), axis).toRotationMatrix())
+              : cf::Mat3(Eigen::AngleAxisd(std::sqrt(3.0) * half * std::abs(u(rng)), random_unit())
+                             .toRotationMatrix() *
+                         R_c);
+      const double m = v.local_margin(s, R);
+      INFO(cf::to_string(s) << " half " << half << (arc ? " arc" : " cube"));
+      CHECK(m <= bound + 1e-12);  // rounding of the products
+      bounded += m > -1 ? 1 : 0;
+    }
+  }
+  CHECK(bounded > 10000);  // most samples are not degenerate (-1), so the check has teeth
 }

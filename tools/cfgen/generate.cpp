@@ -82,7 +82,8 @@ nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args,
                       {"valid", l.valid},
                       {"found_by_motion", l.by_motion},
                       {"found_by_symmetry", l.by_symmetry},
-                      {"found_by_neighbours", l.by_neighbours}});
+                      {"found_by_neighbours", l.by_neighbours},
+                      {"found_by_cells", l.by_cells}});
   // The undecided sets, in canonical order; only the first kUndecidedListed are listed, so
   // that a pair with many keeps a file of reasonable size (the count is always exact).
   constexpr std::size_t kUndecidedListed = 100;
@@ -98,6 +99,7 @@ nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args,
                    {"symmetries", {{"A", e.symmetries_a}, {"B", e.symmetries_b}}},
                    {"min_witness_clearance_mm", e.cfs.empty() ? 0.0 : e.min_clearance},
                    {"min_witness_margin_mm", e.cfs.empty() ? 0.0 : e.min_margin},
+                   {"refuted_over_cells", e.refuted_over_cells},
                    {"undecided", e.undecided.size()},
                    {"undecided_sets", undecided}};
   // Timing goes to stderr, not into the file, so that the same input gives the same bytes.

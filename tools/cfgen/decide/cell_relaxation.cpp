@@ -1,6 +1,7 @@
 #include "cfgen/decide/cell_relaxation.hpp"
 
 #include "cfgen/verify/rotation_conditions.hpp"
+#include "cfgen/verify/verifier.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -55,8 +56,8 @@ std::size_t CellRelaxation::choices() const {
 }
 
 CellRelaxation::CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs,
-                               double touch_tol, double margin)
-    : A_(a), B_(b), pcs_(pcs), touch_tol_(touch_tol), margin_(margin) {
+                               double touch_tol, double margin, double local_slack)
+    : A_(a), B_(b), pcs_(pcs), touch_tol_(touch_tol), margin_(margin), local_slack_(local_slack) {
   if (pcs.empty() || num_vars(pcs) > LinearProgram::kMaxVars)
     throw std::invalid_argument("CellRelaxation: a set of 1 to 3 PCs");
   const Polyhedron& mA = *A_.model;
@@ -102,48 +103,61 @@ CellRelaxation::CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcS
   }
 }
 
-CellRelaxation::Verdict CellRelaxation::rotation_test(const Mat3& R_c, double beta, int& pc) const {
+CellRelaxation::Verdict CellRelaxation::rotation_test(const Mat3& R_c, const TurnBound& turn,
+                                                      int& pc) const {
   const Polyhedron& mA = *A_.model;
   const Polyhedron& mB = *B_.model;
   for (pc = 0; pc < pcs_.size(); ++pc) {
     const Pc& x = pcs_[pc];
     const ElementKind ka = a_kind(x.type), kb = b_kind(x.type);
-    // Opposite normals (f-f), an edge parallel to the face (e-f, f-e): each side moves by at
-    // most beta per unit length over the cell.
-    if (x.type == PcType::kFF &&
-        (R_c * mA.face(FaceId(x.a)).normal + mB.face(FaceId(x.b)).normal).norm() > beta)
-      return Verdict::kRotation;
-    if (x.type == PcType::kEF &&
-        std::abs((R_c * mA.edge(EdgeId(x.a)).dir).dot(mB.face(FaceId(x.b)).normal)) > beta)
-      return Verdict::kRotation;
-    if (x.type == PcType::kFE &&
-        std::abs((R_c * mA.face(FaceId(x.a)).normal).dot(mB.edge(EdgeId(x.b)).dir)) > beta)
-      return Verdict::kRotation;
+    // Opposite normals (f-f), an edge parallel to the face (e-f, f-e): A's vector moves by at
+    // most turn(vector) over the cell.
+    if (x.type == PcType::kFF) {
+      const Vec3& na = mA.face(FaceId(x.a)).normal;
+      if ((R_c * na + mB.face(FaceId(x.b)).normal).norm() > turn.of(na)) return Verdict::kRotation;
+    }
+    if (x.type == PcType::kEF) {
+      const Vec3& ea = mA.edge(EdgeId(x.a)).dir;
+      if (std::abs((R_c * ea).dot(mB.face(FaceId(x.b)).normal)) > turn.of(ea))
+        return Verdict::kRotation;
+    }
+    if (x.type == PcType::kFE) {
+      const Vec3& na = mA.face(FaceId(x.a)).normal;
+      if (std::abs((R_c * na).dot(mB.edge(EdgeId(x.b)).dir)) > turn.of(na))
+        return Verdict::kRotation;
+    }
     // Local non-penetration against a face: the other solid's tangent directions at the
     // contact (a vertex's edge rays, an edge's wedge sides) lie on the face's outer side.
-    // n: the face's outward normal in B's frame; R: what turns the directions into it.
-    auto penetrates = [&](const ModelInfo& m, ElementKind k, int i, const Vec3& n, const Mat3& R) {
-      const auto below = [&](const Vec3& d) { return n.dot(R * d) < -beta; };
-      if (k == ElementKind::kVertex) {
-        const auto& rays = m.cones[static_cast<std::size_t>(i)].rays;
-        return std::any_of(rays.begin(), rays.end(), below);
-      }
+    // below(d, n, moved): d . n < 0 for every rotation of the cell, `moved` the most the
+    // rotation changes it.
+    const auto below = [](const Vec3& d, const Vec3& n, double moved) { return d.dot(n) < -moved; };
+    auto tangents = [](const ModelInfo& m, ElementKind k, int i) {
+      if (k == ElementKind::kVertex) return m.cones[static_cast<std::size_t>(i)].rays;
       const EdgeWedge& w = m.wedges[static_cast<std::size_t>(i)];
-      return below(w.into_left) || below(w.into_right);
+      return std::vector<Vec3>{w.into_left, w.into_right};
     };
-    if (kb == ElementKind::kFace && ka != ElementKind::kFace &&
-        penetrates(A_, ka, x.a, mB.face(FaceId(x.b)).normal, R_c))
-      return Verdict::kCone;
-    if (ka == ElementKind::kFace && kb != ElementKind::kFace &&
-        penetrates(B_, kb, x.b, R_c * mA.face(FaceId(x.a)).normal, Mat3::Identity()))
-      return Verdict::kCone;
+    if (kb == ElementKind::kFace && ka != ElementKind::kFace) {
+      const Vec3& nb = mB.face(FaceId(x.b)).normal;
+      for (const Vec3& d : tangents(A_, ka, x.a))
+        if (below(R_c * d, nb, turn.of(d))) return Verdict::kCone;
+    }
+    if (ka == ElementKind::kFace && kb != ElementKind::kFace) {
+      const Vec3& na = mA.face(FaceId(x.a)).normal;
+      for (const Vec3& d : tangents(B_, kb, x.b))
+        if (below(d, R_c * na, turn.of(na))) return Verdict::kCone;
+    }
   }
+  // The slack a witness keeps at every contact: an e-e whose edges turn parallel, or a
+  // tangent direction lying in the face, is degenerate there, and the cells near such a
+  // limit pose are refuted once they are small against the slack.
+  if (local_slack_ > 0 && local_margin_bound(A_, B_, pcs_, R_c, turn, &pc) < local_slack_)
+    return Verdict::kCone;
   pc = -1;
   return Verdict::kOpen;
 }
 
-void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, double beta, int& slot,
-                                 const std::vector<int>& choice) const {
+void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, const TurnBound& turn,
+                                 int& slot, const std::vector<int>& choice) const {
   const Pc& pc = pcs_[i];
   const Polyhedron& mA = *A_.model;
   const Polyhedron& mB = *B_.model;
@@ -185,9 +199,9 @@ void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, doub
       lp.upper[var + k] = {true, hi[k]};
     }
   }
-  double reach = 0;
-  for (const Vec3& x : pts) reach = std::max(reach, (x - pivot_).norm());
-  const double widen = beta * reach + touch_tol_ + 1e-12 * size_;
+  double moved = 0;
+  for (const Vec3& x : pts) moved = std::max(moved, turn.of(x - pivot_));
+  const double widen = moved + touch_tol_ + 1e-12 * size_;
   const Vec3 p0 = R_c * (x0 - pivot_);
   std::vector<Vec3> Rg;
   for (const Vec3& d : g) Rg.push_back(R_c * d);
@@ -231,29 +245,35 @@ void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, doub
   }
 }
 
-LinearProgram CellRelaxation::program(const Mat3& R_c, double beta, const std::vector<int>& choice,
-                                      const Vec3& t_lo, const Vec3& t_hi) const {
+LinearProgram CellRelaxation::program(const Mat3& R_c, const TurnBound& turn,
+                                      const std::vector<int>& choice, const Vec3& t_lo,
+                                      const Vec3& t_hi) const {
   LinearProgram lp(num_vars(pcs_));
   for (int j = 0; j < 3; ++j) {
     lp.lower[j] = {true, t_lo[j]};
     lp.upper[j] = {true, std::max(t_lo[j], t_hi[j])};
   }
   int slot = 0;
-  for (int i = 0; i < pcs_.size(); ++i) add_contact(lp, i, R_c, beta, slot, choice);
+  for (int i = 0; i < pcs_.size(); ++i) add_contact(lp, i, R_c, turn, slot, choice);
   return lp;
 }
 
 CellRelaxation::Refutation CellRelaxation::refute(const RotationCell& cell, Vec3& t_lo, Vec3& t_hi,
                                                   bool with_certificates,
                                                   std::size_t max_choices) const {
+  return refute(rotation_at(cell.centre), TurnBound{turn_bound(cell)}, t_lo, t_hi,
+                with_certificates, max_choices);
+}
+
+CellRelaxation::Refutation CellRelaxation::refute(const Mat3& R_c, const TurnBound& turn,
+                                                  Vec3& t_lo, Vec3& t_hi, bool with_certificates,
+                                                  std::size_t max_choices) const {
   Refutation out;
   if (empty_) {
     out.verdict = Verdict::kBounds;
     return out;
   }
-  const Mat3 R_c = rotation_at(cell.centre);
-  const double beta = turn_bound(cell);
-  out.verdict = rotation_test(R_c, beta, out.pc);
+  out.verdict = rotation_test(R_c, turn, out.pc);
   if (out.verdict != Verdict::kOpen) return out;
   const std::size_t choices = this->choices();
   if (choices > max_choices) return out;
@@ -261,7 +281,7 @@ CellRelaxation::Refutation CellRelaxation::refute(const RotationCell& cell, Vec3
   Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
   bool open = false;
   for (std::size_t c = 0; c < choices; ++c) {
-    LinearProgram lp = program(R_c, beta, choice, t_lo, t_hi);
+    LinearProgram lp = program(R_c, turn, choice, t_lo, t_hi);
     if (solve(lp).status == LpResult::Status::kOptimal) {
       open = true;
       // The translations this choice allows: each coordinate's least and greatest value.
@@ -301,10 +321,10 @@ CellRelaxation::Refutation CellRelaxation::refute(const RotationCell& cell, Vec3
 
 bool CellRelaxation::holds_at(const Mat3& R) const {
   int pc = -1;
-  if (empty_ || rotation_test(R, 10 * kRotTol, pc) != Verdict::kOpen) return false;
+  if (empty_ || rotation_test(R, TurnBound{10 * kRotTol}, pc) != Verdict::kOpen) return false;
   std::vector<int> choice(slot_sizes_.size(), 0);
   for (std::size_t c = 0; c < choices(); ++c) {
-    if (solve(program(R, 0.0, choice, t_lo_, t_hi_)).status == LpResult::Status::kOptimal)
+    if (solve(program(R, TurnBound{}, choice, t_lo_, t_hi_)).status == LpResult::Status::kOptimal)
       return true;
     next_choice(choice, slot_sizes_);
   }

@@ -29,15 +29,19 @@ class CellRelaxation {
   /// verifier's min_margin, a refutation shows that no witness exists (every witness has
   /// its contacts that far inside, Verifier::contact_margin), not that no pose realises
   /// the set.
+  /// local_slack (a sine): the local non-penetration margin each pose must keep
+  /// (local_margin_bound); with the verifier's verified_local_slack(), as with min_margin, a
+  /// refutation shows that no witness exists. 0: only penetration refutes.
   CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs, double touch_tol,
-                 double margin = 0);
+                 double margin = 0, double local_slack = 0);
 
   /// Why a cell holds no pose of the set.
   enum class Verdict {
     kOpen,      // not refuted: some pose of the relaxation may have its rotation here
     kBounds,    // the PCs' contact points cannot be near enough for any rotation
     kRotation,  // a PC's rotational condition misses by more than the turn bound (pc)
-    kCone,      // a PC is locally penetrating for every rotation of the cell (pc)
+    kCone,      // a PC is locally penetrating (or below local_slack) for every rotation of
+                // the cell (pc)
     kProgram,   // the translation programs of every choice of convex pieces are infeasible
     kDeep,      // a point of one solid lies inside the other at every pose (DeepPoints)
   };
@@ -54,6 +58,9 @@ class CellRelaxation {
   /// the cell open.
   Refutation refute(const RotationCell& cell, Vec3& t_lo, Vec3& t_hi, bool with_certificates,
                     std::size_t max_choices = 4096) const;
+  /// The same for the rotations that turn A's vectors at most `turn` from where R_c does.
+  Refutation refute(const Mat3& R_c, const TurnBound& turn, Vec3& t_lo, Vec3& t_hi,
+                    bool with_certificates, std::size_t max_choices = 4096) const;
 
   /// True when at rotation R (meeting the rotational conditions to 10 kRotTol) the contacts
   /// can hold in their closed elements without local penetration: the relaxation holds at a
@@ -61,10 +68,10 @@ class CellRelaxation {
   bool holds_at(const Mat3& R) const;
 
   /// The program over the translation and the contacts' parameters at the centre rotation R_c
-  /// of a cell with turn bound beta, for one choice of convex pieces (an index per face slot,
-  /// slot_sizes() order): rows a . x <= b, every variable bounded.
-  /// The translation of the pivot is bounded by [t_lo, t_hi].
-  LinearProgram program(const Mat3& R_c, double beta, const std::vector<int>& choice,
+  /// of a set of rotations that turn A's vectors at most `turn`, for one choice of convex pieces
+  /// (an index per face slot, slot_sizes() order): rows a . x <= b, every variable bounded. The
+  /// translation of the pivot is bounded by [t_lo, t_hi].
+  LinearProgram program(const Mat3& R_c, const TurnBound& turn, const std::vector<int>& choice,
                         const Vec3& t_lo, const Vec3& t_hi) const;
   /// mm, B's frame: the translations of the pivot any pose of the set can have (each PC's
   /// element of B grown by how far its element of A reaches from the pivot).
@@ -83,8 +90,8 @@ class CellRelaxation {
     ElementKind kind;
     int index;
   };
-  Verdict rotation_test(const Mat3& R_c, double beta, int& pc) const;
-  void add_contact(LinearProgram& lp, int pc, const Mat3& R_c, double beta, int& slot,
+  Verdict rotation_test(const Mat3& R_c, const TurnBound& turn, int& pc) const;
+  void add_contact(LinearProgram& lp, int pc, const Mat3& R_c, const TurnBound& turn, int& slot,
                    const std::vector<int>& choice) const;
 
   const ModelInfo& A_;
@@ -92,10 +99,11 @@ class CellRelaxation {
   PcSet pcs_;
   Vec3 pivot_ = Vec3::Zero();
   std::vector<int> slot_sizes_;
-  double size_ = 0;       // mm, the larger model's bounding-box diagonal
-  double touch_tol_ = 0;  // mm
-  double margin_ = 0;     // mm
-  Vec3 t_lo_, t_hi_;      // mm: bounds of the translation every PC allows
+  double size_ = 0;         // mm, the larger model's bounding-box diagonal
+  double touch_tol_ = 0;    // mm
+  double margin_ = 0;       // mm
+  double local_slack_ = 0;  // sine
+  Vec3 t_lo_, t_hi_;        // mm: bounds of the translation every PC allows
   bool empty_ = false;
 };
 

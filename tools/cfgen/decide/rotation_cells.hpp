@@ -4,6 +4,8 @@
 /// a set"): cubes in axis-angle coordinates r (rotation by |r| rad about r / |r|). Every
 /// rotation has coordinates in the ball |r| <= pi, so cells covering that ball cover SO(3).
 
+#include "cfgen/verify/turn_bound.hpp"
+
 #include <cf/types.hpp>
 
 #include <array>

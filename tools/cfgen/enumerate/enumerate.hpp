@@ -38,6 +38,7 @@ struct LevelStats {
   std::size_t by_motion = 0;      // of the valid ones, found by the closure by motion
   std::size_t by_symmetry = 0;    // of the valid ones, images of another's witness
   std::size_t by_neighbours = 0;  // of the valid ones, found near their neighbours' witnesses
+  std::size_t by_cells = 0;       // of the valid ones, found by the search over cells of poses
 };
 
 struct Enumeration {
@@ -48,6 +49,7 @@ struct Enumeration {
   double min_margin = 0;                           // mm, smallest LP margin of a witness's contacts
   std::size_t symmetries_a = 1, symmetries_b = 1;  // the models' symmetries, identity included
   std::vector<PcSet> undecided;                    // failed candidates with no proof of invalidity
+  std::size_t refuted_over_cells = 0;              // failed candidates refuted by search_cells
 };
 
 /// One level of a run as predicted (RunEstimate). Candidates are the sets the level proposes;

@@ -143,6 +143,7 @@ class Enumerator {
   // finish.cpp
   void close_orbits();
   void find_undecided();
+  void add_with_images(const PcSet& s, const Witness& w, PcSetSet& known);
   void build_records();
   void finished(ProgressEvent& ev, Clock::time_point t0, const std::string& result);
 

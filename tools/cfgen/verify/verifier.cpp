@@ -25,63 +25,103 @@ namespace cf::gen {
 
 using namespace internal;
 
+namespace {
+
+// An upper bound of an e-e's local margin (the sine of the angle between the edges, and how
+// far the plane holding both is from cutting either wedge) over the rotations `turn`
+// allows: the edges' cross product c moves by at most d = turn(edge of A), its direction N by
+// at most 2 d / |c| (|u/|u| - v/|v|| <= 2 |u - v| / |v|).
+double ee_margin_bound(const ModelInfo& A_, const ModelInfo& B_, const Pc& pc, const Mat3& R,
+                       const TurnBound& turn) {
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  if (!A.edges()[pc.a].convex || !B.edges()[pc.b].convex) return -1;
+  const EdgeWedge& wa = A_.wedges[pc.a];
+  const EdgeWedge& wb = B_.wedges[pc.b];
+  const double d = turn.of(A.edges()[pc.a].dir);
+  Vec3 N = (R * A.edges()[pc.a].dir).cross(B.edges()[pc.b].dir);
+  const double sin_cross = N.norm();
+  if (d == 0 && sin_cross < 1e-9) return -1;
+  if (sin_cross <= d) return sin_cross + d;  // N may point anywhere
+  N /= sin_cross;
+  const double dN = 2 * d / sin_cross;
+  auto side = [&](const Vec3& n) {
+    return std::min({-wb.into_left.dot(n) + dN, -wb.into_right.dot(n) + dN,
+                     (R * wa.into_left).dot(n) + turn.of(wa.into_left) + dN,
+                     (R * wa.into_right).dot(n) + turn.of(wa.into_right) + dN});
+  };
+  return std::min(sin_cross + d, std::max(side(N), side(-N)));
+}
+
+}  // namespace
+
 Verifier::Verifier(const ModelInfo& a, const ModelInfo& b, const SearchParams& p)
     : A_(a), B_(b), p_(p), scale_(std::max(a.model->size(), b.model->size())) {}
 
 double Verifier::verified_local_slack() const { return 0.5 * std::sin(p_.angle_margin); }
 
-double Verifier::local_margin(const PcSet& pcs, const Mat3& R) const {
+double local_margin_bound(const ModelInfo& A_, const ModelInfo& B_, const PcSet& pcs, const Mat3& R,
+                          const TurnBound& turn, int* which) {
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
   double m = 1.0;
-  for (const Pc& pc : pcs) {
+  if (which) *which = -1;
+  // Each term is a dot product of two unit vectors, one of them turned: over the rotations
+  // it exceeds its value at R by at most how far `turn` lets that one move.
+  auto cone_term = [&](const auto& rays, const Vec3& n, bool rays_turn, double dn) {
+    double t = 1.0;
+    for (const Vec3& r : rays) t = std::min(t, r.dot(n) + (rays_turn ? turn.of(r) : dn));
+    return t;
+  };
+  for (int k = 0; k < pcs.size(); ++k) {
+    const Pc& pc = pcs[k];
+    double t = 1.0;
     switch (pc.type) {
-      case PcType::kFF:
-        m = std::min(m, 1.0 - (R * A.faces()[pc.a].normal + B.faces()[pc.b].normal).norm());
-        break;
-      case PcType::kVF: {
-        const auto& cone = A_.cones[pc.a];
-        if (!cone.pointed) return -1;
-        const Vec3 nb = R.transpose() * B.faces()[pc.b].normal;
-        for (const Vec3& r : cone.rays) m = std::min(m, r.dot(nb));
+      case PcType::kFF: {
+        const Vec3& na = A.faces()[pc.a].normal;
+        t = 1.0 - (R * na + B.faces()[pc.b].normal).norm() + turn.of(na);
         break;
       }
+      case PcType::kVF:
+        t = !A_.cones[pc.a].pointed
+                ? -1
+                : cone_term(A_.cones[pc.a].rays, R.transpose() * B.faces()[pc.b].normal, true, 0);
+        break;
       case PcType::kFV: {
-        const auto& cone = B_.cones[pc.b];
-        if (!cone.pointed) return -1;
-        const Vec3 na = R * A.faces()[pc.a].normal;
-        for (const Vec3& r : cone.rays) m = std::min(m, r.dot(na));
+        const Vec3& na = A.faces()[pc.a].normal;
+        t = !B_.cones[pc.b].pointed ? -1
+                                    : cone_term(B_.cones[pc.b].rays, R * na, false, turn.of(na));
         break;
       }
       case PcType::kEF: {
-        if (!A.edges()[pc.a].convex) return -1;
-        const Vec3 nb = R.transpose() * B.faces()[pc.b].normal;
-        m = std::min({m, A_.wedges[pc.a].into_left.dot(nb), A_.wedges[pc.a].into_right.dot(nb)});
+        const EdgeWedge& w = A_.wedges[pc.a];
+        t = !A.edges()[pc.a].convex ? -1
+                                    : cone_term(std::array<Vec3, 2>{w.into_left, w.into_right},
+                                                R.transpose() * B.faces()[pc.b].normal, true, 0);
         break;
       }
       case PcType::kFE: {
-        if (!B.edges()[pc.b].convex) return -1;
-        const Vec3 na = R * A.faces()[pc.a].normal;
-        m = std::min({m, B_.wedges[pc.b].into_left.dot(na), B_.wedges[pc.b].into_right.dot(na)});
+        const Vec3& na = A.faces()[pc.a].normal;
+        const EdgeWedge& w = B_.wedges[pc.b];
+        t = !B.edges()[pc.b].convex ? -1
+                                    : cone_term(std::array<Vec3, 2>{w.into_left, w.into_right},
+                                                R * na, false, turn.of(na));
         break;
       }
-      case PcType::kEE: {
-        if (!A.edges()[pc.a].convex || !B.edges()[pc.b].convex) return -1;
-        Vec3 N = (R * A.edges()[pc.a].dir).cross(B.edges()[pc.b].dir);
-        const double sin_cross = N.norm();
-        if (sin_cross < 1e-9) return -1;
-        N /= sin_cross;
-        auto side = [&](const Vec3& n) {
-          return std::min({-B_.wedges[pc.b].into_left.dot(n), -B_.wedges[pc.b].into_right.dot(n),
-                           (R * A_.wedges[pc.a].into_left).dot(n),
-                           (R * A_.wedges[pc.a].into_right).dot(n)});
-        };
-        m = std::min({m, sin_cross, std::max(side(N), side(-N))});
+      case PcType::kEE:
+        t = ee_margin_bound(A_, B_, pc, R, turn);
         break;
-      }
+    }
+    if (t < m) {
+      m = t;
+      if (which) *which = k;
     }
   }
   return m;
+}
+
+double Verifier::local_margin(const PcSet& pcs, const Mat3& R) const {
+  return local_margin_bound(A_, B_, pcs, R, TurnBound{});
 }
 
 std::pair<Vec3, double> Verifier::contact_plane(const Pc& pc, const Pose& pose) const {

@@ -8,6 +8,7 @@
 /// the two models' analyses (analysis.hpp).
 
 #include "cfgen/verify/analysis.hpp"
+#include "cfgen/verify/turn_bound.hpp"
 
 #include <cf/graph.hpp>
 
@@ -33,6 +34,14 @@ struct SearchParams {
 /// a pair does not change the contact set.
 bool covered_by(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs, ElementKind ka, int a,
                 ElementKind kb, int b);
+
+/// An upper bound, over a set of rotations that turn each vector x of A's frame at most
+/// turn(x) from where R turns it, of the PCs' local non-penetration margin
+/// (Verifier::local_margin: a sine, negative when a contact is penetrating or degenerate).
+/// turn = {} gives the margin at R. which: when given, the index in `pcs` of the PC whose
+/// term is smallest (-1 when none is below 1).
+double local_margin_bound(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs, const Mat3& R,
+                          const TurnBound& turn, int* which = nullptr);
 
 class Verifier {
  public:
