@@ -1,4 +1,4 @@
-// The generator at growing model size (the scale issue; SPEC section 7): an n-gon peg in a
+// The generator at growing model size (the scale issue; docs/spec.md, section 7): an n-gon peg in a
 // block with an n-gon through-hole, n = 3, 4, 6, 8, 12, 16, on 1 and 2 threads, with one
 // search per orbit of the pair's symmetries (symmetry:1, cfgen's default) and searching every
 // set (symmetry:0, --no-symmetry). Reports the

@@ -1,4 +1,4 @@
-// Detection + identification per servo tick (SPEC section 7), side by side with FCL's
+// Detection + identification per servo tick (docs/spec.md, section 7), side by side with FCL's
 // distance query on the same meshes and poses: the cube against the L-block, and two
 // faceted spheres of 2,000 and 2,016 faces (with the paper's epsilon of 1 mm, and with one
 // scaled to their facets, 0.1 mm), on poses far apart (each tick from scratch) and on a

@@ -1,5 +1,5 @@
 // The full servo step (detect, identify, classify, force: HapticRenderer::step) on the
-// paper's cube against its L-shaped block (SPEC section 7: median <= 5 us, 99.9th
+// paper's cube against its L-shaped block (docs/spec.md, section 7: median <= 5 us, 99.9th
 // percentile <= 20 us), and its parts. Each step is timed on its own so that the median and
 // the 99.9th percentile are reported (counters median_us, p99_us, p999_us, max_us).
 //
@@ -368,13 +368,13 @@ BENCHMARK(BM_ForceOnlyIntrinsic)
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
-// The servo step with the proxy on (SPEC 6b, the default), intrinsic as above (minimum of
-// each tick over R replays from reset()): over the bundled trajectories (A's pose within
-// the detection band: the proxy is the device pose on all but a few ticks), and over a
-// scripted hand that presses into B: down 5 mm into the floor (0.3 s), slide 15 mm while
-// pressed (0.6 s), press into the inner corner wall 3 mm (0.4 s), lift out (0.3 s); 1,600
-// ticks at 1 kHz, nearly all of them held by the proxy. Counters as above, plus
-// `constrained_share` (ticks on which the proxy held A back) and `passes_max`.
+// The servo step with the proxy on (docs/spec.md, section 6b; the default), intrinsic as above
+// (minimum of each tick over R replays from reset()): over the bundled trajectories (A's pose
+// within the detection band: the proxy is the device pose on all but a few ticks), and over a
+// scripted hand that presses into B: down 5 mm into the floor (0.3 s), slide 15 mm while pressed
+// (0.6 s), press into the inner corner wall 3 mm (0.4 s), lift out (0.3 s); 1,600 ticks at 1 kHz,
+// nearly all of them held by the proxy. Counters as above, plus `constrained_share` (ticks on which
+// the proxy held A back) and `passes_max`.
 
 std::vector<Tick> press_ticks() {
   std::vector<Tick> out;

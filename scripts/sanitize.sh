@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The sanitizer and fuzz build (SPEC section 5b, docs/bad-input.md): libcf, cfinspect,
+# The sanitizer and fuzz build (docs/spec.md, section 5b; docs/bad-input.md): libcf, cfinspect,
 # cfreplay and their tests built with clang, AddressSanitizer and UndefinedBehaviorSanitizer
 # in their own build tree (CGAL's cfgen stays out: CF_WITH_CGAL=OFF), the libFuzzer targets
 # of fuzz/ beside them; then the tests run there. scripts/test.sh runs it after the main

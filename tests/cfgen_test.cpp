@@ -1,12 +1,12 @@
-// Independent tests of the CF graph generator (tools/cfgen, SPEC sections 3-5b).
+// Independent tests of the CF graph generator (tools/cfgen; docs/spec.md, sections 3-5b).
 //
 // Everything that decides what a contact *is* lives in this file and is written from the
-// SPEC, not from the generator: open-set touching of two elements, domination, PC types,
-// contact planes, interpenetration by ray casting, first contact of a translated polyhedron.
-// From libcf it uses only the model data (features, adjacency) and the closed-set distances
-// of cf::element_distance / cf::point_face. The generator's own WitnessSearch appears only
-// in failure messages (what its verify() says about a pose this file found) and for the
-// U-channel's two-PC sets (see that test).
+// specification (docs/spec.md), not from the generator: open-set touching of two elements,
+// domination, PC types, contact planes, interpenetration by ray casting, first contact of a
+// translated polyhedron. From libcf it uses only the model data (features, adjacency) and the
+// closed-set distances of cf::element_distance / cf::point_face. The generator's own WitnessSearch
+// appears only in failure messages (what its verify() says about a pose this file found) and for
+// the U-channel's two-PC sets (see that test).
 //
 // Sections:
 //  0. the oracle itself on poses with known answers;
@@ -15,7 +15,7 @@
 //  2. every witness of every generated graph re-verified;
 //  3. recall: random guarded and sliding motions; every clean CF reached must be in the
 //     graph (plus the poses earlier runs found missing, kept as fixed cases);
-//  4. transitions (gain/lose/change) against the SPEC section 4 rules, both directions;
+//  4. transitions (gain/lose/change) against the rules of docs/spec.md, section 4, both directions;
 //  5. determinism: the whole cube/L-block graph with 1 and 2 threads, and cfgen's file.
 //
 // Each model pair is generated once per process (the tests of one pair are SECTIONs of one
@@ -368,7 +368,7 @@ std::vector<std::pair<double, double>> line_in_open_face(const Placed& S, int f,
 }
 
 // ---------------------------------------------------------------------------------------
-// Open-set touching (SPEC section 4)
+// Open-set touching (docs/spec.md, section 4)
 // ---------------------------------------------------------------------------------------
 
 enum class Touch { kNone, kTouch, kPenetrate };
@@ -516,7 +516,7 @@ TouchResult open_touch(const Placed& A, K ka, int a, const Placed& B, K kb, int 
   return r;
 }
 
-// Element (k, i) is (k2, j) or lies on its boundary (SPEC section 4's domination).
+// Element (k, i) is (k2, j) or lies on its boundary (the domination of docs/spec.md, section 4).
 bool within_closure(const Polyhedron& m, K k, int i, K k2, int j) {
   if (k == k2) return i == j;
   if (k == K::kVertex && k2 == K::kEdge) {
@@ -1234,8 +1234,8 @@ void check_recall(const Generated& g, const std::string& label, int trials, std:
 // Section 4: transitions
 // ---------------------------------------------------------------------------------------
 
-// SPEC section 4: neighbouring PCs, one step through a degenerate touch, "under the matching
-// boundary relations". `x` is the PC with the larger element(s).
+// docs/spec.md, section 4: neighbouring PCs, one step through a degenerate touch, "under the
+// matching boundary relations". `x` is the PC with the larger element(s).
 bool neighbour_dir(const Pc& x, const Pc& y, const Polyhedron& A, const Polyhedron& B) {
   auto edge_bounds = [](const Polyhedron& m, int e, int f) {
     return within_closure(m, K::kEdge, e, K::kFace, f);
@@ -1320,7 +1320,8 @@ void check_transitions(const Generated& g, const std::string& label) {
       fail("no reverse of " + std::string(cf::to_string(static_cast<cf::TransitionKind>(k))) + " " +
            std::to_string(f) + " -> " + std::to_string(t));
   }
-  // Completeness: every pair of graph CFs that the SPEC's rules relate has its transition.
+  // Completeness: every pair of graph CFs that the rules of docs/spec.md, section 4, relate has its
+  // transition.
   std::size_t expected_gain = 0, expected_change = 0;
   std::vector<std::vector<int>> by_size(4);
   for (std::size_t i = 0; i < n; ++i)
@@ -1354,7 +1355,7 @@ void check_transitions(const Generated& g, const std::string& label) {
       }
   WARN(label << ": " << G.num_transitions() << " transitions (" << kinds[0] << " gain, " << kinds[1]
              << " lose, " << kinds[2]
-             << " change); by the SPEC rules over the graph's CFs: " << expected_gain
+             << " change); by the spec's rules over the graph's CFs: " << expected_gain
              << " gain and " << expected_change << " change expected; " << bad << " problems");
   INFO("first problems:\n" << failures.str());
   CHECK(bad == 0);
@@ -1830,8 +1831,8 @@ TEST_CASE("cfgen: cube vs L-block", "[cfgen]") {
     for (const PcSet& s : ff2)
       CHECK(A.faces()[static_cast<std::size_t>(s[0].a)].normal.dot(
                 A.faces()[static_cast<std::size_t>(s[1].a)].normal) > -0.5);
-    // SPEC section 4: the L-block is the union of two convex pieces and the cube is convex, so
-    // all PCs with one piece share a plane: no three-PC CF.
+    // docs/spec.md, section 4: the L-block is the union of two convex pieces and the cube is
+    // convex, so all PCs with one piece share a plane: no three-PC CF.
     CHECK(count_size(*g.graph, 3) == 0);
   }
   SECTION("witnesses") { check_witnesses(g, "cube vs L-block"); }

@@ -94,8 +94,8 @@ cfinspect_test(dot_unwritable fail "${_g}/box_l.json --dot ${_out}/no/such/dir/x
 cfinspect_test(no_args fail "" "no graph file given")
 cfinspect_test(bad_option fail "${_g}/box_l.json --bogus" "--bogus")
 
-# Every graph shipped in data/graphs must pass the full schema check (SPEC section 5: "every
-# written graph validates"). Globbed at configure time: re-run cmake after adding one.
+# Every graph shipped in data/graphs must pass the full schema check (docs/spec.md, section 5:
+# "every written graph validates"). Globbed at configure time: re-run cmake after adding one.
 file(GLOB _data_graphs ${PROJECT_SOURCE_DIR}/data/graphs/*.json ${PROJECT_SOURCE_DIR}/data/graphs/*.cbor)
 foreach(_graph IN LISTS _data_graphs)
   get_filename_component(_name ${_graph} NAME)

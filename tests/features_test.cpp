@@ -1,4 +1,4 @@
-// Feature extraction (SPEC section 3, docs/features.md) on the default models and on
+// Feature extraction (docs/spec.md, section 3; docs/features.md) on the default models and on
 // constructed meshes; the JSON schema of the model object; the cfgen --features command.
 
 #include "mesh/model_loader.hpp"

@@ -1,5 +1,5 @@
 // Contact force and moment with hand-computed values: paper eqs. (1)-(9) and the per-MT
-// rules of section 4.4, with the SPEC readings (docs/force-model.md).
+// rules of section 4.4, with the readings of docs/spec.md, section 6 (docs/force-model.md).
 //
 // Scene: A is a 20 mm cube [0,20]^3 in its frame. B's faces are only named by index: the
 // floor is the plane y = 0 (normal +y), walls are given per test. Defaults: K = 2.3 N/mm,

@@ -167,7 +167,8 @@ TEST_CASE("prior motion from the previous and current PC sets (paper section 4.2
 }
 
 TEST_CASE(
-    "several PCs broken at once are MT5 through the graph (SPEC 4: lose is any proper subset)",
+    "several PCs broken at once are MT5 through the graph (docs/spec.md, section 4: lose is any "
+    "proper subset)",
     "[motion]") {
   // The cube seated in the corner block's three walls leaving two of them in one tick: the
   // graph lists single losses; the run time derives the double one from the PC sets.

@@ -1,4 +1,4 @@
-// The proxy (SPEC section 6b) checked against the independent oracle (tests/oracle).
+// The proxy (docs/spec.md, section 6b) checked against the independent oracle (tests/oracle).
 //
 // The recall test keeps, for each fixed seed, the generated pair, cfgen's graph and
 // samples.csv: poses where the oracle realised a CF of the graph by exact first contacts

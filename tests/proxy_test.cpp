@@ -1,7 +1,7 @@
-// The proxy of SPEC 6b (libcf/src/proxy/proxy.cpp) on the paper's cube against its L-block
-// and against a thin plate: pressing into a face, an edge and the inner corner, sliding
-// while pressed, a one-tick jump through a wall, letting go, the servo rate, and the proxy
-// off as the paper's literal model.
+// The proxy of section 6b of docs/spec.md (libcf/src/proxy/proxy.cpp) on the paper's cube against
+// its L-block and against a thin plate: pressing into a face, an edge and the inner corner, sliding
+// while pressed, a one-tick jump through a wall, letting go, the servo rate, and the proxy off as
+// the paper's literal model.
 
 #include <cf/detector.hpp>
 #include <cf/renderer.hpp>

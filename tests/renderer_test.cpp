@@ -241,7 +241,7 @@ TEST_CASE("a second plane's contact pushes from epsilon on, without a step at it
   // near as the CF's own PC (docs/runtime.md, Identification).
   const cf::CfGraph g = corner_graph();
   // Past the wall's surface the proxy (on by default) holds A at it, and the load is eq.
-  // (1)'s K epsilon plus the constraint's, which keeps eq. (1)'s slope (SPEC 6b).
+  // (1)'s K epsilon plus the constraint's, which keeps eq. (1)'s slope (docs/spec.md, section 6b).
   auto wall_push = [](const cf::HapticResult& res) {
     double f = 0;
     for (int k = 0; k < res.force->num_pcs + res.force->num_approaching; ++k) {

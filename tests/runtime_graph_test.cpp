@@ -347,8 +347,9 @@ TEST_CASE(
         same_by_fit += r.cf == X;
         if (!(ok && geo) && shown++ < 10)
           notes << name << ": near CF " << i << " by fit: " << describe(r) << "\n";
-        // Coming from X: X, else a neighbour, whenever one of them stands at P (SPEC 6's
-        // preference); elsewhere only when none does (the motion changed more than one step).
+        // Coming from X: X, else a neighbour, whenever one of them stands at P (the preference
+        // of docs/spec.md, section 6); elsewhere only when none does (the motion changed more than
+        // one step).
         bool near_stands = stands(r, rec.pcs);
         for (const cf::Transition& t : g.out_transitions(X))
           near_stands = near_stands || stands(r, g.cf(t.to).pcs);

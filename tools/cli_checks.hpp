@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// CLI11 validators shared by the tools (SPEC section 5b: an option value must be a finite
+/// CLI11 validators shared by the tools (docs/spec.md, section 5b: an option value must be a finite
 /// number in range), and their --version text. CLI::Range lets NaN through (every comparison with
 /// NaN is false) and says nothing about infinity; these do not. The range shows in --help.
 

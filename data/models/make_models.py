@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the default models of data/models (see docs/models.md). Run from anywhere:
     python3 data/models/make_models.py
-Coordinates in mm, y up (gravity along -y, SPEC section 2), facets counter-clockwise seen
+Coordinates in mm, y up (gravity along -y; docs/spec.md, section 2), facets counter-clockwise seen
 from outside. The OFF files are polygonal; l_block_tri.obj is the L-block triangulated by ear
 clipping with the same vertex order and the facets in the same order (polygon k becomes
 consecutive triangles), so its features equal l_block.off's index for index."""

@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
   try {
     // --- What an application does once: the model, shared by every servo thread. ---
     const cf::CfGraph graph = cf::CfGraph::load(graph_path);
-    const cf::CfModel model(graph, cf::Params{});  // the proxy is on by default (SPEC 6b)
+    const cf::CfModel model(graph, cf::Params{});  // proxy on by default: docs/spec.md, section 6b
     cf::CfState state(model);                      // the servo thread's own
 
     // The hand's script (the cube of the bundled L-block graph touches the floor with its

@@ -1,5 +1,5 @@
 #pragma once
-// Independent test oracle: what holds between A and B at one pose (SPEC section 4).
+// Independent test oracle: what holds between A and B at one pose (docs/spec.md, section 4).
 //
 //  - touching pairs of open elements (vertex, open edge, open face), with a length tolerance;
 //  - interior disjointness, exactly in the combinatorial sense: A and B have overlapping

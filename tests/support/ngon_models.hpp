@@ -1,6 +1,6 @@
 #pragma once
-// n-gon pegs and holes written in code (SPEC section 7's scale pairs): an n-gon prism, and
-// a block (an n-gon tube) with an n-gon through-hole.
+// n-gon pegs and holes written in code (the scale pairs of docs/spec.md, section 7): an n-gon
+// prism, and a block (an n-gon tube) with an n-gon through-hole.
 
 #include "scratch.hpp"
 

@@ -120,7 +120,7 @@ nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args,
   if (args.thorough)
     meta["parameters"]["thorough"] = true;  // absent otherwise: the same bytes as before
   meta["generator"] = {{"name", "cfgen"}, {"a_model", args.a_path}, {"b_model", args.b_path}};
-  // Coordinates are stored in mm; the unit each model file was read in (SPEC section 2).
+  // Coordinates are stored in mm; the unit each model file was read in (docs/spec.md, section 2).
   meta["source_units"] = {{"A", args.load_a.units}, {"B", args.load_b.units}};
 
   return meta;
@@ -198,7 +198,7 @@ RunPlan plan_run(const gen::WitnessSearch& ws, const gen::EnumerateOptions& opt,
 int run_generate(const GenerateArgs& args) {
   const auto t0 = std::chrono::steady_clock::now();
   // The output path is checked before the work: not a device, FIFO or directory, not one of
-  // the models (SPEC section 5b).
+  // the models (docs/spec.md, section 5b).
   const std::vector<std::string> inputs{args.a_path, args.b_path};
   // Of K shards, shard 0 writes the graph.
   const bool writes = !args.estimate && args.shard.index == 0;

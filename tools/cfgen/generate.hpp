@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// cfgen's graph generation mode (SPEC section 5b): `cfgen A_MODEL B_MODEL -o GRAPH.json`.
+/// cfgen's graph generation mode (docs/spec.md, section 5b): `cfgen A_MODEL B_MODEL -o GRAPH.json`.
 /// main.cpp parses the command line; run_generate does the work: it loads the models, makes
 /// the decide layer's WitnessSearch and the execute layer's Executor, runs the enumeration
 /// and writes the graph.

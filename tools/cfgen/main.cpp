@@ -1,8 +1,8 @@
-// cfgen: builds CF graphs (SPEC section 5b) and prints the features of a model.
-//   cfgen --features MODEL                 the model object (SPEC section 5) as JSON on stdout
-//   cfgen A_MODEL B_MODEL --estimate       the run predicted, on stdout
-//   cfgen A_MODEL B_MODEL -o GRAPH.json    the CF graph of A against B
-//   cfgen A_MODEL B_MODEL -o GRAPH.json --checkpoint DIR --shard i/K   one of K processes
+// cfgen: builds CF graphs (docs/spec.md, section 5b) and prints the features of a model.
+//   cfgen --features MODEL                 the model object (docs/spec.md, section 5) as JSON on
+//   stdout cfgen A_MODEL B_MODEL --estimate       the run predicted, on stdout cfgen A_MODEL
+//   B_MODEL -o GRAPH.json    the CF graph of A against B cfgen A_MODEL B_MODEL -o GRAPH.json
+//   --checkpoint DIR --shard i/K   one of K processes
 
 #include "cfgen/execute/shard.hpp"
 #include "cfgen/execute/stop.hpp"
@@ -162,7 +162,7 @@ int main(int argc, char** argv) {
   app.add_option("--coplanar-tol", coplanar_tol,
                  "coplanarity tolerance relative to the model's bounding-box diagonal")
       ->check(cf::cli::finite_range(cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol));
-  // Model units (SPEC section 2): files carry none; mm unless said otherwise.
+  // Model units (docs/spec.md, section 2): files carry none; mm unless said otherwise.
   const auto unit_names = CLI::IsMember({"mm", "cm", "m", "in"});
   app.add_option("--units", units,
                  "length unit of every model file: mm, cm, m or in (the graph stores mm)")

@@ -1,6 +1,6 @@
 // cfinspect: validates a CF graph file against the schema and summarises it, answers
 // queries (CFs holding a PC, a CF's transitions, one CF, the CF at a pose) and exports
-// Graphviz DOT (SPEC section 5b). One translation unit, no CGAL.
+// Graphviz DOT (docs/spec.md, section 5b). One translation unit, no CGAL.
 
 #include <cf/file_io.hpp>
 #include <cf/graph.hpp>
@@ -361,7 +361,7 @@ int run(int argc, char** argv) {
   if (!pose_text.empty()) pose = parse_pose(pose_text);
 
   // An output path is checked before the load: never the graph itself, a device, a FIFO
-  // or a directory (SPEC section 5b).
+  // or a directory (docs/spec.md, section 5b).
   if (!dot_path.empty()) cf::check_output_path(dot_path, {path}, "writing DOT");
   if (html_path.empty() && !(replay_path.empty() && trajectory_path.empty())) {
     std::cerr << "cfinspect: --replay and --trajectory go with --html (see --help)\n";

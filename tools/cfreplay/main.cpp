@@ -1,5 +1,5 @@
 // cfreplay: runs the run-time loop (detect, identify, classify, force) over a trajectory of A
-// and writes one row per servo tick (SPEC section 5b).
+// and writes one row per servo tick (docs/spec.md, section 5b).
 //   cfreplay --graph GRAPH.json --trajectory POSES.csv -o OUT.csv [--plot OUT.svg]
 
 #include "replay_io.hpp"
@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
       "moment of every servo tick.\n"
       "  POSES.csv: header t,tx,ty,tz,qw,qx,qy,qz (s, mm, unit quaternion of R; x_B = R x_A + t)\n"
       "  POSES.csv is the device: where the hand holds A. With the proxy (default) A is rendered\n"
-      "  at a proxy pose that never goes into B (SPEC 6b).\n"
+      "  at a proxy pose that never goes into B (docs/spec.md, section 6b).\n"
       "  OUT.csv:   t,cf,pcs,motion,Fx,Fy,Fz,Mx,My,Mz (the rendered wrench: coupling + contact at\n"
       "             the proxy + gravity; world; N, N mm), then the same in A's frame (FAx..MAz),\n"
       "             the status, the per-PC friction regimes (then approaching:PC for each contact\n"
@@ -58,8 +58,8 @@ int main(int argc, char** argv) {
   app.add_option(
          "--proxy", proxy,
          "'on': the trajectory is the device and A is rendered at a proxy that stays out of B, "
-         "felt through a spring (SPEC 6b); 'off': A's pose is the trajectory (the paper's literal "
-         "model)")
+         "felt through a spring (docs/spec.md, section 6b); 'off': A's pose is the trajectory "
+         "(the paper's literal model)")
       ->check(CLI::IsMember({"on", "off"}));
   app.add_option("--proxy-stiffness", P.proxy.stiffness_N_per_mm,
                  "the proxy coupling's stiffness, N/mm")
@@ -117,7 +117,7 @@ int main(int argc, char** argv) {
   P.centroid = centroid == "volume" ? cf::CentroidChoice::kVolume : cf::CentroidChoice::kVertexMean;
 
   try {
-    // Output paths first, so that a bad one fails before the work (SPEC section 5b).
+    // Output paths first, so that a bad one fails before the work (docs/spec.md, section 5b).
     const std::vector<std::string> inputs{graph_path, traj_path};
     cf::check_output_path(out_path, inputs, "writing");
     if (!plot_path.empty()) cf::check_output_path(plot_path, inputs, "writing");

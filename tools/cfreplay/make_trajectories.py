@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the scripted trajectories of data/trajectories/ for cfreplay (SPEC section 5b).
+"""Writes the scripted trajectories of data/trajectories/ for cfreplay (docs/spec.md, section 5b).
 
     python3 tools/cfreplay/make_trajectories.py [--rate 1000] [--out data/trajectories]
 
@@ -19,7 +19,7 @@ Scenarios (the cube A against the L-block or the corner block B):
   cube_lblock_break.csv     from the corner, leave the wall, then lift off     (MT5, none)
   cube_corner_seat.csv      corner block: land, slide into x wall, then z wall (three f-f)
   cube_lblock_press.csv     a device pressing: from 1 mm above the floor to 10 mm inside it,
-                            hold, slide 15 mm while pressed, pull out (for the proxy, SPEC 6b:
+                            hold, slide 15 mm while pressed, pull out (for the proxy, docs/spec.md, section 6b:
                             `cfreplay --proxy off` renders nothing but gravity once A is
                             deeper than 1 mm)
 """

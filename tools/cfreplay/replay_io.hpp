@@ -1,6 +1,6 @@
 #pragma once
-// cfreplay's files (SPEC section 5b): the trajectory CSV it reads, the force CSV and the SVG
-// plot it writes. CGAL-free; linked into cfreplay and its tests.
+// cfreplay's files (docs/spec.md, section 5b): the trajectory CSV it reads, the force CSV and the
+// SVG plot it writes. CGAL-free; linked into cfreplay and its tests.
 
 #include <cf/types.hpp>
 
@@ -45,7 +45,7 @@ struct Row {
   Vec3 Fc_W = Vec3::Zero(), Mc_W = Vec3::Zero();
 };
 
-/// The output header (SPEC 5b columns first).
+/// The output header (the columns of section 5b of docs/spec.md first).
 const char* output_header();
 /// Formats one row (no newline).
 std::string format_row(const Row& row);

@@ -1,5 +1,5 @@
 #pragma once
-// Runs the renderer over a trajectory: one output row per servo tick (SPEC section 5b).
+// Runs the renderer over a trajectory: one output row per servo tick (docs/spec.md, section 5b).
 
 #include "replay_io.hpp"
 

@@ -16,7 +16,7 @@ namespace cf::tools::detail {
 /// zero-area and non-planar facets, several solids, negative volume. Throws cf::Error.
 void check_soup(const PolygonSoup& soup, const std::string& source, const LoadOptions& options);
 
-/// Faces, edges and vertices of SPEC section 3 from a soup that passed check_soup.
+/// Faces, edges and vertices of section 3 of docs/spec.md from a soup that passed check_soup.
 cf::Polyhedron extract_features(const PolygonSoup& soup, const std::string& source,
                                 const std::string& name, const LoadOptions& options);
 

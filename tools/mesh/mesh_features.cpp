@@ -1,4 +1,4 @@
-// CGAL-free validation of a polygon soup and extraction of the features of SPEC section 3.
+// CGAL-free validation of a polygon soup and extraction of the features of docs/spec.md, section 3.
 // The rules implemented here are documented in docs/features.md; keep the two in step.
 
 #include "mesh_detail.hpp"

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// Reading a polyhedral model from a mesh file (OFF, OBJ, STL, PLY), validating it and
-/// extracting its features (SPEC section 3). CGAL-free interface: CGAL stays inside
+/// extracting its features (docs/spec.md, section 3). CGAL-free interface: CGAL stays inside
 /// model_loader.cpp. Definitions, tolerances and index rules: docs/features.md.
 
 #include <cf/polyhedron.hpp>
@@ -19,7 +19,7 @@ constexpr double kMaxCoplanarTol = 0.1;
 /// areas and volumes lose all precision, and no haptic scene is that large.
 constexpr double kMaxCoordinateMm = 1e9;
 
-/// Millimetres per unit of a model file's unit name (SPEC section 2: mm, cm, m, in);
+/// Millimetres per unit of a model file's unit name (docs/spec.md, section 2: mm, cm, m, in);
 /// 0 for an unknown name.
 double mm_per_unit(const std::string& unit);
 
@@ -78,7 +78,7 @@ cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& sourc
 
 /// Empty when `model` is a reasonable size against the contact threshold `epsilon_mm` (the
 /// paper's 1 mm by default), else a warning naming the sizes and `unit_option`, the option
-/// that gives the file's unit (SPEC section 2).
+/// that gives the file's unit (docs/spec.md, section 2).
 std::string size_warning(const cf::Polyhedron& model, const std::string& which,
                          const std::string& unit_option, double epsilon_mm = 1.0);
 

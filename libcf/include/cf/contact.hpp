@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Contacts detected at a pose: the candidate principal contacts of SPEC section 6, each
+/// Contacts detected at a pose: the candidate principal contacts of section 6 of docs/spec.md, each
 /// with its distance, point of action and task frame, and a fixed-capacity set of them.
 
 #include <cf/pc.hpp>
@@ -33,7 +33,7 @@ struct ContactPc {
   ///   a dominance penalty when another detected contact dominates this one
   /// (docs/runtime.md gives the tolerances).
   double misfit = 0;
-  /// True when another detected contact dominates this one (SPEC section 4: its elements
+  /// True when another detected contact dominates this one (docs/spec.md, section 4: its elements
   /// are those of the other or lie on their boundaries), e.g. a v-f beside the e-f of an
   /// edge ending at that vertex, and that contact's shape fits within
   /// DetectionParams::dominance_fit of its tolerances (a face tilted by most of its

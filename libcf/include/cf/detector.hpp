@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Candidate principal contacts at a pose (SPEC section 6, paper section 4.1): every pair
+/// Candidate principal contacts at a pose (docs/spec.md, section 6; paper section 4.1): every pair
 /// of an element of A and an element of B that is within the contact threshold and whose
 /// type is consistent within tolerances. Built once per model pair; `detect` allocates
 /// nothing. docs/runtime.md describes every test and tolerance.

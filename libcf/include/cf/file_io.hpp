@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// Reading input files and writing output files the way SPEC section 5b requires, and the
-/// checks every cf tool applies to what it reads (quaternions, model sizes). libcf's graph
+/// Reading input files and writing output files the way section 5b of docs/spec.md requires, and
+/// the checks every cf tool applies to what it reads (quaternions, model sizes). libcf's graph
 /// reading and writing use it; so do the tools, through this public header.
 ///
 /// - Reading never blocks: the file is opened non-blocking and anything that is not a
@@ -55,8 +55,8 @@ void write_outputs(const std::vector<OutputFile>& files, const std::vector<std::
 /// of input (then "..."), for quoting file content in a one-line message.
 std::string printable(const std::string& text, std::size_t max = 60);
 
-/// One tolerance for a quaternion typed or read by any tool (SPEC section 5b): within 1e-3 of
-/// norm 1 (four significant digits) it is accepted and normalised, beyond it refused.
+/// One tolerance for a quaternion typed or read by any tool (docs/spec.md, section 5b): within 1e-3
+/// of norm 1 (four significant digits) it is accepted and normalised, beyond it refused.
 constexpr double kUnitQuaternionTolerance = 1e-3;
 
 /// Empty when | |q| - 1 | <= kUnitQuaternionTolerance (and q finite), else the reason with
@@ -64,7 +64,7 @@ constexpr double kUnitQuaternionTolerance = 1e-3;
 std::string quaternion_problem(double w, double x, double y, double z);
 
 /// Below this many epsilon across (bounding-box diagonal) a model is small against the
-/// contact threshold, above kLargeModel epsilon it is large (SPEC section 2: a model whose
+/// contact threshold, above kLargeModel epsilon it is large (docs/spec.md, section 2: a model whose
 /// unit was not given may be in metres, or in micrometres).
 constexpr double kSmallModel = 10;
 constexpr double kLargeModel = 1e5;

@@ -1,7 +1,8 @@
 #pragma once
 /// @file
-/// Contact formations and the CF graph of SPEC section 5 (the PC vocabulary is cf/pc.hpp).
-/// The graph is immutable once built or loaded; Boost.Graph and nlohmann live behind it.
+/// Contact formations and the CF graph of section 5 of docs/spec.md (the PC vocabulary is
+/// cf/pc.hpp). The graph is immutable once built or loaded; Boost.Graph and nlohmann live
+/// behind it.
 
 #include <cf/pc.hpp>
 #include <cf/polyhedron.hpp>
@@ -19,7 +20,7 @@ namespace cf {
 
 using CfId = Id<struct CfTag>;
 
-/// Prior-motion kinds a transition allows (SPEC section 4).
+/// Prior-motion kinds a transition allows (docs/spec.md, section 4).
 enum class TransitionKind : std::uint8_t { kGain, kLose, kChange };
 /// "gain", "lose", "change" as in the graph file.
 const char* to_string(TransitionKind kind);
@@ -67,7 +68,7 @@ struct GraphLoadOptions {
   bool full_schema_check = false;
 };
 
-/// The CF graph of a model pair (SPEC section 5). Immutable; share one `const CfGraph`
+/// The CF graph of a model pair (docs/spec.md, section 5). Immutable; share one `const CfGraph`
 /// between threads.
 class CfGraph {
  public:

@@ -1,9 +1,9 @@
 #pragma once
 /// @file
-/// Run-time CF identification (SPEC section 6, paper section 4.1): detect the candidate PCs
-/// at a pose and choose among their consistent interpretations a PC set that is a CF of the
-/// graph, preferring the previous CF, then a graph neighbour of it, then the best geometric
-/// fit. Bounded time, no heap allocation per step. docs/runtime.md describes the rules.
+/// Run-time CF identification (docs/spec.md, section 6; paper section 4.1): detect the candidate
+/// PCs at a pose and choose among their consistent interpretations a PC set that is a CF of the
+/// graph, preferring the previous CF, then a graph neighbour of it, then the best geometric fit.
+/// Bounded time, no heap allocation per step. docs/runtime.md describes the rules.
 
 #include <cf/contact.hpp>
 #include <cf/graph.hpp>

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The run time's parameters, one tree (`cf::Params`): the contact threshold, the force
-/// model (SPEC section 2 and section 6, paper section 4), and under it detection
+/// model (docs/spec.md, sections 2 and 6; paper section 4), and under it detection
 /// (`Params::detection`) and identification (`Params::identification`). Defaults are the
 /// paper's values; every choice the paper leaves open is a named option here, described in
 /// docs/force-model.md and docs/runtime.md. Every field's name or comment gives its unit.
@@ -12,7 +12,7 @@
 
 namespace cf {
 
-/// How s_pj of eqs. (3)-(4) is measured (SPEC section 6).
+/// How s_pj of eqs. (3)-(4) is measured (docs/spec.md, section 6).
 enum class FrictionDisplacement : std::uint8_t {
   /// Tangential displacement of p_j since the PC last entered sticking (a stick anchor).
   /// Independent of the servo rate. When eq. (3) fails the anchor is dragged along so that
@@ -88,9 +88,9 @@ struct IdentificationParams {
   double touch_distance_mm = 0.001;
 };
 
-/// The proxy (SPEC section 6b, docs/force-model.md "The proxy"): a 6-DOF god-object pose of
-/// A that follows the device pose but never penetrates B by more than max_penetration_mm,
-/// and a spring (and damper) coupling the device to it.
+/// The proxy (docs/spec.md, section 6b; docs/force-model.md "The proxy"): a 6-DOF god-object pose
+/// of A that follows the device pose but never penetrates B by more than max_penetration_mm, and a
+/// spring (and damper) coupling the device to it.
 struct ProxyParams {
   /// false: no proxy; A's pose is the device pose (the paper's literal model).
   bool enabled = true;
@@ -131,13 +131,13 @@ struct ProxyParams {
 /// friction, gravity and smoothing. ContactDetector, CfIdentifier, ForceModel and
 /// HapticRenderer each read the parts they need from one Params.
 struct Params {
-  // --- Paper's experimental values (paper section 6, SPEC section 2) ---
+  // --- Paper's experimental values (paper section 6; docs/spec.md, section 2) ---
   double mass_kg = 0.5;             ///< m, mass of A
   double gravity_N_per_kg = 9.8;    ///< g, acting along -y of the world
   double stiffness_N_per_mm = 2.3;  ///< K of eq. (1)
   double kp_N_per_mm = 1.6;         ///< K_p of eqs. (3)-(4)
   double mu_static = 0.7;           ///< mu of eqs. (2), (3), (6)
-  double mu_kinetic = 0.08;         ///< mu_D of eq. (5) (SPEC reading)
+  double mu_kinetic = 0.08;         ///< mu_D of eq. (5) (docs/spec.md, section 6)
   /// The contact threshold: of eq. (1), of detection (element pairs farther apart are not in
   /// contact) and of identification. The only epsilon of the run time.
   double epsilon_mm = 1.0;

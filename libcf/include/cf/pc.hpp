@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The vocabulary of principal contacts (SPEC section 4, paper Fig. 1): element kinds, PC
+/// The vocabulary of principal contacts (docs/spec.md, section 4; paper Fig. 1): element kinds, PC
 /// types with their element kinds and geometric extent, PCs, PC sets, and the relations
 /// between the elements of a model (closure) and between PCs (dominance, neighbouring PCs).
 /// Everything else in libcf, and cfgen, speaks in these terms.
@@ -151,14 +151,14 @@ std::string check_pc(const Pc& pc, const Polyhedron& A, const Polyhedron& B,
 /// @pre the indices are in range for their kinds in m.
 bool in_closure(const Polyhedron& m, ElementKind kx, int x, ElementKind ky, int y);
 
-/// True when PC `y` dominates PC `x` (SPEC section 4): they differ, and each element of x is
-/// in the closure of the element of y on the same side (e.g. the e-f of an edge dominates
-/// the v-f of its end vertices on the same face).
+/// True when PC `y` dominates PC `x` (docs/spec.md, section 4): they differ, and each element
+/// of x is in the closure of the element of y on the same side (e.g. the e-f of an edge
+/// dominates the v-f of its end vertices on the same face).
 /// @pre the indices are in range for the element kinds the types name in A and B.
 bool dominates(const Polyhedron& A, const Polyhedron& B, const Pc& y, const Pc& x);
 
-/// The PCs neighbouring `pc` (SPEC section 4): one step through a degenerate touch, under the
-/// boundary relations of A and B (edge bounds face, vertex ends edge; the table is in
+/// The PCs neighbouring `pc` (docs/spec.md, section 4): one step through a degenerate touch,
+/// under the boundary relations of A and B (edge bounds face, vertex ends edge; the table is in
 /// docs/generator.md). Sorted, without repeats; the relation is symmetric. This is the rule
 /// behind `change` transitions, for cfgen and for the graph reader's checks.
 /// @pre pc's indices are in range for the element kinds its type names in A and B.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// A featured polyhedron: the faces, edges and vertices of SPEC section 3 with their
+/// A featured polyhedron: the faces, edges and vertices of section 3 of docs/spec.md with their
 /// adjacency, planes and mass properties. CGAL-free; built by the tools from a mesh or read
 /// from the `models.A` / `models.B` objects of a graph file.
 
@@ -53,8 +53,8 @@ class Polyhedron {
  public:
   Polyhedron() = default;
 
-  /// Builds the feature structure from the SPEC section 5 model arrays and derives everything
-  /// else (edge-face incidence, convexity, planes, adjacency, mass properties).
+  /// Builds the feature structure from the model arrays of docs/spec.md, section 5, and derives
+  /// everything else (edge-face incidence, convexity, planes, adjacency, mass properties).
   /// @param name       the model's display name.
   /// @param vertices   feature vertices, mm.
   /// @param edges      pairs of vertex indices.
@@ -131,8 +131,8 @@ class Polyhedron {
   Vec3 bbox_max_ = Vec3::Zero();
 };
 
-/// Serialises the model in the form of SPEC section 5 (`models.A`), plus derived fields that
-/// readers may ignore (face planes, edge convexity, mass properties).
+/// Serialises the model in the form of section 5 of docs/spec.md (`models.A`), plus derived
+/// fields that readers may ignore (face planes, edge convexity, mass properties).
 /// @param indent  spaces per level; -1 writes one line.
 std::string to_json(const Polyhedron& model, int indent = 2);
 

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The run-time servo loop of SPEC section 6 as one object: a CfModel (its own, or one
+/// The run-time servo loop of section 6 of docs/spec.md as one object: a CfModel (its own, or one
 /// shared with other threads) and this thread's CfState, stepped by cf::step (cf/servo.hpp).
 /// step() allocates nothing.
 

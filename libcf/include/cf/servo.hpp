@@ -1,10 +1,10 @@
 #pragma once
 /// @file
-/// One servo tick of SPEC section 6 as stages, each a free function of the immutable
+/// One servo tick of section 6 of docs/spec.md as stages, each a free function of the immutable
 /// CfModel, the thread's CfState and the previous stage's result (after FCL's
 /// request/result structs and Box2D's free functions):
 ///
-///     const Pose X_WA = cf::move_proxy(model, state, X_WD, t_s).X_WP;  // SPEC 6b
+///     const Pose X_WA = cf::move_proxy(model, state, X_WD, t_s).X_WP;  // docs/spec.md, section 6b
 ///     const ContactSet& contacts = cf::detect(model, state, X_WA);
 ///     const Identification& id   = cf::identify(model, state, contacts);
 ///     const PriorMotion motion   = cf::classify_motion(model, state, id);
@@ -75,8 +75,8 @@ struct HapticResult {
 };
 
 /// Stage 0 (with ProxyParams::enabled): moves the proxy towards the device pose X_WD (mm,
-/// B's frame) as far as B allows (SPEC 6b) and computes the coupling. The stages below then
-/// run at the proxy pose. The result lives in `state` until the next move_proxy.
+/// B's frame) as far as B allows (docs/spec.md, section 6b) and computes the coupling. The stages
+/// below then run at the proxy pose. The result lives in `state` until the next move_proxy.
 const ProxyResult& move_proxy(const CfModel& model, CfState& state, const Pose& X_WD, double t_s);
 
 /// Stage 1: the candidate PCs at the pose X_WA of A (mm, in B's frame, which is the world),

@@ -15,7 +15,7 @@ namespace cf {
 using Vec3 = Eigen::Vector3d;  ///< mm unless a name or comment says otherwise
 using Mat3 = Eigen::Matrix3d;
 
-/// Rigid pose of A in B's (the world's) frame: x_B = R_BA * x_A + t_BA (SPEC section 2).
+/// Rigid pose of A in B's (the world's) frame: x_B = R_BA * x_A + t_BA (docs/spec.md, section 2).
 struct Pose {
   Mat3 R_BA = Mat3::Identity();  ///< rotation taking A-frame vectors to B-frame vectors
   Vec3 t_BA = Vec3::Zero();      ///< mm, A's origin in B's frame

@@ -171,7 +171,8 @@ void bind_graph(py::module_& m) {
       .def(
           "to_json", [](const Polyhedron& P, int indent) { return cf::to_json(P, indent); },
           py::arg("indent") = 2,
-          "The model object of the graph file (SPEC section 5), as cfgen --features prints it.")
+          "The model object of the graph file (docs/spec.md, section 5), as cfgen --features "
+          "prints it.")
       .def("__repr__", [](const Polyhedron& P) {
         return "<cf.Polyhedron '" + P.name() + "': " + std::to_string(P.num_vertices()) +
                " vertices, " + std::to_string(P.num_edges()) + " edges, " +

@@ -45,9 +45,9 @@ void finish_contacts(const FinishContext& ctx, FinishScratch& s, ContactSet& cs)
   sort_contacts(ctx.small_indices, s, cs);
   const int n = cs.size();
   const double eps = ctx.epsilon_mm;
-  // Dominance (SPEC 4) by a contact whose shape fits well: its misfit without the distance
-  // term (angle / tolerance + in-plane gap / epsilon) is at most dominance_fit. A looser
-  // dominator (a face tilted by more than that share of its tolerance over an edge that
+  // Dominance (docs/spec.md, section 4) by a contact whose shape fits well: its misfit without
+  // the distance term (angle / tolerance + in-plane gap / epsilon) is at most dominance_fit. A
+  // looser dominator (a face tilted by more than that share of its tolerance over an edge that
   // touches exactly) does not settle the reading: both stand and the previous CF or the fit
   // decides (a hysteresis band instead of a flip at the tolerance). misfit is not changed
   // until every flag is set, so the shapes below are the emitted ones.

@@ -1,7 +1,7 @@
 #pragma once
-// Finishing a detection's contacts: canonical order, dominance (SPEC section 4's PC rule)
-// and contact planes. One free function over the contacts the exact tests emitted; what it
-// reads of the model pair and the parameters is passed in, its scratch is the caller's.
+// Finishing a detection's contacts: canonical order, dominance (the PC rule of docs/spec.md,
+// section 4) and contact planes. One free function over the contacts the exact tests emitted; what
+// it reads of the model pair and the parameters is passed in, its scratch is the caller's.
 
 #include <cf/contact.hpp>
 #include <cf/polyhedron.hpp>

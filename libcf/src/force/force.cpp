@@ -1,5 +1,5 @@
 // Contact force and moment (paper sections 4.3-5). See docs/force-model.md for every
-// equation, the SPEC readings and the per-MT rules.
+// equation, the readings of docs/spec.md, section 6, and the per-MT rules.
 
 #include <cf/force.hpp>
 
@@ -122,7 +122,8 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
   for (int i = 0; i < n; ++i) {
     if (conservative) {
       // Several interpretations of one physical contact (paper Fig. 3) must not add up:
-      // keep the contacts no other detected contact dominates (SPEC section 4's PC rule).
+      // keep the contacts no other detected contact dominates (the PC rule of docs/spec.md,
+      // section 4).
       bool dom = false;
       for (int j = 0; j < n && !dom; ++j) dom = j != i && dominates(*A_, *B_, pcs[j].pc, pcs[i].pc);
       if (dom) continue;

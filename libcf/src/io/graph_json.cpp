@@ -1,5 +1,5 @@
-// The CF graph file (SPEC section 5): writing (deterministic, whole-or-nothing) and reading
-// (JSON or CBOR, schema-validated, every fault named by file and JSON pointer).
+// The CF graph file (docs/spec.md, section 5): writing (deterministic, whole-or-nothing) and
+// reading (JSON or CBOR, schema-validated, every fault named by file and JSON pointer).
 
 #include "graph_schema.hpp"
 #include "json_util.hpp"

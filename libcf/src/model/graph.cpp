@@ -69,7 +69,7 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
   for (std::size_t i = 0; i < n; ++i) {
     const PcSet& pcs = cfs[i].pcs;
     if (pcs.empty()) where.cf_fault(i, "a CF needs 1 to 3 PCs, this one has none");
-    // PCs of one CF have pairwise distinct contact planes (SPEC section 4): two PCs on the
+    // PCs of one CF have pairwise distinct contact planes (docs/spec.md, section 4): two PCs on the
     // same face of B (types x-f) or of A (types f-x) share that face's plane.
     for (int p = 0; p < pcs.size(); ++p)
       for (int q = p + 1; q < pcs.size(); ++q) {
@@ -93,7 +93,7 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
           i, "PC set {" + to_string(pcs) + "} repeats CF " + std::to_string(it->second.value()));
   }
 
-  // `change` (SPEC section 4, MT3), as cfgen builds it: the target is the source with each
+  // `change` (MT3; docs/spec.md, section 4), as cfgen builds it: the target is the source with each
   // PC kept or replaced by one of its neighbouring PCs, all distinct. So some one-to-one
   // pairing maps every source PC to an equal or a neighbouring target PC (sizes are equal).
   std::unordered_map<Pc, std::vector<Pc>, detail::PcHash> neighbours_of;

@@ -264,8 +264,8 @@ PriorMotion classify_prior_motion(const PcSet& prev, const PcSet& cur, const CfG
       }
       return pm;
     }
-    // SPEC 4: `lose` is any proper, non-empty subset of the CF (paper 3.1: "more than one
-    // PC can be broken at the same time"); the graph lists the single losses, the run time
+    // docs/spec.md, section 4: `lose` is any proper, non-empty subset of the CF (paper 3.1: "more
+    // than one PC can be broken at the same time"); the graph lists the single losses, the run time
     // derives the rest from the PC sets of two CFs of the graph.
     if (cur.size() < prev.size() && subset_of(cur, prev)) {
       pm.type = MotionType::kMT5;

@@ -1,9 +1,9 @@
-// The 6-DOF god-object proxy (SPEC 6b; docs/force-model.md "The proxy"): each tick the
-// proxy moves towards the device pose along the swept path, in sub-steps short enough that
-// detection sees every wall, and at each sub-step takes the motion closest to its target in
-// the coupling's metric under the linearised non-penetration constraints of its point
-// contacts (v-f, f-v, e-e: the corners of every contact region) and Coulomb friction, by
-// projected Gauss-Seidel on the constraint forces.
+// The 6-DOF god-object proxy (docs/spec.md, section 6b; docs/force-model.md "The proxy"): each tick
+// the proxy moves towards the device pose along the swept path, in sub-steps short enough that
+// detection sees every wall, and at each sub-step takes the motion closest to its target in the
+// coupling's metric under the linearised non-penetration constraints of its point contacts (v-f,
+// f-v, e-e: the corners of every contact region) and Coulomb friction, by projected Gauss-Seidel on
+// the constraint forces.
 
 #include "proxy.hpp"
 

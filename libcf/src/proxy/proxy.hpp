@@ -1,6 +1,6 @@
 #pragma once
-// The proxy stage (SPEC 6b): its model part (A's metric about the grip point, the swept
-// motion's reach) and its per-thread state, and the step itself. servo.cpp calls it.
+// The proxy stage (docs/spec.md, section 6b): its model part (A's metric about the grip point, the
+// swept motion's reach) and its per-thread state, and the step itself. servo.cpp calls it.
 
 #include <cf/contact.hpp>
 #include <cf/params.hpp>
@@ -49,8 +49,8 @@ struct ProxyState {
 /// A state for `pm` (its lookahead detection's state sized).
 void init_proxy_state(const ProxyModel& pm, ProxyState& s);
 
-/// Moves the proxy towards X_WP (SPEC 6b) and fills s.result (coupling included). Detects
-/// with `ds` into `at` (the stages' own contact set), so that the stages at the final proxy
+/// Moves the proxy towards X_WP (docs/spec.md, section 6b) and fills s.result (coupling included).
+/// Detects with `ds` into `at` (the stages' own contact set), so that the stages at the final proxy
 /// pose find its contacts there. No heap allocation.
 void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, DetectedAt& at,
                 ProxyState& s, const Pose& X_WD, double t_s);

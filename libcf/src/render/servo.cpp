@@ -1,5 +1,6 @@
-// The servo tick as stages over an immutable model and a per-thread state (SPEC section 6),
-// and the two objects that hold a model and a state: HapticRenderer and CfIdentifier.
+// The servo tick as stages over an immutable model and a per-thread state (docs/spec.md,
+// section 6), and the two objects that hold a model and a state: HapticRenderer and
+// CfIdentifier.
 
 #include <cf/identifier.hpp>
 #include <cf/renderer.hpp>

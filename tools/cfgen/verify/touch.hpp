@@ -1,6 +1,6 @@
 #pragma once
-// Open-set touching (SPEC section 4): faces without their boundary, edges without their end
-// points. Two closed elements at distance zero may meet only on their boundaries; those pairs
+// Open-set touching (docs/spec.md, section 4): faces without their boundary, edges without their
+// end points. Two closed elements at distance zero may meet only on their boundaries; those pairs
 // do not touch, their boundary elements do.
 
 #include <cf/geometry.hpp>
