@@ -309,18 +309,11 @@ TEST_CASE(
   const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, limits, &search, &evidence);
   REQUIRE(r.outcome == CellSearchResult::Outcome::kRefuted);
   // The arcs refuted tile [-pi, pi]; the e-e (index 1) is the PC below the slack.
-  std::vector<std::pair<double, double>> arcs;
+  check_arcs_cover(evidence);
   for (const auto& e : evidence) {
-    REQUIRE(e.arc.half > 0);
     CHECK(e.refutation.verdict == CellRelaxation::Verdict::kCone);
     CHECK(e.refutation.pc == 1);
-    arcs.push_back({e.arc.centre - e.arc.half, e.arc.centre + e.arc.half});
   }
-  std::sort(arcs.begin(), arcs.end());
-  REQUIRE(!arcs.empty());
-  CHECK(arcs.front().first <= -M_PI);
-  CHECK(arcs.back().second >= M_PI);
-  for (std::size_t k = 1; k < arcs.size(); ++k) CHECK(arcs[k].first <= arcs[k - 1].second);
   // The same set with the faces apart (no f-f) is not refuted by this argument: A's edge can
   // turn away from B's.
   const PcSet apart({Pc{PcType::kEE, ea, eb}});
