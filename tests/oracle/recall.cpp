@@ -338,9 +338,9 @@ RecallResult run_pair(const Mesh& A, const Mesh& B, const std::string& dir, cons
       if (in_graph.count(k)) {
         ++r.found;
         if (samples_out) {
-          // The CF's pose for the run time's identification test (tests/identify_oracle_test):
-          // its PCs, how far the nearest contact that is not another reading of them is,
-          // and the pose.
+          // The CF's pose for the run time's identification test
+          // (tests/libcf/identify_oracle_test): its PCs, how far the nearest contact that is
+          // not another reading of them is, and the pose.
           const double free_mm = C.clearance_outside(s.pose, k);
           *samples_out << key_string(k) << ',' << (std::isfinite(free_mm) ? free_mm : 1e9);
           for (int i = 0; i < 3; ++i)

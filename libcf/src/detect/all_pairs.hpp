@@ -2,7 +2,7 @@
 // The reference detection, beside the culled one (as CHAI3D keeps CCollisionBrute beside
 // CCollisionAABB): every element pair of the two models straight to the exact tests, with
 // no trees, no cheap rejections and no kept pairs (DetectionParams::use_bvh = false). For
-// checking the culling (tests/detector_test.cpp) and for comparison only.
+// checking the culling (tests/libcf/detector_test.cpp) and for comparison only.
 
 #include "exact.hpp"
 

@@ -4,8 +4,8 @@
 // Green's theorem over the clipped boundaries. Allocation-free: the caller passes scratch.
 //
 // Why not Boost.Geometry here: its intersection allocates internally (turn lists, output
-// rings), and the servo step must not allocate (docs/spec.md, section 7). tests/detector_test.cpp
-// checks this code against boost::geometry::intersection.
+// rings), and the servo step must not allocate (docs/spec.md, section 7).
+// tests/libcf/detector_test.cpp checks this code against boost::geometry::intersection.
 
 #include "model/point_location.hpp"
 

@@ -1,10 +1,10 @@
 # Tests of cfinspect --html (the browser viewer, tools/cfinspect/viewer). Included from
-# tests/CMakeLists.txt after cfinspect_test.cmake, whose cfinspect_test() it uses.
+# tests/tools/CMakeLists.txt after cfinspect_test.cmake, whose cfinspect_test() it uses.
 if(NOT TARGET cfinspect)
   return()
 endif()
-set(_v ${CMAKE_CURRENT_SOURCE_DIR}/data/viewer)
-set(_box ${CMAKE_CURRENT_SOURCE_DIR}/data/graphs/box_l.json)
+set(_v ${CF_TEST_DATA_DIR}/viewer)
+set(_box ${CF_TEST_DATA_DIR}/graphs/box_l.json)
 
 # The command line: bad combinations and bad replays fail with one line naming the file.
 cfinspect_test(html_replay_without_html fail "${_box} --replay ${_v}/replay_box_l.csv" "--replay and --trajectory go with --html")

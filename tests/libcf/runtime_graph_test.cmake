@@ -1,7 +1,7 @@
 # runtime_graph_test: identification and rendering on the generated default graphs. Included
-# from tests/CMakeLists.txt when cfgen and cfreplay are built. Two fixture tests run cfgen on
-# the default model pairs into this build tree; every runtime_graph_test case requires them
-# and finds the graphs through CF_RUNTIME_GRAPH_DIR.
+# from tests/libcf/CMakeLists.txt when cfgen and cfreplay are built. Two fixture tests run
+# cfgen on the default model pairs into this build tree; every runtime_graph_test case
+# requires them and finds the graphs through CF_RUNTIME_GRAPH_DIR.
 if(NOT TARGET cfgen OR NOT TARGET cfreplay_core)
   return()
 endif()

@@ -1,7 +1,7 @@
 // Identification and rendering on the generated default graphs (cube against the L-block and
 // against the corner block): the witness of every CF, perturbed witnesses, short pose
 // sequences between neighbouring CFs, and the recorded trajectories through the renderer.
-// The graphs are written by cfgen in ctest fixtures (tests/runtime_graph_test.cmake) into
+// The graphs are written by cfgen in ctest fixtures (tests/libcf/runtime_graph_test.cmake) into
 // the directory CF_RUNTIME_GRAPH_DIR names. Counts are printed on stdout (ctest -V).
 
 #include "replay_io.hpp"

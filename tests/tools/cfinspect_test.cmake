@@ -1,4 +1,4 @@
-# cfinspect tests. Included from tests/CMakeLists.txt, this file registers the tests; run
+# cfinspect tests. Included from tests/tools/CMakeLists.txt, this file registers the tests; run
 # with `cmake -P` it is the checker each test runs: it runs cfinspect with ARGS and checks
 # the exit status, the output against EXPECT (a regex), and for failures that stderr is
 # exactly one line.
@@ -43,7 +43,7 @@ endif()
 if(NOT TARGET cfinspect)
   return()
 endif()
-set(_g ${CMAKE_CURRENT_SOURCE_DIR}/data/graphs)
+set(_g ${CF_TEST_DATA_DIR}/graphs)
 set(_out ${CMAKE_CURRENT_BINARY_DIR}/cfinspect_out)
 file(MAKE_DIRECTORY ${_out})
 function(cfinspect_test name mode args expect)
@@ -53,7 +53,7 @@ function(cfinspect_test name mode args expect)
   set_tests_properties(cfinspect:${name} PROPERTIES TIMEOUT 120 LABELS cfinspect)
 endfunction()
 
-# Summary and queries on the hand-made cube / L-block graph (see graph_test.cpp).
+# Summary and queries on the hand-made cube / L-block graph (see tests/libcf/graph_test.cpp).
 cfinspect_test(summary ok "${_g}/box_l.json"
   "valid cf-graph v1 \\(full schema check\\).*model A 'cube': 8 vertices, 12 edges \\(0 reflex\\), 6 faces.*model B 'L-block': 12 vertices, 18 edges \\(1 reflex\\), 8 faces.*CFs: 5.*by number of PCs: 1: 4, 2: 1, 3: 0.*f-f 4 \\(3\\), e-f 1 \\(1\\), f-e 0 \\(0\\), v-f 1 \\(1\\).*transitions: 8 \\(gain 2, lose 2, change 4\\), 0 without their reverse.*out-degree: min 1, mean 1.60, max 2.*connected components: 1 \\(largest 5 CFs, 0 isolated CFs\\)")
 cfinspect_test(summary_sorted_keys ok "${_g}/box_l_sorted.json" "CFs: 5")
