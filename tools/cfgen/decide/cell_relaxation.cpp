@@ -128,23 +128,26 @@ CellRelaxation::Verdict CellRelaxation::rotation_test(const Mat3& R_c, const Tur
     }
     // Local non-penetration against a face: the other solid's tangent directions at the
     // contact (a vertex's edge rays, an edge's wedge sides) lie on the face's outer side.
-    // below(d, n, moved): d . n < 0 for every rotation of the cell, `moved` the most the
-    // rotation changes it.
-    const auto below = [](const Vec3& d, const Vec3& n, double moved) { return d.dot(n) < -moved; };
-    auto tangents = [](const ModelInfo& m, ElementKind k, int i) {
-      if (k == ElementKind::kVertex) return m.cones[static_cast<std::size_t>(i)].rays;
+    // Whether pred holds for one of the solid's tangent directions at element i, read in place.
+    auto any_tangent = [](const ModelInfo& m, ElementKind k, int i, const auto& pred) {
+      if (k == ElementKind::kVertex) {
+        const auto& rays = m.cones[static_cast<std::size_t>(i)].rays;
+        return std::any_of(rays.begin(), rays.end(), pred);
+      }
       const EdgeWedge& w = m.wedges[static_cast<std::size_t>(i)];
-      return std::vector<Vec3>{w.into_left, w.into_right};
+      return pred(w.into_left) || pred(w.into_right);
     };
+    // d . n < 0 for every rotation of the cell, `moved` the most the rotation changes it.
     if (kb == ElementKind::kFace && ka != ElementKind::kFace) {
       const Vec3& nb = mB.face(FaceId(x.b)).normal;
-      for (const Vec3& d : tangents(A_, ka, x.a))
-        if (below(R_c * d, nb, turn.of(d))) return Verdict::kCone;
+      if (any_tangent(A_, ka, x.a, [&](const Vec3& d) { return (R_c * d).dot(nb) < -turn.of(d); }))
+        return Verdict::kCone;
     }
     if (ka == ElementKind::kFace && kb != ElementKind::kFace) {
-      const Vec3& na = mA.face(FaceId(x.a)).normal;
-      for (const Vec3& d : tangents(B_, kb, x.b))
-        if (below(d, R_c * na, turn.of(na))) return Verdict::kCone;
+      const Vec3 na = R_c * mA.face(FaceId(x.a)).normal;
+      const double moved = turn.of(mA.face(FaceId(x.a)).normal);
+      if (any_tangent(B_, kb, x.b, [&](const Vec3& d) { return d.dot(na) < -moved; }))
+        return Verdict::kCone;
     }
   }
   // The slack a witness keeps at every contact: an e-e whose edges turn parallel, or a

@@ -16,7 +16,11 @@ struct TurnBound {
   double any = 0;            // per unit length
   double about = 0;          // per unit distance from the axis
   Vec3 axis = Vec3::Zero();  // unit, A's frame
-  double of(const Vec3& x) const { return any * x.norm() + about * x.cross(axis).norm(); }
+  double of(const Vec3& x) const {
+    // Nothing turned (the verifier's own margin, on every pose it checks): no norms.
+    if (any == 0 && about == 0) return 0;
+    return any * x.norm() + about * x.cross(axis).norm();
+  }
   double unit() const { return any + about; }  // the most a unit vector moves
 };
 
