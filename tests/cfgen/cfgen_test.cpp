@@ -1,15 +1,16 @@
 // Independent tests of the CF graph generator (tools/cfgen; docs/spec.md, sections 3-5b).
 //
-// Everything that decides what a contact *is* lives in this file and is written from the
-// specification (docs/spec.md), not from the generator: open-set touching of two elements,
-// domination, PC types, contact planes, interpenetration by ray casting, first contact of a
-// translated polyhedron. From libcf it uses only the model data (features, adjacency) and the
-// closed-set distances of cf::element_distance / cf::point_face. The generator's own WitnessSearch
-// appears only in failure messages (what its verify() says about a pose this file found) and for
-// the U-channel's two-PC sets (see that test).
+// What a contact *is* is decided by the independent oracle (tests/oracle, written from the
+// specification; it shares no code with tools/ or libcf/): open-set touching of two elements,
+// domination, PC types, contact planes, interior disjointness, the first contact of a
+// translated polyhedron, the rules of transitions, and the shapes built in memory. The oracle
+// reads cfgen's models as plain data only, their vertices, edges and face loops
+// (cf::test::to_oracle), so that both number the elements alike. The generator's own
+// WitnessSearch appears only in failure messages (what its verify() says about a pose the
+// oracle found) and for the U-channel's two-PC sets (see that test).
 //
 // Sections:
-//  0. the oracle itself on poses with known answers;
+//  0. the oracle, as this file uses it, on poses with known answers;
 //  1. hand-derived CF sets, with hand-made witnesses: cube on a big box, cube vs L-block,
 //     cube vs corner block, cube vs a U-channel whose inner walls face each other 40 mm apart;
 //  2. every witness of every generated graph re-verified;
@@ -23,9 +24,14 @@
 
 #include "cfgen/enumerate/enumerate.hpp"
 #include "cfgen/generate.hpp"
+#include "classify.hpp"
 #include "mesh/model_loader.hpp"
+#include "motion.hpp"
+#include "oracle_pair.hpp"
+#include "oracle_pose.hpp"
+#include "shapes.hpp"
+#include "transitions.hpp"
 
-#include <cf/geometry.hpp>
 #include <cf/graph.hpp>
 #include <cf/polyhedron.hpp>
 
@@ -39,7 +45,6 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -51,7 +56,6 @@
 #include <vector>
 
 namespace fs = std::filesystem;
-using cf::ElementKind;
 using cf::Mat3;
 using cf::Pc;
 using cf::PcSet;
@@ -60,7 +64,6 @@ using cf::Polyhedron;
 using cf::Pose;
 using cf::Vec3;
 using K = cf::ElementKind;
-using V2 = Eigen::Vector2d;
 
 namespace {
 
@@ -68,24 +71,37 @@ namespace {
 // Tolerances
 // ---------------------------------------------------------------------------------------
 
-// Two elements touch when their closed distance is below this (mm). The generator's own
-// touch tolerance is 1e-9 and its witnesses keep every other pair >= 1e-2 mm apart, so
-// 1e-7 separates "touching" from "apart" by five orders of magnitude either way.
+// Two elements touch when their closed distance is below this (mm). The oracle classifies
+// with it, not with its own default (1e-7 of the smaller model's diagonal: 5e-6 mm for the
+// 30 mm cube). The generator's own touch tolerance is 1e-9 and its witnesses keep every other
+// pair >= 1e-2 mm apart, so 1e-7 separates "touching" from "apart" by five orders of
+// magnitude either way.
 constexpr double kTouchTol = 1e-7;
 // A second, coarser tolerance: a random pose whose classification changes between kTouchTol
 // and this is too close to a boundary case to be judged, and is skipped in the recall test.
 constexpr double kCoarseTol = 1e-5;
-// Contact planes closer than this (unit normals' cross product, offsets in mm) are the same.
-constexpr double kPlaneTol = 1e-6;
-// A point counts as strictly inside a solid when it is this far (mm) from its boundary.
-constexpr double kInsideMargin = 1e-6;
-// Radius (mm) of the probe points around each contact, to catch interpenetration that is
-// purely local (two wedges crossing at an e-e touch, an edge poking through a vertex).
-constexpr double kProbeRadius = 1e-3;
+// The oracle's other tolerances (tests/oracle/README.md) replace those of this file's earlier
+// in-file checks:
+//  - two contact planes are one when their normals are within 1e-6 rad and their offsets
+//    within 4 x kTouchTol (before: 1e-5 mm); between that and 1e-4 rad or 100 x kTouchTol the
+//    oracle calls the pose near-degenerate, and the recall test skips it like a disagreement
+//    of the two tolerances;
+//  - interiors intersect when the tangent cones of some touching pair overlap, decided
+//    exactly up to an angular slack of 1e-6 rad (2 kTouchTol over a line contact's length,
+//    4 kTouchTol over the root of a face contact's area: the tilt the touch tolerance itself
+//    allows); before, points more than 1e-6 mm inside a solid were looked for within 1e-3 mm
+//    of each contact, which missed shallower or narrower overlaps;
+//  - a translation's first contact counts events within kTouchTol of an element (before:
+//    1e-9 mm off a face, 1e-12 of an edge's length): looser, but a pose that close to a
+//    contact touches at kTouchTol anyway, and every pose reached is classified before it
+//    counts.
+
+// How far along a translation (mm) a pose is classified to see whether the translation
+// pushes into a contact held at its start (or half-way to its first contact when that is
+// nearer): far above kTouchTol, far below any feature of the models.
+constexpr double kProbeStep = 1e-3;
 
 const std::string kModels = std::string(CF_SOURCE_DIR) + "/data/models/";
-
-double cross2(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 Mat3 align(const Vec3& from, const Vec3& to) {
   return Eigen::Quaterniond::FromTwoVectors(from, to).toRotationMatrix();
@@ -112,55 +128,60 @@ std::string vec_str(const Vec3& v) {
   os << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
   return os.str();
 }
-std::string pose_str(const Pose& p) {
-  std::ostringstream os;
-  os << "R=[" << vec_str(p.R_BA.row(0).transpose()) << ", " << vec_str(p.R_BA.row(1).transpose())
-     << ", " << vec_str(p.R_BA.row(2).transpose()) << "] t=" << vec_str(p.t_BA);
-  return os.str();
-}
+std::string pose_str(const Pose& p) { return oracle::pose_string(cf::test::to_oracle(p)); }
 
 // ---------------------------------------------------------------------------------------
-// Models built in memory
+// The oracle on one model pair
 // ---------------------------------------------------------------------------------------
 
-Polyhedron from_soup(const std::string& name, std::vector<Vec3> pts,
-                     std::vector<std::vector<int>> polys) {
-  cf::tools::PolygonSoup soup;
-  soup.points = std::move(pts);
-  soup.polygons = std::move(polys);
-  cf::tools::LoadOptions opt;
-  opt.name = name;
-  return cf::tools::model_from_soup(soup, name, opt);
+oracle::Tolerances tolerances(double len) {
+  oracle::Tolerances t;  // angular slack: the oracle's, 1e-6 rad
+  t.len = len;
+  t.gap = 100 * len;  // the oracle's sampler's; unused here
+  return t;
 }
 
-// Axis-aligned box [0, s]^3 (same facet layout as data/models/make_models.py).
-Polyhedron big_box(double s) {
-  std::vector<Vec3> v{{0, 0, 0}, {s, 0, 0}, {s, s, 0}, {0, s, 0},
-                      {0, 0, s}, {s, 0, s}, {s, s, s}, {0, s, s}};
-  return from_soup(
-      "big_box", v,
-      {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}});
+// The oracle's verdict at a pose, with its PCs in the project's types.
+struct Analysis {
+  oracle::Verdict v;
+  PcSet pcs;  // the PCs, unless penetrating, degenerate or more than 3
+  bool contact() const { return !v.touches.empty(); }
+  bool clean() const { return v.valid_cf(); }
+  std::string describe() const { return v.describe(); }
+};
+
+// Number of PCs of a degenerate type (v-v, v-e, e-v, collinear e-e).
+int degenerate_pcs(const Analysis& an) {
+  int n = 0;
+  for (int i : an.v.pcs)
+    if (!oracle::nondegenerate(an.v.touches[static_cast<std::size_t>(i)].type)) ++n;
+  return n;
 }
 
-// Extrusion along z of a counter-clockwise xy polygon.
-Polyhedron prism(const std::string& name, const std::vector<V2>& poly, double z0, double z1) {
-  const int n = static_cast<int>(poly.size());
-  std::vector<Vec3> v;
-  for (const V2& p : poly) v.emplace_back(p.x(), p.y(), z0);
-  for (const V2& p : poly) v.emplace_back(p.x(), p.y(), z1);
-  std::vector<std::vector<int>> f(2);
-  for (int i = n - 1; i >= 0; --i) f[0].push_back(i);
-  for (int i = 0; i < n; ++i) f[1].push_back(n + i);
-  for (int i = 0; i < n; ++i) f.push_back({i, (i + 1) % n, n + (i + 1) % n, n + i});
-  return from_soup(name, v, f);
-}
+// The oracle's polyhedra rebuilt from cfgen's models, and its classifier at both tolerances.
+struct Oracle {
+  Oracle(const Polyhedron& a, const Polyhedron& b)
+      : A(cf::test::to_oracle(a, a.name())),
+        B(cf::test::to_oracle(b, b.name())),
+        fine(A, B, tolerances(kTouchTol)),
+        coarse(A, B, tolerances(kCoarseTol)) {}
+  Oracle(const Oracle&) = delete;
+  Oracle& operator=(const Oracle&) = delete;
 
-// U-channel, 80 x 80 x 80 mm: floor 20 thick, two arms 20 thick; the slot between the arms
-// is 40 mm wide (x in 20..60), more than the 30 mm cube.
-Polyhedron u_channel() {
-  return prism("u_channel",
-               {{0, 0}, {80, 0}, {80, 80}, {60, 80}, {60, 20}, {20, 20}, {20, 80}, {0, 80}}, 0, 80);
-}
+  // `clearance`: also the distance to the nearest pair that does not touch (costs a pass
+  // over every pair).
+  Analysis analyse(const Pose& p, const oracle::Classifier& at, bool clearance = false) const {
+    Analysis an;
+    an.v = at.classify(cf::test::to_oracle(p), clearance);
+    if (!an.v.penetrating && !an.v.degenerate && !an.v.too_many && !an.v.pcs.empty())
+      an.pcs = cf::test::to_cf(an.v.key());
+    return an;
+  }
+  Analysis analyse(const Pose& p) const { return analyse(p, fine); }
+
+  const oracle::Poly A, B;
+  const oracle::Classifier fine, coarse;  // at kTouchTol, at kCoarseTol
+};
 
 // ---------------------------------------------------------------------------------------
 // Generated graphs, once per process
@@ -168,6 +189,7 @@ Polyhedron u_channel() {
 
 struct Generated {
   std::unique_ptr<Polyhedron> A, B;  // stable addresses: ModelInfo points at them
+  std::unique_ptr<Oracle> oracle;
   cf::gen::ModelInfo ai, bi;
   cf::gen::Enumeration e;
   std::unique_ptr<cf::CfGraph> graph;
@@ -182,6 +204,7 @@ const Generated& generated(const std::string& key, const std::function<Polyhedro
   auto g = std::make_unique<Generated>();
   g->A = std::make_unique<Polyhedron>(make_a());
   g->B = std::make_unique<Polyhedron>(make_b());
+  g->oracle = std::make_unique<Oracle>(*g->A, *g->B);
   const auto t0 = std::chrono::steady_clock::now();
   g->ai = cf::gen::analyse_model(*g->A);
   g->bi = cf::gen::analyse_model(*g->B);
@@ -209,558 +232,11 @@ const Generated& cube_corner_block() {
       [] { return load("corner_block.off"); });
 }
 
-// ---------------------------------------------------------------------------------------
-// Model geometry for the independent checks
-// ---------------------------------------------------------------------------------------
-
-struct FaceGeom {
-  Vec3 n;                              // outward unit normal (model frame)
-  double d;                            // plane n . x = d
-  Vec3 u, w;                           // in-plane axes
-  std::vector<std::vector<V2>> loops;  // every loop, in (u, w) coordinates
-  Vec3 c;                              // bounding sphere
-  double r = 0;
-};
-
-// Signed in-plane distance from q to the boundary of a face: > 0 inside the open region
-// (even-odd rule over all loops, so holes are outside), < 0 outside, 0 on the boundary.
-double inset2d(const FaceGeom& f, const V2& q) {
-  bool in = false;
-  double bd = std::numeric_limits<double>::infinity();
-  for (const auto& loop : f.loops)
-    for (std::size_t k = 0; k < loop.size(); ++k) {
-      const V2& a = loop[k];
-      const V2& b = loop[(k + 1) % loop.size()];
-      if ((a.y() > q.y()) != (b.y() > q.y())) {
-        const double x = a.x() + (q.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y());
-        if (x > q.x()) in = !in;
-      }
-      const V2 ab = b - a;
-      const double s = std::clamp((q - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
-      bd = std::min(bd, (a + s * ab - q).norm());
-    }
-  return in ? bd : -bd;
-}
-
-struct ModelGeom {
-  const Polyhedron* m = nullptr;
-  std::vector<FaceGeom> faces;
-  Vec3 center;  // bounding sphere of the whole model
-  double radius = 0;
-
-  explicit ModelGeom(const Polyhedron& model) : m(&model) {
-    for (const cf::Face& F : model.faces()) {
-      FaceGeom g;
-      g.n = F.normal;
-      g.d = F.offset;
-      const Vec3 ref = std::abs(g.n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-      g.u = g.n.cross(ref).normalized();
-      g.w = g.n.cross(g.u);
-      Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-      for (const auto& loop : F.loops) {
-        g.loops.emplace_back();
-        for (cf::VertexId v : loop) {
-          const Vec3& p = model.vertex(v).p;
-          g.loops.back().emplace_back(g.u.dot(p), g.w.dot(p));
-          lo = lo.cwiseMin(p);
-          hi = hi.cwiseMax(p);
-        }
-      }
-      g.c = 0.5 * (lo + hi);
-      for (const auto& loop : F.loops)
-        for (cf::VertexId v : loop) g.r = std::max(g.r, (model.vertex(v).p - g.c).norm());
-      faces.push_back(std::move(g));
-    }
-    center = 0.5 * (model.bbox_min() + model.bbox_max());
-    radius = 0.5 * (model.bbox_max() - model.bbox_min()).norm();
-  }
-};
-
-// A model placed by a pose (B: the identity), with world-frame accessors.
-struct Placed {
-  const ModelGeom* g;
-  Pose pose;
-  const Polyhedron& m() const { return *g->m; }
-  Vec3 vertex(int i) const { return pose.apply(m().vertices()[static_cast<std::size_t>(i)].p); }
-  Vec3 edge_pt(int e, int end) const { return pose.apply(m().edge_point(cf::EdgeId(e), end)); }
-  Vec3 normal(int f) const { return pose.R_BA * g->faces[static_cast<std::size_t>(f)].n; }
-  double offset(int f) const {
-    return g->faces[static_cast<std::size_t>(f)].d + normal(f).dot(pose.t_BA);
-  }
-  double plane_dist(int f, const Vec3& p) const { return normal(f).dot(p) - offset(f); }
-  V2 to2d(int f, const Vec3& p) const {
-    const FaceGeom& F = g->faces[static_cast<std::size_t>(f)];
-    const Vec3 q = pose.inverse_apply(p);
-    return {F.u.dot(q), F.w.dot(q)};
-  }
-  V2 dir2d(int f, const Vec3& d) const {
-    const FaceGeom& F = g->faces[static_cast<std::size_t>(f)];
-    const Vec3 q = pose.R_BA.transpose() * d;
-    return {F.u.dot(q), F.w.dot(q)};
-  }
-  double inset(int f, const Vec3& p) const {
-    return inset2d(g->faces[static_cast<std::size_t>(f)], to2d(f, p));
-  }
-  // Bounding sphere of an element, world frame.
-  std::pair<Vec3, double> sphere(K k, int i) const {
-    if (k == K::kVertex) return {vertex(i), 0.0};
-    if (k == K::kEdge) {
-      const Vec3 a = edge_pt(i, 0), b = edge_pt(i, 1);
-      return {0.5 * (a + b), 0.5 * (b - a).norm()};
-    }
-    const FaceGeom& F = g->faces[static_cast<std::size_t>(i)];
-    return {pose.apply(F.c), F.r};
-  }
-};
-
-int count(const Polyhedron& m, K k) {
-  return static_cast<int>(k == K::kVertex ? m.num_vertices()
-                          : k == K::kEdge ? m.num_edges()
-                                          : m.num_faces());
-}
-
-// Parameters along the line P + t D (world, in face f's plane) in (t0, t1) where it crosses
-// the boundary of face f, sorted, with t0 and t1 included.
-std::vector<double> cuts_on_line(const Placed& S, int f, const Vec3& P, const Vec3& D, double t0,
-                                 double t1, double tol) {
-  std::vector<double> cuts{t0, t1};
-  const V2 q0 = S.to2d(f, P), e = S.dir2d(f, D);
-  for (const auto& loop : S.g->faces[static_cast<std::size_t>(f)].loops)
-    for (std::size_t k = 0; k < loop.size(); ++k) {
-      const V2& a = loop[k];
-      const V2 s = loop[(k + 1) % loop.size()] - a;
-      const double den = cross2(e, s);
-      const V2 w = a - q0;
-      if (std::abs(den) > 1e-12 * s.norm()) {
-        const double t = cross2(w, s) / den, r = cross2(w, e) / den;
-        if (r >= -1e-9 && r <= 1 + 1e-9 && t > t0 && t < t1) cuts.push_back(t);
-      } else if (std::abs(cross2(w, e)) / e.norm() < tol) {  // collinear: both ends cut
-        for (const V2& x : {a, V2(a + s)}) {
-          const double t = (x - q0).dot(e) / e.squaredNorm();
-          if (t > t0 && t < t1) cuts.push_back(t);
-        }
-      }
-    }
-  std::sort(cuts.begin(), cuts.end());
-  return cuts;
-}
-
-// Does the open segment (t0, t1) of the line share more than tol with the open face?
-bool line_meets_open_face(const Placed& S, int f, const Vec3& P, const Vec3& D, double t0,
-                          double t1, double tol) {
-  const std::vector<double> cuts = cuts_on_line(S, f, P, D, t0, t1, tol);
-  for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
-    if (cuts[i + 1] - cuts[i] <= tol) continue;
-    if (S.inset(f, P + 0.5 * (cuts[i] + cuts[i + 1]) * D) > tol) return true;
-  }
-  return false;
-}
-
-// Open sub-intervals of the whole line inside the open face.
-std::vector<std::pair<double, double>> line_in_open_face(const Placed& S, int f, const Vec3& P,
-                                                         const Vec3& D, double tol) {
-  const std::vector<double> cuts = cuts_on_line(S, f, P, D, -1e6, 1e6, tol);
-  std::vector<std::pair<double, double>> out;
-  for (std::size_t i = 0; i + 1 < cuts.size(); ++i)
-    if (cuts[i + 1] - cuts[i] > tol && S.inset(f, P + 0.5 * (cuts[i] + cuts[i + 1]) * D) > tol)
-      out.push_back({cuts[i], cuts[i + 1]});
-  return out;
-}
-
-// ---------------------------------------------------------------------------------------
-// Open-set touching (docs/spec.md, section 4)
-// ---------------------------------------------------------------------------------------
-
-enum class Touch { kNone, kTouch, kPenetrate };
-
-// The open edge (p0, p1) contains the point closest to p, by more than tol from the ends.
-bool in_open_edge(const Vec3& p, const Vec3& p0, const Vec3& p1, double tol) {
-  const double len = (p1 - p0).norm();
-  const double s = (p - p0).dot(p1 - p0) / len;
-  return s > tol && s < len - tol;
-}
-
-// Open edge (p0, p1) against open face f of S (the edge belongs to the other solid).
-Touch touch_edge_face(const Vec3& p0, const Vec3& p1, const Placed& S, int f, double tol) {
-  const double h0 = S.plane_dist(f, p0), h1 = S.plane_dist(f, p1);
-  if (std::abs(h0) <= tol && std::abs(h1) <= tol) {
-    // In the plane: some part of the open edge lies in the open face.
-    const double len = (p1 - p0).norm();
-    return line_meets_open_face(S, f, p0, (p1 - p0) / len, 0, len, tol) ? Touch::kTouch
-                                                                        : Touch::kNone;
-  }
-  if ((h0 > tol && h1 < -tol) || (h0 < -tol && h1 > tol)) {
-    // Crosses the plane at one interior point: inside the open face it pierces the solid.
-    const Vec3 x = p0 + (h0 / (h0 - h1)) * (p1 - p0);
-    return S.inset(f, x) > tol ? Touch::kPenetrate : Touch::kNone;
-  }
-  return Touch::kNone;  // meets the plane at an end point at most: that is a vertex touch
-}
-
-// Coplanar faces: do the open regions overlap? The boundary of the overlap is made of pieces
-// of the two faces' boundaries; each piece lies between two consecutive crossings with the
-// other face's boundary, so testing both sides of the midpoint of every such piece finds a
-// point in both open regions whenever the overlap is not empty.
-bool coplanar_overlap(const Placed& S1, int f1, const Placed& S2, int f2, double tol) {
-  const double delta = 20 * tol;
-  for (int pass = 0; pass < 2; ++pass) {
-    const Placed& P = pass == 0 ? S1 : S2;
-    const Placed& Q = pass == 0 ? S2 : S1;
-    const int fp = pass == 0 ? f1 : f2, fq = pass == 0 ? f2 : f1;
-    const Vec3 n = Q.normal(fq);
-    for (const auto& loop : P.m().face(cf::FaceId(fp)).loops)
-      for (std::size_t k = 0; k < loop.size(); ++k) {
-        const Vec3 a = P.pose.apply(P.m().vertex(loop[k]).p);
-        const Vec3 b = P.pose.apply(P.m().vertex(loop[(k + 1) % loop.size()]).p);
-        const double len = (b - a).norm();
-        const Vec3 D = (b - a) / len, perp = n.cross(D);
-        const std::vector<double> cuts = cuts_on_line(Q, fq, a, D, 0, len, tol);
-        for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
-          if (cuts[i + 1] - cuts[i] <= 2 * delta) continue;
-          const Vec3 m = a + 0.5 * (cuts[i] + cuts[i + 1]) * D;
-          for (double sg : {-1.0, 1.0}) {
-            const Vec3 x = m + sg * delta * perp;
-            if (P.inset(fp, x) > tol && Q.inset(fq, x) > tol) return true;
-          }
-        }
-      }
-  }
-  return false;
-}
-
-Touch touch_face_face(const Placed& A, int fa, const Placed& B, int fb, double tol) {
-  const Vec3 na = A.normal(fa), nb = B.normal(fb);
-  const cf::Face& Fa = A.m().face(cf::FaceId(fa));
-  const cf::Face& Fb = B.m().face(cf::FaceId(fb));
-  double amin = 1e300, amax = -1e300, bmin = 1e300, bmax = -1e300;
-  for (cf::VertexId v : Fa.vertices) {
-    const double h = B.plane_dist(fb, A.pose.apply(A.m().vertex(v).p));
-    amin = std::min(amin, h);
-    amax = std::max(amax, h);
-  }
-  if (amax <= tol && amin >= -tol) {  // coplanar
-    if (!coplanar_overlap(A, fa, B, fb, tol)) return Touch::kNone;
-    // Same orientation: both solids on the same side of the shared region.
-    return na.dot(nb) < 0 ? Touch::kTouch : Touch::kPenetrate;
-  }
-  for (cf::VertexId v : Fb.vertices) {
-    const double h = A.plane_dist(fa, B.pose.apply(B.m().vertex(v).p));
-    bmin = std::min(bmin, h);
-    bmax = std::max(bmax, h);
-  }
-  // The open faces can share points off a common plane only where both straddle the other's
-  // plane: then along the planes' intersection line, and that is a transversal crossing.
-  if (!(amax > tol && amin < -tol && bmax > tol && bmin < -tol)) return Touch::kNone;
-  const double k = na.dot(nb);
-  if (std::abs(k) > 1 - 1e-12) return Touch::kNone;
-  const double da = A.offset(fa), db = B.offset(fb);
-  const Vec3 P = ((da - db * k) * na + (db - da * k) * nb) / (1 - k * k);
-  const Vec3 D = na.cross(nb).normalized();
-  for (const auto& [a0, a1] : line_in_open_face(A, fa, P, D, tol))
-    for (const auto& [b0, b1] : line_in_open_face(B, fb, P, D, tol))
-      if (std::min(a1, b1) - std::max(a0, b0) > tol) return Touch::kPenetrate;
-  return Touch::kNone;
-}
-
-struct TouchResult {
-  Touch touch = Touch::kNone;
-  bool parallel_ee = false;  // collinear e-e: degenerate
-};
-
-// Element a (kind ka) of posed A and element b (kind kb) of B, known to be within tol as
-// closed sets: do the open elements share a point?
-TouchResult open_touch(const Placed& A, K ka, int a, const Placed& B, K kb, int b, double tol) {
-  TouchResult r;
-  auto yes = [](bool x) { return x ? Touch::kTouch : Touch::kNone; };
-  if (ka == K::kVertex && kb == K::kVertex) {
-    r.touch = Touch::kTouch;
-  } else if (ka == K::kVertex && kb == K::kEdge) {
-    r.touch = yes(in_open_edge(A.vertex(a), B.edge_pt(b, 0), B.edge_pt(b, 1), tol));
-  } else if (ka == K::kEdge && kb == K::kVertex) {
-    r.touch = yes(in_open_edge(B.vertex(b), A.edge_pt(a, 0), A.edge_pt(a, 1), tol));
-  } else if (ka == K::kVertex && kb == K::kFace) {
-    const Vec3 p = A.vertex(a);
-    r.touch = yes(std::abs(B.plane_dist(b, p)) <= tol && B.inset(b, p) > tol);
-  } else if (ka == K::kFace && kb == K::kVertex) {
-    const Vec3 p = B.vertex(b);
-    r.touch = yes(std::abs(A.plane_dist(a, p)) <= tol && A.inset(a, p) > tol);
-  } else if (ka == K::kEdge && kb == K::kEdge) {
-    const Vec3 p0 = A.edge_pt(a, 0), p1 = A.edge_pt(a, 1), q0 = B.edge_pt(b, 0),
-               q1 = B.edge_pt(b, 1);
-    const Vec3 da = (p1 - p0).normalized(), db = (q1 - q0).normalized();
-    const Vec3 c = da.cross(db);
-    if (c.norm() > 1e-9) {
-      // Closest points of the two lines; both strictly inside their edges.
-      const Vec3 w = p0 - q0;
-      const double bb = da.dot(db), d = da.dot(w), e = db.dot(w);
-      const double den = 1 - bb * bb;
-      const double s = (bb * e - d) / den, t = (e - bb * d) / den;
-      const Vec3 x = p0 + s * da, y = q0 + t * db;
-      r.touch = yes((x - y).norm() <= tol && in_open_edge(x, p0, p1, tol) &&
-                    in_open_edge(y, q0, q1, tol));
-    } else {
-      // Parallel (and within tol, so collinear): the open intervals overlap by more than tol.
-      const double la = (p1 - p0).norm();
-      double s0 = (q0 - p0).dot(da), s1 = (q1 - p0).dot(da);
-      if (s0 > s1) std::swap(s0, s1);
-      r.touch = yes(std::min(la, s1) - std::max(0.0, s0) > tol);
-      r.parallel_ee = true;
-    }
-  } else if (ka == K::kEdge && kb == K::kFace) {
-    r.touch = touch_edge_face(A.edge_pt(a, 0), A.edge_pt(a, 1), B, b, tol);
-  } else if (ka == K::kFace && kb == K::kEdge) {
-    r.touch = touch_edge_face(B.edge_pt(b, 0), B.edge_pt(b, 1), A, a, tol);
-  } else {
-    r.touch = touch_face_face(A, a, B, b, tol);
-  }
-  return r;
-}
-
-// Element (k, i) is (k2, j) or lies on its boundary (the domination of docs/spec.md, section 4).
-bool within_closure(const Polyhedron& m, K k, int i, K k2, int j) {
-  if (k == k2) return i == j;
-  if (k == K::kVertex && k2 == K::kEdge) {
-    const cf::Edge& e = m.edges()[static_cast<std::size_t>(j)];
-    return e.v0.value() == i || e.v1.value() == i;
-  }
-  if (k == K::kVertex && k2 == K::kFace) {
-    const auto& vs = m.faces()[static_cast<std::size_t>(j)].vertices;
-    return std::find(vs.begin(), vs.end(), cf::VertexId(i)) != vs.end();
-  }
-  if (k == K::kEdge && k2 == K::kFace) {
-    const cf::Edge& e = m.edges()[static_cast<std::size_t>(i)];
-    return e.left.value() == j || e.right.value() == j;
-  }
-  return false;
-}
-
-// Odd number of crossings of a ray from q (model frame) with the faces.
-bool ray_cast_inside(const Placed& S, const Vec3& q) {
-  static const Vec3 dirs[] = {
-      Vec3(0.5377, 0.8323, 0.1357).normalized(), Vec3(-0.3121, 0.1743, 0.9339).normalized(),
-      Vec3(0.7071, -0.5003, 0.4999).normalized(), Vec3(-0.1234, -0.9111, -0.3932).normalized(),
-      Vec3(0.9436, 0.2317, -0.2367).normalized()};
-  for (const Vec3& dir : dirs) {
-    int crossings = 0;
-    bool bad = false;
-    for (const FaceGeom& F : S.g->faces) {
-      const double den = F.n.dot(dir);
-      if (std::abs(den) < 1e-9)
-        continue;  // parallel: no crossing (q in the plane fails the margin)
-      const double t = (F.d - F.n.dot(q)) / den;
-      if (t <= 0) continue;
-      const Vec3 h = q + t * dir;
-      const double s = inset2d(F, {F.u.dot(h), F.w.dot(h)});
-      if (std::abs(s) < 1e-6) {
-        bad = true;
-        break;
-      }
-      if (s > 0) ++crossings;
-    }
-    if (!bad) return crossings % 2 == 1;
-  }
-  return false;
-}
-
-// Strictly inside the placed solid (by more than margin from its boundary): ray casting in
-// the model frame, with rays that graze a face's boundary retried in another direction. A
-// point on the boundary may cast either way; the margin test after the cast rejects it.
-bool inside_solid(const Placed& S, const Vec3& p_world, double margin) {
-  const Polyhedron& m = S.m();
-  const Vec3 q = S.pose.inverse_apply(p_world);
-  if (!ray_cast_inside(S, q)) return false;
-  for (std::size_t f = 0; f < m.num_faces(); ++f)
-    if (cf::point_face(q, m, cf::FaceId(static_cast<int>(f))).distance <= margin) return false;
-  return true;
-}
-
-// ---------------------------------------------------------------------------------------
-// Pose analysis: the CF that a pose realises, computed from the geometry alone
-// ---------------------------------------------------------------------------------------
-
-struct Contact {
-  K ka;
-  int a;
-  K kb;
-  int b;
-  bool parallel_ee = false;
-  Vec3 point;
-};
-
-struct ContactPlane {
-  Vec3 n;    // unit, pointing from B into A
-  double d;  // n . x = d
-};
-
-struct Analysis {
-  std::vector<Contact> touching;
-  std::vector<Contact> undominated;
-  bool penetrating = false;
-  std::string why;     // what penetrates
-  int degenerate = 0;  // undominated touches of degenerate type (v-v, v-e, e-v, collinear e-e)
-  bool shared_plane = false;
-  bool too_many = false;             // more than 3 PCs
-  PcSet pcs;                         // the PCs, when none of the above
-  std::vector<ContactPlane> planes;  // of the non-degenerate undominated touches
-  std::vector<Vec3> points;          // their contact points
-
-  bool contact() const { return !touching.empty(); }
-  bool clean() const {
-    return contact() && !penetrating && degenerate == 0 && !shared_plane && !too_many;
-  }
-  std::string signature() const {
-    std::ostringstream os;
-    os << penetrating << degenerate << shared_plane << too_many << ":" << cf::to_string(pcs);
-    return os.str();
-  }
-  std::string describe() const {
-    std::ostringstream os;
-    os << "touching:";
-    for (const Contact& c : touching)
-      os << " "
-         << "vef"[static_cast<int>(c.ka)] << c.a << "-"
-         << "vef"[static_cast<int>(c.kb)] << c.b;
-    os << " | undominated:";
-    for (const Contact& c : undominated)
-      os << " "
-         << "vef"[static_cast<int>(c.ka)] << c.a << "-"
-         << "vef"[static_cast<int>(c.kb)] << c.b << (c.parallel_ee ? "(collinear)" : "");
-    if (penetrating) os << " | PENETRATING: " << why;
-    if (shared_plane) os << " | two PCs share a contact plane";
-    return os.str();
-  }
-};
-
-std::optional<PcType> pc_type(K ka, K kb, bool parallel_ee) {
-  if (ka == K::kFace && kb == K::kFace) return PcType::kFF;
-  if (ka == K::kEdge && kb == K::kFace) return PcType::kEF;
-  if (ka == K::kFace && kb == K::kEdge) return PcType::kFE;
-  if (ka == K::kVertex && kb == K::kFace) return PcType::kVF;
-  if (ka == K::kFace && kb == K::kVertex) return PcType::kFV;
-  if (ka == K::kEdge && kb == K::kEdge && !parallel_ee) return PcType::kEE;
-  return std::nullopt;
-}
-
-ContactPlane contact_plane(const Placed& A, const Placed& B, const Contact& c) {
-  if (c.kb == K::kFace) return {B.normal(c.b), B.offset(c.b)};
-  if (c.ka == K::kFace) return {-A.normal(c.a), -A.offset(c.a)};
-  // e-e: the plane of both edges, oriented along B's edge's outward bisector.
-  const Vec3 da = A.edge_pt(c.a, 1) - A.edge_pt(c.a, 0), db = B.edge_pt(c.b, 1) - B.edge_pt(c.b, 0);
-  Vec3 n = da.cross(db).normalized();
-  const cf::Edge& eb = B.m().edges()[static_cast<std::size_t>(c.b)];
-  const Vec3 bis = B.normal(eb.left.value()) + B.normal(eb.right.value());
-  if (n.dot(bis) < 0) n = -n;
-  return {n, n.dot(c.point)};
-}
-
-bool same_plane(const ContactPlane& x, const ContactPlane& y) {
-  if (x.n.cross(y.n).norm() > kPlaneTol) return false;
-  const double sg = x.n.dot(y.n) > 0 ? 1.0 : -1.0;
-  return std::abs(x.d - sg * y.d) <= kPlaneTol * 10;
-}
-
-Analysis analyse(const ModelGeom& ga, const ModelGeom& gb, const Pose& pose, double tol) {
-  const Placed A{&ga, pose}, B{&gb, Pose()};
-  Analysis out;
-  // Whole-model bounding spheres first: far apart means no contact at all.
-  if ((pose.apply(ga.center) - gb.center).norm() > ga.radius + gb.radius + tol) return out;
-  const K kinds[] = {K::kVertex, K::kEdge, K::kFace};
-  std::vector<std::pair<Vec3, double>> sb[3];
-  for (K kb : kinds)
-    for (int b = 0; b < count(*gb.m, kb); ++b) sb[static_cast<int>(kb)].push_back(B.sphere(kb, b));
-  for (K ka : kinds)
-    for (int a = 0; a < count(*ga.m, ka); ++a) {
-      const auto [ca, ra] = A.sphere(ka, a);
-      for (K kb : kinds)
-        for (int b = 0; b < count(*gb.m, kb); ++b) {
-          const auto& [cb, rb] = sb[static_cast<int>(kb)][static_cast<std::size_t>(b)];
-          if ((ca - cb).norm() - ra - rb > tol) continue;
-          const cf::ClosestPoints cp = cf::element_distance(*ga.m, pose, ka, a, *gb.m, kb, b);
-          if (cp.distance > tol) continue;
-          const TouchResult t = open_touch(A, ka, a, B, kb, b, tol);
-          if (t.touch == Touch::kPenetrate && !out.penetrating) {
-            out.penetrating = true;
-            out.why = std::string("open ") + "vef"[static_cast<int>(ka)] + std::to_string(a) +
-                      " crosses open " + "vef"[static_cast<int>(kb)] + std::to_string(b);
-          }
-          if (t.touch != Touch::kNone)
-            out.touching.push_back({ka, a, kb, b, t.parallel_ee, 0.5 * (cp.p_a + cp.p_b)});
-        }
-    }
-  if (out.touching.empty()) return out;
-  // Domination.
-  for (const Contact& c : out.touching) {
-    bool dominated = false;
-    for (const Contact& o : out.touching)
-      if (&o != &c && within_closure(*ga.m, c.ka, c.a, o.ka, o.a) &&
-          within_closure(*gb.m, c.kb, c.b, o.kb, o.b))
-        dominated = true;
-    if (!dominated) out.undominated.push_back(c);
-  }
-  std::vector<Pc> pcs;
-  for (const Contact& c : out.undominated) {
-    const auto t = pc_type(c.ka, c.kb, c.parallel_ee);
-    if (!t) {
-      ++out.degenerate;
-      continue;
-    }
-    pcs.push_back({*t, c.a, c.b});
-    out.planes.push_back(contact_plane(A, B, c));
-    out.points.push_back(c.point);
-  }
-  for (std::size_t i = 0; i < out.planes.size(); ++i)
-    for (std::size_t j = i + 1; j < out.planes.size(); ++j)
-      if (same_plane(out.planes[i], out.planes[j])) out.shared_plane = true;
-  if (pcs.size() > 3)
-    out.too_many = true;
-  else if (out.degenerate == 0)
-    out.pcs = PcSet(pcs);
-  // Interiors disjoint: no vertex of one strictly inside the other (edges crossing faces
-  // transversally were reported above), and no probe point next to a contact inside both.
-  for (int v = 0; v < count(*ga.m, K::kVertex) && !out.penetrating; ++v)
-    if (inside_solid(B, A.vertex(v), kInsideMargin)) {
-      out.penetrating = true;
-      out.why = "vertex v" + std::to_string(v) + " of A inside B";
-    }
-  for (int v = 0; v < count(*gb.m, K::kVertex) && !out.penetrating; ++v)
-    if (inside_solid(A, B.vertex(v), kInsideMargin)) {
-      out.penetrating = true;
-      out.why = "vertex v" + std::to_string(v) + " of B inside A";
-    }
-  for (const Contact& c : out.touching) {
-    if (out.penetrating) break;
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          if (dx == 0 && dy == 0 && dz == 0) continue;
-          const Vec3 x = c.point + kProbeRadius * Vec3(dx, dy, dz).normalized();
-          if (!out.penetrating && inside_solid(A, x, kInsideMargin) &&
-              inside_solid(B, x, kInsideMargin)) {
-            out.penetrating = true;
-            out.why = "probe point " + vec_str(x) + " inside both";
-          }
-        }
-  }
-  return out;
-}
-
-// Smallest closed distance (mm) between element pairs that do not touch at `pose`, up to
-// `cap`: how far the pose is from gaining another contact.
-double pose_clearance(const ModelGeom& ga, const ModelGeom& gb, const Pose& pose, double cap) {
-  const Placed A{&ga, pose}, B{&gb, Pose()};
-  double best = cap;
-  const K kinds[] = {K::kVertex, K::kEdge, K::kFace};
-  for (K ka : kinds)
-    for (int a = 0; a < count(*ga.m, ka); ++a)
-      for (K kb : kinds)
-        for (int b = 0; b < count(*gb.m, kb); ++b) {
-          const auto [ca, ra] = A.sphere(ka, a);
-          const auto [cb, rb] = B.sphere(kb, b);
-          if ((ca - cb).norm() - ra - rb >= best) continue;
-          const double d = cf::element_distance(*ga.m, pose, ka, a, *gb.m, kb, b).distance;
-          if (d > kTouchTol) best = std::min(best, d);
-        }
-  return best;
+// The oracle's box [0, 200]^3 and its U-channel, 80 x 80 x 80 mm: floor 20 thick, two arms 20
+// thick; the slot between the arms is 40 mm wide (x in 20..60), more than the 30 mm cube.
+Polyhedron big_box() { return cf::test::from_oracle(oracle::make_box(200, 200, 200), "big_box"); }
+Polyhedron u_channel() {
+  return cf::test::from_oracle(oracle::make_u_channel(40, 20, 20, 80, 80), "u_channel");
 }
 
 // ---------------------------------------------------------------------------------------
@@ -768,23 +244,22 @@ double pose_clearance(const ModelGeom& ga, const ModelGeom& gb, const Pose& pose
 // ---------------------------------------------------------------------------------------
 
 void check_witnesses(const Generated& g, const std::string& label) {
-  const ModelGeom ga(*g.A), gb(*g.B);
   std::size_t ok = 0, bad = 0;
   std::size_t by_size[4] = {0, 0, 0, 0};
   std::ostringstream failures;
   for (std::size_t i = 0; i < g.graph->num_cfs(); ++i) {
     const cf::CfRecord& r = g.graph->cf(cf::CfId(static_cast<int>(i)));
-    const Analysis an = analyse(ga, gb, r.witness, kTouchTol);
+    const Analysis an = g.oracle->analyse(r.witness);
     std::string why;
     if (!an.contact())
       why = "no contact at the witness";
-    else if (an.penetrating)
+    else if (an.v.penetrating)
       why = "interiors intersect";
-    else if (an.degenerate)
+    else if (an.v.degenerate)
       why = "degenerate undominated touch";
-    else if (an.shared_plane)
+    else if (an.v.same_plane)
       why = "two PCs share a contact plane";
-    else if (an.too_many)
+    else if (an.v.too_many)
       why = "more than 3 PCs";
     else if (an.pcs != r.pcs)
       why = "PCs differ: geometry gives {" + cf::to_string(an.pcs) + "}";
@@ -808,58 +283,6 @@ void check_witnesses(const Generated& g, const std::string& label) {
 // Section 3: recall by random guarded and sliding motions
 // ---------------------------------------------------------------------------------------
 
-// Smallest s >= s_min at which A, translated from `pose` by s * u, first touches B (closed
-// sets); infinity when it never does. Under a translation the first contact is a vertex
-// reaching a face, a face reaching a vertex, or an edge reaching an edge.
-double first_contact(const ModelGeom& ga, const ModelGeom& gb, const Pose& pose, const Vec3& u,
-                     double s_min) {
-  const Polyhedron& A = *ga.m;
-  const Polyhedron& B = *gb.m;
-  const Placed PA{&ga, pose};
-  double best = std::numeric_limits<double>::infinity();
-  std::vector<Vec3> va;
-  for (int i = 0; i < count(A, K::kVertex); ++i) va.push_back(PA.vertex(i));
-  constexpr double kIn = -1e-9;  // closed face: the boundary counts
-  for (const FaceGeom& F : gb.faces) {
-    const double den = F.n.dot(u);
-    if (den > -1e-12) continue;  // only approaching the face from its front
-    for (const Vec3& p : va) {
-      const double s = (F.d - F.n.dot(p)) / den;
-      if (s < s_min || s >= best) continue;
-      const Vec3 h = p + s * u;
-      if (inset2d(F, {F.u.dot(h), F.w.dot(h)}) >= kIn) best = s;
-    }
-  }
-  for (int f = 0; f < count(A, K::kFace); ++f) {
-    const Vec3 m = PA.normal(f);
-    const double den = m.dot(u);
-    if (den < 1e-12) continue;
-    const double e = PA.offset(f);
-    const FaceGeom& F = ga.faces[static_cast<std::size_t>(f)];
-    for (const cf::Vertex& vb : B.vertices()) {
-      const double s = (m.dot(vb.p) - e) / den;
-      if (s < s_min || s >= best) continue;
-      const Vec3 x = pose.inverse_apply(vb.p - s * u);
-      if (inset2d(F, {F.u.dot(x), F.w.dot(x)}) >= kIn) best = s;
-    }
-  }
-  for (int ea = 0; ea < count(A, K::kEdge); ++ea) {
-    const Vec3 p0 = PA.edge_pt(ea, 0), da = PA.edge_pt(ea, 1) - p0;
-    for (int eb = 0; eb < count(B, K::kEdge); ++eb) {
-      const Vec3 q0 = B.edge_point(cf::EdgeId(eb), 0), db = B.edge_point(cf::EdgeId(eb), 1) - q0;
-      Mat3 M;
-      M << u, da, -db;
-      const double det = M.determinant();
-      if (std::abs(det) < 1e-9 * da.norm() * db.norm()) continue;
-      const Vec3 x = M.inverse() * (q0 - p0);
-      if (x(0) < s_min || x(0) >= best) continue;
-      if (x(1) < -1e-12 || x(1) > 1 + 1e-12 || x(2) < -1e-12 || x(2) > 1 + 1e-12) continue;
-      best = x(0);
-    }
-  }
-  return best;
-}
-
 struct RecallStats {
   int trials = 0, missed_b = 0, poses = 0, no_contact = 0, penetrating = 0, ambiguous = 0,
       degenerate = 0, shared_plane = 0, too_many = 0, clean = 0, clean_found = 0;
@@ -868,11 +291,24 @@ struct RecallStats {
   std::vector<std::string> penetrations;
 };
 
+// What the classification says, for comparing it at the two tolerances.
+std::string signature(const Analysis& an) {
+  std::ostringstream os;
+  os << an.v.penetrating << an.v.degenerate << an.v.same_plane << an.v.too_many << ":"
+     << oracle::key_string(an.v.key());
+  return os.str();
+}
+
 class Explorer {
  public:
-  Explorer(const Generated& g, std::uint32_t seed) : g_(g), ga_(*g.A), gb_(*g.B), rng_(seed) {
-    for (std::size_t e = 0; e < g.B->num_edges(); ++e)
-      if (!g.B->edges()[e].convex) reflex_.push_back(static_cast<int>(e));
+  Explorer(const Generated& g, std::uint32_t seed)
+      : g_(g), o_(*g.oracle), A_(o_.A), B_(o_.B), rng_(seed) {
+    for (std::size_t e = 0; e < B_.E.size(); ++e)
+      if (!B_.E[e].convex) reflex_.push_back(static_cast<int>(e));
+    center_a_ = 0.5 * (A_.box.lo + A_.box.hi);
+    radius_a_ = 0.5 * A_.diag;
+    radius_b_ = 0.5 * B_.diag;
+    reach_ = 4 * (radius_a_ + radius_b_) + 10;
   }
 
   RecallStats run(int trials) {
@@ -881,8 +317,28 @@ class Explorer {
   }
 
  private:
+  // A non-degenerate PC, with its contact plane's normal (from B into A) and a contact point
+  // (the middle of a line contact).
+  struct Contact {
+    oracle::PcType type;
+    int a, b;
+    Vec3 n, point;
+  };
+  std::vector<Contact> contacts(const Analysis& an) const {
+    std::vector<Contact> out;
+    for (int i : an.v.pcs) {
+      const oracle::Touch& t = an.v.touches[static_cast<std::size_t>(i)];
+      if (!oracle::nondegenerate(t.type)) continue;
+      const bool line = t.type == oracle::PcType::EF || t.type == oracle::PcType::FE;
+      out.push_back({t.type, t.a, t.b, oracle::normal_into_a(B_, t),
+                     line ? Vec3(0.5 * (t.p0 + t.p1)) : t.p0});
+    }
+    return out;
+  }
+
   double uni(double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng_); }
   int pick(int n) { return std::uniform_int_distribution<int>(0, n - 1)(rng_); }
+  int pick(std::size_t n) { return pick(static_cast<int>(n)); }
   Vec3 random_unit() {
     std::normal_distribution<double> nd;
     Vec3 v;
@@ -902,26 +358,30 @@ class Explorer {
     const double angle = pick(2) == 0 ? pick(4) * M_PI / 2 : uni(0, 2 * M_PI);
     return axis_angle(axis, angle);
   }
-  Vec3 random_point_on_edge(int e) {
-    const double s = uni(0.05, 0.95);
-    return (1 - s) * g_.B->edge_point(cf::EdgeId(e), 0) + s * g_.B->edge_point(cf::EdgeId(e), 1);
+  Vec3 point_on_edge(const oracle::Poly& P, int e, double s) const {
+    const oracle::Edge& E = P.E[static_cast<std::size_t>(e)];
+    return (1 - s) * P.V[static_cast<std::size_t>(E.v0)].p +
+           s * P.V[static_cast<std::size_t>(E.v1)].p;
   }
-  Vec3 reflex_bisector(int e) const {
-    const cf::Edge& E = g_.B->edges()[static_cast<std::size_t>(e)];
-    return (g_.B->face(E.left).normal + g_.B->face(E.right).normal).normalized();
+  Vec3 random_point_on_edge(int e) { return point_on_edge(B_, e, uni(0.05, 0.95)); }
+  // The sum of the normals of an edge's two faces, normalized.
+  static Vec3 bisector(const oracle::Poly& P, int e) {
+    const oracle::Edge& E = P.E[static_cast<std::size_t>(e)];
+    return (P.F[static_cast<std::size_t>(E.face[0])].n + P.F[static_cast<std::size_t>(E.face[1])].n)
+        .normalized();
   }
   Vec3 point_on_b_face(int f) {
-    const cf::Face& F = g_.B->faces()[static_cast<std::size_t>(f)];
-    const FaceGeom& G = gb_.faces[static_cast<std::size_t>(f)];
+    const oracle::Face& F = B_.F[static_cast<std::size_t>(f)];
     double u0 = 1e300, u1 = -1e300, w0 = 1e300, w1 = -1e300;
-    for (const auto& loop : G.loops)
-      for (const V2& p : loop) {
+    for (const auto& loop : F.loops2)
+      for (const oracle::Vec2& p : loop) {
         u0 = std::min(u0, p.x()), u1 = std::max(u1, p.x());
         w0 = std::min(w0, p.y()), w1 = std::max(w1, p.y());
       }
     for (int k = 0; k < 100; ++k) {
-      const V2 q(uni(u0, u1), uni(w0, w1));
-      if (inset2d(G, q) > 0.5) return q.x() * G.u + q.y() * G.w + G.d * G.n;
+      const oracle::Vec2 q(uni(u0, u1), uni(w0, w1));
+      if (oracle::inside_loops(F.loops2, q) && oracle::dist_to_loops(F.loops2, q) > 0.5)
+        return F.to3(q);
     }
     return F.centroid;
   }
@@ -929,31 +389,33 @@ class Explorer {
   // Classifies a pose, counts it, and checks the graph.
   Analysis record(const Pose& pose) {
     ++st_.poses;
-    const Analysis fine = analyse(ga_, gb_, pose, kTouchTol);
+    const Analysis fine = o_.analyse(pose);
     history_ += " -> {" + fine.describe() + "} at " + pose_str(pose) + "\n";
     if (!fine.contact()) {
       ++st_.no_contact;
       return fine;
     }
-    const Analysis coarse = analyse(ga_, gb_, pose, kCoarseTol);
-    if (fine.penetrating && coarse.penetrating) {
+    const Analysis coarse = o_.analyse(pose, o_.coarse);
+    if (fine.v.penetrating && coarse.v.penetrating) {
       ++st_.penetrating;
       if (st_.penetrations.size() < 5)
         st_.penetrations.push_back(fine.describe() + " at " + pose_str(pose) + " after " +
                                    history_);
       return fine;
     }
-    // Includes slivers: nearly coplanar faces (a tilt of 1e-4 rad) that cross over less
-    // than the fine tolerance's worth of depth.
-    if (coarse.signature() != fine.signature()) {
+    // Includes slivers (nearly coplanar faces, a tilt of 1e-4 rad, that cross over less than
+    // the fine tolerance's worth of depth), and the poses the oracle itself calls
+    // near-degenerate (an e-e crossing next to an edge's end, a line contact of tiny length,
+    // two contact planes nearly one, a sliver of f-f overlap).
+    if (signature(coarse) != signature(fine) || !fine.v.uncertain.empty()) {
       ++st_.ambiguous;
       return fine;
     }
-    if (fine.degenerate)
+    if (fine.v.degenerate)
       ++st_.degenerate;
-    else if (fine.too_many)
+    else if (fine.v.too_many)
       ++st_.too_many;
-    else if (fine.shared_plane)
+    else if (fine.v.same_plane)
       ++st_.shared_plane;
     else {
       ++st_.clean;
@@ -967,58 +429,67 @@ class Explorer {
     return fine;
   }
 
-  // A, from a start pose clear of B, moved along u until it touches; nullopt when it misses.
-  std::optional<Pose> guarded(const Pose& start, const Vec3& u, double s_min) {
-    const double s = first_contact(ga_, gb_, start, u, s_min);
+  // The oracle's first contact of A translated from p along u (mm; infinite when there is
+  // none within reach_). Events at the start are skipped, except a vertex pushed into a face
+  // it touches (then 0).
+  double first_contact(const Pose& p, const Vec3& u) const {
+    oracle::Motion m;
+    m.u = u;
+    return oracle::time_of_impact(A_, B_, cf::test::to_oracle(p), m, reach_, kTouchTol);
+  }
+
+  // A, moved from p along u until it touches; nullopt when it misses. A contact held at p
+  // that the motion pushes into (an edge on an edge, whose event at the start
+  // first_contact skips) stops it at once.
+  std::optional<Pose> guarded(const Pose& p, const Vec3& u) {
+    const double s = first_contact(p, u);
+    if (s > 0 && o_.analyse(translated(p, std::min(kProbeStep, 0.5 * s) * u)).v.penetrating)
+      return p;
     if (!std::isfinite(s)) return std::nullopt;
-    return translated(start, s * u);
+    return translated(p, s * u);
   }
 
   void trial() {
     ++st_.trials;
-    const Polyhedron& A = *g_.A;
-    const Polyhedron& B = *g_.B;
+    const oracle::Poly& A = A_;
+    const oracle::Poly& B = B_;
     Mat3 R;
     Vec3 u, target;
     switch (pick(reflex_.empty() ? 4 : 5)) {
       case 4: {  // towards a concave corner of B, any orientation
-        const int eb = reflex_[static_cast<std::size_t>(pick(static_cast<int>(reflex_.size())))];
+        const int eb = reflex_[static_cast<std::size_t>(pick(reflex_.size()))];
         R = random_rotation();
         target = random_point_on_edge(eb);
-        u = (-reflex_bisector(eb) + 0.7 * random_unit()).normalized();
+        u = (-bisector(B, eb) + 0.7 * random_unit()).normalized();
         break;
       }
       case 0:  // anything
         R = random_rotation();
-        target = B.bbox_min() +
-                 (B.bbox_max() - B.bbox_min()).cwiseProduct(Vec3(uni(0, 1), uni(0, 1), uni(0, 1)));
+        target =
+            B.box.lo + (B.box.hi - B.box.lo).cwiseProduct(Vec3(uni(0, 1), uni(0, 1), uni(0, 1)));
         u = random_unit();
         break;
       case 1: {  // a face of A parallel to a face of B, approaching it
-        const int fa = pick(count(A, K::kFace)), fb = pick(count(B, K::kFace));
-        const Vec3 nb = B.faces()[static_cast<std::size_t>(fb)].normal;
-        R = spin(nb) * align(A.faces()[static_cast<std::size_t>(fa)].normal, -nb);
+        const int fa = pick(A.F.size()), fb = pick(B.F.size());
+        const Vec3 nb = B.F[static_cast<std::size_t>(fb)].n;
+        R = spin(nb) * align(A.F[static_cast<std::size_t>(fa)].n, -nb);
         target = point_on_b_face(fb);
         u = pick(3) ? -nb : (random_unit() - 2 * nb).normalized();
         break;
       }
       case 2: {  // an edge of A parallel to a face of B
-        const int ea = pick(count(A, K::kEdge)), fb = pick(count(B, K::kFace));
-        const cf::Edge& e = A.edges()[static_cast<std::size_t>(ea)];
-        const Vec3 bis = (A.face(e.left).normal + A.face(e.right).normal).normalized();
-        const Vec3 nb = B.faces()[static_cast<std::size_t>(fb)].normal;
-        R = spin(nb) * align(bis, -nb);
+        const int ea = pick(A.E.size()), fb = pick(B.F.size());
+        const Vec3 nb = B.F[static_cast<std::size_t>(fb)].n;
+        R = spin(nb) * align(bisector(A, ea), -nb);
         target = point_on_b_face(fb);
         u = pick(3) ? -nb : (random_unit() - 2 * nb).normalized();
         break;
       }
       default: {  // a face of A square to the bisector of an edge of B
-        const int fa = pick(count(A, K::kFace)), eb = pick(count(B, K::kEdge));
-        const cf::Edge& e = B.edges()[static_cast<std::size_t>(eb)];
-        const Vec3 bis = (B.face(e.left).normal + B.face(e.right).normal).normalized();
-        R = spin(bis) * align(A.faces()[static_cast<std::size_t>(fa)].normal, -bis);
-        const double s = uni(0.05, 0.95);
-        target = (1 - s) * B.edge_point(cf::EdgeId(eb), 0) + s * B.edge_point(cf::EdgeId(eb), 1);
+        const int fa = pick(A.F.size()), eb = pick(B.E.size());
+        const Vec3 bis = bisector(B, eb);
+        R = spin(bis) * align(A.F[static_cast<std::size_t>(fa)].n, -bis);
+        target = point_on_edge(B, eb, uni(0.05, 0.95));
         u = pick(3) ? -bis : (random_unit() - 2 * bis).normalized();
         break;
       }
@@ -1026,9 +497,9 @@ class Explorer {
     // Start well clear of B's bounding sphere, on the line through the target.
     Pose start;
     start.R_BA = R;
-    start.t_BA = target - u * (ga_.radius + 2 * gb_.radius + 1) - R * ga_.center;
+    start.t_BA = target - u * (radius_a_ + 2 * radius_b_ + 1) - R * center_a_;
     history_ = "approach from " + pose_str(start) + " along " + vec_str(u);
-    std::optional<Pose> pose = guarded(start, u, 0);
+    std::optional<Pose> pose = guarded(start, u);
     if (!pose) {
       ++st_.missed_b;
       return;
@@ -1036,22 +507,24 @@ class Explorer {
     Analysis an = record(*pose);
     const int steps = 1 + pick(8);
     for (int k = 0; k < steps; ++k) {
-      if (!an.contact() || an.penetrating || an.planes.empty()) return;
+      if (!an.contact() || an.v.penetrating) return;
+      const std::vector<Contact> cs = contacts(an);
+      if (cs.empty()) return;
       std::optional<Pose> next;
       switch (pick(5)) {
         case 0:
         case 1:
           history_ += ", slide";
-          next = slide(*pose, an);
+          next = slide(*pose, cs);
           break;
         case 2:
         case 3:
           history_ += ", snap";
-          next = snap(*pose, an);
+          next = snap(*pose, cs);
           break;
         default:
           history_ += ", tilt";
-          next = tilt(*pose, an);
+          next = tilt(*pose, cs);
           break;
       }
       if (!next) return;
@@ -1062,129 +535,136 @@ class Explorer {
 
   // Translates along the contact planes (keeping every contact) until a new contact, or
   // for a random length and then presses A back against B along a contact normal.
-  std::optional<Pose> slide(const Pose& pose, const Analysis& an) {
-    Eigen::MatrixXd N(static_cast<Eigen::Index>(an.planes.size()), 3);
-    for (std::size_t i = 0; i < an.planes.size(); ++i)
-      N.row(static_cast<Eigen::Index>(i)) = an.planes[i].n.transpose();
+  std::optional<Pose> slide(const Pose& pose, const std::vector<Contact>& cs) {
+    Eigen::MatrixXd N(static_cast<Eigen::Index>(cs.size()), 3);
+    for (std::size_t i = 0; i < cs.size(); ++i)
+      N.row(static_cast<Eigen::Index>(i)) = cs[i].n.transpose();
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(N, Eigen::ComputeFullV);
     const auto& sv = svd.singularValues();
     int rank = 0;
     for (Eigen::Index i = 0; i < sv.size(); ++i)
       if (sv(i) > 1e-9) ++rank;
-    if (rank >= 3) return tilt(pose, an);
+    if (rank >= 3) return tilt(pose, cs);
     Vec3 u = Vec3::Zero();
     if (!reflex_.empty() && pick(2) == 0) {
       // Towards a concave corner of B, within the contact planes.
-      const int eb = reflex_[static_cast<std::size_t>(pick(static_cast<int>(reflex_.size())))];
-      const Vec3 d = random_point_on_edge(eb) - an.points[0];
+      const int eb = reflex_[static_cast<std::size_t>(pick(reflex_.size()))];
+      const Vec3 d = random_point_on_edge(eb) - cs[0].point;
       for (int c = rank; c < 3; ++c) u += d.dot(svd.matrixV().col(c)) * svd.matrixV().col(c);
     } else {
       for (int c = rank; c < 3; ++c) u += uni(-1, 1) * svd.matrixV().col(c);
     }
     if (u.norm() < 1e-6) return std::nullopt;
     u.normalize();
-    const double s = first_contact(ga_, gb_, pose, u, 1e-7);
+    const double s = first_contact(pose, u);
     const double len = uni(5, 80);
     // A touch already present (a dominated one off the contact planes, such as an edge of A
-    // through a vertex of B) may block the slide at once; first_contact ignores s = 0.
-    if (analyse(ga_, gb_, translated(pose, std::min(1e-3, 0.5 * std::min(s, len)) * u), kTouchTol)
-            .penetrating)
+    // through a vertex of B) may block the slide at once.
+    if (s == 0 || o_.analyse(translated(pose, std::min(kProbeStep, 0.5 * std::min(s, len)) * u))
+                      .v.penetrating)
       return std::nullopt;
     if (s <= len) return translated(pose, s * u);
-    const Vec3 n = an.planes[static_cast<std::size_t>(pick(static_cast<int>(an.planes.size())))].n;
-    return guarded(translated(pose, len * u), -n, -1e-9);
+    const Vec3 n = cs[static_cast<std::size_t>(pick(cs.size()))].n;
+    return guarded(translated(pose, len * u), -n);
   }
 
   // Rotates about a contact to bring a neighbouring element flat against the other solid
   // (v-f -> e-f, e-f -> f-f, f-e -> f-f, f-v -> f-e, e-e -> e-f), then re-establishes
   // contact if the rotation pushed A into B or off it.
-  std::optional<Pose> snap(const Pose& pose, const Analysis& an) {
-    const Polyhedron& A = *g_.A;
-    const Polyhedron& B = *g_.B;
-    const Placed PA{&ga_, pose}, PB{&gb_, Pose()};
-    std::vector<std::size_t> idx;
-    for (std::size_t i = 0; i < an.undominated.size(); ++i)
-      if (pc_type(an.undominated[i].ka, an.undominated[i].kb, an.undominated[i].parallel_ee))
-        idx.push_back(i);
-    if (idx.empty()) return std::nullopt;
-    const std::size_t i = idx[static_cast<std::size_t>(pick(static_cast<int>(idx.size())))];
-    const Contact& c = an.undominated[i];
-    const ContactPlane cp = contact_plane(PA, PB, c);
-    const PcType t = *pc_type(c.ka, c.kb, c.parallel_ee);
+  std::optional<Pose> snap(const Pose& pose, const std::vector<Contact>& cs) {
+    const oracle::Poly& A = A_;
+    const oracle::Poly& B = B_;
+    const Contact& c = cs[static_cast<std::size_t>(pick(cs.size()))];
+    const Mat3& R = pose.R_BA;
+    auto vertex = [](const oracle::Poly& P, int v) -> const oracle::Vertex& {
+      return P.V[static_cast<std::size_t>(v)];
+    };
+    auto edge = [](const oracle::Poly& P, int e) -> const oracle::Edge& {
+      return P.E[static_cast<std::size_t>(e)];
+    };
+    auto normal = [](const oracle::Poly& P, int f) -> const Vec3& {
+      return P.F[static_cast<std::size_t>(f)].n;
+    };
     Mat3 Q = Mat3::Identity();
     Vec3 pivot = c.point;
     auto flatten_dir = [&](const Vec3& d, const Vec3& n) {  // rotate d into the plane normal to n
       const Vec3 dp = d - d.dot(n) * n;
       return dp.norm() < 1e-9 ? Mat3(Mat3::Identity()) : align(d.normalized(), dp.normalized());
     };
-    switch (t) {
-      case PcType::kVF: {
-        const auto& es = A.vertices()[static_cast<std::size_t>(c.a)].edges;
-        const int e = es[static_cast<std::size_t>(pick(static_cast<int>(es.size())))].value();
-        const Vec3 p = PA.vertex(c.a);
-        const Vec3 other =
-            (PA.edge_pt(e, 0) - p).norm() < 1e-9 ? PA.edge_pt(e, 1) : PA.edge_pt(e, 0);
-        Q = flatten_dir(other - p, cp.n);
+    switch (c.type) {
+      case oracle::PcType::VF: {
+        const auto& es = vertex(A, c.a).edges;
+        const oracle::Edge& e = edge(A, es[static_cast<std::size_t>(pick(es.size()))]);
+        const Vec3 p = pose.apply(vertex(A, c.a).p);
+        const Vec3 other = pose.apply(vertex(A, e.v0 == c.a ? e.v1 : e.v0).p);
+        Q = flatten_dir(other - p, c.n);
         pivot = p;
         break;
       }
-      case PcType::kEF: {
-        const cf::Edge& e = A.edges()[static_cast<std::size_t>(c.a)];
-        const int f = pick(2) ? e.left.value() : e.right.value();
-        Q = align(PA.normal(f), -cp.n);
+      case oracle::PcType::EF: {
+        const oracle::Edge& e = edge(A, c.a);
+        const int f = pick(2) ? e.face[0] : e.face[1];
+        Q = align(R * normal(A, f), -c.n);
         break;
       }
-      case PcType::kFE: {
-        const cf::Edge& e = B.edges()[static_cast<std::size_t>(c.b)];
-        const int f = pick(2) ? e.left.value() : e.right.value();
-        Q = align(PA.normal(c.a), -PB.normal(f));
+      case oracle::PcType::FE: {
+        const oracle::Edge& e = edge(B, c.b);
+        const int f = pick(2) ? e.face[0] : e.face[1];
+        Q = align(R * normal(A, c.a), -normal(B, f));
         break;
       }
-      case PcType::kFV: {
-        const auto& es = B.vertices()[static_cast<std::size_t>(c.b)].edges;
-        const int e = es[static_cast<std::size_t>(pick(static_cast<int>(es.size())))].value();
-        const Vec3 d = B.edge_point(cf::EdgeId(e), 1) - B.edge_point(cf::EdgeId(e), 0);
-        const Vec3 m = PA.normal(c.a);
-        const Vec3 mp = m - m.dot(d.normalized()) * d.normalized();
+      case oracle::PcType::FV: {
+        const auto& es = vertex(B, c.b).edges;
+        const Vec3 d = edge(B, es[static_cast<std::size_t>(pick(es.size()))]).dir;
+        const Vec3 m = R * normal(A, c.a);
+        const Vec3 mp = m - m.dot(d) * d;
         Q = align(m, mp.normalized());
-        pivot = PB.vertex(c.b);
+        pivot = vertex(B, c.b).p;
         break;
       }
-      case PcType::kEE: {
-        const cf::Edge& e = B.edges()[static_cast<std::size_t>(c.b)];
-        const int f = pick(2) ? e.left.value() : e.right.value();
-        Q = flatten_dir(PA.edge_pt(c.a, 1) - PA.edge_pt(c.a, 0), PB.normal(f));
+      case oracle::PcType::EE: {
+        const oracle::Edge& e = edge(B, c.b);
+        const int f = pick(2) ? e.face[0] : e.face[1];
+        const oracle::Edge& ea = edge(A, c.a);
+        Q = flatten_dir(R * (vertex(A, ea.v1).p - vertex(A, ea.v0).p), normal(B, f));
         break;
       }
-      case PcType::kFF:
-        return tilt(pose, an);
+      case oracle::PcType::FF:
+        return tilt(pose, cs);
+      default:  // degenerate types: never in cs
+        return std::nullopt;
     }
-    return resettle(rotate_about(pose, Q, pivot), cp.n);
+    return resettle(rotate_about(pose, Q, pivot), c.n);
   }
 
   // Small random rotation about a contact point, then contact re-established.
-  std::optional<Pose> tilt(const Pose& pose, const Analysis& an) {
-    const std::size_t i = static_cast<std::size_t>(pick(static_cast<int>(an.planes.size())));
+  std::optional<Pose> tilt(const Pose& pose, const std::vector<Contact>& cs) {
+    const std::size_t i = static_cast<std::size_t>(pick(cs.size()));
     const Mat3 Q = axis_angle(random_unit(), uni(0.01, 0.3));
-    return resettle(rotate_about(pose, Q, an.points[i]), an.planes[i].n);
+    return resettle(rotate_about(pose, Q, cs[i].point), cs[i].n);
   }
 
   // After a rotation: if A now penetrates B, back it off along n until clear; then press it
   // against B along -n.
   std::optional<Pose> resettle(const Pose& rotated, const Vec3& n) {
     Pose p = rotated;
-    const Analysis an = analyse(ga_, gb_, p, kTouchTol);
-    if (an.contact() && !an.penetrating) return p;
-    if (an.penetrating) {
+    const Analysis an = o_.analyse(p);
+    if (an.contact() && !an.v.penetrating) return p;
+    if (an.v.penetrating) {
       p = translated(p, 40 * n);
-      const Analysis clear = analyse(ga_, gb_, p, kTouchTol);
+      const Analysis clear = o_.analyse(p);
       if (clear.contact()) return std::nullopt;
     }
-    return guarded(p, -n, -1e-9);
+    return guarded(p, -n);
   }
 
   const Generated& g_;
-  ModelGeom ga_, gb_;
+  const Oracle& o_;
+  const oracle::Poly& A_;
+  const oracle::Poly& B_;
+  Vec3 center_a_;  // A's bounding box: centre (A's frame), half diagonals of A and B
+  double radius_a_ = 0, radius_b_ = 0;
+  double reach_ = 0;  // longest translation to a first contact (mm)
   std::mt19937 rng_;
   RecallStats st_;
   std::string history_;      // the current trial's moves, for messages
@@ -1209,14 +689,13 @@ void check_recall(const Generated& g, const std::string& label, int trials, std:
   // What the generator's own pose verification says about each pose (diagnostics for
   // whoever fixes the generator: accepted means the witness search missed it).
   const cf::gen::WitnessSearch search(g.ai, g.bi, cf::gen::SearchParams{});
-  const ModelGeom ex_ga(*g.A), ex_gb(*g.B);
   for (const auto& [pcs, v] : st.missing) {
     if (++n > 25) break;
     std::string why;
     const double clearance = search.verify(PcSet(pcs), v.first, &why);
     os << "  {" << cf::to_string(PcSet(pcs)) << "} at " << pose_str(v.first)
-       << " (clearance of that pose " << pose_clearance(ex_ga, ex_gb, v.first, 1.0)
-       << " mm; cfgen's verify: "
+       << " (clearance of that pose "
+       << g.oracle->analyse(v.first, g.oracle->fine, true).v.clearance << " mm; cfgen's verify: "
        << (clearance >= 0 ? "accepts, clearance " + std::to_string(clearance) + " mm"
                           : "rejects: " + why)
        << ")\n";
@@ -1234,60 +713,14 @@ void check_recall(const Generated& g, const std::string& label, int trials, std:
 // Section 4: transitions
 // ---------------------------------------------------------------------------------------
 
-// docs/spec.md, section 4: neighbouring PCs, one step through a degenerate touch, "under the
-// matching boundary relations". `x` is the PC with the larger element(s).
-bool neighbour_dir(const Pc& x, const Pc& y, const Polyhedron& A, const Polyhedron& B) {
-  auto edge_bounds = [](const Polyhedron& m, int e, int f) {
-    return within_closure(m, K::kEdge, e, K::kFace, f);
-  };
-  auto vertex_ends = [](const Polyhedron& m, int v, int e) {
-    return within_closure(m, K::kVertex, v, K::kEdge, e);
-  };
-  using T = PcType;
-  if (x.type == T::kFF && y.type == T::kEF) return x.b == y.b && edge_bounds(A, y.a, x.a);
-  if (x.type == T::kFF && y.type == T::kFE) return x.a == y.a && edge_bounds(B, y.b, x.b);
-  if (x.type == T::kEF && y.type == T::kVF) return x.b == y.b && vertex_ends(A, y.a, x.a);
-  if (x.type == T::kEF && y.type == T::kEE) return x.a == y.a && edge_bounds(B, y.b, x.b);
-  if (x.type == T::kFE && y.type == T::kFV) return x.a == y.a && vertex_ends(B, y.b, x.b);
-  if (x.type == T::kFE && y.type == T::kEE) return x.b == y.b && edge_bounds(A, y.a, x.a);
-  if (x.type == T::kVF && y.type == T::kEE)
-    return vertex_ends(A, x.a, y.a) && edge_bounds(B, y.b, x.b);
-  if (x.type == T::kFV && y.type == T::kEE)
-    return vertex_ends(B, x.b, y.b) && edge_bounds(A, y.a, x.a);
-  return false;
-}
-bool neighbours(const Pc& x, const Pc& y, const Polyhedron& A, const Polyhedron& B) {
-  return neighbour_dir(x, y, A, B) || neighbour_dir(y, x, A, B);
-}
-
-// Same size, different, and some pairing maps each PC to an equal or neighbouring PC.
-bool is_change(const PcSet& s, const PcSet& t, const Polyhedron& A, const Polyhedron& B) {
-  if (s.size() != t.size() || s == t) return false;
-  std::vector<int> perm(static_cast<std::size_t>(t.size()));
-  for (int i = 0; i < t.size(); ++i) perm[static_cast<std::size_t>(i)] = i;
-  do {
-    bool ok = true;
-    for (int i = 0; i < s.size() && ok; ++i) {
-      const Pc& x = s[i];
-      const Pc& y = t[perm[static_cast<std::size_t>(i)]];
-      ok = x == y || neighbours(x, y, A, B);
-    }
-    if (ok) return true;
-  } while (std::next_permutation(perm.begin(), perm.end()));
-  return false;
-}
-bool is_subset_plus_one(const PcSet& small, const PcSet& big) {
-  if (big.size() != small.size() + 1) return false;
-  for (const Pc& p : small)
-    if (!big.contains(p)) return false;
-  return true;
-}
-
 void check_transitions(const Generated& g, const std::string& label) {
   const cf::CfGraph& G = *g.graph;
-  const Polyhedron& A = *g.A;
-  const Polyhedron& B = *g.B;
+  const oracle::Poly& A = g.oracle->A;
+  const oracle::Poly& B = g.oracle->B;
   const std::size_t n = G.num_cfs();
+  std::vector<oracle::CfKey> keys;  // by CF id
+  for (std::size_t i = 0; i < n; ++i)
+    keys.push_back(cf::test::to_oracle(G.cf(cf::CfId(static_cast<int>(i))).pcs));
   std::set<std::tuple<int, int, int>> all;
   std::size_t kinds[3] = {0, 0, 0}, bad = 0;
   std::ostringstream failures;
@@ -1298,15 +731,17 @@ void check_transitions(const Generated& g, const std::string& label) {
     const cf::Transition& t = G.transition(i);
     const PcSet& from = G.cf(t.from).pcs;
     const PcSet& to = G.cf(t.to).pcs;
+    const oracle::CfKey& kf = keys[t.from.index()];
+    const oracle::CfKey& kt = keys[t.to.index()];
     all.insert({t.from.value(), t.to.value(), static_cast<int>(t.kind)});
     ++kinds[static_cast<int>(t.kind)];
     const std::string desc = std::string(cf::to_string(t.kind)) + " {" + cf::to_string(from) +
                              "} -> {" + cf::to_string(to) + "}";
-    if (t.kind == cf::TransitionKind::kGain && !is_subset_plus_one(from, to))
+    if (t.kind == cf::TransitionKind::kGain && !oracle::is_gain(kf, kt))
       fail(desc + ": not exactly one PC gained");
-    if (t.kind == cf::TransitionKind::kLose && !is_subset_plus_one(to, from))
+    if (t.kind == cf::TransitionKind::kLose && !oracle::is_gain(kt, kf))
       fail(desc + ": not exactly one PC lost");
-    if (t.kind == cf::TransitionKind::kChange && !is_change(from, to, A, B))
+    if (t.kind == cf::TransitionKind::kChange && !oracle::is_change(A, B, kf, kt))
       fail(desc + ": not a replacement by neighbouring PCs");
   }
   // Reverse pairs.
@@ -1348,7 +783,9 @@ void check_transitions(const Generated& g, const std::string& label) {
         if (i == j) continue;
         const PcSet& s = G.cf(cf::CfId(i)).pcs;
         const PcSet& t = G.cf(cf::CfId(j)).pcs;
-        if (!is_change(s, t, A, B)) continue;
+        if (!oracle::is_change(A, B, keys[static_cast<std::size_t>(i)],
+                               keys[static_cast<std::size_t>(j)]))
+          continue;
         ++expected_change;
         if (!all.count({i, j, static_cast<int>(cf::TransitionKind::kChange)}))
           fail("missing change {" + cf::to_string(s) + "} -> {" + cf::to_string(t) + "}");
@@ -1397,19 +834,22 @@ std::map<PcType, int> single_pc_counts(const cf::CfGraph& G) {
 // every A element qualifies (the cube is convex), B's reflex edges never touch with an edge
 // (f-e, e-e), and B's non-pointed vertices are exactly those on a reflex edge (a 270-degree
 // corner in one of their faces; all other vertices are three convex 90-degree edges).
-std::set<std::vector<Pc>> allowed_single_pcs(const Polyhedron& A, const Polyhedron& B) {
+// Convexity as the oracle derives it from the face loops.
+std::set<std::vector<Pc>> allowed_single_pcs(const oracle::Poly& A, const oracle::Poly& B) {
+  auto count = [](const oracle::Poly& P, K k) {
+    return static_cast<int>(k == K::kVertex ? P.V.size() : k == K::kEdge ? P.E.size() : P.F.size());
+  };
   std::set<int> nonpointed;
-  for (const cf::Edge& e : B.edges())
+  for (const oracle::Edge& e : B.E)
     if (!e.convex) {
-      nonpointed.insert(e.v0.value());
-      nonpointed.insert(e.v1.value());
+      nonpointed.insert(e.v0);
+      nonpointed.insert(e.v1);
     }
   std::set<std::vector<Pc>> out;
   for (PcType t : {PcType::kFF, PcType::kEF, PcType::kFE, PcType::kVF, PcType::kFV, PcType::kEE})
     for (int a = 0; a < count(A, cf::a_kind(t)); ++a)
       for (int b = 0; b < count(B, cf::b_kind(t)); ++b) {
-        if ((t == PcType::kFE || t == PcType::kEE) &&
-            !B.edges()[static_cast<std::size_t>(b)].convex)
+        if ((t == PcType::kFE || t == PcType::kEE) && !B.E[static_cast<std::size_t>(b)].convex)
           continue;
         if (t == PcType::kFV && nonpointed.count(b)) continue;
         out.insert({Pc{t, a, b}});
@@ -1430,7 +870,7 @@ void check_single_pcs(const Generated& g, const std::map<PcType, int>& expected)
   CHECK(total == total_expected);
   // The hand counts equal the size of the set local convexity allows, and that set is what
   // the graph holds.
-  const auto allowed = allowed_single_pcs(*g.A, *g.B);
+  const auto allowed = allowed_single_pcs(g.oracle->A, g.oracle->B);
   CHECK(static_cast<int>(allowed.size()) == total_expected);
   std::ostringstream missing;
   int n_missing = 0;
@@ -1464,8 +904,8 @@ std::size_t count_size(const cf::CfGraph& G, int size) {
 }
 
 // The cube seated on B faces: cube face with normal src[k] flat against the plane with
-// outward normal dst[k], cube centred at `center`. Returns the pose and checks with this
-// file's own analysis that it realises exactly those f-f PCs.
+// outward normal dst[k], cube centred at `center` (check_hand_cf has the oracle confirm that
+// it realises exactly those f-f PCs).
 Pose seat_pose(const std::vector<Vec3>& src, const std::vector<Vec3>& dst, const Vec3& center) {
   // R maps src[k] to -dst[k]; with two pairs the third axis follows by the cross product.
   Mat3 S, D;
@@ -1481,12 +921,11 @@ Pose seat_pose(const std::vector<Vec3>& src, const std::vector<Vec3>& dst, const
   return p;
 }
 
-// A CF derived by hand, with a witness built by hand: this file's analysis must confirm the
-// witness, and the graph must hold the CF. When it does not, the message says what cfgen's
-// own pose verification thinks of the hand witness (accepted: its search missed the CF).
-void check_hand_cf(const Generated& g, const ModelGeom& ga, const ModelGeom& gb, const PcSet& s,
-                   const Pose& p) {
-  const Analysis an = analyse(ga, gb, p, kTouchTol);
+// A CF derived by hand, with a witness built by hand: the oracle must confirm the witness, and
+// the graph must hold the CF. When it does not, the message says what cfgen's own pose
+// verification thinks of the hand witness (accepted: its search missed the CF).
+void check_hand_cf(const Generated& g, const PcSet& s, const Pose& p) {
+  const Analysis an = g.oracle->analyse(p);
   INFO("hand witness for {" << cf::to_string(s) << "}: " << pose_str(p)
                             << "; geometry: " << an.describe());
   CHECK(an.clean());
@@ -1505,7 +944,7 @@ void check_hand_cf(const Generated& g, const ModelGeom& ga, const ModelGeom& gb,
 
 // Poses that this file's random motions (section 3) reached with earlier versions of cfgen
 // (up to commit 297f4f3), whose CFs the graph lacked then: kept as fixed cases, each checked
-// like a hand witness (this file's analysis must confirm the PCs; the graph must hold them).
+// like a hand witness (the oracle must confirm the PCs; the graph must hold them).
 struct KnownPose {
   const char* pcs;
   std::array<double, 9> R;  // row-major
@@ -1651,7 +1090,6 @@ const KnownPose kKnownCornerBlock[] = {
 };
 
 void check_known_poses(const Generated& g, const KnownPose* begin, const KnownPose* end) {
-  const ModelGeom ga(*g.A), gb(*g.B);
   for (const KnownPose* k = begin; k != end; ++k) {
     std::vector<Pc> pcs;
     std::stringstream ss(k->pcs);
@@ -1660,19 +1098,20 @@ void check_known_poses(const Generated& g, const KnownPose* begin, const KnownPo
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) p.R_BA(r, c) = k->R[static_cast<std::size_t>(3 * r + c)];
     p.t_BA = Vec3(k->t[0], k->t[1], k->t[2]);
-    check_hand_cf(g, ga, gb, PcSet(pcs), p);
+    check_hand_cf(g, PcSet(pcs), p);
   }
 }
 
 }  // namespace
 
 // =======================================================================================
-// 0. The oracle: this file's contact analysis on poses whose answer is known
+// 0. The oracle, as this file uses it (cfgen's models, kTouchTol), on poses whose answer is
+//    known
 // =======================================================================================
 
 TEST_CASE("cfgen test oracle: contact analysis of known poses", "[cfgen][oracle]") {
   const Polyhedron A = load("cube.off"), B = load("l_block.off");
-  const ModelGeom ga(A), gb(B);
+  const Oracle o(A, B);
   const int floor = face_with(B, Vec3::UnitY(), 20);
   const int bottom = cube_face(A, -Vec3::UnitY());
   auto at = [](const Mat3& R, const Vec3& t) {
@@ -1683,22 +1122,22 @@ TEST_CASE("cfgen test oracle: contact analysis of known poses", "[cfgen][oracle]
   };
   // Flat on the floor, 20 mm from the wall: one f-f; the bottom face's edges and vertices
   // touch the floor too but are dominated.
-  const Analysis flat = analyse(ga, gb, at(Mat3::Identity(), Vec3(70, 35, 40)), kTouchTol);
+  const Analysis flat = o.analyse(at(Mat3::Identity(), Vec3(70, 35, 40)));
   CHECK(flat.clean());
   CHECK(flat.pcs == PcSet({Pc{PcType::kFF, bottom, floor}}));
-  CHECK(flat.touching.size() == 9);  // the face, its 4 edges, its 4 vertices
+  CHECK(flat.v.touches.size() == 9);  // the face, its 4 edges, its 4 vertices
   // 1 micrometre into the floor, or above it.
-  CHECK(analyse(ga, gb, at(Mat3::Identity(), Vec3(70, 35 - 1e-3, 40)), kTouchTol).penetrating);
-  CHECK_FALSE(analyse(ga, gb, at(Mat3::Identity(), Vec3(70, 35 + 1e-3, 40)), kTouchTol).contact());
+  CHECK(o.analyse(at(Mat3::Identity(), Vec3(70, 35 - 1e-3, 40))).v.penetrating);
+  CHECK_FALSE(o.analyse(at(Mat3::Identity(), Vec3(70, 35 + 1e-3, 40))).contact());
   // Against the wall as well (x = 20): two f-f, with distinct contact planes.
-  const Analysis corner = analyse(ga, gb, at(Mat3::Identity(), Vec3(35, 35, 40)), kTouchTol);
+  const Analysis corner = o.analyse(at(Mat3::Identity(), Vec3(35, 35, 40)));
   CHECK(corner.clean());
   CHECK(corner.pcs ==
         PcSet({Pc{PcType::kFF, bottom, floor},
                Pc{PcType::kFF, cube_face(A, -Vec3::UnitX()), face_with(B, Vec3::UnitX(), 20)}}));
   // On an edge: 45 degrees about z, the lowest edge (along z) on the floor.
   const Mat3 Rz = axis_angle(Vec3::UnitZ(), M_PI / 4);
-  const Analysis edge = analyse(ga, gb, at(Rz, Vec3(70, 20 + 15 * std::sqrt(2.0), 40)), kTouchTol);
+  const Analysis edge = o.analyse(at(Rz, Vec3(70, 20 + 15 * std::sqrt(2.0), 40)));
   CHECK(edge.clean());
   REQUIRE(edge.pcs.size() == 1);
   CHECK(edge.pcs[0].type == PcType::kEF);
@@ -1708,8 +1147,7 @@ TEST_CASE("cfgen test oracle: contact analysis of known poses", "[cfgen][oracle]
   int lo = 0;
   for (int v = 1; v < 8; ++v)
     if ((Rg * A.vertices()[v].p).y() < (Rg * A.vertices()[lo].p).y()) lo = v;
-  const Analysis vertex =
-      analyse(ga, gb, at(Rg, Vec3(70, 20 - (Rg * A.vertices()[lo].p).y(), 40)), kTouchTol);
+  const Analysis vertex = o.analyse(at(Rg, Vec3(70, 20 - (Rg * A.vertices()[lo].p).y(), 40)));
   CHECK(vertex.clean());
   CHECK(vertex.pcs == PcSet({Pc{PcType::kVF, lo, floor}}));
   // A vertex on a convex edge of B (the top edge of the floor's end, x = 120, y = 20), the
@@ -1718,10 +1156,9 @@ TEST_CASE("cfgen test oracle: contact analysis of known poses", "[cfgen][oracle]
   int ext = 0;
   for (int v = 1; v < 8; ++v)
     if ((Rg * A.vertices()[v].p).dot(bis) < (Rg * A.vertices()[ext].p).dot(bis)) ext = v;
-  const Analysis ve =
-      analyse(ga, gb, at(Rg, Vec3(120, 20, 40) - Rg * A.vertices()[ext].p), kTouchTol);
-  CHECK_FALSE(ve.penetrating);
-  CHECK(ve.degenerate == 1);
+  const Analysis ve = o.analyse(at(Rg, Vec3(120, 20, 40) - Rg * A.vertices()[ext].p));
+  CHECK_FALSE(ve.v.penetrating);
+  CHECK(degenerate_pcs(ve) == 1);
   CHECK_FALSE(ve.clean());
   // Edges crossing: the cube's lowest edge (along z, as above) across the floor's end edge
   // (along z too, so turn the cube 30 degrees about the bisector first).
@@ -1734,14 +1171,14 @@ TEST_CASE("cfgen test oracle: contact analysis of known poses", "[cfgen][oracle]
     if (h < best) best = h, e_lo = e;
   }
   const Vec3 mid = 0.5 * (A.edge_point(cf::EdgeId(e_lo), 0) + A.edge_point(cf::EdgeId(e_lo), 1));
-  const Analysis ee = analyse(ga, gb, at(Rc, Vec3(120, 20, 40) - Rc * mid), kTouchTol);
+  const Analysis ee = o.analyse(at(Rc, Vec3(120, 20, 40) - Rc * mid));
   INFO(ee.describe());
   CHECK(ee.clean());
   REQUIRE(ee.pcs.size() == 1);
   CHECK(ee.pcs[0].type == PcType::kEE);
   CHECK(ee.pcs[0].a == e_lo);
   // The same pushed 1 micrometre further into B along the bisector: penetrating.
-  CHECK(analyse(ga, gb, at(Rc, Vec3(120, 20, 40) - Rc * mid - 1e-3 * bis), kTouchTol).penetrating);
+  CHECK(o.analyse(at(Rc, Vec3(120, 20, 40) - Rc * mid - 1e-3 * bis)).v.penetrating);
 }
 
 // =======================================================================================
@@ -1758,7 +1195,7 @@ TEST_CASE("cfgen: cube on a large box, every single-PC CF and nothing else", "[c
   // spans it; two edges crossing inside both lie in it), so two PCs never have distinct
   // planes. In particular no two PCs on the same face of B.
   const Generated& g = generated(
-      "cube/big_box", [] { return load("cube.off"); }, [] { return big_box(200); });
+      "cube/big_box", [] { return load("cube.off"); }, big_box);
   WARN("cube vs 200 mm box: " << g.graph->num_cfs() << " CFs generated in " << g.seconds << " s");
   check_single_pcs(g, {{PcType::kFF, 36},
                        {PcType::kEF, 72},
@@ -1785,7 +1222,6 @@ TEST_CASE("cfgen: cube vs L-block", "[cfgen]") {
   const Generated& g = cube_l_block();
   const Polyhedron& A = *g.A;
   const Polyhedron& B = *g.B;
-  const ModelGeom ga(A), gb(B);
   WARN("cube vs L-block: " << g.graph->num_cfs() << " CFs (" << count_size(*g.graph, 1) << " + "
                            << count_size(*g.graph, 2) << " + " << count_size(*g.graph, 3) << "), "
                            << g.graph->num_transitions() << " transitions, generated in "
@@ -1820,7 +1256,7 @@ TEST_CASE("cfgen: cube vs L-block", "[cfgen]") {
         expected.insert({s.begin(), s.end()});
         // Independent witness: the cube in the corner, centred 15 mm off both faces.
         const Pose p = seat_pose({n1, n2}, {Vec3::UnitY(), Vec3::UnitX()}, Vec3(35, 35, 40));
-        check_hand_cf(g, ga, gb, s, p);
+        check_hand_cf(g, s, p);
       }
     CHECK(expected.size() == 24);
     const auto ff2 = all_ff(*g.graph, 2);
@@ -1882,7 +1318,6 @@ TEST_CASE("cfgen: cube vs corner block", "[cfgen]") {
   const Generated& g = cube_corner_block();
   const Polyhedron& A = *g.A;
   const Polyhedron& B = *g.B;
-  const ModelGeom ga(A), gb(B);
   WARN("cube vs corner block: " << g.graph->num_cfs() << " CFs (" << count_size(*g.graph, 1)
                                 << " + " << count_size(*g.graph, 2) << " + "
                                 << count_size(*g.graph, 3) << "), " << g.graph->num_transitions()
@@ -1917,7 +1352,7 @@ TEST_CASE("cfgen: cube vs corner block", "[cfgen]") {
         const Vec3 spin_to = inner_n[(k + 1) % 3];
         const Pose p = seat_pose({n1, other}, {inner_n[k], spin_to}, center);
         const PcSet s({Pc{PcType::kFF, cube_face(A, n1), inner[k]}});
-        check_hand_cf(g, ga, gb, s, p);
+        check_hand_cf(g, s, p);
       }
     // {f-f, f-f}: two adjacent cube faces on two of the three inner faces (the only pairs of
     // B faces across a reflex edge): 3 face pairs x 6 x 4 = 72.
@@ -1937,7 +1372,7 @@ TEST_CASE("cfgen: cube vs corner block", "[cfgen]") {
             center(ax1) = 35;
             center(ax2) = 35;
             const Pose p = seat_pose({n1, n2}, {inner_n[k1], inner_n[k2]}, center);
-            check_hand_cf(g, ga, gb, s, p);
+            check_hand_cf(g, s, p);
           }
     CHECK(expected2.size() == 72);
     // The seat: three mutually adjacent cube faces on floor, x-wall and z-wall. The map of
@@ -1958,7 +1393,7 @@ TEST_CASE("cfgen: cube vs corner block", "[cfgen]") {
                          Pc{PcType::kFF, cube_face(A, n3), zwall}});
           expected3.insert({s.begin(), s.end()});
           const Pose p = seat_pose({n1, n2}, {Vec3::UnitY(), Vec3::UnitX()}, Vec3(35, 35, 35));
-          check_hand_cf(g, ga, gb, s, p);
+          check_hand_cf(g, s, p);
         }
     CHECK(expected3.size() == 24);
     std::set<std::vector<Pc>> got2, got3;
@@ -1987,7 +1422,6 @@ TEST_CASE("cfgen: cube in a U-channel wider than the cube", "[cfgen][hand]") {
       "cube/u_channel", [] { return load("cube.off"); }, u_channel, 1);
   const Polyhedron& A = *g.A;
   const Polyhedron& B = *g.B;
-  const ModelGeom ga(A), gb(B);
   WARN("cube vs U-channel (one PC): " << g.graph->num_cfs() << " CFs, generated in " << g.seconds
                                       << " s");
   // One PC: 16 vertices, 24 edges, 10 faces; the two reflex edges run along the slot's
@@ -2009,7 +1443,7 @@ TEST_CASE("cfgen: cube in a U-channel wider than the cube", "[cfgen][hand]") {
   for (const Vec3& n : axes()) {
     const Vec3 other = std::abs(n.dot(Vec3::UnitX())) < 0.5 ? Vec3::UnitX() : Vec3::UnitZ();
     const Pose p = seat_pose({n, other}, {Vec3::UnitY(), Vec3::UnitX()}, Vec3(40, 35, 40));
-    check_hand_cf(g, ga, gb, PcSet({Pc{PcType::kFF, cube_face(A, n), floor}}), p);
+    check_hand_cf(g, PcSet({Pc{PcType::kFF, cube_face(A, n), floor}}), p);
   }
   // The cube tilted by 0.15 rad about a generic axis: its lowest vertex on the slot floor, or
   // its leftmost vertex on the left wall (its width grows to about 36 mm, still clear).
@@ -2023,9 +1457,9 @@ TEST_CASE("cfgen: cube in a U-channel wider than the cube", "[cfgen][hand]") {
     Pose p;
     p.R_BA = R;
     p.t_BA = Vec3(40, 20 - (R * A.vertices()[lo].p).y(), 40);
-    check_hand_cf(g, ga, gb, PcSet({Pc{PcType::kVF, lo, floor}}), p);
+    check_hand_cf(g, PcSet({Pc{PcType::kVF, lo, floor}}), p);
     p.t_BA = Vec3(20 - (R * A.vertices()[lx].p).x(), 50, 40);
-    check_hand_cf(g, ga, gb, PcSet({Pc{PcType::kVF, lx, left}}), p);
+    check_hand_cf(g, PcSet({Pc{PcType::kVF, lx, left}}), p);
   }
   // A cube face on the slot floor's front edge (y = 20, z = 0, x in 20..60), the face
   // tilted 45 degrees between the floor and the front face, cube edges along x: the cube
@@ -2042,13 +1476,13 @@ TEST_CASE("cfgen: cube in a U-channel wider than the cube", "[cfgen][hand]") {
   for (const Vec3& n : axes()) {
     const Vec3 other = std::abs(n.dot(Vec3::UnitX())) < 0.5 ? Vec3::UnitX() : Vec3::UnitY();
     const Pose p = seat_pose({n, other}, {m, Vec3::UnitX()}, Vec3(40, 20, 0) + 15 * m);
-    check_hand_cf(g, ga, gb, PcSet({Pc{PcType::kFE, cube_face(A, n), front_edge}}), p);
+    check_hand_cf(g, PcSet({Pc{PcType::kFE, cube_face(A, n), front_edge}}), p);
   }
 
   // Two PCs. Opposite cube faces (30 mm apart) can never lie on both walls (40 mm apart):
   // the search must find no witness for {f-f(a, left wall), f-f(opposite of a, right wall)}.
   // Across the slot's two reflex edges, floor (y = 20) with either wall, with adjacent cube
-  // faces: 2 x 6 x 4 = 48 CFs that must be found, with witnesses this file confirms.
+  // faces: 2 x 6 x 4 = 48 CFs that must be found, with witnesses the oracle confirms.
   const cf::gen::WitnessSearch search(g.ai, g.bi, cf::gen::SearchParams{});
   auto seeds = [&](const PcSet& s) {
     std::vector<Mat3> out;
@@ -2061,7 +1495,7 @@ TEST_CASE("cfgen: cube in a U-channel wider than the cube", "[cfgen][hand]") {
         {Pc{PcType::kFF, cube_face(A, n), left}, Pc{PcType::kFF, cube_face(A, -n), right}});
     const cf::gen::Witness w = search.find(s, seeds(s));
     INFO("{" << cf::to_string(s) << "} cannot be realised (walls 40 mm apart); a claimed witness: "
-             << pose_str(w.pose) << ": " << analyse(ga, gb, w.pose, kTouchTol).describe());
+             << pose_str(w.pose) << ": " << g.oracle->analyse(w.pose).describe());
     CHECK_FALSE(w.found);
   }
   int found = 0;
@@ -2072,10 +1506,10 @@ TEST_CASE("cfgen: cube in a U-channel wider than the cube", "[cfgen][hand]") {
         const int wall = side == 0 ? left : right;
         const PcSet s(
             {Pc{PcType::kFF, cube_face(A, n1), floor}, Pc{PcType::kFF, cube_face(A, n2), wall}});
-        // This file's own witness first: the cube in the slot's corner.
+        // A hand-made witness first: the cube in the slot's corner.
         const Vec3 wn = side == 0 ? Vec3(Vec3::UnitX()) : Vec3(-Vec3::UnitX());
         const Pose p = seat_pose({n1, n2}, {Vec3::UnitY(), wn}, Vec3(side == 0 ? 35 : 45, 35, 40));
-        const Analysis hand = analyse(ga, gb, p, kTouchTol);
+        const Analysis hand = g.oracle->analyse(p);
         INFO("hand witness for {" << cf::to_string(s) << "}: " << pose_str(p) << ": "
                                   << hand.describe());
         CHECK(hand.clean());
@@ -2085,7 +1519,7 @@ TEST_CASE("cfgen: cube in a U-channel wider than the cube", "[cfgen][hand]") {
         CHECK(w.found);
         if (!w.found) continue;
         ++found;
-        const Analysis an = analyse(ga, gb, w.pose, kTouchTol);
+        const Analysis an = g.oracle->analyse(w.pose);
         INFO("its witness " << pose_str(w.pose) << ": " << an.describe());
         CHECK(an.clean());
         CHECK(an.pcs == s);

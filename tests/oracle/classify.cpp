@@ -108,6 +108,16 @@ Tolerances default_tolerances(const Poly& A, const Poly& B) {
   return t;
 }
 
+Vec3 normal_into_a(const Poly& B, const Touch& t) {
+  Vec3 m = t.normal;
+  if (t.type == PcType::FE || t.type == PcType::FV) m = -m;
+  if (t.type == PcType::EE) {
+    const Edge& eb = B.E[t.b];
+    if (m.dot(B.F[eb.face[0]].n + B.F[eb.face[1]].n) < 0) m = -m;
+  }
+  return m;
+}
+
 CfKey Verdict::key() const {
   CfKey k;
   for (int i : pcs) k.push_back(Pc{touches[i].type, touches[i].a, touches[i].b});

@@ -64,8 +64,17 @@ struct Touch {
   double sin_angle = 1;      // e-e: sine of the angle between the edges
   bool near_end = false;     // e-e: crossing close to an edge end or at a small angle
   Vec3 p0 = Vec3::Zero(), p1 = Vec3::Zero();  // world: contact point (p0) or segment (p0, p1)
-  Vec3 normal = Vec3::Zero();                 // contact plane normal (world, nondegenerate types)
+  // Contact plane normal (world, non-degenerate types) as found: B's face's outward normal for
+  // f-f, e-f, v-f, A's for f-e, f-v, either side for e-e; normal_into_a orients it.
+  Vec3 normal = Vec3::Zero();
 };
+
+/// The normal of a non-degenerate touch's contact plane (docs/spec.md, section 4), oriented
+/// from B into A (the direction in which A leaves B): B's face normal for f-f, e-f and v-f;
+/// minus A's face normal for f-e and f-v (Touch::normal is A's, outward); for e-e the normal of
+/// the plane of both edges, on the side of B's edge's outward bisector (the sum of its two
+/// faces' normals). World frame, unit.
+Vec3 normal_into_a(const Poly& B, const Touch& t);
 
 struct Verdict {
   bool penetrating = false;

@@ -1,12 +1,13 @@
 // Unit tests of the independent oracle's own geometry: shape families, the feature rebuild,
-// touching/PC classification, the tangent-cone interior test (including the L-foot-in-wall
-// case), times of impact and a smoke run of the sampler.
+// touching/PC classification, contact normals, the tangent-cone interior test (including the
+// L-foot-in-wall case), the transition rules, times of impact and a smoke run of the sampler.
 
 #include "classify.hpp"
 #include "graph.hpp"
 #include "motion.hpp"
 #include "sampler.hpp"
 #include "shapes.hpp"
+#include "transitions.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -15,6 +16,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <set>
 
@@ -215,6 +217,88 @@ TEST_CASE("a cube edge crossing a table edge is e-e") {
   CHECK(C.classify(X).penetrating);
 }
 
+TEST_CASE("contact normals point from B into A for every non-degenerate type") {
+  // Exact up to rounding of the rotations (coordinates of tens of mm).
+  constexpr double kSame = 1e-12;
+  Poly A = cube(10);
+  Poly floor_ = prism({{-50, -50}, {50, -50}, {50, 50}, {-50, 50}}, -20, 0, "floor");
+  Classifier C(A, floor_, tol_for(A, floor_));
+  // One PC of the pose, with its normal into A.
+  auto only = [](const Poly& B, const Verdict& V) {
+    INFO(V.describe());
+    REQUIRE(V.valid_cf());
+    REQUIRE(V.pcs.size() == 1);
+    const Touch& t = V.touches[V.pcs[0]];
+    return std::make_pair(t.type, normal_into_a(B, t));
+  };
+  // On the floor (top face z = 0): f-f flat, e-f tilted about x, v-f tilted about two axes;
+  // B's face normal, +z, each time.
+  Pose X;
+  X.t = Vec3(3, -4, 0);
+  auto [ff, n_ff] = only(floor_, C.classify(X));
+  CHECK(ff == PcType::FF);
+  CHECK((n_ff - Vec3(0, 0, 1)).norm() < kSame);
+  Pose Y;
+  Y.R = Eigen::AngleAxisd(0.3, Vec3::UnitX()).toRotationMatrix();
+  auto [ef, n_ef] = only(floor_, C.classify(Y));
+  CHECK(ef == PcType::EF);
+  CHECK((n_ef - Vec3(0, 0, 1)).norm() < kSame);
+  Pose Z;
+  Z.R = Eigen::AngleAxisd(0.3, Vec3::UnitX()).toRotationMatrix() *
+        Eigen::AngleAxisd(-0.2, Vec3::UnitY()).toRotationMatrix();
+  auto [vf, n_vf] = only(floor_, C.classify(Z));
+  CHECK(vf == PcType::VF);
+  CHECK((n_vf - Vec3(0, 0, 1)).norm() < kSame);
+  // A table (x <= 0, z <= 0), its edge along y at x = z = 0. The cube's bottom face turned 45
+  // degrees about y so that its outward normal is (-1, 0, -1)/sqrt(2), its centre on the edge:
+  // f-e, and the normal into A is minus the face's, (1, 0, 1)/sqrt(2).
+  Poly table = prism({{-50, -50}, {0, -50}, {0, 50}, {-50, 50}}, -20, 0, "table");
+  Classifier T(A, table, tol_for(A, table));
+  Pose F;
+  F.R = Eigen::AngleAxisd(kPi / 4, Vec3::UnitY()).toRotationMatrix();
+  F.t = Vec3(0, 7, 0) - F.R * Vec3(5, 5, 0);
+  const Verdict VF = T.classify(F);
+  auto [fe, n_fe] = only(table, VF);
+  CHECK(fe == PcType::FE);
+  CHECK((VF.touches[VF.pcs[0]].normal - Vec3(-1, 0, -1).normalized()).norm() < kSame);
+  CHECK((n_fe - Vec3(1, 0, 1).normalized()).norm() < kSame);
+  // A block in the octant x, y, z <= 0, the cube's bottom face square to (1, 1, 1) with its
+  // centre on the block's corner vertex: f-v, normal into A (1, 1, 1)/sqrt(3).
+  Poly block = prism({{-50, -50}, {0, -50}, {0, 0}, {-50, 0}}, -20, 0, "block");
+  Classifier K(A, block, tol_for(A, block));
+  Pose G;
+  G.R = Eigen::Quaterniond::FromTwoVectors(Vec3(0, 0, -1), -Vec3(1, 1, 1).normalized())
+            .toRotationMatrix();
+  G.t = -G.R * Vec3(5, 5, 0);
+  auto [fv, n_fv] = only(block, K.classify(G));
+  CHECK(fv == PcType::FV);
+  CHECK((n_fv - Vec3(1, 1, 1).normalized()).norm() < kSame);
+  // The cube's edge across the table's edge (as in the e-e test above): the plane of both
+  // edges, on the side of the table edge's outward bisector (1, 0, 1)/sqrt(2), whichever way
+  // the cross product of the edges points.
+  Vec3 d = Vec3(1, 0, -1).normalized();
+  Vec3 s = d.cross(Vec3(0, 1, 0)).normalized();
+  Vec3 c = d.cross(s).normalized();
+  Vec3 n1 = (-s + c).normalized(), n2 = (-s - c).normalized();
+  Pose E;
+  E.R.col(0) = d;
+  E.R.col(1) = -n1;
+  E.R.col(2) = -n2;
+  if (E.R.determinant() < 0) {
+    E.R.col(1) = -n2;
+    E.R.col(2) = -n1;
+  }
+  E.t = Vec3(0, 7, 0) - E.R * Vec3(5, 0, 0);
+  const Verdict VE = T.classify(E);
+  auto [ee, n_ee] = only(table, VE);
+  CHECK(ee == PcType::EE);
+  CHECK((s - Vec3(1, 0, 1).normalized()).norm() < kSame);
+  CHECK((n_ee - s).norm() < kSame);
+  Touch flipped = VE.touches[VE.pcs[0]];
+  flipped.normal = -flipped.normal;
+  CHECK((normal_into_a(table, flipped) - s).norm() < kSame);
+}
+
 TEST_CASE("the L-foot inside a wall is caught although elements only touch on boundaries") {
   // B: floor slab (top y = 0 for x > 0) and a wall x in [-10, 0] rising to y = 20; reflex edge
   // at x = 0, y = 0. A: an L-part whose bottom face (y = 0) runs through B's reflex edge and
@@ -307,6 +391,78 @@ TEST_CASE("tangent cones: closed forms") {
   CHECK(point_in_cone(kl, Vec3(-1, 1, 1).normalized()));
   CHECK_FALSE(point_in_cone(kl, Vec3(1, 1, 1).normalized()));
   CHECK_FALSE(point_in_cone(kl, Vec3(1, 1, -1).normalized()));
+}
+
+TEST_CASE("the transition rules (docs/spec.md section 4) on a cube against a box") {
+  // Two convex boxes (8 vertices, 12 edges, 6 faces, three edges and three faces at every
+  // vertex): each PC's neighbours, counted by hand from the boundary relations of
+  // docs/spec.md, section 4.
+  //   f-f: 4 e-f (A's face's edges) + 4 f-e (B's face's edges)                        = 8
+  //   e-f: 2 f-f (the edge's faces) + 2 v-f (its ends) + 4 e-e (B's face's edges)      = 8
+  //   f-e: 2 f-f + 2 f-v + 4 e-e, likewise                                             = 8
+  //   v-f: 3 e-f (the vertex's edges) + 3 x 4 e-e (those edges, B's face's edges)      = 15
+  //   f-v: 3 f-e + 4 x 3 e-e, likewise                                                 = 15
+  //   e-e: 2 e-f + 2 f-e (the edges' faces) + 2 x 2 v-f + 2 x 2 f-v (ends and faces)   = 12
+  Poly A = cube(10);
+  Poly B = prism({{-50, -50}, {50, -50}, {50, 50}, {-50, 50}}, -20, 0, "floor");
+  const std::map<PcType, int> expected = {{PcType::FF, 8},  {PcType::EF, 8},  {PcType::FE, 8},
+                                          {PcType::VF, 15}, {PcType::FV, 15}, {PcType::EE, 12}};
+  auto count = [](const Poly& P, int kind) {
+    return static_cast<int>(kind == 0 ? P.V.size() : kind == 1 ? P.E.size() : P.F.size());
+  };
+  std::vector<Pc> all;
+  for (const auto& [t, n] : expected)
+    for (int a = 0; a < count(A, kind_a(t)); ++a)
+      for (int b = 0; b < count(B, kind_b(t)); ++b) all.push_back(Pc{t, a, b});
+  CHECK(all.size() == 6 * 6 + 12 * 6 + 6 * 12 + 8 * 6 + 6 * 8 + 12 * 12);
+  int asymmetric = 0;
+  for (const Pc& x : all) {
+    int n = 0;
+    for (const Pc& y : all) {
+      const bool nb = neighbouring_pcs(A, B, x, y);
+      if (nb != neighbouring_pcs(A, B, y, x)) ++asymmetric;
+      n += nb ? 1 : 0;
+    }
+    INFO(key_string({x}));
+    CHECK(n == expected.at(x.type));
+  }
+  CHECK(asymmetric == 0);
+  // Real elements: A's bottom face and B's top face, an edge and a vertex of A's bottom.
+  const int fa = face_with_normal(A, Vec3(0, 0, -1)), fb = face_with_normal(B, Vec3(0, 0, 1));
+  const int fa2 = face_with_normal(A, Vec3(1, 0, 0)), fb2 = face_with_normal(B, Vec3(-1, 0, 0));
+  REQUIRE(fa >= 0);
+  REQUIRE(fb >= 0);
+  const int ea = A.edge_index(0, 1);  // (0,0,0)-(10,0,0), on the bottom face
+  REQUIRE(ea >= 0);
+  REQUIRE(A.edge_on_face(ea, fa));
+  const int eb_off = B.edge_index(0, 4);  // a vertical edge of B: not on its top face
+  REQUIRE(eb_off >= 0);
+  REQUIRE_FALSE(B.edge_on_face(eb_off, fb));
+  CHECK(neighbouring_pcs(A, B, Pc{PcType::FF, fa, fb}, Pc{PcType::EF, ea, fb}));
+  CHECK_FALSE(neighbouring_pcs(A, B, Pc{PcType::FF, fa, fb}, Pc{PcType::EF, ea, fb2}));
+  CHECK_FALSE(neighbouring_pcs(A, B, Pc{PcType::FF, fa, fb}, Pc{PcType::FF, fa, fb}));
+  CHECK(neighbouring_pcs(A, B, Pc{PcType::EF, ea, fb}, Pc{PcType::VF, 0, fb}));
+  CHECK_FALSE(neighbouring_pcs(A, B, Pc{PcType::EF, ea, fb}, Pc{PcType::VF, 2, fb}));
+  CHECK_FALSE(neighbouring_pcs(A, B, Pc{PcType::EF, ea, fb}, Pc{PcType::EE, ea, eb_off}));
+  auto key = [](std::vector<Pc> pcs) {
+    std::sort(pcs.begin(), pcs.end());
+    return pcs;
+  };
+  const CfKey ff = key({{PcType::FF, fa, fb}});
+  const CfKey ff2 = key({{PcType::FF, fa, fb}, {PcType::FF, fa2, fb2}});
+  CHECK(is_gain(ff, ff2));
+  CHECK_FALSE(is_gain(ff2, ff));  // a lose, not a gain
+  CHECK_FALSE(is_gain(ff, ff));
+  CHECK_FALSE(is_gain(key({{PcType::EF, ea, fb}}), ff2));  // not a subset
+  CHECK_FALSE(is_gain(CfKey{}, ff2));                      // two PCs added
+  // A change replaces PCs by neighbours, one to one, in any order of the sorted keys.
+  CHECK(is_change(A, B, ff, key({{PcType::EF, ea, fb}})));
+  CHECK(is_change(A, B, key({{PcType::EF, ea, fb}}), ff));
+  CHECK_FALSE(is_change(A, B, ff, key({{PcType::VF, 0, fb}})));  // two steps: f-f, e-f, v-f
+  CHECK_FALSE(is_change(A, B, ff, ff));
+  CHECK_FALSE(is_change(A, B, ff, ff2));
+  CHECK(is_change(A, B, ff2, key({{PcType::FF, fa2, fb2}, {PcType::EF, ea, fb}})));
+  CHECK_FALSE(is_change(A, B, ff2, key({{PcType::FF, fa2, fb2}, {PcType::VF, 0, fb}})));
 }
 
 TEST_CASE("time of impact: translation is exact, rotation lands on contact") {

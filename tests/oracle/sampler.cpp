@@ -310,13 +310,7 @@ void Sampler::walk(Pose X, Verdict V, const std::string& fam) {
         pts.push_back(0.5 * (t.p0 + t.p1));
         lines.emplace_back(t.p0, t.p1);
       }
-      Vec3 m = n;
-      if (t.type == PcType::FE || t.type == PcType::FV) m = -n;
-      if (t.type == PcType::EE) {
-        const Edge& eb = B_.E[t.b];
-        if (m.dot(B_.F[eb.face[0]].n + B_.F[eb.face[1]].n) < 0) m = -m;
-      }
-      into_a.push_back(m);
+      into_a.push_back(normal_into_a(B_, t));
     }
     if (normals.empty()) return;
     double pick = U(0, 1);

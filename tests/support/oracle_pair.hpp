@@ -1,8 +1,8 @@
 #pragma once
 // A pair of the independent oracle's shape families (tests/oracle/shapes.hpp), written out and
 // read back through cfgen's loader, with the oracle's own polyhedra rebuilt from what cfgen
-// read: both sides then number the elements alike. For the tests that link cfgen_core and the
-// oracle (cf_oracle).
+// read: both sides then number the elements alike; and one of the oracle's meshes as cfgen's
+// model (from_oracle). For the tests that link cfgen_core and the oracle (cf_oracle).
 
 #include "mesh/model_loader.hpp"
 #include "poly.hpp"
@@ -37,6 +37,17 @@ inline oracle::Poly to_oracle(const cf::Polyhedron& m, const std::string& name) 
     faces.push_back(loops);
   }
   return oracle::build_poly(verts, edges, faces, name);
+}
+
+/// cfgen's model of one of the oracle's meshes, read as its loader reads a file's polygon
+/// soup (coplanar facets joined into faces, vertices inside a face or an edge dropped).
+inline cf::Polyhedron from_oracle(const oracle::Mesh& mesh, const std::string& name) {
+  cf::tools::PolygonSoup soup;
+  soup.points = mesh.V;
+  soup.polygons = mesh.F;
+  cf::tools::LoadOptions options;
+  options.name = name;
+  return cf::tools::model_from_soup(soup, name, options);
 }
 
 struct OraclePair {
