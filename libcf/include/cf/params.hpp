@@ -118,8 +118,8 @@ struct ProxyParams {
   /// breaking away, a fast hand) is first looked along with the detection band widened to
   /// lookahead_epsilons * epsilon_mm, and goes up to 0.75 of that band at once, stopping
   /// half an epsilon short of the first contact in it: one detection instead of one per
-  /// 0.75 epsilon. Turns step as before. 1 turns it off; where the proxy ends is the same
-  /// either way (the solve at every sub-step uses the stages' own detection).
+  /// 0.75 epsilon. Turns advance one sub-step at a time. 1 turns it off; where the proxy
+  /// ends is the same either way (the solve at every sub-step uses the stages' own detection).
   double lookahead_epsilons = 4.0;
   /// Projected Gauss-Seidel sweeps of the constraint solve per (sub-)step (at most).
   int solver_iterations = 60;

@@ -485,7 +485,7 @@ void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, De
     if (sweep > step_len) {
       // Too long to be sure of: advance by step_len and look again; a translation as far as
       // the lookahead band shows it free. (A turn's contacts in the band would be linearised
-      // about points up to the band's width from where they touch: turns step as before.)
+      // about points up to the band's width from where they touch: turns advance by step_len.)
       const bool translation = xi.tail<3>().norm() * pm.reach_mm <= 1e-6 * step_len;
       const double f = pm.look && translation ? look_ahead(X, xi.head<3>()) : step_len / sweep;
       X = moved(X, g_A, f * xi.head<3>(), f * xi.tail<3>());

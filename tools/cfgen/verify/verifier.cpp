@@ -313,7 +313,7 @@ bool Verifier::overlap_at(const Pose& pose, ElementKind ka, int a, ElementKind k
 double Verifier::verify(const PcSet& pcs, const Pose& pose, std::string* why,
                         FailedPair* failed) const {
   // The reason is written only when asked for: verify runs millions of times a run, most of
-  // them to reject, and a message built each time was a heap allocation or five.
+  // them to reject, and a message built each time would be a heap allocation or five.
   auto reject = [&](const char* reason) {
     if (why) *why = reason;
     return -1.0;
