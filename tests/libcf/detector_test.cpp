@@ -897,3 +897,69 @@ TEST_CASE("a negative reuse margin is refused", "[detector]") {
   CHECK_THROWS_WITH(cf::ContactDetector(tmod::cube(), tmod::l_block(), p),
                     Catch::Contains("parameter reuse_margin_mm must be non-negative"));
 }
+
+// The centre of the slab's plane (ContactPc::centre_W) along a sweep of poses: that of its
+// deepest contact.
+std::vector<Vec3> slab_centres(const std::vector<cf::Pose>& poses) {
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  std::vector<Vec3> out;
+  for (const cf::Pose& p : poses) {
+    det.detect(p, cs);
+    const cf::ContactPc* deepest = nullptr;
+    for (const cf::ContactPc& c : cs)
+      if (c.R_WT.col(1).y() > 0.99 && (!deepest || c.distance < deepest->distance)) deepest = &c;
+    REQUIRE(deepest);
+    out.push_back(deepest->centre_W);
+  }
+  return out;
+}
+
+// Largest step between consecutive centres over the mean step: a centre that jumped where a
+// contact joins or leaves the plane (at a tolerance, or as its offset crosses epsilon) would
+// make one step a sizeable share of the whole travel, tens of mean steps.
+double largest_over_mean_step(const std::vector<Vec3>& c) {
+  double largest = 0, sum = 0;
+  for (std::size_t i = 1; i < c.size(); ++i) {
+    const double s = (c[i] - c[i - 1]).norm();
+    largest = std::max(largest, s), sum += s;
+  }
+  return largest / (sum / static_cast<double>(c.size() - 1));
+}
+
+TEST_CASE("a plane's force acts at the depth-weighted centre of its contacts", "[detector]") {
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  SECTION("flush: the f-f, its edges' e-f and its corners' v-f weigh alike: the region's") {
+    det.detect(pose(Eigen::Matrix3d::Identity(), {70, 35.3, 40}), cs);
+    REQUIRE(cs.size() == 9);
+    for (const cf::ContactPc& c : cs) {
+      CHECK(c.fit == Approx(1));
+      CHECK((c.centre_W - Vec3(70, 20.3, 40)).norm() < kTol);
+    }
+  }
+  SECTION("tilting through the f-f tolerance, the centre runs to the low edge continuously") {
+    // About z through the low edge x = 55 (cube corner at -15, -15), the edge 0.3 mm up: the
+    // f-f's tolerance atan(1 / 30) = 0.033 rad is passed at step 333 of 600.
+    std::vector<cf::Pose> poses;
+    for (int i = 0; i <= 600; ++i) {
+      const Eigen::Matrix3d R = rot(1e-4 * i, {0, 0, 1});
+      const Vec3 low = R * Vec3(-15, -15, 0);
+      poses.push_back(pose(R, Vec3(55, 20.3, 40) - low));
+    }
+    const std::vector<Vec3> c = slab_centres(poses);
+    CHECK(c.front().x() == Approx(70).margin(1e-9));
+    CHECK(c.back().x() == Approx(55).margin(1e-6));  // the low edge alone is in the band
+    CHECK(largest_over_mean_step(c) < 5);
+  }
+  SECTION("a face lowered over the slab's outer edge: the f-e joins the plane continuously") {
+    // The cube over x = 120 (half over the slab), turned 0.5 degrees about x: the f-e of its
+    // bottom on the slab's edge lies in the cube's plane, epsilon-close to the slab's.
+    std::vector<cf::Pose> poses;
+    for (int i = 0; i <= 400; ++i)
+      poses.push_back(pose(rot(0.5 * M_PI / 180, {1, 0, 0}), {128, 35.98 - 0.001 * i, 40}));
+    CHECK(largest_over_mean_step(slab_centres(poses)) < 5);
+  }
+}

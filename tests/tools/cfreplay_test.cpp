@@ -179,7 +179,7 @@ TEST_CASE("over whole trajectories: friction <= mu F_cy, and F and M recomputed 
         CHECK(fn == Approx(2.3 * (1.0 - f.distance)).margin(1e-9));
         CHECK(ft <= 0.7 * fn * (1 + 1e-12) + 1e-12);
         F += f.F_W;
-        M += (f.p_W - o).cross(f.F_W);
+        M += (f.centre_W - o).cross(f.F_W);  // where its plane's force acts
         ++pcs_checked;
       }
       CHECK((r.F_W - F).norm() < 1e-9);

@@ -31,7 +31,9 @@ int main(int argc, char** argv) {
       "             the proxy + gravity; world; N, N mm), then the same in A's frame (FAx..MAz),\n"
       "             the status, the per-PC friction regimes (then approaching:PC for each contact\n"
       "             pushing by eq. (1) alone), the proxy pose proxy_tx..proxy_qz and the contact\n"
-      "             wrench Fcx..Mcz (what B exerts on A).\n"
+      "             wrench Fcx..Mcz (what B exerts on A), and the force model's\n"
+      "             discontinuities by design at the tick (slip_onset, impact_end,\n"
+      "             regime_switch, hold_release, pc_lost; docs/force-model.md).\n"
       "Defaults are the paper's: m 0.5 kg, g 9.8 N/kg along -y, K 2.3 N/mm, K_p 1.6 N/mm,\n"
       "mu 0.7, mu_D 0.08, epsilon 1 mm (docs/force-model.md).",
       "cfreplay"};

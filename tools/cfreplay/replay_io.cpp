@@ -121,7 +121,8 @@ std::vector<Sample> read_trajectory(const std::string& path) {
 
 const char* output_header() {
   return "t,cf,pcs,motion,Fx,Fy,Fz,Mx,My,Mz,FAx,FAy,FAz,MAx,MAy,MAz,status,regimes,"
-         "proxy_tx,proxy_ty,proxy_tz,proxy_qw,proxy_qx,proxy_qy,proxy_qz,Fcx,Fcy,Fcz,Mcx,Mcy,Mcz";
+         "proxy_tx,proxy_ty,proxy_tz,proxy_qw,proxy_qx,proxy_qy,proxy_qz,Fcx,Fcy,Fcz,Mcx,Mcy,Mcz,"
+         "discontinuities";
 }
 
 std::string format_row(const Row& r) {
@@ -131,12 +132,13 @@ std::string format_row(const Row& r) {
   char buf[1024];
   std::snprintf(buf, sizeof buf,
                 "%.6f,%d,%s,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%s,%s,"
-                "%.9g,%.9g,%.9g,%.12f,%.12f,%.12f,%.12f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g",
+                "%.9g,%.9g,%.9g,%.12f,%.12f,%.12f,%.12f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%s",
                 r.t, r.cf, r.pcs.c_str(), r.motion.c_str(), r.F_W.x(), r.F_W.y(), r.F_W.z(),
                 r.M_W.x(), r.M_W.y(), r.M_W.z(), r.F_A.x(), r.F_A.y(), r.F_A.z(), r.M_A.x(),
                 r.M_A.y(), r.M_A.z(), r.status.c_str(), r.regimes.c_str(), r.X_WP.t_BA.x(),
                 r.X_WP.t_BA.y(), r.X_WP.t_BA.z(), q.w(), q.x(), q.y(), q.z(), r.Fc_W.x(),
-                r.Fc_W.y(), r.Fc_W.z(), r.Mc_W.x(), r.Mc_W.y(), r.Mc_W.z());
+                r.Fc_W.y(), r.Fc_W.z(), r.Mc_W.x(), r.Mc_W.y(), r.Mc_W.z(),
+                r.discontinuities.c_str());
   return buf;
 }
 

@@ -39,7 +39,9 @@ struct Row {
   Vec3 F_W = Vec3::Zero(), M_W = Vec3::Zero(), F_A = Vec3::Zero(), M_A = Vec3::Zero();
   std::string status;   ///< identification / rendering status
   std::string regimes;  ///< per-PC friction regimes joined by ';'
-  Pose X_WP;            ///< where A was rendered: the proxy pose (the device pose without it)
+  /// the force model's discontinuities by design at this tick (cf::discontinuities_string)
+  std::string discontinuities;
+  Pose X_WP;  ///< where A was rendered: the proxy pose (the device pose without it)
   /// What B exerts on A (eqs. (1)-(8) plus the proxy's constraint forces), about the
   /// moment's reference point, world axes.
   Vec3 Fc_W = Vec3::Zero(), Mc_W = Vec3::Zero();

@@ -28,6 +28,7 @@ Row make_row(const HapticResult& r) {
     // Approaching contacts (eq. (1) only) follow, named, as they are not among the pcs.
     for (int k = r.force->num_pcs; k < r.force->num_pcs + r.force->num_approaching; ++k)
       row.regimes += (k ? ";" : "") + std::string("approaching:") + to_string(r.force->pcs[k].pc);
+    row.discontinuities = discontinuities_string(r.force->discontinuities);
   }
   return row;
 }

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 
 namespace cf {
 
@@ -40,6 +41,19 @@ struct ContactPc {
   /// tolerance does not dominate the edge touching under it). Dominated contacts remain
   /// candidates (paper Fig. 3).
   bool dominated = false;
+  /// How far inside its type's detection conditions the contact lies: 1 well inside, falling
+  /// continuously to 0 at the edge of any of them (the angular tolerance of f-f, e-f and
+  /// f-e, the in-plane gap, the wedges' and a vertex's edges' tolerances, e-e's crossing
+  /// angle). It weighs p_W in the centre of its plane (centre_W).
+  double fit = 1;
+  /// mm, world frame: where the force of this contact's plane acts, the depth-weighted centre
+  /// of the plane's contact region: the mean of the p_W of the detected contacts weighted by
+  /// fit (epsilon - distance) and by how nearly each lies in this contact's plane (parallel
+  /// within the largest angular tolerance, its origin within epsilon of the plane); p_W when
+  /// all weigh 0 (docs/runtime.md, "Where a plane's force acts"). It moves continuously while
+  /// A does, whichever contact of the region a reading takes. Set by ContactDetector::detect;
+  /// a contact made by other code may leave it unset (NaN), and its force then acts at p_W.
+  Vec3 centre_W = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
   /// Index of the contact plane group at this pose (contacts whose planes coincide within
   /// tolerance share it; a CF takes at most one contact per group); -1 before grouping.
   std::int16_t plane = -1;

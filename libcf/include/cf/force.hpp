@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 
 namespace cf {
 
@@ -29,13 +30,32 @@ enum class Regime : std::uint8_t {
 /// "none", "impact_static", "stick", "max_static", "kinetic", "approaching".
 const char* to_string(Regime regime);
 
+/// The force model's discontinuities by design (docs/force-model.md, "Continuity"): bit
+/// flags of ForceResult::discontinuities. Between flagged ticks the wrench moves
+/// continuously with the pose.
+enum Discontinuity : std::uint32_t {
+  kSlipOnset = 1u << 0,     ///< a PC static last tick slides now (eq. (3) fails: mu to mu_D)
+  kImpactEnd = 1u << 1,     ///< eq. (2)'s impact friction ends
+  kRegimeSwitch = 1u << 2,  ///< another friction regime set by the motion type (eq. (5) or
+                            ///< (6), MT3's all-kinetic rule, case (c)'s choice), or the
+                            ///< conservative laws start or end
+  kHoldRelease = 1u << 3,   ///< section 4.5's hold of F_cy lets go
+  kPcLost = 1u << 4,        ///< a PC that pushed last tick is gone and no PC of its plane follows
+                            ///< (MT5 with the device pressed in: the proxy drops towards it)
+  kPcGained = 1u << 5,      ///< a PC gained in a plane no PC held: its friction (eq. (2) or (5))
+                            ///< starts where eq. (1) alone pushed while it approached
+};
+/// "slip_onset|impact_end|..." for the flags set, "" for none.
+std::string discontinuities_string(std::uint32_t flags);
+
 /// Per-PC diagnostics and force.
 struct PcForce {
   Pc pc;
   PcExtent extent = PcExtent::kPoint;
   Mat3 R_WT = Mat3::Identity();  ///< task frame axes in the world (y: normal into A)
   Vec3 origin_W = Vec3::Zero();  ///< task frame origin, mm
-  Vec3 p_W = Vec3::Zero();       ///< point of action p_j, mm
+  Vec3 p_W = Vec3::Zero();       ///< the contact's point p_j, mm: its motion gives s_pj
+  Vec3 centre_W = Vec3::Zero();  ///< mm, where the force acts: ContactPc::centre_W, else p_W
   double distance = 0;           ///< d_j, mm
   double F_cy = 0;               ///< N, eq. (1) (after the hold of section 4.5)
   double s_mm = 0;               ///< s_pj as used in eq. (3)
@@ -56,6 +76,8 @@ struct ForceResult {
   int num_approaching = 0;  ///< entries after the PCs; num_pcs + num_approaching <= kMaxPcs
   bool truncated = false;   ///< more contacts than kMaxPcs were given; the rest are ignored
   MotionType motion = MotionType::kNone;
+  /// Discontinuity flags: why the wrench may jump at this tick; 0 when it moves continuously.
+  std::uint32_t discontinuities = 0;
   /// Rendered with the conservative laws (normal force eq. (1) + kinetic friction eq. (5)
   /// on the non-dominated contacts) because no CF or transition of the graph fits.
   bool conservative = false;
@@ -111,14 +133,25 @@ class ForceModel {
     Vec3 anchor_A = Vec3::Zero();  ///< material point of A the anchor holds, A frame
     Vec3 anchor_W = Vec3::Zero();  ///< where it is tied, world
     double held_fcy = 0;
+    // Last tick's reading of the PC: its plane (unit normal into A, a point on it; mm), its
+    // regime, its F_cy (N) and whether the hold set it.
+    Vec3 n_W = Vec3::Zero();
+    Vec3 origin_W = Vec3::Zero();
+    Regime regime = Regime::kNone;
+    double F_cy = 0;
+    bool held = false;
   };
   Slot* find_slot(const Pc& pc);
   Slot* new_slot(const Pc& pc);
+  Slot* same_plane_unseen(const ContactPc& c);
+  std::uint32_t regime_changes(int m) const;
 
   const Polyhedron* A_;
   const Polyhedron* B_;
   Params params_;
   Vec3 centroid_A_;
+  double cos_plane_ = 1;  ///< cos of the detection's largest angular tolerance
+  bool conservative_prev_ = false;
   std::array<Slot, ForceResult::kMaxPcs> slots_{};
   bool has_prev_ = false;
   Pose prev_pose_;

@@ -71,6 +71,13 @@ struct DetectionParams {
   /// The results are the same for any value; 0 turns it off. A larger margin keeps more
   /// pairs for more ticks.
   double reuse_margin_mm = 0.3;
+
+  /// rad: the largest angular tolerance any contact gets (angular_tolerance_rad when set,
+  /// else max_angular_tolerance_rad); two contacts whose normals differ by more are in
+  /// different planes.
+  double largest_angular_tolerance_rad() const {
+    return angular_tolerance_rad > 0 ? angular_tolerance_rad : max_angular_tolerance_rad;
+  }
 };
 
 /// Parameters of identification (CfIdentifier; docs/runtime.md).

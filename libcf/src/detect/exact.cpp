@@ -76,12 +76,22 @@ PairOutcome turned_away(double lin, double rot) {
 // Turned away for good whatever the pose (a reflex edge).
 PairOutcome never() { return turned_away(0, std::numeric_limits<double>::infinity()); }
 
+// x / scale within [0, 1]: the share left of a margin of size `scale` (1 when it has none).
+double share(double x, double scale) { return scale > 0 ? std::clamp(x / scale, 0.0, 1.0) : 1.0; }
+
+// The share left of the wedge tolerance of an edge whose wings dip by `dip` (wedge_dip:
+// rejected above 0), its wings' tolerances being sin_l and sin_r.
+double wedge_share(double dip, double sin_l, double sin_r) {
+  return share(-dip, std::max(sin_l, sin_r));
+}
+
 PairOutcome contact(PcType type, int ia, int ib, double d, const Vec3& p_W, const Vec3& origin,
-                    const Mat3& R_WT, double misfit) {
+                    const Mat3& R_WT, double misfit, double fit) {
   PairOutcome o;
   ContactPc& c = o.contact.emplace();
   c.pc = {type, ia, ib};
   c.distance = d;
+  c.fit = fit;
   c.p_W = p_W;
   c.origin_W = origin;
   c.R_WT = R_WT;
@@ -259,11 +269,13 @@ PairOutcome vertex_face(const PairTables& t, PosedA& P, int v, int fb) {
   const double h = F.normal.dot(p) - F.offset;
   if (!t.in_band(h)) return {};
   // A's edges at the vertex must not run into B (beyond the angular tolerance).
+  double fit = 1;
   for (EdgeId e : a.vertex(VertexId(v)).edges) {
     const Edge& E = a.edge(e);
     const Vec3& q = P.world(a, E.v0 == VertexId(v) ? E.v1 : E.v0);
     const double w = F.normal.dot(q - p), lim = -t.sin_tol_edge_a[e.index()] * E.length;
     if (w < lim) return turned_away(0, (lim - w) / E.length - t.geo_tol);  // q - p turns with A
+    fit = std::min(fit, share(w - lim, -lim));
   }
   const Loc2 loc = locate(t.flat_b.poly(fb), Vec2(F.u.dot(p), F.v.dot(p)));
   const double gap = (loc.inside || loc.dist <= t.geo_tol) ? 0.0 : loc.dist;
@@ -272,7 +284,8 @@ PairOutcome vertex_face(const PairTables& t, PosedA& P, int v, int fb) {
   // On the face's boundary (a vertex on an edge, or outside): the open face does not touch.
   const bool boundary = !loc.inside || loc.dist <= 10 * t.geo_tol;
   return contact(PcType::kVF, v, fb, h, p, p - h * F.normal, task_frame(F.normal, F.u),
-                 std::abs(h) / t.eps + gap / t.eps + (boundary ? kAlongBoundaryPenalty : 0.0));
+                 std::abs(h) / t.eps + gap / t.eps + (boundary ? kAlongBoundaryPenalty : 0.0),
+                 fit * share(t.in_plane - gap, t.in_plane));
 }
 
 // ---- f-v: face of A on vertex of B ---------------------------------------------------------
@@ -284,12 +297,14 @@ PairOutcome face_vertex(const PairTables& t, PosedA& P, int fa, int v) {
   const Vec3 qA = pose.inverse_apply(q);
   const double h = F.normal.dot(qA) - F.offset;
   if (!t.in_band(h)) return {};
+  double fit = 1;
   for (EdgeId e : b.vertex(VertexId(v)).edges) {
     const Edge& E = b.edge(e);
     const Vec3& o = b.vertex(E.v0 == VertexId(v) ? E.v1 : E.v0).p;
     const Vec3 wA = pose.R_BA.transpose() * (o - q);
     const double w = F.normal.dot(wA), lim = -t.sin_tol_edge_b[e.index()] * E.length;
     if (w < lim) return turned_away(0, (lim - w) / E.length - t.geo_tol);
+    fit = std::min(fit, share(w - lim, -lim));
   }
   const Loc2 loc = locate(t.flat_a.poly(fa), Vec2(F.u.dot(qA), F.v.dot(qA)));
   const double gap = (loc.inside || loc.dist <= t.geo_tol) ? 0.0 : loc.dist;
@@ -304,7 +319,8 @@ PairOutcome face_vertex(const PairTables& t, PosedA& P, int fa, int v) {
   const Vec3 onA = q - h * nW;
   const bool boundary = !loc.inside || loc.dist <= 10 * t.geo_tol;  // as in v-f
   return contact(PcType::kFV, fa, v, h, onA, onA, task_frame(-nW, pose.R_BA * F.u),
-                 std::abs(h) / t.eps + gap / t.eps + (boundary ? kAlongBoundaryPenalty : 0.0));
+                 std::abs(h) / t.eps + gap / t.eps + (boundary ? kAlongBoundaryPenalty : 0.0),
+                 fit * share(t.in_plane - gap, t.in_plane));
 }
 
 // ---- e-f: edge of A on face of B -----------------------------------------------------------
@@ -335,7 +351,9 @@ PairOutcome edge_face(const PairTables& t, PosedA& P, ExactScratch& s, int e, in
   const double hc = F.normal.dot(p) - F.offset;
   return contact(
       PcType::kEF, e, fb, d, p, p - hc * F.normal, task_frame(F.normal, dW),
-      ang / tol + std::abs(d) / t.eps + gap / t.eps + (on_boundary ? kAlongBoundaryPenalty : 0.0));
+      ang / tol + std::abs(d) / t.eps + gap / t.eps + (on_boundary ? kAlongBoundaryPenalty : 0.0),
+      share(tol - ang, tol) * share(t.in_plane - gap, t.in_plane) *
+          wedge_share(dip, t.sin_tol_face_a[E.left.index()], t.sin_tol_face_a[E.right.index()]));
 }
 
 // ---- f-e: face of A on edge of B -----------------------------------------------------------
@@ -371,7 +389,9 @@ PairOutcome face_edge(const PairTables& t, PosedA& P, ExactScratch& s, int fa, i
   const Vec3 onA = pose.apply(qcA - (F.normal.dot(qcA) - F.offset) * F.normal);
   return contact(
       PcType::kFE, fa, e, d, onA, onA, task_frame(-(pose.R_BA * F.normal), E.dir),
-      ang / tol + std::abs(d) / t.eps + gap / t.eps + (on_boundary ? kAlongBoundaryPenalty : 0.0));
+      ang / tol + std::abs(d) / t.eps + gap / t.eps + (on_boundary ? kAlongBoundaryPenalty : 0.0),
+      share(tol - ang, tol) * share(t.in_plane - gap, t.in_plane) *
+          wedge_share(dip, t.sin_tol_face_b[E.left.index()], t.sin_tol_face_b[E.right.index()]));
 }
 
 // ---- f-f: face of A on face of B -----------------------------------------------------------
@@ -430,7 +450,8 @@ PairOutcome face_face(const PairTables& t, PosedA& P, ExactScratch& s, int fa, i
   if (ang > tol || !t.in_band(dmin)) return {};
   const Vec3 origin = ov.centroid.x() * FB.u + ov.centroid.y() * FB.v + FB.offset * FB.normal;
   return contact(PcType::kFF, fa, fb, dmin, origin + height(ov.centroid) * FB.normal, origin,
-                 task_frame(FB.normal, FB.u), ang / tol + std::abs(dmin) / t.eps);
+                 task_frame(FB.normal, FB.u), ang / tol + std::abs(dmin) / t.eps,
+                 share(tol - ang, tol));
 }
 
 // ---- e-e: edge of A crossing edge of B -----------------------------------------------------
@@ -448,9 +469,9 @@ PairOutcome edge_edge(const PairTables& t, PosedA& P, int ea, int eb) {
   Vec3 n = uA.cross(uB);
   const double sn = n.norm();
   // The tolerance of the shorter edge (atan(eps / L) falls with L): the larger sine.
-  if (sn <= std::max(t.sin_tol_edge_a[static_cast<std::size_t>(ea)],
-                     t.sin_tol_edge_b[static_cast<std::size_t>(eb)]))
-    return {};  // near-parallel: not e-e
+  const double sin_par = std::max(t.sin_tol_edge_a[static_cast<std::size_t>(ea)],
+                                  t.sin_tol_edge_b[static_cast<std::size_t>(eb)]);
+  if (sn <= sin_par) return {};  // near-parallel: not e-e
   n /= sn;
   // Closest points of the two lines (unit directions): s along A, u along B.
   const Vec3 r = p0 - q0;
@@ -485,8 +506,12 @@ PairOutcome edge_edge(const PairTables& t, PosedA& P, int ea, int eb) {
   // do not cross there.
   const bool at_end = std::min({std::abs(s), std::abs(s - EA.length), std::abs(u),
                                 std::abs(u - EB.length)}) <= t.geo_tol;
+  const double fit =
+      share(sn - sin_par, sin_par) * share(t.in_plane - over, t.in_plane) *
+      wedge_share(dip_a, t.sin_tol_face_a[EA.left.index()], t.sin_tol_face_a[EA.right.index()]) *
+      wedge_share(dip_b, t.sin_tol_face_b[EB.left.index()], t.sin_tol_face_b[EB.right.index()]);
   return contact(PcType::kEE, ea, eb, d, pA, pB, task_frame(n, uB),
-                 std::abs(d) / t.eps + over / t.eps + (at_end ? kAlongBoundaryPenalty : 0.0));
+                 std::abs(d) / t.eps + over / t.eps + (at_end ? kAlongBoundaryPenalty : 0.0), fit);
 }
 
 }  // namespace cf::detail

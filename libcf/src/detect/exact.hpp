@@ -86,10 +86,7 @@ struct PairTables {
   double orth_allow = 0;
 
   /// rad: the largest angular tolerance any pair can get.
-  double max_tol() const {
-    return prm.angular_tolerance_rad > 0 ? prm.angular_tolerance_rad
-                                         : prm.max_angular_tolerance_rad;
-  }
+  double max_tol() const { return prm.largest_angular_tolerance_rad(); }
   /// rad: the angular tolerance of a contact region of this extent (mm).
   double tol_for(double extent) const {
     if (prm.angular_tolerance_rad > 0) return prm.angular_tolerance_rad;

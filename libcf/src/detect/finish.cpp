@@ -39,6 +39,42 @@ void sort_contacts(bool small_indices, FinishScratch& s, ContactSet& cs) {
   for (int i = first_moved; i < n; ++i) cs[i] = s.sort_buf[static_cast<std::size_t>(i)];
 }
 
+// Where each plane's force acts: the mean of the points of the contacts in its plane, each
+// weighted by its fit and by how deep in the band it lies (epsilon - distance, eq. (1)'s
+// factor), so that a contact entering the band or leaving its type's conditions moves the
+// centre continuously. Over a face flush with the plane its contacts (the f-f, the e-f of
+// its edges, the v-f of its corners) weigh alike and the centre is the region's; tilted, it
+// runs towards the deeper side. "In its plane" is itself graded, not the groups' yes or no:
+// contact j counts for c's plane by how nearly parallel their normals are (1 parallel, 0 at
+// the largest angular tolerance) and how nearly their task-frame origins lie in each other's
+// planes (1 on them, 0 epsilon off), so that a contact drifting into a plane joins its
+// centre continuously.
+void plane_centres(double eps, double cos_plane, ContactSet& cs) {
+  const int n = cs.size();
+  const auto share = [](double x, double scale) {
+    return scale > 0 ? std::clamp(x / scale, 0.0, 1.0) : (x >= 0 ? 1.0 : 0.0);
+  };
+  for (int i = 0; i < n; ++i) {
+    ContactPc& c = cs[i];
+    const Vec3 nc = c.R_WT.col(1);
+    Vec3 moment = Vec3::Zero();
+    double weight = 0;
+    for (int j = 0; j < n; ++j) {
+      const ContactPc& o = cs[j];
+      const double w = o.fit * std::max(0.0, eps - o.distance);
+      if (w <= 0) continue;
+      const Vec3 no = o.R_WT.col(1);
+      const Vec3 gap = o.origin_W - c.origin_W;
+      const double off = std::max(std::abs(nc.dot(gap)), std::abs(no.dot(gap)));
+      const double m =
+          j == i ? 1.0 : share(nc.dot(no) - cos_plane, 1 - cos_plane) * share(eps - off, eps);
+      moment += m * w * o.p_W;
+      weight += m * w;
+    }
+    c.centre_W = weight > 0 ? Vec3(moment / weight) : c.p_W;
+  }
+}
+
 }  // namespace
 
 void finish_contacts(const FinishContext& ctx, FinishScratch& s, ContactSet& cs) {
@@ -122,6 +158,7 @@ void finish_contacts(const FinishContext& ctx, FinishScratch& s, ContactSet& cs)
     }
   }
   cs.set_num_planes(groups);
+  plane_centres(eps, ctx.cos_plane_tolerance, cs);
 }
 
 }  // namespace cf::detail

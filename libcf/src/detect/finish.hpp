@@ -32,8 +32,8 @@ struct FinishScratch {
   std::array<int, ContactSet::kCapacity> reps{};  ///< first member of each plane group
 };
 
-/// Sorts `cs` by PC, sets `dominated` (adding the penalty to those misfits) and groups the
-/// contacts into contact planes (`plane`, `num_planes`).
+/// Sorts `cs` by PC, sets `dominated` (adding the penalty to those misfits), groups the
+/// contacts into contact planes (`plane`, `num_planes`) and sets each one's `centre_W`.
 void finish_contacts(const FinishContext& ctx, FinishScratch& scratch, ContactSet& cs);
 
 }  // namespace cf::detail

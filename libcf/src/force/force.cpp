@@ -29,6 +29,16 @@ const char* to_string(Regime regime) {
   return "none";
 }
 
+std::string discontinuities_string(std::uint32_t flags) {
+  static const std::pair<Discontinuity, const char*> kNames[] = {
+      {kSlipOnset, "slip_onset"},     {kImpactEnd, "impact_end"}, {kRegimeSwitch, "regime_switch"},
+      {kHoldRelease, "hold_release"}, {kPcLost, "pc_lost"},       {kPcGained, "pc_gained"}};
+  std::string out;
+  for (const auto& [flag, name] : kNames)
+    if (flags & flag) out += (out.empty() ? "" : "|") + std::string(name);
+  return out;
+}
+
 namespace {
 
 // mm: tangential motions below this have no direction (round-off of poses in mm).
@@ -49,7 +59,10 @@ bool compliant(MotionType m) {
 }  // namespace
 
 ForceModel::ForceModel(const Polyhedron& A, const Polyhedron& B, const Params& params)
-    : A_(&A), B_(&B), params_(params) {
+    : A_(&A),
+      B_(&B),
+      params_(params),
+      cos_plane_(std::cos(params.detection.largest_angular_tolerance_rad())) {
   centroid_A_ =
       params_.centroid == CentroidChoice::kVolume ? A.volume_centroid() : A.vertex_centroid();
 }
@@ -57,6 +70,7 @@ ForceModel::ForceModel(const Polyhedron& A, const Polyhedron& B, const Params& p
 void ForceModel::reset() {
   for (Slot& s : slots_) s = Slot();
   has_prev_ = false;
+  conservative_prev_ = false;
   filt_valid_ = false;
   filt_F_.setZero();
   filt_M_.setZero();
@@ -81,11 +95,35 @@ ForceModel::Slot* ForceModel::new_slot(const Pc& pc) {
     if (!s.seen && stale == nullptr) stale = &s;
   }
   CF_DEMAND(stale != nullptr);
+  if (stale->used && stale->F_cy > 0) result_.discontinuities |= kPcLost;  // pushed last tick
   *stale = Slot();
   stale->used = true;
   stale->pc = pc;
   return stale;
 }
+
+// A slot of last tick's PCs that no PC of this tick holds (yet) and whose plane is c's: the
+// same contact region read as another PC (an f-f read as the e-f of its edge). Its friction
+// state carries over, so that a change of reading does not drop the anchor.
+ForceModel::Slot* ForceModel::same_plane_unseen(const ContactPc& c) {
+  const Vec3 n = c.R_WT.col(1);
+  for (Slot& s : slots_)
+    if (s.used && !s.seen && s.n_W.dot(n) >= cos_plane_ &&
+        std::abs(n.dot(c.origin_W - s.origin_W)) <= params_.epsilon_mm)
+      return &s;
+  return nullptr;
+}
+
+namespace {
+// The flag of a PC's regime changing from `was` to `now` (both rendered regimes).
+std::uint32_t regime_change(Regime was, Regime now) {
+  if (was == now) return 0;
+  const bool was_static = was == Regime::kStick || was == Regime::kImpactStatic;
+  if (was_static && (now == Regime::kKinetic || now == Regime::kMaxStatic)) return kSlipOnset;
+  if (was == Regime::kImpactStatic) return kImpactEnd;
+  return kRegimeSwitch;
+}
+}  // namespace
 
 namespace {
 // A PcForce carrying the contact's geometry (type, task frame, point, distance), no force yet.
@@ -96,6 +134,7 @@ PcForce with_geometry(const ContactPc& c) {
   f.R_WT = c.R_WT;
   f.origin_W = c.origin_W;
   f.p_W = c.p_W;
+  f.centre_W = c.centre_W.allFinite() ? c.centre_W : c.p_W;  // unset: at the contact
   f.distance = c.distance;
   return f;
 }
@@ -111,6 +150,7 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
   r.conservative = conservative;
   r.motion = conservative ? MotionType::kNone : prior.type;
   r.check = MotionCheck();
+  r.discontinuities = has_prev_ && conservative != conservative_prev_ ? kRegimeSwitch : 0;
   r.freedoms = Freedoms();
   const double dt = has_prev_ ? t_s - prev_t_ : 0.0;
 
@@ -144,6 +184,7 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
   Vec3 dir_static[ForceResult::kMaxPcs];
   Vec3 dir_kinetic[ForceResult::kMaxPcs];
   Slot* slot[ForceResult::kMaxPcs];
+  bool gained[ForceResult::kMaxPcs];  // a fresh slot no PC of last tick handed its state
   const bool anchor_mode = P.friction_displacement == FrictionDisplacement::kStickAnchor;
   const bool hold = P.hold_fcy_threshold_N > 0 && compliant(r.motion);
   for (int k = 0; k < m; ++k) {
@@ -161,20 +202,35 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
     Slot* s = find_slot(c.pc);
     const bool fresh = s == nullptr;
     if (fresh) {
+      // Another reading of a region last tick's PCs held keeps that PC's friction state.
+      Slot* before = same_plane_unseen(c);
+      const Slot carried = before != nullptr ? *before : Slot();
+      if (before != nullptr) before->used = false;
       s = new_slot(c.pc);  // one exists: at most kMaxPcs PCs, stale slots are reused
       s->anchor_A = p_A;
       s->anchor_W = c.p_W;
+      if (carried.used) {
+        s->anchor_A = carried.anchor_A, s->anchor_W = carried.anchor_W;
+        s->held_fcy = carried.held_fcy, s->held = carried.held;
+        s->regime = carried.regime, s->F_cy = carried.F_cy;
+      }
     }
+    gained[k] = fresh && s->regime == Regime::kNone;
     s->seen = true;
+    s->n_W = nrm;
+    s->origin_W = c.origin_W;
     slot[k] = s;
 
     const double raw = std::max(0.0, P.stiffness_N_per_mm * (P.epsilon_mm - c.distance));
-    if (hold && !fresh && std::abs(raw - s->held_fcy) < P.hold_fcy_threshold_N) {
+    const bool held = hold && !fresh && std::abs(raw - s->held_fcy) < P.hold_fcy_threshold_N;
+    if (held) {
       f.F_cy = s->held_fcy;
     } else {
+      if (s->held && raw != s->held_fcy) r.discontinuities |= kHoldRelease;
       f.F_cy = raw;
       s->held_fcy = raw;
     }
+    s->held = held;
     f.s_bound_mm = P.mu_static * f.F_cy / P.kp_N_per_mm;
 
     if (anchor_mode) {
@@ -322,7 +378,13 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
     f.F_T = Vec3(Ff.x(), f.F_cy, Ff.z());
     f.F_W = f.R_WT * f.F_T;
     F_c += f.F_W;
-    M_c += (f.p_W - r.reference_W).cross(f.F_W);
+    M_c += (f.centre_W - r.reference_W).cross(f.F_W);
+    if (slot[k]->regime != Regime::kNone)
+      r.discontinuities |= regime_change(slot[k]->regime, f.regime);
+    else if (gained[k] && Ff.squaredNorm() > 0)
+      r.discontinuities |= kPcGained;
+    slot[k]->regime = f.regime;
+    slot[k]->F_cy = f.F_cy;
 
     if (anchor_mode) {
       Slot* s = slot[k];
@@ -357,11 +419,15 @@ const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactP
       f.F_T = Vec3(0.0, f.F_cy, 0.0);
       f.F_W = f.R_WT * f.F_T;
       F_c += f.F_W;
-      M_c += (f.p_W - r.reference_W).cross(f.F_W);
+      M_c += (f.centre_W - r.reference_W).cross(f.F_W);
     }
   }
   for (Slot& s : slots_)
-    if (s.used && !s.seen) s = Slot();
+    if (s.used && !s.seen) {
+      if (s.F_cy > 0) r.discontinuities |= kPcLost;
+      s = Slot();
+    }
+  conservative_prev_ = conservative;
 
   // --- Smoothing (section 4.5): low-pass across ticks, rate independent ---
   if (P.interpolation_time_constant_s > 0 && filt_valid_ && dt > 0) {

@@ -270,10 +270,14 @@ struct IdentifyScratch {
       if (held[static_cast<std::size_t>(g)] ||
           accounted(g, chosen, n, farthest + prm.touch_distance_mm) != 0)
         continue;
+      // The plane's nearest contact that no other dominates: a face flush with the plane
+      // reads as its f-f, not as whichever of its corners round-off puts nearest.
       int best = -1;
       for (int k = 0; k < count[static_cast<std::size_t>(g)]; ++k) {
         const int i = members[static_cast<std::size_t>(g)][static_cast<std::size_t>(k)];
-        if (best < 0 || cs[i].distance < cs[best].distance) best = i;
+        if (best < 0 || cs[i].dominated < cs[best].dominated ||
+            (cs[i].dominated == cs[best].dominated && cs[i].distance < cs[best].distance))
+          best = i;
       }
       if (best >= 0 && res->num_approaching < static_cast<int>(res->approaching.size()))
         res->approaching[static_cast<std::size_t>(res->num_approaching++)] = cs[best];
