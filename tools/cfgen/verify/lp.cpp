@@ -11,10 +11,10 @@
 
 namespace cf::gen {
 
-// The witness search solves some hundred thousand programs of at most ten variables and a few
-// dozen rows; a general solver spends most of its time building and freeing its problem. This
-// one is dense and small:
-//  1. the equality rows are solved once, x = x0 + N z, leaving d <= 10 free coordinates z;
+// The witness search solves millions of programs of at most ten variables (thirteen with a
+// turn's three: LinearProgram::kMaxVars) and a few dozen rows; a general solver spends most
+// of its time building and freeing its problem. This one is dense and small:
+//  1. the equality rows are solved once, x = x0 + N z, leaving d <= 13 free coordinates z;
 //  2. the rest, G z <= h (bounds included, rows scaled to unit length), is solved through its
 //     dual, min h.y subject to G^T y = -c_z, y >= 0: a tableau of only d rows, pivoted by
 //     Bland's rule, which cannot cycle on the degenerate vertices these programs are full of;
@@ -43,7 +43,7 @@ using RowMatMap =
 using VecMap = Eigen::Map<VectorXd>;
 
 // Per-thread storage for the matrices whose size follows the number of rows, grown and
-// never freed: a run solves some million programs.
+// never freed: a run solves millions of programs.
 struct Workspace {
   std::vector<double> G, h, Gz, hz, htol, At, hk, hk_tol, T, tol;
   std::vector<int> keep, basic, tight;
