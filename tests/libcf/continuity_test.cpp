@@ -23,11 +23,11 @@ namespace {
 //   |dF| <= 1.5 k (|dx| + r_A |dtheta|),  |dM| <= r_A |dF| + m g r_A |dtheta|,
 // k the contact and coupling stiffness (2.3 N/mm), r_A the cube's radius about its centre
 // (the grip point and moment reference), m g its weight (0.5 kg at 9.8 N/kg).
-constexpr double kStiffness = 2.3;                  // N/mm, eq. (1)'s K and the coupling's
-const double kRadiusA = 15 * std::sqrt(3.0);        // mm
-constexpr double kWeight = 0.5 * 9.8;               // N
-constexpr double kRoundOffF = 1e-9;                 // N: a force recomputed at the same pose
-constexpr double kRoundOffM = 1e-6;                 // N mm: moments of forces at 60 mm arms
+constexpr double kStiffness = 2.3;            // N/mm, eq. (1)'s K and the coupling's
+const double kRadiusA = 15 * std::sqrt(3.0);  // mm
+constexpr double kWeight = 0.5 * 9.8;         // N
+constexpr double kRoundOffF = 1e-9;           // N: a force recomputed at the same pose
+constexpr double kRoundOffM = 1e-6;           // N mm: moments of forces at 60 mm arms
 // How far past the bound an unflagged tick may go. A plane's force acts at the depth-weighted
 // centre of its contacts, which runs across the region as more of it enters the band while
 // the force grows: on these paths up to 1.73 times the bound, continuously (one tick's step is
@@ -112,8 +112,8 @@ const cf::CfGraph& cube_l_graph() {
 
 void check(const std::string& name, const std::vector<Tick>& ticks) {
   const Verdict v = replay(cube_l_graph(), ticks);
-  INFO(name << ": worst unflagged tick " << v.worst_tick << " of " << v.ticks << " at "
-            << v.worst << " times the bound: " << v.worst_reading << "; flagged " << v.flagged);
+  INFO(name << ": worst unflagged tick " << v.worst_tick << " of " << v.ticks << " at " << v.worst
+            << " times the bound: " << v.worst_reading << "; flagged " << v.flagged);
   CHECK(v.worst <= kDriftFactor);
   CHECK(v.flagged <= kMaxFlagged);
 }
@@ -133,7 +133,8 @@ TEST_CASE("pressed into the slab and slid into the wall, the wrench moves with t
     for (const double rate : {1000.0, 10000.0}) {
       std::ostringstream name;
       name << "tilt " << tilt.deg << " deg about axis " << tilt.axis << " at " << rate << " Hz";
-      check(name.str(), path({{45, 37, 40}, {45, 33, 40}, {34, 33, 40}}, tilt.deg, tilt.axis, rate));
+      check(name.str(),
+            path({{45, 37, 40}, {45, 33, 40}, {34, 33, 40}}, tilt.deg, tilt.axis, rate));
     }
 }
 
