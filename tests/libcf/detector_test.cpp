@@ -289,6 +289,44 @@ TEST_CASE("an edge of A crossing the slab's edge: e-e", "[detector]") {
   check_frame(c);
 }
 
+TEST_CASE("a reading beside a face counts only while its two points are within the band",
+          "[detector]") {
+  const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
+  cf::ContactDetector det(a, b);
+  cf::ContactSet cs;
+  // The cube's bottom face (2) on the slab's edge x = 120, y = 20 (f-e), turned by 30 degrees
+  // about z so that it drops beyond the edge. Its edge x = 15 (vertices 1 and 5) overhangs the
+  // slab's edge by `over` along the face: beside the slab's top (face 4) by over cos 30 and
+  // below its plane by over sin 30, outside B. Read on face 4 it is a contact at
+  // -over sin 30 whose points are `over` apart: within the band (1 mm) at 0.5, not at 1.1,
+  // although its in-plane gap (0.95 mm) is within in_plane_tolerance_mm (1 mm).
+  const double alpha = M_PI / 6;
+  const Eigen::Matrix3d R = rot(-alpha, {0, 0, 1});
+  const int edge = edge_between(a, 1, 5);
+  for (const double over : {0.5, 1.1}) {
+    CAPTURE(over);
+    det.detect(pose(R, Vec3(120, 20, 40) - R * Vec3(15 - over, -15, 0)), cs);
+    const cf::ContactPc* fe = find(cs, PcType::kFE, 2, edge_between(b, 2, 8));
+    REQUIRE(fe);
+    CHECK(fe->distance == Approx(0).margin(kTol));
+    const cf::ContactPc* ef = find(cs, PcType::kEF, edge, 4);
+    const cf::ContactPc* vf1 = find(cs, PcType::kVF, 1, 4);
+    const cf::ContactPc* vf5 = find(cs, PcType::kVF, 5, 4);
+    if (over < 1) {
+      REQUIRE(ef);
+      REQUIRE(vf1);
+      REQUIRE(vf5);
+      CHECK(ef->distance == Approx(-over * std::sin(alpha)).margin(kTol));
+      CHECK(vf1->distance == Approx(-over * std::sin(alpha)).margin(kTol));
+      CHECK(ef->fit > 0);
+    } else {
+      CHECK_FALSE(ef);
+      CHECK_FALSE(vf1);
+      CHECK_FALSE(vf5);
+    }
+  }
+}
+
 TEST_CASE("no contact far away; a deep penetration is not a contact", "[detector]") {
   const cf::Polyhedron a = tmod::cube(), b = tmod::l_block();
   cf::ContactDetector det(a, b);

@@ -1,6 +1,7 @@
 // Unit tests of the independent oracle's own geometry: shape families, the feature rebuild,
 // touching/PC classification, contact normals, the tangent-cone interior test (including the
-// L-foot-in-wall case), the transition rules, times of impact and a smoke run of the sampler.
+// L-foot-in-wall case), the transition rules, times of impact, a smoke run of the sampler and
+// the test of unambiguous poses.
 
 #include "classify.hpp"
 #include "graph.hpp"
@@ -8,6 +9,7 @@
 #include "sampler.hpp"
 #include "shapes.hpp"
 #include "transitions.hpp"
+#include "unambiguous.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -88,6 +90,8 @@ TEST_CASE("every shape family and every pairing gives closed, outward, manifold 
       {make_ngon_prism(3, 5, 10, 0.2), 5, 6},
       {make_ngon_prism(8, 5, 10, 0.2), 10, 16},
       {make_wedge(10, 6, 3, 8), 5, 6},
+      {make_pyramid(10, 8, 7, 1, -2), 5, 5},
+      {make_ramp_step(20, 6, 15, 8, 14, 4, 9, 3, 30), 11, 18},
   };
   for (const auto& f : fam) {
     INFO(f.m.name);
@@ -117,6 +121,14 @@ TEST_CASE("every shape family and every pairing gives closed, outward, manifold 
     pairings.insert(P.pairing);
   }
   CHECK(pairings.size() == static_cast<std::size_t>(kPairings));
+  for (int which = 0; which < kExtraPairings; ++which)
+    for (std::uint64_t seed = 1; seed < 9; ++seed) {
+      ShapePair P = make_extra_pair(which, seed);
+      INFO("extra " << which << " seed " << seed << ": " << P.desc);
+      CHECK(check_mesh(P.A).empty());
+      CHECK(check_mesh(P.B).empty());
+      CHECK(P.pairing == -1 - which);
+    }
 }
 
 TEST_CASE("triangulation of a square with an octagonal hole adds up") {
@@ -595,4 +607,62 @@ TEST_CASE("graph reader and witness checker on a hand-written graph") {
   std::ofstream(bad) << "{\"format\": \"cf-graph\", \"models\": {}}";
   CHECK_THROWS_AS(read_graph(bad), std::runtime_error);
   std::filesystem::remove(bad);
+}
+
+TEST_CASE("unambiguous poses: other pairs beyond the band, leaning ones beyond their tolerance") {
+  // B: a floor (top y = 0 for x in [-30, 50]) with a wall (face x = -30), z in [-50, 50].
+  Poly B = prism({{-50, -20}, {50, -20}, {50, 0}, {-30, 0}, {-30, 40}, {-50, 40}}, -50, 50, "L");
+  const BandParams band;  // epsilon 1 mm, margins 0.05 mm and 10%
+  {
+    Poly A = cube(10);
+    Classifier C(A, B, tol_for(A, B));
+    // Face-down on the floor: one f-f; its own corners and edges are readings of it.
+    Pose X;
+    X.t = Vec3(-28, 0, -5);  // 2 mm from the wall
+    Verdict V = C.classify(X);
+    REQUIRE(V.valid_cf());
+    REQUIRE(V.key().size() == 1);
+    Ambiguity a = check_unambiguous(A, B, X, V.key(), band);
+    INFO(a.why);
+    CHECK(a.unambiguous);
+    // 1.04 mm from the wall (within epsilon + margin): the wall's pairs are in the band.
+    X.t.x() = -30 + 1.04;
+    V = C.classify(X);
+    REQUIRE(V.key().size() == 1);
+    a = check_unambiguous(A, B, X, V.key(), band);
+    CHECK_FALSE(a.unambiguous);
+    CHECK(a.why.find("distance") != std::string::npos);
+    X.t.x() = -30 + 1.06;
+    CHECK(check_unambiguous(A, B, X, C.classify(X).key(), band).unambiguous);
+  }
+  {
+    // A 30 mm cube on its edge (along z, at x = 5), its bottom face tilted up by theta: that
+    // face's f-f and its two edges' e-f are within the band (they meet the floor along the
+    // edge or at its ends), their tolerance atan(1 / (30 cos theta)), about 0.0333 rad:
+    // unambiguous beyond 1.1 times that.
+    Poly A = cube(30);
+    Classifier C(A, B, tol_for(A, B));
+    const double tol = std::atan(1.0 / 30);
+    for (double theta : {0.036, 0.05}) {
+      CAPTURE(theta);
+      Pose X;
+      X.R = Eigen::AngleAxisd(theta, Vec3::UnitZ()).toRotationMatrix();
+      X.t = Vec3(5, 0, -15);
+      Verdict V = C.classify(X);
+      REQUIRE(V.valid_cf());
+      REQUIRE(V.key().size() == 1);
+      CHECK(V.key()[0].type == PcType::EF);
+      CHECK(30 * std::sin(theta) > band.eps + band.dist_margin);  // the far edge is beyond
+      const Ambiguity a = check_unambiguous(A, B, X, V.key(), band);
+      INFO(a.why);
+      CHECK(std::abs(std::atan(1.0 / (30 * std::cos(theta))) - tol) < 1e-3);
+      if (theta < 1.1 * tol) {
+        CHECK_FALSE(a.unambiguous);
+        CHECK(a.why.find("within the band at angle") != std::string::npos);
+      } else {
+        CHECK(a.unambiguous);
+        CHECK(a.leaning >= 1);
+      }
+    }
+  }
 }

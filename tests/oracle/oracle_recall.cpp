@@ -2,8 +2,11 @@
 //
 //   oracle_recall --seed N [--cfgen PATH] [--budget SECONDS] [--keep DIR] [-j THREADS]
 //                 [--sampler-seed K] [--rounds K] [--pose R00,..,R22,tx,ty,tz]... [--quiet]
-//                 [--cfgen-timeout S]
+//                 [--cfgen-timeout S] [--extra K]
 //   oracle_recall A.off B.off [same options]
+//
+// --extra K takes the pair of seed N from the pairings outside the seeded cycle
+// (oracle::make_extra_pair: 0 pyramid, 1 wedge, 2 n-gon prism, each against a ramp step).
 //
 // --pose classifies that pose of A with the oracle and says whether the graph holds its CF
 // (every reported miss prints such a recheck command line).
@@ -39,6 +42,8 @@ void usage() {
       "DIR/seed_N. --rounds: stop the sampler after K rounds (deterministic with a large budget).\n"
       "--cfgen-timeout S: give up on cfgen after S seconds (status 2).\n"
       "--pose: classify this pose of A (x_B = R x_A + t) and say whether the graph holds its CF.\n"
+      "--extra K: with --seed N, the pair of seed N of extra pairing K (0 pyramid, 1 wedge,\n"
+      "2 n-gon prism, each against a ramp step), kept in DIR/extra_K_seed_N.\n"
       "--quiet: only the summary line. Environment: CF_CFGEN_PATH overrides the cfgen binary.");
 }
 }  // namespace
@@ -48,6 +53,7 @@ int main(int argc, char** argv) {
   o.cfgen = CF_CFGEN;
   if (const char* e = std::getenv("CF_CFGEN_PATH")) o.cfgen = e;
   bool have_seed = false, quiet = false;
+  int extra = -1;
   std::uint64_t seed = 0;
   std::vector<std::string> files;
   try {
@@ -84,6 +90,10 @@ int main(int argc, char** argv) {
         if (!oracle::parse_pose_arg(val(), &X))
           throw std::runtime_error("--pose needs 12 numbers R00,...,R22,tx,ty,tz (R a rotation)");
         o.check_poses.push_back(X);
+      } else if (a == "--extra") {
+        extra = std::stoi(val());
+        if (extra < 0 || extra >= oracle::kExtraPairings)
+          throw std::runtime_error("--extra out of range");
       } else if (a == "--quiet" || a == "-q") {
         quiet = true;
       } else if (!a.empty() && a[0] == '-') {
@@ -94,12 +104,14 @@ int main(int argc, char** argv) {
     }
     if (have_seed == !files.empty() || (!files.empty() && files.size() != 2))
       throw std::runtime_error("give either --seed N or two model files");
+    if (extra >= 0 && !have_seed) throw std::runtime_error("--extra needs --seed N");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oracle_recall: %s\n", e.what());
     return 2;
   }
-  oracle::RecallResult r = have_seed ? oracle::run_recall_seed(seed, o)
-                                     : oracle::run_recall_files(files[0], files[1], o);
+  oracle::RecallResult r = !have_seed   ? oracle::run_recall_files(files[0], files[1], o)
+                           : extra >= 0 ? oracle::run_recall_extra(extra, seed, o)
+                                        : oracle::run_recall_seed(seed, o);
   std::cout << r.line() << "\n";
   if (!quiet) {
     std::cout << "  sampler: " << r.sampler_stats.str() << "\n";

@@ -76,9 +76,12 @@ std::string RecallResult::line() const {
                 "%s graph=%d sampled=%d misses=%zu recall=%.1f%% unsound=%d marginal=%d dropped=%d "
                 "cfgen=%.1fs "
                 "sampler=%.1fs",
-                from_seed ? ("seed=" + std::to_string(seed)).c_str() : "files", graph_cfs, sampled,
-                misses.size(), recall(), check.unsound, check.marginal, unstable + suspect, cfgen_s,
-                sampler_s);
+                from_seed ? ((extra >= 0 ? "extra=" + std::to_string(extra) + " " : std::string()) +
+                             "seed=" + std::to_string(seed))
+                                .c_str()
+                          : "files",
+                graph_cfs, sampled, misses.size(), recall(), check.unsound, check.marginal,
+                unstable + suspect, cfgen_s, sampler_s);
   std::string s = buf;
   if (!ok) s += " ERROR: " + error;
   if (!model_problems.empty()) s += " MODEL-MISMATCH";
@@ -87,7 +90,13 @@ std::string RecallResult::line() const {
 
 std::string RecallResult::details() const {
   std::ostringstream o;
-  std::string who = from_seed ? "seed " + std::to_string(seed) : a_path + " " + b_path;
+  const std::string seed_arg =
+      (extra >= 0 ? "--extra " + std::to_string(extra) + " " : std::string()) + "--seed " +
+      std::to_string(seed);
+  std::string who = !from_seed ? a_path + " " + b_path
+                    : extra >= 0
+                        ? "extra " + std::to_string(extra) + " seed " + std::to_string(seed)
+                        : "seed " + std::to_string(seed);
   for (const auto& p : model_problems) o << "  MODEL " << who << ": " << p << "\n";
   for (const auto& p : pose_reports) o << "  CHECK " << p << "\n";
   if (ok) {
@@ -109,7 +118,7 @@ std::string RecallResult::details() const {
       << " {" << key_string(w.key) << "}: " << w.problem << "\n    pose " << pose_string(w.pose)
       << "\n";
     if (from_seed)
-      o << "    recheck: oracle_recall --seed " << seed << " --budget 0 --pose " << pose_arg(w.pose)
+      o << "    recheck: oracle_recall " << seed_arg << " --budget 0 --pose " << pose_arg(w.pose)
         << "\n";
   }
   for (const auto& m : suspects)
@@ -136,7 +145,7 @@ std::string RecallResult::details() const {
       << (m.sample.clearance < 0.01 ? " (below cfgen's default --min-clearance 0.01 mm)" : "")
       << " via " << m.sample.how << "\n    pose " << pose_string(m.sample.pose) << "\n";
     if (from_seed)
-      o << "    recheck: oracle_recall --seed " << seed << " --budget 0 --pose "
+      o << "    recheck: oracle_recall " << seed_arg << " --budget 0 --pose "
         << pose_arg(m.sample.pose) << "\n";
   }
   return o.str();
@@ -380,13 +389,9 @@ std::string make_dir(const RecallOptions& o, const std::string& leaf, bool* temp
   return std::string(buf.data());
 }
 
-}  // namespace
-
-RecallResult run_recall_seed(std::uint64_t seed, const RecallOptions& o) {
-  RecallResult r;
-  r.seed = seed;
+RecallResult run_generated(const ShapePair& P, RecallResult r, const std::string& leaf,
+                           const RecallOptions& o) {
   r.from_seed = true;
-  ShapePair P = make_pair(seed);
   r.desc = P.desc;
   std::string pa = check_mesh(P.A), pb = check_mesh(P.B);
   if (!pa.empty() || !pb.empty()) {
@@ -396,7 +401,7 @@ RecallResult run_recall_seed(std::uint64_t seed, const RecallOptions& o) {
   bool tmp = false;
   std::string dir;
   try {
-    dir = make_dir(o, "seed_" + std::to_string(seed), &tmp);
+    dir = make_dir(o, leaf, &tmp);
   } catch (const std::exception& e) {
     r.error = e.what();
     return r;
@@ -407,6 +412,22 @@ RecallResult run_recall_seed(std::uint64_t seed, const RecallOptions& o) {
     fs::remove_all(dir, ec);
   }
   return r;
+}
+
+}  // namespace
+
+RecallResult run_recall_seed(std::uint64_t seed, const RecallOptions& o) {
+  RecallResult r;
+  r.seed = seed;
+  return run_generated(make_pair(seed), r, "seed_" + std::to_string(seed), o);
+}
+
+RecallResult run_recall_extra(int which, std::uint64_t seed, const RecallOptions& o) {
+  RecallResult r;
+  r.seed = seed;
+  r.extra = which;
+  return run_generated(make_extra_pair(which, seed), r,
+                       "extra_" + std::to_string(which) + "_seed_" + std::to_string(seed), o);
 }
 
 RecallResult run_recall_files(const std::string& a_off, const std::string& b_off,

@@ -36,6 +36,7 @@ struct RecallResult {
   std::string error;
   std::uint64_t seed = 0;
   bool from_seed = false;
+  int extra = -1;  // >= 0: the pair is make_extra_pair(extra, seed)
   std::string desc;
   std::string a_path, b_path, graph_path;
   int graph_cfs = 0;
@@ -65,6 +66,8 @@ bool parse_pose_arg(const std::string& a, Pose* X);
 std::string signature(const CfKey& k);
 
 RecallResult run_recall_seed(std::uint64_t seed, const RecallOptions& o);
+/// The pair make_extra_pair(which, seed) (kept as DIR/extra_<which>_seed_<seed>).
+RecallResult run_recall_extra(int which, std::uint64_t seed, const RecallOptions& o);
 RecallResult run_recall_files(const std::string& a_off, const std::string& b_off,
                               const RecallOptions& o);
 

@@ -286,6 +286,7 @@ Verdict Sampler::record(const Pose& X, const std::string& how) {
     return V;
   }
   ++st_.accepted;
+  if (o_.on_accept) o_.on_accept(X, V, how);
   CfKey k = V.key();
   auto it = found_.find(k);
   if (it == found_.end() || it->second.clearance < V.clearance)

@@ -18,6 +18,7 @@
 #include "motion.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <random>
 #include <string>
@@ -30,6 +31,9 @@ struct SamplerOptions {
   int max_walk = 10;
   long max_rounds = 0;  // stop after this many rounds (0: only the time budget); with a budget
                         // that is not reached first, the run is deterministic for a seed
+  // Called at every accepted pose (every pose that counts, not only each CF's best), with
+  // its classification and how the sampler got there; it does not steer the sampler.
+  std::function<void(const Pose&, const Verdict&, const std::string& how)> on_accept;
 };
 
 struct Sample {

@@ -540,6 +540,32 @@ Mesh make_wedge(double a, double b, double c, double d) {
   return m;
 }
 
+Mesh make_pyramid(double a, double b, double h, double ox, double oy) {
+  Mesh m;
+  m.name = "pyramid";
+  m.V = {Vec3(0, 0, 0), Vec3(a, 0, 0), Vec3(a, b, 0), Vec3(0, b, 0),
+         Vec3(a / 2 + ox, b / 2 + oy, h)};
+  m.F = {{3, 2, 1, 0}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+  return m;
+}
+
+Mesh make_ramp_step(double w1, double run, double w2, double h1, double h2, double g0, double gw,
+                    double gd, double d) {
+  const double W = w1 + run + w2;
+  Mesh m = extrude({{0, 0},
+                    {W, 0},
+                    {W, h2},
+                    {w1 + run, h2},
+                    {w1, h1},
+                    {g0 + gw, h1},
+                    {g0 + gw / 2, h1 - gd},
+                    {g0, h1},
+                    {0, h1}},
+                   {}, d);
+  m.name = "ramp step";
+  return m;
+}
+
 // ---------------------------------------------------------------------------------------
 // Pairings
 // ---------------------------------------------------------------------------------------
@@ -637,6 +663,14 @@ Made wedge_r(Rng& r, double lo, double hi) {
   double a = r.U(lo, hi), b = r.U(lo, hi), c = r.U(0, 1) * a, d = r.U(lo, hi);
   return {make_wedge(a, b, c, d),
           "wedge " + f1(a) + "x" + f1(b) + " apex " + f1(c) + " depth " + f1(d)};
+}
+Made ramp_step_r(Rng& r) {
+  double w1 = r.U(15, 35), run = r.U(3, 15), w2 = r.U(10, 30), h1 = r.U(6, 15),
+         h2 = h1 + r.U(3, 15), gw = r.U(0.3, 0.6) * w1, g0 = r.U(0.1, 0.9) * (w1 - gw),
+         gd = std::min(r.U(0.2, 0.6) * gw, 0.7 * h1), d = r.U(20, 50);
+  return {make_ramp_step(w1, run, w2, h1, h2, g0, gw, gd, d),
+          "ramp step " + f1(w1) + "/" + f1(run) + "/" + f1(w2) + " heights " + f1(h1) + "/" +
+              f1(h2) + " groove " + f1(gw) + "x" + f1(gd) + " at " + f1(g0) + " length " + f1(d)};
 }
 }  // namespace
 
@@ -756,6 +790,44 @@ ShapePair make_pair(std::uint64_t seed) {
   P.A.name = a.m.name;
   P.B.name = b.m.name;
   P.desc = std::string(pairing_name(P.pairing)) + ": " + a.d + " | " + b.d;
+  return P;
+}
+
+const char* extra_pairing_name(int which) {
+  static const char* names[kExtraPairings] = {
+      "pyramid against ramp step", "wedge against ramp step", "n-gon prism against ramp step"};
+  return names[((which % kExtraPairings) + kExtraPairings) % kExtraPairings];
+}
+
+ShapePair make_extra_pair(int which, std::uint64_t seed) {
+  Rng r(seed);
+  ShapePair P;
+  which = ((which % kExtraPairings) + kExtraPairings) % kExtraPairings;
+  P.pairing = -1 - which;
+  Made a, b;
+  switch (which) {
+    case 0: {
+      double x = r.U(6, 20), y = r.U(6, 20), h = r.U(5, 20), ox = r.U(-0.3, 0.3) * x,
+             oy = r.U(-0.3, 0.3) * y;
+      a = {make_pyramid(x, y, h, ox, oy), "pyramid " + f1(x) + "x" + f1(y) + " height " + f1(h) +
+                                              " apex offset " + f1(ox) + "," + f1(oy)};
+      break;
+    }
+    case 1:
+      a = wedge_r(r, 5, 20);
+      break;
+    default:
+      a = ngon_prism_r(r, r.I(3, 6), r.U(3, 8), r.U(8, 25));
+      break;
+  }
+  b = ramp_step_r(r);
+  a.m.name = "A: " + a.d;
+  b.m.name = "B: " + b.d;
+  P.A = transform(a.m, random_rigid(r.g));
+  P.B = transform(b.m, random_rigid(r.g));
+  P.A.name = a.m.name;
+  P.B.name = b.m.name;
+  P.desc = std::string(extra_pairing_name(which)) + ": " + a.d + " | " + b.d;
   return P;
 }
 

@@ -60,6 +60,15 @@ Mesh make_ngon_hole_block(double w, double h, int n, double r, double phase);
 Mesh make_ngon_prism(int n, double r, double l, double phase);
 /// Triangular prism: triangle (0,0), (a,0), (c,b), extruded by d.
 Mesh make_wedge(double a, double b, double c, double d);
+/// Square-based pyramid: base a x b at z = 0, apex at (a/2 + ox, b/2 + oy, h) (four edges at
+/// the apex, no face pair at a right angle unless by chance).
+Mesh make_pyramid(double a, double b, double h, double ox, double oy);
+/// Block whose top is a lower level (height h1, run w1) with a V-groove across it (from x = g0,
+/// width gw, depth gd), a ramp rising over `run` to an upper level (height h2, run w2);
+/// extruded by d. Obtuse convex edges at the ramp's top and the groove's lips, reflex ones at
+/// the ramp's foot and the groove's bottom.
+Mesh make_ramp_step(double w1, double run, double w2, double h1, double h2, double g0, double gw,
+                    double gd, double d);
 /// Extrusion of a polygon (outer CCW, holes CW) along z by d; caps triangulated when needed.
 Mesh extrude(const std::vector<Vec2>& outer, const std::vector<std::vector<Vec2>>& holes, double d);
 /// Ear clipping of a polygon with holes; triangles index into the concatenation of the loops.
@@ -75,5 +84,12 @@ constexpr int kPairings = 12;
 /// The pair of seed: pairing = seed % kPairings, proportions from std::mt19937_64(seed).
 ShapePair make_pair(std::uint64_t seed);
 const char* pairing_name(int pairing);
+
+/// Pairings outside the seeded cycle (the recall test's seeds keep their pairings): 0 pyramid
+/// against a ramp step, 1 wedge against a ramp step, 2 n-gon prism against a ramp step;
+/// proportions from std::mt19937_64(seed). ShapePair::pairing is -1 - which.
+constexpr int kExtraPairings = 3;
+ShapePair make_extra_pair(int which, std::uint64_t seed);
+const char* extra_pairing_name(int which);
 
 }  // namespace oracle

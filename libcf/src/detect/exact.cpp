@@ -79,6 +79,16 @@ PairOutcome never() { return turned_away(0, std::numeric_limits<double>::infinit
 // x / scale within [0, 1]: the share left of a margin of size `scale` (1 when it has none).
 double share(double x, double scale) { return scale > 0 ? std::clamp(x / scale, 0.0, 1.0) : 1.0; }
 
+// The share left of PairTables::within_band_beside's margin for a contact at distance d
+// read `gap` beside its element: 1 in the element (gap 0), 0 where the two points it measures
+// reach the band's limit.
+double beside_share(const PairTables& t, double d, double gap) {
+  if (gap <= 0) return 1.0;
+  const double lim = d >= 0 ? t.eps : t.depth;
+  const double allowed = std::sqrt(std::max(0.0, lim * lim - d * d));
+  return allowed > 0 ? std::clamp((allowed - gap) / allowed, 0.0, 1.0) : 0.0;
+}
+
 // The share left of the wedge tolerance of an edge whose wings dip by `dip` (wedge_dip:
 // rejected above 0), its wings' tolerances being sin_l and sin_r.
 double wedge_share(double dip, double sin_l, double sin_r) {
@@ -184,7 +194,10 @@ bool line_on_face(const PairTables& t, ExactScratch& s, const Polyhedron& m, con
     *span = 0;
     *on_boundary = true;  // the segment does not enter the face: at most its boundary touches
   }
-  return t.in_band(*d);
+  // Beside the face, the nearest point of the segment and of the face's boundary must be
+  // within the band too (they bound the elements' distance; no certificate: the elements may
+  // come closer elsewhere).
+  return t.in_band(*d) && t.within_band_beside(*d, *gap);
 }
 
 }  // namespace
@@ -281,11 +294,16 @@ PairOutcome vertex_face(const PairTables& t, PosedA& P, int v, int fb) {
   const double gap = (loc.inside || loc.dist <= t.geo_tol) ? 0.0 : loc.dist;
   // The vertex's projection on B's plane moves at most as far as the vertex.
   if (gap > t.in_plane) return turned_away(gap - t.in_plane - t.geo_tol, 0);
+  // Beside the face the vertex is hypot(h, gap) from it (a vertex below the plane beside a
+  // convex edge is outside B, not h deep in it): within the band, or no contact. That
+  // distance changes at most as far as the vertex moves; beyond max(eps, depth) it fails.
+  if (!t.within_band_beside(h, gap))
+    return turned_away(std::hypot(h, gap) - std::max(t.eps, t.depth) - t.geo_tol, 0);
   // On the face's boundary (a vertex on an edge, or outside): the open face does not touch.
   const bool boundary = !loc.inside || loc.dist <= 10 * t.geo_tol;
   return contact(PcType::kVF, v, fb, h, p, p - h * F.normal, task_frame(F.normal, F.u),
                  std::abs(h) / t.eps + gap / t.eps + (boundary ? kAlongBoundaryPenalty : 0.0),
-                 fit * share(t.in_plane - gap, t.in_plane));
+                 fit * share(t.in_plane - gap, t.in_plane) * beside_share(t, h, gap));
 }
 
 // ---- f-v: face of A on vertex of B ---------------------------------------------------------
@@ -315,12 +333,18 @@ PairOutcome face_vertex(const PairTables& t, PosedA& P, int fa, int v) {
                ? turned_away(t.seen_from_a(gap - t.in_plane, (q - P.origin_posed).norm()), 0)
                : PairOutcome{};
   }
+  if (!t.within_band_beside(h, gap)) {  // as in v-f
+    return P.certifying ? turned_away(t.seen_from_a(std::hypot(h, gap) - std::max(t.eps, t.depth),
+                                                    (q - P.origin_posed).norm()),
+                                      0)
+                        : PairOutcome{};
+  }
   const Vec3 nW = pose.R_BA * F.normal;
   const Vec3 onA = q - h * nW;
   const bool boundary = !loc.inside || loc.dist <= 10 * t.geo_tol;  // as in v-f
   return contact(PcType::kFV, fa, v, h, onA, onA, task_frame(-nW, pose.R_BA * F.u),
                  std::abs(h) / t.eps + gap / t.eps + (boundary ? kAlongBoundaryPenalty : 0.0),
-                 fit * share(t.in_plane - gap, t.in_plane));
+                 fit * share(t.in_plane - gap, t.in_plane) * beside_share(t, h, gap));
 }
 
 // ---- e-f: edge of A on face of B -----------------------------------------------------------
@@ -352,7 +376,7 @@ PairOutcome edge_face(const PairTables& t, PosedA& P, ExactScratch& s, int e, in
   return contact(
       PcType::kEF, e, fb, d, p, p - hc * F.normal, task_frame(F.normal, dW),
       ang / tol + std::abs(d) / t.eps + gap / t.eps + (on_boundary ? kAlongBoundaryPenalty : 0.0),
-      share(tol - ang, tol) * share(t.in_plane - gap, t.in_plane) *
+      share(tol - ang, tol) * share(t.in_plane - gap, t.in_plane) * beside_share(t, d, gap) *
           wedge_share(dip, t.sin_tol_face_a[E.left.index()], t.sin_tol_face_a[E.right.index()]));
 }
 
@@ -390,7 +414,7 @@ PairOutcome face_edge(const PairTables& t, PosedA& P, ExactScratch& s, int fa, i
   return contact(
       PcType::kFE, fa, e, d, onA, onA, task_frame(-(pose.R_BA * F.normal), E.dir),
       ang / tol + std::abs(d) / t.eps + gap / t.eps + (on_boundary ? kAlongBoundaryPenalty : 0.0),
-      share(tol - ang, tol) * share(t.in_plane - gap, t.in_plane) *
+      share(tol - ang, tol) * share(t.in_plane - gap, t.in_plane) * beside_share(t, d, gap) *
           wedge_share(dip, t.sin_tol_face_b[E.left.index()], t.sin_tol_face_b[E.right.index()]));
 }
 
@@ -490,6 +514,10 @@ PairOutcome edge_edge(const PairTables& t, PosedA& P, int ea, int eb) {
   if (side < 0) n = -n;
   const double d = (pA - pB).dot(n);
   if (!t.in_band(d)) return {};
+  // With a closest point clamped to an end the two points are also apart in the plane: they
+  // must be within the band (as a vertex beside a face; no certificate, as for over).
+  const double gap = over > 0 ? ((pA - pB) - d * n).norm() : 0.0;
+  if (!t.within_band_beside(d, gap)) return {};
   // The wedges of the two edges must lie on their own sides of the contact plane.
   const double dip_a = wedge_dip(pose.R_BA.transpose() * n, t.wings_a[static_cast<std::size_t>(ea)],
                                  EA, t.sin_tol_face_a);
@@ -508,6 +536,7 @@ PairOutcome edge_edge(const PairTables& t, PosedA& P, int ea, int eb) {
                                 std::abs(u - EB.length)}) <= t.geo_tol;
   const double fit =
       share(sn - sin_par, sin_par) * share(t.in_plane - over, t.in_plane) *
+      beside_share(t, d, gap) *
       wedge_share(dip_a, t.sin_tol_face_a[EA.left.index()], t.sin_tol_face_a[EA.right.index()]) *
       wedge_share(dip_b, t.sin_tol_face_b[EB.left.index()], t.sin_tol_face_b[EB.right.index()]);
   return contact(PcType::kEE, ea, eb, d, pA, pB, task_frame(n, uB),

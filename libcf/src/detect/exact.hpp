@@ -94,6 +94,15 @@ struct PairTables {
     return std::clamp(t, prm.min_angular_tolerance_rad, prm.max_angular_tolerance_rad);
   }
   bool in_band(double d) const { return d <= eps && d >= -depth; }
+  /// A contact read beside its element (in-plane gap > 0: a vertex beside a face, an edge
+  /// beside a face or past the end of an edge) at distance d measures two points hypot(d, gap)
+  /// apart: they must be within the band too, at most epsilon apart when d >= 0 and at most
+  /// max_penetration_mm when d < 0 (docs/runtime.md, "Tests per type"). In the element
+  /// (gap 0) this is in_band(d).
+  bool within_band_beside(double d, double gap) const {
+    const double lim = d >= 0 ? eps : depth;
+    return d * d + gap * gap <= lim * lim;
+  }
   /// The certificate of a distance `gap` of B's point(s), at most `reach_mm` from A's
   /// posed origin, as A sees them.
   double seen_from_a(double gap, double reach_mm) const {
