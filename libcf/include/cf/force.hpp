@@ -96,15 +96,62 @@ struct ForceResult {
   Vec3 M_A = Vec3::Zero();          ///< eq. (9) in A's axes
 };
 
-/// The force model with its per-tick state (stick anchors, held F_cy, previous pose).
-/// Create once; step() allocates nothing.
+/// The force model's per-tick state (after MuJoCo's `mjData`, as CfState is the servo's): all
+/// that ForceModel::step() writes, and all that one tick hands the next. Plain values of fixed
+/// capacity; a default-constructed ForceState is the state before the first tick.
+struct ForceState {
+  /// One PC's friction memory while it (or another reading of its contact plane) is rendered.
+  struct Slot {
+    Pc pc;
+    bool used = false;             ///< holds a PC of the last tick (or of this one)
+    bool seen = false;             ///< this tick renders it (set during step())
+    Vec3 anchor_A = Vec3::Zero();  ///< the stick anchor: material point of A it holds, A frame
+    Vec3 anchor_W = Vec3::Zero();  ///< where that point is tied, world
+    double held_fcy = 0;           ///< N, F_cy as section 4.5's hold holds it
+    bool held = false;             ///< the hold set the last tick's F_cy
+    /// The last tick's reading of the PC: its plane (unit normal into A, a point on it; mm),
+    /// its regime and its F_cy (N).
+    Vec3 n_W = Vec3::Zero();
+    Vec3 origin_W = Vec3::Zero();
+    Regime regime = Regime::kNone;
+    double F_cy = 0;
+  };
+  std::array<Slot, ForceResult::kMaxPcs> slots{};
+  bool has_prev = false;           ///< a tick was rendered since construction or reset()
+  Pose prev_pose;                  ///< pose of A at the last tick: p_j's motion, MT2's check
+  double prev_t_s = 0;             ///< s, time of the last tick: the filter's time step
+  bool prev_conservative = false;  ///< the last tick rendered with the conservative laws
+  /// Section 4.5's low-pass filter of the total contact force (N) and moment (N mm).
+  Vec3 filtered_F_W = Vec3::Zero();
+  Vec3 filtered_M_W = Vec3::Zero();
+  bool filter_valid = false;
+  ForceResult result;  ///< the last tick's result (step() returns a reference to it)
+};
+
+/// The force model: a fixed part, set at construction and never written (the models, the
+/// parameters and what is derived from them once), and one ForceState, all that step()
+/// writes. Create once; step() allocates nothing.
 class ForceModel {
  public:
+  /// What step() reads and never writes (after MuJoCo's `mjModel`, as CfModel is the servo's).
+  struct Fixed {
+    /// The models must outlive this (they are the graph's models at run time).
+    Fixed(const Polyhedron& A, const Polyhedron& B, const Params& params);
+    const Polyhedron* A;
+    const Polyhedron* B;
+    Params params;
+    Vec3 centroid_A = Vec3::Zero();  ///< p_g, mm in A's frame (Params::centroid)
+    /// cos of detection's largest angular tolerance: two readings of one contact plane have
+    /// normals at least this close.
+    double cos_plane = 1;
+  };
+
   /// The models must outlive the ForceModel (they are the graph's models at run time).
   ForceModel(const Polyhedron& A, const Polyhedron& B, const Params& params = Params());
 
-  /// Forgets the previous tick (anchors, held forces, filter, previous pose).
-  void reset();
+  /// Forgets the previous tick: the state becomes a default ForceState (anchors, held
+  /// forces, filter, previous pose).
+  void reset() { state_ = ForceState(); }
 
   /// One servo tick.
   /// @param pose          pose of A now.
@@ -122,44 +169,15 @@ class ForceModel {
                           const PriorMotion& prior, bool conservative = false,
                           const ContactPc* approaching = nullptr, int n_approaching = 0);
 
-  const ForceResult& result() const { return result_; }
-  const Params& params() const { return params_; }
+  const ForceResult& result() const { return state_.result; }
+  const Params& params() const { return fixed_.params; }
+  const Fixed& fixed() const { return fixed_; }
+  /// The per-tick state (stick anchors, held F_cy, last regimes, previous pose, filter).
+  const ForceState& state() const { return state_; }
 
  private:
-  struct Slot {
-    Pc pc;
-    bool used = false;
-    bool seen = false;
-    Vec3 anchor_A = Vec3::Zero();  ///< material point of A the anchor holds, A frame
-    Vec3 anchor_W = Vec3::Zero();  ///< where it is tied, world
-    double held_fcy = 0;
-    // Last tick's reading of the PC: its plane (unit normal into A, a point on it; mm), its
-    // regime, its F_cy (N) and whether the hold set it.
-    Vec3 n_W = Vec3::Zero();
-    Vec3 origin_W = Vec3::Zero();
-    Regime regime = Regime::kNone;
-    double F_cy = 0;
-    bool held = false;
-  };
-  Slot* find_slot(const Pc& pc);
-  Slot* new_slot(const Pc& pc);
-  Slot* same_plane_unseen(const ContactPc& c);
-  std::uint32_t regime_changes(int m) const;
-
-  const Polyhedron* A_;
-  const Polyhedron* B_;
-  Params params_;
-  Vec3 centroid_A_;
-  double cos_plane_ = 1;  ///< cos of the detection's largest angular tolerance
-  bool conservative_prev_ = false;
-  std::array<Slot, ForceResult::kMaxPcs> slots_{};
-  bool has_prev_ = false;
-  Pose prev_pose_;
-  double prev_t_ = 0;
-  Vec3 filt_F_ = Vec3::Zero();
-  Vec3 filt_M_ = Vec3::Zero();
-  bool filt_valid_ = false;
-  ForceResult result_;
+  Fixed fixed_;
+  ForceState state_;
 };
 
 }  // namespace cf

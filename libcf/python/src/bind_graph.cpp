@@ -49,91 +49,16 @@ py::array_t<double> quaternion_wxyz(const cf::Mat3& R) {
 
 py::object optional_int(int v) { return v < 0 ? py::object(py::none()) : py::object(py::int_(v)); }
 
-}  // namespace
+using cf::Polyhedron;
 
-void bind_graph(py::module_& m) {
-  using cf::Polyhedron;
-  py::class_<Polyhedron>(
-      m, "Polyhedron",
-      "A featured polyhedron (cf::Polyhedron): faces, edges and vertices in mm, indexed as "
-      "in the graph's PCs (docs/features.md).")
-      .def_property_readonly("name", &Polyhedron::name)
-      .def_property_readonly("num_vertices", &Polyhedron::num_vertices)
-      .def_property_readonly("num_edges", &Polyhedron::num_edges)
-      .def_property_readonly("num_faces", &Polyhedron::num_faces)
-      .def_property_readonly(
-          "vertices",
-          [](const Polyhedron& P) {
-            return vec3s(P.num_vertices(), [&](std::size_t i) { return P.vertices()[i].p; });
-          },
-          "(V, 3) float64: the feature vertices, mm, model frame.")
-      .def_property_readonly(
-          "edges",
-          [](const Polyhedron& P) {
-            auto a = array2<std::int32_t>(P.num_edges(), 2);
-            auto r = a.mutable_unchecked<2>();
-            for (std::size_t i = 0; i < P.num_edges(); ++i) {
-              r(static_cast<py::ssize_t>(i), 0) = P.edges()[i].v0.value();
-              r(static_cast<py::ssize_t>(i), 1) = P.edges()[i].v1.value();
-            }
-            return a;
-          },
-          "(E, 2) int32: each edge's end vertices v0 < v1.")
-      .def_property_readonly(
-          "faces",
-          [](const Polyhedron& P) {
-            py::list faces;
-            for (const cf::Face& f : P.faces()) {
-              py::list loops;
-              for (const auto& loop : f.loops) {
-                py::array_t<std::int32_t> a(static_cast<py::ssize_t>(loop.size()));
-                auto r = a.mutable_unchecked<1>();
-                for (std::size_t k = 0; k < loop.size(); ++k)
-                  r(static_cast<py::ssize_t>(k)) = loop[k].value();
-                loops.append(a);
-              }
-              faces.append(loops);
-            }
-            return faces;
-          },
-          "Per face, its loops as int32 arrays of vertex indices: the outer boundary first "
-          "(counter-clockwise seen from outside), then the holes.")
-      .def_property_readonly(
-          "edge_faces",
-          [](const Polyhedron& P) {
-            auto a = array2<std::int32_t>(P.num_edges(), 2);
-            auto r = a.mutable_unchecked<2>();
-            for (std::size_t i = 0; i < P.num_edges(); ++i) {
-              r(static_cast<py::ssize_t>(i), 0) = P.edges()[i].left.value();
-              r(static_cast<py::ssize_t>(i), 1) = P.edges()[i].right.value();
-            }
-            return a;
-          },
-          "(E, 2) int32: each edge's left face (its loop runs v0 -> v1) and right face.")
-      .def_property_readonly(
-          "edge_convex",
-          [](const Polyhedron& P) {
-            py::array_t<bool> a(static_cast<py::ssize_t>(P.num_edges()));
-            for (std::size_t i = 0; i < P.num_edges(); ++i)
-              a.mutable_at(static_cast<py::ssize_t>(i)) = P.edges()[i].convex;
-            return a;
-          },
-          "(E,) bool: interior dihedral angle below pi.")
-      .def_property_readonly(
-          "edge_dihedral",
-          [](const Polyhedron& P) {
-            py::array_t<double> a(static_cast<py::ssize_t>(P.num_edges()));
-            for (std::size_t i = 0; i < P.num_edges(); ++i)
-              a.mutable_at(static_cast<py::ssize_t>(i)) = P.edges()[i].dihedral;
-            return a;
-          },
-          "(E,) float64: interior dihedral angles, rad.")
-      .def_property_readonly(
-          "face_normals",
-          [](const Polyhedron& P) {
-            return vec3s(P.num_faces(), [&](std::size_t i) { return P.faces()[i].normal; });
-          },
-          "(F, 3) float64: outward unit normals.")
+// cf.Polyhedron's faces' planes, areas and centroids, mass properties, JSON and repr.
+void add_polyhedron_faces(py::class_<Polyhedron>& cls) {
+  cls.def_property_readonly(
+         "face_normals",
+         [](const Polyhedron& P) {
+           return vec3s(P.num_faces(), [&](std::size_t i) { return P.faces()[i].normal; });
+         },
+         "(F, 3) float64: outward unit normals.")
       .def_property_readonly(
           "face_offsets",
           [](const Polyhedron& P) {
@@ -178,7 +103,91 @@ void bind_graph(py::module_& m) {
                " vertices, " + std::to_string(P.num_edges()) + " edges, " +
                std::to_string(P.num_faces()) + " faces>";
       });
+}
 
+// cf.Polyhedron: its counts, vertices, edges, faces (loops) and edge properties.
+void bind_polyhedron(py::module_& m) {
+  auto cls =
+      py::class_<Polyhedron>(
+          m, "Polyhedron",
+          "A featured polyhedron (cf::Polyhedron): faces, edges and vertices in mm, indexed as "
+          "in the graph's PCs (docs/features.md).")
+          .def_property_readonly("name", &Polyhedron::name)
+          .def_property_readonly("num_vertices", &Polyhedron::num_vertices)
+          .def_property_readonly("num_edges", &Polyhedron::num_edges)
+          .def_property_readonly("num_faces", &Polyhedron::num_faces)
+          .def_property_readonly(
+              "vertices",
+              [](const Polyhedron& P) {
+                return vec3s(P.num_vertices(), [&](std::size_t i) { return P.vertices()[i].p; });
+              },
+              "(V, 3) float64: the feature vertices, mm, model frame.")
+          .def_property_readonly(
+              "edges",
+              [](const Polyhedron& P) {
+                auto a = array2<std::int32_t>(P.num_edges(), 2);
+                auto r = a.mutable_unchecked<2>();
+                for (std::size_t i = 0; i < P.num_edges(); ++i) {
+                  r(static_cast<py::ssize_t>(i), 0) = P.edges()[i].v0.value();
+                  r(static_cast<py::ssize_t>(i), 1) = P.edges()[i].v1.value();
+                }
+                return a;
+              },
+              "(E, 2) int32: each edge's end vertices v0 < v1.")
+          .def_property_readonly(
+              "faces",
+              [](const Polyhedron& P) {
+                py::list faces;
+                for (const cf::Face& f : P.faces()) {
+                  py::list loops;
+                  for (const auto& loop : f.loops) {
+                    py::array_t<std::int32_t> a(static_cast<py::ssize_t>(loop.size()));
+                    auto r = a.mutable_unchecked<1>();
+                    for (std::size_t k = 0; k < loop.size(); ++k)
+                      r(static_cast<py::ssize_t>(k)) = loop[k].value();
+                    loops.append(a);
+                  }
+                  faces.append(loops);
+                }
+                return faces;
+              },
+              "Per face, its loops as int32 arrays of vertex indices: the outer boundary first "
+              "(counter-clockwise seen from outside), then the holes.")
+          .def_property_readonly(
+              "edge_faces",
+              [](const Polyhedron& P) {
+                auto a = array2<std::int32_t>(P.num_edges(), 2);
+                auto r = a.mutable_unchecked<2>();
+                for (std::size_t i = 0; i < P.num_edges(); ++i) {
+                  r(static_cast<py::ssize_t>(i), 0) = P.edges()[i].left.value();
+                  r(static_cast<py::ssize_t>(i), 1) = P.edges()[i].right.value();
+                }
+                return a;
+              },
+              "(E, 2) int32: each edge's left face (its loop runs v0 -> v1) and right face.")
+          .def_property_readonly(
+              "edge_convex",
+              [](const Polyhedron& P) {
+                py::array_t<bool> a(static_cast<py::ssize_t>(P.num_edges()));
+                for (std::size_t i = 0; i < P.num_edges(); ++i)
+                  a.mutable_at(static_cast<py::ssize_t>(i)) = P.edges()[i].convex;
+                return a;
+              },
+              "(E,) bool: interior dihedral angle below pi.")
+          .def_property_readonly(
+              "edge_dihedral",
+              [](const Polyhedron& P) {
+                py::array_t<double> a(static_cast<py::ssize_t>(P.num_edges()));
+                for (std::size_t i = 0; i < P.num_edges(); ++i)
+                  a.mutable_at(static_cast<py::ssize_t>(i)) = P.edges()[i].dihedral;
+                return a;
+              },
+              "(E,) float64: interior dihedral angles, rad.");
+  add_polyhedron_faces(cls);
+}
+
+// cf.Cf: one CF with its id, PCs, witness and freedoms.
+void bind_cf(py::module_& m) {
   py::class_<CfEntry>(m, "Cf", "One contact formation of a graph (cf::CfRecord) with its id.")
       .def_readonly("id", &CfEntry::id)
       .def_property_readonly(
@@ -224,68 +233,28 @@ void bind_graph(py::module_& m) {
       .def("__repr__", [](const CfEntry& e) {
         return "<cf.Cf " + std::to_string(e.id) + ": " + cf::to_string(e.rec.pcs) + ">";
       });
+}
 
-  py::class_<cf::CfGraph>(
-      m, "CfGraph",
-      "The CF graph of a model pair (cf::CfGraph): CFs, transitions and the two models. "
-      "Immutable; load it with cf.load_graph or make it with cf.generate.")
-      .def_property_readonly("model_a", &cf::CfGraph::model_a,
-                             py::return_value_policy::reference_internal,
-                             "A, the moving polyhedron.")
-      .def_property_readonly("model_b", &cf::CfGraph::model_b,
-                             py::return_value_policy::reference_internal,
-                             "B, the fixed polyhedron (world frame).")
-      .def_property_readonly("num_cfs", &cf::CfGraph::num_cfs)
-      .def_property_readonly("num_transitions", &cf::CfGraph::num_transitions)
-      .def("__len__", &cf::CfGraph::num_cfs)
-      .def(
-          "cf",
-          [](const cf::CfGraph& g, long id) {
-            return CfEntry{static_cast<int>(id), g.cf(checked_id(g, id, "cf"))};
-          },
-          py::arg("id"), "The CF with this id (cf.Error when there is none).")
-      .def_property_readonly(
-          "cfs",
-          [](const cf::CfGraph& g) {
-            py::list out;
-            for (std::size_t i = 0; i < g.num_cfs(); ++i)
-              out.append(
-                  CfEntry{static_cast<int>(i), g.cf(cf::CfId(static_cast<std::int32_t>(i)))});
-            return out;
-          },
-          "Every CF, in id order.")
-      .def(
-          "cf_of",
-          [](const cf::CfGraph& g, const py::object& pcs) -> py::object {
-            const std::optional<cf::CfId> id = g.find(pcset_from_py(pcs));
-            return id ? py::object(py::int_(id->value())) : py::object(py::none());
-          },
-          py::arg("pcs"),
-          "The id of the CF with exactly these PCs ('type:a:b;...', or a list of PCs in any "
-          "order), "
-          "None when the graph has none.")
-      .def(
-          "holds",
-          [](const cf::CfGraph& g, const py::object& pc) { return g.holds(pc_from_py(pc)); },
-          py::arg("pc"), "True when some CF of the graph holds this PC.")
-      .def(
-          "neighbours",
-          [](const cf::CfGraph& g, long id, const std::optional<std::string>& kind) {
-            const cf::CfId c = checked_id(g, id, "neighbours");
-            std::optional<cf::TransitionKind> k;
-            if (kind) {
-              k = cf::transition_kind_from_string(*kind);
-              if (!k)
-                fail("neighbours: kind must be 'gain', 'lose' or 'change', got '" + *kind + "'");
-            }
-            std::vector<int> out;
-            for (const cf::Transition& t : g.out_transitions(c))
-              if (!k || t.kind == *k) out.push_back(t.to.value());
-            return out;
-          },
-          py::arg("id"), py::arg("kind") = py::none(),
-          "Ids of the CFs one transition away from `id` (sorted), all or only of one kind "
-          "('gain', 'lose', 'change').")
+// cf.CfGraph's transitions: neighbours, transitions from a CF, adjacency, all as arrays.
+void add_graph_transitions(py::class_<cf::CfGraph>& cls) {
+  cls.def(
+         "neighbours",
+         [](const cf::CfGraph& g, long id, const std::optional<std::string>& kind) {
+           const cf::CfId c = checked_id(g, id, "neighbours");
+           std::optional<cf::TransitionKind> k;
+           if (kind) {
+             k = cf::transition_kind_from_string(*kind);
+             if (!k)
+               fail("neighbours: kind must be 'gain', 'lose' or 'change', got '" + *kind + "'");
+           }
+           std::vector<int> out;
+           for (const cf::Transition& t : g.out_transitions(c))
+             if (!k || t.kind == *k) out.push_back(t.to.value());
+           return out;
+         },
+         py::arg("id"), py::arg("kind") = py::none(),
+         "Ids of the CFs one transition away from `id` (sorted), all or only of one kind "
+         "('gain', 'lose', 'change').")
       .def(
           "transitions_from",
           [](const cf::CfGraph& g, long id) {
@@ -317,10 +286,59 @@ void bind_graph(py::module_& m) {
             }
             return py::make_tuple(from, to, py::module_::import("numpy").attr("array")(kinds));
           },
-          "Every transition in file order as three arrays: from (int32), to (int32), kind (str).")
-      .def_property_readonly(
-          "metadata_json", &cf::CfGraph::metadata_json,
-          "The file's extra top-level members (statistics, parameters) as JSON text.")
+          "Every transition in file order as three arrays: from (int32), to (int32), kind (str).");
+}
+
+// cf.CfGraph: models, CFs and their queries, transitions, metadata, JSON, saving.
+void bind_cf_graph(py::module_& m) {
+  auto cls =
+      py::class_<cf::CfGraph>(
+          m, "CfGraph",
+          "The CF graph of a model pair (cf::CfGraph): CFs, transitions and the two models. "
+          "Immutable; load it with cf.load_graph or make it with cf.generate.")
+          .def_property_readonly("model_a", &cf::CfGraph::model_a,
+                                 py::return_value_policy::reference_internal,
+                                 "A, the moving polyhedron.")
+          .def_property_readonly("model_b", &cf::CfGraph::model_b,
+                                 py::return_value_policy::reference_internal,
+                                 "B, the fixed polyhedron (world frame).")
+          .def_property_readonly("num_cfs", &cf::CfGraph::num_cfs)
+          .def_property_readonly("num_transitions", &cf::CfGraph::num_transitions)
+          .def("__len__", &cf::CfGraph::num_cfs)
+          .def(
+              "cf",
+              [](const cf::CfGraph& g, long id) {
+                return CfEntry{static_cast<int>(id), g.cf(checked_id(g, id, "cf"))};
+              },
+              py::arg("id"), "The CF with this id (cf.Error when there is none).")
+          .def_property_readonly(
+              "cfs",
+              [](const cf::CfGraph& g) {
+                py::list out;
+                for (std::size_t i = 0; i < g.num_cfs(); ++i)
+                  out.append(
+                      CfEntry{static_cast<int>(i), g.cf(cf::CfId(static_cast<std::int32_t>(i)))});
+                return out;
+              },
+              "Every CF, in id order.")
+          .def(
+              "cf_of",
+              [](const cf::CfGraph& g, const py::object& pcs) -> py::object {
+                const std::optional<cf::CfId> id = g.find(pcset_from_py(pcs));
+                return id ? py::object(py::int_(id->value())) : py::object(py::none());
+              },
+              py::arg("pcs"),
+              "The id of the CF with exactly these PCs ('type:a:b;...', or a list of PCs in any "
+              "order), "
+              "None when the graph has none.")
+          .def(
+              "holds",
+              [](const cf::CfGraph& g, const py::object& pc) { return g.holds(pc_from_py(pc)); },
+              py::arg("pc"), "True when some CF of the graph holds this PC.");
+  add_graph_transitions(cls);
+  cls.def_property_readonly(
+         "metadata_json", &cf::CfGraph::metadata_json,
+         "The file's extra top-level members (statistics, parameters) as JSON text.")
       .def("to_json", &cf::CfGraph::to_json, py::arg("indent") = -1, "The graph file's JSON text.")
       .def("_save", &cf::CfGraph::save, py::arg("path"),
            "Writes the graph (JSON, or CBOR when the name ends in .cbor), whole or not at all.")
@@ -329,7 +347,14 @@ void bind_graph(py::module_& m) {
                "': " + std::to_string(g.num_cfs()) + " CFs, " +
                std::to_string(g.num_transitions()) + " transitions>";
       });
+}
 
+}  // namespace
+
+void bind_graph(py::module_& m) {
+  bind_polyhedron(m);
+  bind_cf(m);
+  bind_cf_graph(m);
   m.def(
       "load_graph",
       [](const std::string& path, bool validate_schema, bool full_schema_check) {

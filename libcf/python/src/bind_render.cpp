@@ -110,9 +110,26 @@ cf::Params params_arg(const py::object& params, const py::kwargs& kw, const std:
   return params_from_kwargs(base, kw, where);
 }
 
-}  // namespace
+/// Renderer.step: the arguments checked, then one tick.
+py::dict renderer_step(Renderer& self, double t_s, const py::object& p, const py::object& q) {
+  const Array pa = as_array(p, "p", "step"), qa = as_array(q, "q", "step");
+  if (pa.ndim() != 1 || pa.shape(0) != 3) fail("step: p must have shape (3,), got " + shape_of(pa));
+  if (qa.ndim() != 1 || qa.shape(0) != 4)
+    fail("step: q must have shape (4,) (w, x, y, z), got " + shape_of(qa));
+  if (!std::isfinite(t_s)) fail("step: t is not finite");
+  if (self.stepped && !(t_s > self.last_t)) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "step: time %.9g s does not increase (previous step: %.9g s)",
+                  t_s, self.last_t);
+    fail(buf);
+  }
+  const cf::Pose pose = pose_from(pa.data(), qa.data(), "step");
+  self.stepped = true;
+  self.last_t = t_s;
+  return step_dict(self.r.step(pose, t_s));
+}
 
-void bind_render(py::module_& m) {
+void bind_renderer(py::module_& m) {
   py::class_<Renderer>(
       m, "Renderer",
       "The haptic renderer (cf::HapticRenderer) of one graph: Renderer(graph, params=None, "
@@ -122,36 +139,15 @@ void bind_render(py::module_& m) {
              return std::make_unique<Renderer>(g, params_arg(params, kw, "Renderer"));
            }),
            py::arg("graph"), py::arg("params") = py::none(), py::keep_alive<1, 2>())
-      .def(
-          "step",
-          [](Renderer& self, double t_s, const py::object& p, const py::object& q) {
-            const Array pa = as_array(p, "p", "step"), qa = as_array(q, "q", "step");
-            if (pa.ndim() != 1 || pa.shape(0) != 3)
-              fail("step: p must have shape (3,), got " + shape_of(pa));
-            if (qa.ndim() != 1 || qa.shape(0) != 4)
-              fail("step: q must have shape (4,) (w, x, y, z), got " + shape_of(qa));
-            if (!std::isfinite(t_s)) fail("step: t is not finite");
-            if (self.stepped && !(t_s > self.last_t)) {
-              char buf[160];
-              std::snprintf(buf, sizeof buf,
-                            "step: time %.9g s does not increase (previous step: %.9g s)", t_s,
-                            self.last_t);
-              fail(buf);
-            }
-            const cf::Pose pose = pose_from(pa.data(), qa.data(), "step");
-            self.stepped = true;
-            self.last_t = t_s;
-            return step_dict(self.r.step(pose, t_s));
-          },
-          py::arg("t"), py::arg("p"), py::arg("q"),
-          "One servo tick at time t (s, increasing), A's translation p (3, mm) and rotation q (4, "
-          "unit "
-          "quaternion w, x, y, z; x_B = R x_A + p). Returns a dict named like cf::HapticResult's "
-          "fields: "
-          "t_s, cf (-1 for none), pcs, motion, status, identification, num_detected, F_W, M_W, "
-          "F_A, "
-          "M_A, and the force model's F_contact_W, F_gravity_W, dof, pc_forces (per PC: regime, "
-          "distance, F_cy, task frame R_WT, ...).")
+      .def("step", &renderer_step, py::arg("t"), py::arg("p"), py::arg("q"),
+           "One servo tick at time t (s, increasing), A's translation p (3, mm) and rotation q (4, "
+           "unit "
+           "quaternion w, x, y, z; x_B = R x_A + p). Returns a dict named like cf::HapticResult's "
+           "fields: "
+           "t_s, cf (-1 for none), pcs, motion, status, identification, num_detected, F_W, M_W, "
+           "F_A, "
+           "M_A, and the force model's F_contact_W, F_gravity_W, dof, pc_forces (per PC: regime, "
+           "distance, F_cy, task frame R_WT, ...).")
       .def(
           "reset",
           [](Renderer& self) {
@@ -160,6 +156,160 @@ void bind_render(py::module_& m) {
           },
           "Forgets the history (previous CF, anchors, filters).")
       .def_property_readonly("params", [](const Renderer& self) { return self.r.params(); });
+}
+
+/// replay's poses from its arrays t (N,), p (N, 3), q (N, 4), checked.
+std::vector<cf::replay::Sample> replay_samples(const py::object& t, const py::object& p,
+                                               const py::object& q, const std::string& where) {
+  const Array ta = as_array(t, "t", where), pa = as_array(p, "p", where),
+              qa = as_array(q, "q", where);
+  if (ta.ndim() != 1) fail(where + ": t must have shape (N,), got " + shape_of(ta));
+  const py::ssize_t n = ta.shape(0);
+  if (n == 0) fail(where + ": no poses (t is empty)");
+  if (pa.ndim() != 2 || pa.shape(0) != n || pa.shape(1) != 3)
+    fail(where + ": p must have shape (N, 3) with N = len(t) = " + std::to_string(n) + ", got " +
+         shape_of(pa));
+  if (qa.ndim() != 2 || qa.shape(0) != n || qa.shape(1) != 4)
+    fail(where + ": q must have shape (N, 4) (w, x, y, z) with N = len(t) = " + std::to_string(n) +
+         ", got " + shape_of(qa));
+  std::vector<cf::replay::Sample> samples(static_cast<std::size_t>(n));
+  const double* T = ta.data();
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const std::string row = where + ": row " + std::to_string(i);
+    if (!std::isfinite(T[i])) fail(row + ": time is not finite");
+    if (i > 0 && !(T[i] > T[i - 1])) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, ": time %.9g s does not increase (previous row: %.9g s)", T[i],
+                    T[i - 1]);
+      fail(row + buf);
+    }
+    cf::replay::Sample& s = samples[static_cast<std::size_t>(i)];
+    s.t = T[i];
+    s.pose = pose_from(pa.data() + 3 * i, qa.data() + 4 * i, row);
+    s.line = static_cast<int>(i);
+  }
+  return samples;
+}
+
+/// What replay reports per tick beyond cfreplay's rows.
+struct ReplayExtras {
+  explicit ReplayExtras(std::size_t N)
+      : num_detected(N),
+        identification(N),
+        Fc(3 * N, 0.0),
+        Mc(3 * N, 0.0),
+        Fg(3 * N, 0.0),
+        conservative(N, 0),
+        dof(N, 6) {}
+  std::vector<std::int32_t> num_detected;
+  std::vector<std::string> identification;
+  std::vector<double> Fc, Mc, Fg;
+  std::vector<std::uint8_t> conservative;
+  std::vector<std::int32_t> dof;
+};
+
+/// cfreplay's loop over the samples, without the GIL.
+void run_replay(const cf::CfGraph& g, const std::vector<cf::replay::Sample>& samples,
+                const cf::Params& P, ReplayRows& rows, ReplayExtras& x) {
+  py::gil_scoped_release release;
+  std::size_t i = 0;
+  rows.rows =
+      cf::replay::run(g, samples, P, [&](const cf::replay::Sample&, const cf::HapticResult& r) {
+        x.num_detected[i] = r.num_detected;
+        x.identification[i] = r.identification;
+        for (int k = 0; k < 3; ++k) {
+          x.Fc[3 * i + static_cast<std::size_t>(k)] = r.F_contact_W[k];
+          x.Mc[3 * i + static_cast<std::size_t>(k)] = r.M_contact_W[k];
+        }
+        if (r.force != nullptr) {
+          for (int k = 0; k < 3; ++k)
+            x.Fg[3 * i + static_cast<std::size_t>(k)] = r.force->F_gravity_W[k];
+          x.conservative[i] = r.force->conservative;
+          x.dof[i] = r.force->freedoms.dof;
+        }
+        ++i;
+      });
+}
+
+/// replay's result: per-tick arrays and lists by name, and the rows for to_csv.
+py::dict replay_dict(std::unique_ptr<ReplayRows> rows, const ReplayExtras& x) {
+  const auto n = static_cast<py::ssize_t>(rows->rows.size());
+  py::dict d;
+  const std::vector<py::ssize_t> shape3{n, 3};
+  py::array_t<double> tt(n), FW(shape3), MW(shape3), FA(shape3), MA(shape3), FC(shape3), MC(shape3),
+      FG(shape3), PP(shape3), PQ(std::vector<py::ssize_t>{n, 4});
+  py::array_t<std::int32_t> cfa(n), nd(n), dofa(n);
+  py::array_t<bool> cons(n);
+  py::list pcs, motion, status, regimes, ident;
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const auto I = static_cast<std::size_t>(i);
+    const cf::replay::Row& r = rows->rows[I];
+    tt.mutable_at(i) = r.t;
+    cfa.mutable_at(i) = r.cf;
+    nd.mutable_at(i) = x.num_detected[I];
+    dofa.mutable_at(i) = x.dof[I];
+    cons.mutable_at(i) = x.conservative[I] != 0;
+    for (int k = 0; k < 3; ++k) {
+      const auto K = 3 * I + static_cast<std::size_t>(k);
+      FW.mutable_at(i, k) = r.F_W[k];
+      MW.mutable_at(i, k) = r.M_W[k];
+      FA.mutable_at(i, k) = r.F_A[k];
+      MA.mutable_at(i, k) = r.M_A[k];
+      FC.mutable_at(i, k) = x.Fc[K];
+      MC.mutable_at(i, k) = x.Mc[K];
+      PP.mutable_at(i, k) = r.X_WP.t_BA[k];
+      FG.mutable_at(i, k) = x.Fg[K];
+    }
+    Eigen::Quaterniond q_WP(r.X_WP.R_BA);
+    if (q_WP.w() < 0) q_WP.coeffs() = -q_WP.coeffs();
+    PQ.mutable_at(i, 0) = q_WP.w();
+    PQ.mutable_at(i, 1) = q_WP.x();
+    PQ.mutable_at(i, 2) = q_WP.y();
+    PQ.mutable_at(i, 3) = q_WP.z();
+    pcs.append(r.pcs);
+    motion.append(r.motion);
+    status.append(r.status);
+    regimes.append(r.regimes);
+    ident.append(x.identification[I]);
+  }
+  d["t_s"] = tt;
+  d["cf"] = cfa;
+  d["pcs"] = pcs;
+  d["motion"] = motion;
+  d["status"] = status;
+  d["identification"] = ident;
+  d["num_detected"] = nd;
+  d["F_W"] = FW;
+  d["M_W"] = MW;
+  d["F_A"] = FA;
+  d["M_A"] = MA;
+  d["F_contact_W"] = FC;
+  d["M_contact_W"] = MC;
+  d["proxy_p"] = PP;
+  d["proxy_q"] = PQ;
+  d["F_gravity_W"] = FG;
+  d["conservative"] = cons;
+  d["dof"] = dofa;
+  d["regimes"] = regimes;
+  d["_rows"] = py::cast(std::move(rows));
+  return d;
+}
+
+py::dict replay(const cf::CfGraph& g, const py::object& t, const py::object& p, const py::object& q,
+                const py::object& params, const py::kwargs& kw) {
+  const std::string where = "replay";
+  const cf::Params P = params_arg(params, kw, where);
+  const std::vector<cf::replay::Sample> samples = replay_samples(t, p, q, where);
+  auto rows = std::make_unique<ReplayRows>();
+  ReplayExtras extras(samples.size());
+  run_replay(g, samples, P, *rows, extras);
+  return replay_dict(std::move(rows), extras);
+}
+
+}  // namespace
+
+void bind_render(py::module_& m) {
+  bind_renderer(m);
 
   py::class_<ReplayRows>(m, "_ReplayRows")
       .def("__len__", [](const ReplayRows& r) { return r.rows.size(); })
@@ -176,128 +326,9 @@ void bind_render(py::module_& m) {
           },
           "The rows as cfreplay writes them (header first).");
 
-  m.def(
-      "replay",
-      [](const cf::CfGraph& g, const py::object& t, const py::object& p, const py::object& q,
-         const py::object& params, const py::kwargs& kw) {
-        const std::string where = "replay";
-        const cf::Params P = params_arg(params, kw, where);
-        const Array ta = as_array(t, "t", where), pa = as_array(p, "p", where),
-                    qa = as_array(q, "q", where);
-        if (ta.ndim() != 1) fail(where + ": t must have shape (N,), got " + shape_of(ta));
-        const py::ssize_t n = ta.shape(0);
-        if (n == 0) fail(where + ": no poses (t is empty)");
-        if (pa.ndim() != 2 || pa.shape(0) != n || pa.shape(1) != 3)
-          fail(where + ": p must have shape (N, 3) with N = len(t) = " + std::to_string(n) +
-               ", got " + shape_of(pa));
-        if (qa.ndim() != 2 || qa.shape(0) != n || qa.shape(1) != 4)
-          fail(where + ": q must have shape (N, 4) (w, x, y, z) with N = len(t) = " +
-               std::to_string(n) + ", got " + shape_of(qa));
-        std::vector<cf::replay::Sample> samples(static_cast<std::size_t>(n));
-        const double* T = ta.data();
-        for (py::ssize_t i = 0; i < n; ++i) {
-          const std::string row = where + ": row " + std::to_string(i);
-          if (!std::isfinite(T[i])) fail(row + ": time is not finite");
-          if (i > 0 && !(T[i] > T[i - 1])) {
-            char buf[160];
-            std::snprintf(buf, sizeof buf, ": time %.9g s does not increase (previous row: %.9g s)",
-                          T[i], T[i - 1]);
-            fail(row + buf);
-          }
-          cf::replay::Sample& s = samples[static_cast<std::size_t>(i)];
-          s.t = T[i];
-          s.pose = pose_from(pa.data() + 3 * i, qa.data() + 4 * i, row);
-          s.line = static_cast<int>(i);
-        }
-
-        const auto N = static_cast<std::size_t>(n);
-        auto rows = std::make_unique<ReplayRows>();
-        std::vector<std::int32_t> num_detected(N);
-        std::vector<std::string> identification(N);
-        std::vector<double> Fc(3 * N, 0.0), Mc(3 * N, 0.0), Fg(3 * N, 0.0);
-        std::vector<std::uint8_t> conservative(N, 0);
-        std::vector<std::int32_t> dof(N, 6);
-        {
-          py::gil_scoped_release release;
-          std::size_t i = 0;
-          rows->rows = cf::replay::run(
-              g, samples, P, [&](const cf::replay::Sample&, const cf::HapticResult& r) {
-                num_detected[i] = r.num_detected;
-                identification[i] = r.identification;
-                for (int k = 0; k < 3; ++k) {
-                  Fc[3 * i + static_cast<std::size_t>(k)] = r.F_contact_W[k];
-                  Mc[3 * i + static_cast<std::size_t>(k)] = r.M_contact_W[k];
-                }
-                if (r.force != nullptr) {
-                  for (int k = 0; k < 3; ++k)
-                    Fg[3 * i + static_cast<std::size_t>(k)] = r.force->F_gravity_W[k];
-                  conservative[i] = r.force->conservative;
-                  dof[i] = r.force->freedoms.dof;
-                }
-                ++i;
-              });
-        }
-
-        py::dict d;
-        const std::vector<py::ssize_t> shape3{n, 3};
-        py::array_t<double> tt(n), FW(shape3), MW(shape3), FA(shape3), MA(shape3), FC(shape3),
-            MC(shape3), FG(shape3), PP(shape3), PQ(std::vector<py::ssize_t>{n, 4});
-        py::array_t<std::int32_t> cfa(n), nd(n), dofa(n);
-        py::array_t<bool> cons(n);
-        py::list pcs, motion, status, regimes, ident;
-        for (py::ssize_t i = 0; i < n; ++i) {
-          const cf::replay::Row& r = rows->rows[static_cast<std::size_t>(i)];
-          tt.mutable_at(i) = r.t;
-          cfa.mutable_at(i) = r.cf;
-          nd.mutable_at(i) = num_detected[static_cast<std::size_t>(i)];
-          dofa.mutable_at(i) = dof[static_cast<std::size_t>(i)];
-          cons.mutable_at(i) = conservative[static_cast<std::size_t>(i)] != 0;
-          for (int k = 0; k < 3; ++k) {
-            FW.mutable_at(i, k) = r.F_W[k];
-            MW.mutable_at(i, k) = r.M_W[k];
-            FA.mutable_at(i, k) = r.F_A[k];
-            MA.mutable_at(i, k) = r.M_A[k];
-            FC.mutable_at(i, k) = Fc[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(k)];
-            MC.mutable_at(i, k) = Mc[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(k)];
-            PP.mutable_at(i, k) = r.X_WP.t_BA[k];
-            FG.mutable_at(i, k) = Fg[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(k)];
-          }
-          Eigen::Quaterniond q_WP(r.X_WP.R_BA);
-          if (q_WP.w() < 0) q_WP.coeffs() = -q_WP.coeffs();
-          PQ.mutable_at(i, 0) = q_WP.w();
-          PQ.mutable_at(i, 1) = q_WP.x();
-          PQ.mutable_at(i, 2) = q_WP.y();
-          PQ.mutable_at(i, 3) = q_WP.z();
-          pcs.append(r.pcs);
-          motion.append(r.motion);
-          status.append(r.status);
-          regimes.append(r.regimes);
-          ident.append(identification[static_cast<std::size_t>(i)]);
-        }
-        d["t_s"] = tt;
-        d["cf"] = cfa;
-        d["pcs"] = pcs;
-        d["motion"] = motion;
-        d["status"] = status;
-        d["identification"] = ident;
-        d["num_detected"] = nd;
-        d["F_W"] = FW;
-        d["M_W"] = MW;
-        d["F_A"] = FA;
-        d["M_A"] = MA;
-        d["F_contact_W"] = FC;
-        d["M_contact_W"] = MC;
-        d["proxy_p"] = PP;
-        d["proxy_q"] = PQ;
-        d["F_gravity_W"] = FG;
-        d["conservative"] = cons;
-        d["dof"] = dofa;
-        d["regimes"] = regimes;
-        d["_rows"] = py::cast(std::move(rows));
-        return d;
-      },
-      py::arg("graph"), py::arg("t"), py::arg("p"), py::arg("q"), py::arg("params") = py::none(),
-      "cfreplay's loop (cf::replay::run) over arrays; the package's cf.replay wraps the result.");
+  m.def("replay", &replay, py::arg("graph"), py::arg("t"), py::arg("p"), py::arg("q"),
+        py::arg("params") = py::none(),
+        "cfreplay's loop (cf::replay::run) over arrays; the package's cf.replay wraps the result.");
 }
 
 }  // namespace cfpy

@@ -72,22 +72,19 @@ void obb_of(const std::vector<Vec3>& pts, double inflate, const Vec3& origin, No
   o.oh = lanes4(h);
 }
 
-}  // namespace
-
 // A face owns the edges it has on its left and the vertices for which it is the first
 // incident face: each element is owned once, and lies on its owner's boundary, so a face's
 // group has the face's own box. Groups of more than kMaxGroup elements are cut into pieces.
 constexpr std::int32_t kMaxGroup = LeafBoxes::kLanes;
 
-Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin, Leaves leaves)
-    : origin_(origin) {
-  leaf_size = std::clamp(leaf_size, 1, leaves == Leaves::kFaceGroups ? 255 / kMaxGroup : 255);
+// The build's units: members in item order, and the items over them.
+struct Items {
   std::vector<BvhElement> members;
   std::vector<Item> items;
-  members.reserve(m.num_vertices() + m.num_edges() + m.num_faces());
-  std::vector<Vec3> pts;
+  std::vector<Vec3> pts;  // scratch
+
   // Closes the item of members[first, end).
-  auto close_item = [&](std::int32_t first) {
+  void close(const Polyhedron& m, std::int32_t first) {
     const auto end = static_cast<std::int32_t>(members.size());
     if (end == first) return;
     pts.clear();
@@ -96,135 +93,210 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin,
     Vec3 lo, hi;
     bounds_of(pts, lo, hi);
     items.push_back({first, end - first, lo, hi});
-  };
-  if (leaves == Leaves::kElements) {
-    auto add = [&](ElementKind kind, std::size_t i) {
-      const auto first = static_cast<std::int32_t>(members.size());
-      members.push_back({kind, static_cast<std::int32_t>(i)});
-      close_item(first);
-    };
-    for (std::size_t i = 0; i < m.num_vertices(); ++i) add(ElementKind::kVertex, i);
-    for (std::size_t i = 0; i < m.num_edges(); ++i) add(ElementKind::kEdge, i);
-    for (std::size_t i = 0; i < m.num_faces(); ++i) add(ElementKind::kFace, i);
-  } else {
-    std::vector<std::vector<BvhElement>> owned(m.num_faces());
-    std::vector<std::int32_t> faceless;  // vertices on no face: items of their own
-    for (std::size_t e = 0; e < m.num_edges(); ++e)
-      owned[m.edges()[e].left.index()].push_back(
-          {ElementKind::kEdge, static_cast<std::int32_t>(e)});
-    for (std::size_t v = 0; v < m.num_vertices(); ++v) {
-      const auto iv = static_cast<std::int32_t>(v);
-      if (m.vertices()[v].faces.empty())
-        faceless.push_back(iv);
-      else
-        owned[m.vertices()[v].faces.front().index()].push_back({ElementKind::kVertex, iv});
-    }
-    for (std::size_t f = 0; f < m.num_faces(); ++f) {
-      auto first = static_cast<std::int32_t>(members.size());
-      members.push_back({ElementKind::kFace, static_cast<std::int32_t>(f)});
-      for (const BvhElement& e : owned[f]) {
-        if (static_cast<std::int32_t>(members.size()) - first == kMaxGroup) {
-          close_item(first);
-          first = static_cast<std::int32_t>(members.size());
-        }
-        members.push_back(e);
+  }
+  // One element as an item of its own.
+  void add_single(const Polyhedron& m, ElementKind kind, std::int32_t i) {
+    const auto first = static_cast<std::int32_t>(members.size());
+    members.push_back({kind, i});
+    close(m, first);
+  }
+};
+
+// Every vertex, edge and face an item of its own.
+void element_items(const Polyhedron& m, Items& it) {
+  for (std::size_t i = 0; i < m.num_vertices(); ++i)
+    it.add_single(m, ElementKind::kVertex, static_cast<std::int32_t>(i));
+  for (std::size_t i = 0; i < m.num_edges(); ++i)
+    it.add_single(m, ElementKind::kEdge, static_cast<std::int32_t>(i));
+  for (std::size_t i = 0; i < m.num_faces(); ++i)
+    it.add_single(m, ElementKind::kFace, static_cast<std::int32_t>(i));
+}
+
+// Each face with the elements it owns (pieces of at most kMaxGroup), then the vertices on no
+// face alone.
+void face_group_items(const Polyhedron& m, Items& it) {
+  std::vector<std::vector<BvhElement>> owned(m.num_faces());
+  std::vector<std::int32_t> faceless;  // vertices on no face: items of their own
+  for (std::size_t e = 0; e < m.num_edges(); ++e)
+    owned[m.edges()[e].left.index()].push_back({ElementKind::kEdge, static_cast<std::int32_t>(e)});
+  for (std::size_t v = 0; v < m.num_vertices(); ++v) {
+    const auto iv = static_cast<std::int32_t>(v);
+    if (m.vertices()[v].faces.empty())
+      faceless.push_back(iv);
+    else
+      owned[m.vertices()[v].faces.front().index()].push_back({ElementKind::kVertex, iv});
+  }
+  for (std::size_t f = 0; f < m.num_faces(); ++f) {
+    auto first = static_cast<std::int32_t>(it.members.size());
+    it.members.push_back({ElementKind::kFace, static_cast<std::int32_t>(f)});
+    for (const BvhElement& e : owned[f]) {
+      if (static_cast<std::int32_t>(it.members.size()) - first == kMaxGroup) {
+        it.close(m, first);
+        first = static_cast<std::int32_t>(it.members.size());
       }
-      close_item(first);
+      it.members.push_back(e);
     }
-    for (std::int32_t v : faceless) {
-      const auto first = static_cast<std::int32_t>(members.size());
-      members.push_back({ElementKind::kVertex, v});
-      close_item(first);
+    it.close(m, first);
+  }
+  for (std::int32_t v : faceless) it.add_single(m, ElementKind::kVertex, v);
+}
+
+// A node over items [begin, end): its boxes (axis-aligned and oriented, inflated), the kinds
+// below it; clo and chi bound the items' centroids.
+void fit_node(const Polyhedron& m, Items& it, std::int32_t begin, std::int32_t end, double inflate,
+              const Vec3& origin, BvhNode& n, NodeBox& box, Vec3& clo, Vec3& chi) {
+  const auto& items = it.items;
+  Vec3 lo = items[static_cast<std::size_t>(begin)].lo,
+       hi = items[static_cast<std::size_t>(begin)].hi;
+  clo = items[static_cast<std::size_t>(begin)].centroid(), chi = clo;
+  for (std::int32_t i = begin; i < end; ++i) {
+    const Item& item = items[static_cast<std::size_t>(i)];
+    lo = lo.cwiseMin(item.lo);
+    hi = hi.cwiseMax(item.hi);
+    clo = clo.cwiseMin(item.centroid());
+    chi = chi.cwiseMax(item.centroid());
+  }
+  round_out(0.5 * (lo + hi), 0.5 * (hi - lo) + Vec3::Constant(inflate), n.center, n.half);
+  it.pts.clear();
+  for (std::int32_t i = begin; i < end; ++i) {
+    const Item& item = items[static_cast<std::size_t>(i)];
+    for (std::int32_t k = item.first; k < item.first + item.count; ++k) {
+      points_of(m, it.members[static_cast<std::size_t>(k)], it.pts);
+      n.kinds |= kind_bit(it.members[static_cast<std::size_t>(k)].kind);
     }
   }
-  if (items.empty()) return;
-  nodes_.reserve(2 * items.size());
-  // Iterative top-down build: median split along the longest axis of the centroids.
+  obb_of(it.pts, inflate, origin, box);
+  Eigen::Vector3f c, h;
+  round_out(0.5 * (lo + hi) - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate), c, h);
+  box.c = lanes4(c);
+  box.h = lanes4(h);
+  n.touchable = touchable_by_a(n.kinds);
+}
+
+// Median split of items [begin, end) along the longest axis of their centroids' bounds (ties
+// by element, so that the tree does not depend on the sort's implementation).
+std::int32_t median_split(Items& it, std::int32_t begin, std::int32_t end, const Vec3& clo,
+                          const Vec3& chi) {
+  int axis = 0;
+  (chi - clo).maxCoeff(&axis);
+  const std::int32_t mid = (begin + end) / 2;
+  const auto& members = it.members;
+  std::nth_element(it.items.begin() + begin, it.items.begin() + mid, it.items.begin() + end,
+                   [axis, &members](const Item& x, const Item& y) {
+                     const double cx = x.lo[axis] + x.hi[axis], cy = y.lo[axis] + y.hi[axis];
+                     if (cx != cy) return cx < cy;
+                     const BvhElement& ex = members[static_cast<std::size_t>(x.first)];
+                     const BvhElement& ey = members[static_cast<std::size_t>(y.first)];
+                     if (ex.kind != ey.kind) return ex.kind < ey.kind;
+                     return ex.index < ey.index;
+                   });
+  return mid;
+}
+
+// Iterative top-down build over the items: leaves of at most leaf_size items (child = ~first
+// item for now). Returns the depth.
+int build_tree(const Polyhedron& m, Items& it, double inflate, int leaf_size, const Vec3& origin,
+               std::vector<BvhNode>& nodes, std::vector<NodeBox>& boxes) {
   struct Task {
     std::int32_t node, begin, end, depth;
   };
+  int depth = 0;
   std::vector<Task> tasks;
-  nodes_.emplace_back();
-  boxes_.resize(2 * items.size());  // a binary tree over n items has fewer than 2n nodes
-  tasks.push_back({0, 0, static_cast<std::int32_t>(items.size()), 1});
+  nodes.emplace_back();
+  boxes.resize(2 * it.items.size());  // a binary tree over n items has fewer than 2n nodes
+  tasks.push_back({0, 0, static_cast<std::int32_t>(it.items.size()), 1});
   while (!tasks.empty()) {
     const Task t = tasks.back();
     tasks.pop_back();
-    depth_ = std::max(depth_, t.depth);
-    Vec3 lo = items[static_cast<std::size_t>(t.begin)].lo,
-         hi = items[static_cast<std::size_t>(t.begin)].hi;
-    Vec3 clo = items[static_cast<std::size_t>(t.begin)].centroid(), chi = clo;
-    for (std::int32_t i = t.begin; i < t.end; ++i) {
-      const Item& it = items[static_cast<std::size_t>(i)];
-      lo = lo.cwiseMin(it.lo);
-      hi = hi.cwiseMax(it.hi);
-      clo = clo.cwiseMin(it.centroid());
-      chi = chi.cwiseMax(it.centroid());
-    }
-    BvhNode& n = nodes_[static_cast<std::size_t>(t.node)];
-    round_out(0.5 * (lo + hi), 0.5 * (hi - lo) + Vec3::Constant(inflate), n.center, n.half);
-    pts.clear();
-    for (std::int32_t i = t.begin; i < t.end; ++i) {
-      const Item& it = items[static_cast<std::size_t>(i)];
-      for (std::int32_t k = it.first; k < it.first + it.count; ++k) {
-        points_of(m, members[static_cast<std::size_t>(k)], pts);
-        n.kinds |= kind_bit(members[static_cast<std::size_t>(k)].kind);
-      }
-    }
-    NodeBox& box = boxes_[static_cast<std::size_t>(t.node)];
-    obb_of(pts, inflate, origin, box);
-    Eigen::Vector3f c, h;
-    round_out(0.5 * (lo + hi) - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate), c, h);
-    box.c = lanes4(c);
-    box.h = lanes4(h);
-    n.touchable = touchable_by_a(n.kinds);
+    depth = std::max(depth, t.depth);
+    Vec3 clo, chi;
+    BvhNode& n = nodes[static_cast<std::size_t>(t.node)];
+    fit_node(m, it, t.begin, t.end, inflate, origin, n, boxes[static_cast<std::size_t>(t.node)],
+             clo, chi);
     if (t.end - t.begin <= leaf_size) {
       n.child = ~t.begin;  // items for now; elements below
       n.count = static_cast<std::uint8_t>(t.end - t.begin);
       continue;
     }
-    // Median split along the longest axis of the centroids.
-    int axis = 0;
-    (chi - clo).maxCoeff(&axis);
-    const std::int32_t mid = (t.begin + t.end) / 2;
-    std::nth_element(items.begin() + t.begin, items.begin() + mid, items.begin() + t.end,
-                     [axis, &members](const Item& x, const Item& y) {
-                       const double cx = x.lo[axis] + x.hi[axis], cy = y.lo[axis] + y.hi[axis];
-                       if (cx != cy) return cx < cy;
-                       const BvhElement& ex = members[static_cast<std::size_t>(x.first)];
-                       const BvhElement& ey = members[static_cast<std::size_t>(y.first)];
-                       if (ex.kind != ey.kind) return ex.kind < ey.kind;
-                       return ex.index < ey.index;
-                     });
-    const auto l = static_cast<std::int32_t>(nodes_.size());
-    nodes_.emplace_back();
-    nodes_.emplace_back();
-    nodes_[static_cast<std::size_t>(t.node)].child = l;
+    const std::int32_t mid = median_split(it, t.begin, t.end, clo, chi);
+    const auto l = static_cast<std::int32_t>(nodes.size());
+    nodes.emplace_back();
+    nodes.emplace_back();
+    nodes[static_cast<std::size_t>(t.node)].child = l;
     tasks.push_back({l, t.begin, mid, t.depth + 1});
     tasks.push_back({l + 1, mid, t.end, t.depth + 1});
   }
-  boxes_.resize(nodes_.size());
-  // Elements in the items' final order; leaves from item ranges to element ranges.
-  std::vector<std::int32_t> offset(items.size() + 1, 0);
-  elements_.reserve(members.size());
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    offset[i] = static_cast<std::int32_t>(elements_.size());
-    const Item& it = items[i];
-    for (std::int32_t k = it.first; k < it.first + it.count; ++k) {
-      const BvhElement& e = members[static_cast<std::size_t>(k)];
-      elements_.push_back(e);
-      pts.clear();
-      points_of(m, e, pts);
+  boxes.resize(nodes.size());
+  return depth;
+}
+
+// The elements in the items' final order with their own boxes; returns where each item's
+// elements start (and, last, their count).
+std::vector<std::int32_t> place_elements(const Polyhedron& m, Items& it, double inflate,
+                                         const Vec3& origin, std::vector<BvhElement>& elements,
+                                         std::vector<ElemBox>& elem_boxes) {
+  std::vector<std::int32_t> offset(it.items.size() + 1, 0);
+  elements.reserve(it.members.size());
+  for (std::size_t i = 0; i < it.items.size(); ++i) {
+    offset[i] = static_cast<std::int32_t>(elements.size());
+    const Item& item = it.items[i];
+    for (std::int32_t k = item.first; k < item.first + item.count; ++k) {
+      const BvhElement& e = it.members[static_cast<std::size_t>(k)];
+      elements.push_back(e);
+      it.pts.clear();
+      points_of(m, e, it.pts);
       Vec3 lo, hi;
-      bounds_of(pts, lo, hi);
+      bounds_of(it.pts, lo, hi);
       Eigen::Vector3f c, h;
       round_out(0.5 * (lo + hi) - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate), c, h);
-      ElemBox& b = elem_boxes_.emplace_back();
+      ElemBox& b = elem_boxes.emplace_back();
       b.c = lanes4(c);
       b.h = lanes4(h);
     }
   }
-  offset[items.size()] = static_cast<std::int32_t>(elements_.size());
+  offset[it.items.size()] = static_cast<std::int32_t>(elements.size());
+  return offset;
+}
+
+// Leaf n's elements' boxes on lanes (one group: at most kMaxGroup == LeafBoxes::kLanes).
+LeafBoxes lane_boxes(const BvhNode& n, const std::vector<BvhElement>& elements,
+                     const std::vector<ElemBox>& elem_boxes) {
+  static_assert(kMaxGroup <= LeafBoxes::kLanes);
+  LeafBoxes L;
+  for (int i = 0; i < 3; ++i) {
+    L.c[i].setZero();
+    L.h[i].setConstant(-1e30f);  // unused lanes: apart from every box
+  }
+  for (int j = 0; j < n.count; ++j) {
+    const auto k = static_cast<std::size_t>(n.element() + j);
+    for (int i = 0; i < 3; ++i) {
+      L.c[i][j] = elem_boxes[k].c[i];
+      L.h[i][j] = elem_boxes[k].h[i];
+    }
+    for (int ka = 0; ka < 3; ++ka)
+      if (kinds_can_touch(kind_bit(static_cast<ElementKind>(ka)), kind_bit(elements[k].kind)))
+        L.touchable_by[ka] = static_cast<std::uint8_t>(L.touchable_by[ka] | (1u << j));
+  }
+  return L;
+}
+
+}  // namespace
+
+Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin, Leaves leaves)
+    : origin_(origin) {
+  leaf_size = std::clamp(leaf_size, 1, leaves == Leaves::kFaceGroups ? 255 / kMaxGroup : 255);
+  Items it;
+  it.members.reserve(m.num_vertices() + m.num_edges() + m.num_faces());
+  if (leaves == Leaves::kElements)
+    element_items(m, it);
+  else
+    face_group_items(m, it);
+  if (it.items.empty()) return;
+  nodes_.reserve(2 * it.items.size());
+  depth_ = build_tree(m, it, inflate, leaf_size, origin, nodes_, boxes_);
+  // Leaves from item ranges to element ranges.
+  const std::vector<std::int32_t> offset =
+      place_elements(m, it, inflate, origin, elements_, elem_boxes_);
   const bool lanes = leaves == Leaves::kFaceGroups && leaf_size == 1;
   if (lanes) leaf_of_element_.assign(elements_.size(), -1);
   for (BvhNode& n : nodes_)
@@ -234,25 +306,9 @@ Bvh::Bvh(const Polyhedron& m, double inflate, int leaf_size, const Vec3& origin,
       n.count = static_cast<std::uint8_t>(offset[static_cast<std::size_t>(e)] -
                                           offset[static_cast<std::size_t>(b)]);
       if (!lanes) continue;
-      // One group: at most kMaxGroup == LeafBoxes::kLanes elements.
-      static_assert(kMaxGroup <= LeafBoxes::kLanes);
       leaf_of_element_[static_cast<std::size_t>(n.element())] =
           static_cast<std::int32_t>(leaf_boxes_.size());
-      LeafBoxes& L = leaf_boxes_.emplace_back();
-      for (int i = 0; i < 3; ++i) {
-        L.c[i].setZero();
-        L.h[i].setConstant(-1e30f);  // unused lanes: apart from every box
-      }
-      for (int j = 0; j < n.count; ++j) {
-        const auto k = static_cast<std::size_t>(n.element() + j);
-        for (int i = 0; i < 3; ++i) {
-          L.c[i][j] = elem_boxes_[k].c[i];
-          L.h[i][j] = elem_boxes_[k].h[i];
-        }
-        for (int ka = 0; ka < 3; ++ka)
-          if (kinds_can_touch(kind_bit(static_cast<ElementKind>(ka)), kind_bit(elements_[k].kind)))
-            L.touchable_by[ka] = static_cast<std::uint8_t>(L.touchable_by[ka] | (1u << j));
-      }
+      leaf_boxes_.push_back(lane_boxes(n, elements_, elem_boxes_));
     }
   const std::int32_t root = 0;
   wide_.reserve(nodes_.size() / 2 + 1);

@@ -295,8 +295,8 @@ struct IdentifyScratch {
           res->cf_pcs[static_cast<std::size_t>(res->num_cf_pcs++)] = res->contacts[chosen[i]];
   }
 
-  void run() {
-    const ContactSet& cs = res->contacts;
+  // The result before anything is found.
+  void clear_result() {
     res->combinations = 0;
     res->capped = false;
     res->num_cf_pcs = 0;
@@ -305,16 +305,12 @@ struct IdentifyScratch {
     res->misfit = 0;
     res->partial_cover = false;
     res->num_approaching = 0;
-    if (cs.empty()) {
-      res->status = IdStatus::kNoContact;
-      return;
-    }
-    const int G = cs.num_planes();
-    if (G > kMaxGroups) {
-      res->status = IdStatus::kTooManyPlanes;
-      return;
-    }
-    // Members of each plane, best fit first (ties: canonical PC order, as detected).
+  }
+
+  // Members of each of the G planes, best fit first (ties: canonical PC order, as detected),
+  // and those of them some CF holds (choosable).
+  void sort_planes(int G) {
+    const ContactSet& cs = res->contacts;
     count.fill(0);
     for (int i = 0; i < cs.size(); ++i) {
       const auto g = static_cast<std::size_t>(cs[i].plane);
@@ -340,19 +336,18 @@ struct IdentifyScratch {
         if (holds(cs[m[static_cast<std::size_t>(i)]].pc))
           c[static_cast<std::size_t>(nc++)] = m[static_cast<std::size_t>(i)];
     }
-    if (try_previous(G)) return;
+  }
 
-    // Enumerate one choosable member or none per plane (none last), at most 3 chosen, every
-    // skipped plane accounted for (apart or explained). Rank: no plane left to an
-    // explanation (another reading of a chosen touch, closures meeting: loose, so only when
-    // no CF holds a PC in that plane), then fewest dominated PCs (a v-f beside the e-f of its
-    // edge is only taken when the e-f cannot form a CF), then previous / neighbour / other,
-    // then total misfit (which favours the exact CF over one that also holds a pair 0.05 mm
-    // away), then enumeration order.
+  // Enumerate one choosable member or none per plane (none last), at most 3 chosen, every
+  // skipped plane accounted for (apart or explained). Rank: no plane left to an
+  // explanation (another reading of a chosen touch, closures meeting: loose, so only when
+  // no CF holds a PC in that plane), then fewest dominated PCs (a v-f beside the e-f of its
+  // edge is only taken when the e-f cannot form a CF), then previous / neighbour / other,
+  // then total misfit (which favours the exact CF over one that also holds a pair 0.05 mm
+  // away), then enumeration order. The best goes to best and best_chosen.
+  void best_interpretation(int G, Ranked& best, int* best_chosen) {
     std::array<int, kMaxGroups> digit{};  // index into choosable, nchoose[g] means "none"
     std::array<bool, kMaxGroups> taken{};
-    Ranked best;
-    int best_chosen[3] = {-1, -1, -1};
     // Also bound the walk itself: combinations with more than 3 planes chosen are skipped
     // without counting.
     long walk = 0;
@@ -394,20 +389,34 @@ struct IdentifyScratch {
         digit[static_cast<std::size_t>(g--)] = 0;
       if (g < 0) break;
     }
-    const CfId best_id = best.id;
-    const int best_n = best.n;
-    const bool best_partial = best.partial;
-    const double best_misfit = best.misfit;
-    const int best_cat = best.cat;
-    if (!best_id.valid()) {
+  }
+
+  void run() {
+    const ContactSet& cs = res->contacts;
+    clear_result();
+    if (cs.empty()) {
+      res->status = IdStatus::kNoContact;
+      return;
+    }
+    const int G = cs.num_planes();
+    if (G > kMaxGroups) {
+      res->status = IdStatus::kTooManyPlanes;
+      return;
+    }
+    sort_planes(G);
+    if (try_previous(G)) return;
+    Ranked best;
+    int best_chosen[3] = {-1, -1, -1};
+    best_interpretation(G, best, best_chosen);
+    if (!best.id.valid()) {
       res->status = G > 3 ? IdStatus::kTooManyPlanes : IdStatus::kOutsideGraph;
       return;
     }
-    IdStatus st = best_cat == 0   ? IdStatus::kMatchedPrevious
-                  : best_cat == 1 ? IdStatus::kMatchedNeighbour
+    IdStatus st = best.cat == 0   ? IdStatus::kMatchedPrevious
+                  : best.cat == 1 ? IdStatus::kMatchedNeighbour
                   : prev.valid()  ? IdStatus::kNonNeighbourJump
                                   : IdStatus::kMatchedByFit;
-    set_result(st, best_id, best_chosen, best_n, best_misfit, best_partial);
+    set_result(st, best.id, best_chosen, best.n, best.misfit, best.partial);
   }
 };
 

@@ -192,6 +192,23 @@ class GraphSax {
   bool start(bool object);
   bool end();
 
+  // scalar() inside an item (a CF, a PC, a witness, a transition), by context.
+  void item_scalar(Ctx c, const Scalar& s);
+  void cf_scalar(const Scalar& s);
+  void pc_scalar(const Scalar& s);
+  void transition_scalar(const Scalar& s);
+  // An index into a table (0 .. 2^31 - 1), else a fault.
+  bool read_index(const Scalar& s, std::int32_t& out);
+  // An integer in lo..hi into out, else a fault.
+  void read_small_int(const Scalar& s, int lo, int hi, int& out);
+  // start() of a container: a root member; one inside a captured member; one inside an item
+  // (returns its context).
+  void start_at_root(bool object);
+  void start_captured(bool object);
+  Ctx start_in_item(Ctx c, bool object);
+  Ctx start_in_cf(bool object);
+  Ctx start_in_witness(bool object);
+
   /// Records the first fault; later item-level events are then only tracked structurally.
   void fault(std::string pointer, std::string what) {
     if (!faulted()) {
@@ -338,103 +355,48 @@ bool GraphSax::scalar(const Scalar& s) {
     return true;
   }
   if (faulted() || c == Ctx::kSkip) return true;
+  item_scalar(c, s);
+  return true;
+}
 
-  auto index = [&](std::int32_t& out) {
-    if (s.is_integer() &&
-        (s.type == Scalar::kUint ? s.u <= 2147483647ULL : (s.i >= 0 && s.i <= 2147483647LL))) {
-      out = static_cast<std::int32_t>(s.type == Scalar::kUint ? s.u
-                                                              : static_cast<std::uint64_t>(s.i));
-      return true;
-    }
-    fault(field_ptr(), "expected a non-negative integer index, got " + s.shown());
-    return false;
-  };
-  auto small_int = [&](int lo, int hi, int& out) {
-    const bool ok =
-        s.is_integer() && (s.type == Scalar::kUint ? s.u <= static_cast<std::uint64_t>(hi)
-                                                   : (s.i >= lo && s.i <= hi));
-    if (!ok) {
-      fault(field_ptr(), "expected an integer in " + std::to_string(lo) + ".." +
-                             std::to_string(hi) + ", got " + s.shown());
-      return;
-    }
-    out = static_cast<int>(s.type == Scalar::kUint ? static_cast<std::int64_t>(s.u) : s.i);
-  };
+bool GraphSax::read_index(const Scalar& s, std::int32_t& out) {
+  if (s.is_integer() &&
+      (s.type == Scalar::kUint ? s.u <= 2147483647ULL : (s.i >= 0 && s.i <= 2147483647LL))) {
+    out =
+        static_cast<std::int32_t>(s.type == Scalar::kUint ? s.u : static_cast<std::uint64_t>(s.i));
+    return true;
+  }
+  fault(field_ptr(), "expected a non-negative integer index, got " + s.shown());
+  return false;
+}
 
+void GraphSax::read_small_int(const Scalar& s, int lo, int hi, int& out) {
+  const bool ok = s.is_integer() && (s.type == Scalar::kUint ? s.u <= static_cast<std::uint64_t>(hi)
+                                                             : (s.i >= lo && s.i <= hi));
+  if (!ok) {
+    fault(field_ptr(), "expected an integer in " + std::to_string(lo) + ".." + std::to_string(hi) +
+                           ", got " + s.shown());
+    return;
+  }
+  out = static_cast<int>(s.type == Scalar::kUint ? static_cast<std::int64_t>(s.u) : s.i);
+}
+
+void GraphSax::item_scalar(Ctx c, const Scalar& s) {
   switch (c) {
     case Ctx::kCfs:
       cfs.emplace_back();
       raw_pcs.emplace_back();
       fault(cf_ptr(), "expected a CF object, got " + s.shown());
       break;
-    case Ctx::kCf: {
-      CfRecord& r = cfs.back();
-      switch (field_) {
-        case Field::kCfId: {
-          has_id_ = true;
-          const auto expected = static_cast<std::int64_t>(cfs.size() - 1);
-          if (!s.is_integer() ||
-              (s.type == Scalar::kInt ? s.i : static_cast<std::int64_t>(s.u)) != expected)
-            fault(field_ptr(), "id " + s.shown() + " should be " + std::to_string(expected) +
-                                   " (CF ids are the array positions)");
-          break;
-        }
-        case Field::kCfPcs:
-          has_pcs_ = true;
-          fault(field_ptr(), "expected an array, got " + s.shown());
-          break;
-        case Field::kCfWitness:
-          has_witness_ = true;
-          fault(field_ptr(), "expected an object, got " + s.shown());
-          break;
-        case Field::kCfDof:
-          small_int(0, 6, r.dof);
-          break;
-        case Field::kCfTdof:
-          small_int(0, 3, r.translation_dof);
-          break;
-        case Field::kCfPure:
-          if (s.type != Scalar::kBool)
-            fault(field_ptr(), "expected true or false, got " + s.shown());
-          else
-            r.pure_rotation = s.b;
-          break;
-        default:
-          break;
-      }
+    case Ctx::kCf:
+      cf_scalar(s);
       break;
-    }
     case Ctx::kPcs:
       ++pc_count_;
       fault(pc_ptr(), "expected a PC object, got " + s.shown());
       break;
     case Ctx::kPc:
-      switch (field_) {
-        case Field::kPcType: {
-          has_type_ = true;
-          if (s.type != Scalar::kString) {
-            fault(field_ptr(), "expected a string, got " + s.shown());
-            break;
-          }
-          const auto type = pc_type_from_string(*s.s);
-          if (!type)
-            fault(field_ptr(), "unknown PC type \"" + *s.s +
-                                   "\" (expected one of f-f, e-f, f-e, v-f, f-v, e-e)");
-          else
-            pc_.type = *type;
-          break;
-        }
-        case Field::kPcA:
-          has_a_ = true;
-          index(pc_.a);
-          break;
-        case Field::kPcB:
-          has_b_ = true;
-          index(pc_.b);
-          break;
-        default:
-          break;
-      }
+      pc_scalar(s);
       break;
     case Ctx::kWitness:
       if (field_ == Field::kWR) has_R_ = true;
@@ -467,41 +429,109 @@ bool GraphSax::scalar(const Scalar& s) {
       transitions.emplace_back();
       fault(tr_ptr(), "expected a transition object, got " + s.shown());
       break;
-    case Ctx::kTransition: {
-      Transition& t = transitions.back();
-      std::int32_t v = -1;
-      switch (field_) {
-        case Field::kTrFrom:
-          has_from_ = true;
-          if (index(v)) t.from = CfId(v);
-          break;
-        case Field::kTrTo:
-          has_to_ = true;
-          if (index(v)) t.to = CfId(v);
-          break;
-        case Field::kTrKind: {
-          has_kind_ = true;
-          if (s.type != Scalar::kString) {
-            fault(field_ptr(), "expected a string, got " + s.shown());
-            break;
-          }
-          const auto kind = transition_kind_from_string(*s.s);
-          if (!kind)
-            fault(field_ptr(),
-                  "unknown transition kind \"" + *s.s + "\" (expected gain, lose or change)");
-          else
-            t.kind = *kind;
-          break;
-        }
-        default:
-          break;
+    case Ctx::kTransition:
+      transition_scalar(s);
+      break;
+    default:
+      break;
+  }
+}
+
+void GraphSax::cf_scalar(const Scalar& s) {
+  CfRecord& r = cfs.back();
+  switch (field_) {
+    case Field::kCfId: {
+      has_id_ = true;
+      const auto expected = static_cast<std::int64_t>(cfs.size() - 1);
+      if (!s.is_integer() ||
+          (s.type == Scalar::kInt ? s.i : static_cast<std::int64_t>(s.u)) != expected)
+        fault(field_ptr(), "id " + s.shown() + " should be " + std::to_string(expected) +
+                               " (CF ids are the array positions)");
+      break;
+    }
+    case Field::kCfPcs:
+      has_pcs_ = true;
+      fault(field_ptr(), "expected an array, got " + s.shown());
+      break;
+    case Field::kCfWitness:
+      has_witness_ = true;
+      fault(field_ptr(), "expected an object, got " + s.shown());
+      break;
+    case Field::kCfDof:
+      read_small_int(s, 0, 6, r.dof);
+      break;
+    case Field::kCfTdof:
+      read_small_int(s, 0, 3, r.translation_dof);
+      break;
+    case Field::kCfPure:
+      if (s.type != Scalar::kBool)
+        fault(field_ptr(), "expected true or false, got " + s.shown());
+      else
+        r.pure_rotation = s.b;
+      break;
+    default:
+      break;
+  }
+}
+
+void GraphSax::pc_scalar(const Scalar& s) {
+  switch (field_) {
+    case Field::kPcType: {
+      has_type_ = true;
+      if (s.type != Scalar::kString) {
+        fault(field_ptr(), "expected a string, got " + s.shown());
+        break;
       }
+      const auto type = pc_type_from_string(*s.s);
+      if (!type)
+        fault(field_ptr(),
+              "unknown PC type \"" + *s.s + "\" (expected one of f-f, e-f, f-e, v-f, f-v, e-e)");
+      else
+        pc_.type = *type;
+      break;
+    }
+    case Field::kPcA:
+      has_a_ = true;
+      read_index(s, pc_.a);
+      break;
+    case Field::kPcB:
+      has_b_ = true;
+      read_index(s, pc_.b);
+      break;
+    default:
+      break;
+  }
+}
+
+void GraphSax::transition_scalar(const Scalar& s) {
+  Transition& t = transitions.back();
+  std::int32_t v = -1;
+  switch (field_) {
+    case Field::kTrFrom:
+      has_from_ = true;
+      if (read_index(s, v)) t.from = CfId(v);
+      break;
+    case Field::kTrTo:
+      has_to_ = true;
+      if (read_index(s, v)) t.to = CfId(v);
+      break;
+    case Field::kTrKind: {
+      has_kind_ = true;
+      if (s.type != Scalar::kString) {
+        fault(field_ptr(), "expected a string, got " + s.shown());
+        break;
+      }
+      const auto kind = transition_kind_from_string(*s.s);
+      if (!kind)
+        fault(field_ptr(),
+              "unknown transition kind \"" + *s.s + "\" (expected gain, lose or change)");
+      else
+        t.kind = *kind;
       break;
     }
     default:
       break;
   }
-  return true;
 }
 
 bool GraphSax::start(bool object) {
@@ -521,47 +551,59 @@ bool GraphSax::start(bool object) {
     return true;
   }
   if (c == Ctx::kRoot) {
-    if (field_ == Field::kRootOther) {
-      json& slot = skeleton[root_key_];
-      slot = object ? json::object() : json::array();
-      capture_.push_back(&slot);
-      stack_.push_back(Ctx::kCapture);
-    } else if (!object && field_ == Field::kRootCfs) {
-      have_cfs = true;
-      stack_.push_back(Ctx::kCfs);
-    } else if (!object && field_ == Field::kRootTransitions) {
-      have_transitions = true;
-      stack_.push_back(Ctx::kTransitions);
-    } else {
-      if (field_ == Field::kRootCfs)
-        have_cfs = true;
-      else
-        have_transitions = true;
-      fault(field_ptr(), std::string("expected an array, got ") + container_name(object));
-      stack_.push_back(Ctx::kSkip);
-    }
+    start_at_root(object);
     return true;
   }
   if (c == Ctx::kCapture) {
-    json* top = capture_.back();
-    json* child;
-    if (top->is_object()) {
-      json& slot = (*top)[capture_key_];
-      slot = object ? json::object() : json::array();
-      child = &slot;
-    } else {
-      top->push_back(object ? json::object() : json::array());
-      child = &top->back();
-    }
-    capture_.push_back(child);
-    stack_.push_back(Ctx::kCapture);
+    start_captured(object);
     return true;
   }
   if (faulted() || c == Ctx::kSkip) {
     stack_.push_back(Ctx::kSkip);
     return true;
   }
+  stack_.push_back(start_in_item(c, object));
+  return true;
+}
 
+void GraphSax::start_at_root(bool object) {
+  if (field_ == Field::kRootOther) {
+    json& slot = skeleton[root_key_];
+    slot = object ? json::object() : json::array();
+    capture_.push_back(&slot);
+    stack_.push_back(Ctx::kCapture);
+  } else if (!object && field_ == Field::kRootCfs) {
+    have_cfs = true;
+    stack_.push_back(Ctx::kCfs);
+  } else if (!object && field_ == Field::kRootTransitions) {
+    have_transitions = true;
+    stack_.push_back(Ctx::kTransitions);
+  } else {
+    if (field_ == Field::kRootCfs)
+      have_cfs = true;
+    else
+      have_transitions = true;
+    fault(field_ptr(), std::string("expected an array, got ") + container_name(object));
+    stack_.push_back(Ctx::kSkip);
+  }
+}
+
+void GraphSax::start_captured(bool object) {
+  json* top = capture_.back();
+  json* child;
+  if (top->is_object()) {
+    json& slot = (*top)[capture_key_];
+    slot = object ? json::object() : json::array();
+    child = &slot;
+  } else {
+    top->push_back(object ? json::object() : json::array());
+    child = &top->back();
+  }
+  capture_.push_back(child);
+  stack_.push_back(Ctx::kCapture);
+}
+
+Ctx GraphSax::start_in_item(Ctx c, bool object) {
   Ctx next = Ctx::kSkip;
   switch (c) {
     case Ctx::kCfs:
@@ -575,24 +617,7 @@ bool GraphSax::start(bool object) {
       }
       break;
     case Ctx::kCf:
-      if (field_ == Field::kCfPcs && !object) {
-        has_pcs_ = true;
-        pc_count_ = 0;
-        next = Ctx::kPcs;
-      } else if (field_ == Field::kCfWitness && object) {
-        has_witness_ = true;
-        has_R_ = has_t_ = false;
-        next = Ctx::kWitness;
-      } else if (field_ == Field::kCfOther) {
-        next = Ctx::kSkip;  // extra members of a CF are allowed and ignored
-      } else {
-        if (field_ == Field::kCfPcs) has_pcs_ = true;
-        if (field_ == Field::kCfWitness) has_witness_ = true;
-        const char* want = field_ == Field::kCfPcs       ? "an array"
-                           : field_ == Field::kCfWitness ? "an object"
-                                                         : "a scalar";
-        fault(field_ptr(), std::string("expected ") + want + ", got " + container_name(object));
-      }
+      next = start_in_cf(object);
       break;
     case Ctx::kPcs:
       ++pc_count_;
@@ -608,17 +633,7 @@ bool GraphSax::start(bool object) {
       fault(field_ptr(), std::string("expected a scalar, got ") + container_name(object));
       break;
     case Ctx::kWitness:
-      if (field_ == Field::kWR) has_R_ = true;
-      if (field_ == Field::kWT) has_t_ = true;
-      if (!object && field_ == Field::kWR) {
-        row_ = 0;
-        next = Ctx::kR;
-      } else if (!object && field_ == Field::kWT) {
-        t_count_ = 0;
-        next = Ctx::kT;
-      } else {
-        fault(field_ptr(), std::string("expected an array, got ") + container_name(object));
-      }
+      next = start_in_witness(object);
       break;
     case Ctx::kR:
       ++row_;
@@ -654,8 +669,43 @@ bool GraphSax::start(bool object) {
     default:
       break;
   }
-  stack_.push_back(next);
-  return true;
+  return next;
+}
+
+Ctx GraphSax::start_in_cf(bool object) {
+  if (field_ == Field::kCfPcs && !object) {
+    has_pcs_ = true;
+    pc_count_ = 0;
+    return Ctx::kPcs;
+  }
+  if (field_ == Field::kCfWitness && object) {
+    has_witness_ = true;
+    has_R_ = has_t_ = false;
+    return Ctx::kWitness;
+  }
+  if (field_ == Field::kCfOther) return Ctx::kSkip;  // extra members of a CF are allowed, ignored
+  if (field_ == Field::kCfPcs) has_pcs_ = true;
+  if (field_ == Field::kCfWitness) has_witness_ = true;
+  const char* want = field_ == Field::kCfPcs       ? "an array"
+                     : field_ == Field::kCfWitness ? "an object"
+                                                   : "a scalar";
+  fault(field_ptr(), std::string("expected ") + want + ", got " + container_name(object));
+  return Ctx::kSkip;
+}
+
+Ctx GraphSax::start_in_witness(bool object) {
+  if (field_ == Field::kWR) has_R_ = true;
+  if (field_ == Field::kWT) has_t_ = true;
+  if (!object && field_ == Field::kWR) {
+    row_ = 0;
+    return Ctx::kR;
+  }
+  if (!object && field_ == Field::kWT) {
+    t_count_ = 0;
+    return Ctx::kT;
+  }
+  fault(field_ptr(), std::string("expected an array, got ") + container_name(object));
+  return Ctx::kSkip;
 }
 
 bool GraphSax::end() {

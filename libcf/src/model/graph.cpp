@@ -61,43 +61,35 @@ std::string check_witness(const Pose& pose, const char** field) {
 
 }  // namespace detail
 
-void CfGraph::Impl::build(const detail::FaultLocator& where) {
-  const std::size_t n = cfs.size();
-  index.clear();
-  index.reserve(n + n / 4);
-  held.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    const PcSet& pcs = cfs[i].pcs;
-    if (pcs.empty()) where.cf_fault(i, "a CF needs 1 to 3 PCs, this one has none");
-    // PCs of one CF have pairwise distinct contact planes (docs/spec.md, section 4): two PCs on the
-    // same face of B (types x-f) or of A (types f-x) share that face's plane.
-    for (int p = 0; p < pcs.size(); ++p)
-      for (int q = p + 1; q < pcs.size(); ++q) {
-        const Pc& x = pcs[p];
-        const Pc& y = pcs[q];
-        const bool same_b_face = b_kind(x.type) == ElementKind::kFace &&
-                                 b_kind(y.type) == ElementKind::kFace && x.b == y.b;
-        const bool same_a_face = a_kind(x.type) == ElementKind::kFace &&
-                                 a_kind(y.type) == ElementKind::kFace && x.a == y.a;
-        if (same_a_face || same_b_face)
-          where.cf_fault(i, "PCs " + to_string(x) + " and " + to_string(y) +
-                                " share the contact plane of " +
-                                (same_b_face ? "B's face " + std::to_string(x.b)
-                                             : "A's face " + std::to_string(x.a)) +
-                                "; the PCs of a CF have distinct contact planes");
-      }
-    for (const Pc& pc : pcs) held.insert(pc);
-    const auto [it, inserted] = index.emplace(pcs, CfId(static_cast<std::int32_t>(i)));
-    if (!inserted)
-      where.cf_fault(
-          i, "PC set {" + to_string(pcs) + "} repeats CF " + std::to_string(it->second.value()));
-  }
+namespace {
 
-  // `change` (MT3; docs/spec.md, section 4), as cfgen builds it: the target is the source with each
-  // PC kept or replaced by one of its neighbouring PCs, all distinct. So some one-to-one
-  // pairing maps every source PC to an equal or a neighbouring target PC (sizes are equal).
-  std::unordered_map<Pc, std::vector<Pc>, detail::PcHash> neighbours_of;
-  const auto replaced_by_neighbours = [&](const PcSet& f, const PcSet& g) {
+// PCs of one CF have pairwise distinct contact planes (docs/spec.md, section 4): two PCs on the
+// same face of B (types x-f) or of A (types f-x) share that face's plane.
+void check_distinct_planes(const PcSet& pcs, std::size_t i, const detail::FaultLocator& where) {
+  for (int p = 0; p < pcs.size(); ++p)
+    for (int q = p + 1; q < pcs.size(); ++q) {
+      const Pc& x = pcs[p];
+      const Pc& y = pcs[q];
+      const bool same_b_face = b_kind(x.type) == ElementKind::kFace &&
+                               b_kind(y.type) == ElementKind::kFace && x.b == y.b;
+      const bool same_a_face = a_kind(x.type) == ElementKind::kFace &&
+                               a_kind(y.type) == ElementKind::kFace && x.a == y.a;
+      if (same_a_face || same_b_face)
+        where.cf_fault(i, "PCs " + to_string(x) + " and " + to_string(y) +
+                              " share the contact plane of " +
+                              (same_b_face ? "B's face " + std::to_string(x.b)
+                                           : "A's face " + std::to_string(x.a)) +
+                              "; the PCs of a CF have distinct contact planes");
+    }
+}
+
+// `change` (MT3; docs/spec.md, section 4), as cfgen builds it: the target is the source with each
+// PC kept or replaced by one of its neighbouring PCs, all distinct. So some one-to-one
+// pairing maps every source PC to an equal or a neighbouring target PC (sizes are equal).
+class ChangeRule {
+ public:
+  ChangeRule(const Polyhedron& a, const Polyhedron& b) : a_(a), b_(b) {}
+  bool holds(const PcSet& f, const PcSet& g) {
     std::array<int, PcSet::kMaxPcs> perm{0, 1, 2};
     do {
       bool ok = true;
@@ -105,75 +97,84 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
         const Pc& x = f[i];
         const Pc& y = g[perm[static_cast<std::size_t>(i)]];
         if (x == y) continue;
-        auto it = neighbours_of.find(x);
-        if (it == neighbours_of.end())
-          it = neighbours_of.emplace(x, neighbouring_pcs(x, a, b)).first;
+        auto it = neighbours_of_.find(x);
+        if (it == neighbours_of_.end())
+          it = neighbours_of_.emplace(x, neighbouring_pcs(x, a_, b_)).first;
         ok = std::binary_search(it->second.begin(), it->second.end(), y);
       }
       if (ok) return true;
     } while (std::next_permutation(perm.begin(), perm.begin() + g.size()));
     return false;
-  };
-
-  out.assign(n, {});
-  for (std::size_t t = 0; t < transitions.size(); ++t) {
-    const Transition& tr = transitions[t];
-    const auto in_range = [&](CfId id, const char* field) {
-      if (!id.valid() || id.index() >= n)
-        where.transition_fault(t, field,
-                               std::string(field) + " = " + std::to_string(id.value()) +
-                                   " is not a CF id (the graph has " + std::to_string(n) + " CFs)");
-    };
-    in_range(tr.from, "from");
-    in_range(tr.to, "to");
-    if (tr.from == tr.to)
-      where.transition_fault(
-          t, "to", "a transition from CF " + std::to_string(tr.from.value()) + " to itself");
-    const PcSet& f = cfs[tr.from.index()].pcs;
-    const PcSet& g = cfs[tr.to.index()].pcs;
-    const auto superset = [](const PcSet& big, const PcSet& small) {
-      if (big.size() != small.size() + 1) return false;
-      for (const Pc& pc : small)
-        if (!big.contains(pc)) return false;
-      return true;
-    };
-    bool ok = false;
-    const char* rule = "";
-    switch (tr.kind) {
-      case TransitionKind::kGain:
-        ok = superset(g, f);
-        rule = "'gain' needs the target to be the source plus one PC";
-        break;
-      case TransitionKind::kLose:
-        ok = superset(f, g);
-        rule = "'lose' needs the target to be the source minus one PC";
-        break;
-      case TransitionKind::kChange:
-        ok = f.size() == g.size();
-        rule = "'change' needs the same number of PCs";
-        if (ok) {
-          ok = f != g && replaced_by_neighbours(f, g);
-          rule =
-              "'change' needs the target to be the source with one or more PCs replaced by "
-              "neighbouring PCs, one for one";
-        }
-        break;
-    }
-    if (!ok)
-      where.transition_fault(t, "kind",
-                             std::string("kind ") + rule + ": CF " +
-                                 std::to_string(tr.from.value()) + " {" + to_string(f) +
-                                 "} -> CF " + std::to_string(tr.to.value()) + " {" + to_string(g) +
-                                 "}");
-    out[tr.from.index()].push_back(tr);
   }
-  for (std::size_t i = 0; i < n; ++i) {
-    auto& list = out[i];
+
+ private:
+  const Polyhedron& a_;
+  const Polyhedron& b_;
+  std::unordered_map<Pc, std::vector<Pc>, detail::PcHash> neighbours_of_;  // a cache
+};
+
+bool one_more(const PcSet& big, const PcSet& small) {
+  if (big.size() != small.size() + 1) return false;
+  for (const Pc& pc : small)
+    if (!big.contains(pc)) return false;
+  return true;
+}
+
+// Transition t: its ends are CF ids, distinct, and its kind holds between their PC sets.
+void check_transition(std::size_t t, const Transition& tr, const std::vector<CfRecord>& cfs,
+                      ChangeRule& change, const detail::FaultLocator& where) {
+  const std::size_t n = cfs.size();
+  const auto in_range = [&](CfId id, const char* field) {
+    if (!id.valid() || id.index() >= n)
+      where.transition_fault(t, field,
+                             std::string(field) + " = " + std::to_string(id.value()) +
+                                 " is not a CF id (the graph has " + std::to_string(n) + " CFs)");
+  };
+  in_range(tr.from, "from");
+  in_range(tr.to, "to");
+  if (tr.from == tr.to)
+    where.transition_fault(
+        t, "to", "a transition from CF " + std::to_string(tr.from.value()) + " to itself");
+  const PcSet& f = cfs[tr.from.index()].pcs;
+  const PcSet& g = cfs[tr.to.index()].pcs;
+  bool ok = false;
+  const char* rule = "";
+  switch (tr.kind) {
+    case TransitionKind::kGain:
+      ok = one_more(g, f);
+      rule = "'gain' needs the target to be the source plus one PC";
+      break;
+    case TransitionKind::kLose:
+      ok = one_more(f, g);
+      rule = "'lose' needs the target to be the source minus one PC";
+      break;
+    case TransitionKind::kChange:
+      ok = f.size() == g.size();
+      rule = "'change' needs the same number of PCs";
+      if (ok) {
+        ok = f != g && change.holds(f, g);
+        rule =
+            "'change' needs the target to be the source with one or more PCs replaced by "
+            "neighbouring PCs, one for one";
+      }
+      break;
+  }
+  if (!ok)
+    where.transition_fault(t, "kind",
+                           std::string("kind ") + rule + ": CF " + std::to_string(tr.from.value()) +
+                               " {" + to_string(f) + "} -> CF " + std::to_string(tr.to.value()) +
+                               " {" + to_string(g) + "}");
+}
+
+// Sorts each CF's transitions by target; a target listed twice is a fault at its second
+// listing in file order.
+void sort_out_lists(std::vector<std::vector<Transition>>& out,
+                    const std::vector<Transition>& transitions, const detail::FaultLocator& where) {
+  for (auto& list : out) {
     std::stable_sort(list.begin(), list.end(),
                      [](const Transition& x, const Transition& y) { return x.to < y.to; });
     for (std::size_t k = 1; k < list.size(); ++k)
       if (list[k].to == list[k - 1].to) {
-        // Find the later of the two in file order, to point at it.
         std::size_t seen = 0, t = 0;
         for (; t < transitions.size(); ++t)
           if (transitions[t].from == list[k].from && transitions[t].to == list[k].to && seen++ == 1)
@@ -183,6 +184,32 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
                                    std::to_string(list[k].to.value()) + " is listed twice");
       }
   }
+}
+
+}  // namespace
+
+void CfGraph::Impl::build(const detail::FaultLocator& where) {
+  const std::size_t n = cfs.size();
+  index.clear();
+  index.reserve(n + n / 4);
+  held.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    const PcSet& pcs = cfs[i].pcs;
+    if (pcs.empty()) where.cf_fault(i, "a CF needs 1 to 3 PCs, this one has none");
+    check_distinct_planes(pcs, i, where);
+    for (const Pc& pc : pcs) held.insert(pc);
+    const auto [it, inserted] = index.emplace(pcs, CfId(static_cast<std::int32_t>(i)));
+    if (!inserted)
+      where.cf_fault(
+          i, "PC set {" + to_string(pcs) + "} repeats CF " + std::to_string(it->second.value()));
+  }
+  ChangeRule change(a, b);
+  out.assign(n, {});
+  for (std::size_t t = 0; t < transitions.size(); ++t) {
+    check_transition(t, transitions[t], cfs, change, where);
+    out[transitions[t].from.index()].push_back(transitions[t]);
+  }
+  sort_out_lists(out, transitions, where);
 }
 
 namespace {

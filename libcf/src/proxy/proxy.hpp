@@ -49,10 +49,11 @@ struct ProxyState {
 /// A state for `pm` (its lookahead detection's state sized).
 void init_proxy_state(const ProxyModel& pm, ProxyState& s);
 
-/// Moves the proxy towards X_WP (docs/spec.md, section 6b) and fills s.result (coupling included).
-/// Detects with `ds` into `at` (the stages' own contact set), so that the stages at the final proxy
-/// pose find its contacts there. No heap allocation.
-void move_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, DetectedAt& at,
-                ProxyState& s, const Pose& X_WD, double t_s);
+/// Advances the proxy towards the device pose X_WD (docs/spec.md, section 6b) and fills s.result
+/// (coupling included): the stage behind cf::move_proxy. Detects with `ds` into `at` (the stages'
+/// own contact set), so that the stages at the final proxy pose find its contacts there. No heap
+/// allocation.
+void advance_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, DetectedAt& at,
+                   ProxyState& s, const Pose& X_WD, double t_s);
 
 }  // namespace cf::detail

@@ -8,6 +8,8 @@
 
 #include "servo_impl.hpp"
 
+#include "../force/force_step.hpp"
+
 #include "../check.hpp"
 
 #include <algorithm>
@@ -36,7 +38,8 @@ CfModel::Impl::Impl(const CfGraph& g, const Params& p)
     : graph(&g),
       params(p),
       detect(detail::make_detect_model(g.model_a(), g.model_b(), p)),
-      proxy(g.model_a(), g.model_b(), p) {
+      proxy(g.model_a(), g.model_b(), p),
+      force(g.model_a(), g.model_b(), p) {
   detail::check_identification_params(p.identification);
 }
 
@@ -53,8 +56,7 @@ const Polyhedron& CfModel::model_b() const { return impl_->graph->model_b(); }
 CfState::Impl::Impl(const CfModel::Impl& m)
     : model(&m),
       detect(detail::make_detect_state(*m.detect)),
-      identify(detail::make_identify_scratch()),
-      force(m.graph->model_a(), m.graph->model_b(), m.params) {
+      identify(detail::make_identify_scratch()) {
   detected.out = &id.contacts;
   detail::init_proxy_state(m.proxy, proxy);
 }
@@ -66,7 +68,7 @@ CfState::CfState(CfState&&) noexcept = default;
 CfState& CfState::operator=(CfState&&) noexcept = default;
 
 void CfState::reset() {
-  impl_->force.reset();
+  impl_->force = ForceState();
   impl_->proxy.has_prev = false;
   impl_->proxy.num_sliding = 0;
   impl_->proxy.num_warm = 0;
@@ -97,7 +99,7 @@ CfState::Impl& state_of(const CfModel::Impl& m, CfState& state, const char* stag
 const ProxyResult& move_proxy(const CfModel& model, CfState& state, const Pose& X_WD, double t_s) {
   const CfModel::Impl& m = internal::Access::get(model);
   CfState::Impl& s = state_of(m, state, "move_proxy");
-  detail::move_proxy(m.proxy, *m.detect, *s.detect, s.detected, s.proxy, X_WD, t_s);
+  detail::advance_proxy(m.proxy, *m.detect, *s.detect, s.detected, s.proxy, X_WD, t_s);
   return s.proxy.result;
 }
 
@@ -157,20 +159,23 @@ const HapticResult& compute_force(const CfModel& model, CfState& state, const Po
     for (int i = 0; i < n; ++i) r.pcs.insert(s.ordered[static_cast<std::size_t>(i)].pc);
     if (motion.transition_in_graph) {
       r.status = RenderStatus::kOk;
-      fr = &s.force.step(X_WA, t_s, s.ordered.data(), n, motion, false, id.approaching.data(),
-                         id.num_approaching);
+      fr = &detail::step_force(m.force, s.force, X_WA, t_s, s.ordered.data(), n, motion, false,
+                               id.approaching.data(), id.num_approaching);
     } else {
       r.status = RenderStatus::kUnlistedTransition;
       const bool have_detected = n_detected > 0;
-      fr = &s.force.step(X_WA, t_s, have_detected ? detected : s.ordered.data(),
-                         have_detected ? n_detected : n, motion, true);
+      fr = &detail::step_force(m.force, s.force, X_WA, t_s,
+                               have_detected ? detected : s.ordered.data(),
+                               have_detected ? n_detected : n, motion, true, nullptr, 0);
     }
   } else if (n_detected > 0) {
     r.status = RenderStatus::kNoFittingCf;
-    fr = &s.force.step(X_WA, t_s, detected, n_detected, PriorMotion(), true);
+    fr = &detail::step_force(m.force, s.force, X_WA, t_s, detected, n_detected, PriorMotion(), true,
+                             nullptr, 0);
   } else {
     r.status = RenderStatus::kNoContact;
-    fr = &s.force.step(X_WA, t_s, nullptr, 0, PriorMotion(), false);
+    fr = &detail::step_force(m.force, s.force, X_WA, t_s, nullptr, 0, PriorMotion(), false, nullptr,
+                             0);
   }
   r.motion = fr->motion;
   r.F_W = fr->F_W;

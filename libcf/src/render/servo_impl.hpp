@@ -20,6 +20,7 @@ struct CfModel::Impl {
   Params params;
   detail::DetectModelPtr detect;  // trees and tables (detect/detector.cpp)
   detail::ProxyModel proxy;       // A's metric about the grip point (proxy/proxy.cpp)
+  ForceModel::Fixed force;        // the force model's models, parameters, A's mass centre
 };
 
 struct CfState::Impl {
@@ -30,7 +31,7 @@ struct CfState::Impl {
   Identification id;            // detect() writes id.contacts, identify() the rest
   detail::DetectedAt detected;  // the pose id.contacts are of (the proxy detects there too)
   CfId previous;                // written by classify_motion only (detail::next_previous)
-  ForceModel force;             // stick anchors, held loads, filters
+  ForceState force;             // stick anchors, held loads, filters
   detail::ProxyState proxy;     // the proxy pose and its history
   std::array<ContactPc, PcSet::kMaxPcs> ordered{};  // the CF's PCs in canonical order
   HapticResult result;
