@@ -93,7 +93,16 @@ class Enumerator {
                      std::size_t count, std::size_t tries);
   std::vector<PcSet> grown_sets(int level, const std::vector<PcSet>& singles, double& mean_added);
   std::vector<PcSet> with_valid_subsets(const std::vector<PcSet>& pool, double& fraction);
-  double explore_seconds(std::size_t count);
+  double explore_seconds(std::size_t count, std::vector<Discovery>& singles);
+  struct PairSample {
+    std::size_t singles = 0;  // motion-only single PCs sampled
+    std::size_t searched = 0;
+    double seconds = 0;  // s of CPU, mean a search took
+    double found = 0;    // share of the pairs found valid
+  };
+  PairSample motion_single_pairs(const std::vector<Discovery>& met, std::size_t count);
+  double after_motion_seconds(const RunEstimate& e, double partners,
+                              const std::vector<Discovery>& met);
   // motion.cpp
   void motion_closure();
   void more_witnesses(Clock::time_point t0);

@@ -9,10 +9,11 @@
 // one PC larger; the share of those whose subsets are all valid (decided for a few hundred)
 // scales them to the level's candidates, and a sample of those, searched, gives the fraction
 // valid and the cost. The closure by motion's cost per witness explored is sampled on the
-// CFs the samples found. The rest of what follows the levels (neighbour rounds, the work done
-// per set rather than per orbit, records, transitions) is not sampled: it is taken from the
-// sets the levels find and fail, their orbits and the cost of their searches, with constants
-// measured on the pairs in docs/performance.md.
+// CFs the samples found, and so are the levels it sets off again: the single PCs those
+// explorations meet that the level-1 search fails, paired and searched. The rest of what follows
+// the levels (neighbour rounds, the work done per set rather than per orbit, records, transitions)
+// is not sampled: it is taken from the sets the levels find and fail, their orbits and the cost of
+// their searches, with constants measured on the pairs in docs/performance.md.
 
 #include "cfgen/enumerate/enumerator.hpp"
 
@@ -42,8 +43,8 @@ constexpr std::size_t kGrowRounds = 8;
 // CFs in the graph per CF the levels find, and per candidate they fail: the rounds after the
 // levels (motion, neighbours, the images of sets found there) find CFs among the sets the
 // levels' searches missed, more where more failed (a peg tilted across a hole's rim).
-constexpr double kCfsPerLevelCf = 0.55;
-constexpr double kCfsPerFailed = 0.40;
+constexpr double kCfsPerLevelCf = 1.05;
+constexpr double kCfsPerFailed = 0.24;
 // CPU time after the levels' searches: the closure by motion, per witness it explores (up to
 // kWitnessesPerOrbit an orbit found), as long as the sampled exploration (explore_seconds);
 // per CF the levels find (its images verified, its changes screened, its record and
@@ -51,12 +52,16 @@ constexpr double kCfsPerFailed = 0.40;
 // screened in every neighbour round); and per member of a failed orbit a neighbour round may
 // search again (up to kOrbitTries an orbit), searches of that cost. The last two are
 // fitted apart because pairs with few symmetries (CGAL's cross and U) have many more failed
-// orbits per failed set than the symmetric n-gon pairs. The cross and U's run was not
-// measured to its end: its constants assume 100 min of CPU (docs/performance.md).
+// orbits per failed set than the symmetric n-gon pairs.
 constexpr double kExploresPerWitness = 1.0;
-constexpr double kFoundSeconds = 85e-6;  // s, on the machine of docs/performance.md
-constexpr double kSearchesPerFailed = 0.02;
-constexpr double kSearchesPerFailedTry = 1.0;
+constexpr double kFoundSeconds = 75e-6;  // s, on the machine of docs/performance.md
+constexpr double kSearchesPerFailed = 0.09;
+constexpr double kSearchesPerFailedTry = 1.5;
+// Single PCs the closure by motion finds per level-1 candidate the level fails: on CGAL's
+// cross against its U (the one pair measured whose levels run again at a cost), about 1,900
+// of 5,300. Their pairs' search cost is sampled (motion_single_pairs); their number is not,
+// as the explorations that meet them are too few in a sample to count them.
+constexpr double kMotionSinglesPerFailed = 0.40;
 // Of a run's time on one thread, the part that runs on one thread whatever the count.
 constexpr double kSerial = 0.25;
 // Transitions per CF: 15.5-25 on the pairs measured.
@@ -261,7 +266,7 @@ std::vector<PcSet> Enumerator::with_valid_subsets(const std::vector<PcSet>& pool
 // of the CFs the samples found (spread over the levels' lists): it varies with the models
 // far more than a search does, as it follows the first contact of every element pair along
 // each direction tried.
-double Enumerator::explore_seconds(std::size_t count) {
+double Enumerator::explore_seconds(std::size_t count, std::vector<Discovery>& singles) {
   std::vector<Task> tasks;
   std::size_t total = 0;
   for (const auto& v : valid_) total += v.size();
@@ -276,14 +281,95 @@ double Enumerator::explore_seconds(std::size_t count) {
   }
   if (tasks.empty()) return 0;
   std::vector<double> sec(tasks.size());
+  std::vector<TaskResult> res(tasks.size());
   runner_.for_each(tasks.size(), [&](std::size_t j) {
     const double c0 = thread_cpu_seconds();
-    decide(search_, tasks[j]);
+    res[j] = decide(search_, tasks[j]);
     sec[j] = thread_cpu_seconds() - c0;
   });
+  // The single PCs met that no sample found, one per orbit.
+  PcSetSet orbits;
+  for (const TaskResult& r : res)
+    for (const Discovery& d : r.met)
+      if (d.pcs.size() == 1 && !witness_rot_.count(d.pcs) && conditions_hold(d.pcs) &&
+          orbits.insert(sym_.canonical(d.pcs)).second)
+        singles.push_back(d);
   double sum = 0;
   for (double x : sec) sum += x;
   return sum / double(tasks.size());
+}
+
+// The levels after the closure by motion pair each single PC it finds with every valid
+// single PC the necessary conditions allow; few of those pairs are valid (a single that only
+// motion reaches holds in a sliver of poses), and their failed searches cost more than a
+// level's (seeded at that sliver, they climb further). Sampled as the run meets them: of the
+// single PCs the sampled explorations met (`met`), those whose orbit the level-1 search
+// fails (up to kOrbitTries members) and whose met pose refines to a witness, up to `count`,
+// each paired with up to kPartnersPerSingle valid singles spread over those it allows,
+// searched as level 2 searches them.
+Enumerator::PairSample Enumerator::motion_single_pairs(const std::vector<Discovery>& met,
+                                                       std::size_t count) {
+  constexpr std::size_t kPartnersPerSingle = 4;
+  // Each met single: its orbit's first kOrbitTries members searched, then its met pose.
+  std::vector<std::vector<Task>> level1(met.size());
+  std::vector<Task> flat;
+  for (std::size_t i = 0; i < met.size(); ++i) {
+    std::vector<PcSet> members;
+    for (std::size_t g = 0; g < sym_.size(); ++g) members.push_back(sym_.image(met[i].pcs, g));
+    std::sort(members.begin(), members.end(), pcset_less);
+    members.erase(std::unique(members.begin(), members.end()), members.end());
+    for (std::size_t k = 0; k < members.size() && k < kOrbitTries; ++k) {
+      Task t;
+      t.pcs = members[k];
+      flat.push_back(t);
+    }
+    Task r;
+    r.kind = Task::Kind::kFindOrRefine;
+    r.pcs = met[i].pcs;
+    r.pose = met[i].pose;
+    flat.push_back(r);
+  }
+  std::vector<TaskResult> res(flat.size());
+  runner_.for_each(flat.size(), [&](std::size_t j) { res[j] = decide(search_, flat[j]); });
+  // The motion-only singles, their witnesses known to seed their pairs.
+  std::vector<Pc> only;
+  for (std::size_t j = 0, i = 0; j < flat.size(); ++i) {
+    bool by_level = false;
+    for (; flat[j].kind == Task::Kind::kFind; ++j) by_level = by_level || res[j].witness.found;
+    if (!by_level && res[j].witness.found && only.size() < count) {
+      witness_rot_.emplace(flat[j].pcs, res[j].witness.pose.R_BA);
+      only.push_back(flat[j].pcs[0]);
+    }
+    ++j;
+  }
+  std::vector<Task> tasks;
+  for (const Pc& p : only) {
+    std::vector<PcSet> pairs;
+    for (const auto& [q, w] : valid_[0]) {
+      if (!pair_ok_.compatible(p, q[0])) continue;
+      PcSet t = q;
+      if (t.insert(p) && search_.plausible(t)) pairs.push_back(t);
+    }
+    for (std::size_t k : spread(pairs.size(), kPartnersPerSingle)) {
+      Task t;
+      t.pcs = pairs[k];
+      t.seeds = seeds_from_subsets(t.pcs);
+      tasks.push_back(std::move(t));
+    }
+  }
+  std::vector<double> sec(tasks.size());
+  std::vector<char> found(tasks.size(), 0);
+  runner_.for_each(tasks.size(), [&](std::size_t j) {
+    const double c0 = thread_cpu_seconds();
+    found[j] = decide(search_, tasks[j]).witness.found;
+    sec[j] = thread_cpu_seconds() - c0;
+  });
+  PairSample out;
+  out.singles = only.size();
+  out.searched = tasks.size();
+  for (std::size_t j = 0; j < tasks.size(); ++j) out.seconds += sec[j], out.found += found[j];
+  if (out.searched) out.seconds /= double(out.searched), out.found /= double(out.searched);
+  return out;
 }
 
 namespace {
@@ -308,6 +394,26 @@ void extrapolate(LevelEstimate& l, const Sample& s, bool by_orbit) {
 
 }  // namespace
 
+// s of CPU the levels take again after the closure by motion: the single PCs it finds (a
+// share of level 1's failed sets), each with `partners` level-2 candidates, the failed among
+// them searched as a failed level-2 orbit's members are, at the cost sampled on such pairs
+// (none when the sample meets no such single).
+double Enumerator::after_motion_seconds(const RunEstimate& e, double partners,
+                                        const std::vector<Discovery>& met) {
+  if (opt_.max_pcs < 2) return 0;
+  const LevelEstimate& l1 = e.levels[0];
+  const LevelEstimate& l2 = e.levels[1];
+  const double l2_failed = l2.candidates - l2.valid;
+  const double tries = l2_failed > 0 ? l2.failed_tries / l2_failed : 0;
+  const PairSample ps = motion_single_pairs(met, samples_);
+  const double pairs = kMotionSinglesPerFailed * std::max(0.0, l1.candidates - l1.valid) * partners;
+  if (std::getenv("CF_ESTIMATE_DEBUG"))
+    std::fprintf(stderr,
+                 "CAL after_motion pairs %g tries %g pair_s %g pair_found %g n %zu singles %zu\n",
+                 pairs, tries, ps.seconds, ps.found, ps.searched, ps.singles);
+  return pairs * (1 - ps.found) * tries * ps.seconds;
+}
+
 RunEstimate Enumerator::estimate(int threads, std::size_t samples) {
   samples_ = std::max<std::size_t>(1, samples);
   const auto t0 = Clock::now();
@@ -330,11 +436,13 @@ RunEstimate Enumerator::estimate(int threads, std::size_t samples) {
   extrapolate(l1, s1, true);
   // Levels 2 and 3: a valid set of the level below and a level-1 candidate the necessary
   // conditions allow with it make a candidate when its subsets one PC smaller are valid.
+  double partners = 0;  // level-2 candidates per valid single PC
   for (int level = 1; level < opt_.max_pcs && level < 3; ++level) {
     const LevelEstimate& below = e.levels[level - 1];
     if (valid_[level - 1].empty() || below.valid <= 0) break;
     double added = 0, fraction = 0;
     const std::vector<PcSet> pool = with_valid_subsets(grown_sets(level, c1, added), fraction);
+    if (level == 1) partners = added * fraction;
     LevelEstimate& l = e.levels[level];
     l.candidates = below.valid * added * fraction / (level + 1);  // each counted by its PCs
     const Sample sample = sample_sets(level, pool, subsets, samples_, kOrbitTries);
@@ -351,12 +459,17 @@ RunEstimate Enumerator::estimate(int threads, std::size_t samples) {
   }
   // s of CPU a search takes, on the mean over the levels' searches.
   const double search_seconds = searches > 0 ? level_cpu / searches : 0;
-  const double explore_s = explore_seconds(samples_);
+  std::vector<Discovery> met_singles;
+  const double explore_s = explore_seconds(samples_, met_singles);
+  if (std::getenv("CF_ESTIMATE_DEBUG"))
+    std::fprintf(stderr, "CAL met_singles %zu\n", met_singles.size());
+  const double after_motion = after_motion_seconds(e, partners, met_singles);
   e.cfs = kCfsPerLevelCf * found + kCfsPerFailed * failed;
   e.transitions = e.cfs * kTransitionsPerCf;
   e.cpu_seconds =
       level_cpu + kExploresPerWitness * explore_s * explored + kFoundSeconds * found +
-      search_seconds * (kSearchesPerFailed * failed + kSearchesPerFailedTry * failed_tries);
+      search_seconds * (kSearchesPerFailed * failed + kSearchesPerFailedTry * failed_tries) +
+      after_motion;
   e.seconds = e.cpu_seconds * (kSerial + (1 - kSerial) / e.threads);
   e.peak_bytes = base_bytes + kBytesPerCf * e.cfs;
   if (std::getenv("CF_ESTIMATE_DEBUG"))
@@ -367,9 +480,9 @@ RunEstimate Enumerator::estimate(int threads, std::size_t samples) {
   if (std::getenv("CF_ESTIMATE_DEBUG"))
     std::fprintf(stderr,
                  "CAL level_cpu %g found %g failed %g search_s %g base %g explore_s %g explored %g "
-                 "failed_tries %g\n",
+                 "failed_tries %g after_motion %g\n",
                  level_cpu, found, failed, search_seconds, base_bytes, explore_s, explored,
-                 failed_tries);
+                 failed_tries, after_motion);
   e.sample_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return e;
 }
