@@ -221,6 +221,34 @@ TEST_CASE("malformed files are parse errors", "[mesh_io]") {
           "index.obj': parse error: facet 0 refers to vertex 3 but the file has 3 vertices"));
 }
 
+TEST_CASE("data after what the header declares is refused, with its byte offset", "[mesh_io]") {
+  // Two models in one OFF file: the second would be dropped without a word.
+  const std::string one = off_text(kCubeV, kCubeF);
+  CHECK_THROWS_WITH(
+      load_model(write_file("two.off", one + one)),
+      Catch::Contains("two.off': parse error: line 17: byte offset " + std::to_string(one.size()) +
+                      ": data after the 6 facets the header declares (a second model"));
+  // White space and comments after the last facet are fine.
+  check_cube(load_model(write_file("tail.off", one + "\n# the end\n\n")));
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  CHECK_THROWS_WITH(
+      load_model(write_file("extra.ply", ply + "3 0 2 1\n")),
+      Catch::Contains("extra.ply': parse error: line 14, byte offset " +
+                      std::to_string(ply.size()) +
+                      ": 8 bytes of data after the last element the header declares"));
+  std::string bin =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\n"
+      "property float y\nproperty float z\nend_header\n";
+  bin += std::string(12, '\0');
+  CHECK_THROWS_WITH(
+      load_model(write_file("extra_bin.ply", bin + "abc")),
+      Catch::Contains("extra_bin.ply': parse error: byte offset " + std::to_string(bin.size()) +
+                      ": 3 bytes of data after the last element"));
+}
+
 TEST_CASE("header counts are checked against the file's size before anything is allocated",
           "[mesh_io][hostile]") {
   // Each of these used to allocate gigabytes (CGAL reserves what the header says).
@@ -421,7 +449,21 @@ TEST_CASE("broken solids are rejected with the reason", "[mesh_io]") {
     f[2] = {0, 1, 5, 8, 4};
     f.push_back({4, 8, 5});
     CHECK_THROWS_WITH(load_model(write_file("sliver.off", off_text(v, f))),
-                      Catch::Contains("sliver.off': degenerate facet: facet 6 has zero area"));
+                      Catch::Contains("sliver.off': degenerate facet: facet 6 is too thin: its "
+                                      "height ("));
+  }
+  SECTION("a needle is refused for its height, with its area") {
+    // Facet 6 is a triangle 10 mm long whose apex lies 1e-9 mm off its base: its area is
+    // not zero, its height is below 1e-7 of the diagonal (1.7e-6 mm).
+    std::vector<cf::Vec3> v = kCubeV;
+    v.push_back({5, 1e-9, 10});
+    auto f = kCubeF;
+    f[2] = {0, 1, 5, 8, 4};
+    f.push_back({4, 8, 5});
+    CHECK_THROWS_WITH(load_model(write_file("needle.off", off_text(v, f))),
+                      Catch::Contains("needle.off': degenerate facet: facet 6 is too thin: its "
+                                      "height (1e-09 mm, twice its area 5e-09 mm^2 over its "
+                                      "longest side 10 mm) is below 1.73205e-06 mm"));
   }
   SECTION("non-planar facet") {
     std::vector<cf::Vec3> v = kCubeV;

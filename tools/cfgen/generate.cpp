@@ -33,7 +33,8 @@ double length_scale(const Polyhedron& A, const Polyhedron& B) {
 gen::SearchParams scaled_search(const Polyhedron& A, const Polyhedron& B,
                                 const RelativeLengths& rel, gen::SearchParams base) {
   const double D = length_scale(A, B);
-  base.touch_tol = rel.touch_tol * D;
+  base.touch_tol =
+      std::max(rel.touch_tol * D, kTouchPerPrecision * (model_precision(A) + model_precision(B)));
   base.min_clearance = rel.min_clearance * D;
   base.good_clearance = rel.good_clearance * D;
   base.min_margin = rel.min_margin * D;
@@ -64,8 +65,9 @@ int stopped_status(const GenerateArgs& args, const std::string& checkpoint_dir) 
 
 // The graph's "meta" record: statistics, the parameters and the generator (docs/graph-format.md).
 nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args,
-                          const gen::SearchParams& s, const gen::EnumerateOptions& opt,
-                          double diag) {
+                          const gen::SearchParams& s, const gen::EnumerateOptions& opt, double diag,
+                          const Polyhedron& A, const Polyhedron& B, double precision_a,
+                          double precision_b) {
   nlohmann::json meta;
   nlohmann::json by_count = nlohmann::json::object(), by_type = nlohmann::json::object();
   for (const CfRecord& r : e.cfs) {
@@ -109,6 +111,8 @@ nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args,
                         {"good_clearance_rel", args.rel.good_clearance},
                         {"min_margin_rel", args.rel.min_margin},
                         {"touch_tol_mm", s.touch_tol},
+                        {"precision_mm", {{"A", precision_a}, {"B", precision_b}}},
+                        {"planarity_mm", {{"A", model_precision(A)}, {"B", model_precision(B)}}},
                         {"min_clearance_mm", s.min_clearance},
                         {"good_clearance_mm", s.good_clearance},
                         {"min_margin_mm", s.min_margin},
@@ -203,8 +207,10 @@ int run_generate(const GenerateArgs& args) {
   // Of K shards, shard 0 writes the graph.
   const bool writes = !args.estimate && args.shard.index == 0;
   if (writes) check_output_path(args.out_path, inputs, "writing graph");
-  const Polyhedron A = load_model(args.a_path, args.load_a);
-  const Polyhedron B = load_model(args.b_path, args.load_b);
+  const MeasuredModel ma = load_measured_model(args.a_path, args.load_a);
+  const MeasuredModel mb = load_measured_model(args.b_path, args.load_b);
+  const Polyhedron& A = ma.model;
+  const Polyhedron& B = mb.model;
   // The other ranks of an MPI run say nothing that rank 0 says.
   if (!args.share.load || args.shard.index == 0)
     for (const auto& [m, which, option] :
@@ -291,7 +297,8 @@ int run_generate(const GenerateArgs& args) {
               << (writes ? "" : "; shard 0 writes the graph") << '\n';
   if (!writes) return 0;
 
-  const nlohmann::json meta = graph_meta(e, args, search, opt, diag);
+  const nlohmann::json meta =
+      graph_meta(e, args, search, opt, diag, A, B, ma.precision_mm, mb.precision_mm);
   const std::size_t n_cfs = e.cfs.size(), n_tr = e.transitions.size();
   // Moved, not copied: a large graph's records and transitions are hundreds of MB.
   const CfGraph graph =

@@ -29,10 +29,19 @@ struct RelativeLengths {
   double min_margin = 2e-4;      ///< contact points at least this far inside their elements
 };
 
+/// The touch tolerance is at least this many times the sum of the models' planarities
+/// (model_precision): two faces each planar to p_A and p_B touch along their whole extent at
+/// a pose that puts every vertex of each within p_A + p_B of the other's plane, and the pose
+/// itself is found only to rounding; twice that sum again is the margin (docs/features.md,
+/// "Precision").
+constexpr double kTouchPerPrecision = 4;
+
 /// D in mm: the smaller model's bounding-box diagonal, the unit of RelativeLengths.
 double length_scale(const Polyhedron& A, const Polyhedron& B);
 
-/// `base` with its lengths set to `rel` times length_scale(A, B): the search cfgen runs.
+/// `base` with its lengths set to `rel` times length_scale(A, B), the touch tolerance at
+/// least kTouchPerPrecision times the models' planarities summed (model_precision): the
+/// search cfgen runs.
 gen::SearchParams scaled_search(const Polyhedron& A, const Polyhedron& B,
                                 const RelativeLengths& rel, gen::SearchParams base = {});
 

@@ -17,7 +17,10 @@ namespace cf::tools::detail {
 void check_soup(const PolygonSoup& soup, const std::string& source, const LoadOptions& options);
 
 /// Faces, edges and vertices of section 3 of docs/spec.md from a soup that passed check_soup.
+/// off_plane, when given: mm, the largest distance of a feature vertex from the fitted plane
+/// of one of its faces as read (before the snap): the file's precision as its data show it.
 cf::Polyhedron extract_features(const PolygonSoup& soup, const std::string& source,
-                                const std::string& name, const LoadOptions& options);
+                                const std::string& name, const LoadOptions& options,
+                                double* off_plane = nullptr);
 
 }  // namespace cf::tools::detail

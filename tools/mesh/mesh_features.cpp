@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <sstream>
@@ -21,9 +22,13 @@ namespace {
 // below this fraction of the bounding-box diagonal: zero up to the rounding of coordinates
 // that came through single precision (STL), which is about 6e-8 of the largest coordinate.
 constexpr double kDegenerateRelTol = 1e-7;
-// Feature vertices further than this (relative to the diagonal) from the fitted plane of one
-// of their faces are moved onto the planes' intersection; exact input is left untouched.
-constexpr double kSnapRelTol = 1e-9;
+// Feature vertices further than this many units of rounding (the machine epsilon times the
+// largest coordinate) from the fitted plane of one of their faces are moved onto the planes'
+// intersection: a file written with fewer digits than a double holds (float32 STL, 6-10
+// digits) has faces planar only to its own precision, and an f-f contact between such faces
+// would hold nowhere within the touch tolerance. Points on their planes to the arithmetic's
+// rounding (exact or 17-digit input) are left untouched.
+constexpr double kSnapRoundings = 64;
 
 std::string num(double x) {
   std::ostringstream os;
@@ -190,8 +195,10 @@ void check_soup(const PolygonSoup& s, const std::string& src, const LoadOptions&
       longest = std::max(longest, (P[F[f][k]] - P[F[f][(k + 1) % F[f].size()]]).norm());
     const double height = n2.norm() / longest;  // 2 area / longest side
     if (!(height > kDegenerateRelTol * diag))
-      fail(src, "degenerate facet: facet " + std::to_string(f) + " has zero area (area " +
-                    num(0.5 * n2.norm()) + " mm^2)");
+      fail(src, "degenerate facet: facet " + std::to_string(f) + " is too thin: its height (" +
+                    num(height) + " mm, twice its area " + num(0.5 * n2.norm()) +
+                    " mm^2 over its longest side " + num(longest) + " mm) is below " +
+                    num(kDegenerateRelTol * diag) + " mm (1e-7 of the model's diagonal)");
     if (F[f].size() > 3) {
       const Vec3 n = n2.normalized();
       const Vec3 c = mean_point(P, F[f]);
@@ -225,7 +232,8 @@ void check_soup(const PolygonSoup& s, const std::string& src, const LoadOptions&
 }
 
 cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
-                                const std::string& name, const LoadOptions& opt) {
+                                const std::string& name, const LoadOptions& opt,
+                                double* off_plane) {
   const auto& P = s.points;
   const auto& F = s.polygons;
   const int nf = static_cast<int>(F.size());
@@ -436,7 +444,10 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
   std::sort(edges.begin(), edges.end());
 
   // Coordinates: the input points, moved onto the intersection of their faces' planes only
-  // when they are off by more than rounding (single-precision input).
+  // when they are off by more than rounding (input written with fewer digits).
+  double largest = 0;
+  for (const Vec3& p : P) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+  const double rounding = std::numeric_limits<double>::epsilon() * largest;
   std::vector<Vec3> coords;
   coords.reserve(feature_points.size());
   for (std::size_t i = 0; i < feature_points.size(); ++i) {
@@ -452,7 +463,8 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
       res[q] = plane_d[fs[q]] - plane_n[fs[q]].dot(p);
       dev = std::max(dev, std::abs(res[q]));
     }
-    if (dev <= kSnapRelTol * diag) {
+    if (off_plane) *off_plane = std::max(*off_plane, dev);
+    if (dev <= kSnapRoundings * rounding) {
       coords.push_back(p);
     } else {
       Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -469,3 +481,16 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
 }
 
 }  // namespace cf::tools::detail
+
+namespace cf::tools {
+
+double model_precision(const cf::Polyhedron& m) {
+  double largest = 0, off = 0;
+  for (const auto& v : m.vertices()) largest = std::max(largest, v.p.cwiseAbs().maxCoeff());
+  for (const auto& f : m.faces())
+    for (VertexId i : f.vertices)
+      off = std::max(off, std::abs(f.normal.dot(m.vertex(i).p) - f.offset));
+  return std::max(off, kPrecisionRoundings * std::numeric_limits<double>::epsilon() * largest);
+}
+
+}  // namespace cf::tools

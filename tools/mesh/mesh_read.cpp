@@ -220,6 +220,13 @@ RawSoup read_off(std::string_view text, const std::string& src) {
     }
     s.polygons.push_back(std::move(poly));
   }
+  // A second model, or counts smaller than the data, would be dropped without a word.
+  if (in.next(tok))
+    parse_fail(src, in.line(),
+               "byte offset " + std::to_string(tok[0].data() - text.data()) + ": data after the " +
+                   std::to_string(nf) +
+                   " facets the header declares (a second model, or counts that do not match "
+                   "the data)");
   return s;
 }
 
@@ -491,8 +498,25 @@ struct PlyElement {
 /// The data section of a PLY file, ascii or binary, read value by value.
 class PlyData {
  public:
-  PlyData(std::string_view data, int format, const std::string& src, int header_lines)
-      : d_(data), format_(format), src_(src), line_(header_lines + 1) {}
+  /// data: the bytes after the header, which ends at byte offset `base` of the file.
+  PlyData(std::string_view data, std::size_t base, int format, const std::string& src,
+          int header_lines)
+      : d_(data), base_(base), format_(format), src_(src), line_(header_lines + 1) {}
+
+  /// Refuses anything but white space (ascii) or nothing (binary) after the last element: a
+  /// second model, or counts that do not match the data, would be dropped without a word.
+  void expect_end() {
+    std::size_t q = p_;
+    int line = line_;
+    if (format_ == 0)
+      for (; q < d_.size() && is_space(d_[q]); ++q) line += d_[q] == '\n';
+    if (q >= d_.size()) return;
+    const std::string where = format_ == 0 ? "line " + std::to_string(line) + ", " : "";
+    fail(src_, "parse error: " + where + "byte offset " + std::to_string(base_ + q) + ": " +
+                   std::to_string(d_.size() - q) +
+                   " bytes of data after the last element the header declares (a second "
+                   "model, or element counts that do not match the data)");
+  }
 
   double value(PlyType t, const char* what) {
     if (format_ == 0) {
@@ -574,7 +598,8 @@ class PlyData {
 
  private:
   std::string_view d_;
-  int format_;  // 0 ascii, 1 little endian, 2 big endian
+  std::size_t base_;  // byte offset of d_ in the file
+  int format_;        // 0 ascii, 1 little endian, 2 big endian
   const std::string& src_;
   std::size_t p_ = 0;
   int line_;
@@ -658,7 +683,8 @@ RawSoup read_ply(std::string_view bytes, const std::string& src) {
   if (!ended) fail(src, "parse error: the PLY header has no 'end_header'");
   if (format < 0) fail(src, "parse error: the PLY header has no 'format' line");
 
-  PlyData data(bytes.substr(std::min(pos, bytes.size())), format, src, line);
+  PlyData data(bytes.substr(std::min(pos, bytes.size())), std::min(pos, bytes.size()), format, src,
+               line);
   // Counts against the size: every item of every element takes at least its minimum bytes.
   long double need = 0;
   for (const PlyElement& e : elements) {
@@ -739,6 +765,7 @@ RawSoup read_ply(std::string_view bytes, const std::string& src) {
     }
   }
   if (!have_vertices) fail(src, "parse error: the PLY file has no element 'vertex'");
+  data.expect_end();
   return s;
 }
 

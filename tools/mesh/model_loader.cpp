@@ -72,8 +72,8 @@ void check_self_intersection(const PolygonSoup& s, const std::string& src) {
 
 }  // namespace
 
-cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& source,
-                               const LoadOptions& options) {
+MeasuredModel measured_model_from_soup(const PolygonSoup& soup, const std::string& source,
+                                       const LoadOptions& options) {
   if (!(options.coplanar_rel_tol >= kMinCoplanarTol &&
         options.coplanar_rel_tol <= kMaxCoplanarTol)) {
     char buf[160];
@@ -96,7 +96,15 @@ cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& sourc
   detail::check_soup(soup, source, options);
   if (options.check_self_intersection) check_self_intersection(soup, source);
   const std::string name = options.name.empty() ? fs::path(source).stem().string() : options.name;
-  return detail::extract_features(soup, source, name, options);
+  double off_plane = 0;
+  cf::Polyhedron model = detail::extract_features(soup, source, name, options, &off_plane);
+  const double precision = std::max(off_plane, model_precision(model));
+  return {std::move(model), precision};
+}
+
+cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& source,
+                               const LoadOptions& options) {
+  return measured_model_from_soup(soup, source, options).model;
 }
 
 std::string size_warning(const cf::Polyhedron& model, const std::string& which,
@@ -115,13 +123,17 @@ double mm_per_unit(const std::string& unit) {
   return 0;
 }
 
-cf::Polyhedron load_model(const std::string& path, const LoadOptions& options) {
+MeasuredModel load_measured_model(const std::string& path, const LoadOptions& options) {
   const double scale = mm_per_unit(options.units);
   if (!(scale > 0)) fail(path, "unknown unit '" + options.units + "' (expected mm, cm, m or in)");
   PolygonSoup soup = read_polygon_soup(path);
   if (scale != 1)
     for (Vec3& p : soup.points) p *= scale;
-  return model_from_soup(soup, path, options);
+  return measured_model_from_soup(soup, path, options);
+}
+
+cf::Polyhedron load_model(const std::string& path, const LoadOptions& options) {
+  return load_measured_model(path, options).model;
 }
 
 }  // namespace cf::tools

@@ -76,6 +76,27 @@ PolygonSoup read_polygon_soup(const std::string& path);
 cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& source,
                                const LoadOptions& options = {});
 
+/// Units of rounding (the machine epsilon times the largest coordinate) a model is taken to
+/// be exact to at best: a pose applied to a point far from the origin rounds by about that
+/// much (docs/features.md, "Precision").
+constexpr double kPrecisionRoundings = 4;
+
+/// mm: how closely a model's geometry holds as it stands: the largest distance of a face's
+/// vertex from the face's plane, and at least kPrecisionRoundings units of rounding of its
+/// largest coordinate (a model far from its origin).
+double model_precision(const cf::Polyhedron& model);
+
+/// A model and how closely its file holds it (docs/features.md, "Precision").
+struct MeasuredModel {
+  cf::Polyhedron model;
+  /// mm: the larger of model_precision(model) and the largest distance of a feature vertex
+  /// from the fitted plane of one of its faces as the file gave it (before the vertex was
+  /// moved onto its planes): about the rounding of the file's coordinates (float32, or the
+  /// digits written). The generator's touch and symmetry tolerances are at least a multiple
+  /// of it (tools/cfgen/generate.hpp).
+  double precision_mm = 0;
+};
+
 /// Empty when `model` is a reasonable size against the contact threshold `epsilon_mm` (the
 /// paper's 1 mm by default), else a warning naming the sizes and `unit_option`, the option
 /// that gives the file's unit (docs/spec.md, section 2).
@@ -85,5 +106,14 @@ std::string size_warning(const cf::Polyhedron& model, const std::string& which,
 /// read_polygon_soup, the points converted from options.units to mm, then model_from_soup.
 /// @throws cf::Error with a one-line message that names the file and the problem.
 cf::Polyhedron load_model(const std::string& path, const LoadOptions& options = {});
+
+/// model_from_soup, with the model's precision.
+/// @throws as model_from_soup.
+MeasuredModel measured_model_from_soup(const PolygonSoup& soup, const std::string& source,
+                                       const LoadOptions& options = {});
+
+/// load_model, with the model's precision.
+/// @throws as load_model.
+MeasuredModel load_measured_model(const std::string& path, const LoadOptions& options = {});
 
 }  // namespace cf::tools
