@@ -31,6 +31,10 @@ namespace {
 
 // Sets whose partners are counted to predict the next level's candidates.
 constexpr std::size_t kRows = 256;
+// CFs explored per set sampled a level: the single PCs that only motion reaches are met by
+// few explorations, and their pairs' cost weighs heavily where they are many (CGAL's cross
+// and U: with one, the prediction of its run varied by a fifth from one estimate to the next).
+constexpr std::size_t kExploresPerSample = 2;
 // Batches of samples_ sets, at most, whose unknown subsets are decided to find a level's
 // candidates to sample.
 constexpr std::size_t kGrowRounds = 8;
@@ -54,8 +58,8 @@ constexpr double kCfsPerFailed = 0.24;
 // fitted apart because pairs with few symmetries (CGAL's cross and U) have many more failed
 // orbits per failed set than the symmetric n-gon pairs.
 constexpr double kExploresPerWitness = 1.0;
-constexpr double kFoundSeconds = 75e-6;  // s, on the machine of docs/performance.md
-constexpr double kSearchesPerFailed = 0.09;
+constexpr double kFoundSeconds = 40e-6;  // s, on the machine of docs/performance.md
+constexpr double kSearchesPerFailed = 0.06;
 constexpr double kSearchesPerFailedTry = 1.5;
 // Single PCs the closure by motion finds per level-1 candidate the level fails: on CGAL's
 // cross against its U (the one pair measured whose levels run again at a cost), about 1,900
@@ -66,9 +70,12 @@ constexpr double kMotionSinglesPerFailed = 0.40;
 constexpr double kSerial = 0.25;
 // Transitions per CF: 15.5-25 on the pairs measured.
 constexpr double kTransitionsPerCf = 18;
-// Resident bytes per CF at the run's peak (records, the search's sets, the transitions built
-// and sorted), above what the models take.
-constexpr double kBytesPerCf = 1750;
+// Resident bytes at the run's peak above what the models take: per CF (records, the search's
+// sets, the transitions built and sorted), and per member of a failed orbit a neighbour round
+// may search (the rounds' memory of what they screened and searched: CGAL's cross and U, the
+// one pair measured with many, peaked at 1.3-1.8 GB for 420,843 CFs, docs/performance.md).
+constexpr double kBytesPerCf = 1550;
+constexpr double kBytesPerFailedTry = 1000;
 
 // k indices spread evenly over [0, n).
 std::vector<std::size_t> spread(std::size_t n, std::size_t k) {
@@ -460,7 +467,7 @@ RunEstimate Enumerator::estimate(int threads, std::size_t samples) {
   // s of CPU a search takes, on the mean over the levels' searches.
   const double search_seconds = searches > 0 ? level_cpu / searches : 0;
   std::vector<Discovery> met_singles;
-  const double explore_s = explore_seconds(samples_, met_singles);
+  const double explore_s = explore_seconds(kExploresPerSample * samples_, met_singles);
   if (std::getenv("CF_ESTIMATE_DEBUG"))
     std::fprintf(stderr, "CAL met_singles %zu\n", met_singles.size());
   const double after_motion = after_motion_seconds(e, partners, met_singles);
@@ -471,7 +478,7 @@ RunEstimate Enumerator::estimate(int threads, std::size_t samples) {
       search_seconds * (kSearchesPerFailed * failed + kSearchesPerFailedTry * failed_tries) +
       after_motion;
   e.seconds = e.cpu_seconds * (kSerial + (1 - kSerial) / e.threads);
-  e.peak_bytes = base_bytes + kBytesPerCf * e.cfs;
+  e.peak_bytes = base_bytes + kBytesPerCf * e.cfs + kBytesPerFailedTry * failed_tries;
   if (std::getenv("CF_ESTIMATE_DEBUG"))
     for (const LevelEstimate& l : e.levels)
       std::fprintf(stderr,
