@@ -294,6 +294,19 @@ std::string mesh_text(const Polytope& P, Format format, int digits, const std::s
     return out;
   }
   std::ostringstream os = number_stream(digits);
+  // PLY's ascii body and OFF's after their headers: a point a line, then each face as its
+  // vertex count and indices.
+  auto points_then_counted_faces = [&] {
+    for (const Vec& x : P.v) {
+      put_point(os, x);
+      os << '\n';
+    }
+    for (const auto& f : P.faces) {
+      os << f.size();
+      for (int c : f) os << ' ' << c;
+      os << '\n';
+    }
+  };
   switch (format) {
     case Format::kStlAscii:  // as most exporters: %e with digits - 1 decimals
       os << std::scientific << std::setprecision(digits - 1) << "solid " << name << '\n';
@@ -330,28 +343,12 @@ std::string mesh_text(const Polytope& P, Format format, int digits, const std::s
          << P.num_vertices() << "\nproperty " << type << " x\nproperty " << type << " y\nproperty "
          << type << " z\nelement face " << P.num_faces()
          << "\nproperty list uchar int vertex_indices\nend_header\n";
-      for (const Vec& x : P.v) {
-        put_point(os, x);
-        os << '\n';
-      }
-      for (const auto& f : P.faces) {
-        os << f.size();
-        for (int c : f) os << ' ' << c;
-        os << '\n';
-      }
+      points_then_counted_faces();
       break;
     }
     case Format::kOff:
       os << "OFF\n" << P.num_vertices() << ' ' << P.num_faces() << " 0\n";
-      for (const Vec& x : P.v) {
-        put_point(os, x);
-        os << '\n';
-      }
-      for (const auto& f : P.faces) {
-        os << f.size();
-        for (int c : f) os << ' ' << c;
-        os << '\n';
-      }
+      points_then_counted_faces();
       break;
     case Format::kStlBinary:
       break;
