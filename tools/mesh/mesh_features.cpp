@@ -252,12 +252,20 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
     centre[f] = mean_point(P, F[f]);
   }
 
-  // Faces: region growing from the lowest unassigned facet, breadth first over shared edges.
+  // Faces: region growing from the largest unassigned facet, breadth first over shared edges.
   // A neighbour joins when it faces the same way and all its vertices lie within tol of the
   // region's current plane (area-weighted normal and centroid of the facets so far).
+  // Regions grow from the largest facets first: a thin facet's own normal is off by its
+  // corners' rounding over its height (a triangle of a file written at 6 digits), and a
+  // region started from it could refuse its coplanar neighbours. They are numbered by their
+  // lowest facet afterwards, so the order is the same as growing them in facet order.
+  std::vector<int> by_area(nf);
+  for (int f = 0; f < nf; ++f) by_area[f] = f;
+  std::stable_sort(by_area.begin(), by_area.end(),
+                   [&](int a, int b) { return area2[a].norm() > area2[b].norm(); });
   std::vector<int> region(nf, -1);
   std::vector<int> seed;
-  for (int s0 = 0; s0 < nf; ++s0) {
+  for (int s0 : by_area) {
     if (region[s0] >= 0) continue;
     const int r = static_cast<int>(seed.size());
     seed.push_back(s0);
@@ -286,6 +294,14 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
     }
   }
   const int nr = static_cast<int>(seed.size());
+  {
+    std::vector<int> lowest(nr, nf), order(nr), renumber(nr);
+    for (int f = 0; f < nf; ++f) lowest[region[f]] = std::min(lowest[region[f]], f);
+    for (int r = 0; r < nr; ++r) order[r] = r;
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return lowest[a] < lowest[b]; });
+    for (int r = 0; r < nr; ++r) renumber[order[r]] = r, seed[r] = lowest[order[r]];
+    for (int& r : region) r = renumber[r];
+  }
 
   // Plane of each face: least squares through all its mesh vertices, oriented like the facets.
   std::vector<std::vector<int>> region_vertices(nr);
