@@ -49,20 +49,28 @@ void sort_contacts(bool small_indices, FinishScratch& s, ContactSet& cs) {
 // the largest angular tolerance) and how nearly their task-frame origins lie in each other's
 // planes (1 on them, 0 epsilon off), so that a contact drifting into a plane joins its
 // centre continuously.
-void plane_centres(double eps, double cos_plane, ContactSet& cs) {
+void plane_centres(double eps, double cos_plane, FinishScratch& s, ContactSet& cs) {
   const int n = cs.size();
   const auto share = [](double x, double scale) {
     return scale > 0 ? std::clamp(x / scale, 0.0, 1.0) : (x >= 0 ? 1.0 : 0.0);
   };
+  // Each contact's weight once: the pairs below are n x (contacts that weigh).
+  int m = 0;
+  for (int j = 0; j < n; ++j) {
+    const double w = cs[j].fit * std::max(0.0, eps - cs[j].distance);
+    if (w <= 0) continue;
+    s.weighted[static_cast<std::size_t>(m)] = j;
+    s.weight[static_cast<std::size_t>(m++)] = w;
+  }
   for (int i = 0; i < n; ++i) {
     ContactPc& c = cs[i];
     const Vec3 nc = c.R_WT.col(1);
     Vec3 moment = Vec3::Zero();
     double weight = 0;
-    for (int j = 0; j < n; ++j) {
+    for (int k = 0; k < m; ++k) {
+      const int j = s.weighted[static_cast<std::size_t>(k)];
+      const double w = s.weight[static_cast<std::size_t>(k)];
       const ContactPc& o = cs[j];
-      const double w = o.fit * std::max(0.0, eps - o.distance);
-      if (w <= 0) continue;
       const Vec3 no = o.R_WT.col(1);
       const Vec3 gap = o.origin_W - c.origin_W;
       const double off = std::max(std::abs(nc.dot(gap)), std::abs(no.dot(gap)));
@@ -158,7 +166,7 @@ void finish_contacts(const FinishContext& ctx, FinishScratch& s, ContactSet& cs)
     }
   }
   cs.set_num_planes(groups);
-  plane_centres(eps, ctx.cos_plane_tolerance, cs);
+  plane_centres(eps, ctx.cos_plane_tolerance, s, cs);
 }
 
 }  // namespace cf::detail

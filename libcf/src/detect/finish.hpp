@@ -30,6 +30,10 @@ struct FinishScratch {
   /// well enough to.
   std::array<std::array<int, ContactSet::kCapacity>, 3> dominators{};
   std::array<int, ContactSet::kCapacity> reps{};  ///< first member of each plane group
+  /// The contacts that weigh in a plane's centre (fit * (epsilon - distance) > 0), and that
+  /// weight, in contact order.
+  std::array<int, ContactSet::kCapacity> weighted{};
+  std::array<double, ContactSet::kCapacity> weight{};
 };
 
 /// Sorts `cs` by PC, sets `dominated` (adding the penalty to those misfits), groups the
