@@ -32,10 +32,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The floor for this test over all pairs together, and per pair the level the
-// checks written apart from the project ask for.
-constexpr double kMinShareAll = 0.999, kMinSharePerPair = 0.995;
-
 struct PairResult {
   std::string dir;
   int unambiguous = 0, correct = 0;
@@ -103,8 +99,11 @@ TEST_CASE("identification from a cold start at the oracle's unambiguous poses",
     all_correct += r.correct;
     CAPTURE(r.dir, r.correct, r.unambiguous);
     CHECK(r.unambiguous > 0);
-    CHECK(r.correct >= kMinSharePerPair * r.unambiguous);
+    // Every one: the seeds are fixed and the detection reads an unambiguous pose exactly
+    // (3,733 of 3,733 here, 37,381 of 37,381 in identify_unambiguous_oracle_test), so a
+    // single miss is a regression, not noise. The pose is printed above.
+    CHECK(r.correct == r.unambiguous);
   }
   std::cout << "all pairs: " << all_correct << " of " << all << "\n";
-  CHECK(all_correct >= kMinShareAll * all);
+  CHECK(all_correct == all);
 }
