@@ -92,7 +92,7 @@ constexpr std::size_t kRunPredictionSamples = 32;
 
 /// Predicts a run of enumerate() with `opt` on `threads` threads, without running it: the
 /// sets it decides go to `runner`'s threads (for_each), never as stages. samples: orbits
-/// searched per level, and CFs explored.
+/// searched per level; twice as many CFs are explored by motion.
 /// @throws Stopped when the runner was asked to stop.
 RunEstimate estimate(const WitnessSearch& search, const EnumerateOptions& opt, StageRunner& runner,
                      int threads, std::size_t samples = kEstimateSamples);
