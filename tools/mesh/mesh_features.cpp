@@ -231,6 +231,72 @@ void check_soup(const PolygonSoup& s, const std::string& src, const LoadOptions&
                   "from outside)");
 }
 
+namespace {
+
+// The faces: maximal edge-connected regions of coplanar facets (docs/features.md), grown
+// breadth first over shared edges. A neighbour joins when it faces the same way and all its
+// vertices lie within tol of the region's current plane (area-weighted normal and centroid of
+// the facets so far). Regions grow from the largest facets first: a thin facet's own normal
+// is off by its corners' rounding over its height (a triangle of a file written at 6 digits),
+// and a region started from it could refuse its coplanar neighbours. They are numbered by
+// their lowest facet afterwards, the order of growing them in facet order.
+struct FacetRegions {
+  std::vector<int> region;  // of each facet
+  std::vector<int> seed;    // of each region, its lowest facet
+};
+
+FacetRegions grow_faces(const PolygonSoup& s, const HalfEdges& he, const std::vector<Vec3>& area2,
+                        const std::vector<Vec3>& centre, double tol) {
+  const auto& P = s.points;
+  const auto& F = s.polygons;
+  const int nf = static_cast<int>(F.size());
+  std::vector<int> by_area(nf);
+  for (int f = 0; f < nf; ++f) by_area[f] = f;
+  std::stable_sort(by_area.begin(), by_area.end(),
+                   [&](int a, int b) { return area2[a].norm() > area2[b].norm(); });
+  FacetRegions out;
+  std::vector<int>& region = out.region;
+  region.assign(nf, -1);
+  int nr = 0;
+  for (int s0 : by_area) {
+    if (region[s0] >= 0) continue;
+    const int r = nr++;
+    region[s0] = r;
+    Vec3 N = area2[s0];
+    Vec3 C = area2[s0].norm() * centre[s0];
+    double W = area2[s0].norm();
+    std::vector<int> queue{s0};
+    for (std::size_t qi = 0; qi < queue.size(); ++qi) {
+      const int f = queue[qi];
+      for (int k = 0; k < static_cast<int>(F[f].size()); ++k) {
+        const int g = he.at(key(F[f][(k + 1) % F[f].size()], F[f][k])).first;
+        if (region[g] >= 0) continue;
+        const Vec3 n = N.normalized();
+        const Vec3 c = C / W;
+        if (!(n.dot(area2[g]) > 0)) continue;
+        bool flat = true;
+        for (int i : F[g]) flat = flat && std::abs(n.dot(P[i] - c)) <= tol;
+        if (!flat) continue;
+        region[g] = r;
+        N += area2[g];
+        C += area2[g].norm() * centre[g];
+        W += area2[g].norm();
+        queue.push_back(g);
+      }
+    }
+  }
+  std::vector<int> lowest(nr, nf), order(nr), renumber(nr);
+  for (int f = 0; f < nf; ++f) lowest[region[f]] = std::min(lowest[region[f]], f);
+  for (int r = 0; r < nr; ++r) order[r] = r;
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return lowest[a] < lowest[b]; });
+  out.seed.resize(nr);
+  for (int r = 0; r < nr; ++r) renumber[order[r]] = r, out.seed[r] = lowest[order[r]];
+  for (int& r : region) r = renumber[r];
+  return out;
+}
+
+}  // namespace
+
 cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
                                 const std::string& name, const LoadOptions& opt,
                                 double* off_plane) {
@@ -252,56 +318,10 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
     centre[f] = mean_point(P, F[f]);
   }
 
-  // Faces: region growing from the largest unassigned facet, breadth first over shared edges.
-  // A neighbour joins when it faces the same way and all its vertices lie within tol of the
-  // region's current plane (area-weighted normal and centroid of the facets so far).
-  // Regions grow from the largest facets first: a thin facet's own normal is off by its
-  // corners' rounding over its height (a triangle of a file written at 6 digits), and a
-  // region started from it could refuse its coplanar neighbours. They are numbered by their
-  // lowest facet afterwards, so the order is the same as growing them in facet order.
-  std::vector<int> by_area(nf);
-  for (int f = 0; f < nf; ++f) by_area[f] = f;
-  std::stable_sort(by_area.begin(), by_area.end(),
-                   [&](int a, int b) { return area2[a].norm() > area2[b].norm(); });
-  std::vector<int> region(nf, -1);
-  std::vector<int> seed;
-  for (int s0 : by_area) {
-    if (region[s0] >= 0) continue;
-    const int r = static_cast<int>(seed.size());
-    seed.push_back(s0);
-    region[s0] = r;
-    Vec3 N = area2[s0];
-    Vec3 C = area2[s0].norm() * centre[s0];
-    double W = area2[s0].norm();
-    std::vector<int> queue{s0};
-    for (std::size_t qi = 0; qi < queue.size(); ++qi) {
-      const int f = queue[qi];
-      for (int k = 0; k < static_cast<int>(F[f].size()); ++k) {
-        const int g = twin(f, k).first;
-        if (region[g] >= 0) continue;
-        const Vec3 n = N.normalized();
-        const Vec3 c = C / W;
-        if (!(n.dot(area2[g]) > 0)) continue;
-        bool flat = true;
-        for (int i : F[g]) flat = flat && std::abs(n.dot(P[i] - c)) <= tol;
-        if (!flat) continue;
-        region[g] = r;
-        N += area2[g];
-        C += area2[g].norm() * centre[g];
-        W += area2[g].norm();
-        queue.push_back(g);
-      }
-    }
-  }
+  const FacetRegions faces = grow_faces(s, he, area2, centre, tol);
+  const std::vector<int>& region = faces.region;
+  const std::vector<int>& seed = faces.seed;
   const int nr = static_cast<int>(seed.size());
-  {
-    std::vector<int> lowest(nr, nf), order(nr), renumber(nr);
-    for (int f = 0; f < nf; ++f) lowest[region[f]] = std::min(lowest[region[f]], f);
-    for (int r = 0; r < nr; ++r) order[r] = r;
-    std::sort(order.begin(), order.end(), [&](int a, int b) { return lowest[a] < lowest[b]; });
-    for (int r = 0; r < nr; ++r) renumber[order[r]] = r, seed[r] = lowest[order[r]];
-    for (int& r : region) r = renumber[r];
-  }
 
   // Plane of each face: least squares through all its mesh vertices, oriented like the facets.
   std::vector<std::vector<int>> region_vertices(nr);

@@ -125,6 +125,18 @@ struct RawSoup {
 
 // --- OFF ---------------------------------------------------------------------------------
 
+// Refuses a token after an OFF's declared facets: a second model, or counts smaller than the
+// data, would be dropped without a word.
+void expect_off_end(Lines& in, std::string_view text, long long facets, const std::string& src) {
+  std::vector<std::string_view> tok;
+  if (in.next(tok))
+    parse_fail(src, in.line(),
+               "byte offset " + std::to_string(tok[0].data() - text.data()) + ": data after the " +
+                   std::to_string(facets) +
+                   " facets the header declares (a second model, or counts that do not match "
+                   "the data)");
+}
+
 RawSoup read_off(std::string_view text, const std::string& src) {
   RawSoup s;
   Lines in(text, true);
@@ -220,13 +232,7 @@ RawSoup read_off(std::string_view text, const std::string& src) {
     }
     s.polygons.push_back(std::move(poly));
   }
-  // A second model, or counts smaller than the data, would be dropped without a word.
-  if (in.next(tok))
-    parse_fail(src, in.line(),
-               "byte offset " + std::to_string(tok[0].data() - text.data()) + ": data after the " +
-                   std::to_string(nf) +
-                   " facets the header declares (a second model, or counts that do not match "
-                   "the data)");
+  expect_off_end(in, text, nf, src);
   return s;
 }
 
