@@ -58,6 +58,33 @@ Vec3 unit_or_zero(const Vec3& v) {
   return l > kTinyMm ? Vec3(v / l) : Vec3::Zero();
 }
 
+// The stick anchor's stretch after the anchored material point moves by d (tangential, mm)
+// from stretch w0, the anchor trailing at most L (mm) behind it: w0 + d while that is within
+// L. Past L the anchor is dragged along the string and the stretch turns towards d as a
+// tractrix does, tan(phi/2) shrinking by e^(-s/L) over a straight travel s (phi: the angle
+// between the stretch and d). Exact for a straight tick, so the anchor, and the friction
+// along it, do not depend on how a path is cut into ticks (docs/force-model.md, "s_pj").
+Vec3 trail(const Vec3& w0, const Vec3& d, double L) {
+  const Vec3 chord = w0 + d;
+  if (chord.norm() <= L) return chord;
+  if (!(L > 0)) return Vec3::Zero();
+  // Where along d the stretch reaches L: |w0 + t d| = L, the root in (0, 1]; or the start,
+  // pulled in to L, when a bound smaller than last tick's already holds the anchor there.
+  double t0 = 0;
+  Vec3 w = w0 * (L / std::max(w0.norm(), L));
+  if (w0.norm() < L) {
+    const double a = d.squaredNorm(), b = w0.dot(d), c = w0.squaredNorm() - L * L;
+    t0 = (-b + std::sqrt(b * b - a * c)) / a;
+    w = w0 + t0 * d;
+  }
+  const double travel = (1 - t0) * d.norm();
+  const Vec3 u = unit_or_zero(d);
+  const Vec3 across = unit_or_zero(w - u * u.dot(w));
+  const double phi0 = std::atan2((w - u * u.dot(w)).norm(), u.dot(w));
+  const double phi1 = 2 * std::atan(std::tan(0.5 * phi0) * std::exp(-travel / L));
+  return L * (std::cos(phi1) * u + std::sin(phi1) * across);
+}
+
 bool compliant(MotionType m) {
   return m == MotionType::kMT2a || m == MotionType::kMT2b || m == MotionType::kMT2c ||
          m == MotionType::kMT3 || m == MotionType::kMT4 || m == MotionType::kMT5;
@@ -71,6 +98,7 @@ struct PcWork {
   bool gained[kMaxPcs];       // a fresh slot that no PC of last tick handed its state
   Vec3 dir_static[kMaxPcs];   // unit, world: eqs. (4) and (6)'s direction
   Vec3 dir_kinetic[kMaxPcs];  // unit, world: eq. (5)'s
+  Vec3 trail[kMaxPcs];        // mm, world: the anchor's stretch after its drag (trail())
 };
 
 // ---- The tick's start and the contacts rendered ----
@@ -223,20 +251,30 @@ double normal_force(const Params& P, Slot& slot, double distance, bool hold, std
   return F_cy;
 }
 
-// s_pj and friction's directions: static along the stick anchor's stretch (or, per tick, the
-// tick's tangential motion t_tick); kinetic along t_tick, or the static one when p_j did not
-// move tangentially.
-void displacement(bool anchor_mode, const Pose& pose, const Slot& slot, const Vec3& nrm,
-                  const Vec3& t_tick, PcForce& f, Vec3& dir_static, Vec3& dir_kinetic) {
+// s_pj and friction's directions. With the stick anchor, s_pj is the stretch of its material
+// point from the tie point, and every friction law acts along the stretch as the anchor's drag
+// leaves it (`trail`): p_j's motion over its last eq. (3) bound of travel, which a proxy's
+// sub-micron settling cannot turn as it turns a 1 um tick's own motion at 10 kHz. Per tick
+// (and with no stretch), the tick's tangential motion t_tick.
+void displacement(bool anchor_mode, const Pose& pose, const Pose* prev_pose, const Slot& slot,
+                  const Vec3& nrm, const Vec3& t_tick, PcForce& f, Vec3& dir_static,
+                  Vec3& dir_kinetic, Vec3& stretch_after) {
+  stretch_after = Vec3::Zero();
   if (anchor_mode) {
-    const Vec3 stretch = tangential(pose.apply(slot.anchor_A) - slot.anchor_W, nrm);
-    f.s_mm = stretch.norm();
-    dir_static = unit_or_zero(stretch);
+    const Vec3 now = pose.apply(slot.anchor_A);
+    const Vec3 before = prev_pose != nullptr ? prev_pose->apply(slot.anchor_A) : now;
+    const Vec3 w0 = tangential(before - slot.anchor_W, nrm), d = tangential(now - before, nrm);
+    f.s_mm = (w0 + d).norm();
+    stretch_after = trail(w0, d, f.s_bound_mm);
+    dir_static = unit_or_zero(stretch_after);
   } else {
     f.s_mm = t_tick.norm();
     dir_static = unit_or_zero(t_tick);
   }
-  dir_kinetic = t_tick.norm() > kTinyMm ? unit_or_zero(t_tick) : dir_static;
+  if (anchor_mode && stretch_after.norm() > kTinyMm)
+    dir_kinetic = dir_static;
+  else
+    dir_kinetic = t_tick.norm() > kTinyMm ? unit_or_zero(t_tick) : dir_static;
 }
 
 // Each rendered PC's geometry, the motion [a b c] of A's material point at p_j over the
@@ -267,7 +305,8 @@ void read_pcs(const ForceModel::Fixed& fm, ForceState& s, const Pose& pose, cons
 
     f.F_cy = normal_force(P, slot, c.distance, hold && !fresh, r.discontinuities);
     f.s_bound_mm = P.mu_static * f.F_cy / P.kp_N_per_mm;
-    displacement(anchor_mode, pose, slot, nrm, t_tick, f, w.dir_static[k], w.dir_kinetic[k]);
+    displacement(anchor_mode, pose, s.has_prev ? &s.prev_pose : nullptr, slot, nrm, t_tick, f,
+                 w.dir_static[k], w.dir_kinetic[k], w.trail[k]);
   }
 }
 
@@ -425,7 +464,8 @@ std::uint32_t friction_flags(const Slot& slot, const PcForce& f, bool gained, co
 }
 
 // The stick anchor after the tick's friction Ff (docs/force-model.md, "s_pj").
-void move_anchor(const Params& P, const Pose& pose, const PcForce& f, const Vec3& Ff, Slot& slot) {
+void move_anchor(const Params& P, const Pose& pose, const PcForce& f, const Vec3& Ff,
+                 const Vec3& stretch_after, Slot& slot) {
   if (f.regime == Regime::kImpactStatic) {
     // Pre-stretch the new anchor so that eq. (4) continues the impact friction on the
     // next ticks instead of dropping it: the result does not depend on the servo rate.
@@ -433,9 +473,7 @@ void move_anchor(const Params& P, const Pose& pose, const PcForce& f, const Vec3
     slot.anchor_W = f.p_W + f.R_WT * Ff / P.kp_N_per_mm;
   } else if (f.regime != Regime::kStick && f.s_mm > f.s_bound_mm) {
     // Eq. (3) fails: the PC slips and the anchor is dragged to trail at the bound.
-    const Vec3 now = pose.apply(slot.anchor_A);
-    slot.anchor_W =
-        now - tangential(now - slot.anchor_W, f.R_WT.col(1)).normalized() * f.s_bound_mm;
+    slot.anchor_W = pose.apply(slot.anchor_A) - stretch_after;
   }
 }
 
@@ -452,7 +490,7 @@ void render_pcs(const Params& P, ForceState& s, const Pose& pose, const PcWork& 
     r.discontinuities |= friction_flags(slot, f, w.gained[k], Ff);
     slot.regime = f.regime;
     slot.F_cy = f.F_cy;
-    if (anchor_mode) move_anchor(P, pose, f, Ff, slot);
+    if (anchor_mode) move_anchor(P, pose, f, Ff, w.trail[k], slot);
   }
   r.num_pcs = w.m;
 }
