@@ -109,6 +109,8 @@ if [[ "$group" == cfgen ]]; then
   done
   check cfgen_touch_tol_range 2 "^cfgen: --touch-tol: '1' is outside \[[-+.e0-9]+, [-+.e0-9]+\]" -- "$CFGEN" "$M/cube.off" "$M/l_block.off" -o nan.json --touch-tol 1
   check cfgen_threads_range 2 "^cfgen: --threads: Value 100000 not in range 0 to 1024" -- "$CFGEN" "$M/cube.off" "$M/l_block.off" -o nan.json -j 100000
+  check cfgen_good_below_min_clearance 2 "^cfgen: --good-clearance 0.0001 is below --min-clearance 0.0002: a witness is kept only when its clearance reaches --min-clearance" -- "$CFGEN" "$M/cube.off" "$M/l_block.off" -o nan.json --good-clearance 1e-4
+  check cfgen_min_above_good_clearance 2 "^cfgen: --good-clearance 0.02 is below --min-clearance 0.03" -- "$CFGEN" "$M/cube.off" "$M/l_block.off" -o nan.json --min-clearance 0.03
   absent cfgen_bad_options_no_output nan.json
   help=$("$CFGEN" --help)
   if grep -q -- '--coplanar-tol FLOAT:\[1e-12, 0.1\]' <<<"$help" && grep -q -- '--touch-tol FLOAT:\[[-+.e0-9]*, [-+.e0-9]*\]' <<<"$help"; then
@@ -228,6 +230,12 @@ if [[ "$group" == cfreplay ]]; then
   check cfreplay_epsilon_huge 2 "^cfreplay: --epsilon: '1e308' is outside \[1e-06, 1000\]" -- "${run[@]}" -o o.csv --epsilon 1e308
   check cfreplay_stiffness_zero 2 "^cfreplay: --stiffness: '0' is outside \[1e-09, 1e\+09\]" -- "${run[@]}" -o o.csv --stiffness 0
   check cfreplay_mass_negative 2 "^cfreplay: --mass: '-1' is outside \[0, 1e\+06\]" -- "${run[@]}" -o o.csv --mass -1
+  # Options checked together, before the work.
+  check cfreplay_moment_ref_and_point 2 "^cfreplay: --moment-ref origin contradicts --moment-point, which sets the moment's reference point; give one" -- "${run[@]}" -o o.csv --moment-ref origin --moment-point 1 2 3
+  check cfreplay_moment_ref_point_alone 2 "^cfreplay: --moment-ref point needs --moment-point X Y Z" -- "${run[@]}" -o o.csv --moment-ref point
+  check cfreplay_mu_d_above_default_mu 2 "^cfreplay: --mu-d 0.9 is above --mu 0.7 \(the default\): kinetic friction cannot exceed static friction; give --mu-d at most --mu" -- "${run[@]}" -o o.csv --mu-d 0.9
+  check cfreplay_mu_below_default_mu_d 2 "^cfreplay: --mu-d 0.08 \(the default\) is above --mu 0.05" -- "${run[@]}" -o o.csv --mu 0.05
+  absent cfreplay_contradictions_no_output o.csv
   # Outputs.
   cp "$P" in.csv
   check out_device 1 "^cfreplay: writing '/dev/full': is a character device; output files must be regular files" -- "$CFREPLAY" --graph "$G" --trajectory in.csv -o /dev/full

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <tuple>
@@ -25,6 +26,20 @@
 #include <unistd.h>
 
 namespace cf::tools {
+
+std::string conflicting_lengths(const RelativeLengths& rel, bool python_names) {
+  if (rel.good_clearance >= rel.min_clearance) return "";
+  const char* good = python_names ? "good_clearance" : "--good-clearance";
+  const char* min = python_names ? "min_clearance" : "--min-clearance";
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                "%s %g is below %s %g: a witness is kept only when its clearance reaches %s, "
+                "and the search stops at %s, so no witness would be kept; give %s at least %s "
+                "(defaults: %g and %g x D)",
+                good, rel.good_clearance, min, rel.min_clearance, min, good, good, min,
+                RelativeLengths{}.good_clearance, RelativeLengths{}.min_clearance);
+  return buf;
+}
 
 double length_scale(const Polyhedron& A, const Polyhedron& B) {
   return std::min((A.bbox_max() - A.bbox_min()).norm(), (B.bbox_max() - B.bbox_min()).norm());

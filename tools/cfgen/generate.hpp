@@ -29,6 +29,13 @@ struct RelativeLengths {
   double min_margin = 2e-4;      ///< contact points at least this far inside their elements
 };
 
+/// Empty when the lengths can hold together, else why not, naming both options (as the
+/// command line spells them, or as the Python binding's keywords with `python_names`). A
+/// witness is kept only when its clearance reaches min_clearance, and the search reports a
+/// clearance of at most good_clearance, so good_clearance below min_clearance refuses every
+/// witness: 0 CFs, as a silent consequence of two values each inside its range.
+std::string conflicting_lengths(const RelativeLengths& rel, bool python_names = false);
+
 /// The touch tolerance is at least this many times the sum of the models' planarities
 /// (model_precision): two faces each planar to p_A and p_B touch along their whole extent at
 /// a pose that puts every vertex of each within p_A + p_B of the other's plane, and the pose

@@ -187,6 +187,10 @@ int main(int argc, char** argv) {
   }
   gen.symmetry = !no_symmetry;
   gen.thorough = thorough;
+  if (const std::string why = cf::tools::conflicting_lengths(gen.rel); !why.empty()) {
+    std::cerr << "cfgen: " << why << " (see cfgen --help)\n";
+    return 2;
+  }
 
   try {
     cf::tools::LoadOptions load;

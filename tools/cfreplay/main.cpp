@@ -13,11 +13,55 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
 #include <exception>
 #include <iostream>
 #include <map>
 #include <string>
 #include <vector>
+
+namespace {
+
+// The options given as words, and which of the related ones were given.
+struct Choices {
+  std::string friction, moment_ref, centroid, proxy;
+  std::vector<double> moment_point;
+  bool moment_ref_given, mu_given, mu_d_given;
+};
+
+std::string with_default(double v, bool given) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g%s", v, given ? "" : " (the default)");
+  return buf;
+}
+
+// The choices in P, and the options that contradict each other refused before the work
+// (docs/bad-input.md, "Options checked together"): empty, or why.
+std::string apply_choices(const Choices& c, cf::Params& P) {
+  P.proxy.enabled = c.proxy == "on";
+  P.friction_displacement = c.friction == "per-tick" ? cf::FrictionDisplacement::kPerTick
+                                                     : cf::FrictionDisplacement::kStickAnchor;
+  P.centroid =
+      c.centroid == "volume" ? cf::CentroidChoice::kVolume : cf::CentroidChoice::kVertexMean;
+  P.moment_reference =
+      c.moment_ref == "centroid" ? cf::MomentReference::kACentroid : cf::MomentReference::kAOrigin;
+  if (!c.moment_point.empty()) {
+    if (c.moment_ref_given && c.moment_ref != "point")
+      return "--moment-ref " + c.moment_ref +
+             " contradicts --moment-point, which sets the moment's reference point; give one";
+    P.moment_reference = cf::MomentReference::kAPoint;
+    P.moment_point_A = cf::Vec3(c.moment_point[0], c.moment_point[1], c.moment_point[2]);
+  } else if (c.moment_ref == "point") {
+    return "--moment-ref point needs --moment-point X Y Z";
+  }
+  if (P.mu_kinetic > P.mu_static)
+    return "--mu-d " + with_default(P.mu_kinetic, c.mu_d_given) + " is above --mu " +
+           with_default(P.mu_static, c.mu_given) +
+           ": kinetic friction cannot exceed static friction; give --mu-d at most --mu";
+  return "";
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using cf::cli::finite_range;
@@ -75,10 +119,12 @@ int main(int argc, char** argv) {
   app.add_option("--tau", P.interpolation_time_constant_s,
                  "low-pass time constant of the total contact force and moment (s); 0: off")
       ->check(finite_range(0, 1e3));
-  app.add_option("--moment-ref", moment_ref,
-                 "moment about A's 'origin' (paper eq. (9)), its 'centroid', or the 'point' given "
-                 "by --moment-point")
-      ->check(CLI::IsMember({"origin", "centroid", "point"}));
+  CLI::Option* moment_ref_opt =
+      app.add_option(
+             "--moment-ref", moment_ref,
+             "moment about A's 'origin' (paper eq. (9)), its 'centroid', or the 'point' given "
+             "by --moment-point")
+          ->check(CLI::IsMember({"origin", "centroid", "point"}));
   std::vector<double> moment_point;
   app.add_option(
          "--moment-point", moment_point,
@@ -90,9 +136,10 @@ int main(int argc, char** argv) {
   app.add_option("--mass", P.mass_kg, "m, kg")->check(finite_range(0, 1e6));
   app.add_option("--stiffness", P.stiffness_N_per_mm, "K, N/mm")->check(finite_range(1e-9, 1e9));
   app.add_option("--kp", P.kp_N_per_mm, "K_p, N/mm")->check(finite_range(1e-9, 1e9));
-  app.add_option("--mu", P.mu_static, "static friction coefficient")->check(finite_range(0, 100));
-  app.add_option("--mu-d", P.mu_kinetic, "kinetic friction coefficient")
-      ->check(finite_range(0, 100));
+  CLI::Option* mu_opt = app.add_option("--mu", P.mu_static, "static friction coefficient")
+                            ->check(finite_range(0, 100));
+  CLI::Option* mu_d_opt = app.add_option("--mu-d", P.mu_kinetic, "kinetic friction coefficient")
+                              ->check(finite_range(0, 100));
   app.add_option("--epsilon", P.epsilon_mm, "contact threshold, mm")
       ->check(finite_range(1e-6, 1e3));
 
@@ -104,19 +151,14 @@ int main(int argc, char** argv) {
     std::cerr << "cfreplay: " << e.what() << " (see cfreplay --help)\n";
     return 2;
   }
-  P.proxy.enabled = proxy == "on";
-  P.friction_displacement = friction == "per-tick" ? cf::FrictionDisplacement::kPerTick
-                                                   : cf::FrictionDisplacement::kStickAnchor;
-  P.moment_reference =
-      moment_ref == "centroid" ? cf::MomentReference::kACentroid : cf::MomentReference::kAOrigin;
-  if (!moment_point.empty()) {
-    P.moment_reference = cf::MomentReference::kAPoint;
-    P.moment_point_A = cf::Vec3(moment_point[0], moment_point[1], moment_point[2]);
-  } else if (moment_ref == "point") {
-    std::cerr << "cfreplay: --moment-ref point needs --moment-point X Y Z (see cfreplay --help)\n";
+  const std::string why =
+      apply_choices({friction, moment_ref, centroid, proxy, moment_point,
+                     moment_ref_opt->count() > 0, mu_opt->count() > 0, mu_d_opt->count() > 0},
+                    P);
+  if (!why.empty()) {
+    std::cerr << "cfreplay: " << why << " (see cfreplay --help)\n";
     return 2;
   }
-  P.centroid = centroid == "volume" ? cf::CentroidChoice::kVolume : cf::CentroidChoice::kVertexMean;
 
   try {
     // Output paths first, so that a bad one fails before the work (docs/spec.md, section 5b).

@@ -149,6 +149,8 @@ void bind_tools(py::module_& m) {
         g.rel.min_clearance = min_clearance;
         g.rel.good_clearance = good_clearance;
         g.rel.min_margin = min_margin;
+        if (const std::string why = cf::tools::conflicting_lengths(g.rel, true); !why.empty())
+          fail(where + ": " + why);
         g.search.angle_margin = angle_margin;
         g.search.theta_samples = theta_samples;
         g.search.max_rotations = max_rotations;

@@ -72,6 +72,9 @@ def test_generate_errors(tmp_path):
         cf.generate(a, a, max_pcs=4)
     with pytest.raises(cf.Error, match=r"^generate: min_clearance must be a finite number in \[1e-09, 0\.1\], got 1$"):
         cf.generate(a, a, min_clearance=1.0)
+    # Each in its range, together no witness would be kept: refused before any work.
+    with pytest.raises(cf.Error, match=r"^generate: good_clearance 0\.0001 is below min_clearance 0\.0002: "):
+        cf.generate(a, a, good_clearance=1e-4)
     with pytest.raises(cf.Error, match=r"missing\.off"):
         cf.generate(a, tmp_path / "missing.off")
     with pytest.raises(TypeError):
