@@ -100,6 +100,7 @@ if [[ "$group" == cfgen ]]; then
   printf '\xff\xff\xff\x7f' >>count.stl
   check stl_binary_count 1 "count.stl': parse error: not an ascii STL \(no 'solid'\), and as binary STL its header says 2147483647 triangles \([0-9]+ bytes\) but the file has 84 bytes" -- "$CFGEN" --features count.stl
   check model_fifo 1 "fifo.off': cannot open file: is a FIFO \(named pipe\), not a regular file" -- "$CFGEN" --features fifo.off
+  check path_escapes 1 "^cfgen: loading '\\\\x1B\[2J\\\\x1B\[31mred\.off': cannot open file: no such file" -- "$CFGEN" --features $'\e[2J\e[31mred.off'
   check model_directory 1 "dir.off': cannot open file: is a directory, not a regular file" -- "$CFGEN" --features dir.off
 
   # Options: finite and in range, the range in --help.
@@ -149,6 +150,8 @@ fi
 if [[ "$group" == cfinspect ]]; then
   check graph_fifo 1 "^cfinspect: reading 'fifo.json': cannot open: is a FIFO \(named pipe\), not a regular file" -- "$CFINSPECT" fifo.json
   check graph_fifo_cbor 1 "^cfinspect: reading 'fifo.cbor': cannot open: is a FIFO" -- "$CFINSPECT" fifo.cbor
+  # A path holding terminal escapes is quoted with them made visible.
+  check path_escapes 1 "^cfinspect: reading '\\\\x1B\[5mblink\\\\xC2\\\\x9B\.json': cannot open: no such file" -- "$CFINSPECT" $'\e[5mblink\xc2\x9b.json'
   check graph_directory 1 "^cfinspect: reading 'dir.json': cannot open: is a directory, not a regular file" -- "$CFINSPECT" dir.json
   check graph_device 1 "^cfinspect: reading '/dev/zero': cannot open: is a character device, not a regular file" -- "$CFINSPECT" /dev/zero
   python3 -c "import sys; sys.stdout.buffer.write(b'\xa1\x61x' + b'\x81' * 100000 + b'\xf6')" >deep.cbor
@@ -209,6 +212,7 @@ fi
 if [[ "$group" == cfreplay ]]; then
   run=("$CFREPLAY" --graph "$G" --trajectory "$P")
   check graph_fifo 1 "^cfreplay: reading 'fifo.json': cannot open: is a FIFO \(named pipe\), not a regular file" -- "$CFREPLAY" --graph fifo.json --trajectory "$P" -o o.csv
+  check path_escapes 1 "^cfreplay: reading '\\\\x1B\]0;title\\\\x07g\.json': cannot open: no such file" -- "$CFREPLAY" --graph $'\e]0;title\ag.json' --trajectory "$P" -o o.csv
   check trajectory_fifo 1 "^cfreplay: fifo.csv: cannot open the trajectory: is a FIFO \(named pipe\), not a regular file" -- "$CFREPLAY" --graph "$G" --trajectory fifo.csv -o o.csv
   check trajectory_directory 1 "^cfreplay: dir.csv: cannot open the trajectory: is a directory, not a regular file" -- "$CFREPLAY" --graph "$G" --trajectory dir.csv -o o.csv
   head -c 3000 /dev/urandom >garbage.csv

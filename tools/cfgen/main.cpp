@@ -12,6 +12,7 @@
 #endif
 #include "cli_checks.hpp"
 #include "mesh/model_loader.hpp"
+#include "safe_stderr.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -113,6 +114,7 @@ void add_run_options(CLI::App& app, cf::tools::GenerateArgs& gen, std::string& s
 }  // namespace
 
 int main(int argc, char** argv) {
+  const cf::cli::TerminalSafeStderr safe_stderr;  // paths as typed cannot drive the terminal
   CLI::App app{
       "cfgen: contact-formation graph generator.\n"
       "  cfgen A_MODEL B_MODEL -o GRAPH.json   write the CF graph of A (moving) against B (fixed)\n"

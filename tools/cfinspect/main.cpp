@@ -8,6 +8,7 @@
 
 #include "cli_checks.hpp"  // finite_range, version_text
 #include "html.hpp"        // --html: the browser viewer
+#include "safe_stderr.hpp"
 
 #include <CLI/CLI.hpp>
 #include <boost/graph/adjacency_list.hpp>
@@ -492,6 +493,7 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const cf::cli::TerminalSafeStderr safe_stderr;  // paths as typed cannot drive the terminal
   try {
     return run(argc, argv);
   } catch (const Failure& f) {

@@ -10,6 +10,7 @@
 
 #include <cf/file_io.hpp>
 #include "cli_checks.hpp"
+#include "safe_stderr.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -64,6 +65,7 @@ std::string apply_choices(const Choices& c, cf::Params& P) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const cf::cli::TerminalSafeStderr safe_stderr;  // paths as typed cannot drive the terminal
   using cf::cli::finite_range;
   CLI::App app{
       "cfreplay: replays a trajectory of A against the CF graph and writes the haptic force and\n"
