@@ -141,6 +141,11 @@ if [[ "$group" == cfgen ]]; then
   check out_is_input 1 "writing graph 'a.off': is an input of this run; refusing to overwrite it" -- "$CFGEN" a.off "$M/l_block.off" -o a.off
   ln -s a.off link_to_a.off
   check out_links_to_input 1 "writing graph 'link_to_a.off': is the same file as the input 'a.off'" -- "$CFGEN" a.off "$M/l_block.off" -o link_to_a.off
+  mkdir -p ck_dir
+  check out_in_checkpoint 1 "^cfgen: writing graph 'ck_dir/checkpoint.json': is inside the checkpoint directory 'ck_dir'" -- "$CFGEN" a.off "$M/l_block.off" --checkpoint ck_dir -o ck_dir/checkpoint.json
+  long_name=$(printf 'g%.0s' {1..250}).json
+  check out_longest_name 0 "" -- "$CFGEN" a.off "$M/l_block.off" -q --max-pcs 1 -o "$long_name"
+  rm -f "$long_name"
   check out_no_directory 1 "writing graph 'no/such/g.json': the directory 'no/such' does not exist" -- "$CFGEN" a.off "$M/l_block.off" -o no/such/g.json
   if cmp -s a.off "$M/cube.off" && [[ -p out_fifo.json && -d dir.json ]]; then report out_inputs_intact 1 ""; else report out_inputs_intact 0 "an input or special file was changed"; fi
   absent out_nothing_left new no
@@ -195,6 +200,8 @@ EOF
   check dot_fifo 1 "^cfinspect: writing DOT 'out_fifo.json': is a FIFO" -- "$CFINSPECT" g.json --dot out_fifo.json
   check dot_directory 1 "^cfinspect: writing DOT 'dir.json': is a directory" -- "$CFINSPECT" g.json --dot dir.json
   check dot_over_input 1 "^cfinspect: writing DOT 'g.json': is an input of this run; refusing to overwrite it" -- "$CFINSPECT" g.json --dot g.json
+  check dot_same_as_html 1 "^cfinspect: writing HTML './new.dot': is also the output 'new.dot'; each output needs its own file" -- "$CFINSPECT" g.json --dot new.dot --html ./new.dot
+  absent dot_same_as_html_nothing_written new.dot
   if cmp -s g.json "$G"; then report dot_input_intact 1 ""; else report dot_input_intact 0 "g.json changed"; fi
   echo old >target.dot
   ln -s target.dot link.dot
@@ -249,6 +256,8 @@ if [[ "$group" == cfreplay ]]; then
   check out_is_trajectory 1 "^cfreplay: writing 'in.csv': is an input of this run; refusing to overwrite it" -- "$CFREPLAY" --graph "$G" --trajectory in.csv -o in.csv
   check plot_is_trajectory 1 "^cfreplay: writing 'in.csv': is an input of this run" -- "$CFREPLAY" --graph "$G" --trajectory in.csv -o o.csv --plot in.csv
   check out_same_as_plot 1 "^cfreplay: writing 'same.csv': is also the output 'same.csv'" -- "$CFREPLAY" --graph "$G" --trajectory in.csv -o same.csv --plot same.csv
+  check out_same_as_plot_dot_slash 1 "^cfreplay: writing './new_same.csv': is also the output 'new_same.csv'; each output needs its own file" -- "$CFREPLAY" --graph "$G" --trajectory in.csv -o new_same.csv --plot ./new_same.csv
+  absent out_same_as_plot_nothing_written new_same.csv
   check plot_no_directory 1 "^cfreplay: writing 'no/such/p.svg': the directory 'no/such' does not exist" -- "$CFREPLAY" --graph "$G" --trajectory in.csv -o o.csv --plot no/such/p.svg
   if cmp -s in.csv "$P"; then report out_input_intact 1 ""; else report out_input_intact 0 "in.csv changed"; fi
   absent cfreplay_no_csv_left o.csv same.csv

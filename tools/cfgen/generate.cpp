@@ -212,6 +212,16 @@ RunPlan plan_run(const gen::WitnessSearch& ws, const gen::EnumerateOptions& opt,
   return plan;
 }
 
+// The graph is not written into the checkpoint directory, which a run reads, rewrites and
+// removes on success (`--checkpoint ck -o ck/checkpoint.json` wrote the graph over it).
+void check_outside_checkpoint(const std::string& out_path, const std::string& checkpoint_dir) {
+  if (checkpoint_dir.empty()) return;
+  const std::string dir = canonical_path(checkpoint_dir), out = canonical_path(out_path);
+  if (out.size() > dir.size() && out.compare(0, dir.size(), dir) == 0 && out[dir.size()] == '/')
+    throw Error("writing graph '" + out_path + "': is inside the checkpoint directory '" +
+                checkpoint_dir + "', which the run rewrites and removes; write it elsewhere");
+}
+
 }  // namespace
 
 int run_generate(const GenerateArgs& args) {
@@ -222,6 +232,7 @@ int run_generate(const GenerateArgs& args) {
   // Of K shards, shard 0 writes the graph.
   const bool writes = !args.estimate && args.shard.index == 0;
   if (writes) check_output_path(args.out_path, inputs, "writing graph");
+  if (writes) check_outside_checkpoint(args.out_path, args.checkpoint_dir);
   const MeasuredModel ma = load_measured_model(args.a_path, args.load_a);
   const MeasuredModel mb = load_measured_model(args.b_path, args.load_b);
   const Polyhedron& A = ma.model;

@@ -375,7 +375,7 @@ int run(int argc, char** argv) {
   std::vector<std::string> html_inputs{path};  // never written over
   for (const std::string* p : {&replay_path, &trajectory_path})
     if (!p->empty()) html_inputs.push_back(*p);
-  if (!html_path.empty()) cf::check_output_path(html_path, html_inputs, "writing HTML");
+  if (!html_path.empty()) cf::check_output_path(html_path, html_inputs, "writing HTML", {dot_path});
   cf::GraphLoadOptions options;
   options.full_schema_check = !fast;
   const cf::CfGraph g = cf::CfGraph::load(path, options);

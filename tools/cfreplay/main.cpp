@@ -166,7 +166,7 @@ int main(int argc, char** argv) {
     // Output paths first, so that a bad one fails before the work (docs/spec.md, section 5b).
     const std::vector<std::string> inputs{graph_path, traj_path};
     cf::check_output_path(out_path, inputs, "writing");
-    if (!plot_path.empty()) cf::check_output_path(plot_path, inputs, "writing");
+    if (!plot_path.empty()) cf::check_output_path(plot_path, inputs, "writing", {out_path});
     const cf::CfGraph graph = cf::CfGraph::load(graph_path);
     for (const auto& [m, which] :
          {std::pair{&graph.model_a(), "A"}, std::pair{&graph.model_b(), "B"}})

@@ -36,13 +36,19 @@ struct OutputFile {
   std::string bytes;
 };
 
-/// Checks that `path` can be an output of a run that reads `inputs`: not empty, not naming a
-/// directory, not a device, FIFO, socket or directory (after following symlinks), not the
-/// same file as an input. Call it before the work, so that a bad path fails fast; the
-/// writers below check again.
+/// Checks that `path` can be an output of a run that reads `inputs` and writes `outputs`
+/// besides it: not empty, not naming a directory, not a device, FIFO, socket or directory
+/// (after following symlinks), not the same file as an input or as another output (also
+/// when none exists yet: "o.csv" and "./o.csv" are one file), its name no longer than the
+/// file system takes. Call it before the work, so that a bad path fails fast; the writers
+/// below check again.
 /// @throws cf::Error "<what> '<path>': <reason>".
 void check_output_path(const std::string& path, const std::vector<std::string>& inputs,
-                       const char* what);
+                       const char* what, const std::vector<std::string>& outputs = {});
+
+/// The absolute path `path` names, symlinks and "." / ".." resolved as far as the path
+/// exists, the rest normalised: equal for two paths that name one file, existing or not.
+std::string canonical_path(const std::string& path);
 
 /// Writes every file whole, or none of them: all the temporary files are written and synced
 /// first, then renamed into place (symlinks followed). Two outputs naming the same file are

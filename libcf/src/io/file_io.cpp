@@ -6,11 +6,17 @@
 
 #include "streamed_output.hpp"
 
+#include <algorithm>
+#include <array>
+#include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <iterator>
+#include <mutex>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -64,6 +70,18 @@ std::string resolve_links(const std::string& path, std::string& why) {
   return p;
 }
 
+/// "<target>.tmp-XXXXXX" for mkstemp, the target's name cut short when the whole would be
+/// longer than the file system's names (a 250-byte output name is legal; its temporary too).
+std::string temp_name(const std::string& target) {
+  static constexpr char kSuffix[] = ".tmp-XXXXXX";
+  const std::size_t slash = target.find_last_of('/');
+  const std::size_t name_start = slash == std::string::npos ? 0 : slash + 1;
+  const long name_max = ::pathconf(dir_of(target).c_str(), _PC_NAME_MAX);
+  const std::size_t room =
+      name_max > 0 ? static_cast<std::size_t>(name_max) - (sizeof kSuffix - 1) : target.size();
+  return target.substr(0, name_start + std::min(target.size() - name_start, room)) + kSuffix;
+}
+
 [[noreturn]] void refuse(const char* what, const std::string& path, const std::string& why) {
   throw Error(std::string(what) + " '" + path + "': " + why);
 }
@@ -98,16 +116,102 @@ std::string checked_target(const std::string& path, const std::vector<std::strin
                (errno == ENOENT ? std::string("does not exist")
                                 : "cannot be checked: " + errno_text(errno)));
   if (!S_ISDIR(sd.st_mode)) refuse(what, path, "'" + dir + "' is not a directory");
+  const long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  const std::size_t name_len = target.size() - target.find_last_of('/') - 1;
+  if (name_max > 0 && name_len > static_cast<std::size_t>(name_max))
+    refuse(what, path,
+           "the file name is " + std::to_string(name_len) + " bytes, longer than the " +
+               std::to_string(name_max) + " the file system takes");
   if (::access(dir.c_str(), W_OK) != 0)
     refuse(what, path, "the directory '" + dir + "' is not writable: " + errno_text(errno));
   return target;
 }
 
-std::string canonical_key(const std::string& target) {
-  std::error_code ec;
-  const std::filesystem::path p = std::filesystem::weakly_canonical(target, ec);
-  return ec ? target : p.string();
+// ---- Temporary files removed when a signal ends the process mid-write ----
+//
+// While outputs are written, SIGINT, SIGTERM and SIGHUP, where they would end the process
+// (their disposition is the default), first remove the temporary files being written, then
+// end it as the default would. A signal the program handles itself (cfgen's stop between
+// tasks, Python's KeyboardInterrupt) or ignores is left alone: the write then finishes, or
+// fails and cleans up, as usual.
+
+constexpr int kCleanupSignals[] = {SIGINT, SIGTERM, SIGHUP};
+constexpr int kTempSlots = 32;
+char g_temp_path[kTempSlots][4096];
+std::atomic<bool> g_temp_used[kTempSlots];
+
+extern "C" void remove_temps_and_die(int sig) {
+  for (int i = 0; i < kTempSlots; ++i)
+    if (g_temp_used[i].load()) ::unlink(g_temp_path[i]);
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
 }
+
+/// Installs the handler for the signals left at their default while some write is in
+/// progress (the first one in), and puts the defaults back after the last one.
+class SignalCleanup {
+ public:
+  SignalCleanup() {
+    const std::lock_guard<std::mutex> lock(mutex());
+    if (active()++ > 0) return;
+    for (std::size_t k = 0; k < std::size(kCleanupSignals); ++k) {
+      struct sigaction old {};
+      installed()[k] = sigaction(kCleanupSignals[k], nullptr, &old) == 0 &&
+                       !(old.sa_flags & SA_SIGINFO) && old.sa_handler == SIG_DFL;
+      if (!installed()[k]) continue;
+      struct sigaction sa {};
+      sa.sa_handler = remove_temps_and_die;
+      sigemptyset(&sa.sa_mask);
+      sigaction(kCleanupSignals[k], &sa, nullptr);
+    }
+  }
+  ~SignalCleanup() {
+    const std::lock_guard<std::mutex> lock(mutex());
+    if (--active() > 0) return;
+    for (std::size_t k = 0; k < std::size(kCleanupSignals); ++k)
+      if (installed()[k]) std::signal(kCleanupSignals[k], SIG_DFL);
+  }
+  SignalCleanup(const SignalCleanup&) = delete;
+  SignalCleanup& operator=(const SignalCleanup&) = delete;
+
+  /// Registers a temporary file (its slot, or -1 when every slot is taken or the path is
+  /// too long: that file is then only removed by the usual paths).
+  static int add(const std::string& path) {
+    if (path.size() >= sizeof g_temp_path[0]) return -1;
+    for (int i = 0; i < kTempSlots; ++i) {
+      bool expected = false;
+      if (!g_temp_used[i].load() && claimed()[i].compare_exchange_strong(expected, true)) {
+        std::memcpy(g_temp_path[i], path.c_str(), path.size() + 1);
+        g_temp_used[i].store(true);
+        return i;
+      }
+    }
+    return -1;
+  }
+  static void remove(int slot) {
+    if (slot < 0) return;
+    g_temp_used[slot].store(false);
+    claimed()[slot].store(false);
+  }
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  static int& active() {
+    static int n = 0;
+    return n;
+  }
+  static std::array<bool, std::size(kCleanupSignals)>& installed() {
+    static std::array<bool, std::size(kCleanupSignals)> on{};
+    return on;
+  }
+  static std::array<std::atomic<bool>, kTempSlots>& claimed() {
+    static std::array<std::atomic<bool>, kTempSlots> c{};
+    return c;
+  }
+};
 
 }  // namespace
 
@@ -171,8 +275,21 @@ bool read_input_file(const std::string& path, std::string& bytes, std::string& w
 }
 
 void check_output_path(const std::string& path, const std::vector<std::string>& inputs,
-                       const char* what) {
-  checked_target(path, inputs, what);
+                       const char* what, const std::vector<std::string>& outputs) {
+  const std::string key = canonical_path(checked_target(path, inputs, what));
+  for (const std::string& other : outputs) {
+    std::string why;
+    if (!other.empty() && canonical_path(resolve_links(other, why)) == key)
+      refuse(what, path, "is also the output '" + other + "'; each output needs its own file");
+  }
+}
+
+std::string canonical_path(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path abs = std::filesystem::absolute(path, ec);
+  if (ec) return path;
+  const std::filesystem::path p = std::filesystem::weakly_canonical(abs, ec);
+  return (ec ? abs : p).lexically_normal().string();
 }
 
 void write_outputs(const std::vector<OutputFile>& files, const std::vector<std::string>& inputs,
@@ -191,21 +308,30 @@ void write_streamed_outputs(const std::vector<StreamedOutput>& files,
   std::vector<std::string> targets, keys;
   for (const StreamedOutput& f : files) {
     targets.push_back(checked_target(f.path, inputs, what));
-    keys.push_back(canonical_key(targets.back()));
+    keys.push_back(canonical_path(targets.back()));
     for (std::size_t k = 0; k + 1 < keys.size(); ++k)
       if (keys[k] == keys.back())
         refuse(what, f.path,
                "is also the output '" + files[k].path + "'; each output needs its own file");
   }
   std::vector<std::string> temps;
+  std::vector<int> slots;
+  const SignalCleanup cleanup;
   auto discard = [&temps] {
     for (const std::string& t : temps) ::unlink(t.c_str());
   };
+  // Slots free again when this function returns, whichever way.
+  struct Release {
+    std::vector<int>& slots;
+    ~Release() {
+      for (int k : slots) SignalCleanup::remove(k);
+    }
+  } release{slots};
   const mode_t mask = ::umask(0);
   ::umask(mask);
   for (std::size_t i = 0; i < files.size(); ++i) {
     const std::string& target = targets[i];
-    std::string tmp = target + ".tmp-XXXXXX";
+    std::string tmp = temp_name(target);
     const int fd = ::mkstemp(tmp.data());
     if (fd < 0) {
       const int e = errno;
@@ -214,6 +340,7 @@ void write_streamed_outputs(const std::vector<StreamedOutput>& files,
              "cannot create a temporary file in '" + dir_of(target) + "': " + errno_text(e));
     }
     temps.push_back(tmp);
+    slots.push_back(SignalCleanup::add(tmp));
     int err = 0;
     // After a failed write the rest of the bytes are dropped; the error is reported below.
     const ByteSink sink = [fd, &err](const char* data, std::size_t size) {
