@@ -13,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 
+#include <locale.h>
 #include <unistd.h>
 
 namespace cf::replay {
@@ -41,6 +42,26 @@ std::vector<std::string> split(const std::string& line) {
   return out;
 }
 
+// The "C" numeric locale: numbers are read and written with a '.' whatever locale the
+// process runs in (in Python, locale.setlocale(LC_ALL, '') under de_DE made the CSV's
+// numbers '0,199000', their commas read as column separators).
+locale_t c_numeric() {
+  static const locale_t c = newlocale(LC_NUMERIC_MASK, "C", static_cast<locale_t>(nullptr));
+  return c;
+}
+
+// This thread formats in the C numeric locale while it lives.
+class CNumeric {
+ public:
+  CNumeric() : old_(uselocale(c_numeric())) {}
+  ~CNumeric() { uselocale(old_); }
+  CNumeric(const CNumeric&) = delete;
+  CNumeric& operator=(const CNumeric&) = delete;
+
+ private:
+  locale_t old_;
+};
+
 [[noreturn]] void fail(const std::string& source, int line, const std::string& why) {
   throw Error(source + ":" + std::to_string(line) + ": " + why);
 }
@@ -49,7 +70,7 @@ double number(const std::string& field, const char* column, const std::string& s
   if (field.empty()) fail(source, line, std::string("column '") + column + "' is empty");
   errno = 0;
   char* end = nullptr;
-  const double v = std::strtod(field.c_str(), &end);
+  const double v = strtod_l(field.c_str(), &end, c_numeric());
   if (end != field.c_str() + field.size() || errno == ERANGE || !std::isfinite(v))
     fail(source, line,
          std::string("column '") + column + "' is not a finite number: '" + printable(field) + "'");
@@ -95,9 +116,11 @@ std::vector<Sample> parse_trajectory(const std::string& text, const std::string&
     smp.t = v[0];
     smp.pose.R_BA = q.toRotationMatrix();
     smp.pose.t_BA = Vec3(v[1], v[2], v[3]);
+    smp.q = {v[4], v[5], v[6], v[7]};
     smp.line = line;
     if (!out.empty() && !(smp.t > out.back().t)) {
       char buf[160];
+      const CNumeric c_numbers;
       std::snprintf(buf, sizeof buf,
                     "time %.9g s does not increase (previous row, line %d: %.9g s)", smp.t,
                     out.back().line, out.back().t);
@@ -126,6 +149,7 @@ const char* output_header() {
 }
 
 std::string format_row(const Row& r) {
+  const CNumeric c_numbers;
   // The proxy's attitude as a unit quaternion with qw >= 0 (one of the two that name it).
   Eigen::Quaterniond q(r.X_WP.R_BA);
   if (q.w() < 0) q.coeffs() = -q.coeffs();
@@ -191,6 +215,7 @@ double nice_step(double range) {
 }  // namespace
 
 std::string svg_plot(const std::vector<Row>& rows, const std::string& title) {
+  const CNumeric c_numbers;
   const double W = 1100, left = 70, right = 20, top = 40, panel_h = 240, gap = 50;
   const double plot_w = W - left - right;
   const double H = top + 2 * panel_h + gap + 50;

@@ -4,6 +4,7 @@
 
 #include <cf/types.hpp>
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -11,9 +12,10 @@ namespace cf::replay {
 
 /// One row of POSES.csv.
 struct Sample {
-  double t = 0;  ///< s
-  Pose pose;
-  int line = 0;  ///< 1-based line in the file, for messages
+  double t = 0;                         ///< s
+  Pose pose;                            ///< its quaternion normalised
+  std::array<double, 4> q{1, 0, 0, 0};  ///< (qw, qx, qy, qz) as read, before normalising
+  int line = 0;                         ///< 1-based line in the file, for messages
 };
 
 /// Largest | |q| - 1 | accepted; such quaternions are normalised. Beyond it a row is not a

@@ -38,7 +38,9 @@ def load_graph(path, validate_schema=True, full_schema_check=False):
     schema validator over every CF and transition (slower). Raises cf.Error naming the file,
     the JSON pointer and the problem.
     """
-    return _cf.load_graph(_os.fspath(path), validate_schema, full_schema_check)
+    g = _cf.load_graph(_os.fspath(path), validate_schema, full_schema_check)
+    g._source_path = _os.fspath(path)  # an input that ReplayResult.to_csv never overwrites
+    return g
 
 
 def load_model(path, units="mm", coplanar_rel_tol=None, check_self_intersection=True, name=""):
@@ -99,7 +101,8 @@ def replay(graph, t, p, q, params=None, **kwargs):
     over every pose (cf::replay::run, the loop of cfreplay); the result is a
     cf.ReplayResult whose arrays are named like cf::HapticResult's fields.
     """
-    return ReplayResult(_cf.replay(graph, t, p, q, params, **kwargs))
+    inputs = [getattr(graph, "_source_path", None)]
+    return ReplayResult(_cf.replay(graph, t, p, q, params, **kwargs), [i for i in inputs if i])
 
 
 def _save(self, path):

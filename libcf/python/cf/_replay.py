@@ -1,6 +1,10 @@
 """The result of cf.replay, and reading cfreplay's trajectory files into arrays."""
 
+import os as _os
+
 import numpy as _np
+
+from . import _cf
 
 
 class ReplayResult:
@@ -31,8 +35,9 @@ class ReplayResult:
                "F_A", "M_A", "F_contact_W", "M_contact_W", "F_gravity_W", "proxy_p", "proxy_q", "conservative",
                "dof", "regimes")
 
-    def __init__(self, d):
+    def __init__(self, d, inputs=()):
         self._rows = d.pop("_rows")
+        self._inputs = list(inputs)
         for name in self._FIELDS:
             v = d[name]
             setattr(self, name, _np.array(v, dtype=str) if isinstance(v, list) else v)
@@ -50,29 +55,19 @@ class ReplayResult:
         return f"<cf.ReplayResult: {n} ticks, {contact} in contact, {len(set(self.cf[self.cf >= 0]))} CFs>"
 
     def to_csv(self, path=None):
-        """cfreplay's CSV (header t,cf,pcs,motion,Fx,...,status,regimes); written to path when given."""
+        """cfreplay's CSV (header t,cf,pcs,motion,Fx,...,status,regimes), '.' decimals in any
+        locale; written to path when given, as cfreplay writes: whole or not at all, never over
+        the graph the result came from, never to a device, FIFO or directory (cf.Error)."""
         text = self._rows.csv()
         if path is not None:
-            with open(path, "w", encoding="utf-8") as f:
-                f.write(text)
+            _cf._write_text(_os.fspath(path), text, self._inputs)
         return text
 
 
 def read_trajectory(path):
     """Reads a cfreplay trajectory CSV (header t,tx,ty,tz,qw,qx,qy,qz; '#' lines and blank lines
-    skipped) into (t (N,), p (N, 3), q (N, 4)) float64 arrays, ready for cf.replay."""
-    rows = []
-    header = None
-    with open(path, encoding="utf-8") as f:
-        for line in f:
-            s = line.strip()
-            if not s or s.startswith("#"):
-                continue
-            if header is None:
-                header = [c.strip() for c in s.split(",")]
-                if header != ["t", "tx", "ty", "tz", "qw", "qx", "qy", "qz"]:
-                    raise ValueError(f"{path}: expected the header 't,tx,ty,tz,qw,qx,qy,qz', found '{s}'")
-                continue
-            rows.append([float(x) for x in s.split(",")])
-    a = _np.array(rows, dtype=float).reshape(-1, 8)
-    return a[:, 0].copy(), a[:, 1:4].copy(), a[:, 4:8].copy()
+    skipped) into (t (N,), p (N, 3), q (N, 4)) float64 arrays, ready for cf.replay. The reader
+    is cfreplay's: a FIFO, device or directory is refused without blocking, and so is a row
+    that is not a pose (a field not a finite number, a quaternion off unit norm, a time that
+    does not increase), with cf.Error naming the file and line."""
+    return _cf._read_trajectory(_os.fspath(path))

@@ -293,7 +293,7 @@ void add_graph_transitions(py::class_<cf::CfGraph>& cls) {
 void bind_cf_graph(py::module_& m) {
   auto cls =
       py::class_<cf::CfGraph>(
-          m, "CfGraph",
+          m, "CfGraph", py::dynamic_attr(),
           "The CF graph of a model pair (cf::CfGraph): CFs, transitions and the two models. "
           "Immutable; load it with cf.load_graph or make it with cf.generate.")
           .def_property_readonly("model_a", &cf::CfGraph::model_a,

@@ -6,6 +6,8 @@
 #include "replay_io.hpp"   // cfreplay_core: Sample, Row, format_row, output_header
 #include "replay_run.hpp"  // cfreplay_core: run
 
+#include <cf/file_io.hpp>
+
 #include <cf/renderer.hpp>
 
 #include <Eigen/Geometry>
@@ -325,6 +327,38 @@ void bind_render(py::module_& m) {
             return text;
           },
           "The rows as cfreplay writes them (header first).");
+
+  m.def(
+      "_read_trajectory",
+      [](const std::string& path) {
+        std::vector<cf::replay::Sample> samples;
+        {
+          py::gil_scoped_release release;
+          samples = cf::replay::read_trajectory(path);
+        }
+        const auto n = static_cast<py::ssize_t>(samples.size());
+        py::array_t<double> t(n), p({n, py::ssize_t{3}}), q({n, py::ssize_t{4}});
+        auto tt = t.mutable_unchecked<1>();
+        auto pp = p.mutable_unchecked<2>();
+        auto qq = q.mutable_unchecked<2>();
+        for (py::ssize_t i = 0; i < n; ++i) {
+          const cf::replay::Sample& s = samples[static_cast<std::size_t>(i)];
+          tt(i) = s.t;
+          for (py::ssize_t k = 0; k < 3; ++k) pp(i, k) = s.pose.t_BA[k];
+          for (py::ssize_t k = 0; k < 4; ++k) qq(i, k) = s.q[static_cast<std::size_t>(k)];
+        }
+        return py::make_tuple(t, p, q);
+      },
+      py::arg("path"),
+      "cfreplay's trajectory reader (cf::replay::read_trajectory): (t, p, q) arrays, q as read.");
+  m.def(
+      "_write_text",
+      [](const std::string& path, const std::string& text, const std::vector<std::string>& inputs) {
+        py::gil_scoped_release release;
+        cf::write_outputs({{path, text}}, inputs, "writing");
+      },
+      py::arg("path"), py::arg("text"), py::arg("inputs"),
+      "Writes a file whole or not at all, never over one of `inputs` (cf::write_outputs).");
 
   m.def("replay", &replay, py::arg("graph"), py::arg("t"), py::arg("p"), py::arg("q"),
         py::arg("params") = py::none(),
