@@ -138,7 +138,8 @@ std::vector<Sample> parse_trajectory(const std::string& text, const std::string&
 std::vector<Sample> read_trajectory(const std::string& path) {
   // Never blocks on a FIFO; a directory or a device is refused before reading.
   std::string text, why;
-  if (!read_input_file(path, text, why)) throw Error(path + ": cannot open the trajectory: " + why);
+  if (!read_input_file(path, text, why))
+    throw FileError(path + ": cannot open the trajectory: " + why);
   return parse_trajectory(text, path);
 }
 

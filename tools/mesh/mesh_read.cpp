@@ -841,7 +841,8 @@ PolygonSoup parse_polygon_soup(std::string_view bytes, MeshFormat format,
 PolygonSoup read_polygon_soup(const std::string& path) {
   const MeshFormat format = mesh_format_of(path);
   std::string bytes, why;
-  if (!cf::read_input_file(path, bytes, why)) fail(path, "cannot open file: " + why);
+  if (!cf::read_input_file(path, bytes, why))
+    throw cf::FileError("loading '" + path + "': cannot open file: " + why);
   return parse_polygon_soup(bytes, format, path);
 }
 

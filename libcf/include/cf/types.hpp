@@ -55,6 +55,15 @@ class Error : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// An Error about a file as such: it cannot be opened or read (missing, a FIFO, a device, a
+/// directory, too large), or an output cannot be written there (an input of the run, a
+/// special file, no such directory, a failed write). Python raises it as cf.FileError, both
+/// a cf.Error and an OSError.
+class FileError : public Error {
+ public:
+  using Error::Error;
+};
+
 }  // namespace cf
 
 template <class Tag>

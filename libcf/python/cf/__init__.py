@@ -11,21 +11,22 @@ The C++ library libcf and the project's tools, bound with pybind11 (docs/python.
 - ``cf.replay(graph, t, p, q, **params)``: cfreplay's loop over numpy arrays of poses.
 
 Units are mm, N, kg, N mm and s; poses are x_B = R x_A + p with R the unit quaternion
-q = (w, x, y, z). Bad input raises ``cf.Error`` (a ValueError) with libcf's message.
+q = (w, x, y, z). Bad input raises ``cf.Error`` (a ValueError) with libcf's message; a file
+that cannot be read or written as such raises ``cf.FileError``, both a cf.Error and an OSError.
 """
 
 import os as _os
 import tempfile as _tempfile
 
 from . import _cf
-from ._cf import Cf, CfGraph, Error, Params, Pc, Polyhedron, Renderer
+from ._cf import Cf, CfGraph, Error, FileError, Params, Pc, Polyhedron, Renderer
 from ._replay import ReplayResult, read_trajectory
 from ._networkx import to_networkx as _to_networkx
 
 HAVE_TOOLS = _cf.HAVE_TOOLS
 
 __all__ = [
-    "Cf", "CfGraph", "Error", "Params", "Pc", "Polyhedron", "Renderer", "ReplayResult",
+    "Cf", "CfGraph", "Error", "FileError", "Params", "Pc", "Polyhedron", "Renderer", "ReplayResult",
     "generate", "load_graph", "load_model", "read_trajectory", "replay", "HAVE_TOOLS",
 ]
 

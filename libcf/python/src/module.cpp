@@ -304,6 +304,26 @@ PYBIND11_MODULE(_cf, m) {
   py::register_exception<cf::Error>(m, "Error", PyExc_ValueError).doc() =
       "Bad input (a file, a model, a graph, a trajectory, a parameter): a ValueError whose message "
       "is libcf's.";
+  // cf.FileError: a cf.Error and an OSError, for a file that cannot be read or written as such
+  // (cf::FileError). Registered after cf.Error, so that its translator is tried first.
+  static PyObject* file_error = nullptr;
+  {
+    const py::tuple bases = py::make_tuple(m.attr("Error"), py::handle(PyExc_OSError));
+    file_error = PyErr_NewExceptionWithDoc(
+        "cf._cf.FileError",
+        "A file that cannot be read or written as such (missing, a FIFO, a device, an input of "
+        "the run, no such directory): both a cf.Error and an OSError, with the tools' message.",
+        bases.ptr(), nullptr);
+    if (file_error == nullptr) throw py::error_already_set();
+    m.attr("FileError") = py::handle(file_error);
+  }
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const cf::FileError& e) {
+      PyErr_SetString(file_error, e.what());
+    }
+  });
 
   py::class_<cf::Pc>(m, "Pc",
                      "A principal contact: a PC type and the indices of A's and B's elements.")

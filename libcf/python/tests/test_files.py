@@ -25,10 +25,23 @@ def result_and_graph(tmp_path):
     return cf.replay(g, t[:40], p[:40], q[:40]), graph_path
 
 
+def test_file_errors_are_both_cf_errors_and_os_errors(tmp_path):
+    assert issubclass(cf.FileError, cf.Error) and issubclass(cf.FileError, OSError)
+    with pytest.raises(OSError, match=r"^reading '.*missing\.json': cannot open: no such file$"):
+        cf.load_graph(tmp_path / "missing.json")
+    with pytest.raises(cf.FileError):
+        cf.read_trajectory(tmp_path / "missing.csv")
+    bad = tmp_path / "bad.json"
+    bad.write_text("{")
+    with pytest.raises(cf.Error) as e:  # the file opens: its content is the problem
+        cf.load_graph(bad)
+    assert not isinstance(e.value, OSError)
+
+
 def test_to_csv_never_writes_over_the_graph(result_and_graph):
     r, graph_path = result_and_graph
     before = graph_path.read_bytes()
-    with pytest.raises(cf.Error, match=r"^writing '.*g\.json': is an input of this run; refusing to overwrite it$"):
+    with pytest.raises(cf.FileError, match=r"^writing '.*g\.json': is an input of this run; refusing to overwrite it$"):
         r.to_csv(graph_path)
     assert graph_path.read_bytes() == before
 

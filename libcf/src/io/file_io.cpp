@@ -83,7 +83,7 @@ std::string temp_name(const std::string& target) {
 }
 
 [[noreturn]] void refuse(const char* what, const std::string& path, const std::string& why) {
-  throw Error(std::string(what) + " '" + path + "': " + why);
+  throw FileError(std::string(what) + " '" + path + "': " + why);
 }
 
 /// The file a write to `path` would replace, after the checks of check_output_path.

@@ -396,7 +396,7 @@ CfGraph CfGraph::load(const std::string& path, const GraphLoadOptions& options) 
   // Never blocks on a FIFO; a directory, a device or a FIFO is refused before reading.
   std::string bytes, why;
   if (!read_input_file(path, bytes, why))
-    throw Error("reading '" + path + "': cannot open: " + why);
+    throw FileError("reading '" + path + "': cannot open: " + why);
   CfGraph g;
   g.impl_ = detail::read_graph(bytes, path, is_cbor_path(path), options);
   return g;
