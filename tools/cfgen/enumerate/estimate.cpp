@@ -40,15 +40,17 @@ constexpr std::size_t kExploresPerSample = 2;
 constexpr std::size_t kGrowRounds = 8;
 
 // Constants that turn the levels into a run, fitted (least worst ratio) on the bundled pairs,
-// the n-gon pegs and holes n = 3..12 and CGAL's star, cross and U (star against cross and
-// against itself, cross against U) at one thread (scripts/estimate-errors.sh);
-// docs/performance.md ("Estimates") gives the errors that remain.
+// the n-gon pegs and holes n = 3..12 and CGAL's star, cross and U and three.js's emerald
+// (star against cross and against itself, cross against U, emerald against itself) at one thread
+// (scripts/estimate-errors.sh); docs/performance.md ("Estimates") gives the errors that remain.
 //
 // CFs in the graph per CF the levels find, and per candidate they fail: the rounds after the
 // levels (motion, neighbours, the images of sets found there) find CFs among the sets the
-// levels' searches missed, more where more failed (a peg tilted across a hole's rim).
-constexpr double kCfsPerLevelCf = 1.05;
-constexpr double kCfsPerFailed = 0.24;
+// levels' searches missed, more where more failed (a peg tilted across a hole's rim), but
+// few of a pair whose failed sets are most of its candidates (the emerald against itself:
+// 2.2 million failed, 168,000 CFs found after the levels).
+constexpr double kCfsPerLevelCf = 1.48;
+constexpr double kCfsPerFailed = 0.038;
 // CPU time after the levels' searches: the closure by motion, per witness it explores (up to
 // kWitnessesPerOrbit an orbit found), as long as the sampled exploration (explore_seconds);
 // per CF the levels find (its images verified, its changes screened, its record and
@@ -72,10 +74,11 @@ constexpr double kSerial = 0.25;
 constexpr double kTransitionsPerCf = 18;
 // Resident bytes at the run's peak above what the models take: per CF (records, the search's
 // sets, the transitions built and sorted), and per member of a failed orbit a neighbour round
-// may search (the rounds' memory of what they screened and searched: CGAL's cross and U, the
-// one pair measured with many, peaked at 1.3-1.8 GB for 420,843 CFs, docs/performance.md).
-constexpr double kBytesPerCf = 1550;
-constexpr double kBytesPerFailedTry = 1000;
+// may search (the rounds' memory of what they screened and searched: CGAL's cross and U
+// peaked at 1.3-1.8 GB for 420,843 CFs, the emerald against itself at 2.6 GB for 537,872,
+// with 0.4 and 2.2 million such members predicted; docs/performance.md).
+constexpr double kBytesPerCf = 1650;
+constexpr double kBytesPerFailedTry = 1300;
 
 // k indices spread evenly over [0, n).
 std::vector<std::size_t> spread(std::size_t n, std::size_t k) {
