@@ -429,6 +429,20 @@ TEST_CASE("from_parts rejects empty, repeated and coplanar PC sets", "[graph]") 
                     Catch::Contains("share the contact plane of B's face 4"));
   CHECK_THROWS_WITH(build({rec({pc(PcType::kFF, 2, 4), pc(PcType::kFV, 2, 3)})}),
                     Catch::Contains("share the contact plane of A's face 2"));
+  // An edge of A's face 2 on an edge of B's face 4 is dominated by the faces' own f-f.
+  const int ea = static_cast<int>(cf_test::box(10, 10, 10).faces()[2].edges[0].index());
+  const int eb = static_cast<int>(cf_test::l_block().faces()[4].edges[0].index());
+  CHECK_THROWS_WITH(
+      build({rec({pc(PcType::kFF, 2, 4), pc(PcType::kEE, ea, eb)})}),
+      Catch::Contains("CF 0: PC e-e:" + std::to_string(ea) + ":" + std::to_string(eb) +
+                      " is dominated by its PC f-f:2:4 (both its elements lie in the other's); "
+                      "a CF's PCs are principal"));
+  cf::CfRecord freed = rec({pc(PcType::kVF, 0, 4)});
+  freed.dof = 2;
+  freed.translation_dof = 3;
+  CHECK_THROWS_WITH(build({freed}), Catch::Contains("CF 0: translation_dof = 3 exceeds dof = 2"));
+  freed.translation_dof = 2;
+  CHECK_NOTHROW(build({freed}));
   cf::CfRecord r = rec({pc(PcType::kVF, 0, 4)});
   r.witness.R_BA *= 1.01;  // what from_parts accepts must load back: witnesses are poses
   CHECK_THROWS_WITH(build({r}), Catch::Contains("CF 0: witness R: not a rotation matrix"));
@@ -514,20 +528,20 @@ TEST_CASE("from_parts accepts a change only where PCs are replaced by neighbouri
   const int fb2 = E.left.value() == 4 ? E.right.value() : E.left.value();
   REQUIRE((E.left.value() == 4 || E.right.value() == 4));
   const std::vector<cf::CfRecord> cfs = {
-      rec({pc(PcType::kFF, 2, 4)}),                            // 0
-      rec({pc(PcType::kEF, 0, 4)}),                            // 1: f-f:2:4's edge 0 on the floor
-      rec({pc(PcType::kVF, 0, 4)}),                            // 2: edge 0's end on the floor
-      rec({pc(PcType::kFF, 5, 5)}),                            // 3: the wall
-      rec({pc(PcType::kFF, 2, 4), pc(PcType::kFF, 5, 5)}),     // 4
-      rec({pc(PcType::kEF, 0, 4), pc(PcType::kFF, 5, 5)}),     // 5: 4 with one PC replaced
-      rec({pc(PcType::kVF, 0, 4), pc(PcType::kFF, 5, 5)}),     // 6
-      rec({pc(PcType::kVF, 0, 4), pc(PcType::kEE, 0, eb)}),    // 7: v-f:0:4 and its neighbour e-e
-      rec({pc(PcType::kEF, 0, fb2), pc(PcType::kEE, 0, eb)}),  // 8: e-e's neighbour e-f
+      rec({pc(PcType::kFF, 2, 4)}),                           // 0
+      rec({pc(PcType::kEF, 0, 4)}),                           // 1: f-f:2:4's edge 0 on the floor
+      rec({pc(PcType::kVF, 0, 4)}),                           // 2: edge 0's end on the floor
+      rec({pc(PcType::kFF, 5, 5)}),                           // 3: the wall
+      rec({pc(PcType::kFF, 2, 4), pc(PcType::kFF, 5, 5)}),    // 4
+      rec({pc(PcType::kEF, 0, 4), pc(PcType::kFF, 5, 5)}),    // 5: 4 with one PC replaced
+      rec({pc(PcType::kVF, 0, 4), pc(PcType::kFF, 5, 5)}),    // 6
+      rec({pc(PcType::kVF, 0, 4), pc(PcType::kEE, 0, eb)}),   // 7: v-f:0:4 and its neighbour e-e
+      rec({pc(PcType::kEF, 0, fb2), pc(PcType::kVF, 0, 4)}),  // 8: 7's e-e as its neighbour e-f
   };
   using K = TransitionKind;
-  // One PC replaced, both ways; one of two replaced; and a chain: v-f -> e-e (already held)
-  // while e-e -> e-f. cfgen builds that last one too (each PC kept or replaced by one of its
-  // neighbours, one for one), though e-f:0:fb2 is no neighbour of v-f:0:4.
+  // One PC replaced, both ways; one of two replaced; and 7 <-> 8: v-f:0:4 kept while e-e:0:eb
+  // becomes its neighbour e-f:0:fb2 (each PC kept or replaced by one of its neighbours, one for
+  // one). (e-e:0:eb beside e-f:0:fb2 would not be a CF: the e-f dominates it.)
   CHECK_NOTHROW(build(
       cfs, {tr(0, 1, K::kChange), tr(1, 0, K::kChange), tr(1, 2, K::kChange), tr(4, 5, K::kChange),
             tr(5, 6, K::kChange), tr(7, 8, K::kChange), tr(8, 7, K::kChange)}));

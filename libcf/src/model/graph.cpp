@@ -83,6 +83,21 @@ void check_distinct_planes(const PcSet& pcs, std::size_t i, const detail::FaultL
     }
 }
 
+// A CF's PCs are principal (none dominated by another of its PCs: docs/spec.md, section 4) and
+// its freedoms ordered (translation_dof at most dof) when the record has them.
+void check_principal_and_freedoms(const CfRecord& r, const Polyhedron& A, const Polyhedron& B,
+                                  std::size_t i, const detail::FaultLocator& where) {
+  for (int p = 0; p < r.pcs.size(); ++p)
+    for (int q = 0; q < r.pcs.size(); ++q)
+      if (p != q && dominates(A, B, r.pcs[q], r.pcs[p]))
+        where.cf_fault(i, "PC " + to_string(r.pcs[p]) + " is dominated by its PC " +
+                              to_string(r.pcs[q]) +
+                              " (both its elements lie in the other's); a CF's PCs are principal");
+  if (r.dof >= 0 && r.translation_dof > r.dof)
+    where.cf_fault(i, "translation_dof = " + std::to_string(r.translation_dof) +
+                          " exceeds dof = " + std::to_string(r.dof));
+}
+
 // `change` (MT3; docs/spec.md, section 4), as cfgen builds it: the target is the source with each
 // PC kept or replaced by one of its neighbouring PCs, all distinct. So some one-to-one
 // pairing maps every source PC to an equal or a neighbouring target PC (sizes are equal).
@@ -197,6 +212,7 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
     const PcSet& pcs = cfs[i].pcs;
     if (pcs.empty()) where.cf_fault(i, "a CF needs 1 to 3 PCs, this one has none");
     check_distinct_planes(pcs, i, where);
+    check_principal_and_freedoms(cfs[i], a, b, i, where);
     for (const Pc& pc : pcs) held.insert(pc);
     const auto [it, inserted] = index.emplace(pcs, CfId(static_cast<std::int32_t>(i)));
     if (!inserted)
