@@ -79,8 +79,9 @@ Vec3 trail(const Vec3& w0, const Vec3& d, double L) {
   }
   const double travel = (1 - t0) * d.norm();
   const Vec3 u = unit_or_zero(d);
-  const Vec3 across = unit_or_zero(w - u * u.dot(w));
-  const double phi0 = std::atan2((w - u * u.dot(w)).norm(), u.dot(w));
+  const Vec3 w_across = w - u * u.dot(w);  // the stretch's part across the motion
+  const Vec3 across = unit_or_zero(w_across);
+  const double phi0 = std::atan2(w_across.norm(), u.dot(w));
   const double phi1 = 2 * std::atan(std::tan(0.5 * phi0) * std::exp(-travel / L));
   return L * (std::cos(phi1) * u + std::sin(phi1) * across);
 }
