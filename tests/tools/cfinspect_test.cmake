@@ -53,9 +53,20 @@ function(cfinspect_test name mode args expect)
   set_tests_properties(cfinspect:${name} PROPERTIES TIMEOUT 120 LABELS cfinspect)
 endfunction()
 
+# What the witness check says of N CFs: verified by cfgen's verify, or not checked in a build
+# without CGAL (the sanitizer build).
+function(witnesses_checked out n)
+  if(CF_WITH_CGAL)
+    set(${out} "; ${n} witnesses verified" PARENT_SCOPE)
+  else()
+    set(${out} "; witnesses not checked: built without CGAL" PARENT_SCOPE)
+  endif()
+endfunction()
+
 # Summary and queries on the hand-made cube / L-block graph (see tests/libcf/graph_test.cpp).
+witnesses_checked(_w5 5)
 cfinspect_test(summary ok "${_g}/box_l.json"
-  "valid cf-graph v1 \\(full schema check\\).*model A 'cube': 8 vertices, 12 edges \\(0 reflex\\), 6 faces.*model B 'L-block': 12 vertices, 18 edges \\(1 reflex\\), 8 faces.*CFs: 5.*by number of PCs: 1: 4, 2: 1, 3: 0.*f-f 4 \\(3\\), e-f 1 \\(1\\), f-e 0 \\(0\\), v-f 1 \\(1\\).*transitions: 8 \\(gain 2, lose 2, change 4\\), 0 without their reverse.*out-degree: min 1, mean 1.60, max 2.*connected components: 1 \\(largest 5 CFs, 0 isolated CFs\\)")
+  "valid cf-graph v1 \\(full schema check${_w5}\\).*model A 'cube': 8 vertices, 12 edges \\(0 reflex\\), 6 faces.*model B 'L-block': 12 vertices, 18 edges \\(1 reflex\\), 8 faces.*CFs: 5.*by number of PCs: 1: 4, 2: 1, 3: 0.*f-f 4 \\(3\\), e-f 1 \\(1\\), f-e 0 \\(0\\), v-f 1 \\(1\\).*transitions: 8 \\(gain 2, lose 2, change 4\\), 0 without their reverse.*out-degree: min 1, mean 1.60, max 2.*connected components: 1 \\(largest 5 CFs, 0 isolated CFs\\)")
 cfinspect_test(summary_sorted_keys ok "${_g}/box_l_sorted.json" "CFs: 5")
 cfinspect_test(summary_json ok "${_g}/box_l.json --json"
   "\"valid\": true.*\"count\": 5.*\"2\": 1.*\"by_kind\": {[^}]*\"gain\": 2,[^}]*\"change\": 4.*\"components\": {[^}]*\"count\": 1")
@@ -75,7 +86,16 @@ cfinspect_test(dot ok "${_g}/box_l.json --dot ${_out}/box_l.dot" "wrote .*box_l.
   -DFILE_OUT=${_out}/box_l.dot
   "-DFILE_EXPECT=^digraph G {.*2\\[label=\"2: f-f:2:4;f-f:5:5\"\\];.*0->2 \\[label=\"gain\", style=solid\\];.*2->0 \\[label=\"lose\", style=dashed\\];.*3->4 \\[label=\"change\", style=dotted\\];")
 cfinspect_test(print_schema ok "--print-schema" "draft-07" -DSAME_AS=${PROJECT_SOURCE_DIR}/schemas/cf-graph.schema.json)
-cfinspect_test(help ok "--help" "--holding.*--neighbours.*--dot.*--pose.*--json")
+cfinspect_test(help ok "--help" "--holding.*--neighbours.*--dot.*--pose.*--json.*--verify")
+cfinspect_test(summary_fast ok "${_g}/box_l.json --fast" "valid cf-graph v1 \\(schema check of the skeleton\\)")
+if(CF_WITH_CGAL)
+  cfinspect_test(summary_fast_verify ok "${_g}/box_l.json --fast --verify -j 1"
+    "valid cf-graph v1 \\(schema check of the skeleton; 5 witnesses verified\\)")
+  cfinspect_test(summary_json_witnesses ok "${_g}/box_l.json --json" "\"witnesses_verified\": 5")
+else()
+  cfinspect_test(verify_without_cgal fail "${_g}/box_l.json --verify"
+    "--verify: this cfinspect was built without CGAL")
+endif()
 
 # Every error: non-zero exit, one line on stderr naming the file and the problem.
 cfinspect_test(missing_file fail "${_g}/no_such.json" "^cfinspect: reading '.*no_such.json': cannot open: no such file\n$")
@@ -94,10 +114,11 @@ cfinspect_test(dot_unwritable fail "${_g}/box_l.json --dot ${_out}/no/such/dir/x
 cfinspect_test(no_args fail "" "no graph file given")
 cfinspect_test(bad_option fail "${_g}/box_l.json --bogus" "--bogus")
 
-# Every graph shipped in data/graphs must pass the full schema check (docs/spec.md, section 5:
+# Every graph shipped in data/graphs must pass the full schema check and the witness check (docs/spec.md, section 5:
 # "every written graph validates"). Globbed at configure time: re-run cmake after adding one.
 file(GLOB _data_graphs ${PROJECT_SOURCE_DIR}/data/graphs/*.json ${PROJECT_SOURCE_DIR}/data/graphs/*.cbor)
 foreach(_graph IN LISTS _data_graphs)
   get_filename_component(_name ${_graph} NAME)
-  cfinspect_test(data_${_name} ok "${_graph}" "valid cf-graph v1 \\(full schema check\\)")
+  witnesses_checked(_w "[0-9]+")
+  cfinspect_test(data_${_name} ok "${_graph}" "valid cf-graph v1 \\(full schema check${_w}\\)")
 endforeach()

@@ -21,6 +21,7 @@ CFREPLAY="$tools/cfreplay"
 CFINSPECT="$tools/cfinspect/cfinspect"
 M="$src/data/models"
 G="$src/tests/data/graphs/box_l.json"
+GEN="$src/data/graphs/cube_l_block.json"  # cfgen's graph of the cube and the L-block
 T="$src/data/trajectories/cube_lblock_corner.csv"
 # A trajectory that fits box_l.json (a few poses of the cube resting on the L-block's floor).
 printf 't,tx,ty,tz,qw,qx,qy,qz\n0,20,10.3,5,1,0,0,0\n0.001,20,10.3,5,1,0,0,0\n' >poses.csv
@@ -207,6 +208,33 @@ EOF
   ln -s target.dot link.dot
   check dot_symlink 0 "^$" -- "$CFINSPECT" g.json --dot link.dot
   if [[ -L link.dot ]] && grep -q '^digraph' target.dot; then report dot_symlink_followed 1 ""; else report dot_symlink_followed 0 "the link was replaced or its target not written"; fi
+  # False graphs (docs/bad-input.md, row 58): every witness is re-checked with cfgen's verify
+  # (when cfinspect was built with it: not in the CGAL-free sanitizer build).
+  if "$CFINSPECT" "$GEN" | grep -q "witnesses verified"; then
+    python3 - "$GEN" <<'PY'
+import json, sys
+src = json.load(open(sys.argv[1]))
+def save(name, edit):
+    g = json.loads(json.dumps(src)); edit(g); json.dump(g, open(name, 'w'))
+def inside(g): g['cfs'][0]['witness'] = {'R': [[1, 0, 0], [0, 1, 0], [0, 0, 1]], 't': [60, 10, 40]}
+def far(g): g['cfs'][0]['witness']['t'] = [1e308, 0, 0]
+def opposite(g):  # the cube's faces 0 (-z) and 1 (+z) on the L-block at once
+    c = dict(g['cfs'][0]); c['id'] = len(g['cfs'])
+    c['pcs'] = [{'type': 'f-f', 'a': 0, 'b': 2}, {'type': 'f-f', 'a': 1, 'b': 3}]
+    for k in ('dof', 'translation_dof', 'pure_rotation', 'planes'): c.pop(k, None)
+    g['cfs'].append(c)
+def dof(g): g['cfs'][574]['dof'] = 2
+for name, edit in (('inside.json', inside), ('far.json', far), ('opposite.json', opposite), ('dof.json', dof)):
+    save(name, edit)
+PY
+    check witness_inside_b 1 "^cfinspect: 'inside.json' at /cfs/0: CF 0 \{f-f:0:0\}: witness refused by verify: .* \(1 of 1390 CFs fail the witness check\)$" -- "$CFINSPECT" inside.json
+    check witness_far 1 "^cfinspect: 'far.json' at /cfs/0: CF 0 \{f-f:0:0\}: witness puts A 1e\+308 mm beyond touching B \(1 of 1390" -- "$CFINSPECT" far.json
+    check witness_opposite_faces 1 "^cfinspect: 'opposite.json' at /cfs/1390: CF 1390 \{f-f:0:2;f-f:1:3\}: witness refused by verify: " -- "$CFINSPECT" opposite.json
+    check witness_dof 1 "^cfinspect: 'dof.json' at /cfs/574: CF 574 \{f-f:0:4;f-f:2:5\}: dof = 2, but 1 at the witness" -- "$CFINSPECT" dof.json
+    check witness_check_with_query 1 "^cfinspect: 'far.json' at /cfs/0: " -- "$CFINSPECT" far.json --cf 3
+    check witness_fast_skips 0 "^$" -- "$CFINSPECT" far.json --fast
+    check witness_fast_verify 1 "^cfinspect: 'far.json' at /cfs/0: " -- "$CFINSPECT" far.json --fast --verify
+  fi
   # A graph without CF: valid, with a warning, exit 0.
   python3 -c "
 import json; g = json.load(open('$G')); g['cfs'] = []; g['transitions'] = []

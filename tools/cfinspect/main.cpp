@@ -1,6 +1,7 @@
-// cfinspect: validates a CF graph file against the schema and summarises it, answers
-// queries (CFs holding a PC, a CF's transitions, one CF, the CF at a pose) and exports
-// Graphviz DOT (docs/spec.md, section 5b). One translation unit, no CGAL.
+// cfinspect: validates a CF graph file against the schema, re-checks its witnesses with
+// cfgen's verify (witness_check.cpp, the only part that needs CGAL) and summarises it,
+// answers queries (CFs holding a PC, a CF's transitions, one CF, the CF at a pose) and
+// exports Graphviz DOT and the browser viewer (docs/spec.md, section 5b).
 
 #include <cf/file_io.hpp>
 #include <cf/graph.hpp>
@@ -9,6 +10,7 @@
 #include "cli_checks.hpp"  // finite_range, version_text
 #include "html.hpp"        // --html: the browser viewer
 #include "safe_stderr.hpp"
+#include "witness_check.hpp"  // --verify
 
 #include <CLI/CLI.hpp>
 #include <boost/graph/adjacency_list.hpp>
@@ -108,12 +110,19 @@ ojson model_json(const cf::Polyhedron& m) {
   return j;
 }
 
-ojson summary_json(const std::string& path, const cf::CfGraph& g, const Summary& s,
-                   bool full_check) {
+// What the witness check did, for the summary's first line.
+std::string witness_words(const cf::inspect::WitnessCheck& w, bool full_check) {
+  if (w.available) return "; " + std::to_string(w.checked) + " witnesses verified";
+  return full_check ? "; witnesses not checked: built without CGAL" : "";
+}
+
+ojson summary_json(const std::string& path, const cf::CfGraph& g, const Summary& s, bool full_check,
+                   const cf::inspect::WitnessCheck& w) {
   ojson j = ojson::object();
   j["file"] = path;
   j["valid"] = true;
   j["schema_check"] = full_check ? "full" : "skeleton";
+  j["witnesses_verified"] = w.available ? ojson(w.checked) : ojson(nullptr);
   j["models"] = {{"A", model_json(g.model_a())}, {"B", model_json(g.model_b())}};
   ojson by_size = ojson::object();
   for (std::size_t k = 1; k <= 3; ++k) by_size[std::to_string(k)] = s.cfs_by_size[k];
@@ -138,14 +147,15 @@ ojson summary_json(const std::string& path, const cf::CfGraph& g, const Summary&
 }
 
 void print_summary(std::ostream& out, const std::string& path, const cf::CfGraph& g,
-                   const Summary& s, bool full_check) {
+                   const Summary& s, bool full_check, const cf::inspect::WitnessCheck& w) {
   auto model_line = [&](const char* which, const cf::Polyhedron& m) {
     out << "model " << which << " '" << cf::printable(m.name()) << "': " << m.num_vertices()
         << " vertices, " << m.num_edges() << " edges (" << reflex_edges(m) << " reflex), "
         << m.num_faces() << " faces\n";
   };
   out << path << ": valid cf-graph v1 ("
-      << (full_check ? "full schema check" : "schema check of the skeleton") << ")\n";
+      << (full_check ? "full schema check" : "schema check of the skeleton")
+      << witness_words(w, full_check) << ")\n";
   model_line("A", g.model_a());
   model_line("B", g.model_b());
   out << "CFs: " << g.num_cfs() << "\n";
@@ -299,40 +309,210 @@ cf::Pose parse_pose(const std::string& text) {
   return p;
 }
 
-int run(int argc, char** argv) {
-  CLI::App app{
-      "cfinspect: validate a CF graph file against the schema, summarise it, answer queries, "
-      "export DOT"};
-  app.set_version_flag("--version", cf::cli::version_text("cfinspect"));
+// The command line.
+struct Options {
   std::string path, holding_text, dot_path, pose_text, html_path, replay_path, trajectory_path;
   long long neighbours_id = -1, cf_id = -1;
-  bool as_json = false, fast = false, print_schema = false;
-  double epsilon = 1.0;
-  app.add_option("graph", path, "CF graph file (.json, or .cbor)");
-  app.add_option("--holding", holding_text,
+  bool neighbours = false, cf = false;  // --neighbours, --cf given
+  bool as_json = false, fast = false, print_schema = false, verify = false;
+  double epsilon = 1.0;  // mm
+  int threads = 0;       // 0: the hardware's count
+};
+
+void add_options(CLI::App& app, Options& o) {
+  app.add_option("graph", o.path, "CF graph file (.json, or .cbor)");
+  app.add_option("--holding", o.holding_text,
                  "list the CFs that hold this PC, TYPE:A:B (e.g. v-f:3:5)");
-  app.add_option("--neighbours,--neighbors", neighbours_id, "list the transitions leaving CF ID");
-  app.add_option("--cf", cf_id, "print CF ID with its witness pose and freedoms");
-  app.add_option("--dot", dot_path,
+  app.add_option("--neighbours,--neighbors", o.neighbours_id, "list the transitions leaving CF ID");
+  app.add_option("--cf", o.cf_id, "print CF ID with its witness pose and freedoms");
+  app.add_option("--dot", o.dot_path,
                  "write the graph as Graphviz DOT (labels: PC lists; edges: kinds)");
-  app.add_option("--pose", pose_text,
+  app.add_option("--pose", o.pose_text,
                  "identify the CF at the pose tx,ty,tz,qw,qx,qy,qz of A (mm, unit quaternion; as "
                  "in POSES.csv)");
-  app.add_option("--epsilon", epsilon,
+  app.add_option("--epsilon", o.epsilon,
                  "contact threshold for --pose, mm (default 1.0, the paper's)")
       ->check(cf::cli::finite_range(1e-6, 1e3));
-  app.add_option("--html", html_path,
+  app.add_option("--html", o.html_path,
                  "write the browser viewer of the graph: one self-contained HTML file");
-  app.add_option("--replay", replay_path,
+  app.add_option("--replay", o.replay_path,
                  "with --html: a cfreplay output CSV for the page to animate");
-  app.add_option("--trajectory", trajectory_path,
+  app.add_option("--trajectory", o.trajectory_path,
                  "with --replay: the POSES.csv it was replayed from (moves A)");
-  app.add_flag("--json", as_json, "machine-readable output (the summary or the query's answer)");
-  app.add_flag(
-      "--fast", fast,
-      "check the items of cfs/transitions with the reader's rules instead of the full schema");
-  app.add_flag("--print-schema", print_schema,
+  app.add_flag("--json", o.as_json, "machine-readable output (the summary or the query's answer)");
+  app.add_flag("--fast", o.fast,
+               "check the items of cfs/transitions with the reader's rules instead of the full "
+               "schema, and skip the witness check");
+  app.add_flag("--verify", o.verify,
+               "re-check every CF's witness and freedoms with cfgen's verify (part of the "
+               "default full check; with --fast, only this)");
+  app.add_option("-j,--threads", o.threads, "threads of the witness check (0: all cores)")
+      ->check(CLI::Range(0, 1024));
+  app.add_flag("--print-schema", o.print_schema,
                "print the JSON Schema of graph files (schemas/cf-graph.schema.json) and exit");
+}
+
+// The files --html reads, never written over.
+std::vector<std::string> html_inputs(const Options& o) {
+  std::vector<std::string> in{o.path};
+  for (const std::string* p : {&o.replay_path, &o.trajectory_path})
+    if (!p->empty()) in.push_back(*p);
+  return in;
+}
+
+// The inputs that go together, and the output paths, checked before the (possibly long)
+// load so that mistakes fail fast. Returns 0, or the exit status of a usage error.
+int check_arguments(const Options& o) {
+  if (o.path.empty()) {
+    std::cerr << "cfinspect: no graph file given (see --help)\n";
+    return 2;
+  }
+  if (o.html_path.empty() && !(o.replay_path.empty() && o.trajectory_path.empty())) {
+    std::cerr << "cfinspect: --replay and --trajectory go with --html (see --help)\n";
+    return 2;
+  }
+  if (!o.trajectory_path.empty() && o.replay_path.empty()) {
+    std::cerr << "cfinspect: --trajectory goes with --replay (see --help)\n";
+    return 2;
+  }
+  // Never the graph itself, a device, a FIFO or a directory (docs/spec.md, section 5b).
+  if (!o.dot_path.empty()) cf::check_output_path(o.dot_path, {o.path}, "writing DOT");
+  if (!o.html_path.empty())
+    cf::check_output_path(o.html_path, html_inputs(o), "writing HTML", {o.dot_path});
+  return 0;
+}
+
+// Warnings (stderr, exit status 0): nothing to identify, or models whose size suggests a
+// unit mistake.
+void warn_about(const cf::CfGraph& g, double epsilon) {
+  if (g.num_cfs() == 0)
+    std::cerr << "cfinspect: warning: the graph has no CF (A " << g.model_a().size()
+              << " mm across, B " << g.model_b().size()
+              << " mm across): nothing can be identified; were the models' units right?\n";
+  for (const auto& [m, which] : {std::pair{&g.model_a(), "A"}, std::pair{&g.model_b(), "B"}})
+    if (const std::string w = cf::size_warning(*m, which, epsilon); !w.empty())
+      std::cerr << "cfinspect: warning: " << w << "\n";
+}
+
+// The witness check, when asked for or part of the full check: a graph whose witness or
+// freedoms do not hold is refused, naming the first such CF.
+cf::inspect::WitnessCheck check_witnesses(const Options& o, const cf::CfGraph& g) {
+  if (o.fast && !o.verify) return {};
+  cf::inspect::WitnessCheck w = cf::inspect::check_witnesses(g, o.threads);
+  if (!w.available && o.verify)
+    throw Failure{
+        "--verify: this cfinspect was built without CGAL (CF_WITH_CGAL=OFF), so "
+        "without the generator's verify"};
+  if (w.failed > 0) {
+    const cf::CfId id(static_cast<int>(w.first_bad));
+    throw Failure{"'" + o.path + "' at /cfs/" + std::to_string(w.first_bad) + ": CF " +
+                  std::to_string(w.first_bad) + " {" + cf::to_string(g.cf(id).pcs) +
+                  "}: " + cf::printable(w.why) + " (" + std::to_string(w.failed) + " of " +
+                  std::to_string(w.checked) + " CFs fail the witness check)"};
+  }
+  return w;
+}
+
+void answer_holding(const Options& o, const cf::CfGraph& g, ojson& answer) {
+  const std::optional<cf::Pc> pc = cf::pc_from_string(o.holding_text);
+  const char* field = "";
+  if (std::string why = cf::check_pc(*pc, g.model_a(), g.model_b(), &field); !why.empty())
+    throw Failure{"--holding '" + o.holding_text + "': " + why};
+  const auto ids = holding(g, *pc);
+  if (o.as_json) {
+    ojson list = ojson::array();
+    for (cf::CfId id : ids) list.push_back({{"id", id.value()}, {"pcs", pcs_json(g.cf(id).pcs)}});
+    answer["holding"] = {{"pc", cf::to_string(*pc)}, {"cfs", list}};
+    return;
+  }
+  std::cout << ids.size() << " CFs hold " << cf::to_string(*pc) << "\n";
+  for (cf::CfId id : ids)
+    std::cout << "  CF " << id.value() << ": " << cf::to_string(g.cf(id).pcs) << "\n";
+}
+
+void answer_pose(const Options& o, const cf::CfGraph& g, const cf::Pose& pose, ojson& answer) {
+  cf::Params params;
+  params.epsilon_mm = o.epsilon;
+  cf::CfIdentifier identifier(g, params);
+  const cf::Identification& r = identifier.step(pose);
+  if (o.as_json) {
+    ojson candidates = ojson::array();
+    for (int i = 0; i < r.contacts.size(); ++i) {
+      const cf::ContactPc& c = r.contacts[i];
+      candidates.push_back({{"pc", cf::to_string(c.pc)}, {"distance", c.distance}});
+    }
+    answer["pose"] = {{"status", cf::to_string(r.status)},
+                      {"cf", r.has_cf() ? r.cf.value() : -1},
+                      {"pcs", pcs_json(r.pcs)},
+                      {"candidates", candidates}};
+    return;
+  }
+  std::cout << "pose: " << cf::to_string(r.status) << ", CF " << (r.has_cf() ? r.cf.value() : -1);
+  if (r.has_cf()) std::cout << " {" << cf::to_string(r.pcs) << "}";
+  std::cout << ", " << r.contacts.size() << " candidate PCs within " << o.epsilon << " mm\n";
+  for (int i = 0; i < r.contacts.size(); ++i)
+    std::cout << "  " << cf::to_string(r.contacts[i].pc) << " at " << r.contacts[i].distance
+              << " mm\n";
+}
+
+// --holding, --neighbours, --cf, --pose. Returns whether one was asked.
+bool answer_queries(const Options& o, const cf::CfGraph& g, const std::optional<cf::Pose>& pose,
+                    ojson& answer) {
+  if (!o.holding_text.empty()) answer_holding(o, g, answer);
+  if (o.neighbours) {
+    const cf::CfId id = parse_cf_id(g, o.path, o.neighbours_id);
+    if (o.as_json)
+      answer["neighbours"] = cf_json(g, id)["transitions"];
+    else
+      print_neighbours(std::cout, g, id);
+  }
+  if (o.cf) {
+    const cf::CfId id = parse_cf_id(g, o.path, o.cf_id);
+    if (o.as_json)
+      answer["cf"] = cf_json(g, id);
+    else
+      print_cf(std::cout, g, id);
+  }
+  if (pose) answer_pose(o, g, *pose, answer);
+  return !o.holding_text.empty() || o.neighbours || o.cf || pose;
+}
+
+// --dot and --html.
+void write_exports(const Options& o, const cf::CfGraph& g, ojson& answer) {
+  if (!o.dot_path.empty()) {
+    cf::write_outputs({{o.dot_path, dot_text(g)}}, {o.path}, "writing DOT");
+    if (!o.as_json)
+      std::cout << "wrote " << o.dot_path << " (" << g.num_cfs() << " nodes, "
+                << g.num_transitions() << " edges)\n";
+    else
+      answer["dot"] = o.dot_path;
+  }
+  if (o.html_path.empty()) return;
+  // The graph file's own text when it is JSON (with cfgen's contact planes, which the
+  // loaded graph does not keep); the re-serialised graph for CBOR.
+  const std::string& path = o.path;
+  const bool cbor = path.size() >= 5 && path.compare(path.size() - 5, 5, ".cbor") == 0;
+  cf::inspect::ViewerInputs in{path,
+                               cbor ? g.to_json(-1) : cf::inspect::read_text_file(path, "reading"),
+                               g.num_cfs(),
+                               o.replay_path,
+                               o.trajectory_path,
+                               o.cf_id};
+  cf::write_outputs({{o.html_path, cf::inspect::viewer_html(in)}}, html_inputs(o), "writing HTML");
+  if (!o.as_json)
+    std::cout << "wrote " << o.html_path << " (viewer of " << g.num_cfs() << " CFs"
+              << (o.replay_path.empty() ? "" : ", with the replay") << ")\n";
+  else
+    answer["html"] = o.html_path;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{
+      "cfinspect: validate a CF graph file against the schema and re-check its witnesses, "
+      "summarise it, answer queries, export DOT and the browser viewer"};
+  app.set_version_flag("--version", cf::cli::version_text("cfinspect"));
+  Options o;
+  add_options(app, o);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -343,150 +523,37 @@ int run(int argc, char** argv) {
     std::cerr << "cfinspect: " << e.what() << " (see --help)\n";
     return 2;
   }
-  if (print_schema) {
+  if (o.print_schema) {
     std::cout << cf::graph_schema_text();
     return 0;
   }
-  if (path.empty()) {
-    std::cerr << "cfinspect: no graph file given (see --help)\n";
-    return 2;
-  }
-  // Parse the query arguments before the (possibly long) load, so typos fail fast.
-  std::optional<cf::Pc> holding_pc;
-  if (!holding_text.empty()) {
-    holding_pc = cf::pc_from_string(holding_text);
-    if (!holding_pc)
-      throw Failure{"--holding '" + holding_text + "': expected TYPE:A:B such as v-f:3:5"};
-  }
+  o.neighbours = o.neighbours_id != -1 || app.count("--neighbours") > 0;
+  o.cf = o.cf_id != -1 || app.count("--cf") > 0;
+  if (const int status = check_arguments(o)) return status;
+  // The query arguments before the load, so typos fail fast.
+  if (!o.holding_text.empty() && !cf::pc_from_string(o.holding_text))
+    throw Failure{"--holding '" + o.holding_text + "': expected TYPE:A:B such as v-f:3:5"};
   std::optional<cf::Pose> pose;
-  if (!pose_text.empty()) pose = parse_pose(pose_text);
-
-  // An output path is checked before the load: never the graph itself, a device, a FIFO
-  // or a directory (docs/spec.md, section 5b).
-  if (!dot_path.empty()) cf::check_output_path(dot_path, {path}, "writing DOT");
-  if (html_path.empty() && !(replay_path.empty() && trajectory_path.empty())) {
-    std::cerr << "cfinspect: --replay and --trajectory go with --html (see --help)\n";
-    return 2;
-  }
-  if (!trajectory_path.empty() && replay_path.empty()) {
-    std::cerr << "cfinspect: --trajectory goes with --replay (see --help)\n";
-    return 2;
-  }
-  std::vector<std::string> html_inputs{path};  // never written over
-  for (const std::string* p : {&replay_path, &trajectory_path})
-    if (!p->empty()) html_inputs.push_back(*p);
-  if (!html_path.empty()) cf::check_output_path(html_path, html_inputs, "writing HTML", {dot_path});
+  if (!o.pose_text.empty()) pose = parse_pose(o.pose_text);
   cf::GraphLoadOptions options;
-  options.full_schema_check = !fast;
-  const cf::CfGraph g = cf::CfGraph::load(path, options);
-  // Warnings (stderr, exit status 0): nothing to identify, or models whose size suggests a
-  // unit mistake.
-  if (g.num_cfs() == 0)
-    std::cerr << "cfinspect: warning: the graph has no CF (A " << g.model_a().size()
-              << " mm across, B " << g.model_b().size()
-              << " mm across): nothing can be identified; were the models' units right?\n";
-  for (const auto& [m, which] : {std::pair{&g.model_a(), "A"}, std::pair{&g.model_b(), "B"}})
-    if (const std::string w = cf::size_warning(*m, which, epsilon); !w.empty())
-      std::cerr << "cfinspect: warning: " << w << "\n";
-
-  bool queried = false;
+  options.full_schema_check = !o.fast;
+  const cf::CfGraph g = cf::CfGraph::load(o.path, options);
+  warn_about(g, o.epsilon);
+  const cf::inspect::WitnessCheck witnesses = check_witnesses(o, g);
   ojson answer = ojson::object();
-  if (holding_pc) {
-    queried = true;
-    const cf::Pc& pc = *holding_pc;
-    const char* field = "";
-    if (std::string why = cf::check_pc(pc, g.model_a(), g.model_b(), &field); !why.empty())
-      throw Failure{"--holding '" + holding_text + "': " + why};
-    const auto ids = holding(g, pc);
-    if (as_json) {
-      ojson list = ojson::array();
-      for (cf::CfId id : ids) list.push_back({{"id", id.value()}, {"pcs", pcs_json(g.cf(id).pcs)}});
-      answer["holding"] = {{"pc", cf::to_string(pc)}, {"cfs", list}};
-    } else {
-      std::cout << ids.size() << " CFs hold " << cf::to_string(pc) << "\n";
-      for (cf::CfId id : ids)
-        std::cout << "  CF " << id.value() << ": " << cf::to_string(g.cf(id).pcs) << "\n";
-    }
-  }
-  if (neighbours_id != -1 || app.count("--neighbours")) {
-    queried = true;
-    const cf::CfId id = parse_cf_id(g, path, neighbours_id);
-    if (as_json)
-      answer["neighbours"] = cf_json(g, id)["transitions"];
-    else
-      print_neighbours(std::cout, g, id);
-  }
-  if (cf_id != -1 || app.count("--cf")) {
-    queried = true;
-    const cf::CfId id = parse_cf_id(g, path, cf_id);
-    if (as_json)
-      answer["cf"] = cf_json(g, id);
-    else
-      print_cf(std::cout, g, id);
-  }
-  if (pose) {
-    queried = true;
-    cf::Params params;
-    params.epsilon_mm = epsilon;
-    cf::CfIdentifier identifier(g, params);
-    const cf::Identification& r = identifier.step(*pose);
-    if (as_json) {
-      ojson candidates = ojson::array();
-      for (int i = 0; i < r.contacts.size(); ++i) {
-        const cf::ContactPc& c = r.contacts[i];
-        candidates.push_back({{"pc", cf::to_string(c.pc)}, {"distance", c.distance}});
-      }
-      answer["pose"] = {{"status", cf::to_string(r.status)},
-                        {"cf", r.has_cf() ? r.cf.value() : -1},
-                        {"pcs", pcs_json(r.pcs)},
-                        {"candidates", candidates}};
-    } else {
-      std::cout << "pose: " << cf::to_string(r.status) << ", CF "
-                << (r.has_cf() ? r.cf.value() : -1);
-      if (r.has_cf()) std::cout << " {" << cf::to_string(r.pcs) << "}";
-      std::cout << ", " << r.contacts.size() << " candidate PCs within " << epsilon << " mm\n";
-      for (int i = 0; i < r.contacts.size(); ++i)
-        std::cout << "  " << cf::to_string(r.contacts[i].pc) << " at " << r.contacts[i].distance
-                  << " mm\n";
-    }
-  }
-  if (!dot_path.empty()) {
-    cf::write_outputs({{dot_path, dot_text(g)}}, {path}, "writing DOT");
-    if (!as_json)
-      std::cout << "wrote " << dot_path << " (" << g.num_cfs() << " nodes, " << g.num_transitions()
-                << " edges)\n";
-    else
-      answer["dot"] = dot_path;
-  }
-  if (!html_path.empty()) {
-    // The graph file's own text when it is JSON (with cfgen's contact planes, which the
-    // loaded graph does not keep); the re-serialised graph for CBOR.
-    const bool cbor = path.size() >= 5 && path.compare(path.size() - 5, 5, ".cbor") == 0;
-    cf::inspect::ViewerInputs in{
-        path,
-        cbor ? g.to_json(-1) : cf::inspect::read_text_file(path, "reading"),
-        g.num_cfs(),
-        replay_path,
-        trajectory_path,
-        cf_id};
-    cf::write_outputs({{html_path, cf::inspect::viewer_html(in)}}, html_inputs, "writing HTML");
-    if (!as_json)
-      std::cout << "wrote " << html_path << " (viewer of " << g.num_cfs() << " CFs"
-                << (replay_path.empty() ? "" : ", with the replay") << ")\n";
-    else
-      answer["html"] = html_path;
-  }
+  const bool queried = answer_queries(o, g, pose, answer);
+  write_exports(o, g, answer);
   if (!queried) {  // no query: the summary (also after --dot, --html)
     const Summary s = summarise(g);
-    if (as_json) {
-      ojson summary = summary_json(path, g, s, !fast);
+    if (o.as_json) {
+      ojson summary = summary_json(o.path, g, s, !o.fast, witnesses);
       for (auto it = answer.begin(); it != answer.end(); ++it) summary[it.key()] = it.value();
       answer = std::move(summary);
     } else {
-      print_summary(std::cout, path, g, s, !fast);
+      print_summary(std::cout, o.path, g, s, !o.fast, witnesses);
     }
   }
-  if (as_json) std::cout << answer.dump(2, ' ', false, ojson::error_handler_t::replace) << "\n";
+  if (o.as_json) std::cout << answer.dump(2, ' ', false, ojson::error_handler_t::replace) << "\n";
   return 0;
 }
 
