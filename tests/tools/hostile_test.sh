@@ -254,6 +254,15 @@ if [[ "$group" == cfreplay ]]; then
   check trajectory_binary_garbage 1 "^cfreplay: garbage.csv:[0-9]+: " -- "$CFREPLAY" --graph "$G" --trajectory garbage.csv -o o.csv
   printf 't,tx,ty,tz,qw,qx,qy,qz\n0,1,2,\x01\x9b[31m,1,0,0,0\n' >escape.csv
   check trajectory_escape_sequence 1 "^cfreplay: escape.csv:2: column 'tz' is not a finite number: '\\\\x01\\\\x9B\[31m'" -- "$CFREPLAY" --graph "$G" --trajectory escape.csv -o o.csv
+  # Decimal numbers only; a subnormal time is a number; times 1e-7 s apart stay distinct.
+  printf 't,tx,ty,tz,qw,qx,qy,qz\n0,0x14,10.3,5,1,0,0,0\n' >hex.csv
+  check trajectory_hex_float 1 "^cfreplay: hex.csv:2: column 'tx' is not a decimal number: '0x14'" -- "$CFREPLAY" --graph "$G" --trajectory hex.csv -o o.csv
+  printf 't,tx,ty,tz,qw,qx,qy,qz\n0,20,10.3,5,1,0,0,0\n5e-324,20,10.3,5,1,0,0,0\n' >subnormal.csv
+  check trajectory_subnormal_time 0 "^cfreplay: 2 ticks" -- "$CFREPLAY" --graph "$G" --trajectory subnormal.csv -o subnormal_out.csv
+  printf 't,tx,ty,tz,qw,qx,qy,qz\n0,20,10.3,5,1,0,0,0\n1e-7,20,10.3,5,1,0,0,0\n2e-7,20,10.3,5,1,0,0,0\n' >fine.csv
+  check trajectory_fine_times 0 "^cfreplay: 3 ticks" -- "$CFREPLAY" --graph "$G" --trajectory fine.csv -o fine_out.csv
+  if [[ $(cut -d, -f1 fine_out.csv | tr '\n' ' ') == "t 0 1e-07 2e-07 " ]]; then report fine_times_distinct 1 ""; else report fine_times_distinct 0 "t column: $(cut -d, -f1 fine_out.csv | tr '\n' ' ')"; fi
+  rm -f subnormal_out.csv fine_out.csv
   printf 't,tx,ty,tz,qw,qx,qy,qz\n0,20,10.3,5,0.7071,0.7071,0,0\n' >q4.csv
   check quaternion_4_decimals 0 "^cfreplay: 1 ticks" -- "$CFREPLAY" --graph "$G" --trajectory q4.csv -o q4_out.csv
   printf 't,tx,ty,tz,qw,qx,qy,qz\n0,20,10.3,5,1,0.1,0,0\n' >q_bad.csv

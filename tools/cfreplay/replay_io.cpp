@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cfloat>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -70,8 +72,15 @@ double number(const std::string& field, const char* column, const std::string& s
   if (field.empty()) fail(source, line, std::string("column '") + column + "' is empty");
   errno = 0;
   char* end = nullptr;
+  // Decimal only: strtod also reads hexadecimal ("0x1p4"), which no CSV writer means.
+  if (field.find_first_of("xX") != std::string::npos)
+    fail(
+        source, line,
+        std::string("column '") + column + "' is not a decimal number: '" + printable(field) + "'");
   const double v = strtod_l(field.c_str(), &end, c_numeric());
-  if (end != field.c_str() + field.size() || errno == ERANGE || !std::isfinite(v))
+  // ERANGE also reports an underflow (5e-324, a subnormal), whose result is the nearest double.
+  const bool overflow = errno == ERANGE && std::abs(v) > DBL_MIN;
+  if (end != field.c_str() + field.size() || overflow || !std::isfinite(v))
     fail(source, line,
          std::string("column '") + column + "' is not a finite number: '" + printable(field) + "'");
   return v;
@@ -154,11 +163,15 @@ std::string format_row(const Row& r) {
   // The proxy's attitude as a unit quaternion with qw >= 0 (one of the two that name it).
   Eigen::Quaterniond q(r.X_WP.R_BA);
   if (q.w() < 0) q.coeffs() = -q.coeffs();
+  // The time as its shortest round-trip decimal, so that any two distinct times stay distinct
+  // (ticks of 1e-7 s too) and a time read from a trajectory is written as it was given.
+  char t[32];
+  *std::to_chars(t, t + sizeof t - 1, r.t).ptr = '\0';
   char buf[1024];
   std::snprintf(buf, sizeof buf,
-                "%.6f,%d,%s,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%s,%s,"
+                "%s,%d,%s,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%s,%s,"
                 "%.9g,%.9g,%.9g,%.12f,%.12f,%.12f,%.12f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%s",
-                r.t, r.cf, r.pcs.c_str(), r.motion.c_str(), r.F_W.x(), r.F_W.y(), r.F_W.z(),
+                t, r.cf, r.pcs.c_str(), r.motion.c_str(), r.F_W.x(), r.F_W.y(), r.F_W.z(),
                 r.M_W.x(), r.M_W.y(), r.M_W.z(), r.F_A.x(), r.F_A.y(), r.F_A.z(), r.M_A.x(),
                 r.M_A.y(), r.M_A.z(), r.status.c_str(), r.regimes.c_str(), r.X_WP.t_BA.x(),
                 r.X_WP.t_BA.y(), r.X_WP.t_BA.z(), q.w(), q.x(), q.y(), q.z(), r.Fc_W.x(),
