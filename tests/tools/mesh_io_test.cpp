@@ -427,6 +427,52 @@ TEST_CASE("broken solids are rejected with the reason", "[mesh_io]") {
     CHECK_THROWS_WITH(load_model(write_file("selfx.off", off_text(v, triangulate(kCubeF)))),
                       Catch::Contains("selfx.off': self-intersection: facets"));
   }
+  SECTION("self-intersection, with a vertex along an edge") {
+    // The same, with the midpoint of edge 0-1 a vertex of both triangles along that edge: the
+    // test drops such straight vertices first (a 30,000-gon of them took minutes), and must
+    // still see the intersection.
+    std::vector<cf::Vec3> v = kCubeV;
+    v[6] = {5, 5, -5};
+    v.push_back({5, 0, 0});  // 8
+    auto f = triangulate(kCubeF);
+    for (auto& t : f) {
+      if (t == std::vector<int>{0, 2, 1}) t = {0, 2, 1, 8};
+      if (t == std::vector<int>{0, 1, 5}) t = {0, 8, 1, 5};
+    }
+    CHECK_THROWS_WITH(load_model(write_file("selfx_straight.off", off_text(v, f))),
+                      Catch::Contains("selfx_straight.off': self-intersection: facets"));
+    v[6] = kCubeV[6];  // the cube again: valid, the midpoint no corner of it
+    CHECK(load_model(write_file("straight.off", off_text(v, f))).num_vertices() == 8);
+  }
+  SECTION("self-intersection in a face written as strips, with vertices along its edges") {
+    // A 10 mm cube whose bottom is one polygon with 100 vertices on each side, whose sides are
+    // strips of quads and whose top is a fan of triangles around its centre: the test merges
+    // each side's strips and the top's fan and drops the straight vertices first, and must
+    // still see the top's centre pulled down through the bottom.
+    constexpr int k = 100, n = 4 * k;
+    std::vector<cf::Vec3> v;
+    for (double z : {0.0, 10.0})
+      for (int s = 0; s < 4; ++s)
+        for (int i = 0; i < k; ++i) {
+          const double f = 10.0 * i / k;
+          const cf::Vec3 p[] = {{f, 0, z}, {10, f, z}, {10 - f, 10, z}, {0, 10 - f, z}};
+          v.push_back(p[s]);
+        }
+    v.push_back({5, 5, 10});  // the top's centre: 2n
+    std::vector<std::vector<int>> f(1);
+    for (int i = n - 1; i >= 0; --i) f[0].push_back(i);  // the bottom, seen from below
+    for (int i = 0; i < n; ++i) {
+      const int j = (i + 1) % n;
+      f.push_back({i, j, n + j, n + i});
+      f.push_back({n + i, n + j, 2 * n});
+    }
+    const cf::Polyhedron cube = load_model(write_file("cube_strips.off", off_text(v, f)));
+    CHECK(cube.num_vertices() == 8);
+    CHECK(cube.num_faces() == 6);
+    v[2 * n] = {5, 5, -5};  // through the bottom (the volume stays positive: 500 mm^3)
+    CHECK_THROWS_WITH(load_model(write_file("cube_strips_through.off", off_text(v, f))),
+                      Catch::Contains("cube_strips_through.off': self-intersection: facets"));
+  }
   SECTION("degenerate facet: repeated vertex") {
     auto f = kCubeF;
     f[0] = {0, 3, 3, 2, 1};
