@@ -4,6 +4,7 @@
 /// number in range), and their --version text. CLI::Range lets NaN through (every comparison with
 /// NaN is false) and says nothing about infinity; these do not. The range shows in --help.
 
+#include <cf/params.hpp>
 #include <cf/version.hpp>
 
 #include <CLI/CLI.hpp>
@@ -33,6 +34,24 @@ inline CLI::Validator finite_range(double lo, double hi) {
         if (text.empty() || end == b || *end != '\0') return "'" + text + "' is not a number";
         if (!std::isfinite(v)) return "'" + text + "' is not a finite number";
         if (v < lo || v > hi) return "'" + text + "' is outside " + range;
+        return {};
+      },
+      range);
+}
+
+/// A finite number that libcf's parameter table accepts for `spec` (cf/params.hpp): the same
+/// range as the library's validate(), shown in --help.
+inline CLI::Validator param_range(const cf::ParamSpec& spec) {
+  const std::string range = std::string(spec.lo_open ? "(" : "[") + bound_text(spec.lo) + ", " +
+                            bound_text(spec.hi) + "]";
+  return CLI::Validator(
+      [spec, range](std::string& text) -> std::string {
+        const char* b = text.c_str();
+        char* end = nullptr;
+        const double v = std::strtod(b, &end);
+        if (text.empty() || end == b || *end != '\0') return "'" + text + "' is not a number";
+        if (!std::isfinite(v)) return "'" + text + "' is not a finite number";
+        if (!spec.problem(v).empty()) return "'" + text + "' is outside " + range;
         return {};
       },
       range);

@@ -344,11 +344,12 @@ TEST_CASE("bad parameters are rejected with their name", "[detector]") {
   cf::Params p;
   p.epsilon_mm = -1;
   CHECK_THROWS_WITH(cf::ContactDetector(tmod::cube(), tmod::l_block(), p),
-                    Catch::Contains("parameter epsilon_mm must be positive"));
+                    Catch::Contains("parameter epsilon_mm = -1 is outside [1e-06, 1000] mm"));
   p = cf::Params();
   p.detection.max_penetration_mm = std::nan("");
-  CHECK_THROWS_WITH(cf::ContactDetector(tmod::cube(), tmod::l_block(), p),
-                    Catch::Contains("parameter max_penetration_mm must be non-negative"));
+  CHECK_THROWS_WITH(
+      cf::ContactDetector(tmod::cube(), tmod::l_block(), p),
+      Catch::Contains("parameter detection.max_penetration_mm = nan is outside [0, 1000000] mm"));
 }
 
 TEST_CASE("overlap of polygons with holes matches Boost.Geometry", "[detector]") {
@@ -932,8 +933,9 @@ TEST_CASE("kept pairs serve rotations, and rotations rounded to float", "[detect
 TEST_CASE("a negative reuse margin is refused", "[detector]") {
   cf::Params p;
   p.detection.reuse_margin_mm = -0.1;
-  CHECK_THROWS_WITH(cf::ContactDetector(tmod::cube(), tmod::l_block(), p),
-                    Catch::Contains("parameter reuse_margin_mm must be non-negative"));
+  CHECK_THROWS_WITH(
+      cf::ContactDetector(tmod::cube(), tmod::l_block(), p),
+      Catch::Contains("parameter detection.reuse_margin_mm = -0.1 is outside [0, 1000000] mm"));
 }
 
 // The centre of the slab's plane (ContactPc::centre_W) along a sweep of poses: that of its

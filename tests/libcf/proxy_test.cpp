@@ -404,18 +404,17 @@ TEST_CASE("proxy parameters out of range are refused by name", "[proxy]") {
   p.proxy.stiffness_N_per_mm = 0;
   CHECK_THROWS_WITH(
       cf::HapticRenderer(g, p),
-      "cf::Params: parameter proxy.stiffness_N_per_mm must be finite and positive, got 0.000000");
+      "cf::Params: parameter proxy.stiffness_N_per_mm = 0 is outside (0, 1e+09] N/mm");
   p = cf::Params();
   p.proxy.max_substeps = 0;
   CHECK_THROWS_WITH(cf::HapticRenderer(g, p),
-                    "cf::Params: parameter proxy.max_substeps must be at least 1, got 0");
+                    "cf::Params: parameter proxy.max_substeps = 0 is below 1");
   p = cf::Params();
   p.proxy.damping_N_s_per_mm = -1;
   CHECK_THROWS_WITH(cf::HapticRenderer(g, p),
-                    Catch::Contains("proxy.damping_N_s_per_mm must be finite and non-negative"));
+                    Catch::Contains("proxy.damping_N_s_per_mm = -1 is outside [0, 1e+09] N s/mm"));
   p = cf::Params();
   p.proxy.lookahead_epsilons = 0.5;
-  CHECK_THROWS_WITH(
-      cf::HapticRenderer(g, p),
-      "cf::Params: parameter proxy.lookahead_epsilons must be finite and at least 1, got 0.500000");
+  CHECK_THROWS_WITH(cf::HapticRenderer(g, p),
+                    "cf::Params: parameter proxy.lookahead_epsilons = 0.5 is outside [1, 1000]");
 }

@@ -222,14 +222,14 @@ TEST_CASE("one parameter tree: epsilon, detection and identification reach the r
   // Out-of-range values of the subtrees are refused by the stage that reads them.
   cf::Params bad = P;
   bad.detection.reuse_margin_mm = -1;
-  CHECK_THROWS_WITH(cf::HapticRenderer(g, bad),
-                    Catch::Contains("parameter reuse_margin_mm must be non-negative"));
+  CHECK_THROWS_WITH(
+      cf::HapticRenderer(g, bad),
+      Catch::Contains("parameter detection.reuse_margin_mm = -1 is outside [0, 1000000] mm"));
   bad = P;
   bad.identification.max_combinations = 0;
   CHECK_THROWS_WITH(
       cf::HapticRenderer(g, bad),
-      Catch::Contains(
-          "cf::Params: parameter identification.max_combinations must be at least 1, got 0"));
+      Catch::Contains("cf::Params: parameter identification.max_combinations = 0 is below 1"));
 }
 
 TEST_CASE("a second plane's contact pushes from epsilon on, without a step at its gain",

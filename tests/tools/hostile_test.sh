@@ -276,7 +276,7 @@ if [[ "$group" == cfreplay ]]; then
   done
   check cfreplay_moment_point_nan 2 "^cfreplay: --moment-point: 'nan' is not a finite number" -- "${run[@]}" -o o.csv --moment-point nan 0 0
   check cfreplay_epsilon_huge 2 "^cfreplay: --epsilon: '1e308' is outside \[1e-06, 1000\]" -- "${run[@]}" -o o.csv --epsilon 1e308
-  check cfreplay_stiffness_zero 2 "^cfreplay: --stiffness: '0' is outside \[1e-09, 1e\+09\]" -- "${run[@]}" -o o.csv --stiffness 0
+  check cfreplay_stiffness_zero 2 "^cfreplay: --stiffness: '0' is outside \(0, 1e\+09\]" -- "${run[@]}" -o o.csv --stiffness 0
   check cfreplay_mass_negative 2 "^cfreplay: --mass: '-1' is outside \[0, 1e\+06\]" -- "${run[@]}" -o o.csv --mass -1
   # Options checked together, before the work.
   check cfreplay_moment_ref_and_point 2 "^cfreplay: --moment-ref origin contradicts --moment-point, which sets the moment's reference point; give one" -- "${run[@]}" -o o.csv --moment-ref origin --moment-point 1 2 3

@@ -109,18 +109,6 @@ int main(int argc, char** argv) {
          "felt through a spring (docs/spec.md, section 6b); 'off': A's pose is the trajectory "
          "(the paper's literal model)")
       ->check(CLI::IsMember({"on", "off"}));
-  app.add_option("--proxy-stiffness", P.proxy.stiffness_N_per_mm,
-                 "the proxy coupling's stiffness, N/mm")
-      ->check(finite_range(1e-9, 1e9));
-  app.add_option("--proxy-damping", P.proxy.damping_N_s_per_mm,
-                 "the proxy coupling's damping, N s/mm")
-      ->check(finite_range(0, 1e9));
-  app.add_option("--hold", P.hold_fcy_threshold_N,
-                 "hold F_cy while it changes by less than this (N); 0: off")
-      ->check(finite_range(0, 1e6));
-  app.add_option("--tau", P.interpolation_time_constant_s,
-                 "low-pass time constant of the total contact force and moment (s); 0: off")
-      ->check(finite_range(0, 1e3));
   CLI::Option* moment_ref_opt =
       app.add_option(
              "--moment-ref", moment_ref,
@@ -135,15 +123,15 @@ int main(int argc, char** argv) {
       ->check(finite_range(-1e9, 1e9));
   app.add_option("--centroid", centroid, "mass centre: 'vertex' mean (paper) or 'volume' centroid")
       ->check(CLI::IsMember({"vertex", "volume"}));
-  app.add_option("--mass", P.mass_kg, "m, kg")->check(finite_range(0, 1e6));
-  app.add_option("--stiffness", P.stiffness_N_per_mm, "K, N/mm")->check(finite_range(1e-9, 1e9));
-  app.add_option("--kp", P.kp_N_per_mm, "K_p, N/mm")->check(finite_range(1e-9, 1e9));
-  CLI::Option* mu_opt = app.add_option("--mu", P.mu_static, "static friction coefficient")
-                            ->check(finite_range(0, 100));
-  CLI::Option* mu_d_opt = app.add_option("--mu-d", P.mu_kinetic, "kinetic friction coefficient")
-                              ->check(finite_range(0, 100));
-  app.add_option("--epsilon", P.epsilon_mm, "contact threshold, mm")
-      ->check(finite_range(1e-6, 1e3));
+  // The real-valued parameters that have an option: names, ranges and help from libcf's
+  // parameter table (cf::param_specs), so they are checked as the library checks them.
+  std::map<std::string, CLI::Option*> given;
+  for (const cf::ParamSpec& spec : cf::param_specs()) {
+    if (!spec.option) continue;
+    const std::string unit = *spec.unit ? std::string(", ") + spec.unit : "";
+    given[spec.path] = app.add_option(spec.option, spec.field(P), spec.doc + unit)
+                           ->check(cf::cli::param_range(spec));
+  }
 
   try {
     app.parse(argc, argv);
@@ -153,10 +141,10 @@ int main(int argc, char** argv) {
     std::cerr << "cfreplay: " << e.what() << " (see cfreplay --help)\n";
     return 2;
   }
-  const std::string why =
-      apply_choices({friction, moment_ref, centroid, proxy, moment_point,
-                     moment_ref_opt->count() > 0, mu_opt->count() > 0, mu_d_opt->count() > 0},
-                    P);
+  const std::string why = apply_choices(
+      {friction, moment_ref, centroid, proxy, moment_point, moment_ref_opt->count() > 0,
+       given.at("mu_static")->count() > 0, given.at("mu_kinetic")->count() > 0},
+      P);
   if (!why.empty()) {
     std::cerr << "cfreplay: " << why << " (see cfreplay --help)\n";
     return 2;

@@ -21,7 +21,7 @@ class ContactDetector {
  public:
   /// Builds the bounding volume hierarchies of both models (copied). Uses
   /// `params.epsilon_mm` and `params.detection`.
-  /// @throws cf::Error when a parameter is not finite or negative where it must not be.
+  /// @throws cf::Error when a parameter is out of range (validate(), cf/params.hpp).
   ContactDetector(const Polyhedron& a, const Polyhedron& b, const Params& params = {});
   ~ContactDetector();
   ContactDetector(ContactDetector&&) noexcept;

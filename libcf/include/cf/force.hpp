@@ -147,6 +147,7 @@ class ForceModel {
   };
 
   /// The models must outlive the ForceModel (they are the graph's models at run time).
+  /// @throws cf::Error when a parameter is out of range (validate(), cf/params.hpp).
   ForceModel(const Polyhedron& A, const Polyhedron& B, const Params& params = Params());
 
   /// Forgets the previous tick: the state becomes a default ForceState (anchors, held

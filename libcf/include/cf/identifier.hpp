@@ -63,7 +63,7 @@ struct Identification {
 class CfIdentifier {
  public:
   /// Uses `params.epsilon_mm`, `params.detection` and `params.identification`.
-  /// @throws cf::Error when a parameter is out of range (named in the message).
+  /// @throws cf::Error when a parameter is out of range (validate(), cf/params.hpp).
   explicit CfIdentifier(const CfGraph& graph, const Params& params = {});
   ~CfIdentifier();
   CfIdentifier(CfIdentifier&&) noexcept;

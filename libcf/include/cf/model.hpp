@@ -22,7 +22,7 @@ class CfModel {
  public:
   /// Builds detection's trees and tables for the graph's models (copied into the model).
   /// @param graph  must outlive the model and every state made from it.
-  /// @throws cf::Error when a parameter is out of range (named in the message).
+  /// @throws cf::Error when a parameter is out of range (validate(), cf/params.hpp).
   explicit CfModel(const CfGraph& graph, const Params& params = {});
   ~CfModel();
   CfModel(CfModel&&) noexcept;

@@ -9,6 +9,8 @@
 #include <cf/types.hpp>
 
 #include <cstdint>
+#include <string>
+#include <vector>
 
 namespace cf {
 
@@ -192,5 +194,37 @@ struct Params {
   IdentificationParams identification;
   ProxyParams proxy;
 };
+
+}  // namespace cf
+
+namespace cf {
+
+/// One real-valued parameter of Params: where it is in the tree, its names, unit and the
+/// values accepted. param_specs() lists every one: the one table from which validate(), the
+/// options of cfreplay and the keywords of the Python package take their ranges and help.
+struct ParamSpec {
+  const char* path;    ///< its path in Params ("mu_static", "proxy.stiffness_N_per_mm")
+  const char* python;  ///< the Python keyword
+  const char* option;  ///< cfreplay's option ("--mu"), or nullptr when it has none
+  const char* unit;    ///< "N/mm", "rad", ...; "" for a plain number
+  double lo, hi;       ///< accepted: finite and in [lo, hi] (in (lo, hi] with lo_open)
+  bool lo_open;
+  const char* doc;            ///< one line, for --help and Python's docs
+  double& (*field)(Params&);  ///< the value in a tree
+  double get(const Params& p) const { return field(const_cast<Params&>(p)); }
+  /// Empty when `v` is accepted, else why not: "mu_static = -1 is outside [0, 100]".
+  std::string problem(double v) const;
+};
+
+/// Every real-valued parameter of Params, in the tree's order.
+const std::vector<ParamSpec>& param_specs();
+
+/// Checks a parameter tree: every real value against param_specs(), the integers (at least
+/// 1), the points (finite), and the constraints between parameters (kinetic friction at most
+/// static friction, the derived angular tolerances' floor at most their ceiling).
+/// ContactDetector, CfIdentifier, ForceModel, HapticRenderer and CfModel call it.
+/// @throws cf::Error "cf::Params: parameter <path> = <value> is outside <range> <unit>", or
+/// naming both parameters of a constraint.
+void validate(const Params& p);
 
 }  // namespace cf

@@ -20,7 +20,7 @@ class HapticRenderer {
  public:
   /// Builds its own CfModel of the graph.
   /// @param graph  must outlive the renderer.
-  /// @throws cf::Error when a parameter is out of range (named in the message).
+  /// @throws cf::Error when a parameter is out of range (validate(), cf/params.hpp).
   explicit HapticRenderer(const CfGraph& graph, const Params& params = Params());
   /// Steps a model shared with other renderers (one per thread).
   /// @param model  must outlive the renderer.

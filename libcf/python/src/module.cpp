@@ -30,66 +30,10 @@ cf::Pose pose_from(const double* p, const double* q, const std::string& where) {
 
 namespace {
 
-struct DoubleField {
-  const char* name;
-  double& (*ref)(cf::Params&);  // the field in the tree
-  double lo, hi;
-  const char* doc;
-  double get(const cf::Params& P) const { return ref(const_cast<cf::Params&>(P)); }
-};
-
-// A field of cf::Params, or of its detection or identification subtree (the Python names
-// are flat: every name in the tree is unique).
-#define CF_FIELD(path) [](cf::Params& P) -> double& { return P.path; }
-
-// Every double of cf::Params, with the ranges cfreplay's options accept where it has one.
-const std::vector<DoubleField>& double_fields() {
-  static const std::vector<DoubleField> f{
-      {"mass_kg", CF_FIELD(mass_kg), 0, 1e6, "m, mass of A (kg)"},
-      {"gravity_N_per_kg", CF_FIELD(gravity_N_per_kg), -1e6, 1e6, "g along -y of the world (N/kg)"},
-      {"stiffness_N_per_mm", CF_FIELD(stiffness_N_per_mm), 1e-9, 1e9, "K of eq. (1) (N/mm)"},
-      {"kp_N_per_mm", CF_FIELD(kp_N_per_mm), 1e-9, 1e9, "K_p of eqs. (3)-(4) (N/mm)"},
-      {"mu_static", CF_FIELD(mu_static), 0, 100, "mu of eqs. (2), (3), (6)"},
-      {"mu_kinetic", CF_FIELD(mu_kinetic), 0, 100, "mu_D of eq. (5)"},
-      {"epsilon_mm", CF_FIELD(epsilon_mm), 1e-6, 1e3, "contact threshold of eq. (1) (mm)"},
-      {"freedom_rank_tolerance", CF_FIELD(freedom_rank_tolerance), 0, 1,
-       "relative singular-value tolerance of the freedoms' null space"},
-      {"motion_angle_tolerance_rad", CF_FIELD(motion_angle_tolerance_rad), 0, M_PI,
-       "'approximately along' angle of paper Fig. 10 (rad)"},
-      {"motion_noise_mm", CF_FIELD(motion_noise_mm), 0, 1e3,
-       "pose changes below this are no motion (mm)"},
-      {"hold_fcy_threshold_N", CF_FIELD(hold_fcy_threshold_N), 0, 1e6,
-       "hold F_cy while it changes by less than this (N); 0: off"},
-      {"interpolation_time_constant_s", CF_FIELD(interpolation_time_constant_s), 0, 1e3,
-       "low-pass time constant of the contact force and moment (s); 0: off"},
-      {"max_penetration_mm", CF_FIELD(detection.max_penetration_mm), 0, 1e6,
-       "deepest interpenetration still a contact (mm)"},
-      {"in_plane_tolerance_mm", CF_FIELD(detection.in_plane_tolerance_mm), -1e6, 1e6,
-       "how far outside an element a contact may fall (mm); <= 0: epsilon_mm"},
-      {"angular_tolerance_rad", CF_FIELD(detection.angular_tolerance_rad), -M_PI, M_PI,
-       "fixed angular tolerance of near-parallel (rad); <= 0: from each contact region"},
-      {"min_angular_tolerance_rad", CF_FIELD(detection.min_angular_tolerance_rad), 1e-12, M_PI,
-       "least derived angular tolerance (rad)"},
-      {"max_angular_tolerance_rad", CF_FIELD(detection.max_angular_tolerance_rad), 1e-12, M_PI,
-       "largest derived angular tolerance (rad)"},
-      {"dominance_penalty", CF_FIELD(detection.dominance_penalty), 0, 1e6,
-       "misfit added to a dominated contact"},
-      {"dominance_fit", CF_FIELD(detection.dominance_fit), 0, 1e6,
-       "share of its tolerances within which a contact dominates"},
-      {"reuse_margin_mm", CF_FIELD(detection.reuse_margin_mm), 0, 1e6,
-       "margin of the element pairs kept between ticks (mm); 0: off"},
-      {"touch_distance_mm", CF_FIELD(identification.touch_distance_mm), 0, 1e6,
-       "contacts a CF must hold: those within this of touching (mm)"},
-      {"proxy_stiffness_N_per_mm", CF_FIELD(proxy.stiffness_N_per_mm), 1e-9, 1e9,
-       "the proxy coupling's stiffness (N/mm)"},
-      {"proxy_damping_N_s_per_mm", CF_FIELD(proxy.damping_N_s_per_mm), 0, 1e9,
-       "the proxy coupling's damping (N s/mm)"},
-      {"proxy_max_penetration_mm", CF_FIELD(proxy.max_penetration_mm), 1e-9, 1e3,
-       "deepest penetration of B the proxy is left with (mm)"},
-  };
-  return f;
-}
-#undef CF_FIELD
+// The real-valued parameters: names, ranges and help from libcf's table (cf::param_specs),
+// under their Python keywords (flat: every keyword is unique).
+using DoubleField = cf::ParamSpec;
+const std::vector<cf::ParamSpec>& double_fields() { return cf::param_specs(); }
 
 template <class E>
 struct EnumField {
@@ -136,15 +80,15 @@ double double_value(const DoubleField& f, const py::handle& h, const std::string
     if (py::isinstance<py::bool_>(h) || py::isinstance<py::str>(h)) throw py::cast_error();
     v = py::float_(py::reinterpret_borrow<py::object>(h)).cast<double>();
   } catch (const py::error_already_set&) {
-    fail(where + ": " + f.name + " must be a number, got " + std::string(py::repr(h)));
+    fail(where + ": " + f.python + " must be a number, got " + std::string(py::repr(h)));
   } catch (const py::cast_error&) {
-    fail(where + ": " + f.name + " must be a number, got " + std::string(py::repr(h)));
+    fail(where + ": " + f.python + " must be a number, got " + std::string(py::repr(h)));
   }
-  if (!std::isfinite(v) || v < f.lo || v > f.hi) {
+  if (!f.problem(v).empty()) {
     char buf[120];
-    std::snprintf(buf, sizeof buf, " must be a finite number in [%g, %g], got %.17g", f.lo, f.hi,
-                  v);
-    fail(where + ": " + f.name + buf);
+    std::snprintf(buf, sizeof buf, " must be a finite number in %s%g, %g], got %.17g",
+                  f.lo_open ? "(" : "[", f.lo, f.hi, v);
+    fail(where + ": " + f.python + buf);
   }
   return v;
 }
@@ -165,8 +109,8 @@ cf::Vec3 vec3_value(const char* name, const py::handle& h, const std::string& wh
 void set_param(cf::Params& P, const std::string& key, const py::handle& value,
                const std::string& where) {
   for (const DoubleField& f : double_fields())
-    if (key == f.name) {
-      f.ref(P) = double_value(f, value, where);
+    if (key == f.python) {
+      f.field(P) = double_value(f, value, where);
       return;
     }
   if (key == kFriction.name) {
@@ -197,7 +141,7 @@ void set_param(cf::Params& P, const std::string& key, const py::handle& value,
   } else {
     std::string names;
     for (const DoubleField& f : double_fields())
-      names += std::string(names.empty() ? "" : ", ") + f.name;
+      names += std::string(names.empty() ? "" : ", ") + f.python;
     names +=
         std::string(", ") + kFriction.name + ", " + kCentroid.name + ", " + kMomentRef.name +
         ", moment_point_A, render_approaching, use_bvh, max_combinations, proxy, proxy_friction, "
@@ -208,7 +152,7 @@ void set_param(cf::Params& P, const std::string& key, const py::handle& value,
 
 py::dict params_to_dict(const cf::Params& P) {
   py::dict d;
-  for (const DoubleField& f : double_fields()) d[f.name] = f.get(P);
+  for (const DoubleField& f : double_fields()) d[f.python] = f.get(P);
   d[kFriction.name] = enum_name(kFriction, P.friction_displacement);
   d[kCentroid.name] = enum_name(kCentroid, P.centroid);
   d[kMomentRef.name] = enum_name(kMomentRef, P.moment_reference);

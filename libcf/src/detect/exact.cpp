@@ -229,20 +229,7 @@ PairTables::PairTables(const Polyhedron& ma, const Polyhedron& mb, const Params&
       wings_a(wings_of(ma)),
       wings_b(wings_of(mb)),
       origin_A(origin) {
-  auto check = [](double v, const char* name, bool positive) {
-    if (!std::isfinite(v) || v < 0 || (positive && v == 0))
-      throw Error(std::string("ContactDetector: parameter ") + name + " must be " +
-                  (positive ? "positive" : "non-negative") + ", got " + std::to_string(v));
-  };
-  check(params.epsilon_mm, "epsilon_mm", true);
-  check(prm.max_penetration_mm, "max_penetration_mm", false);
-  check(prm.min_angular_tolerance_rad, "min_angular_tolerance_rad", true);
-  check(prm.max_angular_tolerance_rad, "max_angular_tolerance_rad", true);
-  check(prm.dominance_penalty, "dominance_penalty", false);
-  check(prm.dominance_fit, "dominance_fit", false);
-  check(prm.reuse_margin_mm, "reuse_margin_mm", false);
-  if (!std::isfinite(prm.in_plane_tolerance_mm) || !std::isfinite(prm.angular_tolerance_rad))
-    throw Error("ContactDetector: in_plane_tolerance_mm and angular_tolerance_rad must be finite");
+  validate(params);
   eps = params.epsilon_mm;
   depth = prm.max_penetration_mm;
   in_plane = prm.in_plane_tolerance_mm > 0 ? prm.in_plane_tolerance_mm : eps;

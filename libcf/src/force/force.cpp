@@ -581,7 +581,9 @@ ForceModel::Fixed::Fixed(const Polyhedron& a, const Polyhedron& b, const Params&
       B(&b),
       params(p),
       centroid_A(p.centroid == CentroidChoice::kVolume ? a.volume_centroid() : a.vertex_centroid()),
-      cos_plane(std::cos(p.detection.largest_angular_tolerance_rad())) {}
+      cos_plane(std::cos(p.detection.largest_angular_tolerance_rad())) {
+  validate(p);
+}
 
 ForceModel::ForceModel(const Polyhedron& A, const Polyhedron& B, const Params& params)
     : fixed_(A, B, params) {}

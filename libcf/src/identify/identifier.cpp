@@ -434,17 +434,6 @@ void identify(const CfGraph& graph, const IdentificationParams& params, double e
   s.res = nullptr;
 }
 
-void check_identification_params(const IdentificationParams& params) {
-  if (params.max_combinations < 1)
-    throw Error("cf::Params: parameter identification.max_combinations must be at least 1, got " +
-                std::to_string(params.max_combinations));
-  if (!std::isfinite(params.touch_distance_mm) || params.touch_distance_mm < 0)
-    throw Error(
-        "cf::Params: parameter identification.touch_distance_mm must be finite and non-negative, "
-        "got " +
-        std::to_string(params.touch_distance_mm));
-}
-
 }  // namespace detail
 
 }  // namespace cf

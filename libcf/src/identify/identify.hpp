@@ -23,9 +23,6 @@ IdentifyScratchPtr make_identify_scratch();
 void identify(const CfGraph& graph, const IdentificationParams& params, double epsilon_mm,
               CfId previous, IdentifyScratch& s, Identification& id);
 
-/// @throws cf::Error naming an identification parameter out of range.
-void check_identification_params(const IdentificationParams& params);
-
 /// The CF preferred at the next tick after `id`: its CF; none after a tick without contact;
 /// the same as before when the contacts fit no CF.
 inline CfId next_previous(CfId previous, const Identification& id) {

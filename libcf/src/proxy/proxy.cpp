@@ -50,10 +50,6 @@ Mat3 rotation_matrix(const Vec3& w) {
 
 bool is_point_type(PcType t) { return extent(t) == PcExtent::kPoint; }
 
-void require(bool ok, const std::string& what) {
-  if (!ok) throw Error("cf::Params: parameter proxy." + what);
-}
-
 // A corner's friction (l1, l2) at its Coulomb bound mu ln (to rounding): where Gauss-Seidel
 // left it, the corner would slip.
 bool at_friction_bound(double l1, double l2, double mu, double ln) {
@@ -252,23 +248,7 @@ Params lookahead_params(const Params& p) {
 ProxyModel::ProxyModel(const Polyhedron& a, const Polyhedron& b, const Params& p)
     : prm(p.proxy), epsilon_mm(p.epsilon_mm), mu_static(p.mu_static), mu_kinetic(p.mu_kinetic) {
   const ProxyParams& q = p.proxy;
-  require(std::isfinite(q.stiffness_N_per_mm) && q.stiffness_N_per_mm > 0,
-          "stiffness_N_per_mm must be finite and positive, got " +
-              std::to_string(q.stiffness_N_per_mm));
-  require(std::isfinite(q.damping_N_s_per_mm) && q.damping_N_s_per_mm >= 0,
-          "damping_N_s_per_mm must be finite and non-negative, got " +
-              std::to_string(q.damping_N_s_per_mm));
-  require(std::isfinite(q.max_penetration_mm) && q.max_penetration_mm > 0,
-          "max_penetration_mm must be finite and positive, got " +
-              std::to_string(q.max_penetration_mm));
-  require(q.grip_point_A.allFinite(), "grip_point_A must be finite");
-  require(q.max_substeps >= 1,
-          "max_substeps must be at least 1, got " + std::to_string(q.max_substeps));
-  require(q.solver_iterations >= 1,
-          "solver_iterations must be at least 1, got " + std::to_string(q.solver_iterations));
-  require(std::isfinite(q.lookahead_epsilons) && q.lookahead_epsilons >= 1,
-          "lookahead_epsilons must be finite and at least 1, got " +
-              std::to_string(q.lookahead_epsilons));
+  validate(p);
   // A's bounding box as a solid: its inertia per unit mass about its centre, moved to the
   // grip point. The metric only has to weigh radians against millimetres as A's mass does.
   const Vec3 lo = a.bbox_min(), hi = a.bbox_max(), size = hi - lo, c = 0.5 * (lo + hi);

@@ -40,7 +40,7 @@ CfModel::Impl::Impl(const CfGraph& g, const Params& p)
       detect(detail::make_detect_model(g.model_a(), g.model_b(), p)),
       proxy(g.model_a(), g.model_b(), p),
       force(g.model_a(), g.model_b(), p) {
-  detail::check_identification_params(p.identification);
+  validate(p);
 }
 
 CfModel::CfModel(const CfGraph& graph, const Params& params)
