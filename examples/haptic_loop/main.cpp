@@ -14,9 +14,12 @@
 // --check: exit 1 unless the rate held, every tick with the device below the floor had a CF
 // and the proxy stayed on the floor (what the tests run).
 
+#include "servo_loop.hpp"
 #include "simulated_hand.hpp"
 
 #include <cf/renderer.hpp>
+
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <atomic>
@@ -52,7 +55,8 @@ int usage(const char* why) {
   std::fprintf(
       stderr,
       "cf_haptic_loop: %s\nusage: cf_haptic_loop --graph GRAPH.json [--rate HZ (1000..10000)] "
-      "[--duration S] [--trace trace.csv] [--device device.csv] [--check]\n",
+      "[--duration S] [--scale S] [--max-force N] [--max-torque NMM] [--max-stiffness N/MM] "
+      "[--ramp S] [--trace trace.csv] [--device device.csv] [--check]\n",
       why);
   return 2;
 }
@@ -62,8 +66,14 @@ int usage(const char* why) {
 int main(int argc, char** argv) {
   std::string graph_path, trace_path = "haptic_loop_trace.csv",
                           device_path = "haptic_loop_device.csv";
-  double rate_hz = 1000, duration_s = 3;
+  double rate_hz = 1000, duration_s = 3, scale = 1;
   bool check = false;
+  // A device that renders this scene unchanged; a 3D Systems Touch is --max-force 3.3
+  // --max-stiffness 1 (its torque is not actuated: --max-torque 0, the default here too).
+  haptic_loop::DeviceLimits limits;
+  limits.max_force_N = 20;
+  limits.max_stiffness_N_per_mm = 2.3;
+  limits.ramp_s = 0.2;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&](const char* name) -> const char* {
@@ -80,6 +90,16 @@ int main(int argc, char** argv) {
       trace_path = value("--trace");
     else if (a == "--device")
       device_path = value("--device");
+    else if (a == "--scale")
+      scale = std::atof(value("--scale"));
+    else if (a == "--max-force")
+      limits.max_force_N = std::atof(value("--max-force"));
+    else if (a == "--max-torque")
+      limits.max_torque_Nmm = std::atof(value("--max-torque"));
+    else if (a == "--max-stiffness")
+      limits.max_stiffness_N_per_mm = std::atof(value("--max-stiffness"));
+    else if (a == "--ramp")
+      limits.ramp_s = std::atof(value("--ramp"));
     else if (a == "--check")
       check = true;
     else
@@ -88,21 +108,34 @@ int main(int argc, char** argv) {
   if (graph_path.empty()) return usage("--graph is required");
   if (!(rate_hz >= 1000 && rate_hz <= 10000)) return usage("--rate must be in [1000, 10000] Hz");
   if (!(duration_s > 0 && duration_s <= 600)) return usage("--duration must be in (0, 600] s");
+  if (!(scale > 0 && scale <= 1e3)) return usage("--scale must be in (0, 1000]");
+  if (!(limits.max_force_N > 0 && limits.max_force_N <= 1e3))
+    return usage("--max-force must be in (0, 1000] N");
+  if (!(limits.max_torque_Nmm >= 0 && limits.max_torque_Nmm <= 1e6))
+    return usage("--max-torque must be in [0, 1e6] N mm (0: a force-only device)");
+  if (!(limits.max_stiffness_N_per_mm > 0 && limits.max_stiffness_N_per_mm <= 1e3))
+    return usage("--max-stiffness must be in (0, 1000] N/mm");
+  if (!(limits.ramp_s >= 0 && limits.ramp_s <= 10)) return usage("--ramp must be in [0, 10] s");
 
   try {
     // --- What an application does once: the model, shared by every servo thread. ---
     const cf::CfGraph graph = cf::CfGraph::load(graph_path);
-    const cf::CfModel model(graph, cf::Params{});  // proxy on by default: docs/spec.md, section 6b
-    cf::CfState state(model);                      // the servo thread's own
+    // The device's limits and workspace (safety.hpp): the renderer's stiffnesses lowered to
+    // what the device renders stably at this scale. Proxy on by default (docs/spec.md, 6b).
+    haptic_loop::Workspace workspace;
+    workspace.scale = scale;
+    const cf::CfModel model(graph, haptic_loop::stable_params(cf::Params{}, limits, workspace));
+    cf::CfState state(model);  // the servo thread's own
 
     // The hand's script (the cube of the bundled L-block graph touches the floor with its
     // centre at y = 35 mm; the hand carries A's 4.9 N, so it sags 4.9 mm below its target).
-    auto script = [](double t) {
+    // The script is in the scene; the hand moves the device, whose workspace is scaled.
+    auto script = [scale](double t) -> cf::Vec3 {
       const double down = std::clamp(t / 0.8, 0.0, 1.0),
                    slide = std::clamp((t - 1.2) / 1.0, 0.0, 1.0),
                    up = std::clamp((t - 2.4) / 0.4, 0.0, 1.0);
-      return cf::Vec3(70 - 20 * slide, 45 - 20 * down + 30 * up,
-                      40);  // down to 10 mm below touching
+      return cf::Vec3(70 - 20 * slide, 45 - 20 * down + 30 * up, 40) /
+             scale;  // down to 10 mm below touching
     };
     haptic_loop::SimulatedHand device(rate_hz, duration_s, script);
 
@@ -110,28 +143,29 @@ int main(int argc, char** argv) {
     std::vector<TickRecord> records(n);
     std::atomic<std::size_t> done{0};
 
-    // --- The servo thread: read, step, write, wait. Allocates nothing. ---
+    // --- The servo thread: read, map, step, guard, write, wait (servo_loop.hpp). Allocates
+    // nothing per tick; an exception writes a zero wrench and ends the loop. ---
+    haptic_loop::LoopStatus status;
+    std::string realtime;
     std::thread servo([&] {
-      std::size_t i = 0;
-      while (device.wait_next_tick() && i < n) {
-        const cf::Pose X_WD = device.read_pose();
-        const auto a = std::chrono::steady_clock::now();
-        const cf::HapticResult& out = cf::step(model, state, X_WD, device.t_s());
-        const auto b = std::chrono::steady_clock::now();
-        device.write_wrench(out.F_W, out.M_W);
-        TickRecord& r = records[i];
-        r.t_s = out.t_s;
-        r.cf = out.cf.value();
-        r.status = out.status;
-        r.motion = out.motion;
-        r.F_W = out.F_W;
-        r.Fc_W = out.F_contact_W;
-        r.X_WD = out.X_WD;
-        r.X_WP = out.X_WP;
-        r.step_us = std::chrono::duration<double, std::micro>(b - a).count();
-        r.late_us = std::chrono::duration<double, std::micro>(device.late()).count();
-        done.store(++i, std::memory_order_release);
-      }
+      realtime = haptic_loop::request_realtime();
+      status = haptic_loop::run_servo(
+          device, model, state, limits, workspace, 1.0 / rate_hz, static_cast<long long>(n),
+          [&](long long i, const cf::HapticResult& out, const haptic_loop::DeviceWrench&,
+              double late_s, double step_s) {
+            TickRecord& r = records[static_cast<std::size_t>(i)];
+            r.t_s = out.t_s;
+            r.cf = out.cf.value();
+            r.status = out.status;
+            r.motion = out.motion;
+            r.F_W = out.F_W;
+            r.Fc_W = out.F_contact_W;
+            r.X_WD = out.X_WD;
+            r.X_WP = out.X_WP;
+            r.step_us = 1e6 * step_s;
+            r.late_us = 1e6 * late_s;
+            done.store(static_cast<std::size_t>(i) + 1, std::memory_order_release);
+          });
     });
 
     // --- The main thread: statistics once a second. ---
@@ -162,6 +196,10 @@ int main(int argc, char** argv) {
     }
     servo.join();
     report(done.load(), false);
+    if (!realtime.empty()) std::printf("note: %s\n", realtime.c_str());
+    std::printf("%lld ticks saturated at the device's limits, %lld zeroed by the watchdog\n",
+                status.saturated, status.zeroed);
+    if (status.failed) throw std::runtime_error("the servo loop stopped: " + status.error);
     const std::size_t ticks = done.load();
 
     // --- Trace and device trajectory. ---
@@ -184,8 +222,11 @@ int main(int argc, char** argv) {
           r.t_s, r.cf, cf::to_string(r.status), cf::to_string(r.motion), r.F_W.x(), r.F_W.y(),
           r.F_W.z(), r.Fc_W.x(), r.Fc_W.y(), r.Fc_W.z(), r.X_WD.t_BA.x(), r.X_WD.t_BA.y(),
           r.X_WD.t_BA.z(), r.X_WP.t_BA.x(), r.X_WP.t_BA.y(), r.X_WP.t_BA.z(), r.step_us, r.late_us);
-      std::fprintf(d, "%.6f,%.6f,%.6f,%.6f,1,0,0,0\n", r.t_s, r.X_WD.t_BA.x(), r.X_WD.t_BA.y(),
-                   r.X_WD.t_BA.z());
+      // The device's full pose: its attitude as a unit quaternion (qw >= 0), as cfreplay reads.
+      Eigen::Quaterniond q(r.X_WD.R_BA);
+      if (q.w() < 0) q.coeffs() = -q.coeffs();
+      std::fprintf(d, "%.6f,%.6f,%.6f,%.6f,%.12f,%.12f,%.12f,%.12f\n", r.t_s, r.X_WD.t_BA.x(),
+                   r.X_WD.t_BA.y(), r.X_WD.t_BA.z(), q.w(), q.x(), q.y(), q.z());
       if (r.X_WD.t_BA.y() < 35.0) {
         ++inside;
         inside_without_cf += r.cf < 0 ? 1 : 0;
