@@ -30,8 +30,8 @@ cf::Mat3 turn_y(double a) { return Eigen::AngleAxisd(a, Vec3::UnitY()).toRotatio
 // Ticks are not paced (the loop runs as fast as it can) except where a test sleeps.
 class ScriptedHand final : public haptic_loop::Device {
  public:
-  int sleep_at = -1;     // the call of wait_next_tick that sleeps 3.5 ms first
-  int throw_at = -1;     // the read_pose call that throws
+  int sleep_at = -1;       // the call of wait_next_tick that sleeps 3.5 ms first
+  int throw_at = -1;       // the read_pose call that throws
   std::vector<Vec3> F, M;  // written, device axes
 
   cf::Pose read_pose() override {
@@ -87,9 +87,10 @@ TEST_CASE("the stiffnesses are lowered to what the device renders stably at the 
   CHECK(haptic_loop::stable_params(cf::Params{}, d, w).stiffness_N_per_mm == 2.3);
 }
 
-TEST_CASE("the guard saturates, drops torque on a force-only device, ramps in and zeroes late "
-          "ticks",
-          "[haptic_loop]") {
+TEST_CASE(
+    "the guard saturates, drops torque on a force-only device, ramps in and zeroes late "
+    "ticks",
+    "[haptic_loop]") {
   DeviceLimits d;
   d.max_force_N = 3.3;
   d.max_torque_Nmm = 0;  // force only
@@ -116,11 +117,12 @@ TEST_CASE("the guard saturates, drops torque on a force-only device, ramps in an
   CHECK(haptic_loop::guard_wrench(Vec3(std::nan(""), 0, 0), M, 1.0, 0, d, w).zeroed);
 }
 
-TEST_CASE("the servo loop holds the limits and the ramp on every tick of a 6-DOF hand, zeroes a "
-          "late tick and stops cleanly on an exception",
-          "[haptic_loop]") {
-  const cf::CfGraph g = cf::CfGraph::load(std::string(CF_SOURCE_DIR) +
-                                          "/data/graphs/cube_l_block.json");
+TEST_CASE(
+    "the servo loop holds the limits and the ramp on every tick of a 6-DOF hand, zeroes a "
+    "late tick and stops cleanly on an exception",
+    "[haptic_loop]") {
+  const cf::CfGraph g =
+      cf::CfGraph::load(std::string(CF_SOURCE_DIR) + "/data/graphs/cube_l_block.json");
   DeviceLimits d;
   d.max_force_N = 3.3;
   d.max_torque_Nmm = 50;
@@ -133,14 +135,14 @@ TEST_CASE("the servo loop holds the limits and the ramp on every tick of a 6-DOF
   hand.throw_at = 400;  // 0.4 s: pressed 10 mm into the floor
   std::vector<double> t, rendered;
   std::vector<int> cf_id;
-  const haptic_loop::LoopStatus s = haptic_loop::run_servo(
-      hand, model, state, d, w, 0.001, 1000,
-      [&](long long, const cf::HapticResult& out, const haptic_loop::DeviceWrench&, double,
-          double) {
-        t.push_back(out.t_s);
-        rendered.push_back(out.F_W.norm());
-        cf_id.push_back(out.cf.value());
-      });
+  const haptic_loop::LoopStatus s =
+      haptic_loop::run_servo(hand, model, state, d, w, 0.001, 1000,
+                             [&](long long, const cf::HapticResult& out,
+                                 const haptic_loop::DeviceWrench&, double, double) {
+                               t.push_back(out.t_s);
+                               rendered.push_back(out.F_W.norm());
+                               cf_id.push_back(out.cf.value());
+                             });
   REQUIRE(s.failed);
   CHECK(s.error == "device unplugged");
   CHECK(s.ticks == 400);
@@ -149,8 +151,8 @@ TEST_CASE("the servo loop holds the limits and the ramp on every tick of a 6-DOF
   CHECK(hand.M.back() == Vec3::Zero());
   CHECK(s.zeroed >= 1);
   CHECK(hand.F[1] == Vec3::Zero());  // the late tick
-  CHECK(s.saturated > 0);           // pressed 10 mm in: far more than 3.3 N rendered
-  CHECK(cf_id[399] >= 0);           // and in contact
+  CHECK(s.saturated > 0);            // pressed 10 mm in: far more than 3.3 N rendered
+  CHECK(cf_id[399] >= 0);            // and in contact
   for (std::size_t i = 0; i < hand.F.size(); ++i) {
     INFO("tick " << i);
     CHECK(hand.F[i].norm() <= 3.3 * (1 + 1e-12));
