@@ -178,12 +178,12 @@ int main(int argc, char** argv) {
       }
       if (step.empty()) return;
       std::printf(
-          "t %5.2f s: %6zu ticks%s, step median %.2f us p99 %.2f max %.2f, late median %.1f us p99 "
-          "%.1f "
-          "max %.1f\n",
-          records[upto - 1].t_s, upto - shown, full_second ? " in the last second" : " to the end",
-          quantile(step, 0.5), quantile(step, 0.99), quantile(step, 1.0), quantile(late, 0.5),
-          quantile(late, 0.99), quantile(late, 1.0));
+          "t %5.2f s: %6zu %s%s, step median %.2f us p99 %.2f max %.2f, late median %.1f us p99 "
+          "%.1f max %.1f\n",
+          records[upto - 1].t_s, upto - shown, upto - shown == 1 ? "tick" : "ticks",
+          full_second ? " in the last second" : " to the end", quantile(step, 0.5),
+          quantile(step, 0.99), quantile(step, 1.0), quantile(late, 0.5), quantile(late, 0.99),
+          quantile(late, 1.0));
       shown = upto;
     };
     auto next = std::chrono::steady_clock::now();
@@ -238,11 +238,10 @@ int main(int argc, char** argv) {
     std::vector<double> late;
     for (std::size_t k = 0; k < ticks; ++k) late.push_back(records[k].late_us);
     std::printf(
-        "%zu ticks at %.0f Hz; device below the floor on %d, without a CF on %d; proxy at most "
-        "%.4f mm "
-        "into the floor; trace %s, device poses %s\n",
-        ticks, rate_hz, inside, inside_without_cf, deepest_proxy, trace_path.c_str(),
-        device_path.c_str());
+        "%zu %s at %.0f Hz; device below the floor on %d, without a CF on %d; proxy at most "
+        "%.4f mm into the floor; trace %s, device poses %s\n",
+        ticks, ticks == 1 ? "tick" : "ticks", rate_hz, inside, inside_without_cf, deepest_proxy,
+        trace_path.c_str(), device_path.c_str());
     if (check) {
       const bool rate_held = ticks + 1 >= static_cast<std::size_t>(duration_s * rate_hz);
       if (!rate_held || inside == 0 || inside_without_cf > 0 || deepest_proxy > 0.01 + 1e-9) {

@@ -13,18 +13,18 @@
 #include <cstdio>
 #include <cstdlib>
 
-namespace cf::detail {
+namespace cf::internal {
 
 [[noreturn]] inline void demand_failed(const char* condition, const char* file, int line) {
   std::fprintf(stderr, "libcf: internal check failed: %s at %s:%d\n", condition, file, line);
   std::abort();
 }
 
-}  // namespace cf::detail
+}  // namespace cf::internal
 
-#define CF_DEMAND(cond)                                                                       \
-  do {                                                                                        \
-    if (__builtin_expect(!(cond), 0)) ::cf::detail::demand_failed(#cond, __FILE__, __LINE__); \
+#define CF_DEMAND(cond)                                                                         \
+  do {                                                                                          \
+    if (__builtin_expect(!(cond), 0)) ::cf::internal::demand_failed(#cond, __FILE__, __LINE__); \
   } while (false)
 
 #define CF_REQUIRE(cond, message)                                 \

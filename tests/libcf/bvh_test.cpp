@@ -21,14 +21,14 @@ constexpr double kSlack = 1e-4;
 Vec3 head(const Eigen::Array4f& v) { return v.head<3>().cast<double>().matrix(); }
 
 // Is p inside the node's axis-aligned box and its oriented box?
-bool in_boxes(const cf::detail::NodeBox& n, const Vec3& p) {
+bool in_boxes(const cf::internal::NodeBox& n, const Vec3& p) {
   if (((p - head(n.c)).cwiseAbs() - head(n.h)).maxCoeff() > kSlack) return false;
   for (int k = 0; k < 3; ++k)
     if (std::abs(head(n.ax[k]).dot(p - head(n.oc))) > n.oh[k] + kSlack) return false;
   return true;
 }
 
-void points(const cf::Polyhedron& m, const cf::detail::BvhElement& e, std::vector<Vec3>& out) {
+void points(const cf::Polyhedron& m, const cf::internal::BvhElement& e, std::vector<Vec3>& out) {
   out.clear();
   switch (e.kind) {
     case cf::ElementKind::kVertex:
@@ -47,7 +47,7 @@ void points(const cf::Polyhedron& m, const cf::detail::BvhElement& e, std::vecto
 
 // Separated by the axis-aligned boxes, or on either oriented box's thinnest axis, in double
 // precision.
-bool apart_reference(const cf::detail::NodeBox& p, const cf::detail::NodeBox& q) {
+bool apart_reference(const cf::internal::NodeBox& p, const cf::internal::NodeBox& q) {
   if (((head(p.c) - head(q.c)).cwiseAbs() - head(p.h) - head(q.h)).maxCoeff() > 0) return true;
   const Vec3 d = head(p.oc) - head(q.oc);
   auto apart_on = [&](const Vec3& u) {
@@ -61,12 +61,12 @@ bool apart_reference(const cf::detail::NodeBox& p, const cf::detail::NodeBox& q)
 
 // A random box: oriented box at centre c with random axes and half extents, the axis-aligned
 // box around it grown by `aabb_grow`.
-cf::detail::NodeBox random_box(std::mt19937& rng, const Vec3& c, double aabb_grow) {
+cf::internal::NodeBox random_box(std::mt19937& rng, const Vec3& c, double aabb_grow) {
   std::uniform_real_distribution<double> u(-1, 1), h(0.05, 3);
   const Eigen::Matrix3d R =
       Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized().toRotationMatrix();
   const Vec3 half(h(rng), h(rng), h(rng));
-  cf::detail::NodeBox b;
+  cf::internal::NodeBox b;
   for (int k = 0; k < 3; ++k) {
     b.ax[k] << R.col(k).cast<float>(), 0.0f;
   }
@@ -84,11 +84,11 @@ TEST_CASE("every element is in one leaf, and every node's boxes hold it", "[bvh]
   // Off its frame's origin, with the boxes' centres relative to the sphere's centre.
   const Vec3 centre(100, -20, 5);
   const cf::Polyhedron m = tmod::faceted_sphere(30, 40, 50, centre, "sphere2000");
-  const auto leaves = GENERATE(cf::detail::Leaves::kElements, cf::detail::Leaves::kFaceGroups);
+  const auto leaves = GENERATE(cf::internal::Leaves::kElements, cf::internal::Leaves::kFaceGroups);
   for (int leaf : {1, 2, 4}) {
     for (double inflate : {0.0, 0.25}) {
-      CAPTURE(leaves == cf::detail::Leaves::kFaceGroups, leaf, inflate);
-      const cf::detail::Bvh t(m, inflate, leaf, centre, leaves);
+      CAPTURE(leaves == cf::internal::Leaves::kFaceGroups, leaf, inflate);
+      const cf::internal::Bvh t(m, inflate, leaf, centre, leaves);
       const auto& nodes = t.nodes();
       REQUIRE(t.boxes().size() == nodes.size());
       const std::size_t n_elements = m.num_vertices() + m.num_edges() + m.num_faces();
@@ -96,10 +96,10 @@ TEST_CASE("every element is in one leaf, and every node's boxes hold it", "[bvh]
       REQUIRE(t.element_boxes().size() == n_elements);
       // Each (kind, index) once among the leaves' elements.
       std::vector<int> seen(n_elements, 0);
-      for (const cf::detail::BvhNode& n : nodes)
+      for (const cf::internal::BvhNode& n : nodes)
         if (n.leaf())
           for (int e = 0; e < n.count; ++e) {
-            const cf::detail::BvhElement& x =
+            const cf::internal::BvhElement& x =
                 t.elements()[static_cast<std::size_t>(n.element() + e)];
             const std::size_t base = x.kind == cf::ElementKind::kVertex ? 0
                                      : x.kind == cf::ElementKind::kEdge
@@ -116,7 +116,7 @@ TEST_CASE("every element is in one leaf, and every node's boxes hold it", "[bvh]
         auto [i, chain] = todo.back();
         todo.pop_back();
         chain.push_back(i);
-        const cf::detail::BvhNode& n = nodes[static_cast<std::size_t>(i)];
+        const cf::internal::BvhNode& n = nodes[static_cast<std::size_t>(i)];
         if (!n.leaf()) {
           todo.push_back({n.left(), chain});
           todo.push_back({n.right(), chain});
@@ -126,7 +126,7 @@ TEST_CASE("every element is in one leaf, and every node's boxes hold it", "[bvh]
           const auto pos = static_cast<std::size_t>(n.element() + e);
           points(m, t.elements()[pos], pts);
           // The element's own box too.
-          cf::detail::NodeBox own;
+          cf::internal::NodeBox own;
           own.c = t.element_boxes()[pos].c;
           own.h = t.element_boxes()[pos].h;
           own.oc = own.c;
@@ -141,10 +141,10 @@ TEST_CASE("every element is in one leaf, and every node's boxes hold it", "[bvh]
             for (std::int32_t a : chain) {
               ++checked;
               // Inflated boxes hold the points with the inflation to spare.
-              const cf::detail::NodeBox& b = t.boxes()[static_cast<std::size_t>(a)];
+              const cf::internal::NodeBox& b = t.boxes()[static_cast<std::size_t>(a)];
               if (!in_boxes(b, p - centre)) ++outside;
               if (inflate > 0) {
-                cf::detail::NodeBox shrunk = b;
+                cf::internal::NodeBox shrunk = b;
                 shrunk.h -= static_cast<float>(inflate) * Eigen::Array4f(1, 1, 1, 0);
                 shrunk.oh -= static_cast<float>(inflate) * Eigen::Array4f(1, 1, 1, 0);
                 if (!in_boxes(shrunk, p - centre)) ++outside;
@@ -162,7 +162,7 @@ TEST_CASE("oriented boxes of a curved surface's patches are thin along the norma
   // A leaf pair's patch of a 50 mm sphere with 4 mm facets bulges by about 0.1 mm: the
   // oriented box's thinnest half extent is far below its axis-aligned box's.
   const cf::Polyhedron m = tmod::faceted_sphere(50, 42, 48, Vec3::Zero(), "sphere2016");
-  const cf::detail::Bvh t(m, 0.0, 2);
+  const cf::internal::Bvh t(m, 0.0, 2);
   double thin_sum = 0, aabb_sum = 0;
   std::size_t n = 0;
   for (std::size_t i = 0; i < t.nodes().size(); ++i) {
@@ -183,8 +183,8 @@ TEST_CASE("the 4-lane box test agrees with a double-precision separating-axis te
   std::size_t apart = 0, overlap = 0, near_ties = 0;
   for (int i = 0; i < 50000; ++i) {
     // Lane s of p against the four lanes of q, both ways round.
-    cf::detail::NodeBox ps[4], qs[4];
-    cf::detail::Box4 p, q;
+    cf::internal::NodeBox ps[4], qs[4];
+    cf::internal::Box4 p, q;
     for (int j = 0; j < 4; ++j) {
       ps[j] = random_box(rng, Vec3(off(rng), off(rng), off(rng)), grow(rng));
       qs[j] = random_box(rng, Vec3::Zero(), grow(rng));
@@ -192,13 +192,13 @@ TEST_CASE("the 4-lane box test agrees with a double-precision separating-axis te
       q.set_lane(j, qs[j]);
     }
     const int s = i % 4;
-    const unsigned got = cf::detail::overlapping_lanes(p, s, q),
-                   got_back = cf::detail::overlapping_lanes(q, s, p);
+    const unsigned got = cf::internal::overlapping_lanes(p, s, q),
+                   got_back = cf::internal::overlapping_lanes(q, s, p);
     for (int j = 0; j < 4; ++j) {
       const bool ref = apart_reference(ps[s], qs[j]), ref_back = apart_reference(qs[s], ps[j]);
       // Float and double may differ within rounding of a tie: find those by nudging the box.
-      const auto tie = [&](const cf::detail::NodeBox& x, const cf::detail::NodeBox& y) {
-        cf::detail::NodeBox x_in = x, x_out = x;
+      const auto tie = [&](const cf::internal::NodeBox& x, const cf::internal::NodeBox& y) {
+        cf::internal::NodeBox x_in = x, x_out = x;
         const Eigen::Array4f e(1e-4f, 1e-4f, 1e-4f, 0);
         x_in.h += e;
         x_in.oh += e;
@@ -225,43 +225,45 @@ TEST_CASE("the 4-lane box test agrees with a double-precision separating-axis te
 TEST_CASE("face-group leaves hold their element boxes on lanes, tested like one box each",
           "[bvh]") {
   const cf::Polyhedron m = tmod::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000");
-  const cf::detail::Bvh t(m, 0.5, 1, Vec3::Zero(), cf::detail::Leaves::kFaceGroups);
+  const cf::internal::Bvh t(m, 0.5, 1, Vec3::Zero(), cf::internal::Leaves::kFaceGroups);
   // Only face-group trees with one group per leaf carry lanes.
-  CHECK(
-      cf::detail::Bvh(m, 0.5, 1, Vec3::Zero(), cf::detail::Leaves::kElements).leaf_boxes().empty());
-  CHECK(cf::detail::Bvh(m, 0.5, 2, Vec3::Zero(), cf::detail::Leaves::kFaceGroups)
+  CHECK(cf::internal::Bvh(m, 0.5, 1, Vec3::Zero(), cf::internal::Leaves::kElements)
+            .leaf_boxes()
+            .empty());
+  CHECK(cf::internal::Bvh(m, 0.5, 2, Vec3::Zero(), cf::internal::Leaves::kFaceGroups)
             .leaf_boxes()
             .empty());
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> off(-2.5, 2.5), half(0, 2);
   std::size_t leaves = 0, hits = 0, misses = 0;
-  for (const cf::detail::BvhNode& n : t.nodes()) {
+  for (const cf::internal::BvhNode& n : t.nodes()) {
     if (!n.leaf()) continue;
     ++leaves;
-    const cf::detail::LeafBoxes& L = t.leaf_boxes()[static_cast<std::size_t>(t.leaf_index(n))];
+    const cf::internal::LeafBoxes& L = t.leaf_boxes()[static_cast<std::size_t>(t.leaf_index(n))];
     for (int ka = 0; ka < 3; ++ka) {
       unsigned want = 0;
       for (int j = 0; j < n.count; ++j)
-        if (cf::detail::kinds_can_touch(
-                cf::detail::kind_bit(static_cast<cf::ElementKind>(ka)),
-                cf::detail::kind_bit(t.elements()[static_cast<std::size_t>(n.element() + j)].kind)))
+        if (cf::internal::kinds_can_touch(
+                cf::internal::kind_bit(static_cast<cf::ElementKind>(ka)),
+                cf::internal::kind_bit(
+                    t.elements()[static_cast<std::size_t>(n.element() + j)].kind)))
           want |= 1u << j;
       CHECK(L.touchable_by[ka] == want);
     }
     // A few random boxes around the leaf: each lane's answer is its element's box test, and
     // lanes past the leaf's elements never overlap.
-    const cf::detail::ElemBox& first = t.element_boxes()[static_cast<std::size_t>(n.element())];
+    const cf::internal::ElemBox& first = t.element_boxes()[static_cast<std::size_t>(n.element())];
     for (int r = 0; r < 4; ++r) {
-      cf::detail::ElemBox p;
+      cf::internal::ElemBox p;
       p.c = first.c + Eigen::Array4f(static_cast<float>(off(rng)), static_cast<float>(off(rng)),
                                      static_cast<float>(off(rng)), 0);
       p.h = Eigen::Array4f(static_cast<float>(half(rng)), static_cast<float>(half(rng)),
                            static_cast<float>(half(rng)), 0);
-      const unsigned got = cf::detail::overlapping_lanes(p, L);
-      for (int j = 0; j < cf::detail::LeafBoxes::kLanes; ++j) {
+      const unsigned got = cf::internal::overlapping_lanes(p, L);
+      for (int j = 0; j < cf::internal::LeafBoxes::kLanes; ++j) {
         const bool lane = (got >> j) & 1u;
         const bool want =
-            j < n.count && !cf::detail::boxes_apart(
+            j < n.count && !cf::internal::boxes_apart(
                                p, t.element_boxes()[static_cast<std::size_t>(n.element() + j)]);
         CHECK(lane == want);
         (want ? hits : misses) += 1;
@@ -278,8 +280,8 @@ TEST_CASE("face-group leaves hold their element boxes on lanes, tested like one 
 TEST_CASE("the 4-wide tree holds every node once, each inner lane opening into its subtree",
           "[bvh]") {
   const cf::Polyhedron m = tmod::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000");
-  const auto leaves = GENERATE(cf::detail::Leaves::kElements, cf::detail::Leaves::kFaceGroups);
-  const cf::detail::Bvh t(m, 0.25, 1, Vec3::Zero(), leaves);
+  const auto leaves = GENERATE(cf::internal::Leaves::kElements, cf::internal::Leaves::kFaceGroups);
+  const cf::internal::Bvh t(m, 0.25, 1, Vec3::Zero(), leaves);
   const auto& nodes = t.nodes();
   const auto& wide = t.wide();
   REQUIRE(!wide.empty());
@@ -289,7 +291,7 @@ TEST_CASE("the 4-wide tree holds every node once, each inner lane opening into i
   std::vector<int> as_lane(nodes.size(), 0);
   std::size_t leaf_lanes = 0;
   for (std::size_t w = 0; w < wide.size(); ++w) {
-    const cf::detail::WideNode& W = wide[w];
+    const cf::internal::WideNode& W = wide[w];
     for (int j = 0; j < 4; ++j) {
       if (W.node[j] < 0) {
         CHECK(W.wide[j] == -1);
@@ -297,14 +299,14 @@ TEST_CASE("the 4-wide tree holds every node once, each inner lane opening into i
           CHECK(((W.lanes_holding[mask] | W.lanes_touching[mask]) >> j & 1u) == 0);
         continue;
       }
-      const cf::detail::BvhNode& n = nodes[static_cast<std::size_t>(W.node[j])];
+      const cf::internal::BvhNode& n = nodes[static_cast<std::size_t>(W.node[j])];
       ++as_lane[static_cast<std::size_t>(W.node[j])];
       for (unsigned mask = 1; mask < 8; ++mask) {
         CHECK(((W.lanes_holding[mask] >> j) & 1u) == ((n.kinds & mask) ? 1u : 0u));
         CHECK(((W.lanes_touching[mask] >> j) & 1u) == ((n.touchable & mask) ? 1u : 0u));
       }
       // The lane's boxes are the node's.
-      const cf::detail::NodeBox& b = t.boxes()[static_cast<std::size_t>(W.node[j])];
+      const cf::internal::NodeBox& b = t.boxes()[static_cast<std::size_t>(W.node[j])];
       for (int i = 0; i < 3; ++i) {
         CHECK(W.box.c[i][j] == b.c[i]);
         CHECK(W.box.oh[i][j] == b.oh[i]);
@@ -317,12 +319,12 @@ TEST_CASE("the 4-wide tree holds every node once, each inner lane opening into i
       // An inner lane's wide node holds 2 to 4 of its descendants, which together hold all
       // its leaves' elements.
       REQUIRE(W.wide[j] > 0);
-      const cf::detail::WideNode& C = wide[static_cast<std::size_t>(W.wide[j])];
+      const cf::internal::WideNode& C = wide[static_cast<std::size_t>(W.wide[j])];
       int count = 0, elements = 0;
       std::vector<std::int32_t> todo{W.node[j]};
       int below = 0;
       while (!todo.empty()) {
-        const cf::detail::BvhNode& x = nodes[static_cast<std::size_t>(todo.back())];
+        const cf::internal::BvhNode& x = nodes[static_cast<std::size_t>(todo.back())];
         todo.pop_back();
         if (x.leaf())
           below += x.count;
@@ -334,7 +336,7 @@ TEST_CASE("the 4-wide tree holds every node once, each inner lane opening into i
         ++count;
         todo.push_back(C.node[k]);
         while (!todo.empty()) {
-          const cf::detail::BvhNode& x = nodes[static_cast<std::size_t>(todo.back())];
+          const cf::internal::BvhNode& x = nodes[static_cast<std::size_t>(todo.back())];
           todo.pop_back();
           if (x.leaf())
             elements += x.count;

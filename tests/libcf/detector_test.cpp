@@ -1,7 +1,7 @@
 #include <cf/detector.hpp>
 #include <cf/geometry.hpp>
 
-#include "detect/detector_poly.hpp"
+#include "detect/polygon_clipping.hpp"
 #include "fixtures.hpp"
 #include "runtime_models.hpp"
 
@@ -357,10 +357,10 @@ TEST_CASE("overlap of polygons with holes matches Boost.Geometry", "[detector]")
   using BPoint = bg::model::d2::point_xy<double>;
   using BPoly = bg::model::polygon<BPoint, false>;  // counter-clockwise outer rings
   // P: 10 x 10 square with a 4 x 4 hole; Q: an L-shaped hexagon, shifted around.
-  std::vector<cf::detail::Vec2> p = {{0, 0}, {10, 0}, {10, 10}, {0, 10},
-                                     {3, 3}, {3, 7},  {7, 7},   {7, 3}};
+  std::vector<cf::internal::Vec2> p = {{0, 0}, {10, 0}, {10, 10}, {0, 10},
+                                       {3, 3}, {3, 7},  {7, 7},   {7, 3}};
   const int plb[] = {0, 4, 8};
-  const cf::detail::Poly2 P{p.data(), plb, 2};
+  const cf::internal::Poly2 P{p.data(), plb, 2};
   BPoly bp;
   bg::read_wkt("POLYGON((0 0,10 0,10 10,0 10,0 0),(3 3,3 7,7 7,7 3,3 3))", bp);
   std::mt19937 rng(7);
@@ -368,14 +368,14 @@ TEST_CASE("overlap of polygons with holes matches Boost.Geometry", "[detector]")
   std::vector<double> scratch(64);
   for (int k = 0; k < 200; ++k) {
     const double dx = U(rng), dy = U(rng);
-    std::vector<cf::detail::Vec2> q = {{0, 0}, {8, 0}, {8, 3}, {3, 3}, {3, 8}, {0, 8}};
-    for (auto& v : q) v += cf::detail::Vec2(dx, dy);
+    std::vector<cf::internal::Vec2> q = {{0, 0}, {8, 0}, {8, 3}, {3, 3}, {3, 8}, {0, 8}};
+    for (auto& v : q) v += cf::internal::Vec2(dx, dy);
     if (k % 10 == 0)  // exact edge coincidences
-      for (auto& v : q) v -= cf::detail::Vec2(dx, dy);
+      for (auto& v : q) v -= cf::internal::Vec2(dx, dy);
     const int qlb[] = {0, 6};
-    const cf::detail::Poly2 Q{q.data(), qlb, 1};
-    const cf::detail::Overlap2 ov =
-        cf::detail::overlap(P, Q, 1e-9, scratch.data(), [](const auto&) {});
+    const cf::internal::Poly2 Q{q.data(), qlb, 1};
+    const cf::internal::Overlap2 ov =
+        cf::internal::overlap(P, Q, 1e-9, scratch.data(), [](const auto&) {});
     BPoly bq;
     for (const auto& v : q) bg::append(bq.outer(), BPoint(v.x(), v.y()));
     bg::append(bq.outer(), BPoint(q[0].x(), q[0].y()));
@@ -404,7 +404,7 @@ TEST_CASE("overlap of convex polygons by clipping matches the general routine an
   namespace bg = boost::geometry;
   using BPoint = bg::model::d2::point_xy<double>;
   using BPoly = bg::model::polygon<BPoint, false>;
-  using cf::detail::Vec2;
+  using cf::internal::Vec2;
   // Random convex polygons of 3 to 8 sides (points on a perturbed circle, in angle order),
   // sometimes sharing vertices and edges exactly, sometimes with collinear corners.
   std::mt19937 rng(11);
@@ -428,19 +428,19 @@ TEST_CASE("overlap of convex polygons by clipping matches the general routine an
         k % 7 == 0 ? p : convex_poly(Vec2(8 * U(rng) - 4, 8 * U(rng) - 4), 1 + 5 * U(rng));
     if (k % 7 == 0) std::rotate(q.begin(), q.begin() + 1, q.end());  // the same polygon
     const int plb[] = {0, static_cast<int>(p.size())}, qlb[] = {0, static_cast<int>(q.size())};
-    const cf::detail::Poly2 P{p.data(), plb, 1}, Q{q.data(), qlb, 1};
-    REQUIRE(cf::detail::is_convex(P));
-    REQUIRE(cf::detail::is_convex(Q));
+    const cf::internal::Poly2 P{p.data(), plb, 1}, Q{q.data(), qlb, 1};
+    REQUIRE(cf::internal::is_convex(P));
+    REQUIRE(cf::internal::is_convex(Q));
     // A linear function's minimum and maximum over the visited vertices (what ff takes).
     const Vec2 g(0.3, -0.7);
     double lo_c = 1e300, hi_c = -1e300, lo_g = 1e300, hi_g = -1e300;
-    cf::detail::Overlap2 oc;
-    REQUIRE(cf::detail::overlap_convex(P, Q, buf.data(), 32, oc, [&](const Vec2& v) {
+    cf::internal::Overlap2 oc;
+    REQUIRE(cf::internal::overlap_convex(P, Q, buf.data(), 32, oc, [&](const Vec2& v) {
       lo_c = std::min(lo_c, g.dot(v));
       hi_c = std::max(hi_c, g.dot(v));
     }));
-    const cf::detail::Overlap2 og =
-        cf::detail::overlap(P, Q, 1e-9, scratch.data(), [&](const Vec2& v) {
+    const cf::internal::Overlap2 og =
+        cf::internal::overlap(P, Q, 1e-9, scratch.data(), [&](const Vec2& v) {
           lo_g = std::min(lo_g, g.dot(v));
           hi_g = std::max(hi_g, g.dot(v));
         });
@@ -473,7 +473,7 @@ TEST_CASE("overlap of convex polygons by clipping matches the general routine an
 }
 
 TEST_CASE("a segment clipped by a convex polygon matches the general routine", "[detector]") {
-  using cf::detail::Vec2;
+  using cf::internal::Vec2;
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> U(0, 1);
   std::vector<double> scratch(64);
@@ -487,7 +487,7 @@ TEST_CASE("a segment clipped by a convex polygon matches the general routine", "
     std::vector<Vec2> p;
     for (double a : ang) p.push_back(5 * Vec2(std::cos(a), std::sin(a)));
     const int lb[] = {0, n};
-    const cf::detail::Poly2 P{p.data(), lb, 1};
+    const cf::internal::Poly2 P{p.data(), lb, 1};
     // Nearly straight corners are left out: there the two routines' tol bands differ by
     // tol / sin(corner's turn) (below).
     bool sharp = true;
@@ -495,7 +495,7 @@ TEST_CASE("a segment clipped by a convex polygon matches the general routine", "
       const Vec2 u = p[static_cast<std::size_t>((c + 1) % n)] - p[static_cast<std::size_t>(c)];
       const Vec2 v =
           p[static_cast<std::size_t>((c + 2) % n)] - p[static_cast<std::size_t>((c + 1) % n)];
-      sharp = sharp && cf::detail::cross2(u, v) > 0.01 * u.norm() * v.norm();
+      sharp = sharp && cf::internal::cross2(u, v) > 0.01 * u.norm() * v.norm();
     }
     if (!sharp) continue;
     // Segments: random, through two vertices, along an edge (exactly, and beyond its ends).
@@ -510,14 +510,14 @@ TEST_CASE("a segment clipped by a convex polygon matches the general routine", "
       ++along;
     }
     double g0 = 2, g1 = -1, len = 0;
-    cf::detail::clip_segment(a, b, P, 1e-9, cf::detail::OnBoundary::kInclude, scratch.data(),
-                             [&](double t0, double t1) {
-                               g0 = std::min(g0, t0);
-                               g1 = std::max(g1, t1);
-                               len += t1 - t0;
-                             });
+    cf::internal::clip_segment(a, b, P, 1e-9, cf::internal::OnBoundary::kInclude, scratch.data(),
+                               [&](double t0, double t1) {
+                                 g0 = std::min(g0, t0);
+                                 g1 = std::max(g1, t1);
+                                 len += t1 - t0;
+                               });
     double c0 = 0, c1 = 0;
-    const bool hit = cf::detail::clip_segment_convex(a, b, P, 1e-9, &c0, &c1);
+    const bool hit = cf::internal::clip_segment_convex(a, b, P, 1e-9, &c0, &c1);
     INFO("case " << k);
     // A convex polygon cuts a segment in one piece. Both routines take the boundary within
     // tol (1e-9) as inside, the general one by the distance of each piece's midpoint, this
@@ -541,14 +541,14 @@ TEST_CASE("a segment clipped by a convex polygon matches the general routine", "
 }
 
 TEST_CASE("convexity: one loop, no reflex corner", "[detector]") {
-  using cf::detail::Vec2;
+  using cf::internal::Vec2;
   std::vector<Vec2> square = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
   std::vector<Vec2> l_shape = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
   std::vector<Vec2> holed = {{0, 0}, {4, 0}, {4, 4}, {0, 4}, {1, 1}, {1, 3}, {3, 3}, {3, 1}};
   const int lb4[] = {0, 4}, lb6[] = {0, 6}, lb44[] = {0, 4, 8};
-  CHECK(cf::detail::is_convex({square.data(), lb4, 1}));
-  CHECK_FALSE(cf::detail::is_convex({l_shape.data(), lb6, 1}));
-  CHECK_FALSE(cf::detail::is_convex({holed.data(), lb44, 2}));
+  CHECK(cf::internal::is_convex({square.data(), lb4, 1}));
+  CHECK_FALSE(cf::internal::is_convex({l_shape.data(), lb6, 1}));
+  CHECK_FALSE(cf::internal::is_convex({holed.data(), lb44, 2}));
 }
 
 namespace {

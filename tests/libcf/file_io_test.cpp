@@ -78,11 +78,11 @@ TEST_CASE("a signal that ends the process mid-write leaves no temporary file") {
     REQUIRE(child >= 0);
     if (child == 0) {
       std::signal(sig, SIG_DFL);
-      const cf::detail::StreamedOutput out{target, [sig](const cf::detail::ByteSink& sink) {
-                                             sink("{\"half\":", 8);
-                                             std::raise(sig);  // the default ends the process
-                                           }};
-      cf::detail::write_streamed_outputs({out}, {}, "writing graph");
+      const cf::internal::StreamedOutput out{target, [sig](const cf::internal::ByteSink& sink) {
+                                               sink("{\"half\":", 8);
+                                               std::raise(sig);  // the default ends the process
+                                             }};
+      cf::internal::write_streamed_outputs({out}, {}, "writing graph");
       ::_exit(0);
     }
     int status = 0;
@@ -102,12 +102,12 @@ TEST_CASE("a signal the program handles itself does not cut the write short") {
   REQUIRE(child >= 0);
   if (child == 0) {
     std::signal(SIGHUP, [](int) {});  // as cfgen's stop between tasks, or Python's handler
-    const cf::detail::StreamedOutput out{target, [](const cf::detail::ByteSink& sink) {
-                                           sink("{\"a\":", 5);
-                                           std::raise(SIGHUP);
-                                           sink("1}", 2);
-                                         }};
-    cf::detail::write_streamed_outputs({out}, {}, "writing graph");
+    const cf::internal::StreamedOutput out{target, [](const cf::internal::ByteSink& sink) {
+                                             sink("{\"a\":", 5);
+                                             std::raise(SIGHUP);
+                                             sink("1}", 2);
+                                           }};
+    cf::internal::write_streamed_outputs({out}, {}, "writing graph");
     ::_exit(0);
   }
   int status = 0;

@@ -264,7 +264,7 @@ if [[ "$group" == cfreplay ]]; then
   if [[ $(cut -d, -f1 fine_out.csv | tr '\n' ' ') == "t 0 1e-07 2e-07 " ]]; then report fine_times_distinct 1 ""; else report fine_times_distinct 0 "t column: $(cut -d, -f1 fine_out.csv | tr '\n' ' ')"; fi
   rm -f subnormal_out.csv fine_out.csv
   printf 't,tx,ty,tz,qw,qx,qy,qz\n0,20,10.3,5,0.7071,0.7071,0,0\n' >q4.csv
-  check quaternion_4_decimals 0 "^cfreplay: 1 ticks" -- "$CFREPLAY" --graph "$G" --trajectory q4.csv -o q4_out.csv
+  check quaternion_4_decimals 0 "^cfreplay: 1 tick -> " -- "$CFREPLAY" --graph "$G" --trajectory q4.csv -o q4_out.csv
   printf 't,tx,ty,tz,qw,qx,qy,qz\n0,20,10.3,5,1,0.1,0,0\n' >q_bad.csv
   check quaternion_not_unit 1 "^cfreplay: q_bad.csv:2: the quaternion \(qw,qx,qy,qz\) has norm 1.00498756, not 1 within 0.001" -- "$CFREPLAY" --graph "$G" --trajectory q_bad.csv -o o.csv
   python3 -c "import sys; sys.stdout.buffer.write(b'\xa1\x61x' + b'\x81' * 100000 + b'\xf6')" >deep.cbor

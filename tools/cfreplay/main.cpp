@@ -177,7 +177,8 @@ int main(int argc, char** argv) {
       files.push_back(
           {plot_path, cf::replay::svg_plot(rows, traj_path + " against " + graph_path)});
     cf::write_outputs(files, inputs, "writing");
-    std::cerr << "cfreplay: " << rows.size() << " ticks ->" << ' ' << out_path << " (";
+    std::cerr << "cfreplay: " << rows.size() << (rows.size() == 1 ? " tick" : " ticks") << " -> "
+              << out_path << " (";
     bool first = true;
     for (const auto& [s, n] : statuses) {
       std::cerr << (first ? "" : ", ") << s << " " << n;

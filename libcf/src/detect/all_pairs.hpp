@@ -8,7 +8,7 @@
 
 #include <cstddef>
 
-namespace cf::detail {
+namespace cf::internal {
 
 /// Pushes every contact at `p.pose` into `out` (unsorted, unfinished); returns the number
 /// of pairs tested.
@@ -32,4 +32,4 @@ inline std::size_t detect_all_pairs(const PairTables& t, PosedA& p, ExactScratch
   return pairs;
 }
 
-}  // namespace cf::detail
+}  // namespace cf::internal

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace cf::detail {
+namespace cf::internal {
 namespace {
 
 // A unit of the build: one element, or a face with the edges and vertices it owns.
@@ -359,4 +359,4 @@ std::int32_t Bvh::add_wide(const std::int32_t* members, int count) {
   return w;
 }
 
-}  // namespace cf::detail
+}  // namespace cf::internal

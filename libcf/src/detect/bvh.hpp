@@ -19,7 +19,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace cf::detail {
+namespace cf::internal {
 
 // Unrolls the next loop of 3 (GCC and Clang): -O2 does not.
 #define CF_UNROLL3 _Pragma("GCC unroll 3")
@@ -409,4 +409,4 @@ bool descend_wide(const Bvh& ta, const Bvh& tb, PosedA&& posed_a, NodePair* stac
   return ok;
 }
 
-}  // namespace cf::detail
+}  // namespace cf::internal

@@ -16,7 +16,7 @@
 #include <limits>
 #include <vector>
 
-namespace cf::detail {
+namespace cf::internal {
 
 /// Bounds how far any point of A moves from pose p0 to p1 (mm): the move of t.origin_A plus
 /// |R1 - R0| times A's reach from it (Frobenius norm, a bound of the spectral norm).
@@ -124,4 +124,4 @@ class KeptPairs {
   double moved_ = 0, turned_ = 0;  // this call's pose from the kept pose
 };
 
-}  // namespace cf::detail
+}  // namespace cf::internal

@@ -11,7 +11,7 @@
 #include <cstddef>
 #include <memory>
 
-namespace cf::detail {
+namespace cf::internal {
 
 struct DetectModel;
 struct DetectState;
@@ -58,4 +58,4 @@ const Polyhedron& model_b_of(const DetectModel& m);
 std::size_t pairs_tested(const DetectState& s);  ///< in the last detect (ContactDetector)
 bool reused_pairs(const DetectState& s);         ///< the last detect served kept pairs
 
-}  // namespace cf::detail
+}  // namespace cf::internal

@@ -4,11 +4,11 @@
 
 #include "all_pairs.hpp"
 #include "bvh.hpp"
-#include "cheap.hpp"
+#include "cheap_rejections.hpp"
 #include "check.hpp"
 #include "coherence.hpp"
 #include "exact.hpp"
-#include "finish.hpp"
+#include "finish_contacts.hpp"
 
 #include <algorithm>
 #include <array>
@@ -16,12 +16,12 @@
 #include <string>
 #include <vector>
 
-namespace cf::detail {
+namespace cf::internal {
 
 // BVH leaves of a model: one element for small models (with bigger leaves, leaf boxes of the
 // paper's cube and L-block overlap everything), posed like inner nodes (cheaper than exact
 // boxes there: 2.4 against 2.8 us per tick). Big models' nodes are also tested as oriented
-// boxes, four at a time (detail::descend_wide): a curved surface's patches are tilted, and
+// boxes, four at a time (internal::descend_wide): a curved surface's patches are tilted, and
 // the axis-aligned box of a tilted patch is as thick as it is wide, so that two surfaces in
 // contact overlap over many patches; and their leaves hold one face with the edges and
 // vertices it owns, which tile the surface, each element with its own box tested in the
@@ -31,8 +31,8 @@ constexpr std::size_t kBigModelElements = 256;
 static bool is_big(const Polyhedron& m) {
   return m.num_vertices() + m.num_edges() + m.num_faces() >= kBigModelElements;
 }
-static detail::Leaves leaves_for(const Polyhedron& m) {
-  return is_big(m) ? detail::Leaves::kFaceGroups : detail::Leaves::kElements;
+static internal::Leaves leaves_for(const Polyhedron& m) {
+  return is_big(m) ? internal::Leaves::kFaceGroups : internal::Leaves::kElements;
 }
 
 // The immutable part: the models, their trees and the exact tests' tables.
@@ -46,7 +46,7 @@ struct DetectModel {
   // tested in the leaf, and nodes tested as oriented boxes too.
   bool big = false;
   std::vector<Eigen::Array4f> a_vert;  // mm, A's vertices relative to bvh_a.origin(), A's frame
-  FinishContext finishing;             // what finish_contacts reads (finish.hpp)
+  FinishContext finishing;             // what finish_contacts reads (finish_contacts.hpp)
 
   DetectModel(const Polyhedron& ma, const Polyhedron& mb, const Params& params_in)
       : a(ma), b(mb), all(params_in), tab(a, b, params_in, 0.5 * (ma.bbox_min() + ma.bbox_max())) {
@@ -92,14 +92,14 @@ struct DetectState {
     std::uint64_t stamp = 0;
   };
   std::vector<PosedBox> a_box;
-  struct PosedWide {   // big models: a wide node's four boxes
-    detail::Box4 box;  // B's frame
+  struct PosedWide {     // big models: a wide node's four boxes
+    internal::Box4 box;  // B's frame
     std::uint64_t stamp = 0;
   };
   std::vector<PosedWide> a_wide;
   // Big models: A's elements' boxes, from A's vertices posed in single precision.
   struct PosedElem {
-    detail::ElemBox box;  // B's frame
+    internal::ElemBox box;  // B's frame
     std::uint64_t stamp = 0;
   };
   std::vector<PosedElem> a_elem;
@@ -109,7 +109,7 @@ struct DetectState {
   };
   std::vector<PosedVertex> a_vert_posed;
   Mat3 absR = Mat3::Identity();
-  detail::CheapRejections cheap;  // cheap.hpp
+  internal::CheapRejections cheap;  // cheap_rejections.hpp
   Eigen::Matrix3f Rf = Eigen::Matrix3f::Identity(), absRf = Eigen::Matrix3f::Identity();
   Eigen::Array4f Rcol[3];   // R_BA's columns, lane 3 zero (A's vertices' posing)
   Eigen::Array4f a_origin;  // mm, bvh_a's origin posed, B's frame
@@ -117,18 +117,18 @@ struct DetectState {
   // a_origin[i].
   Eigen::Array4f Rb[3][3], absRb[3][3], ob[3];
   // Scratch (sized once).
-  std::vector<detail::NodePair> stack;
-  detail::ExactScratch scratch;
+  std::vector<internal::NodePair> stack;
+  internal::ExactScratch scratch;
   // Per call: the pose, A's vertices posed at it, the stamp of the per-pose caches.
-  detail::PosedA posed;
+  internal::PosedA posed;
   ContactSet* out = nullptr;
   std::size_t pairs = 0;
   // Temporal coherence (coherence.hpp): the pairs kept at a pose and their certificates.
-  using Cert = detail::Cert;
-  detail::KeptPairs kept;
+  using Cert = internal::Cert;
+  internal::KeptPairs kept;
   bool recording = false, reused = false;
-  float grow = 0;                        // mm, added to A's posed boxes in this call
-  detail::FinishScratch finish_scratch;  // finish.hpp
+  float grow = 0;                          // mm, added to A's posed boxes in this call
+  internal::FinishScratch finish_scratch;  // finish_contacts.hpp
 
   explicit DetectState(const DetectModel& m) : cheap(m.tab), scratch(m.tab), posed(m.a) {
     stack.resize(stack_capacity(m.bvh_a, m.bvh_b));
@@ -144,8 +144,8 @@ struct DetectState {
 
   // Small models: does A's BVH node `ia` (posed) overlap B's node? The axis-aligned boxes
   // in B's frame, then, for inner nodes, B's box on A's node's own axes.
-  __attribute__((always_inline)) bool overlap(std::int32_t ia, const detail::BvhNode& A,
-                                              const detail::BvhNode& B) {
+  __attribute__((always_inline)) bool overlap(std::int32_t ia, const internal::BvhNode& A,
+                                              const internal::BvhNode& B) {
     PosedBox& P = a_box[static_cast<std::size_t>(ia)];
     if (P.stamp != posed.stamp) pose_box(P, A);
     const Eigen::Vector3f d = P.c - B.center;
@@ -185,7 +185,7 @@ struct DetectState {
       lo = lo.min(p);
       hi = hi.max(p);
     };
-    const detail::BvhElement& x = M.bvh_a.elements()[static_cast<std::size_t>(i)];
+    const internal::BvhElement& x = M.bvh_a.elements()[static_cast<std::size_t>(i)];
     switch (x.kind) {
       case ElementKind::kVertex:
         add(VertexId(x.index));
@@ -208,14 +208,14 @@ struct DetectState {
     const DetectModel& M = *mp;
     PosedElem& P = a_elem[static_cast<std::size_t>(ia)];
     if (P.stamp != posed.stamp) pose_element(P, ia);
-    return !detail::boxes_apart(P.box, M.bvh_b.element_boxes()[static_cast<std::size_t>(ib)]);
+    return !internal::boxes_apart(P.box, M.bvh_b.element_boxes()[static_cast<std::size_t>(ib)]);
   }
 
   // A's node at the current pose: its box in B's frame.
-  __attribute__((noinline)) void pose_box(PosedBox& P, const detail::BvhNode& N) {
+  __attribute__((noinline)) void pose_box(PosedBox& P, const internal::BvhNode& N) {
     P.stamp = posed.stamp;
-    detail::round_out(posed.pose.apply(N.center.cast<double>()), absR * N.half.cast<double>(), P.c,
-                      P.h);
+    internal::round_out(posed.pose.apply(N.center.cast<double>()), absR * N.half.cast<double>(),
+                        P.c, P.h);
   }
 
   // A big model's wide node w at the current pose, in B's frame, in single precision. Its
@@ -224,7 +224,7 @@ struct DetectState {
   // place) stays far below B's boxes' float slack wherever the two boxes could overlap. The
   // posed axis-aligned box of the oriented box bounds the node as well: the overlap of the
   // two is kept.
-  const detail::Box4& posed_wide(std::int32_t w) {
+  const internal::Box4& posed_wide(std::int32_t w) {
     PosedWide& P = a_wide[static_cast<std::size_t>(w)];
     if (P.stamp != posed.stamp) pose_wide(P, w);
     return P.box;
@@ -233,8 +233,8 @@ struct DetectState {
     const DetectModel& M = *mp;
     using V = Eigen::Array4f;
     P.stamp = posed.stamp;
-    const detail::Box4& N = M.bvh_a.wide()[static_cast<std::size_t>(w)].box;
-    detail::Box4& Q = P.box;
+    const internal::Box4& N = M.bvh_a.wide()[static_cast<std::size_t>(w)].box;
+    internal::Box4& Q = P.box;
     // Unrolled: at -O2 GCC keeps these loops of 3 and spills the temporaries.
     CF_UNROLL3
     for (int k = 0; k < 3; ++k) CF_UNROLL3
@@ -259,17 +259,17 @@ struct DetectState {
   // where B's leaves hold no element lanes (B small).
   __attribute__((always_inline)) void pair(int ia, int ib) {
     const DetectModel& M = *mp;
-    const detail::BvhElement& x = M.bvh_a.elements()[static_cast<std::size_t>(ia)];
-    const detail::BvhElement& y = M.bvh_b.elements()[static_cast<std::size_t>(ib)];
-    if (!detail::kinds_can_touch(detail::kind_bit(x.kind), detail::kind_bit(y.kind))) return;
+    const internal::BvhElement& x = M.bvh_a.elements()[static_cast<std::size_t>(ia)];
+    const internal::BvhElement& y = M.bvh_b.elements()[static_cast<std::size_t>(ib)];
+    if (!internal::kinds_can_touch(internal::kind_bit(x.kind), internal::kind_bit(y.kind))) return;
     if (M.big && !element_boxes_overlap(ia, ib)) return;
     boxed_pair(ia, ib, x, y);
   }
 
   // The cheap rejection and the exact test of a pair, for kept pairs: the certificate of
   // whichever turned it away (none when it passed both).
-  __attribute__((always_inline)) Cert certified_test(const detail::BvhElement& x,
-                                                     const detail::BvhElement& y) {
+  __attribute__((always_inline)) Cert certified_test(const internal::BvhElement& x,
+                                                     const internal::BvhElement& y) {
     const DetectModel& M = *mp;
     Cert c;
     if (cheap.may_touch<true>(M.tab, posed, x.kind, x.index, y.kind, y.index, &c)) c = exact(x, y);
@@ -279,23 +279,23 @@ struct DetectState {
   // Leaves of the two BVHs whose boxes overlap: their element pairs whose kinds can touch
   // and whose own boxes overlap. B's face-group leaves hold their element boxes on SIMD
   // lanes: each of A's elements is tested against all of them at once.
-  void leaf_pair(const detail::BvhNode& A, const detail::BvhNode& B) {
+  void leaf_pair(const internal::BvhNode& A, const internal::BvhNode& B) {
     const DetectModel& M = *mp;
     if (M.bvh_b.leaf_boxes().empty()) {
       for (int i = 0; i < A.count; ++i)
         for (int j = 0; j < B.count; ++j) pair(A.element() + i, B.element() + j);
       return;
     }
-    const detail::LeafBoxes& L =
+    const internal::LeafBoxes& L =
         M.bvh_b.leaf_boxes()[static_cast<std::size_t>(M.bvh_b.leaf_index(B))];
     for (int i = 0; i < A.count; ++i) {
       const int ia = A.element() + i;
-      const detail::BvhElement& x = M.bvh_a.elements()[static_cast<std::size_t>(ia)];
+      const internal::BvhElement& x = M.bvh_a.elements()[static_cast<std::size_t>(ia)];
       unsigned lanes = L.touchable_by[static_cast<std::size_t>(x.kind)];
       if (lanes == 0) continue;
       PosedElem& P = a_elem[static_cast<std::size_t>(ia)];
       if (P.stamp != posed.stamp) pose_element(P, ia);
-      lanes &= detail::overlapping_lanes(P.box, L);
+      lanes &= internal::overlapping_lanes(P.box, L);
       while (lanes != 0) {
         const int ib = B.element() + __builtin_ctz(lanes);
         lanes &= lanes - 1;
@@ -305,8 +305,8 @@ struct DetectState {
   }
 
   // A pair past the kinds and the boxes.
-  __attribute__((always_inline)) void boxed_pair(int ia, int ib, const detail::BvhElement& x,
-                                                 const detail::BvhElement& y) {
+  __attribute__((always_inline)) void boxed_pair(int ia, int ib, const internal::BvhElement& x,
+                                                 const internal::BvhElement& y) {
     const DetectModel& M = *mp;
     ++pairs;
     if (!recording) {
@@ -319,11 +319,11 @@ struct DetectState {
 
   // The exact test of a pair (exact.hpp): its contact goes to the output; returns the
   // certificate of a pair turned away.
-  __attribute__((always_inline)) Cert exact(const detail::BvhElement& x,
-                                            const detail::BvhElement& y) {
+  __attribute__((always_inline)) Cert exact(const internal::BvhElement& x,
+                                            const internal::BvhElement& y) {
     const DetectModel& M = *mp;
-    detail::PairOutcome o =
-        detail::exact_test(M.tab, posed, scratch, x.kind, x.index, y.kind, y.index);
+    internal::PairOutcome o =
+        internal::exact_test(M.tab, posed, scratch, x.kind, x.index, y.kind, y.index);
     if (o.contact) out->push(*o.contact);
     return o.cert;
   }
@@ -337,8 +337,9 @@ struct DetectState {
     pairs = 0;
     ++posed.stamp;  // 64 bits: never wraps, so the per-pose caches need no reset
     if (!M.tab.prm.use_bvh) {
-      pairs = detail::detect_all_pairs(M.tab, posed, scratch, cs);  // the reference (all_pairs.hpp)
-      detail::finish_contacts(M.finishing, finish_scratch, cs);
+      pairs =
+          internal::detect_all_pairs(M.tab, posed, scratch, cs);  // the reference (all_pairs.hpp)
+      internal::finish_contacts(M.finishing, finish_scratch, cs);
       out = nullptr;
       return;
     }
@@ -360,7 +361,7 @@ struct DetectState {
     recording = false;
     if (kept.enabled()) {
       switch (kept.start(M.tab, pose, M.tab.prm.reuse_margin_mm)) {
-        case detail::KeptPairs::Mode::kServe:
+        case internal::KeptPairs::Mode::kServe:
           // The kept pairs whose certificates do not hold go through the cheap rejections and
           // the exact test. Not through the element boxes: with the certificates, posing A's
           // elements for them cost more than the boxes saved (5% more instructions).
@@ -372,36 +373,36 @@ struct DetectState {
                                   M.bvh_b.elements()[static_cast<std::size_t>(ib)]);
           });
           posed.certifying = false;
-          detail::finish_contacts(M.finishing, finish_scratch, cs);
+          internal::finish_contacts(M.finishing, finish_scratch, cs);
           out = nullptr;
           return;
-        case detail::KeptPairs::Mode::kRecord:
+        case internal::KeptPairs::Mode::kRecord:
           recording = true;
           grow = static_cast<float>(M.tab.prm.reuse_margin_mm);
           posed.certifying = true;
           break;
-        case detail::KeptPairs::Mode::kOff:
+        case internal::KeptPairs::Mode::kOff:
           break;
       }
     }
     // The stack is sized for the trees' depths, so the descents cannot overflow it.
-    const auto leaves = [this](const detail::BvhNode& A, const detail::BvhNode& B) {
+    const auto leaves = [this](const internal::BvhNode& A, const internal::BvhNode& B) {
       leaf_pair(A, B);
     };
     const bool complete =
-        M.big ? detail::descend_wide(
+        M.big ? internal::descend_wide(
                     M.bvh_a, M.bvh_b,
-                    [this](std::int32_t w) -> const detail::Box4& { return posed_wide(w); },
+                    [this](std::int32_t w) -> const internal::Box4& { return posed_wide(w); },
                     stack.data(), stack.size(), leaves)
-              : detail::descend(
+              : internal::descend(
                     M.bvh_a, M.bvh_b,
-                    [this](std::int32_t ia, std::int32_t, const detail::BvhNode& A,
-                           const detail::BvhNode& B) { return overlap(ia, A, B); },
+                    [this](std::int32_t ia, std::int32_t, const internal::BvhNode& A,
+                           const internal::BvhNode& B) { return overlap(ia, A, B); },
                     stack.data(), stack.size(), leaves);
     CF_DEMAND(complete);
     if (recording) kept.finish_recording(pose);
     recording = posed.certifying = false;
-    detail::finish_contacts(M.finishing, finish_scratch, cs);
+    internal::finish_contacts(M.finishing, finish_scratch, cs);
     out = nullptr;
   }
 };
@@ -423,33 +424,33 @@ const Polyhedron& model_b_of(const DetectModel& m) { return m.b; }
 std::size_t pairs_tested(const DetectState& s) { return s.pairs; }
 bool reused_pairs(const DetectState& s) { return s.reused; }
 
-}  // namespace cf::detail
+}  // namespace cf::internal
 
 namespace cf {
 
 struct ContactDetector::Impl {
-  detail::DetectModelPtr model;
-  detail::DetectStatePtr state;
+  internal::DetectModelPtr model;
+  internal::DetectStatePtr state;
 };
 
 ContactDetector::ContactDetector(const Polyhedron& a, const Polyhedron& b, const Params& params)
     : impl_(std::make_unique<Impl>()) {
-  impl_->model = detail::make_detect_model(a, b, params);
-  impl_->state = detail::make_detect_state(*impl_->model);
+  impl_->model = internal::make_detect_model(a, b, params);
+  impl_->state = internal::make_detect_state(*impl_->model);
 }
 ContactDetector::~ContactDetector() = default;
 ContactDetector::ContactDetector(ContactDetector&&) noexcept = default;
 ContactDetector& ContactDetector::operator=(ContactDetector&&) noexcept = default;
 
 void ContactDetector::detect(const Pose& pose, ContactSet& out) {
-  detail::detect(*impl_->model, *impl_->state, pose, out);
+  internal::detect(*impl_->model, *impl_->state, pose, out);
 }
-const Params& ContactDetector::params() const { return detail::params_of(*impl_->model); }
-const Polyhedron& ContactDetector::model_a() const { return detail::model_a_of(*impl_->model); }
-const Polyhedron& ContactDetector::model_b() const { return detail::model_b_of(*impl_->model); }
+const Params& ContactDetector::params() const { return internal::params_of(*impl_->model); }
+const Polyhedron& ContactDetector::model_a() const { return internal::model_a_of(*impl_->model); }
+const Polyhedron& ContactDetector::model_b() const { return internal::model_b_of(*impl_->model); }
 std::size_t ContactDetector::last_pairs_tested() const {
-  return detail::pairs_tested(*impl_->state);
+  return internal::pairs_tested(*impl_->state);
 }
-bool ContactDetector::last_reused_pairs() const { return detail::reused_pairs(*impl_->state); }
+bool ContactDetector::last_reused_pairs() const { return internal::reused_pairs(*impl_->state); }
 
 }  // namespace cf

@@ -5,7 +5,7 @@
 #include <limits>
 #include <string>
 
-namespace cf::detail {
+namespace cf::internal {
 
 namespace {
 
@@ -530,4 +530,4 @@ PairOutcome edge_edge(const PairTables& t, PosedA& P, int ea, int eb) {
                  std::abs(d) / t.eps + over / t.eps + (at_end ? kAlongBoundaryPenalty : 0.0), fit);
 }
 
-}  // namespace cf::detail
+}  // namespace cf::internal

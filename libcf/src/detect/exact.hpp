@@ -10,7 +10,7 @@
 #include <cf/params.hpp>
 #include <cf/polyhedron.hpp>
 
-#include "detector_poly.hpp"
+#include "polygon_clipping.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,14 +18,14 @@
 #include <optional>
 #include <vector>
 
-namespace cf::detail {
+namespace cf::internal {
 
 /// Flattened 2D loops of every face of a model, in each face's own (u, v) frame.
 struct FlatFaces {
   std::vector<Vec2> pts;
   std::vector<int> loop_begin;  ///< per loop, plus a sentinel
   std::vector<int> face_first;  ///< per face, its first loop index, plus a sentinel
-  std::vector<char> convex;     ///< per face, detail::is_convex
+  std::vector<char> convex;     ///< per face, internal::is_convex
   int max_face_points = 0;
 
   explicit FlatFaces(const Polyhedron& m);
@@ -170,4 +170,4 @@ inline PairOutcome exact_test(const PairTables& t, PosedA& p, ExactScratch& s, E
   return {};
 }
 
-}  // namespace cf::detail
+}  // namespace cf::internal

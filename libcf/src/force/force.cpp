@@ -591,14 +591,14 @@ ForceModel::ForceModel(const Polyhedron& A, const Polyhedron& B, const Params& p
 const ForceResult& ForceModel::step(const Pose& pose, double t_s, const ContactPc* pcs, int n,
                                     const PriorMotion& prior, bool conservative,
                                     const ContactPc* approaching, int n_approaching) {
-  return detail::step_force(fixed_, state_, pose, t_s, pcs, n, prior, conservative, approaching,
-                            n_approaching);
+  return internal::step_force(fixed_, state_, pose, t_s, pcs, n, prior, conservative, approaching,
+                              n_approaching);
 }
 
-const ForceResult& detail::step_force(const ForceModel::Fixed& fm, ForceState& s, const Pose& pose,
-                                      double t_s, const ContactPc* pcs, int n,
-                                      const PriorMotion& prior, bool conservative,
-                                      const ContactPc* approaching, int n_approaching) {
+const ForceResult& internal::step_force(const ForceModel::Fixed& fm, ForceState& s,
+                                        const Pose& pose, double t_s, const ContactPc* pcs, int n,
+                                        const PriorMotion& prior, bool conservative,
+                                        const ContactPc* approaching, int n_approaching) {
   ForceResult& r = s.result;
   begin_force_tick(s, prior, conservative);
   PcWork w;

@@ -4,11 +4,11 @@
 
 #include <cf/force.hpp>
 
-namespace cf::detail {
+namespace cf::internal {
 
 /// ForceModel::step's tick (its arguments are documented there) on `model` and `state`.
 const ForceResult& step_force(const ForceModel::Fixed& model, ForceState& state, const Pose& pose,
                               double t_s, const ContactPc* pcs, int n, const PriorMotion& prior,
                               bool conservative, const ContactPc* approaching, int n_approaching);
 
-}  // namespace cf::detail
+}  // namespace cf::internal

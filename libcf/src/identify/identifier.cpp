@@ -83,7 +83,7 @@ bool closures_meet(const Polyhedron& m, ElementKind ki, int i, ElementKind kj, i
 
 }  // namespace
 
-namespace detail {
+namespace internal {
 
 struct IdentifyScratch {
   // Set per call by identify().
@@ -434,6 +434,6 @@ void identify(const CfGraph& graph, const IdentificationParams& params, double e
   s.res = nullptr;
 }
 
-}  // namespace detail
+}  // namespace internal
 
 }  // namespace cf

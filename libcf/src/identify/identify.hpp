@@ -9,7 +9,7 @@
 
 #include <memory>
 
-namespace cf::detail {
+namespace cf::internal {
 
 struct IdentifyScratch;
 struct IdentifyScratchDelete {
@@ -30,4 +30,4 @@ inline CfId next_previous(CfId previous, const Identification& id) {
   return id.contacts.empty() ? CfId() : previous;
 }
 
-}  // namespace cf::detail
+}  // namespace cf::internal

@@ -294,14 +294,14 @@ std::string canonical_path(const std::string& path) {
 
 void write_outputs(const std::vector<OutputFile>& files, const std::vector<std::string>& inputs,
                    const char* what) {
-  std::vector<detail::StreamedOutput> streamed;
+  std::vector<internal::StreamedOutput> streamed;
   for (const OutputFile& f : files)
     streamed.push_back(
-        {f.path, [&f](const detail::ByteSink& sink) { sink(f.bytes.data(), f.bytes.size()); }});
-  detail::write_streamed_outputs(streamed, inputs, what);
+        {f.path, [&f](const internal::ByteSink& sink) { sink(f.bytes.data(), f.bytes.size()); }});
+  internal::write_streamed_outputs(streamed, inputs, what);
 }
 
-namespace detail {
+namespace internal {
 
 void write_streamed_outputs(const std::vector<StreamedOutput>& files,
                             const std::vector<std::string>& inputs, const char* what) {
@@ -382,7 +382,7 @@ void write_streamed_outputs(const std::vector<StreamedOutput>& files,
   }
 }
 
-}  // namespace detail
+}  // namespace internal
 
 std::string printable(const std::string& text, std::size_t max) {
   std::string out;

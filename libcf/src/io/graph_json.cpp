@@ -22,8 +22,8 @@ namespace cf {
 
 namespace {
 
-using detail::json;
-using detail::JsonWhere;
+using internal::json;
+using internal::JsonWhere;
 using ojson = nlohmann::ordered_json;
 
 bool ends_with(const std::string& s, const std::string& suffix) {
@@ -92,8 +92,8 @@ ojson graph_json(const CfGraph::Impl& g, bool with_items = true) {
   const json meta = json::parse(g.metadata);
   for (auto it = meta.begin(); it != meta.end(); ++it) root[it.key()] = ojson(it.value());
   ojson models = ojson::object();
-  models["A"] = ojson(detail::polyhedron_to_json(g.a));
-  models["B"] = ojson(detail::polyhedron_to_json(g.b));
+  models["A"] = ojson(internal::polyhedron_to_json(g.a));
+  models["B"] = ojson(internal::polyhedron_to_json(g.b));
   root["models"] = std::move(models);
   ojson cfs = ojson::array();
   ojson tr = ojson::array();
@@ -371,23 +371,23 @@ std::string CfGraph::to_json(int indent) const {
 void CfGraph::save(const std::string& path) const {
   if (is_cbor_path(path)) {
     const std::vector<std::uint8_t> cbor = ojson::to_cbor(graph_json(impl()));
-    detail::write_file_atomically(path, std::string(cbor.begin(), cbor.end()), "writing graph");
+    internal::write_file_atomically(path, std::string(cbor.begin(), cbor.end()), "writing graph");
     return;
   }
   // JSON goes to the file in pieces: a large graph's text is several times its records.
   const Impl& g = impl();
-  detail::write_streamed_outputs({{path,
-                                   [&g](const detail::ByteSink& sink) {
-                                     std::string out;
-                                     out.reserve(kFlushBytes + 65536);
-                                     const Flush flush = [&sink](std::string& piece) {
-                                       sink(piece.data(), piece.size());
-                                       piece.clear();
-                                     };
-                                     emit_json(g, 1, out, &flush);
-                                     sink(out.data(), out.size());
-                                   }}},
-                                 {}, "writing graph");
+  internal::write_streamed_outputs({{path,
+                                     [&g](const internal::ByteSink& sink) {
+                                       std::string out;
+                                       out.reserve(kFlushBytes + 65536);
+                                       const Flush flush = [&sink](std::string& piece) {
+                                         sink(piece.data(), piece.size());
+                                         piece.clear();
+                                       };
+                                       emit_json(g, 1, out, &flush);
+                                       sink(out.data(), out.size());
+                                     }}},
+                                   {}, "writing graph");
 }
 
 CfGraph CfGraph::load(const std::string& path) { return load(path, GraphLoadOptions()); }
@@ -398,23 +398,23 @@ CfGraph CfGraph::load(const std::string& path, const GraphLoadOptions& options) 
   if (!read_input_file(path, bytes, why))
     throw FileError("reading '" + path + "': cannot open: " + why);
   CfGraph g;
-  g.impl_ = detail::read_graph(bytes, path, is_cbor_path(path), options);
+  g.impl_ = internal::read_graph(bytes, path, is_cbor_path(path), options);
   return g;
 }
 
 CfGraph CfGraph::from_bytes(const std::string& bytes, const std::string& source, bool cbor,
                             const GraphLoadOptions& options) {
   CfGraph g;
-  g.impl_ = detail::read_graph(bytes, source, cbor, options);
+  g.impl_ = internal::read_graph(bytes, source, cbor, options);
   return g;
 }
 
-namespace detail {
+namespace internal {
 
 void write_file_atomically(const std::string& path, const std::string& bytes, const char* what) {
   write_outputs({OutputFile{path, bytes}}, {}, what);
 }
 
-}  // namespace detail
+}  // namespace internal
 
 }  // namespace cf

@@ -28,7 +28,7 @@
 #include <simdjson.h>
 #include <sstream>
 
-namespace cf::detail {
+namespace cf::internal {
 
 namespace {
 
@@ -1120,4 +1120,4 @@ std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::s
   return impl;
 }
 
-}  // namespace cf::detail
+}  // namespace cf::internal

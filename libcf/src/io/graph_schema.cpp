@@ -15,7 +15,7 @@
 
 #include <memory>
 
-namespace cf::detail {
+namespace cf::internal {
 
 namespace {
 
@@ -87,4 +87,4 @@ void validate_graph_schema(const nlohmann::json& document, const std::string& so
               ": does not match the cf-graph schema: " + best.description);
 }
 
-}  // namespace cf::detail
+}  // namespace cf::internal

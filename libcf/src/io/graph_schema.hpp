@@ -8,7 +8,7 @@
 
 #include <string>
 
-namespace cf::detail {
+namespace cf::internal {
 
 /// The text of schemas/model.schema.json, which the graph schema refers to for models.A/B.
 const char* model_schema_text();
@@ -18,4 +18,4 @@ const char* model_schema_text();
 ///   schema: <complaint>" for the first (deepest) violation.
 void validate_graph_schema(const nlohmann::json& document, const std::string& source);
 
-}  // namespace cf::detail
+}  // namespace cf::internal

@@ -7,7 +7,7 @@
 
 #include <string>
 
-namespace cf::detail {
+namespace cf::internal {
 
 using json = nlohmann::json;
 
@@ -64,4 +64,4 @@ inline Vec3 json_vec3(const json& j, const JsonWhere& w) {
   return {json_number(j[0], w / 0), json_number(j[1], w / 1), json_number(j[2], w / 2)};
 }
 
-}  // namespace cf::detail
+}  // namespace cf::internal

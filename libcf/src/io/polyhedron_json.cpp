@@ -1,7 +1,7 @@
 #include "polyhedron_json.hpp"
 
 namespace cf {
-namespace detail {
+namespace internal {
 
 namespace {
 json vec_json(const Vec3& p) { return json::array({p.x(), p.y(), p.z()}); }
@@ -83,20 +83,20 @@ Polyhedron polyhedron_from_json(const json& j, const JsonWhere& w) {
   }
 }
 
-}  // namespace detail
+}  // namespace internal
 
 std::string to_json(const Polyhedron& model, int indent) {
-  return detail::polyhedron_to_json(model).dump(indent);
+  return internal::polyhedron_to_json(model).dump(indent);
 }
 
 Polyhedron polyhedron_from_json(const std::string& text, const std::string& source) {
-  detail::json j;
+  internal::json j;
   try {
-    j = detail::json::parse(text);
-  } catch (const detail::json::parse_error& e) {
+    j = internal::json::parse(text);
+  } catch (const internal::json::parse_error& e) {
     throw Error("reading '" + source + "': not valid JSON: " + e.what());
   }
-  return detail::polyhedron_from_json(j, detail::JsonWhere{source, ""});
+  return internal::polyhedron_from_json(j, internal::JsonWhere{source, ""});
 }
 
 }  // namespace cf

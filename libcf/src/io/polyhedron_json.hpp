@@ -5,7 +5,7 @@
 
 #include "json_util.hpp"
 
-namespace cf::detail {
+namespace cf::internal {
 
 json polyhedron_to_json(const Polyhedron& model);
 
@@ -13,4 +13,4 @@ json polyhedron_to_json(const Polyhedron& model);
 /// @throws cf::Error naming the source and the JSON pointer of the fault.
 Polyhedron polyhedron_from_json(const json& j, const JsonWhere& where);
 
-}  // namespace cf::detail
+}  // namespace cf::internal

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace cf::detail {
+namespace cf::internal {
 
 /// Takes the next piece of an output's bytes.
 using ByteSink = std::function<void(const char* data, std::size_t size)>;
@@ -26,4 +26,4 @@ struct StreamedOutput {
 void write_streamed_outputs(const std::vector<StreamedOutput>& files,
                             const std::vector<std::string>& inputs, const char* what);
 
-}  // namespace cf::detail
+}  // namespace cf::internal

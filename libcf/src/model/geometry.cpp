@@ -28,7 +28,7 @@ ClosestPoints swapped(const ClosestPoints& c) { return {c.distance, c.p_b, c.p_a
 
 FaceLocation locate_in_face(const Polyhedron& m, FaceId f, const Vec2& q) {
   const Face& F = m.face(f);
-  detail::PointLocator loc(q);
+  internal::PointLocator loc(q);
   for (std::size_t l = 0; l < F.loops_2d.size(); ++l) {
     const auto& loop = F.loops_2d[l];
     for (std::size_t i = 0, n = loop.size(); i < n; ++i)

@@ -36,7 +36,7 @@ std::optional<TransitionKind> transition_kind_from_string(std::string_view name)
 // ---------------------------------------------------------------------------------------
 // Checks and construction
 
-namespace detail {
+namespace internal {
 
 std::string check_witness(const Pose& pose, const char** field) {
   // Witnesses are written with full double precision; 1e-6 leaves room for hand-written
@@ -59,13 +59,13 @@ std::string check_witness(const Pose& pose, const char** field) {
   return {};
 }
 
-}  // namespace detail
+}  // namespace internal
 
 namespace {
 
 // PCs of one CF have pairwise distinct contact planes (docs/spec.md, section 4): two PCs on the
 // same face of B (types x-f) or of A (types f-x) share that face's plane.
-void check_distinct_planes(const PcSet& pcs, std::size_t i, const detail::FaultLocator& where) {
+void check_distinct_planes(const PcSet& pcs, std::size_t i, const internal::FaultLocator& where) {
   for (int p = 0; p < pcs.size(); ++p)
     for (int q = p + 1; q < pcs.size(); ++q) {
       const Pc& x = pcs[p];
@@ -86,7 +86,7 @@ void check_distinct_planes(const PcSet& pcs, std::size_t i, const detail::FaultL
 // A CF's PCs are principal (none dominated by another of its PCs: docs/spec.md, section 4) and
 // its freedoms ordered (translation_dof at most dof) when the record has them.
 void check_principal_and_freedoms(const CfRecord& r, const Polyhedron& A, const Polyhedron& B,
-                                  std::size_t i, const detail::FaultLocator& where) {
+                                  std::size_t i, const internal::FaultLocator& where) {
   for (int p = 0; p < r.pcs.size(); ++p)
     for (int q = 0; q < r.pcs.size(); ++q)
       if (p != q && dominates(A, B, r.pcs[q], r.pcs[p]))
@@ -125,7 +125,7 @@ class ChangeRule {
  private:
   const Polyhedron& a_;
   const Polyhedron& b_;
-  std::unordered_map<Pc, std::vector<Pc>, detail::PcHash> neighbours_of_;  // a cache
+  std::unordered_map<Pc, std::vector<Pc>, internal::PcHash> neighbours_of_;  // a cache
 };
 
 bool one_more(const PcSet& big, const PcSet& small) {
@@ -137,7 +137,7 @@ bool one_more(const PcSet& big, const PcSet& small) {
 
 // Transition t: its ends are CF ids, distinct, and its kind holds between their PC sets.
 void check_transition(std::size_t t, const Transition& tr, const std::vector<CfRecord>& cfs,
-                      ChangeRule& change, const detail::FaultLocator& where) {
+                      ChangeRule& change, const internal::FaultLocator& where) {
   const std::size_t n = cfs.size();
   const auto in_range = [&](CfId id, const char* field) {
     if (!id.valid() || id.index() >= n)
@@ -184,7 +184,8 @@ void check_transition(std::size_t t, const Transition& tr, const std::vector<CfR
 // Sorts each CF's transitions by target; a target listed twice is a fault at its second
 // listing in file order.
 void sort_out_lists(std::vector<std::vector<Transition>>& out,
-                    const std::vector<Transition>& transitions, const detail::FaultLocator& where) {
+                    const std::vector<Transition>& transitions,
+                    const internal::FaultLocator& where) {
   for (auto& list : out) {
     std::stable_sort(list.begin(), list.end(),
                      [](const Transition& x, const Transition& y) { return x.to < y.to; });
@@ -203,7 +204,7 @@ void sort_out_lists(std::vector<std::vector<Transition>>& out,
 
 }  // namespace
 
-void CfGraph::Impl::build(const detail::FaultLocator& where) {
+void CfGraph::Impl::build(const internal::FaultLocator& where) {
   const std::size_t n = cfs.size();
   index.clear();
   index.reserve(n + n / 4);
@@ -230,7 +231,7 @@ void CfGraph::Impl::build(const detail::FaultLocator& where) {
 
 namespace {
 
-class PartsLocator final : public detail::FaultLocator {
+class PartsLocator final : public internal::FaultLocator {
  public:
   [[noreturn]] void cf_fault(std::size_t cf, const std::string& what) const override {
     throw Error("CfGraph::from_parts: CF " + std::to_string(cf) + ": " + what);
@@ -251,7 +252,7 @@ class PartsLocator final : public detail::FaultLocator {
 
 }  // namespace
 
-std::string detail::check_metadata(const json& meta) {
+std::string internal::check_metadata(const json& meta) {
   static const char* const kReserved[] = {"format", "version", "units",
                                           "models", "cfs",     "transitions"};
   if (!meta.is_object()) return "expected a JSON object, got " + json_short(meta);
@@ -265,13 +266,13 @@ CfGraph CfGraph::from_parts(Polyhedron a, Polyhedron b, std::vector<CfRecord> cf
                             std::vector<Transition> transitions, const std::string& metadata_json) {
   const PartsLocator where;
   auto impl = std::make_unique<Impl>();
-  detail::json meta;
+  internal::json meta;
   try {
-    meta = detail::json::parse(metadata_json.empty() ? std::string("{}") : metadata_json);
-  } catch (const detail::json::parse_error& e) {
+    meta = internal::json::parse(metadata_json.empty() ? std::string("{}") : metadata_json);
+  } catch (const internal::json::parse_error& e) {
     where.metadata_fault(std::string("not valid JSON: ") + e.what());
   }
-  if (std::string why = detail::check_metadata(meta); !why.empty()) where.metadata_fault(why);
+  if (std::string why = internal::check_metadata(meta); !why.empty()) where.metadata_fault(why);
   impl->metadata = meta.dump();
   for (std::size_t i = 0; i < cfs.size(); ++i) {
     const CfRecord& r = cfs[i];
@@ -282,7 +283,7 @@ CfGraph CfGraph::from_parts(Polyhedron a, Polyhedron b, std::vector<CfRecord> cf
     }
     {
       const char* field = "";
-      if (std::string why = detail::check_witness(r.witness, &field); !why.empty())
+      if (std::string why = internal::check_witness(r.witness, &field); !why.empty())
         where.cf_fault(i, std::string("witness ") + field + ": " + why);
     }
     if (r.dof < -1 || r.dof > 6)

@@ -11,7 +11,7 @@
 #include <unordered_set>
 #include <vector>
 
-namespace cf::detail {
+namespace cf::internal {
 
 /// Hash of one PC (type and both indices).
 struct PcHash {
@@ -41,7 +41,7 @@ class FaultLocator {
 /// else the reason. `field` is set to "R" or "t".
 std::string check_witness(const Pose& pose, const char** field);
 
-}  // namespace cf::detail
+}  // namespace cf::internal
 
 namespace cf {
 
@@ -49,33 +49,33 @@ struct CfGraph::Impl {
   Polyhedron a, b;
   std::vector<CfRecord> cfs;
   std::vector<Transition> transitions;
-  std::unordered_map<PcSet, CfId> index;        ///< PC set -> CF, for constant-time find
-  std::unordered_set<Pc, detail::PcHash> held;  ///< every PC some CF holds
-  std::vector<std::vector<Transition>> out;     ///< per CF, sorted by target id
-  std::string metadata;                         ///< JSON object text, canonical dump
+  std::unordered_map<PcSet, CfId> index;          ///< PC set -> CF, for constant-time find
+  std::unordered_set<Pc, internal::PcHash> held;  ///< every PC some CF holds
+  std::vector<std::vector<Transition>> out;       ///< per CF, sorted by target id
+  std::string metadata;                           ///< JSON object text, canonical dump
 
   /// Checks everything that does not need the original PC order (repeated PC sets, PCs
   /// sharing a contact plane, transitions) and builds the index and the out lists. PC index ranges
   /// are the caller's job (check_pc), so that it can point at the PC as given.
-  void build(const detail::FaultLocator& where);
+  void build(const internal::FaultLocator& where);
 };
 
 }  // namespace cf
 
-namespace cf::detail {
+namespace cf::internal {
 /// Empty when `meta` is a JSON object without the graph's own members, else the reason.
 std::string check_metadata(const nlohmann::json& meta);
 /// Writes `bytes` to a temporary file next to `path`, then renames it into place: the file
 /// is whole or untouched. `what` starts the error message ("writing graph").
 /// @throws cf::Error naming the file and the system's reason.
 void write_file_atomically(const std::string& path, const std::string& bytes, const char* what);
-}  // namespace cf::detail
+}  // namespace cf::internal
 
-namespace cf::detail {
+namespace cf::internal {
 /// Reads a graph file's bytes (io/graph_reader.cpp): one streaming pass, then the checks. JSON
 /// is read in place when `bytes` has kReadSlack bytes of capacity past its end (as
 /// read_input_file leaves), else from a padded copy.
 /// @throws cf::Error naming `source`, the JSON pointer and the problem.
 std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::string& source,
                                           bool cbor, const GraphLoadOptions& options);
-}  // namespace cf::detail
+}  // namespace cf::internal

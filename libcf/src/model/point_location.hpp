@@ -1,7 +1,7 @@
 #pragma once
 // Point location in a planar polygon with holes, one boundary segment at a time: the
 // nearest boundary point and the even-odd inside test over every loop. The one place this
-// relation is written; cf::locate_in_face (a face's loops) and detail::locate (the flat
+// relation is written; cf::locate_in_face (a face's loops) and internal::locate (the flat
 // loops of detection) both run it.
 
 #include <Eigen/Core>
@@ -10,7 +10,7 @@
 #include <cmath>
 #include <limits>
 
-namespace cf::detail {
+namespace cf::internal {
 
 struct PointLocator {
   explicit PointLocator(const Eigen::Vector2d& query) : q(query) {}
@@ -46,4 +46,4 @@ struct PointLocator {
   int loop = -1, index = -1;                          ///< the nearest segment
 };
 
-}  // namespace cf::detail
+}  // namespace cf::internal

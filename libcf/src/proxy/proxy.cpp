@@ -16,7 +16,7 @@
 #include <cstdint>
 #include <string>
 
-namespace cf::detail {
+namespace cf::internal {
 
 namespace {
 
@@ -671,4 +671,4 @@ void advance_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds,
   couple(pm, s, X, X_WD, t_s);
 }
 
-}  // namespace cf::detail
+}  // namespace cf::internal

@@ -11,7 +11,7 @@
 
 #include <array>
 
-namespace cf::detail {
+namespace cf::internal {
 
 struct ProxyModel {
   /// @throws cf::Error naming a proxy parameter out of range.
@@ -56,4 +56,4 @@ void init_proxy_state(const ProxyModel& pm, ProxyState& s);
 void advance_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, DetectedAt& at,
                    ProxyState& s, const Pose& X_WD, double t_s);
 
-}  // namespace cf::detail
+}  // namespace cf::internal

@@ -37,7 +37,7 @@ const char* to_string(RenderStatus status) {
 CfModel::Impl::Impl(const CfGraph& g, const Params& p)
     : graph(&g),
       params(p),
-      detect(detail::make_detect_model(g.model_a(), g.model_b(), p)),
+      detect(internal::make_detect_model(g.model_a(), g.model_b(), p)),
       proxy(g.model_a(), g.model_b(), p),
       force(g.model_a(), g.model_b(), p) {
   validate(p);
@@ -55,10 +55,10 @@ const Polyhedron& CfModel::model_b() const { return impl_->graph->model_b(); }
 
 CfState::Impl::Impl(const CfModel::Impl& m)
     : model(&m),
-      detect(detail::make_detect_state(*m.detect)),
-      identify(detail::make_identify_scratch()) {
+      detect(internal::make_detect_state(*m.detect)),
+      identify(internal::make_identify_scratch()) {
   detected.out = &id.contacts;
-  detail::init_proxy_state(m.proxy, proxy);
+  internal::init_proxy_state(m.proxy, proxy);
 }
 
 CfState::CfState(const CfModel& model)
@@ -79,8 +79,8 @@ CfId CfState::previous() const { return impl_->previous; }
 const ContactSet& CfState::contacts() const { return impl_->id.contacts; }
 const Identification& CfState::identification() const { return impl_->id; }
 const HapticResult& CfState::result() const { return impl_->result; }
-std::size_t CfState::last_pairs_tested() const { return detail::pairs_tested(*impl_->detect); }
-bool CfState::last_reused_pairs() const { return detail::reused_pairs(*impl_->detect); }
+std::size_t CfState::last_pairs_tested() const { return internal::pairs_tested(*impl_->detect); }
+bool CfState::last_reused_pairs() const { return internal::reused_pairs(*impl_->detect); }
 
 // ---- the stages ----
 
@@ -99,14 +99,14 @@ CfState::Impl& state_of(const CfModel::Impl& m, CfState& state, const char* stag
 const ProxyResult& move_proxy(const CfModel& model, CfState& state, const Pose& X_WD, double t_s) {
   const CfModel::Impl& m = internal::Access::get(model);
   CfState::Impl& s = state_of(m, state, "move_proxy");
-  detail::advance_proxy(m.proxy, *m.detect, *s.detect, s.detected, s.proxy, X_WD, t_s);
+  internal::advance_proxy(m.proxy, *m.detect, *s.detect, s.detected, s.proxy, X_WD, t_s);
   return s.proxy.result;
 }
 
 const ContactSet& detect(const CfModel& model, CfState& state, const Pose& X_WA) {
   const CfModel::Impl& m = internal::Access::get(model);
   CfState::Impl& s = state_of(m, state, "detect");
-  return detail::detect_at(*m.detect, *s.detect, X_WA, s.detected);
+  return internal::detect_at(*m.detect, *s.detect, X_WA, s.detected);
 }
 
 const Identification& identify(const CfModel& model, CfState& state, const ContactSet& contacts) {
@@ -116,8 +116,8 @@ const Identification& identify(const CfModel& model, CfState& state, const Conta
     s.id.contacts = contacts;
     s.detected.valid = false;  // no longer the contacts of the last detection
   }
-  detail::identify(*m.graph, m.params.identification, m.params.epsilon_mm, s.previous, *s.identify,
-                   s.id);
+  internal::identify(*m.graph, m.params.identification, m.params.epsilon_mm, s.previous,
+                     *s.identify, s.id);
   return s.id;
 }
 
@@ -132,7 +132,7 @@ PriorMotion classify_motion(const CfModel& model, CfState& state, const Identifi
     const PcSet prev = s.previous.valid() ? m.graph->cf(s.previous).pcs : PcSet();
     pm = classify_prior_motion(prev, cur, m.graph, s.previous, id.cf);
   }
-  s.previous = detail::next_previous(s.previous, id);
+  s.previous = internal::next_previous(s.previous, id);
   return pm;
 }
 
@@ -159,23 +159,23 @@ const HapticResult& compute_force(const CfModel& model, CfState& state, const Po
     for (int i = 0; i < n; ++i) r.pcs.insert(s.ordered[static_cast<std::size_t>(i)].pc);
     if (motion.transition_in_graph) {
       r.status = RenderStatus::kOk;
-      fr = &detail::step_force(m.force, s.force, X_WA, t_s, s.ordered.data(), n, motion, false,
-                               id.approaching.data(), id.num_approaching);
+      fr = &internal::step_force(m.force, s.force, X_WA, t_s, s.ordered.data(), n, motion, false,
+                                 id.approaching.data(), id.num_approaching);
     } else {
       r.status = RenderStatus::kUnlistedTransition;
       const bool have_detected = n_detected > 0;
-      fr = &detail::step_force(m.force, s.force, X_WA, t_s,
-                               have_detected ? detected : s.ordered.data(),
-                               have_detected ? n_detected : n, motion, true, nullptr, 0);
+      fr = &internal::step_force(m.force, s.force, X_WA, t_s,
+                                 have_detected ? detected : s.ordered.data(),
+                                 have_detected ? n_detected : n, motion, true, nullptr, 0);
     }
   } else if (n_detected > 0) {
     r.status = RenderStatus::kNoFittingCf;
-    fr = &detail::step_force(m.force, s.force, X_WA, t_s, detected, n_detected, PriorMotion(), true,
-                             nullptr, 0);
+    fr = &internal::step_force(m.force, s.force, X_WA, t_s, detected, n_detected, PriorMotion(),
+                               true, nullptr, 0);
   } else {
     r.status = RenderStatus::kNoContact;
-    fr = &detail::step_force(m.force, s.force, X_WA, t_s, nullptr, 0, PriorMotion(), false, nullptr,
-                             0);
+    fr = &internal::step_force(m.force, s.force, X_WA, t_s, nullptr, 0, PriorMotion(), false,
+                               nullptr, 0);
   }
   r.motion = fr->motion;
   r.F_W = fr->F_W;
@@ -290,7 +290,7 @@ const Identification& CfIdentifier::step(const Pose& pose) {
   const Identification& id =
       identify(impl_->model, impl_->state, detect(impl_->model, impl_->state, pose));
   CfState::Impl& s = internal::Access::get(impl_->state);
-  s.previous = detail::next_previous(s.previous, id);
+  s.previous = internal::next_previous(s.previous, id);
   return id;
 }
 void CfIdentifier::reset() { internal::Access::get(impl_->state).previous = CfId(); }

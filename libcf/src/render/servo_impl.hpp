@@ -18,21 +18,21 @@ struct CfModel::Impl {
   Impl(const CfGraph& g, const Params& p);
   const CfGraph* graph;
   Params params;
-  detail::DetectModelPtr detect;  // trees and tables (detect/detector.cpp)
-  detail::ProxyModel proxy;       // A's metric about the grip point (proxy/proxy.cpp)
-  ForceModel::Fixed force;        // the force model's models, parameters, A's mass centre
+  internal::DetectModelPtr detect;  // trees and tables (detect/detector.cpp)
+  internal::ProxyModel proxy;       // A's metric about the grip point (proxy/proxy.cpp)
+  ForceModel::Fixed force;          // the force model's models, parameters, A's mass centre
 };
 
 struct CfState::Impl {
   explicit Impl(const CfModel::Impl& m);
   const CfModel::Impl* model;  // the model it was sized for: the stages check it
-  detail::DetectStatePtr detect;
-  detail::IdentifyScratchPtr identify;
-  Identification id;            // detect() writes id.contacts, identify() the rest
-  detail::DetectedAt detected;  // the pose id.contacts are of (the proxy detects there too)
-  CfId previous;                // written by classify_motion only (detail::next_previous)
-  ForceState force;             // stick anchors, held loads, filters
-  detail::ProxyState proxy;     // the proxy pose and its history
+  internal::DetectStatePtr detect;
+  internal::IdentifyScratchPtr identify;
+  Identification id;              // detect() writes id.contacts, identify() the rest
+  internal::DetectedAt detected;  // the pose id.contacts are of (the proxy detects there too)
+  CfId previous;                  // written by classify_motion only (internal::next_previous)
+  ForceState force;               // stick anchors, held loads, filters
+  internal::ProxyState proxy;     // the proxy pose and its history
   std::array<ContactPc, PcSet::kMaxPcs> ordered{};  // the CF's PCs in canonical order
   HapticResult result;
 };

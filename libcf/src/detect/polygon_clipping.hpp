@@ -15,7 +15,7 @@
 #include <cmath>
 #include <limits>
 
-namespace cf::detail {
+namespace cf::internal {
 
 using Vec2 = Eigen::Vector2d;
 
@@ -261,4 +261,4 @@ bool overlap_convex(const Poly2& P, const Poly2& Q, Vec2* buf, int cap, Overlap2
   return true;
 }
 
-}  // namespace cf::detail
+}  // namespace cf::internal

@@ -9,7 +9,7 @@
 #include <array>
 #include <cstdint>
 
-namespace cf::detail {
+namespace cf::internal {
 
 /// What finishing reads: the models (closures of elements), the thresholds.
 struct FinishContext {
@@ -40,4 +40,4 @@ struct FinishScratch {
 /// contacts into contact planes (`plane`, `num_planes`) and sets each one's `centre_W`.
 void finish_contacts(const FinishContext& ctx, FinishScratch& scratch, ContactSet& cs);
 
-}  // namespace cf::detail
+}  // namespace cf::internal

@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace cf::detail {
+namespace cf::internal {
 
 class CheapRejections {
  public:
@@ -168,4 +168,4 @@ class CheapRejections {
   std::vector<Seg> seg_b, seg_a;
 };
 
-}  // namespace cf::detail
+}  // namespace cf::internal

@@ -1,11 +1,11 @@
-#include "finish.hpp"
+#include "finish_contacts.hpp"
 
 #include <cf/pc.hpp>
 
 #include <algorithm>
 #include <cmath>
 
-namespace cf::detail {
+namespace cf::internal {
 
 namespace {
 
@@ -74,10 +74,10 @@ void plane_centres(double eps, double cos_plane, FinishScratch& s, ContactSet& c
       const Vec3 no = o.R_WT.col(1);
       const Vec3 gap = o.origin_W - c.origin_W;
       const double off = std::max(std::abs(nc.dot(gap)), std::abs(no.dot(gap)));
-      const double m =
+      const double same_plane =
           j == i ? 1.0 : share(nc.dot(no) - cos_plane, 1 - cos_plane) * share(eps - off, eps);
-      moment += m * w * o.p_W;
-      weight += m * w;
+      moment += same_plane * w * o.p_W;
+      weight += same_plane * w;
     }
     c.centre_W = weight > 0 ? Vec3(moment / weight) : c.p_W;
   }
@@ -169,4 +169,4 @@ void finish_contacts(const FinishContext& ctx, FinishScratch& s, ContactSet& cs)
   plane_centres(eps, ctx.cos_plane_tolerance, s, cs);
 }
 
-}  // namespace cf::detail
+}  // namespace cf::internal
