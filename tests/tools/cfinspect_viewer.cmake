@@ -40,6 +40,7 @@ if(_why STREQUAL "")
       --cfinspect $<TARGET_FILE:cfinspect> --cfreplay $<TARGET_FILE:cfreplay>
       --graph ${PROJECT_SOURCE_DIR}/data/graphs/cube_l_block.json
       --trajectory ${PROJECT_SOURCE_DIR}/data/trajectories/cube_lblock_corner.csv
+      --press ${PROJECT_SOURCE_DIR}/data/trajectories/cube_lblock_press.csv
       --out ${CMAKE_CURRENT_BINARY_DIR}/viewer_out)
 else()
   add_test(NAME cfinspect:viewer_browser

@@ -110,7 +110,7 @@ const scene = new THREE.Scene();
 scene.background = new THREE.Color(0xffffff);
 scene.add(new THREE.HemisphereLight(0xffffff, 0x666677, 2.2));
 const sun = new THREE.DirectionalLight(0xffffff, 0.8);
-sun.position.set(1, 2, 3);
+sun.position.set(1, 3, 2);  // from above: the models and gravity are y-up (docs/spec.md, section 2)
 scene.add(sun);
 
 const size = Math.max(modelSize(modelA), modelSize(modelB));
@@ -123,8 +123,8 @@ scene.add(overlay);
 
 const camera = new THREE.PerspectiveCamera(40, 1, size / 100, size * 100);
 const centreB = new THREE.Box3().setFromObject(groupB).getCenter(new THREE.Vector3());
-camera.up.set(0, 0, 1);
-camera.position.copy(centreB).add(new THREE.Vector3(1.2, -1.6, 1.1).multiplyScalar(size));
+camera.up.set(0, 1, 0);  // y up, as the models are drawn and gravity points (-y)
+camera.position.copy(centreB).add(new THREE.Vector3(1.2, 1.1, 1.6).multiplyScalar(size));
 const controls = new OrbitControls(camera, renderer.domElement);
 controls.target.copy(centreB);
 controls.update();
@@ -140,7 +140,7 @@ function aim() {
   const c = new THREE.Vector3(), n = new THREE.Vector3();
   for (const h of state.highlighted) { c.add(v3(h.plane.point)); n.add(v3(h.plane.normal)); }
   c.divideScalar(state.highlighted.length);
-  if (n.lengthSq() < 1e-6) n.set(0, 0, 1);
+  if (n.lengthSq() < 1e-6) n.set(0, 1, 0);
   n.normalize();
   // Of a few directions around the mean normal, the one that sees every contact plane most
   // squarely from A's side (the smallest cosine with a plane's normal is largest).
@@ -166,8 +166,48 @@ function resize() {
 }
 window.addEventListener('resize', resize);
 
+// The axis triad: B's (the world's) axes as the camera sees them, in the lower left corner.
+const triad = { scene: new THREE.Scene(), camera: new THREE.OrthographicCamera(-1.6, 1.6, 1.6, -1.6, 0.1, 10), px: 130 };
+function textSprite(text, colour) {
+  const c = document.createElement('canvas');
+  c.width = c.height = 64;
+  const g = c.getContext('2d');
+  g.font = 'bold 44px sans-serif';
+  g.fillStyle = colour;
+  g.textAlign = 'center';
+  g.textBaseline = 'middle';
+  g.fillText(text, 32, 34);
+  const sprite = new THREE.Sprite(new THREE.SpriteMaterial({ map: new THREE.CanvasTexture(c), depthTest: false }));
+  sprite.scale.set(0.6, 0.6, 1);
+  return sprite;
+}
+const TRIAD_COLOURS = ['#e02020', '#20a020', '#2040e0'];  // x red, y green, z blue
+[[1, 0, 0], [0, 1, 0], [0, 0, 1]].forEach((d, k) => {
+  triad.scene.add(new THREE.ArrowHelper(v3(d), new THREE.Vector3(), 1, TRIAD_COLOURS[k], 0.36, 0.2));
+  const label = textSprite('xyz'[k], TRIAD_COLOURS[k]);
+  label.position.copy(v3(d).multiplyScalar(1.38));
+  triad.scene.add(label);
+});
+function triadView() {
+  triad.camera.position.copy(camera.position).sub(controls.target).normalize().multiplyScalar(4);
+  triad.camera.up.copy(camera.up);
+  triad.camera.lookAt(0, 0, 0);
+  triad.camera.updateMatrixWorld(true);
+}
+
+renderer.autoClear = false;
 function render() {
+  renderer.clear();
   renderer.render(scene, camera);
+  triadView();
+  const size2 = renderer.getSize(new THREE.Vector2()), s = triad.px;
+  renderer.setScissorTest(true);
+  renderer.setScissor(0, 0, s, s);
+  renderer.setViewport(0, 0, s, s);
+  renderer.clearDepth();
+  renderer.render(triad.scene, triad.camera);
+  renderer.setScissorTest(false);
+  renderer.setViewport(0, 0, size2.x, size2.y);
 }
 
 // Pose {R: rows, t} as a Matrix4 (x_B = R x_A + t).
@@ -278,6 +318,7 @@ const state = {
   selected: -1,
   highlighted: [],  // [{pc, colour, a: {model, kind, index, drawnAt}, b: {...}, plane}] of the CF shown
   listed: [],       // ids in the CF list after the filters
+  listWindow: [0, 0],  // the positions in `listed` drawn as rows
   pose: null,       // A's pose drawn
   replay: null,     // {rows, poses, tick, playing}
 };
@@ -362,15 +403,13 @@ function showCf(id, pose, fromReplay = false) {
       nb.appendChild(b);
     }
   }
-  if (!fromReplay) {
-    const row = document.querySelector(`#cf-list div[data-id="${id}"]`);
-    if (row) { row.classList.add('selected'); row.scrollIntoView({ block: 'nearest' }); }
-  }
+  if (!fromReplay) showInList(id);
   render();
 }
 
 function select(id) {
   if (state.replay) pause();
+  drawGap(null, null);  // the device belongs to a replay's tick
   showCf(id, null);
   aim();
   render();
@@ -403,13 +442,33 @@ function applyFilters() {
     }
     state.listed.push(cf.id);
   }
-  const list = $('cf-list');
+  drawList();
+}
+
+// The listed CFs drawn as rows: at most LIST_LIMIT of them, a window that holds the selected
+// CF (a graph of 100,000 CFs lists the rows around it).
+function drawList() {
+  const at = state.listed.indexOf(state.selected);
+  const from = state.listed.length <= LIST_LIMIT || at < LIST_LIMIT / 2 ? 0
+    : Math.min(at - LIST_LIMIT / 2, state.listed.length - LIST_LIMIT);
+  const shown = state.listed.slice(from, from + LIST_LIMIT);
+  state.listWindow = [from, from + shown.length];
   const html = [];
-  for (const id of state.listed.slice(0, LIST_LIMIT))
+  for (const id of shown)
     html.push(`<div data-id="${id}"${id === state.selected ? ' class="selected"' : ''}>${id}: ${pcsText(graph.cfs[id])}</div>`);
-  list.innerHTML = html.join('');
+  $('cf-list').innerHTML = html.join('');
   $('count').textContent = `${state.listed.length} of ${graph.cfs.length} CFs` +
-    (state.listed.length > LIST_LIMIT ? ` (first ${LIST_LIMIT} listed)` : '');
+    (state.listed.length > LIST_LIMIT ? ` (${from + 1} to ${from + shown.length} listed)` : '');
+}
+
+// The selected CF's row marked and scrolled to the middle of the list (only the list scrolls).
+function showInList(id) {
+  let row = document.querySelector(`#cf-list div[data-id="${id}"]`);
+  if (!row && state.listed.includes(id)) { drawList(); row = document.querySelector(`#cf-list div[data-id="${id}"]`); }
+  if (!row) return;
+  row.classList.add('selected');
+  const list = $('cf-list'), r = row.getBoundingClientRect(), l = list.getBoundingClientRect();
+  list.scrollTop += r.top - l.top - (list.clientHeight - r.height) / 2;
 }
 
 $('cf-list').addEventListener('click', (e) => {
@@ -468,6 +527,40 @@ for (const a of [arrows.F, arrows.M])  // drawn over the models: A's origin is i
   a.traverse((o) => { if (o.material) { o.material.depthTest = false; o.renderOrder = 3; } });
 scene.add(arrows.F, arrows.M);
 
+// The device where the hand holds A, when it is pressed beyond the proxy: A's edges drawn
+// there, and a line from where A is rendered (the proxy) to it.
+const device = new THREE.Group();
+{
+  const ep = [];
+  for (const [i, j] of modelA.edges) ep.push(...modelA.vertices[i], ...modelA.vertices[j]);
+  const eg = new THREE.BufferGeometry();
+  eg.setAttribute('position', new THREE.Float32BufferAttribute(ep, 3));
+  device.userData.ghost = new THREE.LineSegments(eg, new THREE.LineBasicMaterial({ color: 0xe07000, transparent: true, opacity: 0.8, depthTest: false }));
+  device.userData.ghost.matrixAutoUpdate = false;
+  const lg = new THREE.BufferGeometry();
+  lg.setAttribute('position', new THREE.Float32BufferAttribute([0, 0, 0, 0, 0, 0], 3));
+  device.userData.line = new THREE.Line(lg, new THREE.LineBasicMaterial({ color: 0xe07000, depthTest: false }));
+  for (const o of [device.userData.ghost, device.userData.line]) { o.renderOrder = 4; device.add(o); }
+  device.visible = false;
+  scene.add(device);
+}
+const GAP_SHOWN_MM = 1e-6;  // below this the device is at the proxy: nothing to draw
+
+// Draws the device at `devicePose` against A drawn at `rendered`; returns the gap (mm).
+function drawGap(devicePose, rendered) {
+  if (!devicePose || !rendered) { device.visible = false; return 0; }
+  const a = v3(rendered.t), b = v3(devicePose.t), gap = a.distanceTo(b);
+  device.visible = gap > GAP_SHOWN_MM;
+  device.userData.ghost.matrix.copy(poseMatrix(devicePose));
+  device.userData.ghost.matrixWorldNeedsUpdate = true;
+  const pos = device.userData.line.geometry.attributes.position;
+  pos.setXYZ(0, a.x, a.y, a.z);
+  pos.setXYZ(1, b.x, b.y, b.z);
+  pos.needsUpdate = true;
+  device.userData.line.geometry.computeBoundingSphere();
+  return gap;
+}
+
 function loadReplay(csvText, trajText, name) {
   pause();
   const rows = parseReplay(csvText, name, graph.cfs.length);
@@ -505,6 +598,7 @@ function setTick(i) {
   // B), else the trajectory's pose, else the witness of the tick's CF.
   const pose = row.proxy ? row.proxy : r.poses ? r.poses[r.tick] : row.cf >= 0 ? graph.cfs[row.cf].witness : null;
   showCf(row.cf, pose, true);
+  r.gap = row.proxy && r.poses ? drawGap(r.poses[r.tick], row.proxy) : drawGap(null, null);
   if (!pose && row.cf < 0) { arrows.F.visible = arrows.M.visible = false;
 for (const a of [arrows.F, arrows.M])  // drawn over the models: A's origin is inside A
   a.traverse((o) => { if (o.material) { o.material.depthTest = false; o.renderOrder = 3; } }); }
@@ -522,7 +616,8 @@ for (const a of [arrows.F, arrows.M])  // drawn over the models: A's origin is i
   $('tick-info').textContent =
     `tick ${r.tick + 1}/${r.rows.length}  t = ${fmt(row.t)} s  CF ${row.cf}${row.cf >= 0 ? ` {${row.pcs}}` : ''}  motion ${row.motion}  ${row.status}\n` +
     `F = (${row.F.toArray().map((x) => fmt(x, 2)).join(', ')}) N  |F| ${fmt(row.F.length(), 2)}  (orange)\n` +
-    `M = (${row.M.toArray().map((x) => fmt(x, 1)).join(', ')}) N·mm  |M| ${fmt(row.M.length(), 1)}  (purple)`;
+    `M = (${row.M.toArray().map((x) => fmt(x, 1)).join(', ')}) N·mm  |M| ${fmt(row.M.length(), 1)}  (purple)` +
+    (row.proxy && r.poses ? `\ndevice ${fmt(r.gap, 3)} mm beyond the proxy${r.gap > GAP_SHOWN_MM ? ' (orange: A where the hand holds it)' : ''}` : '');
   render();
 }
 
@@ -593,6 +688,28 @@ window.cfViewer = {
   pause,
   loadReplay: (csv, traj, nm = 'replay.csv') => loadReplay(csv, traj, nm),
   poseA: () => groupA.matrix.toArray(),
+  // The gap drawn between the proxy and the device: whether it shows, and its ends (mm).
+  gap: () => ({ visible: device.visible, length: state.replay ? state.replay.gap || 0 : 0,
+    ends: [0, 1].map((k) => [0, 1, 2].map((c) => device.userData.line.geometry.attributes.position.array[3 * k + c])) }),
+  // Where world directions point on the screen: the normalised device coordinates of the
+  // view target moved by `size` along +x, +y, +z, less the target's; and the same for the
+  // triad's axes in its corner.
+  screenAxes: () => {
+    const ndc = (p, cam) => p.clone().project(cam);
+    const o = ndc(controls.target, camera);
+    const main = [[1, 0, 0], [0, 1, 0], [0, 0, 1]].map((d) => ndc(controls.target.clone().addScaledVector(v3(d), size * 0.1), camera).sub(o).toArray().slice(0, 2));
+    triadView();
+    const t0 = ndc(new THREE.Vector3(), triad.camera);
+    const corner = [[1, 0, 0], [0, 1, 0], [0, 0, 1]].map((d) => ndc(v3(d), triad.camera).sub(t0).toArray().slice(0, 2));
+    return { main, triad: corner, triadPx: triad.px, colours: TRIAD_COLOURS };
+  },
+  listScroll: () => {
+    const list = $('cf-list'), row = list.querySelector('div.selected');
+    if (!row) return null;
+    const r = row.getBoundingClientRect(), l = list.getBoundingClientRect();
+    const top = l.top + list.clientTop;  // the list's content, inside its border
+    return { rowTop: r.top - top, rowBottom: r.bottom - top, height: list.clientHeight, scrollTop: list.scrollTop };
+  },
   arrows: () => ({ F: arrows.F.visible, M: arrows.M.visible }),
 };
 
@@ -607,5 +724,7 @@ if (replayText !== null) {
     $('replay-msg').className = 'error';
   }
 }
-if (state.selected < 0 && graph.cfs.length > 0 && !state.replay) select(Number(meta.cf ?? 0));
+// The CF `--cf` names is shown (and its row scrolled into view), also beside a replay.
+if (meta.cf !== undefined && meta.cf !== null) select(Number(meta.cf));
+else if (state.selected < 0 && graph.cfs.length > 0 && !state.replay) select(0);
 state.ready = true;

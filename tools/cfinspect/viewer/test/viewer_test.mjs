@@ -6,7 +6,8 @@
 // console errors, and no request for anything but the page itself.
 //
 //   node viewer_test.mjs --cfinspect BIN --cfreplay BIN --graph G.json --trajectory P.csv
-//                        --out DIR [--screenshots DIR]
+//                        --press PRESS.csv --out DIR [--screenshots DIR]
+// PRESS.csv is a trajectory whose device goes into B, so that the proxy holds A back.
 //
 // Exit 0: passed; 1: failed; 77: skipped (no Chromium or no npm packages), which is a failure
 // under CI=true, where the set-up scripts install them.
@@ -17,7 +18,7 @@ import { pathToFileURL } from 'node:url';
 
 const args = {};
 for (let i = 2; i < process.argv.length; i += 2) args[process.argv[i].replace(/^--/, '')] = process.argv[i + 1];
-for (const k of ['cfinspect', 'cfreplay', 'graph', 'trajectory', 'out'])
+for (const k of ['cfinspect', 'cfreplay', 'graph', 'trajectory', 'press', 'out'])
   if (!args[k]) { console.error(`viewer_test: missing --${k}`); process.exit(2); }
 
 function skip(why) {
@@ -43,6 +44,10 @@ execFileSync(args.cfreplay, ['--graph', args.graph, '--trajectory', args.traject
 const html = (extra) => execFileSync(args.cfinspect, [args.graph, '--fast', ...extra], { encoding: 'utf8' });
 check(/wrote .*graph\.html \(viewer of \d+ CFs\)/.test(html(['--html', plainPage])), 'cfinspect --html writes the page');
 html(['--html', replayPage, '--replay', replayCsv, '--trajectory', args.trajectory]);
+// A device pressed into B, and the last CF named with --cf.
+const pressCsv = join(out, 'press.csv'), pressPage = join(out, 'press.html'), lastPage = join(out, 'last.html');
+execFileSync(args.cfreplay, ['--graph', args.graph, '--trajectory', args.press, '-o', pressCsv], { stdio: 'inherit' });
+html(['--html', pressPage, '--replay', pressCsv, '--trajectory', args.press]);
 
 // What the test expects comes from the files, not from the page.
 const graph = JSON.parse(readFileSync(args.graph, 'utf8'));
@@ -51,6 +56,7 @@ const KIND = { v: 'vertex', e: 'edge', f: 'face' };
 const pcText = (pc) => `${pc.type}:${pc.a}:${pc.b}`;
 // A CF with two PCs of different element kinds and neighbours of two kinds or more, if any.
 const kinds = (id) => new Set(graph.transitions.filter((t) => t.from === id).map((t) => t.kind));
+html(['--html', lastPage, '--cf', String(graph.cfs.length - 1)]);
 const cf = graph.cfs.find((c) => c.pcs.length === 2 && c.pcs[0].type[0] !== c.pcs[1].type[0] && c.pcs[0].type[2] !== c.pcs[1].type[2] && kinds(c.id).size >= 2) ||
   graph.cfs.find((c) => c.pcs.length === 2) || graph.cfs[0];
 
@@ -197,6 +203,60 @@ try {
   check(await rp.evaluate(() => window.cfViewer.state.replay.tick) === k, `the time slider goes to tick ${k}`);
   if (args.screenshots) await rp.screenshot({ path: join(args.screenshots, 'viewer-replay.png') });
   await rp.close();
+
+  // y up, as the models are drawn and gravity points; B's axes in a triad in the corner.
+  const lp = await open(lastPage);
+  const axes = await lp.evaluate(() => window.cfViewer.screenAxes());
+  const [, upMain] = axes.main, [, upTriad] = axes.triad;
+  check(upMain[1] > 0 && upMain[1] > 2 * Math.abs(upMain[0]), 'the world\'s +y points up on the screen', JSON.stringify(axes.main));
+  check(upTriad[1] > 0 && upTriad[1] > 2 * Math.abs(upTriad[0]), 'the triad\'s y axis points up', JSON.stringify(axes.triad));
+  const corner = await lp.evaluate(({ triadPx: px, colours }) => {
+    const src = document.querySelector('#view canvas');
+    const c = document.createElement('canvas');
+    c.width = src.width; c.height = src.height;
+    const ctx = c.getContext('2d');
+    ctx.drawImage(src, 0, 0);
+    const s = Math.round(px * (window.devicePixelRatio || 1));
+    const d = ctx.getImageData(0, c.height - s, s, s).data;
+    const rgb = colours.map((h) => [1, 3, 5].map((i) => parseInt(h.slice(i, i + 2), 16)));
+    const near = (i, q) => Math.abs(d[i] - q[0]) + Math.abs(d[i + 1] - q[1]) + Math.abs(d[i + 2] - q[2]) < 40;
+    const n = [0, 0, 0];
+    for (let i = 0; i < d.length; i += 4) rgb.forEach((q, k) => { if (near(i, q)) ++n[k]; });
+    return n;
+  }, axes);
+  check(corner.every((n) => n > 20), 'the triad\'s three axes are drawn in the lower left corner', JSON.stringify(corner));
+  // --cf: that CF selected, its row scrolled into the list's view.
+  const last = graph.cfs.length - 1;
+  check(await lp.evaluate(() => window.cfViewer.state.selected) === last, `--cf ${last} selects it`);
+  const sc = await lp.evaluate(() => window.cfViewer.listScroll());
+  check(sc !== null && sc.rowTop >= 0 && sc.rowBottom <= sc.height && (graph.cfs.length < 50 || sc.scrollTop > 0),
+    `CF ${last}'s row is scrolled into view`, JSON.stringify(sc));
+  await lp.close();
+
+  // The device pressed beyond the proxy: drawn, and the gap between them, at the tick of
+  // the deepest press (from the files: the trajectory's pose against cfreplay's proxy pose).
+  const pressRows = readFileSync(pressCsv, 'utf8').trim().split('\n');
+  const ph = pressRows[0].split(',');
+  const device = readFileSync(args.press, 'utf8').trim().split('\n').filter((l) => l && !l.startsWith('#')).slice(1)
+    .map((l) => l.split(',').slice(1, 4).map(Number));
+  let deepest = 0, gapMax = -1;
+  pressRows.slice(1).forEach((l, i) => {
+    const f = l.split(','), p = ['proxy_tx', 'proxy_ty', 'proxy_tz'].map((c) => Number(f[ph.indexOf(c)]));
+    const g = Math.hypot(...p.map((x, k) => x - device[i][k]));
+    if (g > gapMax) { gapMax = g; deepest = i; }
+  });
+  const pp = await open(pressPage);
+  await pp.evaluate((k) => window.cfViewer.setTick(k), deepest);
+  const gap = await pp.evaluate(() => window.cfViewer.gap());
+  check(gapMax > 1 && gap.visible && Math.abs(gap.length - gapMax) < 1e-6 * Math.max(1, gapMax) &&
+    gap.ends[1].every((x, k) => Math.abs(x - device[deepest][k]) < 1e-4),
+    `tick ${deepest}: the device drawn ${gapMax.toFixed(3)} mm beyond the proxy`, JSON.stringify(gap));
+  const info = await pp.textContent('#tick-info');
+  check(info.includes(`device ${gapMax.toFixed(3)} mm beyond the proxy`), 'the gap is stated', info);
+  if (args.screenshots) await pp.screenshot({ path: join(args.screenshots, 'viewer-press.png') });
+  await pp.evaluate(() => window.cfViewer.select(0));
+  check(!(await pp.evaluate(() => window.cfViewer.gap())).visible, 'a CF chosen by hand hides the device');
+  await pp.close();
 } catch (e) {
   check(false, 'the browser session', e.stack || String(e));
 } finally {
