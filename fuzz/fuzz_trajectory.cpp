@@ -1,16 +1,19 @@
-// libFuzzer target for cfreplay's trajectory reader (parse_trajectory). A cf::Error is the
-// expected answer to bad input; anything else is a finding.
+// libFuzzer target for the trajectory reader (cf::TrajectoryCsvReader, libcf): every sample
+// read to the end. A cf::Error is the expected answer to bad input; anything else is a finding.
 
-#include "replay_io.hpp"
+#include <cf/replay.hpp>
+#include <cf/types.hpp>
 
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  const std::string text(reinterpret_cast<const char*>(data), size);
+  cf::TrajectoryCsvReader reader(std::string(reinterpret_cast<const char*>(data), size), "fuzz");
   try {
-    (void)cf::replay::parse_trajectory(text, "fuzz");
+    cf::TrajectorySample sample;
+    while (reader.next(sample)) {
+    }
   } catch (const cf::Error&) {
   }
   return 0;

@@ -4,8 +4,6 @@
 #include <cf/file_io.hpp>
 #include <cf/types.hpp>
 
-#include "io/streamed_output.hpp"
-
 #include <catch2/catch.hpp>
 
 #include <csignal>
@@ -78,11 +76,11 @@ TEST_CASE("a signal that ends the process mid-write leaves no temporary file") {
     REQUIRE(child >= 0);
     if (child == 0) {
       std::signal(sig, SIG_DFL);
-      const cf::internal::StreamedOutput out{target, [sig](const cf::internal::ByteSink& sink) {
-                                               sink("{\"half\":", 8);
-                                               std::raise(sig);  // the default ends the process
-                                             }};
-      cf::internal::write_streamed_outputs({out}, {}, "writing graph");
+      const cf::StreamedOutput out{target, [sig](const cf::ByteSink& sink) {
+                                     sink("{\"half\":", 8);
+                                     std::raise(sig);  // the default ends the process
+                                   }};
+      cf::write_streamed_outputs({out}, {}, "writing graph");
       ::_exit(0);
     }
     int status = 0;
@@ -102,12 +100,12 @@ TEST_CASE("a signal the program handles itself does not cut the write short") {
   REQUIRE(child >= 0);
   if (child == 0) {
     std::signal(SIGHUP, [](int) {});  // as cfgen's stop between tasks, or Python's handler
-    const cf::internal::StreamedOutput out{target, [](const cf::internal::ByteSink& sink) {
-                                             sink("{\"a\":", 5);
-                                             std::raise(SIGHUP);
-                                             sink("1}", 2);
-                                           }};
-    cf::internal::write_streamed_outputs({out}, {}, "writing graph");
+    const cf::StreamedOutput out{target, [](const cf::ByteSink& sink) {
+                                   sink("{\"a\":", 5);
+                                   std::raise(SIGHUP);
+                                   sink("1}", 2);
+                                 }};
+    cf::write_streamed_outputs({out}, {}, "writing graph");
     ::_exit(0);
   }
   int status = 0;

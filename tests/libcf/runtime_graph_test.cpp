@@ -4,12 +4,12 @@
 // The graphs are written by cfgen in ctest fixtures (tests/libcf/runtime_graph_test.cmake) into
 // the directory CF_RUNTIME_GRAPH_DIR names. Counts are printed on stdout (ctest -V).
 
-#include "replay_io.hpp"
-#include "replay_run.hpp"
-
 #include <cf/graph.hpp>
 #include <cf/identifier.hpp>
 #include <cf/renderer.hpp>
+#include <cf/replay.hpp>
+
+#include "trajectories.hpp"
 
 #include <Eigen/Dense>
 #include <catch2/catch.hpp>
@@ -570,12 +570,14 @@ TEST_CASE("the renderer on the recorded trajectories identifies CFs on contact t
   };
   for (const Case& k : cases) {
     const cf::CfGraph& g = graph(k.graph);
-    const std::vector<cf::replay::Sample> samples = cf::replay::read_trajectory(
-        std::string(CF_SOURCE_DIR) + "/data/trajectories/" + k.trajectory + ".csv");
-    const std::vector<cf::replay::Row> rows = cf::replay::run(g, samples, cf::Params());
+    const std::vector<cf::ReplayRow> rows = cf::testdata::replay_rows(
+        g,
+        cf::testdata::read_samples(std::string(CF_SOURCE_DIR) + "/data/trajectories/" +
+                                   k.trajectory + ".csv"),
+        cf::Params());
     std::size_t contact = 0, identified = 0, no_fit = 0, unlisted = 0;
     std::vector<std::string> runs;
-    for (const cf::replay::Row& row : rows) {
+    for (const cf::ReplayRow& row : rows) {
       if (row.status != "no_contact") {
         ++contact;
         identified += row.cf >= 0;

@@ -1,14 +1,12 @@
 #pragma once
 // The bundled trajectories data/trajectories/*.csv (t,tx,ty,tz,qw,qx,qy,qz: s, mm, unit
-// quaternion) as poses of A, for the tests and the benchmarks. Part of tests/support.
+// quaternion) as poses of A, and replays of them, for the tests and the benchmarks. Part of
+// tests/support.
 
+#include <cf/replay.hpp>
 #include <cf/types.hpp>
 
-#include <Eigen/Geometry>
-
-#include <fstream>
-#include <sstream>
-#include <stdexcept>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -19,32 +17,54 @@ struct Tick {
   Pose X_WA;
 };
 
-/// Reads one trajectory file; its times are offset by t_offset_s.
-/// @throws std::runtime_error naming the file when it cannot be read or a row is malformed.
+/// Reads one trajectory file with libcf's reader; its times are offset by t_offset_s.
+/// @throws cf::Error naming the file and line when it cannot be read or a row is malformed.
 inline std::vector<Tick> read_trajectory(const std::string& path, double t_offset_s = 0) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("read_trajectory: cannot open " + path);
   std::vector<Tick> out;
-  std::string line;
-  std::getline(in, line);  // header
-  int row = 1;
-  while (std::getline(in, line)) {
-    ++row;
-    double v[8];
-    char c = 0;
-    std::istringstream ss(line);
-    ss >> v[0];
-    for (int i = 1; i < 8; ++i) ss >> c >> v[i];
-    if (!ss)
-      throw std::runtime_error("read_trajectory: " + path + ":" + std::to_string(row) +
-                               ": malformed row");
-    Tick k;
-    k.t_s = t_offset_s + v[0];
-    k.X_WA.t_BA = {v[1], v[2], v[3]};
-    k.X_WA.R_BA = Eigen::Quaterniond(v[4], v[5], v[6], v[7]).normalized().toRotationMatrix();
-    out.push_back(k);
-  }
+  TrajectoryCsvReader reader = TrajectoryCsvReader::open(path);
+  TrajectorySample s;
+  while (reader.next(s)) out.push_back({t_offset_s + s.t_s, s.X_WD});
   return out;
+}
+
+/// Every sample of a trajectory file, as read (libcf's reader).
+inline std::vector<TrajectorySample> read_samples(const std::string& path) {
+  std::vector<TrajectorySample> out;
+  TrajectoryCsvReader reader = TrajectoryCsvReader::open(path);
+  TrajectorySample s;
+  while (reader.next(s)) out.push_back(s);
+  return out;
+}
+
+/// Samples held in memory as a replay's source.
+class SampleSource final : public TrajectorySource {
+ public:
+  explicit SampleSource(const std::vector<TrajectorySample>& samples) : samples_(samples) {}
+  bool next(TrajectorySample& s) override {
+    if (i_ == samples_.size()) return false;
+    s = samples_[i_++];
+    return true;
+  }
+
+ private:
+  const std::vector<TrajectorySample>& samples_;
+  std::size_t i_ = 0;
+};
+
+/// Every row of a replay of `samples` (cf::Replay); `each`, when given, sees each tick's sample
+/// and whole result.
+inline std::vector<ReplayRow> replay_rows(
+    const CfGraph& graph, const std::vector<TrajectorySample>& samples, const Params& params,
+    const std::function<void(const TrajectorySample&, const HapticResult&)>& each = {}) {
+  SampleSource source(samples);
+  Replay replay(graph, params, source);
+  std::vector<ReplayRow> rows;
+  ReplayRow row;
+  while (replay.next(row)) {
+    if (each) each(replay.sample(), replay.result());
+    rows.push_back(row);
+  }
+  return rows;
 }
 
 /// data/trajectories/cube_lblock_{guarded,slide,corner,rotate,break}.csv played back to back

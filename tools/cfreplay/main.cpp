@@ -2,13 +2,13 @@
 // and writes one row per servo tick (docs/spec.md, section 5b).
 //   cfreplay --graph GRAPH.json --trajectory POSES.csv -o OUT.csv [--plot OUT.svg]
 
-#include "replay_io.hpp"
-#include "replay_run.hpp"
-
-#include <cf/graph.hpp>
-#include <cf/params.hpp>
+#include "plot.hpp"
 
 #include <cf/file_io.hpp>
+#include <cf/graph.hpp>
+#include <cf/params.hpp>
+#include <cf/replay.hpp>
+
 #include "cli_checks.hpp"
 #include "safe_stderr.hpp"
 
@@ -160,25 +160,37 @@ int main(int argc, char** argv) {
          {std::pair{&graph.model_a(), "A"}, std::pair{&graph.model_b(), "B"}})
       if (const std::string w = cf::size_warning(*m, which, P.epsilon_mm); !w.empty())
         std::cerr << "cfreplay: warning: " << w << "\n";
-    const std::vector<cf::replay::Sample> samples = cf::replay::read_trajectory(traj_path);
-    const std::vector<cf::replay::Row> rows = cf::replay::run(graph, samples, P);
-
-    std::string text = cf::replay::output_header();
-    text += '\n';
+    auto poses = cf::TrajectoryCsvReader::open(traj_path);
+    cf::Replay replay(graph, P, poses);
+    cf::replay::PlotRecorder plot;
     std::map<std::string, long> statuses;
-    for (const cf::replay::Row& r : rows) {
-      text += cf::replay::format_row(r);
-      text += '\n';
-      ++statuses[r.status];
-    }
-    // Both files or neither: a plot that cannot be written leaves no CSV behind.
-    std::vector<cf::OutputFile> files{{out_path, std::move(text)}};
+    // The CSV is written as the ticks are rendered, the plot after them; both land or neither
+    // does, and memory does not grow with the ticks (docs/performance.md, "Replay").
+    auto write_rows = [&](const cf::ByteSink& sink) {
+      std::string text = std::string(cf::replay_csv_header()) + '\n';
+      cf::ReplayRow row;
+      while (replay.next(row)) {
+        cf::append_csv(row, text);
+        text += '\n';
+        if (text.size() > (1u << 16)) {
+          sink(text.data(), text.size());
+          text.clear();
+        }
+        ++statuses[row.status];
+        if (!plot_path.empty()) plot.add(row);
+      }
+      sink(text.data(), text.size());
+    };
+    std::vector<cf::StreamedOutput> files{{out_path, write_rows}};
     if (!plot_path.empty())
-      files.push_back(
-          {plot_path, cf::replay::svg_plot(rows, traj_path + " against " + graph_path)});
-    cf::write_outputs(files, inputs, "writing");
-    std::cerr << "cfreplay: " << rows.size() << (rows.size() == 1 ? " tick" : " ticks") << " -> "
-              << out_path << " (";
+      files.push_back({plot_path, [&](const cf::ByteSink& sink) {
+                         const std::string svg = plot.svg(traj_path + " against " + graph_path);
+                         sink(svg.data(), svg.size());
+                       }});
+    cf::write_streamed_outputs(files, inputs, "writing");
+    const long ticks = replay.ticks();
+    std::cerr << "cfreplay: " << ticks << (ticks == 1 ? " tick" : " ticks") << " -> " << out_path
+              << " (";
     bool first = true;
     for (const auto& [s, n] : statuses) {
       std::cerr << (first ? "" : ", ") << s << " " << n;

@@ -13,6 +13,7 @@
 /// - Text from a file that goes into a message is made printable first.
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,24 @@ std::string canonical_path(const std::string& path);
 /// @throws cf::Error "<what> '<path>': <reason>"; no temporary file is left behind.
 void write_outputs(const std::vector<OutputFile>& files, const std::vector<std::string>& inputs,
                    const char* what);
+
+/// Takes the next piece of an output's bytes.
+using ByteSink = std::function<void(const char* data, std::size_t size)>;
+
+/// One output produced in pieces: its path, and what writes its bytes, in order, into the
+/// sink it is given.
+struct StreamedOutput {
+  std::string path;
+  std::function<void(const ByteSink&)> produce;
+};
+
+/// write_outputs for outputs too large to hold in memory (a replay of millions of ticks, a
+/// graph): the same checks of the paths, each output produced straight into a temporary
+/// file beside it, in the order given, then all renamed into place. A producer that throws
+/// leaves every target untouched (its exception goes on).
+/// @throws cf::Error "<what> '<path>': <reason>".
+void write_streamed_outputs(const std::vector<StreamedOutput>& files,
+                            const std::vector<std::string>& inputs, const char* what);
 
 /// `text` with every byte that is not printable ASCII written as \xHH, cut to `max` bytes
 /// of input (then "..."), for quoting file content in a one-line message.

@@ -1,14 +1,11 @@
-// cf.Renderer (one servo tick at a pose) and cf._cf.replay (cfreplay's loop, cf::replay::run,
+// cf.Renderer (one servo tick at a pose) and cf._cf.replay (libcf's replay engine, cf::Replay,
 // over numpy arrays of poses).
 
 #include "common.hpp"
 
-#include "replay_io.hpp"   // cfreplay_core: Sample, Row, format_row, output_header
-#include "replay_run.hpp"  // cfreplay_core: run
-
 #include <cf/file_io.hpp>
-
 #include <cf/renderer.hpp>
+#include <cf/replay.hpp>
 
 #include <Eigen/Geometry>
 
@@ -40,7 +37,8 @@ std::string shape_of(const Array& a) {
 /// The per-tick record of one renderer result: the C++ result's fields and cfreplay's row.
 py::dict step_dict(const cf::HapticResult& r) {
   py::dict d;
-  const cf::replay::Row row = cf::replay::make_row(r);
+  cf::ReplayRow row;
+  cf::fill_replay_row(r, row);
   d["t_s"] = r.t_s;
   d["cf"] = r.cf.valid() ? r.cf.value() : -1;
   d["pcs"] = pcs_to_py(r.pcs);
@@ -90,9 +88,24 @@ py::dict step_dict(const cf::HapticResult& r) {
   return d;
 }
 
-/// The rows of a replay, kept for to_csv (cfreplay's format, cf::replay::format_row).
+/// The rows of a replay, kept for to_csv (cfreplay's format, cf::append_csv).
 struct ReplayRows {
-  std::vector<cf::replay::Row> rows;
+  std::vector<cf::ReplayRow> rows;
+};
+
+/// A replay's poses held in memory, as the engine's source.
+class SampleSource final : public cf::TrajectorySource {
+ public:
+  explicit SampleSource(const std::vector<cf::TrajectorySample>& samples) : samples_(samples) {}
+  bool next(cf::TrajectorySample& s) override {
+    if (i_ == samples_.size()) return false;
+    s = samples_[i_++];
+    return true;
+  }
+
+ private:
+  const std::vector<cf::TrajectorySample>& samples_;
+  std::size_t i_ = 0;
 };
 
 /// One renderer bound to its graph (kept alive by the Python object).
@@ -161,8 +174,8 @@ void bind_renderer(py::module_& m) {
 }
 
 /// replay's poses from its arrays t (N,), p (N, 3), q (N, 4), checked.
-std::vector<cf::replay::Sample> replay_samples(const py::object& t, const py::object& p,
-                                               const py::object& q, const std::string& where) {
+std::vector<cf::TrajectorySample> replay_samples(const py::object& t, const py::object& p,
+                                                 const py::object& q, const std::string& where) {
   const Array ta = as_array(t, "t", where), pa = as_array(p, "p", where),
               qa = as_array(q, "q", where);
   if (ta.ndim() != 1) fail(where + ": t must have shape (N,), got " + shape_of(ta));
@@ -174,7 +187,7 @@ std::vector<cf::replay::Sample> replay_samples(const py::object& t, const py::ob
   if (qa.ndim() != 2 || qa.shape(0) != n || qa.shape(1) != 4)
     fail(where + ": q must have shape (N, 4) (w, x, y, z) with N = len(t) = " + std::to_string(n) +
          ", got " + shape_of(qa));
-  std::vector<cf::replay::Sample> samples(static_cast<std::size_t>(n));
+  std::vector<cf::TrajectorySample> samples(static_cast<std::size_t>(n));
   const double* T = ta.data();
   for (py::ssize_t i = 0; i < n; ++i) {
     const std::string row = where + ": row " + std::to_string(i);
@@ -185,10 +198,9 @@ std::vector<cf::replay::Sample> replay_samples(const py::object& t, const py::ob
                     T[i - 1]);
       fail(row + buf);
     }
-    cf::replay::Sample& s = samples[static_cast<std::size_t>(i)];
-    s.t = T[i];
-    s.pose = pose_from(pa.data() + 3 * i, qa.data() + 4 * i, row);
-    s.line = static_cast<int>(i);
+    cf::TrajectorySample& s = samples[static_cast<std::size_t>(i)];
+    s.t_s = T[i];
+    s.X_WD = pose_from(pa.data() + 3 * i, qa.data() + 4 * i, row);
   }
   return samples;
 }
@@ -210,27 +222,28 @@ struct ReplayExtras {
   std::vector<std::int32_t> dof;
 };
 
-/// cfreplay's loop over the samples, without the GIL.
-void run_replay(const cf::CfGraph& g, const std::vector<cf::replay::Sample>& samples,
+/// libcf's replay engine over the samples, without the GIL.
+void run_replay(const cf::CfGraph& g, const std::vector<cf::TrajectorySample>& samples,
                 const cf::Params& P, ReplayRows& rows, ReplayExtras& x) {
   py::gil_scoped_release release;
-  std::size_t i = 0;
-  rows.rows =
-      cf::replay::run(g, samples, P, [&](const cf::replay::Sample&, const cf::HapticResult& r) {
-        x.num_detected[i] = r.num_detected;
-        x.identification[i] = r.identification;
-        for (int k = 0; k < 3; ++k) {
-          x.Fc[3 * i + static_cast<std::size_t>(k)] = r.F_contact_W[k];
-          x.Mc[3 * i + static_cast<std::size_t>(k)] = r.M_contact_W[k];
-        }
-        if (r.force != nullptr) {
-          for (int k = 0; k < 3; ++k)
-            x.Fg[3 * i + static_cast<std::size_t>(k)] = r.force->F_gravity_W[k];
-          x.conservative[i] = r.force->conservative;
-          x.dof[i] = r.force->freedoms.dof;
-        }
-        ++i;
-      });
+  SampleSource source(samples);
+  cf::Replay replay(g, P, source);
+  rows.rows.resize(samples.size());
+  for (std::size_t i = 0; i < samples.size() && replay.next(rows.rows[i]); ++i) {
+    const cf::HapticResult& r = replay.result();
+    x.num_detected[i] = r.num_detected;
+    x.identification[i] = r.identification;
+    for (int k = 0; k < 3; ++k) {
+      x.Fc[3 * i + static_cast<std::size_t>(k)] = r.F_contact_W[k];
+      x.Mc[3 * i + static_cast<std::size_t>(k)] = r.M_contact_W[k];
+    }
+    if (r.force != nullptr) {
+      for (int k = 0; k < 3; ++k)
+        x.Fg[3 * i + static_cast<std::size_t>(k)] = r.force->F_gravity_W[k];
+      x.conservative[i] = r.force->conservative;
+      x.dof[i] = r.force->freedoms.dof;
+    }
+  }
 }
 
 /// replay's result: per-tick arrays and lists by name, and the rows for to_csv.
@@ -245,8 +258,8 @@ py::dict replay_dict(std::unique_ptr<ReplayRows> rows, const ReplayExtras& x) {
   py::list pcs, motion, status, regimes, ident;
   for (py::ssize_t i = 0; i < n; ++i) {
     const auto I = static_cast<std::size_t>(i);
-    const cf::replay::Row& r = rows->rows[I];
-    tt.mutable_at(i) = r.t;
+    const cf::ReplayRow& r = rows->rows[I];
+    tt.mutable_at(i) = r.t_s;
     cfa.mutable_at(i) = r.cf;
     nd.mutable_at(i) = x.num_detected[I];
     dofa.mutable_at(i) = x.dof[I];
@@ -301,7 +314,7 @@ py::dict replay(const cf::CfGraph& g, const py::object& t, const py::object& p, 
                 const py::object& params, const py::kwargs& kw) {
   const std::string where = "replay";
   const cf::Params P = params_arg(params, kw, where);
-  const std::vector<cf::replay::Sample> samples = replay_samples(t, p, q, where);
+  const std::vector<cf::TrajectorySample> samples = replay_samples(t, p, q, where);
   auto rows = std::make_unique<ReplayRows>();
   ReplayExtras extras(samples.size());
   run_replay(g, samples, P, *rows, extras);
@@ -318,10 +331,10 @@ void bind_render(py::module_& m) {
       .def(
           "csv",
           [](const ReplayRows& r) {
-            std::string text = cf::replay::output_header();
+            std::string text = cf::replay_csv_header();
             text += '\n';
-            for (const cf::replay::Row& row : r.rows) {
-              text += cf::replay::format_row(row);
+            for (const cf::ReplayRow& row : r.rows) {
+              cf::append_csv(row, text);
               text += '\n';
             }
             return text;
@@ -331,10 +344,12 @@ void bind_render(py::module_& m) {
   m.def(
       "_read_trajectory",
       [](const std::string& path) {
-        std::vector<cf::replay::Sample> samples;
+        std::vector<cf::TrajectorySample> samples;
         {
           py::gil_scoped_release release;
-          samples = cf::replay::read_trajectory(path);
+          cf::TrajectoryCsvReader reader = cf::TrajectoryCsvReader::open(path);
+          cf::TrajectorySample s;
+          while (reader.next(s)) samples.push_back(s);
         }
         const auto n = static_cast<py::ssize_t>(samples.size());
         py::array_t<double> t(n), p({n, py::ssize_t{3}}), q({n, py::ssize_t{4}});
@@ -342,15 +357,15 @@ void bind_render(py::module_& m) {
         auto pp = p.mutable_unchecked<2>();
         auto qq = q.mutable_unchecked<2>();
         for (py::ssize_t i = 0; i < n; ++i) {
-          const cf::replay::Sample& s = samples[static_cast<std::size_t>(i)];
-          tt(i) = s.t;
-          for (py::ssize_t k = 0; k < 3; ++k) pp(i, k) = s.pose.t_BA[k];
+          const cf::TrajectorySample& s = samples[static_cast<std::size_t>(i)];
+          tt(i) = s.t_s;
+          for (py::ssize_t k = 0; k < 3; ++k) pp(i, k) = s.X_WD.t_BA[k];
           for (py::ssize_t k = 0; k < 4; ++k) qq(i, k) = s.q[static_cast<std::size_t>(k)];
         }
         return py::make_tuple(t, p, q);
       },
       py::arg("path"),
-      "cfreplay's trajectory reader (cf::replay::read_trajectory): (t, p, q) arrays, q as read.");
+      "The trajectory reader (cf::TrajectoryCsvReader): (t, p, q) arrays, q as read.");
   m.def(
       "_write_text",
       [](const std::string& path, const std::string& text, const std::vector<std::string>& inputs) {
@@ -362,7 +377,7 @@ void bind_render(py::module_& m) {
 
   m.def("replay", &replay, py::arg("graph"), py::arg("t"), py::arg("p"), py::arg("q"),
         py::arg("params") = py::none(),
-        "cfreplay's loop (cf::replay::run) over arrays; the package's cf.replay wraps the result.");
+        "The replay engine (cf::Replay) over arrays; the package's cf.replay wraps the result.");
 }
 
 }  // namespace cfpy

@@ -1,4 +1,4 @@
-"""cf.replay and cf.Renderer against the C++ renderer (cf::replay::run, printed with 17 digits
+"""cf.replay and cf.Renderer against the C++ renderer (cf::Replay, printed with 17 digits
 by cf_python_replay_ref) to 1e-12, and against cfreplay's CSV to the 9 digits it prints."""
 
 import csv

@@ -4,7 +4,7 @@
 #include <cf/polyhedron.hpp>
 #include <cf/types.hpp>
 
-#include "streamed_output.hpp"
+#include "input_file.hpp"
 
 #include <algorithm>
 #include <array>
@@ -215,39 +215,53 @@ class SignalCleanup {
 
 }  // namespace
 
-bool read_input_file(const std::string& path, std::string& bytes, std::string& why,
-                     std::size_t max_bytes) {
-  bytes.clear();
+namespace internal {
+
+int open_input_file(const std::string& path, std::string& why, std::size_t max_bytes) {
   if (path.empty()) {
     why = "empty file name";
-    return false;
+    return -1;
   }
   // O_NONBLOCK: opening a FIFO for reading then returns at once instead of waiting for a
   // writer; fstat tells what it is before anything is read.
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
   if (fd < 0) {
     why = errno == ENOENT ? std::string("no such file") : errno_text(errno);
-    return false;
+    return -1;
   }
   struct stat st {};
   if (::fstat(fd, &st) != 0) {
     why = errno_text(errno);
     ::close(fd);
-    return false;
+    return -1;
   }
   if (!S_ISREG(st.st_mode)) {
     why = "is " + kind_of(st.st_mode) + ", not a regular file";
     ::close(fd);
-    return false;
+    return -1;
   }
   if (static_cast<unsigned long long>(st.st_size) > max_bytes) {
     why = "is " + std::to_string(static_cast<long long>(st.st_size)) + " bytes, more than the " +
           std::to_string(max_bytes) + " bytes accepted";
     ::close(fd);
-    return false;
+    return -1;
   }
   const int flags = ::fcntl(fd, F_GETFL);
   if (flags >= 0) ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+  return fd;
+}
+
+std::string read_error(int e) { return "read failed: " + errno_text(e); }
+
+}  // namespace internal
+
+bool read_input_file(const std::string& path, std::string& bytes, std::string& why,
+                     std::size_t max_bytes) {
+  bytes.clear();
+  const int fd = internal::open_input_file(path, why, max_bytes);
+  if (fd < 0) return false;
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) st.st_size = 0;
   // The slack past the end lets a parser that reads ahead (simdjson) take the bytes in place.
   bytes.reserve(static_cast<std::size_t>(st.st_size) + kReadSlack);
   bytes.resize(static_cast<std::size_t>(st.st_size));
@@ -261,7 +275,7 @@ bool read_input_file(const std::string& path, std::string& bytes, std::string& w
     const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
     if (n < 0) {
       if (errno == EINTR) continue;
-      why = "read failed: " + errno_text(errno);
+      why = internal::read_error(errno);
       ::close(fd);
       bytes.clear();
       return false;
@@ -294,14 +308,12 @@ std::string canonical_path(const std::string& path) {
 
 void write_outputs(const std::vector<OutputFile>& files, const std::vector<std::string>& inputs,
                    const char* what) {
-  std::vector<internal::StreamedOutput> streamed;
+  std::vector<StreamedOutput> streamed;
   for (const OutputFile& f : files)
     streamed.push_back(
-        {f.path, [&f](const internal::ByteSink& sink) { sink(f.bytes.data(), f.bytes.size()); }});
-  internal::write_streamed_outputs(streamed, inputs, what);
+        {f.path, [&f](const ByteSink& sink) { sink(f.bytes.data(), f.bytes.size()); }});
+  write_streamed_outputs(streamed, inputs, what);
 }
-
-namespace internal {
 
 void write_streamed_outputs(const std::vector<StreamedOutput>& files,
                             const std::vector<std::string>& inputs, const char* what) {
@@ -381,8 +393,6 @@ void write_streamed_outputs(const std::vector<StreamedOutput>& files,
     }
   }
 }
-
-}  // namespace internal
 
 std::string printable(const std::string& text, std::size_t max) {
   std::string out;

@@ -5,7 +5,6 @@
 #include "json_util.hpp"
 #include "model/graph_impl.hpp"
 #include "polyhedron_json.hpp"
-#include "streamed_output.hpp"
 
 #include <cf/file_io.hpp>
 #include <cf/version.hpp>
@@ -376,18 +375,18 @@ void CfGraph::save(const std::string& path) const {
   }
   // JSON goes to the file in pieces: a large graph's text is several times its records.
   const Impl& g = impl();
-  internal::write_streamed_outputs({{path,
-                                     [&g](const internal::ByteSink& sink) {
-                                       std::string out;
-                                       out.reserve(kFlushBytes + 65536);
-                                       const Flush flush = [&sink](std::string& piece) {
-                                         sink(piece.data(), piece.size());
-                                         piece.clear();
-                                       };
-                                       emit_json(g, 1, out, &flush);
-                                       sink(out.data(), out.size());
-                                     }}},
-                                   {}, "writing graph");
+  write_streamed_outputs({{path,
+                           [&g](const ByteSink& sink) {
+                             std::string out;
+                             out.reserve(kFlushBytes + 65536);
+                             const Flush flush = [&sink](std::string& piece) {
+                               sink(piece.data(), piece.size());
+                               piece.clear();
+                             };
+                             emit_json(g, 1, out, &flush);
+                             sink(out.data(), out.size());
+                           }}},
+                         {}, "writing graph");
 }
 
 CfGraph CfGraph::load(const std::string& path) { return load(path, GraphLoadOptions()); }
