@@ -60,7 +60,10 @@ cf::CfGraph synthetic_graph(std::size_t num_cfs) {
   }
   for (std::size_t i = 0; i < singles.size() && cfs.size() < num_cfs; ++i)
     for (std::size_t j = i + 1; j < singles.size() && cfs.size() < num_cfs; ++j) {
-      if (share_plane(singles[i], singles[j])) continue;
+      // A CF's PCs are principal: none on a plane another holds, none dominating another.
+      if (share_plane(singles[i], singles[j]) || cf::dominates(a, b, singles[i], singles[j]) ||
+          cf::dominates(a, b, singles[j], singles[i]))
+        continue;
       cf::CfRecord r;
       r.pcs = cf::PcSet({singles[i], singles[j]});
       r.witness = witness();

@@ -620,9 +620,13 @@ TEST_CASE(
   ok.append(255, '\x81');
   ok += '\xf6';
   CHECK_THROWS_WITH(CfGraph::from_bytes(ok, "ok.cbor", true), !Catch::Contains("nesting"));
-  const std::string json = "{\"x\":" + std::string(100000, '[') + std::string(100000, ']') + "}";
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  const std::string json = R"({"format": "cf-graph", "version": 1, "x":)" + deep + "}";
   CHECK_THROWS_WITH(CfGraph::from_bytes(json, "deep.json", false),
                     Catch::Contains("nesting deeper than 256 levels"));
+  // Without a format the file is refused as no graph before its members are read.
+  CHECK_THROWS_WITH(CfGraph::from_bytes("{\"x\":" + deep + "}", "deep.json", false),
+                    Catch::Contains("reading 'deep.json' at /: missing member \"format\""));
 }
 
 TEST_CASE("load: invalid UTF-8 in a CBOR graph's strings is reported, not an internal error",
@@ -894,4 +898,37 @@ TEST_CASE("the reader rejects malformed JSON with the line and column", "[graph]
       Catch::Contains("line 1, column 257 near '[': nesting deeper than 256 levels"));
   CHECK_THROWS_WITH(CfGraph::from_bytes(" \n ", "w.json", false),
                     Catch::Contains("line 2, column 2 at the end of the input: empty input"));
+}
+
+TEST_CASE("load: a member named twice is refused, in JSON and in CBOR", "[graph][bad]") {
+  // Readers disagree on what a repeated name means (Python's json keeps the last, this reader
+  // joined two cfs arrays), so the file is refused, at the second one.
+  struct Case {
+    std::string from, to, pointer, name;
+  };
+  const std::vector<Case> cases = {
+      {R"("units": "mm",)", R"("units": "mm", "units": "mm",)", "/units", "units"},
+      {R"("transitions": [)", R"("cfs": [], "transitions": [)", "/cfs", "cfs"},
+      {R"({"id":0,"pcs":[{"type":"f-f","a":2,"b":4}])",
+       R"({"id":0,"pcs":[{"type":"f-f","a":2,"a":3,"b":4}])", "/cfs/0/pcs/0", "a"},
+      {R"({"id":0,"pcs")", R"({"id":0,"id":0,"pcs")", "/cfs/0", "id"},
+      {R"("t":[20.0,10.0,5.0]})", R"("t":[20.0,10.0,5.0],"t":[0,0,0]})", "/cfs/0/witness", "t"},
+      {R"({"from":3,"to":4,"kind":"change"})", R"({"from":3,"to":4,"to":4,"kind":"change"})",
+       "/transitions/", "to"},
+      {R"("name": "cube",)", R"("name": "cube", "name": "box",)", "/models", "name"},
+  };
+  for (const Case& c : cases) {
+    INFO(c.to);
+    const std::string text = fixture_with(c.from, c.to);
+    const std::string want = "member \"" + c.name + "\" appears twice in this object";
+    CHECK_THROWS_WITH(
+        CfGraph::from_bytes(text, "twice.json", false),
+        Catch::Contains("reading 'twice.json' at " + c.pointer) && Catch::Contains(want));
+  }
+  // CBOR: {"format": "cf-graph", "version": 1, "format": "x"}, written byte by byte.
+  const std::string cbor = std::string("\xa3\x66") + "format" + "\x68" + "cf-graph" + "\x67" +
+                           "version" + "\x01\x66" + "format" + "\x61" + "x";
+  CHECK_THROWS_WITH(CfGraph::from_bytes(cbor, "twice.cbor", true),
+                    Catch::Contains("reading 'twice.cbor' at /format: member \"format\" appears "
+                                    "twice in this object"));
 }

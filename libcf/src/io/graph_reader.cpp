@@ -16,12 +16,14 @@
 #include <cf/file_io.hpp>
 #include <cf/version.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <string_view>
 #include <utility>
 
@@ -119,11 +121,44 @@ enum class Field : std::uint8_t {
   kTrOther,
 };
 
+/// The root's `format` and `version` (null: absent): a cf-graph of the version this library
+/// reads, else the reason, naming the member.
+void check_format(const json& format, const JsonWhere& root) {
+  if (!format.is_string() || format.get<std::string>() != "cf-graph")
+    json_fail(root / "format", "format is " + json_short(format) + ", expected \"cf-graph\"");
+}
+void check_version(const json& version, const JsonWhere& root) {
+  if (!version.is_number_integer() || version.get<long long>() != kGraphFormatVersion)
+    json_fail(root / "version", "version " + json_short(version) +
+                                    " is not supported (this library reads version " +
+                                    std::to_string(kGraphFormatVersion) + ")");
+}
+void check_format_and_version(const json* format, const json* version, const JsonWhere& root) {
+  if (format == nullptr) json_fail(root, "missing member \"format\": not a cf-graph file");
+  check_format(*format, root);
+  if (version == nullptr) json_fail(root, "missing member \"version\"");
+  check_version(*version, root);
+}
+
+/// The root's format and version, read before the graph when other members come first (a
+/// file that is no cf-graph, or of another version, is refused before anything is
+/// allocated for what it holds). The scan stops once both are read.
+struct Header {
+  json format, version;
+  bool has_format = false, has_version = false;
+  bool complete() const { return has_format && has_version; }
+  void check(const std::string& source) const {
+    check_format_and_version(has_format ? &format : nullptr, has_version ? &version : nullptr,
+                             JsonWhere{source, ""});
+  }
+};
+
 class GraphSax {
  public:
   GraphSax(const std::string& source, bool cbor) : source_(source), cbor_(cbor) {
     stack_.reserve(16);
-    stack_.push_back(Ctx::kDocument);
+    seen_.reserve(16);
+    push(Ctx::kDocument);
   }
 
   // --- nlohmann SAX interface -----------------------------------------------------------
@@ -183,6 +218,9 @@ class GraphSax {
   std::vector<RawPcs> raw_pcs;
   std::vector<Transition> transitions;
   bool have_cfs = false, have_transitions = false;
+  /// Checks the header when a member other than format and version comes before both
+  /// (cfgen writes them first): a scan of the file's root for them, which throws.
+  std::function<void()> header_scan;
   std::string fault_pointer;  ///< first item-level fault, reported after the parse
   std::string fault_what;
   bool faulted() const { return !fault_what.empty(); }
@@ -227,9 +265,43 @@ class GraphSax {
     return c != Ctx::kDocument && c != Ctx::kRoot && c != Ctx::kCapture;
   }
 
+  /// A member named twice in one object: JSON leaves its meaning open and readers differ
+  /// (the last wins, the first wins, or, here before, two `cfs` arrays joined), so it is
+  /// refused. `seen_` holds, per open item object, a bit per known member read; the root's
+  /// names are kept whole; a captured object (models, metadata) is asked itself.
+  void duplicate(std::string pointer, const std::string& name) {
+    fault(std::move(pointer),
+          "member \"" + printable(name) + "\" appears twice in this object (each name once)");
+  }
+  void push(Ctx c) {
+    stack_.push_back(c);
+    seen_.push_back(0);
+  }
+  bool first_time(Field f) {
+    const std::uint64_t bit = std::uint64_t{1} << static_cast<unsigned>(f);
+    const bool first = (seen_.back() & bit) == 0;
+    seen_.back() |= bit;
+    return first;
+  }
+
   const std::string& source_;
   bool cbor_;
   std::vector<Ctx> stack_;
+  std::vector<std::uint64_t> seen_;  // parallel to stack_
+  std::vector<std::string> root_keys_;
+  bool format_ok_ = false, version_ok_ = false, header_scanned_ = false;
+  /// A root format or version checked as it is read: a file that is no graph stops here.
+  void check_header_member(const json& value) {
+    if (faulted()) return;  // a second "format" is reported as such
+    const JsonWhere root{source_, ""};
+    if (root_key_ == "format") {
+      check_format(value, root);
+      format_ok_ = true;
+    } else if (root_key_ == "version") {
+      check_version(value, root);
+      version_ok_ = true;
+    }
+  }
   Field field_ = Field::kNone;
   std::string root_key_;
   // Capture state: the DOM containers being filled and the key inside each object.
@@ -298,9 +370,19 @@ bool GraphSax::key(std::string& k) {
       field_ = k == "cfs"           ? Field::kRootCfs
                : k == "transitions" ? Field::kRootTransitions
                                     : Field::kRootOther;
+      if (std::find(root_keys_.begin(), root_keys_.end(), k) != root_keys_.end())
+        duplicate("/" + k, k);
+      else
+        root_keys_.push_back(k);
+      if (k != "format" && k != "version" && !(format_ok_ && version_ok_) && !header_scanned_) {
+        header_scanned_ = true;
+        if (header_scan) header_scan();
+      }
       break;
     case Ctx::kCapture:
       capture_key_ = k;
+      if (capture_.back()->is_object() && capture_.back()->contains(k))
+        duplicate("/" + root_key_, k);
       break;
     case Ctx::kCf:
       field_ = k == "id"                ? Field::kCfId
@@ -310,6 +392,7 @@ bool GraphSax::key(std::string& k) {
                : k == "translation_dof" ? Field::kCfTdof
                : k == "pure_rotation"   ? Field::kCfPure
                                         : Field::kCfOther;  // CFs may carry extra members
+      if (field_ != Field::kCfOther && !first_time(field_)) duplicate(cf_ptr(), k);
       break;
     case Ctx::kPc:
       field_ = k == "type" ? Field::kPcType
@@ -318,18 +401,23 @@ bool GraphSax::key(std::string& k) {
                            : Field::kPcOther;
       if (field_ == Field::kPcOther)
         fault(pc_ptr(), "unexpected member \"" + printable(k) + "\" (a PC has type, a and b)");
+      else if (!first_time(field_))
+        duplicate(pc_ptr(), k);
       break;
     case Ctx::kWitness:
       field_ = k == "R" ? Field::kWR : k == "t" ? Field::kWT : Field::kWOther;
       if (field_ == Field::kWOther)
         fault(cf_ptr() + "/witness",
               "unexpected member \"" + printable(k) + "\" (a witness has R and t)");
+      else if (!first_time(field_))
+        duplicate(cf_ptr() + "/witness", k);
       break;
     case Ctx::kTransition:
       field_ = k == "from"   ? Field::kTrFrom
                : k == "to"   ? Field::kTrTo
                : k == "kind" ? Field::kTrKind
                              : Field::kTrOther;
+      if (field_ != Field::kTrOther && !first_time(field_)) duplicate(tr_ptr(), k);
       break;
     default:
       break;  // kSkip
@@ -344,9 +432,10 @@ bool GraphSax::scalar(const Scalar& s) {
     return true;
   }
   if (c == Ctx::kRoot) {
-    if (field_ == Field::kRootOther)
+    if (field_ == Field::kRootOther) {
+      check_header_member(s.to_json());
       skeleton[root_key_] = s.to_json();
-    else
+    } else
       fault(field_ptr(), std::string("expected an array, got ") + s.shown());
     return true;
   }
@@ -544,10 +633,10 @@ bool GraphSax::start(bool object) {
   if (c == Ctx::kDocument) {
     if (!object) {
       skeleton = json::array();  // reported after the parse; the rest is ignored
-      stack_.push_back(Ctx::kSkip);
+      push(Ctx::kSkip);
       return true;
     }
-    stack_.push_back(Ctx::kRoot);
+    push(Ctx::kRoot);
     return true;
   }
   if (c == Ctx::kRoot) {
@@ -559,32 +648,33 @@ bool GraphSax::start(bool object) {
     return true;
   }
   if (faulted() || c == Ctx::kSkip) {
-    stack_.push_back(Ctx::kSkip);
+    push(Ctx::kSkip);
     return true;
   }
-  stack_.push_back(start_in_item(c, object));
+  push(start_in_item(c, object));
   return true;
 }
 
 void GraphSax::start_at_root(bool object) {
   if (field_ == Field::kRootOther) {
+    check_header_member(object ? json::object() : json::array());
     json& slot = skeleton[root_key_];
     slot = object ? json::object() : json::array();
     capture_.push_back(&slot);
-    stack_.push_back(Ctx::kCapture);
+    push(Ctx::kCapture);
   } else if (!object && field_ == Field::kRootCfs) {
     have_cfs = true;
-    stack_.push_back(Ctx::kCfs);
+    push(Ctx::kCfs);
   } else if (!object && field_ == Field::kRootTransitions) {
     have_transitions = true;
-    stack_.push_back(Ctx::kTransitions);
+    push(Ctx::kTransitions);
   } else {
     if (field_ == Field::kRootCfs)
       have_cfs = true;
     else
       have_transitions = true;
     fault(field_ptr(), std::string("expected an array, got ") + container_name(object));
-    stack_.push_back(Ctx::kSkip);
+    push(Ctx::kSkip);
   }
 }
 
@@ -600,7 +690,7 @@ void GraphSax::start_captured(bool object) {
     child = &top->back();
   }
   capture_.push_back(child);
-  stack_.push_back(Ctx::kCapture);
+  push(Ctx::kCapture);
 }
 
 Ctx GraphSax::start_in_item(Ctx c, bool object) {
@@ -711,6 +801,7 @@ Ctx GraphSax::start_in_witness(bool object) {
 bool GraphSax::end() {
   const Ctx c = stack_.back();
   stack_.pop_back();
+  seen_.pop_back();
   if (c == Ctx::kCapture) {
     capture_.pop_back();
     return true;
@@ -774,6 +865,58 @@ bool GraphSax::end() {
   }
   return true;
 }
+
+/// nlohmann SAX handler that reads a CBOR root's format and version and stops; anything
+/// else it skips. A syntax error ends the scan quietly: the reading pass reports it.
+class HeaderSax {
+ public:
+  explicit HeaderSax(Header& h) : h_(h) {}
+  bool null() { return value(json(nullptr)); }
+  bool boolean(bool v) { return value(json(v)); }
+  bool number_integer(std::int64_t v) { return value(json(v)); }
+  bool number_unsigned(std::uint64_t v) { return value(json(v)); }
+  bool number_float(double v, const std::string&) { return value(json(v)); }
+  bool string(std::string& v) { return value(json(v)); }
+  bool binary(json::binary_t&) { return value(json(nullptr)); }
+  bool start_object(std::size_t) { return start(json::object()); }
+  bool start_array(std::size_t) { return start(json::array()); }
+  bool end_object() { return end(); }
+  bool end_array() { return end(); }
+  bool key(std::string& k) {
+    if (depth_ == 1) target_ = k == "format" ? &h_.format : k == "version" ? &h_.version : nullptr;
+    return true;
+  }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) {
+    return false;
+  }
+
+ private:
+  bool value(json v) {
+    if (depth_ == 1 && target_ != nullptr) take(std::move(v));
+    return !h_.complete();
+  }
+  bool start(json empty) {
+    if (depth_ == 0 && !empty.is_object()) return false;  // the reading pass says so
+    if (depth_ == 1 && target_ != nullptr) take(std::move(empty));
+    if (++depth_ > kMaxNesting) return false;
+    return !h_.complete();
+  }
+  bool end() {
+    finished_ = --depth_ == 0;
+    return !finished_ && !h_.complete();
+  }
+  void take(json v) {
+    *target_ = std::move(v);
+    (target_ == &h_.format ? h_.has_format : h_.has_version) = true;
+    target_ = nullptr;
+  }
+  Header& h_;
+  std::size_t depth_ = 0;
+  json* target_ = nullptr;
+
+ public:
+  bool finished_ = false;  ///< the root object was read to its end
+};
 
 /// Drives a SAX handler from simdjson's On-Demand parser: strict RFC 8259 with UTF-8
 /// checked, and every value visited, so the whole document is validated (On Demand checks
@@ -847,6 +990,73 @@ class JsonWalker {
                 std::to_string(line) + ", column " + std::to_string(col) + near + ": " + what);
   }
 
+ public:
+  /// Reads the root object's format and version into `h` with a parser of its own, stopping
+  /// once both are read; false when a syntax error stops the scan (the walk reports it).
+  bool scan_header(Header& h) {
+    simdjson::ondemand::parser parser;
+    simdjson::ondemand::document doc;
+    simdjson::ondemand::object root;
+    if (parser.iterate(text_).get(doc) != simdjson::SUCCESS ||
+        doc.get_object().get(root) != simdjson::SUCCESS)
+      return false;
+    for (auto item : root) {
+      simdjson::ondemand::field field;
+      std::string_view key;
+      if (std::move(item).get(field) != simdjson::SUCCESS ||
+          field.unescaped_key().get(key) != simdjson::SUCCESS)
+        return false;
+      if (key != "format" && key != "version") continue;  // its value is skipped
+      json& out = key == "format" ? h.format : h.version;
+      if (!scalar_json(field.value(), out)) return false;
+      (key == "format" ? h.has_format : h.has_version) = true;
+      if (h.complete()) return true;
+    }
+    return true;
+  }
+
+  /// A value as nlohmann JSON for the header's messages (containers as empty ones).
+  static bool scalar_json(simdjson::ondemand::value v, json& out) {
+    using simdjson::ondemand::json_type;
+    json_type type{};
+    if (v.type().get(type) != simdjson::SUCCESS) return false;
+    std::string_view str;
+    std::int64_t i = 0;
+    double d = 0;
+    bool b = false;
+    switch (type) {
+      case json_type::string:
+        if (v.get_string().get(str) != simdjson::SUCCESS) return false;
+        out = std::string(str);
+        return true;
+      case json_type::number:
+        if (v.get_int64().get(i) == simdjson::SUCCESS)
+          out = i;
+        else if (v.get_double().get(d) == simdjson::SUCCESS)
+          out = d;
+        else
+          return false;
+        return true;
+      case json_type::boolean:
+        if (v.get_bool().get(b) != simdjson::SUCCESS) return false;
+        out = b;
+        return true;
+      case json_type::object:
+        out = json::object();
+        return true;
+      case json_type::array:
+        out = json::array();
+        return true;
+      default: {  // null, or a literal the walk reports ("nul")
+        bool is_null = false;
+        if (v.is_null().get(is_null) != simdjson::SUCCESS || !is_null) return false;
+        out = nullptr;
+        return true;
+      }
+    }
+  }
+
+ private:
   /// Where the parser stopped; `fallback` when it cannot say.
   const char* here(const char* fallback) {
     const char* at = nullptr;
@@ -1050,30 +1260,38 @@ std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::s
   const char* const data = bytes.data();
   const std::size_t size = bytes.size();
   GraphSax sax(source, cbor);
-  if (cbor)
+  if (cbor) {
+    sax.header_scan = [&] {
+      Header header;
+      HeaderSax scan(header);
+      json::sax_parse(data, data + size, &scan, json::input_format_t::cbor, false);
+      if (header.complete() || scan.finished_) header.check(source);
+    };
     json::sax_parse(data, data + size, &sax, json::input_format_t::cbor);
-  else
-    JsonWalker(bytes, source).parse(sax);
+  } else {
+    JsonWalker walker(bytes, source);
+    sax.header_scan = [&] {
+      Header header;
+      if (walker.scan_header(header)) header.check(source);
+    };
+    walker.parse(sax);
+  }
 
   const JsonWhere root{source, ""};
   const json& j = sax.skeleton;
   if (!j.is_object()) json_fail(root, "expected a cf-graph object, got " + json_short(j));
+  // The reading's first fault (a member named twice, a CF that is not one) before the
+  // header's values: the header scan has read format and version already, and a second
+  // "format" must not be reported as the first one's value.
+  if (sax.faulted())
+    throw Error("reading '" + source + "' at " + sax.fault_pointer + ": " + sax.fault_what);
   {
-    const auto it = j.find("format");
-    if (it == j.end()) json_fail(root, "missing member \"format\": not a cf-graph file");
-    if (!it->is_string() || it->get<std::string>() != "cf-graph")
-      json_fail(root / "format", "format is " + json_short(*it) + ", expected \"cf-graph\"");
-    const json& v = json_member(j, "version", root);
-    if (!v.is_number_integer() || v.get<long long>() != kGraphFormatVersion)
-      json_fail(root / "version", "version " + json_short(v) +
-                                      " is not supported (this library reads version " +
-                                      std::to_string(kGraphFormatVersion) + ")");
+    const auto f = j.find("format"), v = j.find("version");
+    check_format_and_version(f == j.end() ? nullptr : &*f, v == j.end() ? nullptr : &*v, root);
     const json& u = json_member(j, "units", root);
     if (!u.is_string() || u.get<std::string>() != "mm")
       json_fail(root / "units", "units " + json_short(u) + " are not supported, expected \"mm\"");
   }
-  if (sax.faulted())
-    throw Error("reading '" + source + "' at " + sax.fault_pointer + ": " + sax.fault_what);
   const JsonWhere wm = root / "models";
   const json& jm = json_member(j, "models", root);
   if (!sax.have_cfs) json_fail(root, "missing member \"cfs\"");
