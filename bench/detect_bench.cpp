@@ -183,7 +183,7 @@ struct Pair {
 
 cf::Params with_epsilon(double eps) {
   cf::Params p;
-  p.epsilon_mm = p.detection.max_penetration_mm = eps;
+  p.epsilon_mm = p.detection.deepest_contact_mm = eps;
   return p;
 }
 
@@ -192,7 +192,7 @@ Pair& cube_l() {
   return p;
 }
 // Spheres of 2,000 (r = 30) and 2,016 faces (r = 50), facets of 2.4 to 6.5 mm, at a contact
-// threshold eps (and max_penetration_mm) with poses whose gaps scale with it.
+// threshold eps (and deepest_contact_mm) with poses whose gaps scale with it.
 Pair sphere_pair(double eps) {
   return {tm::faceted_sphere(30, 40, 50, Vec3::Zero(), "sphere2000"),
           tm::faceted_sphere(50, 42, 48, Vec3::Zero(), "sphere2016"), sphere_poses(30, 50, eps),

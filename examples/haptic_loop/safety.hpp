@@ -49,12 +49,12 @@ struct Workspace {
 
 /// The renderer's stiffnesses lowered to what the device renders stably: a device motion d
 /// is a scene motion scale d, so a scene stiffness K is felt as K scale at the handle.
-/// Returns `p` with stiffness_N_per_mm and proxy.stiffness_N_per_mm at most
+/// Returns `p` with stiffness_N_per_mm and proxy.coupling_stiffness_N_per_mm at most
 /// max_stiffness_N_per_mm / scale (kp_N_per_mm, the friction spring, too).
 inline cf::Params stable_params(cf::Params p, const DeviceLimits& d, const Workspace& w) {
   const double k = d.max_stiffness_N_per_mm / w.scale;
-  p.stiffness_N_per_mm = std::min(p.stiffness_N_per_mm, k);
-  p.proxy.stiffness_N_per_mm = std::min(p.proxy.stiffness_N_per_mm, k);
+  p.contact_stiffness_N_per_mm = std::min(p.contact_stiffness_N_per_mm, k);
+  p.proxy.coupling_stiffness_N_per_mm = std::min(p.proxy.coupling_stiffness_N_per_mm, k);
   p.kp_N_per_mm = std::min(p.kp_N_per_mm, k);
   return p;
 }

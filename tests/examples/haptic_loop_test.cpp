@@ -80,11 +80,11 @@ TEST_CASE("the stiffnesses are lowered to what the device renders stably at the 
   Workspace w;
   w.scale = 4;  // 1 mm of the hand is 4 mm in the scene: a scene stiffness K feels as 4 K
   const cf::Params p = haptic_loop::stable_params(cf::Params{}, d, w);
-  CHECK(p.stiffness_N_per_mm == 0.25);
-  CHECK(p.proxy.stiffness_N_per_mm == 0.25);
+  CHECK(p.contact_stiffness_N_per_mm == 0.25);
+  CHECK(p.proxy.coupling_stiffness_N_per_mm == 0.25);
   CHECK(p.kp_N_per_mm == 0.25);
   w.scale = 0.1;  // a stiffness the device can take is kept
-  CHECK(haptic_loop::stable_params(cf::Params{}, d, w).stiffness_N_per_mm == 2.3);
+  CHECK(haptic_loop::stable_params(cf::Params{}, d, w).contact_stiffness_N_per_mm == 2.3);
 }
 
 TEST_CASE(

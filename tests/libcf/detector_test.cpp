@@ -346,10 +346,10 @@ TEST_CASE("bad parameters are rejected with their name", "[detector]") {
   CHECK_THROWS_WITH(cf::ContactDetector(tmod::cube(), tmod::l_block(), p),
                     Catch::Contains("parameter epsilon_mm = -1 is outside [1e-06, 1000] mm"));
   p = cf::Params();
-  p.detection.max_penetration_mm = std::nan("");
+  p.detection.deepest_contact_mm = std::nan("");
   CHECK_THROWS_WITH(
       cf::ContactDetector(tmod::cube(), tmod::l_block(), p),
-      Catch::Contains("parameter detection.max_penetration_mm = nan is outside [0, 1000000] mm"));
+      Catch::Contains("parameter detection.deepest_contact_mm = nan is outside [0, 1000000] mm"));
 }
 
 TEST_CASE("overlap of polygons with holes matches Boost.Geometry", "[detector]") {
@@ -554,7 +554,7 @@ TEST_CASE("convexity: one loop, no reflex corner", "[detector]") {
 namespace {
 cf::Params band(double eps) {
   cf::Params p;
-  p.epsilon_mm = p.detection.max_penetration_mm = eps;
+  p.epsilon_mm = p.detection.deepest_contact_mm = eps;
   return p;
 }
 cf::Params all_pairs(cf::Params p) {
@@ -613,7 +613,7 @@ TEST_CASE("the BVH finds what all pairs find on faceted spheres", "[detector]") 
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> U(-1, 1);
   int contacts = 0;
-  // Gaps from 1.1 epsilon apart (nothing) to 1.1 epsilon deep (beyond max_penetration_mm):
+  // Gaps from 1.1 epsilon apart (nothing) to 1.1 epsilon deep (beyond deepest_contact_mm):
   // the band's edges on both sides.
   for (int k = 0; k < 32; ++k) {
     const Vec3 dir = Vec3(U(rng), U(rng), U(rng)).normalized();

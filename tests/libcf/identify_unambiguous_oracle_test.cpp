@@ -31,7 +31,7 @@
 //
 // Environment, for exploring (the defaults are the test): CF_UNAMBIGUOUS_ROUNDS (sampler
 // rounds per pair), CF_UNAMBIGUOUS_EPS and CF_UNAMBIGUOUS_DEPTH (epsilon_mm and
-// max_penetration_mm; the property needs max_penetration_mm <= epsilon_mm, see
+// deepest_contact_mm; the property needs deepest_contact_mm <= epsilon_mm, see
 // docs/runtime.md), CF_UNAMBIGUOUS_DIST_MARGIN (mm) and CF_UNAMBIGUOUS_ANG_MARGIN (share),
 // CF_ORACLE_KEEP_DIR and CF_ORACLE_EXTRA_DIR (where the pairs are).
 
@@ -176,7 +176,7 @@ PairResult run_pair(const PairSpec& spec) {
   cf::Params params;  // the defaults; CF_UNAMBIGUOUS_EPS, _DEPTH (mm) try another band
   if (const char* e = std::getenv("CF_UNAMBIGUOUS_EPS")) params.epsilon_mm = std::atof(e);
   if (const char* e = std::getenv("CF_UNAMBIGUOUS_DEPTH"))
-    params.detection.max_penetration_mm = std::atof(e);
+    params.detection.deepest_contact_mm = std::atof(e);
   const cf::CfModel model(graph, params);
   oracle::BandParams band;
   band.eps = model.params().epsilon_mm;

@@ -8,7 +8,7 @@
 //
 //  - every tick where the device pose penetrates B (the oracle's exact interior test) renders
 //    a CF (HapticResult::cf valid);
-//  - the proxy pose X_WP never penetrates B by more than ProxyParams::max_penetration_mm
+//  - the proxy pose X_WP never penetrates B by more than ProxyParams::penetration_tolerance_mm
 //    (plus a numerical tolerance), measured here with the oracle's polyhedra: depth of A's
 //    vertices inside B, of B's vertices inside A, and of crossing edge pairs (below);
 //  - the rendered force along the push direction (out of B, against the device's motion) at
@@ -111,7 +111,7 @@ constexpr double kEndClearanceMarginMm = 1e-3;
 
 // ---- checks -------------------------------------------------------------------------------------
 
-// Added to ProxyParams::max_penetration_mm (0.01 mm) when checking the proxy's depth: the
+// Added to ProxyParams::penetration_tolerance_mm (0.01 mm) when checking the proxy's depth: the
 // oracle's depths and the library's poses are exact to double rounding at coordinates of at
 // most ~100 mm (~1e-13 mm); 1e-6 mm is far above that and four orders below the bound itself.
 constexpr double kProxyDepthNumTolMm = 1e-6;
@@ -423,7 +423,7 @@ void run_sample(const cf::CfModel& model, const oracle::Classifier& C,
   const bool trace =
       trace_env != nullptr && std::string(trace_env) == seed + ":" + std::to_string(s.row);
   const cf::Params& prm = model.params();
-  const double delta = prm.proxy.max_penetration_mm;
+  const double delta = prm.proxy.penetration_tolerance_mm;
   const Eigen::Vector3d gravity(0, -prm.mass_kg * prm.gravity_N_per_kg, 0);
   const std::vector<Tick> ticks = script(d, p);
   cf::CfState state(model);  // cold start per sample
@@ -568,7 +568,7 @@ PairSummary check_pair(const fs::path& dir) {
   const oracle::Graph og = oracle::read_graph(g_path);
   const oracle::Classifier C(og.A, og.B, oracle::default_tolerances(og.A, og.B));
   oracle::Tolerances tol_delta = C.tol();
-  tol_delta.len = model.params().proxy.max_penetration_mm + kProxyDepthNumTolMm;
+  tol_delta.len = model.params().proxy.penetration_tolerance_mm + kProxyDepthNumTolMm;
   const oracle::Classifier C_delta(og.A, og.B, tol_delta);
 
   std::vector<Sample> eligible;

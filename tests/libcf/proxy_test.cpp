@@ -24,7 +24,7 @@ namespace {
 // Default parameters: K = 2.3 N/mm, epsilon = 1 mm, m g = 4.9 N, mu = 0.7, mu_D = 0.08; the
 // coupling's stiffness is K.
 constexpr double kK = 2.3, kEps = 1.0, kWeight = 4.9, kMuD = 0.08;
-// The proxy's allowed depth (ProxyParams::max_penetration_mm) and the solver's residue:
+// The proxy's allowed depth (ProxyParams::penetration_tolerance_mm) and the solver's residue:
 // its sweeps stop when no constraint force moves the proxy by 1e-7 mm.
 constexpr double kDelta = 0.01;
 constexpr double kSolverForce_N = 1e-4;
@@ -118,7 +118,7 @@ TEST_CASE("pressing 1, 5 and 20 mm into a face, an edge and the inner corner", "
         // The coupling is balanced by the constraint forces at rest.
         CHECK((res.proxy->F_coupling_W - res.proxy->F_constraint_W).norm() <= kSolverForce_N * 10);
         // Without the proxy the same pose renders nothing but the weight once it is deeper
-        // than detection's max_penetration_mm (1 mm): what the proxy is for.
+        // than detection's deepest_contact_mm (1 mm): what the proxy is for.
         if (depth <= 1.0) continue;
         cf::HapticRenderer lit2(g, literal);
         double t2 = 0;
@@ -213,7 +213,7 @@ TEST_CASE("with more point contacts than a solve holds, the nearest are kept and
       tm::faceted_sphere(30, 40, 50, cf::Vec3::Zero(), "sphere2000"),
       tm::faceted_sphere(50, 42, 48, cf::Vec3::Zero(), "sphere2016"), {}, {});
   cf::Params p;
-  p.epsilon_mm = p.detection.max_penetration_mm = 4.0;
+  p.epsilon_mm = p.detection.deepest_contact_mm = 4.0;
   cf::HapticRenderer r(g, p);
   double t = 0;
   int most_dropped = 0;
@@ -241,7 +241,7 @@ TEST_CASE("with more point contacts than a solve holds, the nearest are kept and
   }
   INFO("most point contacts left out of a solve: " << most_dropped);
   CHECK(most_dropped > 0);
-  // The allowed depth (ProxyParams::max_penetration_mm) over an independent detection.
+  // The allowed depth (ProxyParams::penetration_tolerance_mm) over an independent detection.
   CHECK(deepest <= kDelta);
 }
 
@@ -401,18 +401,19 @@ TEST_CASE("looking ahead along a long translation saves sub-steps and moves the 
 TEST_CASE("proxy parameters out of range are refused by name", "[proxy]") {
   const cf::CfGraph& g = cube_l_graph();
   cf::Params p;
-  p.proxy.stiffness_N_per_mm = 0;
+  p.proxy.coupling_stiffness_N_per_mm = 0;
   CHECK_THROWS_WITH(
       cf::HapticRenderer(g, p),
-      "cf::Params: parameter proxy.stiffness_N_per_mm = 0 is outside (0, 1e+09] N/mm");
+      "cf::Params: parameter proxy.coupling_stiffness_N_per_mm = 0 is outside (0, 1e+09] N/mm");
   p = cf::Params();
   p.proxy.max_substeps = 0;
   CHECK_THROWS_WITH(cf::HapticRenderer(g, p),
                     "cf::Params: parameter proxy.max_substeps = 0 is below 1");
   p = cf::Params();
-  p.proxy.damping_N_s_per_mm = -1;
-  CHECK_THROWS_WITH(cf::HapticRenderer(g, p),
-                    Catch::Contains("proxy.damping_N_s_per_mm = -1 is outside [0, 1e+09] N s/mm"));
+  p.proxy.coupling_damping_N_s_per_mm = -1;
+  CHECK_THROWS_WITH(
+      cf::HapticRenderer(g, p),
+      Catch::Contains("proxy.coupling_damping_N_s_per_mm = -1 is outside [0, 1e+09] N s/mm"));
   p = cf::Params();
   p.proxy.lookahead_epsilons = 0.5;
   CHECK_THROWS_WITH(cf::HapticRenderer(g, p),

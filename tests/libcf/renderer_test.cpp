@@ -212,7 +212,7 @@ TEST_CASE("one parameter tree: epsilon, detection and identification reach the r
   p.t_BA.y() = 35.2;
   const cf::HapticResult& res = r.step(p, 0.002);
   REQUIRE(res.cf == cf::CfId(0));
-  CHECK(res.F_W.y() == Approx(P.stiffness_N_per_mm * (0.3 - 0.2) - 4.9).margin(1e-9));
+  CHECK(res.F_W.y() == Approx(P.contact_stiffness_N_per_mm * (0.3 - 0.2) - 4.9).margin(1e-9));
   // All pairs instead of the hierarchies: the same wrench.
   cf::Params brute = P;
   brute.detection.use_bvh = false;

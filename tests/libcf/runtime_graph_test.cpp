@@ -40,7 +40,7 @@ using cf::Vec3;
 // poses written as shortest round-trip doubles and of the detector's own arithmetic.
 constexpr double kExact = 1e-6;  // mm
 // Perturbed poses keep every PC of the witness's CF within this band of signed distances
-// (mm; inside the detector's [-max_penetration_mm, epsilon] = [-1, 1]), and the heights over a
+// (mm; inside the detector's [-deepest_contact_mm, epsilon] = [-1, 1]), and the heights over a
 // line or plane PC within kSpread of each other, so that its tilt is within the detector's
 // angular tolerance (the tilt at which the whole contact stays within epsilon = 1 mm).
 constexpr double kBandLo = -0.3, kBandHi = 0.8, kSpread = 0.9;

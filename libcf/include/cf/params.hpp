@@ -38,8 +38,8 @@ enum class MomentReference : std::uint8_t {
 /// itself is Params::epsilon_mm.
 struct DetectionParams {
   /// mm. Deepest interpenetration still reported as a contact (distance down to
-  /// -max_penetration_mm). Deeper pairs are taken as the far side of the other solid.
-  double max_penetration_mm = 1.0;
+  /// -deepest_contact_mm). Deeper pairs are taken as the far side of the other solid.
+  double deepest_contact_mm = 1.0;
   /// mm. How far outside a face (in its plane) or beyond an edge's end a contact may fall
   /// and still count, so that degenerate touches (v-v, v-e, e-v, collinear e-e) yield their
   /// neighbouring non-degenerate interpretations. <= 0 means epsilon_mm.
@@ -98,25 +98,25 @@ struct IdentificationParams {
 };
 
 /// The proxy (docs/spec.md, section 6b; docs/force-model.md "The proxy"): a 6-DOF god-object pose
-/// of A that follows the device pose but never penetrates B by more than max_penetration_mm, and a
-/// spring (and damper) coupling the device to it.
+/// of A that follows the device pose but never penetrates B by more than penetration_tolerance_mm,
+/// and a spring (and damper) coupling the device to it.
 struct ProxyParams {
   /// false: no proxy; A's pose is the device pose (the paper's literal model).
   bool enabled = true;
   /// N/mm. The coupling's translational stiffness, which is also the proxy's metric:
-  /// rotations are weighted by stiffness_N_per_mm times A's inertia per unit mass about the
-  /// grip point (mm^2; that of A's bounding box), so the rotational stiffness is
-  /// stiffness_N_per_mm * J (N mm/rad). The default is eq. (1)'s K, so that past the
+  /// rotations are weighted by coupling_stiffness_N_per_mm times A's inertia per unit mass about
+  /// the grip point (mm^2; that of A's bounding box), so the rotational stiffness is
+  /// coupling_stiffness_N_per_mm * J (N mm/rad). The default is eq. (1)'s K, so that past the
   /// surface the normal force keeps eq. (1)'s slope, and the device's passivity needs are
   /// those of the paper's own band: physical damping above k T / 2 (1.15 N s/m at 1 kHz).
-  double stiffness_N_per_mm = 2.3;
+  double coupling_stiffness_N_per_mm = 2.3;
   /// N s/mm. Coupling damping on the device-proxy velocity difference (rotations weighted
   /// as the stiffness is). 0 by default: virtual damping adds to the physical damping a
   /// sampled spring needs to stay passive (b_device > k T / 2 + damping).
-  double damping_N_s_per_mm = 0.0;
+  double coupling_damping_N_s_per_mm = 0.0;
   /// mm. Deepest penetration of B the proxy is left with (linearisation and solver
   /// residue); a deeper result is corrected before the tick ends.
-  double max_penetration_mm = 0.01;
+  double penetration_tolerance_mm = 0.01;
   /// mm, A's frame: where the device holds A; the coupling acts there.
   Vec3 grip_point_A = Vec3::Zero();
   /// Most sub-steps of one tick's swept motion: each moves every point of A by at most
@@ -141,12 +141,12 @@ struct ProxyParams {
 /// HapticRenderer each read the parts they need from one Params.
 struct Params {
   // --- Paper's experimental values (paper section 6; docs/spec.md, section 2) ---
-  double mass_kg = 0.5;             ///< m, mass of A
-  double gravity_N_per_kg = 9.8;    ///< g, acting along -y of the world
-  double stiffness_N_per_mm = 2.3;  ///< K of eq. (1)
-  double kp_N_per_mm = 1.6;         ///< K_p of eqs. (3)-(4)
-  double mu_static = 0.7;           ///< mu of eqs. (2), (3), (6)
-  double mu_kinetic = 0.08;         ///< mu_D of eq. (5) (docs/spec.md, section 6)
+  double mass_kg = 0.5;                     ///< m, mass of A
+  double gravity_N_per_kg = 9.8;            ///< g, acting along -y of the world
+  double contact_stiffness_N_per_mm = 2.3;  ///< K of eq. (1)
+  double kp_N_per_mm = 1.6;                 ///< K_p of eqs. (3)-(4)
+  double mu_static = 0.7;                   ///< mu of eqs. (2), (3), (6)
+  double mu_kinetic = 0.08;                 ///< mu_D of eq. (5) (docs/spec.md, section 6)
   /// The contact threshold: of eq. (1), of detection (element pairs farther apart are not in
   /// contact) and of identification. The only epsilon of the run time.
   double epsilon_mm = 1.0;
@@ -203,7 +203,7 @@ namespace cf {
 /// values accepted. param_specs() lists every one: the one table from which validate(), the
 /// options of cfreplay and the keywords of the Python package take their ranges and help.
 struct ParamSpec {
-  const char* path;    ///< its path in Params ("mu_static", "proxy.stiffness_N_per_mm")
+  const char* path;    ///< its path in Params ("mu_static", "proxy.coupling_stiffness_N_per_mm")
   const char* python;  ///< the Python keyword
   const char* option;  ///< cfreplay's option ("--mu"), or nullptr when it has none
   const char* unit;    ///< "N/mm", "rad", ...; "" for a plain number
@@ -211,6 +211,9 @@ struct ParamSpec {
   bool lo_open;
   const char* doc;            ///< one line, for --help and Python's docs
   double& (*field)(Params&);  ///< the value in a tree
+  /// The Python keyword before a rename, accepted with a DeprecationWarning for one
+  /// release; nullptr when there was none.
+  const char* deprecated_python = nullptr;
   double get(const Params& p) const { return field(const_cast<Params&>(p)); }
   /// Empty when `v` is accepted, else why not: "mu_static = -1 is outside [0, 100]".
   std::string problem(double v) const;

@@ -2,7 +2,7 @@
 /// @file
 /// The proxy of section 6b of docs/spec.md: a 6-DOF god-object pose X_WP of A that moves towards
 /// the device pose X_WD each tick as far as B allows, never penetrating B by more than
-/// ProxyParams::max_penetration_mm, and the spring-damper coupling between the two that the
+/// ProxyParams::penetration_tolerance_mm, and the spring-damper coupling between the two that the
 /// operator feels. docs/force-model.md ("The proxy") gives the model and its defaults.
 
 #include <cf/contact.hpp>

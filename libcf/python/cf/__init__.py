@@ -98,7 +98,7 @@ def replay(graph, t, p, q, params=None, **kwargs):
     ``t`` (N,) times in s, strictly increasing; ``p`` (N, 3) translations in mm; ``q``
     (N, 4) unit quaternions w, x, y, z (normalised as cfreplay does; |q| must be 1 within
     1e-3). Parameters: a cf.Params and/or keyword arguments with cf::Params' names and
-    units (mass_kg, stiffness_N_per_mm, mu_static, epsilon_mm, ...). A fresh renderer steps
+    units (mass_kg, contact_stiffness_N_per_mm, mu_static, epsilon_mm, ...). A fresh renderer steps
     over every pose (cf::Replay, the engine cfreplay runs); the result is a
     cf.ReplayResult whose arrays are named like cf::HapticResult's fields.
     """

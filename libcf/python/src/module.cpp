@@ -108,11 +108,21 @@ cf::Vec3 vec3_value(const char* name, const py::handle& h, const std::string& wh
 
 void set_param(cf::Params& P, const std::string& key, const py::handle& value,
                const std::string& where) {
-  for (const DoubleField& f : double_fields())
+  for (const DoubleField& f : double_fields()) {
+    if (f.deprecated_python != nullptr && key == f.deprecated_python) {
+      // Renamed (two parameters had one name); the old keyword works for one release.
+      const std::string msg = where + ": parameter '" + key + "' is now '" + f.python +
+                              "'; the old name will be removed in the next release";
+      if (PyErr_WarnEx(PyExc_DeprecationWarning, msg.c_str(), 2) != 0)
+        throw py::error_already_set();
+      f.field(P) = double_value(f, value, where);
+      return;
+    }
     if (key == f.python) {
       f.field(P) = double_value(f, value, where);
       return;
     }
+  }
   if (key == kFriction.name) {
     P.friction_displacement = enum_value(kFriction, value, where);
   } else if (key == kCentroid.name) {

@@ -100,7 +100,7 @@ def test_renderer_step_by_step_equals_replay(case):
 def test_parameters_are_cfreplays_options(l_graph, tmp_path):
     path = DATA / "trajectories" / "cube_lblock_slide.csv"
     t, p, q = cf.read_trajectory(path)
-    kw = dict(mu_static=0.3, mu_kinetic=0.2, stiffness_N_per_mm=1.5, kp_N_per_mm=0.9, mass_kg=0.25,
+    kw = dict(mu_static=0.3, mu_kinetic=0.2, contact_stiffness_N_per_mm=1.5, kp_N_per_mm=0.9, mass_kg=0.25,
               epsilon_mm=0.5, friction_displacement="per_tick", centroid="volume", moment_reference="a_point",
               moment_point_A=[1.0, 2.0, 3.0], hold_fcy_threshold_N=0.01, interpolation_time_constant_s=0.002)
     r = cf.replay(l_graph, t, p, q, **kw)
@@ -126,11 +126,20 @@ def test_detection_and_identification_parameters_are_reachable(l_graph):
     base = cf.replay(l_graph, t, p, q).to_csv()
     # Culling and kept pairs never change a result; the fields are in the one tree.
     assert cf.replay(l_graph, t, p, q, use_bvh=False, reuse_margin_mm=0.0).to_csv() == base
-    params = cf.Params(touch_distance_mm=0.002, max_penetration_mm=0.5, max_combinations=100)
-    assert params.touch_distance_mm == 0.002 and params.max_penetration_mm == 0.5 and params.max_combinations == 100
+    params = cf.Params(touch_distance_mm=0.002, deepest_contact_mm=0.5, max_combinations=100)
+    assert params.touch_distance_mm == 0.002 and params.deepest_contact_mm == 0.5 and params.max_combinations == 100
     assert {"in_plane_tolerance_mm", "angular_tolerance_rad", "dominance_fit", "use_bvh"} <= set(params.to_dict())
     with pytest.raises(cf.Error, match=r"^Params: max_combinations must be an integer in \[1, 1000000000\], got 0$"):
         cf.Params(max_combinations=0)
+    # Names two parameters shared before, kept for one release with a warning.
+    old_names = {"stiffness_N_per_mm": "contact_stiffness_N_per_mm", "max_penetration_mm": "deepest_contact_mm",
+                 "proxy_stiffness_N_per_mm": "proxy_coupling_stiffness_N_per_mm",
+                 "proxy_damping_N_s_per_mm": "proxy_coupling_damping_N_s_per_mm",
+                 "proxy_max_penetration_mm": "proxy_penetration_tolerance_mm"}
+    for old, new in old_names.items():
+        with pytest.warns(DeprecationWarning, match=f"parameter '{old}' is now '{new}'"):
+            renamed = cf.Params(**{old: 0.5})
+        assert renamed.to_dict()[new] == 0.5 and old not in renamed.to_dict()
     with pytest.raises(cf.Error, match=r"^Params: use_bvh must be True or False, got 'yes'$"):
         cf.Params(use_bvh="yes")
 
@@ -152,12 +161,12 @@ def test_the_proxy_keeps_a_pressing_device_in_contact(l_graph):
     assert on.F_contact_W[deepest, 1] == pytest.approx(2.3 * 11, abs=1e-3)
     # Off, A's pose is the device's.
     np.testing.assert_array_equal(off.proxy_p, p)
-    params = cf.Params(proxy=False, proxy_stiffness_N_per_mm=1.5, proxy_friction=False)
-    assert params.to_dict()["proxy"] is False and params.proxy_stiffness_N_per_mm == 1.5
+    params = cf.Params(proxy=False, proxy_coupling_stiffness_N_per_mm=1.5, proxy_friction=False)
+    assert params.to_dict()["proxy"] is False and params.proxy_coupling_stiffness_N_per_mm == 1.5
     with pytest.raises(cf.Error, match=r"^Params: proxy must be True or False, got 1$"):
         cf.Params(proxy=1)
-    with pytest.raises(cf.Error, match=r"^Params: proxy_stiffness_N_per_mm must be a finite number in \(0, 1e\+09\], got 0$"):
-        cf.Params(proxy_stiffness_N_per_mm=0.0)
+    with pytest.raises(cf.Error, match=r"^Params: proxy_coupling_stiffness_N_per_mm must be a finite number in \(0, 1e\+09\], got 0$"):
+        cf.Params(proxy_coupling_stiffness_N_per_mm=0.0)
 
 
 def test_replay_errors_carry_messages(l_graph):

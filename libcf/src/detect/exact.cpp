@@ -231,7 +231,7 @@ PairTables::PairTables(const Polyhedron& ma, const Polyhedron& mb, const Params&
       origin_A(origin) {
   validate(params);
   eps = params.epsilon_mm;
-  depth = prm.max_penetration_mm;
+  depth = prm.deepest_contact_mm;
   in_plane = prm.in_plane_tolerance_mm > 0 ? prm.in_plane_tolerance_mm : eps;
   const double scale = std::max(ma.size(), mb.size());
   geo_tol = 1e-9 * std::max(scale, 1.0);

@@ -68,7 +68,7 @@ struct PairTables {
   const Polyhedron* b;
   DetectionParams prm;
   double eps = 1;       ///< mm, Params::epsilon_mm
-  double depth = 1;     ///< mm, max_penetration_mm
+  double depth = 1;     ///< mm, deepest_contact_mm
   double in_plane = 1;  ///< mm, in_plane_tolerance_mm or epsilon
   double geo_tol =
       0;  ///< mm, coincidence of boundaries in 2D: far below any feature, above rounding
@@ -97,7 +97,7 @@ struct PairTables {
   /// A contact read beside its element (in-plane gap > 0: a vertex beside a face, an edge
   /// beside a face or past the end of an edge) at distance d measures two points hypot(d, gap)
   /// apart: they must be within the band too, at most epsilon apart when d >= 0 and at most
-  /// max_penetration_mm when d < 0 (docs/runtime.md, "Tests per type"). In the element
+  /// deepest_contact_mm when d < 0 (docs/runtime.md, "Tests per type"). In the element
   /// (gap 0) this is in_band(d).
   bool within_band_beside(double d, double gap) const {
     const double lim = d >= 0 ? eps : depth;

@@ -233,7 +233,7 @@ PcForce with_geometry(const ContactPc& c) {
 
 // Eq. (1), N; the clamp only guards round-off (a PC is reported within epsilon).
 double eq1(const Params& P, double distance) {
-  return std::max(0.0, P.stiffness_N_per_mm * (P.epsilon_mm - distance));
+  return std::max(0.0, P.contact_stiffness_N_per_mm * (P.epsilon_mm - distance));
 }
 
 // F_cy: eq. (1), or with section 4.5's hold (`hold`: a compliant motion and a PC of last

@@ -365,7 +365,7 @@ int group_of(const ContactPc& cp, Constraints& c) {
 void add_constraint(const ProxyModel& pm, const ProxyState& s, const ContactPc& cp, const Vec3& g,
                     int j, Constraints& c) {
   const auto J = static_cast<std::size_t>(j);
-  const double k = pm.prm.stiffness_N_per_mm;
+  const double k = pm.prm.coupling_stiffness_N_per_mm;
   const Vec3 rr = cp.p_W - g;
   c.used[J] = cp;
   c.dist[J] = cp.distance;
@@ -402,7 +402,7 @@ bool build_constraints(const ProxyModel& pm, const ProxyState& s, const ContactS
   }
   c.num_groups = 0;
   c.m = 0;
-  c.Winv_rot = X.R_BA * pm.Jinv_A * X.R_BA.transpose() / pm.prm.stiffness_N_per_mm;
+  c.Winv_rot = X.R_BA * pm.Jinv_A * X.R_BA.transpose() / pm.prm.coupling_stiffness_N_per_mm;
   for (int i = 0; i < n_point; ++i) {
     const ContactPc& cp = contacts[c.pick[static_cast<std::size_t>(i)]];
     add_constraint(pm, s, cp, g, c.m++, c);
@@ -542,7 +542,7 @@ Vec6 solve(const ProxyModel& pm, ProxyState& s, Constraints& c, const Vec6& xi_d
     if (gauss_seidel_sweep(c, xi) < kSolveTolerance_mm) break;
     breakaway.after_sweep(pm, c, xi);
   }
-  xi = polish(xi, xi_d, c, pm.prm.stiffness_N_per_mm, pm.mu_kinetic);
+  xi = polish(xi, xi_d, c, pm.prm.coupling_stiffness_N_per_mm, pm.mu_kinetic);
   remember_sliding(c, s);
   remember_forces(c, s);  // the next pass of this tick starts from them
   return xi;
@@ -558,7 +558,7 @@ bool within_depth(const ProxyModel& pm, const DetectModel& dm, DetectState& ds, 
   double deepest = 0;
   for (const ContactPc& c : detect_at(dm, ds, X, at))
     if (is_point_type(c.pc.type)) deepest = std::min(deepest, c.distance);
-  return deepest >= -pm.prm.max_penetration_mm;
+  return deepest >= -pm.prm.penetration_tolerance_mm;
 }
 
 // ---- The tick's end: constraint forces and coupling ----
@@ -595,7 +595,7 @@ void report_constraints(const ProxyModel& pm, ProxyState& s, const Constraints& 
 // to the proxy X.
 void couple(const ProxyModel& pm, ProxyState& s, const Pose& X, const Pose& X_WD, double t_s) {
   const ProxyParams& q = pm.prm;
-  const double k = q.stiffness_N_per_mm;
+  const double k = q.coupling_stiffness_N_per_mm;
   const Vec3& g_A = q.grip_point_A;
   ProxyResult& r = s.result;
   const Vec3 g_P = grip(X, g_A);
@@ -605,12 +605,12 @@ void couple(const ProxyModel& pm, ProxyState& s, const Pose& X, const Pose& X_WD
   r.F_coupling_W = k * (g_P - g_D);
   r.M_coupling_W = k * (J_W * theta);
   const double dt = t_s - s.t_prev_s;
-  if (s.has_prev && dt > 0 && q.damping_N_s_per_mm > 0) {
+  if (s.has_prev && dt > 0 && q.coupling_damping_N_s_per_mm > 0) {
     const Vec3 dv = (g_P - grip(s.X_WP_prev, g_A)) - (g_D - grip(s.X_WD_prev, g_A));
     const Vec3 dw = rotation_vector(X.R_BA * s.X_WP_prev.R_BA.transpose()) -
                     rotation_vector(X_WD.R_BA * s.X_WD_prev.R_BA.transpose());
-    r.F_coupling_W += q.damping_N_s_per_mm * dv / dt;
-    r.M_coupling_W += q.damping_N_s_per_mm * (J_W * dw) / dt;
+    r.F_coupling_W += q.coupling_damping_N_s_per_mm * dv / dt;
+    r.M_coupling_W += q.coupling_damping_N_s_per_mm * (J_W * dw) / dt;
   }
   s.has_prev = true;
   s.X_WP_prev = X;
