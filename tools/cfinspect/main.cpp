@@ -14,7 +14,6 @@
 
 #include <CLI/CLI.hpp>
 #include <boost/graph/adjacency_list.hpp>
-#include <boost/graph/connected_components.hpp>
 #include <boost/graph/graphviz.hpp>
 #include <nlohmann/json.hpp>
 
@@ -27,6 +26,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <numeric>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -83,14 +83,22 @@ Summary summarise(const cf::CfGraph& g) {
       s.max_out = std::max(s.max_out, d);
     }
     s.mean_out = static_cast<double>(g.num_transitions()) / static_cast<double>(n);
-    // Components of the undirected view: CFs reachable from each other by any transitions.
-    boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS> u(n);
+    // Components of the undirected view: CFs reachable from each other by any transitions,
+    // by union-find over the transitions with path halving (a vector of n: an adjacency list
+    // of 2.85 million transitions took a second and 200 MB).
+    std::vector<std::size_t> parent(n);
+    std::iota(parent.begin(), parent.end(), std::size_t{0});
+    const auto root = [&parent](std::size_t i) {
+      for (; parent[i] != i; i = parent[i]) parent[i] = parent[parent[i]];
+      return i;
+    };
     for (std::size_t i = 0; i < g.num_transitions(); ++i)
-      boost::add_edge(g.transition(i).from.index(), g.transition(i).to.index(), u);
-    std::vector<std::size_t> comp(n);
-    s.components = static_cast<std::size_t>(boost::connected_components(u, comp.data()));
-    std::vector<std::size_t> sizes(s.components, 0);
-    for (std::size_t c : comp) ++sizes[c];
+      parent[root(static_cast<std::size_t>(g.transition(i).from.index()))] =
+          root(static_cast<std::size_t>(g.transition(i).to.index()));
+    std::vector<std::size_t> sizes(n, 0);
+    for (std::size_t i = 0; i < n; ++i) ++sizes[root(i)];
+    s.components =
+        n - static_cast<std::size_t>(std::count(sizes.begin(), sizes.end(), std::size_t{0}));
     s.largest_component = *std::max_element(sizes.begin(), sizes.end());
     s.isolated = static_cast<std::size_t>(std::count(sizes.begin(), sizes.end(), std::size_t{1}));
   }
