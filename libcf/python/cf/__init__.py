@@ -114,3 +114,14 @@ def _save(self, path):
 
 CfGraph.save = _save
 CfGraph.to_networkx = _to_networkx
+
+
+def _step_many(self, t, p, q):
+    """N servo ticks at once, at C++ speed (the GIL released): the renderer's state carries
+    on from the ticks before, and on to the next. ``t`` (N,) s, increasing and after the
+    last step; ``p`` (N, 3) mm; ``q`` (N, 4) w, x, y, z. Returns a cf.ReplayResult: the same
+    values, tick by tick, as N calls of step()."""
+    return ReplayResult(self._step_many(t, p, q), [])
+
+
+Renderer.step_many = _step_many

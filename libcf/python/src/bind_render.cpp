@@ -144,6 +144,9 @@ py::dict renderer_step(Renderer& self, double t_s, const py::object& p, const py
   return step_dict(self.r.step(pose, t_s));
 }
 
+py::dict renderer_step_many(Renderer& self, const py::object& t, const py::object& p,
+                            const py::object& q);
+
 void bind_renderer(py::module_& m) {
   py::class_<Renderer>(
       m, "Renderer",
@@ -163,6 +166,8 @@ void bind_renderer(py::module_& m) {
            "F_A, "
            "M_A, and the force model's F_contact_W, F_gravity_W, dof, pc_forces (per PC: regime, "
            "distance, F_cy, task frame R_WT, ...).")
+      .def("_step_many", &renderer_step_many, py::arg("t"), py::arg("p"), py::arg("q"),
+           "N ticks at once (cf.Renderer.step_many wraps the result).")
       .def(
           "reset",
           [](Renderer& self) {
@@ -222,6 +227,21 @@ struct ReplayExtras {
   std::vector<std::int32_t> dof;
 };
 
+/// Tick i's values beyond its row.
+void record_extras(const cf::HapticResult& r, std::size_t i, ReplayExtras& x) {
+  x.num_detected[i] = r.num_detected;
+  x.identification[i] = r.identification;
+  for (int k = 0; k < 3; ++k) {
+    x.Fc[3 * i + static_cast<std::size_t>(k)] = r.F_contact_W[k];
+    x.Mc[3 * i + static_cast<std::size_t>(k)] = r.M_contact_W[k];
+  }
+  if (r.force != nullptr) {
+    for (int k = 0; k < 3; ++k) x.Fg[3 * i + static_cast<std::size_t>(k)] = r.force->F_gravity_W[k];
+    x.conservative[i] = r.force->conservative;
+    x.dof[i] = r.force->freedoms.dof;
+  }
+}
+
 /// libcf's replay engine over the samples, without the GIL.
 void run_replay(const cf::CfGraph& g, const std::vector<cf::TrajectorySample>& samples,
                 const cf::Params& P, ReplayRows& rows, ReplayExtras& x) {
@@ -229,21 +249,8 @@ void run_replay(const cf::CfGraph& g, const std::vector<cf::TrajectorySample>& s
   SampleSource source(samples);
   cf::Replay replay(g, P, source);
   rows.rows.resize(samples.size());
-  for (std::size_t i = 0; i < samples.size() && replay.next(rows.rows[i]); ++i) {
-    const cf::HapticResult& r = replay.result();
-    x.num_detected[i] = r.num_detected;
-    x.identification[i] = r.identification;
-    for (int k = 0; k < 3; ++k) {
-      x.Fc[3 * i + static_cast<std::size_t>(k)] = r.F_contact_W[k];
-      x.Mc[3 * i + static_cast<std::size_t>(k)] = r.M_contact_W[k];
-    }
-    if (r.force != nullptr) {
-      for (int k = 0; k < 3; ++k)
-        x.Fg[3 * i + static_cast<std::size_t>(k)] = r.force->F_gravity_W[k];
-      x.conservative[i] = r.force->conservative;
-      x.dof[i] = r.force->freedoms.dof;
-    }
-  }
+  for (std::size_t i = 0; i < samples.size() && replay.next(rows.rows[i]); ++i)
+    record_extras(replay.result(), i, x);
 }
 
 /// replay's result: per-tick arrays and lists by name, and the rows for to_csv.
@@ -308,6 +315,35 @@ py::dict replay_dict(std::unique_ptr<ReplayRows> rows, const ReplayExtras& x) {
   d["regimes"] = regimes;
   d["_rows"] = py::cast(std::move(rows));
   return d;
+}
+
+/// Renderer.step_many: N ticks of this renderer, its state carried on from the ticks before,
+/// without the GIL. The renderer is held by this call for its length (a second thread
+/// stepping the same Renderer meanwhile is the caller's race, as with any C++ renderer).
+py::dict renderer_step_many(Renderer& self, const py::object& t, const py::object& p,
+                            const py::object& q) {
+  const std::vector<cf::TrajectorySample> samples = replay_samples(t, p, q, "step_many");
+  if (self.stepped && !(samples.front().t_s > self.last_t)) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf,
+                  "step_many: time %.9g s does not increase (previous step: %.9g s)",
+                  samples.front().t_s, self.last_t);
+    fail(buf);
+  }
+  auto rows = std::make_unique<ReplayRows>();
+  ReplayExtras extras(samples.size());
+  rows->rows.resize(samples.size());
+  {
+    py::gil_scoped_release release;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      const cf::HapticResult& r = self.r.step(samples[i].X_WD, samples[i].t_s);
+      cf::fill_replay_row(r, rows->rows[i]);
+      record_extras(r, i, extras);
+    }
+  }
+  self.stepped = true;
+  self.last_t = samples.back().t_s;
+  return replay_dict(std::move(rows), extras);
 }
 
 py::dict replay(const cf::CfGraph& g, const py::object& t, const py::object& p, const py::object& q,

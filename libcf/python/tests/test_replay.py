@@ -97,6 +97,22 @@ def test_renderer_step_by_step_equals_replay(case):
     assert s["cf"] == r.cf[0]
 
 
+def test_step_many_carries_the_renderer_on(case):
+    # A batch of ticks is the same as the ticks one by one, and the state carries across
+    # batches: the trajectory in three batches equals the replay of it whole, bit for bit.
+    name, path, graph, t, p, q, r = case
+    renderer = cf.Renderer(graph)
+    cuts = [0, len(t) // 3, 2 * len(t) // 3, len(t)]
+    parts = [renderer.step_many(t[a:b], p[a:b], q[a:b]) for a, b in zip(cuts, cuts[1:])]
+    for field in ("cf", "F_W", "M_W", "F_A", "M_A", "F_contact_W", "proxy_p", "dof"):
+        np.testing.assert_array_equal(np.concatenate([getattr(x, field) for x in parts]), getattr(r, field))
+    assert sum((list(x.motion) for x in parts), []) == list(r.motion)
+    with pytest.raises(cf.Error, match=r"^step_many: time .* s does not increase \(previous step: .* s\)$"):
+        renderer.step_many(t[:1], p[:1], q[:1])
+    renderer.reset()
+    assert list(renderer.step_many(t[:5], p[:5], q[:5]).cf) == list(r.cf[:5])
+
+
 def test_parameters_are_cfreplays_options(l_graph, tmp_path):
     path = DATA / "trajectories" / "cube_lblock_slide.csv"
     t, p, q = cf.read_trajectory(path)
