@@ -5,7 +5,7 @@ A notebook-style script (cells marked with # %%). From the repository root, afte
 
     PYTHONPATH=build/python /usr/bin/python3 examples/python/replay_forces.py
 
-writes build/replay/forces.png (options: --graph, --trajectory, --png, --mu).
+writes build/replay/forces.png (options: --graph, --trajectory, --png, --mu-static).
 """
 
 # %% Imports: the package cf from the build tree (PYTHONPATH=build/python) and matplotlib.
@@ -25,7 +25,7 @@ ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 ap.add_argument("--graph", default=ROOT / "data" / "graphs" / "cube_l_block.json")
 ap.add_argument("--trajectory", default=ROOT / "data" / "trajectories" / "cube_lblock_corner.csv")
 ap.add_argument("--png", default=ROOT / "build" / "replay" / "forces.png")
-ap.add_argument("--mu", type=float, default=0.7, help="static friction coefficient (mu_static)")
+ap.add_argument("--mu-static", type=float, default=0.7, help="static friction coefficient (mu_static)")
 args = ap.parse_args()
 
 # %% The graph: CFs, transitions, the two models.
@@ -37,7 +37,7 @@ print("A:", graph.model_a, " B:", graph.model_b)
 t, p, q = cf.read_trajectory(args.trajectory)
 
 # %% Replay at C++ speed: cfreplay's loop over every pose; keyword arguments are cf::Params.
-r = cf.replay(graph, t, p, q, mu_static=args.mu)
+r = cf.replay(graph, t, p, q, mu_static=args.mu_static)
 print(f"{len(r)} ticks, {(r.status != 'no_contact').sum()} in contact")
 
 # %% The CFs visited, in order, with their motion types.

@@ -89,3 +89,25 @@ TEST_CASE("the force model checks its parameters", "[params]") {
   CHECK_THROWS_WITH(cf::ForceModel(a, b, p),
                     "cf::Params: parameter kp_N_per_mm = 0 is outside (0, 1e+09] N/mm");
 }
+
+TEST_CASE("one name per parameter: cfreplay's option is the Python keyword in kebab case",
+          "[params]") {
+  int with_option = 0;
+  for (const cf::ParamSpec& spec : cf::param_specs()) {
+    if (spec.option == nullptr) continue;
+    ++with_option;
+    std::string kebab = std::string("--") + spec.python;
+    for (char& c : kebab)
+      if (c == '_') c = '-';
+    CHECK(std::string(spec.option) == kebab);
+    // A renamed option's old name is another name, never one in use.
+    if (spec.deprecated_option != nullptr)
+      for (const cf::ParamSpec& other : cf::param_specs())
+        CHECK((other.option == nullptr || std::string(other.option) != spec.deprecated_option));
+  }
+  CHECK(with_option == 10);
+  // The choices: one spelling for the options and the keywords.
+  CHECK(std::string(cf::to_string(cf::FrictionDisplacement::kPerTick)) == "per_tick");
+  CHECK(std::string(cf::to_string(cf::CentroidChoice::kVertexMean)) == "vertex_mean");
+  CHECK(std::string(cf::to_string(cf::MomentReference::kAPoint)) == "a_point");
+}

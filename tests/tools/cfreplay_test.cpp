@@ -277,16 +277,16 @@ TEST_CASE("cfreplay end to end: output, plot, and a bad row leaves no output", "
   // refused before anything runs.
   const std::string out3 = dir + "/replay_out3.csv";
   const std::string cmd3 = std::string(CF_CFREPLAY) + " --graph " + graph + " --trajectory " +
-                           traj + " -o " + out3 + " --moment-point 0 -15 0 2>" + dir +
+                           traj + " -o " + out3 + " --moment-point-A 0 -15 0 2>" + dir +
                            "/replay_err3.txt";
   REQUIRE(std::system(cmd3.c_str()) == 0);
   CHECK(slurp(out3) != text);  // other moments, same forces
   const std::string cmd4 = std::string(CF_CFREPLAY) + " --graph " + graph + " --trajectory " +
-                           traj + " -o " + dir + "/replay_out4.csv --moment-ref point 2>" + dir +
-                           "/replay_err4.txt";
+                           traj + " -o " + dir + "/replay_out4.csv --moment-reference a_point 2>" +
+                           dir + "/replay_err4.txt";
   CHECK(std::system(cmd4.c_str()) != 0);
   CHECK(slurp(dir + "/replay_err4.txt")
-            .find("cfreplay: --moment-ref point needs --moment-point X Y Z") == 0);
+            .find("cfreplay: --moment-reference a_point needs --moment-point-A X Y Z") == 0);
   CHECK_FALSE(std::ifstream(dir + "/replay_out4.csv").good());
 }
 

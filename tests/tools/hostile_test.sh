@@ -279,19 +279,27 @@ if [[ "$group" == cfreplay ]]; then
   python3 -c "import sys; sys.stdout.buffer.write(b'\xa1\x61x' + b'\x81' * 100000 + b'\xf6')" >deep.cbor
   check cbor_deep_nesting 1 "^cfreplay: reading 'deep.cbor': not valid CBOR: nesting deeper than 256 levels" -- "$CFREPLAY" --graph deep.cbor --trajectory "$P" -o o.csv
   # Options: finite and in range.
-  for opt in --mass --stiffness --kp --mu --mu-d --epsilon --hold --tau; do
+  for opt in --mass-kg --contact-stiffness-N-per-mm --kp-N-per-mm --mu-static --mu-kinetic \
+    --epsilon-mm --hold-fcy-threshold-N --interpolation-time-constant-s; do
     check "cfreplay${opt}_nan" 2 "^cfreplay: ${opt}: 'nan' is not a finite number" -- "${run[@]}" -o o.csv "$opt" nan
     check "cfreplay${opt}_inf" 2 "^cfreplay: ${opt}: 'inf' is not a finite number" -- "${run[@]}" -o o.csv "$opt" inf
   done
-  check cfreplay_moment_point_nan 2 "^cfreplay: --moment-point: 'nan' is not a finite number" -- "${run[@]}" -o o.csv --moment-point nan 0 0
-  check cfreplay_epsilon_huge 2 "^cfreplay: --epsilon: '1e308' is outside \[1e-06, 1000\]" -- "${run[@]}" -o o.csv --epsilon 1e308
-  check cfreplay_stiffness_zero 2 "^cfreplay: --stiffness: '0' is outside \(0, 1e\+09\]" -- "${run[@]}" -o o.csv --stiffness 0
-  check cfreplay_mass_negative 2 "^cfreplay: --mass: '-1' is outside \[0, 1e\+06\]" -- "${run[@]}" -o o.csv --mass -1
+  check cfreplay_moment_point_nan 2 "^cfreplay: --moment-point-A: 'nan' is not a finite number" -- "${run[@]}" -o o.csv --moment-point-A nan 0 0
+  check cfreplay_epsilon_huge 2 "^cfreplay: --epsilon-mm: '1e308' is outside \[1e-06, 1000\]" -- "${run[@]}" -o o.csv --epsilon-mm 1e308
+  check cfreplay_stiffness_zero 2 "^cfreplay: --contact-stiffness-N-per-mm: '0' is outside \(0, 1e\+09\]" -- "${run[@]}" -o o.csv --contact-stiffness-N-per-mm 0
+  check cfreplay_mass_negative 2 "^cfreplay: --mass-kg: '-1' is outside \[0, 1e\+06\]" -- "${run[@]}" -o o.csv --mass-kg -1
+  # The names before the options took the Python keywords': still taken, checked the same,
+  # with a warning naming the new one.
+  check cfreplay_old_name_checked 2 "^cfreplay: --mu: 'nan' is not a finite number" -- "${run[@]}" -o o.csv --mu nan
+  check cfreplay_old_names_warn 0 "^cfreplay: warning: --mu is now --mu-static; the old name goes in the next release" -- "${run[@]}" -o o.csv --mu 0.6 --friction per-tick --moment-ref centroid
+  check cfreplay_old_values_warn 0 "^cfreplay: warning: 'per-tick' is now 'per_tick'" -- "${run[@]}" -o o.csv --friction per-tick
+  rm -f o.csv
   # Options checked together, before the work.
-  check cfreplay_moment_ref_and_point 2 "^cfreplay: --moment-ref origin contradicts --moment-point, which sets the moment's reference point; give one" -- "${run[@]}" -o o.csv --moment-ref origin --moment-point 1 2 3
-  check cfreplay_moment_ref_point_alone 2 "^cfreplay: --moment-ref point needs --moment-point X Y Z" -- "${run[@]}" -o o.csv --moment-ref point
-  check cfreplay_mu_d_above_default_mu 2 "^cfreplay: --mu-d 0.9 is above --mu 0.7 \(the default\): kinetic friction cannot exceed static friction; give --mu-d at most --mu" -- "${run[@]}" -o o.csv --mu-d 0.9
-  check cfreplay_mu_below_default_mu_d 2 "^cfreplay: --mu-d 0.08 \(the default\) is above --mu 0.05" -- "${run[@]}" -o o.csv --mu 0.05
+  check cfreplay_moment_ref_and_point 2 "^cfreplay: --moment-reference a_origin contradicts --moment-point-A, which sets the moment's reference point; give one" -- "${run[@]}" -o o.csv --moment-reference a_origin --moment-point-A 1 2 3
+  check cfreplay_moment_ref_point_alone 2 "^cfreplay: --moment-reference a_point needs --moment-point-A X Y Z" -- "${run[@]}" -o o.csv --moment-reference a_point
+  check cfreplay_mu_d_above_default_mu 2 "^cfreplay: --mu-kinetic 0.9 is above --mu-static 0.7 \(the default\): kinetic friction cannot exceed static friction; give --mu-kinetic at most --mu-static" -- "${run[@]}" -o o.csv --mu-kinetic 0.9
+  check cfreplay_mu_below_default_mu_d 2 "^cfreplay: --mu-kinetic 0.08 \(the default\) is above --mu-static 0.05" -- "${run[@]}" -o o.csv --mu-static 0.05
+  rm -f o.csv
   absent cfreplay_contradictions_no_output o.csv
   # Outputs.
   cp "$P" in.csv

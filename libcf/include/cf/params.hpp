@@ -34,6 +34,20 @@ enum class MomentReference : std::uint8_t {
   kAPoint,     ///< Params::moment_point_A, a point fixed in A (e.g. where the device holds it)
 };
 
+/// The choices' names: the values cfreplay's options and the Python keywords take, one
+/// spelling for both ("stick_anchor", "per_tick"; "vertex_mean", "volume"; "a_origin",
+/// "a_centroid", "a_point").
+const char* to_string(FrictionDisplacement choice);
+const char* to_string(CentroidChoice choice);
+const char* to_string(MomentReference choice);
+/// Every choice of each, in the enum's order.
+inline constexpr FrictionDisplacement kFrictionDisplacements[] = {
+    FrictionDisplacement::kStickAnchor, FrictionDisplacement::kPerTick};
+inline constexpr CentroidChoice kCentroidChoices[] = {CentroidChoice::kVertexMean,
+                                                      CentroidChoice::kVolume};
+inline constexpr MomentReference kMomentReferences[] = {
+    MomentReference::kAOrigin, MomentReference::kACentroid, MomentReference::kAPoint};
+
 /// Tolerances of contact detection (ContactDetector; docs/runtime.md). The contact threshold
 /// itself is Params::epsilon_mm.
 struct DetectionParams {
@@ -205,15 +219,20 @@ namespace cf {
 struct ParamSpec {
   const char* path;    ///< its path in Params ("mu_static", "proxy.coupling_stiffness_N_per_mm")
   const char* python;  ///< the Python keyword
-  const char* option;  ///< cfreplay's option ("--mu"), or nullptr when it has none
-  const char* unit;    ///< "N/mm", "rad", ...; "" for a plain number
-  double lo, hi;       ///< accepted: finite and in [lo, hi] (in (lo, hi] with lo_open)
+  /// cfreplay's option, the Python keyword in kebab case ("--mu-static"), or nullptr when
+  /// it has none.
+  const char* option;
+  const char* unit;  ///< "N/mm", "rad", ...; "" for a plain number
+  double lo, hi;     ///< accepted: finite and in [lo, hi] (in (lo, hi] with lo_open)
   bool lo_open;
   const char* doc;            ///< one line, for --help and Python's docs
   double& (*field)(Params&);  ///< the value in a tree
   /// The Python keyword before a rename, accepted with a DeprecationWarning for one
   /// release; nullptr when there was none.
   const char* deprecated_python = nullptr;
+  /// cfreplay's option before the names were made one ("--mu"), accepted with a warning for
+  /// one release; nullptr when there was none.
+  const char* deprecated_option = nullptr;
   double get(const Params& p) const { return field(const_cast<Params&>(p)); }
   /// Empty when `v` is accepted, else why not: "mu_static = -1 is outside [0, 100]".
   std::string problem(double v) const;

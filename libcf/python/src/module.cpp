@@ -41,17 +41,18 @@ struct EnumField {
   std::vector<std::pair<const char*, E>> values;
 };
 
-const EnumField<cf::FrictionDisplacement> kFriction{
-    "friction_displacement",
-    {{"stick_anchor", cf::FrictionDisplacement::kStickAnchor},
-     {"per_tick", cf::FrictionDisplacement::kPerTick}}};
-const EnumField<cf::CentroidChoice> kCentroid{
-    "centroid",
-    {{"vertex_mean", cf::CentroidChoice::kVertexMean}, {"volume", cf::CentroidChoice::kVolume}}};
-const EnumField<cf::MomentReference> kMomentRef{"moment_reference",
-                                                {{"a_origin", cf::MomentReference::kAOrigin},
-                                                 {"a_centroid", cf::MomentReference::kACentroid},
-                                                 {"a_point", cf::MomentReference::kAPoint}}};
+// The choices' names are libcf's (cf::to_string), the ones cfreplay's options take.
+template <class E, std::size_t N>
+EnumField<E> enum_field(const char* name, const E (&all)[N]) {
+  EnumField<E> f{name, {}};
+  for (E e : all) f.values.emplace_back(cf::to_string(e), e);
+  return f;
+}
+const EnumField<cf::FrictionDisplacement> kFriction =
+    enum_field("friction_displacement", cf::kFrictionDisplacements);
+const EnumField<cf::CentroidChoice> kCentroid = enum_field("centroid", cf::kCentroidChoices);
+const EnumField<cf::MomentReference> kMomentRef =
+    enum_field("moment_reference", cf::kMomentReferences);
 
 template <class E>
 std::string enum_name(const EnumField<E>& f, E v) {

@@ -128,9 +128,9 @@ def test_parameters_are_cfreplays_options(l_graph, tmp_path):
                                                                            if k != "mu_static"}).to_csv() == r.to_csv()
     out = tmp_path / "out.csv"
     subprocess.run([tool("CF_CFREPLAY"), "--graph", str(DATA / "graphs" / "cube_l_block.json"), "--trajectory",
-                    str(path), "-o", str(out), "--mu", "0.3", "--mu-d", "0.2", "--stiffness", "1.5", "--kp", "0.9",
-                    "--mass", "0.25", "--epsilon", "0.5", "--friction", "per-tick", "--centroid", "volume",
-                    "--moment-point", "1", "2", "3", "--hold", "0.01", "--tau", "0.002"],
+                    str(path), "-o", str(out), "--mu-static", "0.3", "--mu-kinetic", "0.2", "--contact-stiffness-N-per-mm", "1.5", "--kp-N-per-mm", "0.9",
+                    "--mass-kg", "0.25", "--epsilon-mm", "0.5", "--friction-displacement", "per_tick", "--centroid", "volume",
+                    "--moment-point-A", "1", "2", "3", "--hold-fcy-threshold-N", "0.01", "--interpolation-time-constant-s", "0.002"],
                    check=True, capture_output=True)
     assert r.to_csv() == out.read_text()
     assert params.mu_static == 0.3 and params.friction_displacement == "per_tick"

@@ -20,6 +20,18 @@ std::string number(double v) {
 
 }  // namespace
 
+const char* to_string(FrictionDisplacement choice) {
+  return choice == FrictionDisplacement::kPerTick ? "per_tick" : "stick_anchor";
+}
+const char* to_string(CentroidChoice choice) {
+  return choice == CentroidChoice::kVolume ? "volume" : "vertex_mean";
+}
+const char* to_string(MomentReference choice) {
+  return choice == MomentReference::kACentroid ? "a_centroid"
+         : choice == MomentReference::kAPoint  ? "a_point"
+                                               : "a_origin";
+}
+
 std::string ParamSpec::problem(double v) const {
   if (std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi) return "";
   return std::string(path) + " = " + number(v) + " is outside " + (lo_open ? "(" : "[") +
@@ -30,19 +42,22 @@ const std::vector<ParamSpec>& param_specs() {
   // Ranges: what the force model, detection and the proxy are defined for (a stiffness is a
   // divisor, so positive), and beyond that wide enough for any unit mistake to be caught.
   static const std::vector<ParamSpec> specs{
-      {"mass_kg", "mass_kg", "--mass", "kg", 0, 1e6, false, "m, mass of A", CF_AT(mass_kg)},
+      {"mass_kg", "mass_kg", "--mass-kg", "kg", 0, 1e6, false, "m, mass of A", CF_AT(mass_kg),
+       nullptr, "--mass"},
       {"gravity_N_per_kg", "gravity_N_per_kg", nullptr, "N/kg", -1e6, 1e6, false,
        "g, along -y of the world", CF_AT(gravity_N_per_kg)},
-      {"contact_stiffness_N_per_mm", "contact_stiffness_N_per_mm", "--stiffness", "N/mm", 0, 1e9,
-       true, "K of eq. (1)", CF_AT(contact_stiffness_N_per_mm), "stiffness_N_per_mm"},
-      {"kp_N_per_mm", "kp_N_per_mm", "--kp", "N/mm", 0, 1e9, true, "K_p of eqs. (3)-(4)",
-       CF_AT(kp_N_per_mm)},
-      {"mu_static", "mu_static", "--mu", "", 0, 100, false,
-       "static friction coefficient, mu of eqs. (2), (3), (6)", CF_AT(mu_static)},
-      {"mu_kinetic", "mu_kinetic", "--mu-d", "", 0, 100, false,
-       "kinetic friction coefficient, mu_D of eq. (5)", CF_AT(mu_kinetic)},
-      {"epsilon_mm", "epsilon_mm", "--epsilon", "mm", 1e-6, 1e3, false,
-       "contact threshold of eq. (1), detection and identification", CF_AT(epsilon_mm)},
+      {"contact_stiffness_N_per_mm", "contact_stiffness_N_per_mm", "--contact-stiffness-N-per-mm",
+       "N/mm", 0, 1e9, true, "K of eq. (1)", CF_AT(contact_stiffness_N_per_mm),
+       "stiffness_N_per_mm", "--stiffness"},
+      {"kp_N_per_mm", "kp_N_per_mm", "--kp-N-per-mm", "N/mm", 0, 1e9, true, "K_p of eqs. (3)-(4)",
+       CF_AT(kp_N_per_mm), nullptr, "--kp"},
+      {"mu_static", "mu_static", "--mu-static", "", 0, 100, false,
+       "static friction coefficient, mu of eqs. (2), (3), (6)", CF_AT(mu_static), nullptr, "--mu"},
+      {"mu_kinetic", "mu_kinetic", "--mu-kinetic", "", 0, 100, false,
+       "kinetic friction coefficient, mu_D of eq. (5)", CF_AT(mu_kinetic), nullptr, "--mu-d"},
+      {"epsilon_mm", "epsilon_mm", "--epsilon-mm", "mm", 1e-6, 1e3, false,
+       "contact threshold of eq. (1), detection and identification", CF_AT(epsilon_mm), nullptr,
+       "--epsilon"},
       {"freedom_rank_tolerance", "freedom_rank_tolerance", nullptr, "", 0, 1, false,
        "relative singular-value tolerance of the freedoms' null space",
        CF_AT(freedom_rank_tolerance)},
@@ -50,11 +65,13 @@ const std::vector<ParamSpec>& param_specs() {
        "'approximately along' angle of paper Fig. 10", CF_AT(motion_angle_tolerance_rad)},
       {"motion_noise_mm", "motion_noise_mm", nullptr, "mm", 0, 1e3, false,
        "pose changes below this are no motion", CF_AT(motion_noise_mm)},
-      {"hold_fcy_threshold_N", "hold_fcy_threshold_N", "--hold", "N", 0, 1e6, false,
-       "hold F_cy while it changes by less than this; 0: off", CF_AT(hold_fcy_threshold_N)},
-      {"interpolation_time_constant_s", "interpolation_time_constant_s", "--tau", "s", 0, 1e3,
-       false, "low-pass time constant of the total contact force and moment; 0: off",
-       CF_AT(interpolation_time_constant_s)},
+      {"hold_fcy_threshold_N", "hold_fcy_threshold_N", "--hold-fcy-threshold-N", "N", 0, 1e6, false,
+       "hold F_cy while it changes by less than this; 0: off", CF_AT(hold_fcy_threshold_N), nullptr,
+       "--hold"},
+      {"interpolation_time_constant_s", "interpolation_time_constant_s",
+       "--interpolation-time-constant-s", "s", 0, 1e3, false,
+       "low-pass time constant of the total contact force and moment; 0: off",
+       CF_AT(interpolation_time_constant_s), nullptr, "--tau"},
       {"detection.deepest_contact_mm", "deepest_contact_mm", nullptr, "mm", 0, 1e6, false,
        "deepest interpenetration still a contact", CF_AT(detection.deepest_contact_mm),
        "max_penetration_mm"},
@@ -78,11 +95,13 @@ const std::vector<ParamSpec>& param_specs() {
        "contacts a CF must hold: those within this of touching",
        CF_AT(identification.touch_distance_mm)},
       {"proxy.coupling_stiffness_N_per_mm", "proxy_coupling_stiffness_N_per_mm",
-       "--proxy-stiffness", "N/mm", 0, 1e9, true, "the proxy coupling's stiffness",
-       CF_AT(proxy.coupling_stiffness_N_per_mm), "proxy_stiffness_N_per_mm"},
-      {"proxy.coupling_damping_N_s_per_mm", "proxy_coupling_damping_N_s_per_mm", "--proxy-damping",
-       "N s/mm", 0, 1e9, false, "the proxy coupling's damping",
-       CF_AT(proxy.coupling_damping_N_s_per_mm), "proxy_damping_N_s_per_mm"},
+       "--proxy-coupling-stiffness-N-per-mm", "N/mm", 0, 1e9, true,
+       "the proxy coupling's stiffness", CF_AT(proxy.coupling_stiffness_N_per_mm),
+       "proxy_stiffness_N_per_mm", "--proxy-stiffness"},
+      {"proxy.coupling_damping_N_s_per_mm", "proxy_coupling_damping_N_s_per_mm",
+       "--proxy-coupling-damping-N-s-per-mm", "N s/mm", 0, 1e9, false,
+       "the proxy coupling's damping", CF_AT(proxy.coupling_damping_N_s_per_mm),
+       "proxy_damping_N_s_per_mm", "--proxy-damping"},
       {"proxy.penetration_tolerance_mm", "proxy_penetration_tolerance_mm", nullptr, "mm", 0, 1e3,
        true, "deepest penetration of B the proxy is left with",
        CF_AT(proxy.penetration_tolerance_mm), "proxy_max_penetration_mm"},
