@@ -355,3 +355,12 @@ TEST_CASE("cfreplay --proxy: a device pressing 10 mm into the floor keeps its CF
   }
 }
 #endif
+
+TEST_CASE("the plot takes rows whose times do not increase (no replay gives them)", "[cfreplay]") {
+  // Repeated and earlier times land in the first bin instead of dividing by a zero bin width.
+  cf::replay::PlotRecorder plot;
+  for (double t : {1.0, 1.0, 0.5, 2.0, 2.0, 3.0}) plot.add(made_row(t, 1, "f-f:2:4", "MT2.a", t));
+  const std::string svg = plot.svg("odd times");
+  CHECK(svg.rfind("<svg", 0) == 0);
+  CHECK(svg.find("CF 1 MT2.a f-f:2:4") != std::string::npos);
+}

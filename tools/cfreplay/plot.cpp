@@ -46,6 +46,10 @@ void PlotRecorder::place(double t, int& bin) {
     bin = 0;
     return;
   }
+  if (!(t > t0_)) {  // not after the first tick (a replay's times increase): its bin
+    bin = 0;
+    return;
+  }
   if (width_ == 0) width_ = t - t0_;  // the second tick opens bin 1
   auto index = [&] { return static_cast<long>(std::floor((t - t0_) / width_)); };
   // Past the last bin: halve the resolution, each bin the merge of two, until the tick fits.

@@ -20,6 +20,7 @@ import tempfile as _tempfile
 
 from . import _cf
 from ._cf import Cf, CfGraph, Error, FileError, Params, Pc, Polyhedron, Renderer
+from ._cf import __version__, graph_format_version
 from ._replay import ReplayResult, read_trajectory
 from ._networkx import to_networkx as _to_networkx
 

@@ -4,6 +4,8 @@
 
 #include "common.hpp"
 
+#include <cf/version.hpp>
+
 #include <cf/file_io.hpp>  // quaternion_problem: the tools' check of a quaternion
 
 #include <cmath>
@@ -255,6 +257,8 @@ PYBIND11_MODULE(_cf, m) {
   using namespace cfpy;
   m.doc() =
       "cf: contact formations of two rigid polyhedra (libcf), the C++ extension of the package cf.";
+  m.attr("__version__") = cf::kVersion;  // the project's version (cmake/version.cmake)
+  m.attr("graph_format_version") = cf::kGraphFormatVersion;
 
   py::register_exception<cf::Error>(m, "Error", PyExc_ValueError).doc() =
       "Bad input (a file, a model, a graph, a trajectory, a parameter): a ValueError whose message "

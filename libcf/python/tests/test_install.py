@@ -25,3 +25,16 @@ def test_installed_package_imports_and_replays(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True, env=env,
                          cwd=tmp_path).stdout.split()
     assert out[0].startswith(str(site)) and int(out[1]) > 100
+
+
+def test_version_from_the_module_and_the_command_line():
+    # The project's version (cmake/version.cmake), as the tools print it.
+    import re
+
+    import cf
+
+    version = (DATA.parent / "cmake" / "version.cmake").read_text()
+    want = re.search(r"CF_VERSION\s+\"?([0-9]+\.[0-9]+\.[0-9]+)", version).group(1)
+    assert cf.__version__ == want and cf.graph_format_version == 1
+    out = subprocess.run([sys.executable, "-m", "cf", "--version"], check=True, capture_output=True, text=True)
+    assert out.stdout == f"cf {want} (graph format 1)\n"
