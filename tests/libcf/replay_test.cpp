@@ -112,7 +112,7 @@ TEST_CASE("the replay engine gives the renderer's result at every tick", "[repla
   const auto samples = cf::testdata::read_samples(std::string(CF_SOURCE_DIR) +
                                                   "/data/trajectories/cube_lblock_corner.csv");
   cf::HapticRenderer by_hand(g);
-  cf::testdata::SampleSource source(samples);
+  cf::TrajectorySamples source(samples);
   cf::Replay replay(g, cf::Params(), source);
   cf::ReplayRow row;
   long ticks = 0, in_contact = 0;
@@ -140,7 +140,7 @@ TEST_CASE("the replay engine refuses a source whose time does not increase", "[r
   samples[0].t_s = 0;
   samples[1].t_s = 0.001;
   samples[2].t_s = 0.001;
-  cf::testdata::SampleSource source(samples);
+  cf::TrajectorySamples source(samples);
   cf::Replay replay(cube_l_block(), cf::Params(), source);
   cf::ReplayRow row;
   CHECK(replay.next(row));

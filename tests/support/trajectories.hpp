@@ -36,27 +36,12 @@ inline std::vector<TrajectorySample> read_samples(const std::string& path) {
   return out;
 }
 
-/// Samples held in memory as a replay's source.
-class SampleSource final : public TrajectorySource {
- public:
-  explicit SampleSource(const std::vector<TrajectorySample>& samples) : samples_(samples) {}
-  bool next(TrajectorySample& s) override {
-    if (i_ == samples_.size()) return false;
-    s = samples_[i_++];
-    return true;
-  }
-
- private:
-  const std::vector<TrajectorySample>& samples_;
-  std::size_t i_ = 0;
-};
-
 /// Every row of a replay of `samples` (cf::Replay); `each`, when given, sees each tick's sample
 /// and whole result.
 inline std::vector<ReplayRow> replay_rows(
     const CfGraph& graph, const std::vector<TrajectorySample>& samples, const Params& params,
     const std::function<void(const TrajectorySample&, const HapticResult&)>& each = {}) {
-  SampleSource source(samples);
+  TrajectorySamples source(samples);
   Replay replay(graph, params, source);
   std::vector<ReplayRow> rows;
   ReplayRow row;

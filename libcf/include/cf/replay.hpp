@@ -19,6 +19,7 @@
 #include <array>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace cf {
 
@@ -37,6 +38,23 @@ class TrajectorySource {
   /// Writes the next sample into `sample`; false (and `sample` untouched) at the end.
   /// @throws cf::Error for a sample that is not a pose, naming where it is.
   virtual bool next(TrajectorySample& sample) = 0;
+};
+
+/// Samples held in memory (an application's recording, arrays from Python), given in order.
+/// The replay checks their times.
+class TrajectorySamples final : public TrajectorySource {
+ public:
+  /// @param samples  must outlive the source.
+  explicit TrajectorySamples(const std::vector<TrajectorySample>& samples) : samples_(samples) {}
+  bool next(TrajectorySample& sample) override {
+    if (next_ == samples_.size()) return false;
+    sample = samples_[next_++];
+    return true;
+  }
+
+ private:
+  const std::vector<TrajectorySample>& samples_;
+  std::size_t next_ = 0;
 };
 
 /// POSES.csv (docs/spec.md, section 5b): the header `t,tx,ty,tz,qw,qx,qy,qz`, then one pose

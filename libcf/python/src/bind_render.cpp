@@ -93,21 +93,6 @@ struct ReplayRows {
   std::vector<cf::ReplayRow> rows;
 };
 
-/// A replay's poses held in memory, as the engine's source.
-class SampleSource final : public cf::TrajectorySource {
- public:
-  explicit SampleSource(const std::vector<cf::TrajectorySample>& samples) : samples_(samples) {}
-  bool next(cf::TrajectorySample& s) override {
-    if (i_ == samples_.size()) return false;
-    s = samples_[i_++];
-    return true;
-  }
-
- private:
-  const std::vector<cf::TrajectorySample>& samples_;
-  std::size_t i_ = 0;
-};
-
 /// One renderer bound to its graph (kept alive by the Python object).
 struct Renderer {
   Renderer(const cf::CfGraph& g, const cf::Params& p) : r(g, p) {}
@@ -246,7 +231,7 @@ void record_extras(const cf::HapticResult& r, std::size_t i, ReplayExtras& x) {
 void run_replay(const cf::CfGraph& g, const std::vector<cf::TrajectorySample>& samples,
                 const cf::Params& P, ReplayRows& rows, ReplayExtras& x) {
   py::gil_scoped_release release;
-  SampleSource source(samples);
+  cf::TrajectorySamples source(samples);
   cf::Replay replay(g, P, source);
   rows.rows.resize(samples.size());
   for (std::size_t i = 0; i < samples.size() && replay.next(rows.rows[i]); ++i)
