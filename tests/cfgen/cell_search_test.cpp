@@ -160,13 +160,45 @@ TEST_CASE("cell relaxation: a cell holding a witness's rotation is never refuted
 
 namespace {
 
+using cf::gen::CellNode;
+
+// The leaves of a search's tree.
+std::vector<CellNode> leaves(const cf::gen::CellTree& tree) {
+  std::vector<CellNode> out;
+  for (const CellNode& n : tree.nodes)
+    if (n.kind == CellNode::Kind::kRefuted || n.kind == CellNode::Kind::kOutsideBall ||
+        n.kind == CellNode::Kind::kUnproven)
+      out.push_back(n);
+  return out;
+}
+
+// Parents come before their children; a split or narrowed node has children, a leaf none.
+void check_tree(const cf::gen::CellTree& tree) {
+  std::vector<int> children(tree.nodes.size(), 0);
+  for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
+    const int parent = tree.nodes[i].parent;
+    CHECK(parent < static_cast<int>(i));
+    CHECK((parent >= 0) == (i > 0));
+    if (parent >= 0) ++children[static_cast<std::size_t>(parent)];
+  }
+  for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
+    const CellNode::Kind k = tree.nodes[i].kind;
+    const bool leaf = k == CellNode::Kind::kRefuted || k == CellNode::Kind::kOutsideBall ||
+                      k == CellNode::Kind::kUnproven;
+    CHECK((children[i] == 0) == leaf);
+    if (k == CellNode::Kind::kSplitTranslation) CHECK(children[i] == 2);
+    if (k == CellNode::Kind::kSplitRotation) CHECK((children[i] == 2 || children[i] == 8));
+  }
+}
+
 // Each refuted program's certificate, rechecked on the program rebuilt from the cell's
 // evidence; the number of such cells.
 std::size_t check_certificates(const cf::test::AnalysedPair& p, const PcSet& s,
-                               const std::vector<cf::gen::CellEvidence>& evidence) {
+                               const std::vector<CellNode>& evidence) {
   std::size_t programs = 0;
   const CellRelaxation relaxation(p.ai, p.bi, s, 1e-9);
   for (const auto& e : evidence) {
+    CHECK(e.kind != CellNode::Kind::kUnproven);
     if (e.refutation.verdict != CellRelaxation::Verdict::kProgram) continue;
     ++programs;
     // One certificate per choice of pieces (convex faces: one).
@@ -179,7 +211,7 @@ std::size_t check_certificates(const cf::test::AnalysedPair& p, const PcSet& s,
 }
 
 // The refuted cubes cover the rotations: each random one lies in one of them.
-void check_cubes_cover(const std::vector<cf::gen::CellEvidence>& evidence) {
+void check_cubes_cover(const std::vector<CellNode>& evidence) {
   std::mt19937 rng(5);
   for (int trial = 0; trial < 500; ++trial) {
     const Vec3 r = random_in(rng, cf::gen::whole_rotation_space());
@@ -191,7 +223,7 @@ void check_cubes_cover(const std::vector<cf::gen::CellEvidence>& evidence) {
 }
 
 // The refuted arcs tile the circle's angles [-pi, pi].
-void check_arcs_cover(const std::vector<cf::gen::CellEvidence>& evidence) {
+void check_arcs_cover(const std::vector<CellNode>& evidence) {
   std::vector<std::pair<double, double>> arcs;
   for (const auto& e : evidence) {
     REQUIRE(e.arc.half > 0);
@@ -224,10 +256,11 @@ TEST_CASE(
         PcSet({Pc{PcType::kFF, kBottom, kTop}, Pc{PcType::kVF, top_vertex, kTop}}),
         PcSet({Pc{PcType::kFF, kBottom, kTop}, Pc{PcType::kVF, top_vertex, kBottom}})}) {
     INFO(cf::to_string(s));
-    std::vector<cf::gen::CellEvidence> evidence;
-    const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, {}, nullptr, &evidence);
+    cf::gen::CellTree tree;
+    const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, {}, nullptr, &tree);
     REQUIRE(r.outcome == CellSearchResult::Outcome::kRefuted);
-    CHECK(evidence.size() <= r.cells);  // the leaves; the cells split are not evidence
+    const std::vector<CellNode> evidence = leaves(tree);
+    check_tree(tree);
     const std::size_t programs = check_certificates(p, s, evidence);
     check_arcs_cover(evidence);
     if (s[1] == Pc{PcType::kVF, top_vertex, kBottom}) CHECK(programs > 0);
@@ -238,10 +271,11 @@ TEST_CASE(
   const int below = cf::test::vertex_at(A, Vec3(10, 10, 0));
   const PcSet s({Pc{PcType::kVF, top_vertex, kTop}, Pc{PcType::kVF, below, kBottom}});
   INFO(cf::to_string(s));
-  std::vector<cf::gen::CellEvidence> evidence;
-  const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, {}, nullptr, &evidence);
+  cf::gen::CellTree tree;
+  const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, {}, nullptr, &tree);
   REQUIRE(r.outcome == CellSearchResult::Outcome::kRefuted);
-  CHECK(evidence.size() < r.cells);
+  const std::vector<CellNode> evidence = leaves(tree);
+  check_tree(tree);
   CHECK(check_certificates(p, s, evidence) > 0);
   check_cubes_cover(evidence);
 }
@@ -305,13 +339,14 @@ TEST_CASE(
   CHECK(cf::gen::search_cells(p.ai, p.bi, s, limits).outcome !=
         CellSearchResult::Outcome::kRefuted);
   limits.local_slack = search.verified_local_slack();
-  std::vector<cf::gen::CellEvidence> evidence;
-  const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, limits, &search, &evidence);
+  cf::gen::CellTree tree;
+  const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, limits, &search, &tree);
   REQUIRE(r.outcome == CellSearchResult::Outcome::kRefuted);
+  const std::vector<CellNode> evidence = leaves(tree);
   // The arcs refuted tile [-pi, pi]; the e-e (index 1) is the PC below the slack.
   check_arcs_cover(evidence);
   for (const auto& e : evidence) {
-    CHECK(e.refutation.verdict == CellRelaxation::Verdict::kCone);
+    CHECK(e.refutation.verdict == CellRelaxation::Verdict::kSlack);
     CHECK(e.refutation.pc == 1);
   }
   // The same set with the faces apart (no f-f) is not refuted by this argument: A's edge can

@@ -1,5 +1,6 @@
 #include "cfgen/generate.hpp"
 
+#include "cfgen/certificate_file.hpp"
 #include "cfgen/enumerate/enumerate.hpp"
 #include "cfgen/execute/progress.hpp"
 #include "cfgen/execute/shard.hpp"
@@ -214,11 +215,12 @@ RunPlan plan_run(const gen::WitnessSearch& ws, const gen::EnumerateOptions& opt,
 
 // The graph is not written into the checkpoint directory, which a run reads, rewrites and
 // removes on success (`--checkpoint ck -o ck/checkpoint.json` wrote the graph over it).
-void check_outside_checkpoint(const std::string& out_path, const std::string& checkpoint_dir) {
+void check_outside_checkpoint(const std::string& out_path, const std::string& checkpoint_dir,
+                              const char* what) {
   if (checkpoint_dir.empty()) return;
   const std::string dir = canonical_path(checkpoint_dir), out = canonical_path(out_path);
   if (out.size() > dir.size() && out.compare(0, dir.size(), dir) == 0 && out[dir.size()] == '/')
-    throw Error("writing graph '" + out_path + "': is inside the checkpoint directory '" +
+    throw Error(std::string(what) + " '" + out_path + "': is inside the checkpoint directory '" +
                 checkpoint_dir + "', which the run rewrites and removes; write it elsewhere");
 }
 
@@ -231,8 +233,13 @@ int run_generate(const GenerateArgs& args) {
   const std::vector<std::string> inputs{args.a_path, args.b_path};
   // Of K shards, shard 0 writes the graph.
   const bool writes = !args.estimate && args.shard.index == 0;
+  const bool certifies = writes && !args.certificates_path.empty();
   if (writes) check_output_path(args.out_path, inputs, "writing graph");
-  if (writes) check_outside_checkpoint(args.out_path, args.checkpoint_dir);
+  if (writes) check_outside_checkpoint(args.out_path, args.checkpoint_dir, "writing graph");
+  if (certifies) {
+    check_output_path(args.certificates_path, inputs, "writing certificates", {args.out_path});
+    check_outside_checkpoint(args.certificates_path, args.checkpoint_dir, "writing certificates");
+  }
   const MeasuredModel ma = load_measured_model(args.a_path, args.load_a);
   const MeasuredModel mb = load_measured_model(args.b_path, args.load_b);
   const Polyhedron& A = ma.model;
@@ -254,6 +261,7 @@ int run_generate(const GenerateArgs& args) {
   opt.use_symmetry = args.symmetry && !args.thorough;
   opt.close_orbits = args.thorough;
   opt.records = writes;  // the other shards stop after the last stage
+  opt.certificates = certifies;
   const gen::WitnessSearch ws(ai, bi, search);
   if (args.estimate) {
     try {
@@ -331,6 +339,7 @@ int run_generate(const GenerateArgs& args) {
       CfGraph::from_parts(A, B, std::move(e.cfs), std::move(e.transitions), meta.dump());
   check_output_path(args.out_path, inputs, "writing graph");
   graph.save(args.out_path);
+  if (certifies) write_certificates(args.certificates_path, inputs, args.out_path, e, ws);
   if (default_checkpoint) remove_checkpoint(checkpoint_dir);
   if (n_cfs == 0)
     std::cerr << "cfgen: warning: the graph has no CF: A (" << A.size() << " mm across) and B ("

@@ -87,6 +87,9 @@ struct GenerateArgs {
   bool no_checkpoint = false;
   /// Predict the run (counts per level, time, memory) on stdout instead of running it.
   bool estimate = false;
+  /// Non-empty: also write the certificate file there (docs/certificates.md), by the process
+  /// that writes the graph, after it.
+  std::string certificates_path;
 };
 
 /// s: a run predicted to take longer keeps a checkpoint unless told not to.

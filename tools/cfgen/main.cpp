@@ -108,7 +108,15 @@ void add_run_options(CLI::App& app, cf::tools::GenerateArgs& gen, std::string& s
           ->check(cf::cli::finite_range(0, 1e6))
           ->capture_default_str()
           ->needs(shard);
-  for (CLI::Option* o : {shard, checkpoint, patience, no_checkpoint, estimate}) added.push_back(o);
+  auto* certificates =
+      app.add_option("--certificates", gen.certificates_path,
+                     "also write every failed candidate set with its outcome and the evidence "
+                     "for it (docs/certificates.md)")
+          ->type_name("FILE")
+          ->needs(out)
+          ->excludes(estimate);
+  for (CLI::Option* o : {shard, checkpoint, patience, no_checkpoint, estimate, certificates})
+    added.push_back(o);
 }
 
 }  // namespace

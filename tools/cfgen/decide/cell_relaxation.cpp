@@ -55,6 +55,16 @@ std::size_t CellRelaxation::choices() const {
   return n;
 }
 
+std::vector<std::vector<int>> CellRelaxation::choice_list() const {
+  std::vector<std::vector<int>> out;
+  std::vector<int> choice(slot_sizes_.size(), 0);
+  for (std::size_t c = 0; c < choices(); ++c) {
+    out.push_back(choice);
+    next_choice(choice, slot_sizes_);
+  }
+  return out;
+}
+
 CellRelaxation::CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs,
                                double touch_tol, double margin, double local_slack)
     : A_(a), B_(b), pcs_(pcs), touch_tol_(touch_tol), margin_(margin), local_slack_(local_slack) {
@@ -104,7 +114,7 @@ CellRelaxation::CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcS
 }
 
 CellRelaxation::Verdict CellRelaxation::rotation_test(const Mat3& R_c, const TurnBound& turn,
-                                                      int& pc) const {
+                                                      int& pc, Vec3& direction) const {
   const Polyhedron& mA = *A_.model;
   const Polyhedron& mB = *B_.model;
   for (pc = 0; pc < pcs_.size(); ++pc) {
@@ -128,14 +138,20 @@ CellRelaxation::Verdict CellRelaxation::rotation_test(const Mat3& R_c, const Tur
     }
     // Local non-penetration against a face: the other solid's tangent directions at the
     // contact (a vertex's edge rays, an edge's wedge sides) lie on the face's outer side.
-    // Whether pred holds for one of the solid's tangent directions at element i, read in place.
-    auto any_tangent = [](const ModelInfo& m, ElementKind k, int i, const auto& pred) {
+    // Whether pred holds for one of the solid's tangent directions at element i, read in
+    // place; that direction goes to `direction`.
+    auto any_tangent = [&direction](const ModelInfo& m, ElementKind k, int i, const auto& pred) {
+      auto hit = [&](const Vec3& d) {
+        if (!pred(d)) return false;
+        direction = d;
+        return true;
+      };
       if (k == ElementKind::kVertex) {
         const auto& rays = m.cones[static_cast<std::size_t>(i)].rays;
-        return std::any_of(rays.begin(), rays.end(), pred);
+        return std::any_of(rays.begin(), rays.end(), hit);
       }
       const EdgeWedge& w = m.wedges[static_cast<std::size_t>(i)];
-      return pred(w.into_left) || pred(w.into_right);
+      return hit(w.into_left) || hit(w.into_right);
     };
     // d . n < 0 for every rotation of the cell, `moved` the most the rotation changes it.
     if (kb == ElementKind::kFace && ka != ElementKind::kFace) {
@@ -154,7 +170,7 @@ CellRelaxation::Verdict CellRelaxation::rotation_test(const Mat3& R_c, const Tur
   // tangent direction lying in the face, is degenerate there, and the cells near such a
   // limit pose are refuted once they are small against the slack.
   if (local_slack_ > 0 && local_margin_bound(A_, B_, pcs_, R_c, turn, &pc) < local_slack_)
-    return Verdict::kCone;
+    return Verdict::kSlack;
   pc = -1;
   return Verdict::kOpen;
 }
@@ -276,7 +292,7 @@ CellRelaxation::Refutation CellRelaxation::refute(const Mat3& R_c, const TurnBou
     out.verdict = Verdict::kBounds;
     return out;
   }
-  out.verdict = rotation_test(R_c, turn, out.pc);
+  out.verdict = rotation_test(R_c, turn, out.pc, out.direction);
   if (out.verdict != Verdict::kOpen) return out;
   const std::size_t choices = this->choices();
   if (choices > max_choices) return out;
@@ -316,15 +332,52 @@ CellRelaxation::Refutation CellRelaxation::refute(const Mat3& R_c, const TurnBou
   // The programs' optima are within the solver's tolerances (reduced costs 1e-9, rows 1e-7
   // (1 + |b|)) of the true ones: grow the range by more than those.
   const Vec3 slack = Vec3::Constant(1e-7 * (1 + size_));
+  const Vec3 lo_given = t_lo, hi_given = t_hi;
   t_lo = t_lo.cwiseMax(lo - slack);
   t_hi = t_hi.cwiseMin(hi + slack);
   out.certificates.clear();
+  if (with_certificates) out.slabs = slabs(R_c, turn, lo_given, hi_given, t_lo, t_hi);
+  return out;
+}
+
+// The parts of the given box outside the narrowed one [lo, hi], cut off one axis after the
+// other, each with the Farkas proofs of its programs: the narrowing rests on the programs'
+// optima, which are not proofs.
+std::vector<CellRelaxation::Slab> CellRelaxation::slabs(const Mat3& R_c, const TurnBound& turn,
+                                                        const Vec3& lo_given, const Vec3& hi_given,
+                                                        const Vec3& lo, const Vec3& hi) const {
+  std::vector<Slab> out;
+  Vec3 rest_lo = lo_given, rest_hi = hi_given;  // what is not cut off yet
+  auto cut = [&](int j, bool low) {
+    Slab slab{rest_lo, rest_hi, {}, true};
+    if (low) {
+      slab.hi[j] = lo[j];
+      rest_lo[j] = lo[j];
+    } else {
+      slab.lo[j] = hi[j];
+      rest_hi[j] = hi[j];
+    }
+    std::vector<int> choice(slot_sizes_.size(), 0);
+    for (std::size_t c = 0; c < choices() && slab.proven; ++c) {
+      std::optional<FarkasCertificate> proof = farkas(program(R_c, turn, choice, slab.lo, slab.hi));
+      slab.proven = proof.has_value();
+      if (proof) slab.proofs.push_back(std::move(*proof));
+      next_choice(choice, slot_sizes_);
+    }
+    out.push_back(std::move(slab));
+  };
+  for (int j = 0; j < 3; ++j) {
+    if (lo[j] > rest_lo[j]) cut(j, true);
+    if (hi[j] < rest_hi[j]) cut(j, false);
+  }
   return out;
 }
 
 bool CellRelaxation::holds_at(const Mat3& R) const {
   int pc = -1;
-  if (empty_ || rotation_test(R, TurnBound{10 * kRotTol}, pc) != Verdict::kOpen) return false;
+  Vec3 direction;
+  if (empty_ || rotation_test(R, TurnBound{10 * kRotTol}, pc, direction) != Verdict::kOpen)
+    return false;
   std::vector<int> choice(slot_sizes_.size(), 0);
   for (std::size_t c = 0; c < choices(); ++c) {
     if (solve(program(R, TurnBound{}, choice, t_lo_, t_hi_)).status == LpResult::Status::kOptimal)

@@ -40,16 +40,30 @@ class CellRelaxation {
     kOpen,      // not refuted: some pose of the relaxation may have its rotation here
     kBounds,    // the PCs' contact points cannot be near enough for any rotation
     kRotation,  // a PC's rotational condition misses by more than the turn bound (pc)
-    kCone,      // a PC is locally penetrating (or below local_slack) for every rotation of
-                // the cell (pc)
+    kCone,      // a PC is locally penetrating for every rotation of the cell (pc, direction)
+    kSlack,     // a PC's local margin is below local_slack for every rotation of the cell (pc)
     kProgram,   // the translation programs of every choice of convex pieces are infeasible
     kDeep,      // a point of one solid lies inside the other at every pose (DeepPoints)
   };
+  /// A part of the given translation box cut off when an open cell's box is narrowed, with
+  /// the proof that no choice of pieces has a solution there.
+  struct Slab {
+    Vec3 lo, hi;                            // mm
+    std::vector<FarkasCertificate> proofs;  // one per choice, in choice order
+    bool proven = false;                    // every choice has its proof
+  };
   struct Refutation {
     Verdict verdict = Verdict::kOpen;
-    int pc = -1;  // kRotation, kCone: the PC's index in the set
-    /// kProgram with certificates asked for: one per choice of pieces, in choice order.
+    int pc = -1;  // kRotation, kCone, kSlack: the PC's index in the set
+    /// kCone: the tangent direction that enters the face (unit, in its own solid's frame:
+    /// A's for a v-f or e-f, B's for an f-v or f-e).
+    Vec3 direction = Vec3::Zero();
+    /// kProgram with certificates asked for: one per choice of pieces, in choice order
+    /// (choice_list() gives the choices).
     std::vector<FarkasCertificate> certificates;
+    /// kOpen with certificates asked for: the slabs the narrowing cut off, tiling the given
+    /// box with the narrowed one.
+    std::vector<Slab> slabs;
   };
   /// Whether some pose with its rotation in the cell and A's pivot at a translation in
   /// [t_lo, t_hi] (mm, B's frame) can meet the relaxation. When the cell stays open, t_lo and
@@ -81,6 +95,8 @@ class CellRelaxation {
   const std::vector<int>& slot_sizes() const { return slot_sizes_; }
   /// Choices of convex pieces: the product of slot_sizes().
   std::size_t choices() const;
+  /// Every choice, in the order refute() tries them (the first slot counting fastest).
+  std::vector<std::vector<int>> choice_list() const;
   /// mm, A's frame: the point the cell's rotations turn A about (the centroid of the PCs'
   /// elements of A); the program's translation is where it goes.
   const Vec3& pivot() const { return pivot_; }
@@ -90,7 +106,9 @@ class CellRelaxation {
     ElementKind kind;
     int index;
   };
-  Verdict rotation_test(const Mat3& R_c, const TurnBound& turn, int& pc) const;
+  Verdict rotation_test(const Mat3& R_c, const TurnBound& turn, int& pc, Vec3& direction) const;
+  std::vector<Slab> slabs(const Mat3& R_c, const TurnBound& turn, const Vec3& lo_given,
+                          const Vec3& hi_given, const Vec3& lo, const Vec3& hi) const;
   void add_contact(LinearProgram& lp, int pc, const Mat3& R_c, const TurnBound& turn, int& slot,
                    const std::vector<int>& choice) const;
 

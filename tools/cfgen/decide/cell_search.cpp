@@ -18,11 +18,13 @@ struct PoseBox {
   RotationCell rot;
   Arc arc;
   Vec3 t_lo, t_hi;
+  int parent = -1;  // its parent's index in the tree, when one is kept
 };
 
 // The rotations of an f-f's circle, R0 Rot(n_A, theta) with R0 n_A = -n_B.
 struct Circle {
   bool on = false;
+  int pc = -1;               // the f-f PC's index in the set
   Vec3 axis = Vec3::Zero();  // A's face normal
   Mat3 R0 = Mat3::Identity();
   Mat3 at(double theta) const { return R0 * Eigen::AngleAxisd(theta, axis).toRotationMatrix(); }
@@ -30,9 +32,10 @@ struct Circle {
 
 Circle circle_of(const PcSet& pcs, const Polyhedron& A, const Polyhedron& B) {
   Circle c;
-  for (const Pc& pc : pcs)
-    if (pc.type == PcType::kFF) {
+  for (int k = 0; k < pcs.size(); ++k)
+    if (const Pc& pc = pcs[k]; pc.type == PcType::kFF) {
       c.on = true;
+      c.pc = k;
       c.axis = A.face(FaceId(pc.a)).normal;
       c.R0 = Eigen::Quaterniond::FromTwoVectors(c.axis, -B.face(FaceId(pc.b)).normal)
                  .toRotationMatrix();
@@ -40,10 +43,6 @@ Circle circle_of(const PcSet& pcs, const Polyhedron& A, const Polyhedron& B) {
     }
   return c;
 }
-
-// A witness meets the f-f's alignment to 10 kRotTol: its rotation is within that angle of
-// the circle (a turn by a moves a unit vector by at most a); twice it for rounding.
-constexpr double kOffCircle = 20 * kRotTol;
 
 Mat3 centre_of(const PoseBox& c, const Circle& circle) {
   return circle.on ? circle.at(c.arc.centre) : rotation_at(c.rot.centre);
@@ -74,34 +73,70 @@ double reach_of(const Polyhedron& A, const Vec3& pivot) {
 }
 
 // Splits the rotations when they move A's points more than the box's spread, else the box
-// along its longest side.
-void split_into(const PoseBox& c, const Circle& circle, double reach, std::vector<PoseBox>& stack) {
+// along its longest side; the children's parent is `node`. The kind of split made.
+CellNode::Kind split_into(const PoseBox& c, const Circle& circle, double reach, int node,
+                          std::vector<PoseBox>& stack, int& axis, double& at) {
   const Vec3 ext = c.t_hi - c.t_lo;
   if (turn_of(c, circle).unit() * reach >= 0.5 * ext.norm()) {
     if (circle.on) {
       const double h = 0.5 * c.arc.half;
       for (double side : {-1.0, 1.0})
-        stack.push_back({c.rot, {c.arc.centre + side * h, h}, c.t_lo, c.t_hi});
-      return;
+        stack.push_back({c.rot, {c.arc.centre + side * h, h}, c.t_lo, c.t_hi, node});
+    } else {
+      for (const RotationCell& r : split(c.rot)) stack.push_back({r, c.arc, c.t_lo, c.t_hi, node});
     }
-    for (const RotationCell& r : split(c.rot)) stack.push_back({r, c.arc, c.t_lo, c.t_hi});
-    return;
+    return CellNode::Kind::kSplitRotation;
   }
-  int k = 0;
-  ext.maxCoeff(&k);
-  const double mid = 0.5 * (c.t_lo[k] + c.t_hi[k]);
+  ext.maxCoeff(&axis);
+  at = 0.5 * (c.t_lo[axis] + c.t_hi[axis]);
   PoseBox low = c, high = c;
-  low.t_hi[k] = mid;
-  high.t_lo[k] = mid;
+  low.t_hi[axis] = at;
+  high.t_lo[axis] = at;
+  low.parent = high.parent = node;
   stack.push_back(low);
   stack.push_back(high);
+  return CellNode::Kind::kSplitTranslation;
+}
+
+// Records a narrowing in the tree: `node` (the box given) becomes kNarrow, with the slabs cut
+// off as leaves and the narrowed box as a new node, whose index is returned.
+int record_narrowing(CellTree& tree, int node, const Vec3& t_lo, const Vec3& t_hi,
+                     std::vector<CellRelaxation::Slab>&& slabs) {
+  const CellNode parent = tree.nodes[static_cast<std::size_t>(node)];
+  tree.nodes[static_cast<std::size_t>(node)].kind = CellNode::Kind::kNarrow;
+  for (CellRelaxation::Slab& slab : slabs) {
+    CellNode leaf = parent;
+    leaf.parent = node;
+    leaf.t_lo = slab.lo;
+    leaf.t_hi = slab.hi;
+    leaf.kind = slab.proven ? CellNode::Kind::kRefuted : CellNode::Kind::kUnproven;
+    leaf.refutation = {};
+    leaf.refutation.verdict = CellRelaxation::Verdict::kProgram;
+    leaf.refutation.certificates = std::move(slab.proofs);
+    tree.nodes.push_back(std::move(leaf));
+  }
+  CellNode inner = parent;
+  inner.parent = node;
+  inner.t_lo = t_lo;
+  inner.t_hi = t_hi;
+  tree.nodes.push_back(std::move(inner));
+  return static_cast<int>(tree.nodes.size()) - 1;
 }
 
 }  // namespace
 
+CellSearchLimits decision_limits(const WitnessSearch& search, std::size_t max_cells) {
+  CellSearchLimits limits;
+  limits.max_cells = max_cells;
+  limits.touch_tol = search.params().touch_tol;
+  limits.margin = search.params().min_margin;
+  limits.local_slack = search.verified_local_slack();
+  return limits;
+}
+
 CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs,
                               const CellSearchLimits& limits, const WitnessSearch* search,
-                              std::vector<CellEvidence>* evidence) {
+                              CellTree* tree) {
   const CellRelaxation relaxation(a, b, pcs, limits.touch_tol, limits.margin, limits.local_slack);
   const DeepPoints deep(a, b);
   const RotConstraints conditions = rotation_constraints(pcs, *a.model, *b.model);
@@ -109,10 +144,11 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
                                (b.model->bbox_max() - b.model->bbox_min()).norm());
   const double reach = reach_of(*a.model, relaxation.pivot());
   const Circle circle = circle_of(pcs, *a.model, *b.model);
+  if (tree) *tree = {relaxation.pivot(), circle.pc, circle.R0, circle.axis, {}};
   CellSearchResult out;
   out.smallest_half = whole_rotation_space().half;
   std::vector<PoseBox> stack{
-      {whole_rotation_space(), {0.0, M_PI}, relaxation.t_lo(), relaxation.t_hi()}};
+      {whole_rotation_space(), {0.0, M_PI}, relaxation.t_lo(), relaxation.t_hi(), -1}};
   double searched_half = HUGE_VAL;  // the rotation half-width of the last cell searched
   while (!stack.empty()) {
     PoseBox c = stack.back();
@@ -122,23 +158,38 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
     out.smallest_half = std::min(out.smallest_half, half);
     const Mat3 R_c = centre_of(c, circle);
     const TurnBound turn = turn_of(c, circle);
-    CellEvidence e{c.rot, circle.on ? c.arc : Arc{}, R_c, turn, c.t_lo, c.t_hi, {}, false, true,
-                   -1};
+    int node = -1;
+    if (tree) {
+      CellNode n;
+      n.parent = c.parent;
+      n.cell = c.rot;
+      n.arc = circle.on ? c.arc : Arc{};
+      n.R_c = R_c;
+      n.turn = turn;
+      n.t_lo = c.t_lo;
+      n.t_hi = c.t_hi;
+      tree->nodes.push_back(std::move(n));
+      node = static_cast<int>(tree->nodes.size()) - 1;
+    }
+    auto leaf = [&]() -> CellNode& { return tree->nodes[static_cast<std::size_t>(node)]; };
     if (!circle.on && outside_rotation_ball(c.rot)) {
-      e.outside_ball = true;
-      if (evidence) evidence->push_back(std::move(e));
+      if (tree) leaf().kind = CellNode::Kind::kOutsideBall;
       continue;
     }
-    e.refutation = relaxation.refute(R_c, turn, c.t_lo, c.t_hi, evidence != nullptr);
-    if (e.refutation.verdict == CellRelaxation::Verdict::kOpen) {
+    CellRelaxation::Refutation r = relaxation.refute(R_c, turn, c.t_lo, c.t_hi, tree != nullptr);
+    if (tree && !r.slabs.empty())
+      node = record_narrowing(*tree, node, c.t_lo, c.t_hi, std::move(r.slabs));
+    if (r.verdict == CellRelaxation::Verdict::kOpen) {
       if (const auto hit = deep.find({R_c, turn.unit(), relaxation.pivot(), c.t_lo, c.t_hi})) {
-        e.refutation.verdict = CellRelaxation::Verdict::kDeep;
-        e.deep_of_a = hit->of_a;
-        e.deep_point = hit->index;
+        r.verdict = CellRelaxation::Verdict::kDeep;
+        if (tree) {
+          leaf().deep_of_a = hit->of_a;
+          leaf().deep_point = hit->index;
+        }
       }
     }
-    if (e.refutation.verdict != CellRelaxation::Verdict::kOpen) {
-      if (evidence) evidence->push_back(std::move(e));
+    if (r.verdict != CellRelaxation::Verdict::kOpen) {
+      if (tree) leaf().refutation = std::move(r);
       continue;
     }
     // A search near the centre's rotation, once a rotation cell (its first translation box)
@@ -154,7 +205,14 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
     searched_half = half;
     if (half < limits.resolution && (c.t_hi - c.t_lo).maxCoeff() < 2 * limits.resolution * size)
       return out;  // kUndecided
-    split_into(c, circle, reach, stack);
+    int axis = -1;
+    double at = 0;
+    const CellNode::Kind kind = split_into(c, circle, reach, node, stack, axis, at);
+    if (tree) {
+      leaf().kind = kind;
+      leaf().axis = axis;
+      leaf().at = at;
+    }
   }
   out.outcome = CellSearchResult::Outcome::kRefuted;
   return out;

@@ -8,11 +8,17 @@
 
 #include "cfgen/decide/cell_relaxation.hpp"
 #include "cfgen/decide/witness.hpp"
+#include "cfgen/verify/rotation_conditions.hpp"
 
 #include <cstddef>
 #include <vector>
 
 namespace cf::gen {
+
+/// rad: how far a rotation of an arc cell may be from the f-f's circle. A witness meets the
+/// f-f's alignment to 10 kRotTol: its rotation is within that angle of the circle (a turn by
+/// a moves a unit vector by at most a); twice it for rounding.
+constexpr double kOffCircle = 20 * kRotTol;
 
 struct CellSearchLimits {
   double resolution = 1.5e-5;     // rad, and times the models' size in mm: cells are not split
@@ -24,6 +30,11 @@ struct CellSearchLimits {
   double search_below = 0.05;  // rad: open rotation cells this small are searched for a witness
 };
 
+/// The limits a run's decision uses (docs/generator.md, "What the search could not decide"):
+/// the verifier's touch tolerance, margin and local slack, so that a refutation shows that no
+/// witness exists; at most max_cells cells.
+CellSearchLimits decision_limits(const WitnessSearch& search, std::size_t max_cells);
+
 /// Angles [centre - half, centre + half] (rad) of the rotations R0 Rot(n_A, theta) that
 /// turn the face of the set's first f-f PC against its face of B (R0 n_A = -n_B, the
 /// shortest such turn). half = 0: not used.
@@ -32,17 +43,38 @@ struct Arc {
   double half = 0;
 };
 
-/// A refuted cell and why, for the certificate file.
-struct CellEvidence {
+/// One node of the branch and bound's tree (docs/certificates.md, "The tree"): a set of poses,
+/// split into its children or refuted as a leaf.
+struct CellNode {
+  enum class Kind {
+    kSplitRotation,     // children: the 8 cubes, or the 2 arcs, of half the width
+    kSplitTranslation,  // children: the box cut across `axis` at `at`
+    kNarrow,            // children: the narrowed box, and the slabs cut off (kProgram leaves)
+    kOutsideBall,       // leaf: the cube holds no axis-angle vector of length <= pi
+    kRefuted,           // leaf: refuted by the relaxation or a deep point (`refutation`)
+    kUnproven,          // leaf: a slab cut off by a narrowing its programs did not prove
+  } kind = Kind::kRefuted;
+  int parent = -1;              // index in CellTree::nodes; -1 for the root
   RotationCell cell;            // the rotations, for a set without an f-f PC
   Arc arc;                      // the rotations, for a set with one (then `cell` is not used)
   Mat3 R_c = Mat3::Identity();  // the rotation at the centre, as the relaxation used it
-  TurnBound turn;               // how far the cell's rotations turn A's vectors from R_c
+  TurnBound turn;               // how far the node's rotations turn A's vectors from R_c
   Vec3 t_lo = Vec3::Zero(), t_hi = Vec3::Zero();  // mm: the translations of A's pivot
-  CellRelaxation::Refutation refutation;          // kDeep: `deep` says which point
-  bool outside_ball = false;  // the cell holds no axis-angle vector of length <= pi
-  bool deep_of_a = true;      // kDeep: a point of A inside B, else of B inside A
-  int deep_point = -1;        // kDeep: its index in DeepPoints::points
+  int axis = -1;                                  // kSplitTranslation: the axis cut
+  double at = 0;                                  // kSplitTranslation: mm, where
+  CellRelaxation::Refutation refutation;          // kRefuted (kDeep: `deep_*` say which point)
+  bool deep_of_a = true;                          // kDeep: a point of A inside B, else of B in A
+  int deep_point = -1;                            // kDeep: its index in DeepPoints::points
+};
+
+/// The tree of a search, parents before children; complete (every leaf refuted) when the
+/// search's outcome is kRefuted.
+struct CellTree {
+  Vec3 pivot = Vec3::Zero();   // mm, A's frame (CellRelaxation::pivot)
+  int circle_pc = -1;          // the f-f PC whose circle the arcs are on; -1: cubes
+  Mat3 R0 = Mat3::Identity();  // the circle's rotation at angle 0 (R0 n_A = -n_B)
+  Vec3 axis = Vec3::Zero();    // the circle's axis, n_A (A's frame)
+  std::vector<CellNode> nodes;
 };
 
 struct CellSearchResult {
@@ -60,10 +92,10 @@ struct CellSearchResult {
 /// over arcs of its circle of rotations. search: when given, each open rotation cell below
 /// limits.search_below is searched for a witness near its centre's rotation (projected onto
 /// the rotational conditions; WitnessSearch::find with seeds_only), and a witness ends the
-/// search. evidence: when given, receives every refuted
-/// cell (they tile the whole space when the outcome is kRefuted).
+/// search. tree: when given, receives the search's tree with the evidence of every leaf
+/// (Farkas certificates, the slabs of each narrowing with theirs).
 CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs,
                               const CellSearchLimits& limits, const WitnessSearch* search = nullptr,
-                              std::vector<CellEvidence>* evidence = nullptr);
+                              CellTree* tree = nullptr);
 
 }  // namespace cf::gen

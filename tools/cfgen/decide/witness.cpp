@@ -27,7 +27,27 @@ using namespace internal;
 WitnessSearch::WitnessSearch(const ModelInfo& a, const ModelInfo& b, const SearchParams& p)
     : Verifier(a, b, p), debug_(std::getenv("CFGEN_DEBUG") != nullptr) {}
 
-bool WitnessSearch::plausible(const PcSet& pcs) const {
+const char* rule_name(Rule rule) {
+  switch (rule) {
+    case Rule::kNone:
+      return "";
+    case Rule::kVertexInTwoPcs:
+      return "vertex-in-two-pcs";
+    case Rule::kDominatedPc:
+      return "dominated-pc";
+    case Rule::kOneContactPlane:
+      return "one-contact-plane";
+    case Rule::kHeightsOverFf:
+      return "heights-over-ff";
+    case Rule::kRotationalConditions:
+      return "rotational-conditions";
+    case Rule::kFiniteRotations:
+      return "finite-rotations";
+  }
+  return "";
+}
+
+RuleVerdict WitnessSearch::implausible_by(const PcSet& pcs) const {
   // A point lies in at most one open element: one vertex cannot make two PCs.
   for (int i = 0; i < pcs.size(); ++i)
     for (int j = i + 1; j < pcs.size(); ++j) {
@@ -35,10 +55,10 @@ bool WitnessSearch::plausible(const PcSet& pcs) const {
       const Pc& y = pcs[j];
       if (a_kind(x.type) == ElementKind::kVertex && a_kind(y.type) == ElementKind::kVertex &&
           x.a == y.a)
-        return false;
+        return {Rule::kVertexInTwoPcs, i, j};
       if (b_kind(x.type) == ElementKind::kVertex && b_kind(y.type) == ElementKind::kVertex &&
           x.b == y.b)
-        return false;
+        return {Rule::kVertexInTwoPcs, i, j};
       // A PC whose two elements lie in the closures of another's is dominated by it, not
       // principal.
       const Polyhedron& A = *A_.model;
@@ -47,14 +67,16 @@ bool WitnessSearch::plausible(const PcSet& pcs) const {
            in_closure(B, b_kind(x.type), x.b, b_kind(y.type), y.b)) ||
           (in_closure(A, a_kind(y.type), y.a, a_kind(x.type), x.a) &&
            in_closure(B, b_kind(y.type), y.b, b_kind(x.type), x.b)))
-        return false;
+        return {Rule::kDominatedPc, i, j};
       // Two PCs on one plane of B, or one plane of A, share their contact plane.
       const bool xb = b_kind(x.type) == ElementKind::kFace,
                  yb = b_kind(y.type) == ElementKind::kFace;
-      if (xb && yb && B_.face_plane[x.b] == B_.face_plane[y.b]) return false;
+      if (xb && yb && B_.face_plane[x.b] == B_.face_plane[y.b])
+        return {Rule::kOneContactPlane, i, j};
       const bool xa = a_kind(x.type) == ElementKind::kFace,
                  ya = a_kind(y.type) == ElementKind::kFace;
-      if (xa && ya && A_.face_plane[x.a] == A_.face_plane[y.a]) return false;
+      if (xa && ya && A_.face_plane[x.a] == A_.face_plane[y.a])
+        return {Rule::kOneContactPlane, i, j};
     }
   // Heights over a face-face contact: while faces a and b lie against each other, a point's
   // depth below A's face plane (along A's normal, into A) is its height over B's face plane
@@ -62,12 +84,14 @@ bool WitnessSearch::plausible(const PcSet& pcs) const {
   // contact point, a common point of its two elements, needs the two elements' height
   // ranges over that plane to meet.
   const double tol = 1e-9 * scale_ + p_.touch_tol;
-  for (const Pc& ff : pcs) {
+  for (int f = 0; f < pcs.size(); ++f) {
+    const Pc& ff = pcs[f];
     if (ff.type != PcType::kFF) continue;
     const Face& fa = A_.model->faces()[ff.a];
     const Face& fb = B_.model->faces()[ff.b];
-    for (const Pc& pc : pcs) {
-      if (pc == ff) continue;
+    for (int k = 0; k < pcs.size(); ++k) {
+      const Pc& pc = pcs[k];
+      if (k == f) continue;
       double a_lo = std::numeric_limits<double>::infinity(), a_hi = -a_lo, b_lo = a_lo,
              b_hi = -a_lo;
       for (const Vec3& p : closure_points(*A_.model, a_kind(pc.type), pc.a)) {
@@ -92,10 +116,10 @@ bool WitnessSearch::plausible(const PcSet& pcs) const {
         meet = b_lo > a_lo + tol && b_lo < a_hi - tol;
       else
         meet = std::max(a_lo, b_lo) < std::min(a_hi, b_hi) - tol;
-      if (!meet) return false;
+      if (!meet) return {Rule::kHeightsOverFf, f, k};
     }
   }
-  return true;
+  return {};
 }
 Witness WitnessSearch::refine(const PcSet& pcs, const Pose& pose) const {
   Witness out;
@@ -151,22 +175,23 @@ std::vector<int> WitnessSearch::piece_slots(const PcSet& pcs) const {
   return slot_sizes;
 }
 
-bool WitnessSearch::refuted(const PcSet& pcs) const {
-  if (!plausible(pcs)) return true;
+RuleVerdict WitnessSearch::refuted_by(const PcSet& pcs) const {
+  if (const RuleVerdict v = implausible_by(pcs); v.rule != Rule::kNone) return v;
   const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
-  if (c.align.empty()) return false;  // a continuous family of rotations: not decided here
+  if (c.align.empty()) return {};  // a continuous family of rotations: not decided here
   bool finite = false;
   const std::vector<Mat3> rots = align_family(c, {}, 0, &finite);
-  if (!finite && !rots.empty()) return false;
+  if (!finite && !rots.empty()) return {};
   if (!finite) {
     // No other condition fixed the spin: the family is continuous unless a condition failed,
     // and align_family returns nothing either way. Tell them apart with one sample.
-    if (!align_family(c, {}, 1).empty()) return false;
+    if (!align_family(c, {}, 1).empty()) return {};
   }
   std::size_t combos = 1;
   const std::vector<int> slot_sizes = piece_slots(pcs);
   for (int n : slot_sizes) combos *= static_cast<std::size_t>(n);
-  if (combos > 4096) return false;
+  if (combos > 4096) return {};
+  if (rots.empty()) return {Rule::kRotationalConditions};
   // Finitely many rotations: each must be locally penetrating or leave no room to place the
   // contacts inside their elements (the LP over every combination of convex pieces).
   for (const Mat3& R : rots) {
@@ -174,11 +199,11 @@ bool WitnessSearch::refuted(const PcSet& pcs) const {
     std::vector<int> choice(slot_sizes.size(), 0);
     for (std::size_t k = 0; k < combos; ++k) {
       const LpResult r = solve(build_lp(pcs, R, choice));
-      if (r.status == LpResult::Status::kOptimal && r.x[3] >= p_.min_margin) return false;
+      if (r.status == LpResult::Status::kOptimal && r.x[3] >= p_.min_margin) return {};
       for (std::size_t i = 0; i < choice.size() && ++choice[i] == slot_sizes[i]; ++i) choice[i] = 0;
     }
   }
-  return true;
+  return {Rule::kFiniteRotations};
 }
 
 }  // namespace cf::gen

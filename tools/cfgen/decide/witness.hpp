@@ -30,6 +30,27 @@ struct Witness {
   double margin = 0;  // mm, the LP margin of the contacts inside their elements
 };
 
+/// The necessary conditions that prove a candidate set invalid without a search of its poses
+/// (docs/generator.md, "When a candidate is declared invalid"; docs/certificates.md, "Rules").
+enum class Rule {
+  kNone,                  // no rule applies
+  kVertexInTwoPcs,        // one vertex in two PCs
+  kDominatedPc,           // a PC's elements lie in the closures of another's
+  kOneContactPlane,       // two PCs' faces of A, or of B, in one plane
+  kHeightsOverFf,         // another PC's elements cannot meet at one height over an f-f
+  kRotationalConditions,  // no rotation meets the rotational conditions
+  kFiniteRotations,       // finitely many rotations, none with room for the contacts
+};
+
+/// The rule's name in the certificate file: "vertex-in-two-pcs", ... ("" for kNone).
+const char* rule_name(Rule rule);
+
+/// A rule that holds, and the indices (in the set) of the PCs it concerns (-1: none).
+struct RuleVerdict {
+  Rule rule = Rule::kNone;
+  int first = -1, second = -1;
+};
+
 /// The search for witnesses (docs/generator.md, "Layers", decide): rotations from the PCs'
 /// conditions, seeds and samples, translations from linear programs, climbs past obstacles;
 /// every pose it returns is one its Verifier accepts.
@@ -52,10 +73,15 @@ class WitnessSearch : public Verifier {
   /// search's tolerances (a necessary condition fails, or its rotational conditions leave
   /// finitely many rotations and at each the PCs are locally penetrating or cannot be placed
   /// inside their elements). False means undecided: the search gave up without a proof.
-  bool refuted(const PcSet& pcs) const;
+  bool refuted(const PcSet& pcs) const { return refuted_by(pcs).rule != Rule::kNone; }
+  /// The rule that proves `pcs` invalid, as refuted() decides it; kNone: undecided.
+  RuleVerdict refuted_by(const PcSet& pcs) const;
 
   /// Cheap necessary conditions on a candidate set (no geometry search).
-  bool plausible(const PcSet& pcs) const;
+  bool plausible(const PcSet& pcs) const { return implausible_by(pcs).rule == Rule::kNone; }
+  /// The first cheap condition that fails (vertex in two PCs, dominated PC, one contact
+  /// plane, heights over an f-f), or kNone.
+  RuleVerdict implausible_by(const PcSet& pcs) const;
 
  private:
   friend class internal::FindRun;  // find's stages (find.cpp)

@@ -6,12 +6,14 @@
 /// (docs/spec.md, section 4). The work goes out as stages to a StageRunner (stage.hpp); the
 /// sets are decided by the decide layer's WitnessSearch.
 
+#include "cfgen/decide/cell_search.hpp"
 #include "cfgen/decide/witness.hpp"
 #include "cfgen/enumerate/stage.hpp"
 
 #include <cf/graph.hpp>
 
 #include <cstddef>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -29,6 +31,20 @@ struct EnumerateOptions {
   /// False: stop once the last stage has run, with the levels' statistics only: no proofs of
   /// invalidity, records or transitions (a shard that does not write the graph).
   bool records = true;
+  /// Keep each failed set's outcome and evidence (Enumeration::decisions) for the certificate
+  /// file (docs/certificates.md).
+  bool certificates = false;
+};
+
+/// A failed candidate set: how it was decided, and the evidence (docs/certificates.md).
+struct SetDecision {
+  PcSet pcs;
+  bool invalid = false;             // false: undecided
+  RuleVerdict rule;                 // invalid by this rule, or (kNone) by `cells`
+  std::shared_ptr<CellTree> cells;  // invalid by cells: the complete tree
+  /// A set a rule refuted whose cells found a witness (a rule that failed): kept invalid, as
+  /// the graph has it, and reported.
+  bool contradicted = false;
 };
 
 struct LevelStats {
@@ -50,6 +66,8 @@ struct Enumeration {
   std::size_t symmetries_a = 1, symmetries_b = 1;  // the models' symmetries, identity included
   std::vector<PcSet> undecided;                    // failed candidates with no proof of invalidity
   std::size_t refuted_over_cells = 0;              // failed candidates refuted by search_cells
+  /// With EnumerateOptions::certificates: every failed set, in canonical order.
+  std::vector<SetDecision> decisions;
 };
 
 /// One level of a run as predicted (RunEstimate). Candidates are the sets the level proposes;

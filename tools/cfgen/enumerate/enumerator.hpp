@@ -152,6 +152,7 @@ class Enumerator {
   // finish.cpp
   void close_orbits();
   void find_undecided();
+  SetDecision certified(const PcSet& s, const RuleVerdict& rule, CellSearchLimits limits) const;
   void add_with_images(const PcSet& s, const Witness& w, PcSetSet& known);
   void build_records();
   void finished(ProgressEvent& ev, Clock::time_point t0, const std::string& result);

@@ -79,22 +79,26 @@ bool has_ff(const PcSet& s) {
 
 }  // namespace
 
+// Cells a set refuted by the finite-rotations rule may take when its certificate is asked
+// for: the rule rests on rotations found in floating point, so the certificate file carries
+// the cells' refutation instead when they give one.
+constexpr std::size_t kCertificateCells = 200;
+
 // What the search could not decide: failed candidates that motion did not find either and
 // that no proof rules out (WitnessSearch::refuted). Those on an f-f's circle of rotations go
 // to the branch and bound over its arcs (search_cells), with the verifier's margins: it
-// refutes a set (no witness exists) or finds a witness.
+// refutes a set (no witness exists) or finds a witness. With opt_.certificates, every failed
+// set's decision and evidence go to out_.decisions.
 void Enumerator::find_undecided() {
   PcSetSet known;
   for (int l = 0; l < 3; ++l)
     for (const auto& [s, w] : valid_[l]) known.insert(s);
-  CellSearchLimits limits;
-  limits.max_cells = kDecisionCells;
-  limits.touch_tol = search_.params().touch_tol;
-  limits.margin = search_.params().min_margin;
-  limits.local_slack = search_.verified_local_slack();
-  enum : char { kDecided, kOpen, kOverCells, kFound };
+  const CellSearchLimits limits = decision_limits(search_, kDecisionCells);
+  const bool keep = opt_.certificates;
+  enum : char { kDecided, kOpen, kOverCells, kFound, kKnown };
   std::vector<char> state(failed_.size(), kDecided);
   std::vector<Witness> found(failed_.size());
+  std::vector<SetDecision> decisions(keep ? failed_.size() : 0);
   const auto t0 = Clock::now();
   ProgressEvent ev{
       "proofs of invalidity", "failed candidate sets", 0, failed_.size(), 0, false, {}};
@@ -102,12 +106,23 @@ void Enumerator::find_undecided() {
       failed_.size(),
       [&](std::size_t i) {
         const PcSet& s = failed_[i];
-        if (known.count(s) || search_.refuted(s)) return;
+        if (known.count(s)) {
+          state[i] = kKnown;
+          return;
+        }
+        const RuleVerdict rule = search_.refuted_by(s);
+        if (keep) decisions[i] = certified(s, rule, limits);
+        if (rule.rule != Rule::kNone) return;
         state[i] = kOpen;
         // A single f-f's relaxation holds wherever its faces overlap: only obstacles refute it.
         if (s.size() < 2 || !has_ff(s)) return;
-        const CellSearchResult r = search_cells(search_.a(), search_.b(), s, limits, &search_);
-        if (r.outcome == CellSearchResult::Outcome::kRefuted) state[i] = kOverCells;
+        auto tree = keep ? std::make_shared<CellTree>() : nullptr;
+        const CellSearchResult r =
+            search_cells(search_.a(), search_.b(), s, limits, &search_, tree.get());
+        if (r.outcome == CellSearchResult::Outcome::kRefuted) {
+          state[i] = kOverCells;
+          if (keep) decisions[i].cells = std::move(tree);
+        }
         if (r.outcome == CellSearchResult::Outcome::kWitness) {
           state[i] = kFound;
           found[i] = r.witness;
@@ -121,6 +136,40 @@ void Enumerator::find_undecided() {
   }
   finished(ev, t0, std::to_string(out_.undecided.size()) + " undecided");
   std::sort(out_.undecided.begin(), out_.undecided.end(), pcset_less);
+  if (!keep) return;
+  // Sets the cells found witnesses for, or made CFs as their images, are in the graph.
+  for (std::size_t i = 0; i < failed_.size(); ++i) {
+    if (known.count(failed_[i])) continue;
+    decisions[i].pcs = failed_[i];
+    decisions[i].invalid = state[i] != kOpen;
+    out_.decisions.push_back(std::move(decisions[i]));
+  }
+  auto less = [](const SetDecision& x, const SetDecision& y) { return pcset_less(x.pcs, y.pcs); };
+  std::sort(out_.decisions.begin(), out_.decisions.end(), less);
+  out_.decisions.erase(
+      std::unique(out_.decisions.begin(), out_.decisions.end(),
+                  [](const SetDecision& x, const SetDecision& y) { return x.pcs == y.pcs; }),
+      out_.decisions.end());
+}
+
+// The evidence for a set `rule` decided: the rule, or for the finite-rotations rule (rotations
+// found in floating point, not a proof) a refutation over the arcs of its f-f's circle when
+// one comes within kCertificateCells.
+SetDecision Enumerator::certified(const PcSet& s, const RuleVerdict& rule,
+                                  CellSearchLimits limits) const {
+  SetDecision d;
+  d.rule = rule;
+  if (rule.rule != Rule::kFiniteRotations) return d;
+  limits.max_cells = kCertificateCells;
+  auto tree = std::make_shared<CellTree>();
+  const CellSearchResult r =
+      search_cells(search_.a(), search_.b(), s, limits, &search_, tree.get());
+  if (r.outcome == CellSearchResult::Outcome::kRefuted) {
+    d.rule = {};
+    d.cells = std::move(tree);
+  }
+  d.contradicted = r.outcome == CellSearchResult::Outcome::kWitness;
+  return d;
 }
 
 // A CF the decision found, and its images under the pair's symmetries that verify.

@@ -1,0 +1,23 @@
+#pragma once
+/// @file
+/// The certificate file (`cfgen --certificates FILE`, docs/certificates.md): every failed
+/// candidate set of a run with its outcome and evidence, for a checker that shares no code with
+/// cfgen.
+
+#include "cfgen/decide/witness.hpp"
+#include "cfgen/enumerate/enumerate.hpp"
+
+#include <string>
+#include <vector>
+
+namespace cf::tools {
+
+/// Writes `e.decisions` (a run with EnumerateOptions::certificates) as the certificate file at
+/// `path`, whole or not at all, never over one of `inputs`. graph_path: the graph written
+/// beside it, named in the file. search: the run's search (its models and tolerances).
+/// @throws cf::Error "writing certificates '<path>': <reason>".
+void write_certificates(const std::string& path, const std::vector<std::string>& inputs,
+                        const std::string& graph_path, const gen::Enumeration& e,
+                        const gen::WitnessSearch& search);
+
+}  // namespace cf::tools
