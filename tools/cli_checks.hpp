@@ -12,6 +12,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <set>
+#include <stdexcept>
 #include <string>
 
 namespace cf::cli {
@@ -55,6 +57,24 @@ inline CLI::Validator param_range(const cf::ParamSpec& spec) {
         return {};
       },
       range);
+}
+
+/// An option under its name before a rename, listed apart in --help: it sets the same value
+/// and, when given, adds "<name> is now <now>" to `notes`, for the tool to print as a warning.
+template <class T>
+CLI::Option* old_option_name(CLI::App& app, const std::string& name, const std::string& now,
+                             T& value, std::set<std::string>& notes) {
+  return app.add_option(name, value)
+      ->group("Old names (work until the next release)")
+      ->each([&notes, name, now](const std::string&) { notes.insert(name + " is now " + now); });
+}
+
+/// The entry of libcf's parameter table for `path` ("epsilon_mm").
+/// @throws std::logic_error when there is none (a tool asking for a parameter libcf lacks).
+inline const cf::ParamSpec& param_spec(const std::string& path) {
+  for (const cf::ParamSpec& spec : cf::param_specs())
+    if (spec.path == path) return spec;
+  throw std::logic_error("no parameter '" + path + "' in cf::param_specs()");
 }
 
 /// What `TOOL --version` prints: "cfgen 0.1.0 (graph format 1)".

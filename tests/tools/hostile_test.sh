@@ -202,8 +202,10 @@ EOF
   check pose_4_decimals 0 "^$" -- "$CFINSPECT" "$G" --pose 20,10.3,5,0.7071,0.7071,0,0
   check pose_not_unit 1 "^cfinspect: --pose '20,10.3,5,1,0.1,0,0': the quaternion \(qw,qx,qy,qz\) has norm 1.00498756, not 1 within 0.001" -- "$CFINSPECT" "$G" --pose 20,10.3,5,1,0.1,0,0
   check pose_nan 1 "^cfinspect: --pose '20,10.3,5,nan,0,0,0': the quaternion \(qw,qx,qy,qz\) has norm nan" -- "$CFINSPECT" "$G" --pose 20,10.3,5,nan,0,0,0
-  check epsilon_nan 2 "^cfinspect: --epsilon: 'nan' is not a finite number" -- "$CFINSPECT" "$G" --pose 20,10.3,5,1,0,0,0 --epsilon nan
-  check epsilon_huge 2 "^cfinspect: --epsilon: '1e308' is outside \[1e-06, 1000\]" -- "$CFINSPECT" "$G" --pose 20,10.3,5,1,0,0,0 --epsilon 1e308
+  check epsilon_nan 2 "^cfinspect: --epsilon-mm: 'nan' is not a finite number" -- "$CFINSPECT" "$G" --pose 20,10.3,5,1,0,0,0 --epsilon-mm nan
+  check epsilon_huge 2 "^cfinspect: --epsilon-mm: '1e308' is outside \[1e-06, 1000\]" -- "$CFINSPECT" "$G" --pose 20,10.3,5,1,0,0,0 --epsilon-mm 1e308
+  check epsilon_old_name_warns 0 "^cfinspect: warning: --epsilon is now --epsilon-mm; the old name goes in the next release" -- "$CFINSPECT" "$G" --pose 20,10.3,5,1,0,0,0 --epsilon 2
+  check epsilon_old_name_checked 2 "^cfinspect: --epsilon: 'nan' is not a finite number" -- "$CFINSPECT" "$G" --pose 20,10.3,5,1,0,0,0 --epsilon nan
   # Outputs.
   cp "$G" g.json
   check dot_device 1 "^cfinspect: writing DOT '/dev/full': is a character device; output files must be regular files" -- "$CFINSPECT" g.json --dot /dev/full

@@ -7,7 +7,7 @@
 #include <cf/graph.hpp>
 #include <cf/identifier.hpp>
 
-#include "cli_checks.hpp"  // finite_range, version_text
+#include "cli_checks.hpp"  // finite_range, param_range, version_text
 #include "html.hpp"        // --html: the browser viewer
 #include "safe_stderr.hpp"
 #include "witness_check.hpp"  // --verify
@@ -27,6 +27,7 @@
 #include <iostream>
 #include <map>
 #include <numeric>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -323,8 +324,9 @@ struct Options {
   long long neighbours_id = -1, cf_id = -1;
   bool neighbours = false, cf = false;  // --neighbours, --cf given
   bool as_json = false, fast = false, print_schema = false, verify = false;
-  double epsilon = 1.0;  // mm
-  int threads = 0;       // 0: the hardware's count
+  double epsilon = 1.0;           // mm
+  std::set<std::string> renamed;  // "--epsilon is now --epsilon-mm", for each old name used
+  int threads = 0;                // 0: the hardware's count
 };
 
 void add_options(CLI::App& app, Options& o) {
@@ -338,9 +340,13 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--pose", o.pose_text,
                  "identify the CF at the pose tx,ty,tz,qw,qx,qy,qz of A (mm, unit quaternion; as "
                  "in POSES.csv)");
-  app.add_option("--epsilon", o.epsilon,
+  // The contact threshold as libcf's parameter table has it (name, range), as cfreplay's.
+  const cf::ParamSpec& epsilon = cf::cli::param_spec("epsilon_mm");
+  app.add_option(epsilon.option, o.epsilon,
                  "contact threshold for --pose, mm (default 1.0, the paper's)")
-      ->check(cf::cli::finite_range(1e-6, 1e3));
+      ->check(cf::cli::param_range(epsilon));
+  cf::cli::old_option_name(app, "--epsilon", epsilon.option, o.epsilon, o.renamed)
+      ->check(cf::cli::param_range(epsilon));
   app.add_option("--html", o.html_path,
                  "write the browser viewer of the graph: one self-contained HTML file");
   app.add_option("--replay", o.replay_path,
@@ -531,6 +537,8 @@ int run(int argc, char** argv) {
     std::cerr << "cfinspect: " << e.what() << " (see --help)\n";
     return 2;
   }
+  for (const std::string& note : o.renamed)
+    std::cerr << "cfinspect: warning: " << note << "; the old name goes in the next release\n";
   if (o.print_schema) {
     std::cout << cf::graph_schema_text();
     return 0;

@@ -74,14 +74,11 @@ std::vector<std::string> choice_names(const E (&all)[N], std::vector<std::string
   return names;
 }
 
-// An option under its name before the rename, listed apart in --help: it sets the same
-// value and leaves a note saying what to write instead.
+// An option under its name before the rename (cf::cli::old_option_name).
 template <class T>
 CLI::Option* old_name(CLI::App& app, Options& o, const std::string& name, const std::string& now,
                       T& value) {
-  return app.add_option(name, value)
-      ->group("Old names (work until the next release)")
-      ->each([&o, name, now](const std::string&) { o.renamed.insert(name + " is now " + now); });
+  return cf::cli::old_option_name(app, name, now, value, o.renamed);
 }
 
 // The choices and the moment's point, each under its name and its old one.
