@@ -537,3 +537,35 @@ TEST_CASE("model_from_soup validates in-memory soups too", "[mesh_io]") {
   CHECK_THROWS_WITH(cf::tools::model_from_soup(soup, "memory"),
                     Catch::Contains("loading 'memory': open boundary"));
 }
+
+TEST_CASE("a file's coordinate rounding is read from how its numbers are written",
+          "[mesh_io][precision]") {
+  using cf::tools::coordinate_rounding;
+  using V = cf::Vec3;
+  // float32 values (binary STL): half a unit in float32's last place at the largest, 2^-24
+  // of it; 20 lies in [16, 32), whose float32 spacing is 2^-19.
+  const float third = 1.0f / 3.0f;
+  CHECK(coordinate_rounding({V(third, 20, -1.5), V(0, 0, 0)}) == std::ldexp(20.0, -24));
+  // Six significant digits (8.66025 for 8.660254...): half a unit of the fifth decimal.
+  CHECK(coordinate_rounding({V(8.66025, 5, 1.23457), V(-8.66025, 5, 0.1)}) ==
+        Approx(0.5e-5).epsilon(1e-9));
+  // Ten digits on a 1e3 scale.
+  CHECK(coordinate_rounding({V(1234.567891, 0.1, 0.2)}) == Approx(0.5e-6).epsilon(1e-9));
+  // Full doubles: a double's own rounding, 2^-53 of the largest.
+  const double x = std::sqrt(2.0) * 10;
+  CHECK(coordinate_rounding({V(x, 1 / 3.0, 0.1)}) == std::ldexp(x, -53));
+  CHECK(coordinate_rounding({V(0, 0, 0)}) == 0);
+}
+
+TEST_CASE("the rounding is measured in the file's unit and recorded in mm",
+          "[mesh_io][precision]") {
+  // Binary STL stores float32: a 1 m cube in metres is rounded to 2^-24 m = 6e-5 mm.
+  const std::string text =
+      "OFF\n8 6 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n"
+      "4 0 2 3 1\n4 4 5 7 6\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n4 1 3 7 5\n";
+  const std::string path = cf::test::write_file("unit_cube.off", text);
+  cf::tools::LoadOptions metres;
+  metres.units = "m";
+  const cf::tools::MeasuredModel m = cf::tools::load_measured_model(path, metres);
+  CHECK(m.rounding_mm == std::ldexp(1.0, -24) * 1000);
+}

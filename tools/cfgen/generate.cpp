@@ -82,8 +82,8 @@ int stopped_status(const GenerateArgs& args, const std::string& checkpoint_dir) 
 // The graph's "meta" record: statistics, the parameters and the generator (docs/graph-format.md).
 nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args,
                           const gen::SearchParams& s, const gen::EnumerateOptions& opt, double diag,
-                          const Polyhedron& A, const Polyhedron& B, double precision_a,
-                          double precision_b) {
+                          const Polyhedron& A, const Polyhedron& B, const MeasuredModel& ma,
+                          const MeasuredModel& mb) {
   nlohmann::json meta;
   nlohmann::json by_count = nlohmann::json::object(), by_type = nlohmann::json::object();
   for (const CfRecord& r : e.cfs) {
@@ -127,7 +127,8 @@ nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args,
                         {"good_clearance_rel", args.rel.good_clearance},
                         {"min_margin_rel", args.rel.min_margin},
                         {"touch_tol_mm", s.touch_tol},
-                        {"precision_mm", {{"A", precision_a}, {"B", precision_b}}},
+                        {"precision_mm", {{"A", ma.precision_mm}, {"B", mb.precision_mm}}},
+                        {"rounding_mm", {{"A", ma.rounding_mm}, {"B", mb.rounding_mm}}},
                         {"planarity_mm", {{"A", model_precision(A)}, {"B", model_precision(B)}}},
                         {"min_clearance_mm", s.min_clearance},
                         {"good_clearance_mm", s.good_clearance},
@@ -331,8 +332,7 @@ int run_generate(const GenerateArgs& args) {
               << (writes ? "" : "; shard 0 writes the graph") << '\n';
   if (!writes) return 0;
 
-  const nlohmann::json meta =
-      graph_meta(e, args, search, opt, diag, A, B, ma.precision_mm, mb.precision_mm);
+  const nlohmann::json meta = graph_meta(e, args, search, opt, diag, A, B, ma, mb);
   const std::size_t n_cfs = e.cfs.size(), n_tr = e.transitions.size();
   // Moved, not copied: a large graph's records and transitions are hundreds of MB.
   const CfGraph graph =

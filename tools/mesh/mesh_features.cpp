@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -519,6 +521,58 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
 }  // namespace cf::tools::detail
 
 namespace cf::tools {
+
+namespace {
+
+// The fewest significant digits (1 to 17) that print x so that it reads back exactly.
+int digits_of(double x) {
+  int lo = 1, hi = 17;  // 17 always reads back (a double's round trip)
+  char buf[40];
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    std::snprintf(buf, sizeof buf, "%.*g", mid, x);
+    if (std::strtod(buf, nullptr) == x)
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  return lo;
+}
+
+// Half a unit of the last of `digits` significant digits of x.
+double half_unit(double x, int digits) {
+  const double exponent = std::floor(std::log10(std::abs(x)));
+  return 0.5 * std::pow(10.0, exponent - digits + 1);
+}
+
+}  // namespace
+
+double coordinate_rounding(const std::vector<Vec3>& points) {
+  double largest = 0;
+  bool float32 = true;
+  for (const Vec3& p : points)
+    for (int k = 0; k < 3; ++k) {
+      largest = std::max(largest, std::abs(p[k]));
+      float32 = float32 && static_cast<double>(static_cast<float>(p[k])) == p[k];
+    }
+  if (largest == 0) return 0;
+  // Half a unit in the last place of float32 at the largest coordinate: 2^-24 of it.
+  if (float32) return std::ldexp(largest, -24);
+  // The writer's digits: the most any coordinate needs ("0.1" in a file written at 6 digits
+  // is 0.100000 with its zeros dropped).
+  const std::size_t n = 3 * points.size();
+  const std::size_t stride = std::max<std::size_t>(1, n / kRoundingSample);
+  int digits = 1;
+  auto read = [&](double x) {
+    if (x != 0 && std::isfinite(x)) digits = std::max(digits, digits_of(x));
+  };
+  for (std::size_t i = 0; i < n; i += stride) read(points[i / 3][static_cast<int>(i % 3)]);
+  for (const Vec3& p : points)
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(p[k]) == largest) read(p[k]);
+  // Never below a double's own rounding (17 digits say more than a double holds).
+  return std::max(half_unit(largest, digits), std::ldexp(largest, -53));
+}
 
 double model_precision(const cf::Polyhedron& m) {
   double largest = 0, off = 0;

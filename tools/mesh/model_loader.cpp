@@ -305,7 +305,8 @@ MeasuredModel measured_model_from_soup(const PolygonSoup& soup, const std::strin
   double off_plane = 0;
   cf::Polyhedron model = detail::extract_features(soup, source, name, options, &off_plane);
   const double precision = std::max(off_plane, model_precision(model));
-  return {std::move(model), precision};
+  // The soup's points as given (load_measured_model measures them before scaling to mm).
+  return {std::move(model), precision, coordinate_rounding(soup.points)};
 }
 
 cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& source,
@@ -333,9 +334,13 @@ MeasuredModel load_measured_model(const std::string& path, const LoadOptions& op
   const double scale = mm_per_unit(options.units);
   if (!(scale > 0)) fail(path, "unknown unit '" + options.units + "' (expected mm, cm, m or in)");
   PolygonSoup soup = read_polygon_soup(path);
+  // How the file wrote its numbers, before they are scaled to mm.
+  const double rounding = coordinate_rounding(soup.points) * scale;
   if (scale != 1)
     for (Vec3& p : soup.points) p *= scale;
-  return measured_model_from_soup(soup, path, options);
+  MeasuredModel out = measured_model_from_soup(soup, path, options);
+  out.rounding_mm = rounding;
+  return out;
 }
 
 cf::Polyhedron load_model(const std::string& path, const LoadOptions& options) {

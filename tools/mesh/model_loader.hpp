@@ -86,15 +86,31 @@ constexpr double kPrecisionRoundings = 4;
 /// largest coordinate (a model far from its origin).
 double model_precision(const cf::Polyhedron& model);
 
+/// The most a coordinate of `points` can be from the value it stands for, by how it was
+/// written (in the points' unit): half a unit in the last place of float32 when every
+/// coordinate is a float32 value (binary STL and PLY, or text printed from floats), else half
+/// a unit of the writer's last significant digit at the largest coordinate (the digits: the
+/// most that any coordinate needs to read back exactly, over a deterministic sample of at
+/// most kRoundingSample coordinates, the largest included), and at least a double's own
+/// rounding. A value written with few digits may be exact, so this is an upper bound
+/// (docs/features.md, "Precision").
+double coordinate_rounding(const std::vector<Vec3>& points);
+
+/// Coordinates coordinate_rounding() reads the digits of (each is a few conversions).
+constexpr std::size_t kRoundingSample = 4096;
+
 /// A model and how closely its file holds it (docs/features.md, "Precision").
 struct MeasuredModel {
   cf::Polyhedron model;
   /// mm: the larger of model_precision(model) and the largest distance of a feature vertex
   /// from the fitted plane of one of its faces as the file gave it (before the vertex was
   /// moved onto its planes): about the rounding of the file's coordinates (float32, or the
-  /// digits written). The generator's touch and symmetry tolerances are at least a multiple
-  /// of it (tools/cfgen/generate.hpp).
+  /// digits written). The generator's touch tolerance is at least a multiple of it
+  /// (tools/cfgen/generate.hpp).
   double precision_mm = 0;
+  /// mm: coordinate_rounding() of the file's points, in mm. The generator's symmetry
+  /// tolerance is a multiple of it, within bounds (tools/cfgen/generate.hpp).
+  double rounding_mm = 0;
 };
 
 /// Empty when `model` is a reasonable size against the contact threshold `epsilon_mm` (the

@@ -57,14 +57,6 @@ double half_of(const PoseBox& c, const Circle& circle) {
   return circle.on ? c.arc.half : c.rot.half;
 }
 
-// Rotations near R_c that meet the set's rotational conditions, where a witness is tried.
-std::vector<Mat3> projections(const RotConstraints& c, const Mat3& R_c) {
-  if (!c.align.empty()) return internal::align_family(c, {R_c}, 0);
-  Mat3 R = R_c;
-  if (!c.perp.empty() && !internal::project_perp(c, R)) return {};
-  return {R};
-}
-
 // How far A's points can move over the cell: its farthest vertex from the pivot.
 double reach_of(const Polyhedron& A, const Vec3& pivot) {
   double r = 0;
@@ -195,7 +187,7 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
     // A search near the centre's rotation, once a rotation cell (its first translation box)
     // is small enough that its rotations are near one another.
     if (search && half <= limits.search_below && half < searched_half) {
-      const Witness w = search->find(pcs, projections(conditions, R_c), true);
+      const Witness w = search->find(pcs, internal::project_onto(conditions, R_c), true);
       if (w.found) {
         out.outcome = CellSearchResult::Outcome::kWitness;
         out.witness = w;

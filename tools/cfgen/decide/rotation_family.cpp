@@ -193,4 +193,11 @@ std::vector<std::vector<Mat3>> walk_family(const RotConstraints& c, const Mat3& 
   return paths;
 }
 
+std::vector<Mat3> project_onto(const RotConstraints& c, const Mat3& R) {
+  if (!c.align.empty()) return align_family(c, {R}, 0);
+  Mat3 out = R;
+  if (!c.perp.empty() && !project_perp(c, out)) return {};
+  return {out};
+}
+
 }  // namespace cf::gen::internal

@@ -26,6 +26,11 @@ std::vector<Mat3> align_family(const RotConstraints& c, const std::vector<Mat3>&
 /// Gauss-Newton projection of R onto { (R u_i) . w_i == 0 }; false when it does not converge.
 bool project_perp(const RotConstraints& c, Mat3& R);
 
+/// The rotations near R that meet the conditions: R projected onto them (an alignment's
+/// family through R's spin, or the perpendicularity conditions by Gauss-Newton); R itself
+/// when there are none; empty when the projection fails.
+std::vector<Mat3> project_onto(const RotConstraints& c, const Mat3& R);
+
 /// Walks a one-parameter family of rotations (one alignment with its spin free, or two
 /// perpendicularity conditions) away from R by steps of about h rad, at most n steps along
 /// each branch: the rotations along each branch, R excluded. Where the two conditions'

@@ -16,9 +16,7 @@ TaskResult decide(const WitnessSearch& search, const Task& task) {
       if (!r.witness.found) r.witness = search.refine(task.pcs, task.pose);
       break;
     case Task::Kind::kVerify:
-      r.witness.pose = task.pose;
-      r.witness.clearance = search.verify(task.pcs, task.pose);
-      r.witness.found = r.witness.clearance >= search.params().min_clearance;
+      r.witness = search.image_witness(task.pcs, task.pose);
       break;
     case Task::Kind::kExplore: {
       r.met = explore_translations(search, task.pcs, task.pose);

@@ -20,7 +20,7 @@ struct Task {
     kFindOrRefine,  // find(pcs, {pose.R_BA}), else refine(pcs, pose): a set met by motion
     kExplore,       // the motions from the witness `pose` of the CF `pcs` (explore.hpp)
     kFindNear,      // find(pcs, seeds, seeds_only): a failed set near its neighbours' witnesses
-    kVerify,        // verify(pcs, pose): an image of a CF at the image of its witness
+    kVerify,        // image_witness(pcs, pose): an image of a CF at the image of its witness
   };
   Kind kind = Kind::kFind;
   PcSet pcs;

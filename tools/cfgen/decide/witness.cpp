@@ -152,6 +152,22 @@ Witness WitnessSearch::refine(const PcSet& pcs, const Pose& pose) const {
   return out;
 }
 
+Witness WitnessSearch::image_witness(const PcSet& pcs, const Pose& image) const {
+  Witness w;
+  w.pose = image;
+  w.clearance = verify(pcs, image);
+  w.found = w.clearance >= p_.min_clearance;
+  if (w.found) return w;
+  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
+  for (const Mat3& R : project_onto(c, image.R_BA)) {
+    Pose q = image;
+    q.R_BA = R;
+    const Witness r = refine(pcs, q);
+    if (r.found) return r;
+  }
+  return w;
+}
+
 std::vector<int> WitnessSearch::piece_slots(const PcSet& pcs) const {
   std::vector<int> slot_sizes;
   for (const Pc& pc : pcs) {

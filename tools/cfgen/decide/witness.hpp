@@ -69,6 +69,13 @@ class WitnessSearch : public Verifier {
   /// verified with the contacts at least min_margin inside their elements.
   Witness refine(const PcSet& pcs, const Pose& pose) const;
 
+  /// A witness for `pcs` at `image`, the image of another CF's witness under a symmetry of
+  /// the models: `image` itself when it verifies; else, since a symmetry found only to the
+  /// files' precision turns and moves the witness by about that much, `image` with its
+  /// rotation projected onto the PCs' rotational conditions and its translation re-solved
+  /// (refine). found: false when neither verifies.
+  Witness image_witness(const PcSet& pcs, const Pose& image) const;
+
   /// For a set `find` found no witness for: true when it is proven invalid within the
   /// search's tolerances (a necessary condition fails, or its rotational conditions leave
   /// finitely many rotations and at each the PCs are locally penetrating or cannot be placed

@@ -19,7 +19,9 @@
 namespace cf::gen::internal {
 
 // Vertices within this fraction of the length scale D match under a symmetry: far below the
-// touch tolerance (2e-11 D by default), so an image witness is verified as the witness was.
+// touch tolerance (2e-11 D by default), so an image witness verifies as the witness did. A
+// file rounded coarser than that (float32, few digits) is symmetric only to its rounding;
+// maps found to 16 times it are not used (docs/features.md, "Precision").
 constexpr double kSymmetryTol = 1e-13;
 // Members of an orbit searched before it counts as failed: each meets the search's fixed
 // samples differently. On the hexagonal peg and hole 2 find 13 orbits more than 1 (4 no more
@@ -195,9 +197,9 @@ class Enumerator {
   std::size_t near_screened_cfs_[3] = {0, 0, 0};
   bool near_screened_none_ = true;  // this round's new_cfs_by_rest() holds every CF
   std::map<Pc, std::vector<Pc>> pc_neighbours_;
-  // The images' clearances of the sets about to be accepted, by set, with the witness pose
-  // they were computed at (prefetch_images); cleared after each batch.
-  PcSetMap<std::pair<Pose, std::vector<double>>> prefetched_;
+  // The images' witnesses of the sets about to be accepted, by set, with the witness pose
+  // they were computed from (prefetch_images); cleared after each batch.
+  PcSetMap<std::pair<Pose, std::vector<Witness>>> prefetched_;
   // The estimate's sets searched and not found (estimate.cpp).
   PcSetSet known_invalid_;
   std::size_t samples_ = kEstimateSamples;  // estimate(): orbits searched per level

@@ -45,11 +45,11 @@ void Enumerator::close_orbits() {
         }
       }
       runner_.for_each(images.size(), [&](std::size_t i) {
-        images[i].second.clearance = search_.verify(images[i].first, images[i].second.pose);
+        images[i].second = search_.image_witness(images[i].first, images[i].second.pose);
       });
       bool refused = false;
       for (auto& [t, v] : images) {
-        if (v.clearance < search_.params().min_clearance) {
+        if (!v.found) {
           refused = true;
           continue;
         }
@@ -178,10 +178,8 @@ void Enumerator::add_with_images(const PcSet& s, const Witness& w, PcSetSet& kno
   for (std::size_t k = 0; k < sym_.size(); ++k) {
     const PcSet t = sym_.image(s, k);
     if (known.count(t)) continue;
-    Witness v = w;
-    v.pose = sym_.image(w.pose, k);
-    v.clearance = search_.verify(t, v.pose);
-    if (v.clearance < search_.params().min_clearance) continue;
+    const Witness v = search_.image_witness(t, sym_.image(w.pose, k));
+    if (!v.found) continue;
     known.insert(t);
     valid_[l].push_back({t, v});
     ++out_.levels[l].valid;

@@ -48,10 +48,9 @@ void Enumerator::accept(int level, const PcSet& s, const Witness& w) {
   for (std::size_t k = 1; k < sym_.size(); ++k) {
     const PcSet t = sym_.image(s, k);
     if (witness_rot_.count(t)) continue;
-    Witness v = w;
-    v.pose = sym_.image(w.pose, k);
-    v.clearance = have ? pre->second.second[k] : search_.verify(t, v.pose);
-    if (v.clearance < search_.params().min_clearance) continue;
+    const Witness v =
+        have ? pre->second.second[k] : search_.image_witness(t, sym_.image(w.pose, k));
+    if (!v.found) continue;
     valid_[level].push_back({t, v});
     witness_rot_.emplace(t, v.pose.R_BA);
     seen_.insert(t);
@@ -60,7 +59,7 @@ void Enumerator::accept(int level, const PcSet& s, const Witness& w) {
 }
 
 // Verifies every image of each set found at the image of its witness, for the accept()
-// calls that follow (in order, on this thread): the same clearances accept() would compute,
+// calls that follow (in order, on this thread): the same witnesses accept() would compute,
 // as a stage of tasks (kVerify), so that threads, shards and ranks share them and a
 // checkpoint keeps them. Images already valid are skipped, as accept() skips them; a set
 // whose witness differs from the one given is verified by accept() itself.
@@ -80,9 +79,8 @@ void Enumerator::prefetch_images(const std::vector<std::pair<PcSet, Pose>>& foun
       of.emplace_back(i, k);
     }
   const std::vector<TaskResult> r = run_tasks(runner_, tasks, nullptr, Clock::now());
-  std::vector<std::vector<double>> clear(found.size(), std::vector<double>(sym_.size(), 0));
-  for (std::size_t j = 0; j < tasks.size(); ++j)
-    clear[of[j].first][of[j].second] = r[j].witness.clearance;
+  std::vector<std::vector<Witness>> clear(found.size(), std::vector<Witness>(sym_.size()));
+  for (std::size_t j = 0; j < tasks.size(); ++j) clear[of[j].first][of[j].second] = r[j].witness;
   for (std::size_t i = 0; i < found.size(); ++i)
     prefetched_.emplace(found[i].first, std::make_pair(found[i].second, std::move(clear[i])));
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -37,6 +38,10 @@ int find_vertex(const std::vector<Vec3>& P, const std::vector<int>& order, const
 bool complete(const Polyhedron& m, const std::vector<Vec3>& P, const std::vector<int>& order,
               Mat3 R, double tol, Symmetry& out) {
   const std::size_t n = P.size();
+  double shortest = HUGE_VAL;
+  for (const Edge& e : m.edges()) shortest = std::min(shortest, e.length);
+  constexpr double kNormalTol = 1e-9;  // an exact model's normals match to rounding
+  const double normal_tol = std::min(0.1, std::max(kNormalTol, 4 * tol / shortest));
   std::vector<int> perm(n);
   for (std::size_t i = 0; i < n; ++i)
     if ((perm[i] = find_vertex(P, order, R * P[i], tol)) < 0) return false;
@@ -81,9 +86,10 @@ bool complete(const Polyhedron& m, const std::vector<Vec3>& P, const std::vector
     std::sort(vs.begin(), vs.end());
     auto it = face_of.find(vs);
     if (it == face_of.end()) return false;
-    constexpr double kNormalTol = 1e-9;  // a face's image has the image normal, not its opposite
+    // A face's image has the image normal, not its opposite: to within how far vertices
+    // matched (tol) turns a face's plane, at most tol / (half its shortest edge) each way.
     if ((R * m.faces()[f].normal - m.faces()[static_cast<std::size_t>(it->second)].normal).norm() >
-        kNormalTol)
+        normal_tol)
       return false;
     out.face[f] = it->second;
   }

@@ -32,7 +32,7 @@ std::vector<Symmetry> symmetries(const Polyhedron& m, double tol);
 /// product with the pose is again a rotation), the identity pair first.
 class PairSymmetries {
  public:
-  /// Only the identity when `enabled` is false.
+  /// Only the identity when `enabled` is false. tol (mm): the maps' tolerance (symmetries()).
   PairSymmetries(const Polyhedron& A, const Polyhedron& B, double tol, bool enabled);
   std::size_t size() const { return pairs_.size(); }
   std::size_t size_a() const { return a_.size(); }

@@ -19,8 +19,10 @@ namespace {
 // (12), clearance, margin]; 3: the witness search climbs past obstacles and the neighbour
 // rounds' tasks (the same tasks give other results, so checkpoints of version 2 are refused);
 // 4: the images of each batch of CFs found verified as a stage of kVerify tasks (the stages
-// are numbered differently); 5: the neighbour rounds' screening in stages of its own.
-constexpr int kVersion = 5;
+// are numbered differently); 5: the neighbour rounds' screening in stages of its own; 6: an
+// image that does not verify at the image of its witness is polished (kVerify tasks give
+// other results) and symmetries hold to the files' rounding.
+constexpr int kVersion = 6;
 constexpr int kMaxShards = 4096;
 
 // The options that shape the graph, in a fixed order (not the thread count, the output or
