@@ -166,8 +166,7 @@ using cf::gen::CellNode;
 std::vector<CellNode> leaves(const cf::gen::CellTree& tree) {
   std::vector<CellNode> out;
   for (const CellNode& n : tree.nodes)
-    if (n.kind == CellNode::Kind::kRefuted || n.kind == CellNode::Kind::kOutsideBall ||
-        n.kind == CellNode::Kind::kUnproven)
+    if (n.kind == CellNode::Kind::kRefuted || n.kind == CellNode::Kind::kOutsideBall)
       out.push_back(n);
   return out;
 }
@@ -183,8 +182,7 @@ void check_tree(const cf::gen::CellTree& tree) {
   }
   for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
     const CellNode::Kind k = tree.nodes[i].kind;
-    const bool leaf = k == CellNode::Kind::kRefuted || k == CellNode::Kind::kOutsideBall ||
-                      k == CellNode::Kind::kUnproven;
+    const bool leaf = k == CellNode::Kind::kRefuted || k == CellNode::Kind::kOutsideBall;
     CHECK((children[i] == 0) == leaf);
     if (k == CellNode::Kind::kSplitTranslation) CHECK(children[i] == 2);
     if (k == CellNode::Kind::kSplitRotation) CHECK((children[i] == 2 || children[i] == 8));
@@ -198,7 +196,6 @@ std::size_t check_certificates(const cf::test::AnalysedPair& p, const PcSet& s,
   std::size_t programs = 0;
   const CellRelaxation relaxation(p.ai, p.bi, s, 1e-9);
   for (const auto& e : evidence) {
-    CHECK(e.kind != CellNode::Kind::kUnproven);
     if (e.refutation.verdict != CellRelaxation::Verdict::kProgram) continue;
     ++programs;
     // One certificate per choice of pieces (convex faces: one).

@@ -41,7 +41,7 @@ json read_json(const std::string& path) {
 }
 
 // Parents before children; a split has its 8 or 2 (rotation) or 2 (translation) children; a
-// leaf none; no leaf left open or unproven in a certificate of an invalid set.
+// leaf none; no leaf left open in a certificate of an invalid set.
 void check_tree(const json& nodes, const std::string& set) {
   INFO(set);
   REQUIRE(!nodes.empty());

@@ -38,8 +38,6 @@ const char* kind_name(const CellNode& n) {
       return "narrow";
     case CellNode::Kind::kOutsideBall:
       return "outside-ball";
-    case CellNode::Kind::kUnproven:
-      return "unproven";
     case CellNode::Kind::kRefuted:
       break;
   }
@@ -76,7 +74,7 @@ json node_json(const CellNode& n, int id, bool circle, const std::vector<std::ve
     j["axis"] = n.axis;
     j["at"] = n.at;
   }
-  if (n.kind != CellNode::Kind::kRefuted && n.kind != CellNode::Kind::kUnproven) return j;
+  if (n.kind != CellNode::Kind::kRefuted) return j;
   if (r.verdict == Verdict::kRotation || r.verdict == Verdict::kCone ||
       r.verdict == Verdict::kSlack)
     j["pc"] = r.pc;

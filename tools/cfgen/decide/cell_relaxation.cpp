@@ -38,6 +38,33 @@ std::pair<Eigen::Vector2d, double> side_row(const ConvexPiece& piece, std::size_
   return {o, o.dot(p)};
 }
 
+// How much of the margin a witness keeps from a boundary side's line soundly carries over
+// (docs/certificates.md, "The programs"): a contact point at least m from the face's
+// boundary is at least m from the side's line where it projects inside the side; past an end
+// where the piece turns by phi < pi / 2 onto a diagonal (the face goes on) or onto a
+// boundary side shorter than m / sin(phi), the piece's wedge there keeps it only
+// m sin(phi) from the line.
+double side_margin_factor(const ConvexPiece& piece, std::size_t k, double margin) {
+  const std::size_t n = piece.points.size();
+  auto dir = [&](std::size_t j) {
+    return Eigen::Vector2d(piece.points[(j + 1) % n] - piece.points[j]).normalized();
+  };
+  auto end_factor = [&](std::size_t next, double cross, double dot) {
+    const double phi = std::atan2(cross, dot);  // the turn onto the next side
+    if (phi >= M_PI / 2) return 1.0;
+    if (phi <= 0) return 0.0;
+    const double s = std::sin(phi);
+    const double length = (piece.points[(next + 1) % n] - piece.points[next]).norm();
+    return piece.boundary[next] && length >= margin / s ? 1.0 : s;
+  };
+  const Eigen::Vector2d e = dir(k), after = dir((k + 1) % n), before = dir((k + n - 1) % n);
+  const double forward =
+      end_factor((k + 1) % n, e.x() * after.y() - e.y() * after.x(), e.dot(after));
+  const double back =
+      end_factor((k + n - 1) % n, before.x() * e.y() - before.y() * e.x(), before.dot(e));
+  return std::min(forward, back);
+}
+
 Vec3 face_point(const Face& f, const Eigen::Vector2d& q) {
   return f.offset * f.normal + q.x() * f.u + q.y() * f.v;
 }
@@ -122,18 +149,20 @@ CellRelaxation::Verdict CellRelaxation::rotation_test(const Mat3& R_c, const Tur
     const ElementKind ka = a_kind(x.type), kb = b_kind(x.type);
     // Opposite normals (f-f), an edge parallel to the face (e-f, f-e): A's vector moves by at
     // most turn(vector) over the cell.
+    // A witness meets each condition to kRotAccepted, not exactly.
     if (x.type == PcType::kFF) {
       const Vec3& na = mA.face(FaceId(x.a)).normal;
-      if ((R_c * na + mB.face(FaceId(x.b)).normal).norm() > turn.of(na)) return Verdict::kRotation;
+      if ((R_c * na + mB.face(FaceId(x.b)).normal).norm() > turn.of(na) + kRotAccepted)
+        return Verdict::kRotation;
     }
     if (x.type == PcType::kEF) {
       const Vec3& ea = mA.edge(EdgeId(x.a)).dir;
-      if (std::abs((R_c * ea).dot(mB.face(FaceId(x.b)).normal)) > turn.of(ea))
+      if (std::abs((R_c * ea).dot(mB.face(FaceId(x.b)).normal)) > turn.of(ea) + kRotAccepted)
         return Verdict::kRotation;
     }
     if (x.type == PcType::kFE) {
       const Vec3& na = mA.face(FaceId(x.a)).normal;
-      if (std::abs((R_c * na).dot(mB.edge(EdgeId(x.b)).dir)) > turn.of(na))
+      if (std::abs((R_c * na).dot(mB.edge(EdgeId(x.b)).dir)) > turn.of(na) + kRotAccepted)
         return Verdict::kRotation;
     }
     // Local non-penetration against a face: the other solid's tangent directions at the
@@ -211,7 +240,7 @@ void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, cons
       // A side on the face's boundary keeps the point the margin inside; a diagonal of the
       // partition does not bound the face.
       lp.add({{var, o.x()}, {var + 1, o.y()}}, Rel::kLessEq,
-             piece.boundary[k] ? off - margin_ : off);
+             piece.boundary[k] ? off - margin_ * side_margin_factor(piece, k, margin_) : off);
     }
     for (int k = 0; k < 2; ++k) {
       lp.lower[var + k] = {true, lo[k]};
@@ -259,7 +288,8 @@ void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, cons
     row(-f.normal, -f.offset);
     for (std::size_t k = 0; k < piece.points.size(); ++k) {
       const auto [o, off] = side_row(piece, k);
-      row(o.x() * f.u + o.y() * f.v, piece.boundary[k] ? off - margin_ : off);
+      row(o.x() * f.u + o.y() * f.v,
+          piece.boundary[k] ? off - margin_ * side_margin_factor(piece, k, margin_) : off);
     }
   }
 }
@@ -332,31 +362,22 @@ CellRelaxation::Refutation CellRelaxation::refute(const Mat3& R_c, const TurnBou
   // The programs' optima are within the solver's tolerances (reduced costs 1e-9, rows 1e-7
   // (1 + |b|)) of the true ones: grow the range by more than those.
   const Vec3 slack = Vec3::Constant(1e-7 * (1 + size_));
-  const Vec3 lo_given = t_lo, hi_given = t_hi;
-  t_lo = t_lo.cwiseMax(lo - slack);
-  t_hi = t_hi.cwiseMin(hi + slack);
   out.certificates.clear();
-  if (with_certificates) out.slabs = slabs(R_c, turn, lo_given, hi_given, t_lo, t_hi);
+  std::vector<Slab> cut = narrow(R_c, turn, t_lo, t_hi, lo - slack, hi + slack);
+  if (with_certificates) out.slabs = std::move(cut);
   return out;
 }
 
-// The parts of the given box outside the narrowed one [lo, hi], cut off one axis after the
-// other, each with the Farkas proofs of its programs: the narrowing rests on the programs'
-// optima, which are not proofs.
-std::vector<CellRelaxation::Slab> CellRelaxation::slabs(const Mat3& R_c, const TurnBound& turn,
-                                                        const Vec3& lo_given, const Vec3& hi_given,
-                                                        const Vec3& lo, const Vec3& hi) const {
+// Narrows [t_lo, t_hi] towards [lo, hi] one side after the other, cutting off a slab only
+// where the Farkas proofs of its programs (every choice of pieces) are found: the bounds come
+// from the programs' optima, which are not proofs. The slabs cut off, with their proofs.
+std::vector<CellRelaxation::Slab> CellRelaxation::narrow(const Mat3& R_c, const TurnBound& turn,
+                                                         Vec3& t_lo, Vec3& t_hi, const Vec3& lo,
+                                                         const Vec3& hi) const {
   std::vector<Slab> out;
-  Vec3 rest_lo = lo_given, rest_hi = hi_given;  // what is not cut off yet
   auto cut = [&](int j, bool low) {
-    Slab slab{rest_lo, rest_hi, {}, true};
-    if (low) {
-      slab.hi[j] = lo[j];
-      rest_lo[j] = lo[j];
-    } else {
-      slab.lo[j] = hi[j];
-      rest_hi[j] = hi[j];
-    }
+    Slab slab{t_lo, t_hi, {}, true};
+    (low ? slab.hi : slab.lo)[j] = low ? lo[j] : hi[j];
     std::vector<int> choice(slot_sizes_.size(), 0);
     for (std::size_t c = 0; c < choices() && slab.proven; ++c) {
       std::optional<FarkasCertificate> proof = farkas(program(R_c, turn, choice, slab.lo, slab.hi));
@@ -364,11 +385,13 @@ std::vector<CellRelaxation::Slab> CellRelaxation::slabs(const Mat3& R_c, const T
       if (proof) slab.proofs.push_back(std::move(*proof));
       next_choice(choice, slot_sizes_);
     }
+    if (!slab.proven) return;
+    (low ? t_lo : t_hi)[j] = low ? lo[j] : hi[j];
     out.push_back(std::move(slab));
   };
   for (int j = 0; j < 3; ++j) {
-    if (lo[j] > rest_lo[j]) cut(j, true);
-    if (hi[j] < rest_hi[j]) cut(j, false);
+    if (lo[j] > t_lo[j]) cut(j, true);
+    if (hi[j] < t_hi[j]) cut(j, false);
   }
   return out;
 }
@@ -376,7 +399,7 @@ std::vector<CellRelaxation::Slab> CellRelaxation::slabs(const Mat3& R_c, const T
 bool CellRelaxation::holds_at(const Mat3& R) const {
   int pc = -1;
   Vec3 direction;
-  if (empty_ || rotation_test(R, TurnBound{10 * kRotTol}, pc, direction) != Verdict::kOpen)
+  if (empty_ || rotation_test(R, TurnBound{kRotAccepted}, pc, direction) != Verdict::kOpen)
     return false;
   std::vector<int> choice(slot_sizes_.size(), 0);
   for (std::size_t c = 0; c < choices(); ++c) {

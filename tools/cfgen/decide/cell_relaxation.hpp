@@ -50,7 +50,7 @@ class CellRelaxation {
   struct Slab {
     Vec3 lo, hi;                            // mm
     std::vector<FarkasCertificate> proofs;  // one per choice, in choice order
-    bool proven = false;                    // every choice has its proof
+    bool proven = false;                    // every choice has its proof (else not cut)
   };
   struct Refutation {
     Verdict verdict = Verdict::kOpen;
@@ -68,7 +68,8 @@ class CellRelaxation {
   /// Whether some pose with its rotation in the cell and A's pivot at a translation in
   /// [t_lo, t_hi] (mm, B's frame) can meet the relaxation. When the cell stays open, t_lo and
   /// t_hi are narrowed to the translations the feasible programs allow (grown by 1e-7 of the
-  /// models' size for the solver's tolerances). Choices of convex pieces beyond max_choices leave
+  /// models' size for the solver's tolerances), a side only where the slab it cuts off is
+  /// proven empty (Farkas certificates). Choices of convex pieces beyond max_choices leave
   /// the cell open.
   Refutation refute(const RotationCell& cell, Vec3& t_lo, Vec3& t_hi, bool with_certificates,
                     std::size_t max_choices = 4096) const;
@@ -107,8 +108,8 @@ class CellRelaxation {
     int index;
   };
   Verdict rotation_test(const Mat3& R_c, const TurnBound& turn, int& pc, Vec3& direction) const;
-  std::vector<Slab> slabs(const Mat3& R_c, const TurnBound& turn, const Vec3& lo_given,
-                          const Vec3& hi_given, const Vec3& lo, const Vec3& hi) const;
+  std::vector<Slab> narrow(const Mat3& R_c, const TurnBound& turn, Vec3& t_lo, Vec3& t_hi,
+                           const Vec3& lo, const Vec3& hi) const;
   void add_contact(LinearProgram& lp, int pc, const Mat3& R_c, const TurnBound& turn, int& slot,
                    const std::vector<int>& choice) const;
 

@@ -101,7 +101,7 @@ int record_narrowing(CellTree& tree, int node, const Vec3& t_lo, const Vec3& t_h
     leaf.parent = node;
     leaf.t_lo = slab.lo;
     leaf.t_hi = slab.hi;
-    leaf.kind = slab.proven ? CellNode::Kind::kRefuted : CellNode::Kind::kUnproven;
+    leaf.kind = CellNode::Kind::kRefuted;  // narrow() cuts off proven slabs only
     leaf.refutation = {};
     leaf.refutation.verdict = CellRelaxation::Verdict::kProgram;
     leaf.refutation.certificates = std::move(slab.proofs);

@@ -16,9 +16,9 @@
 namespace cf::gen {
 
 /// rad: how far a rotation of an arc cell may be from the f-f's circle. A witness meets the
-/// f-f's alignment to 10 kRotTol: its rotation is within that angle of the circle (a turn by
-/// a moves a unit vector by at most a); twice it for rounding.
-constexpr double kOffCircle = 20 * kRotTol;
+/// f-f's alignment to kRotAccepted: its rotation is within that angle of the circle (a turn
+/// by a moves a unit vector by at most a); twice it for rounding.
+constexpr double kOffCircle = 2 * kRotAccepted;
 
 struct CellSearchLimits {
   double resolution = 1.5e-5;     // rad, and times the models' size in mm: cells are not split
@@ -52,7 +52,6 @@ struct CellNode {
     kNarrow,            // children: the narrowed box, and the slabs cut off (kProgram leaves)
     kOutsideBall,       // leaf: the cube holds no axis-angle vector of length <= pi
     kRefuted,           // leaf: refuted by the relaxation or a deep point (`refutation`)
-    kUnproven,          // leaf: a slab cut off by a narrowing its programs did not prove
   } kind = Kind::kRefuted;
   int parent = -1;              // index in CellTree::nodes; -1 for the root
   RotationCell cell;            // the rotations, for a set without an f-f PC

@@ -83,7 +83,10 @@ RuleVerdict WitnessSearch::implausible_by(const PcSet& pcs) const {
   // (along B's normal), whatever the spin and the slide in the plane. So every other PC's
   // contact point, a common point of its two elements, needs the two elements' height
   // ranges over that plane to meet.
-  const double tol = 1e-9 * scale_ + p_.touch_tol;
+  // A witness meets the f-f's alignment to kRotAccepted, which tilts heights by that much
+  // per mm of A; both contacts touch within touch_tol.
+  const Polyhedron& mA = *A_.model;
+  const double tol = kRotAccepted * (mA.bbox_max() - mA.bbox_min()).norm() + 2 * p_.touch_tol;
   for (int f = 0; f < pcs.size(); ++f) {
     const Pc& ff = pcs[f];
     if (ff.type != PcType::kFF) continue;

@@ -17,13 +17,16 @@ struct RotConstraints {
 };
 
 constexpr double kRotTol = 1e-9;  // residual accepted for rotational contact conditions
+/// The residual a witness's rotation may leave in each condition: |R a - b| for an alignment,
+/// |(R u) . w| for a perpendicularity (satisfies()); refutations allow it too.
+constexpr double kRotAccepted = 10 * kRotTol;
 
-/// Whether R meets every condition of `c` to 10 kRotTol.
+/// Whether R meets every condition of `c` to kRotAccepted.
 inline bool satisfies(const RotConstraints& c, const Mat3& R) {
   for (const auto& [a, b] : c.align)
-    if ((R * a - b).norm() > 10 * kRotTol) return false;
+    if ((R * a - b).norm() > kRotAccepted) return false;
   for (const auto& [u, w] : c.perp)
-    if (std::abs((R * u).dot(w)) > 10 * kRotTol) return false;
+    if (std::abs((R * u).dot(w)) > kRotAccepted) return false;
   return true;
 }
 
