@@ -16,6 +16,7 @@
 // and every unsound or marginal witness. Exit status: 0 no miss and no unsound witness,
 // 1 misses or unsound witnesses, 2 usage error or a run that failed.
 
+#include "certificate_check.hpp"
 #include "recall.hpp"
 #include "shapes.hpp"
 
@@ -109,15 +110,30 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "oracle_recall: %s\n", e.what());
     return 2;
   }
+  // cfgen's certificates of invalidity, rechecked while its files exist.
+  oracle::CertificateReport certificates;
+  std::string certificate_error;
+  o.inspect = [&](const oracle::RecallResult& run) {
+    try {
+      certificates = oracle::check_certificate_files(run.graph_path, run.cert_path);
+    } catch (const std::exception& e) {
+      certificate_error = e.what();
+    }
+  };
   oracle::RecallResult r = !have_seed   ? oracle::run_recall_files(files[0], files[1], o)
                            : extra >= 0 ? oracle::run_recall_extra(extra, seed, o)
                                         : oracle::run_recall_seed(seed, o);
   std::cout << r.line() << "\n";
+  if (r.ok)
+    std::cout << "  certificates: "
+              << (certificate_error.empty() ? certificates.summary_line() : certificate_error)
+              << "\n";
+  for (const std::string& line : certificates.rejection_lines()) std::cout << "  " << line << "\n";
   if (!quiet) {
     std::cout << "  sampler: " << r.sampler_stats.str() << "\n";
     std::cout << r.details();
   }
   std::cout.flush();
-  if (!r.ok) return 2;
-  return (r.misses.empty() && r.check.unsound == 0) ? 0 : 1;
+  if (!r.ok || !certificate_error.empty()) return 2;
+  return (r.misses.empty() && r.check.unsound == 0 && certificates.passed()) ? 0 : 1;
 }

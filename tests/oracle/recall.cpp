@@ -163,9 +163,11 @@ double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-// Runs cfgen; returns its exit status (-1 when it could not start); output to log.
+// Runs cfgen, writing the graph g and its certificate file c; returns its exit status (-1
+// when it could not start); output to log.
 int run_cfgen(const std::string& cfgen, const std::string& a, const std::string& b,
-              const std::string& g, int threads, const std::string& log, double timeout_s) {
+              const std::string& g, const std::string& c, int threads, const std::string& log,
+              double timeout_s) {
   pid_t pid = fork();
   if (pid < 0) return -1;
   if (pid == 0) {
@@ -176,8 +178,8 @@ int run_cfgen(const std::string& cfgen, const std::string& a, const std::string&
       close(fd);
     }
     std::string j = std::to_string(threads);
-    execl(cfgen.c_str(), cfgen.c_str(), a.c_str(), b.c_str(), "-o", g.c_str(), "-q", "-j",
-          j.c_str(), static_cast<char*>(nullptr));
+    execl(cfgen.c_str(), cfgen.c_str(), a.c_str(), b.c_str(), "-o", g.c_str(), "--certificates",
+          c.c_str(), "-q", "-j", j.c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
   int st = 0;
@@ -276,6 +278,7 @@ RecallResult run_pair(const Mesh& A, const Mesh& B, const std::string& dir, cons
   r.a_path = (fs::path(dir) / "A.off").string();
   r.b_path = (fs::path(dir) / "B.off").string();
   r.graph_path = (fs::path(dir) / "G.json").string();
+  r.cert_path = (fs::path(dir) / "C.json").string();
   try {
     if (write_models) {
       write_off(A, r.a_path);
@@ -283,8 +286,8 @@ RecallResult run_pair(const Mesh& A, const Mesh& B, const std::string& dir, cons
     }
     double t0 = now_s();
     std::string log = (fs::path(dir) / "cfgen.log").string();
-    int rc =
-        run_cfgen(o.cfgen, r.a_path, r.b_path, r.graph_path, o.threads, log, o.cfgen_timeout_s);
+    int rc = run_cfgen(o.cfgen, r.a_path, r.b_path, r.graph_path, r.cert_path, o.threads, log,
+                       o.cfgen_timeout_s);
     r.cfgen_s = now_s() - t0;
     if (rc == -2) {
       r.error = "cfgen did not finish within " +
@@ -368,6 +371,7 @@ RecallResult run_pair(const Mesh& A, const Mesh& B, const std::string& dir, cons
       r.misses.push_back(Miss{k, s});
     }
     r.ok = true;
+    if (o.inspect) o.inspect(r);  // while the files are there
   } catch (const std::exception& e) {
     r.error = e.what();
   }

@@ -8,10 +8,13 @@
 #include "sampler.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 namespace oracle {
+
+struct RecallResult;
 
 struct RecallOptions {
   std::string cfgen;               // path of the cfgen binary
@@ -24,6 +27,8 @@ struct RecallOptions {
   long sampler_rounds = 0;  // >0: stop the sampler after this many rounds (deterministic)
   std::vector<Pose>
       check_poses;  // classify these poses of A and say whether the graph holds the CF
+  /// Called once a run worked, while its files (models, graph, certificate file) still exist.
+  std::function<void(const RecallResult&)> inspect;
 };
 
 struct Miss {
@@ -39,6 +44,7 @@ struct RecallResult {
   int extra = -1;  // >= 0: the pair is make_extra_pair(extra, seed)
   std::string desc;
   std::string a_path, b_path, graph_path;
+  std::string cert_path;  // cfgen's certificate file (docs/certificates.md), beside the graph
   int graph_cfs = 0;
   int sampled = 0;
   int found = 0;  // sampled and in the graph

@@ -8,6 +8,7 @@
 // ORACLE_BUDGET (cap on the sampler's seconds, default 15), ORACLE_THREADS (cfgen -j, default 2).
 
 #include "recall.hpp"
+#include "certificate_check.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -38,6 +39,11 @@ void run_seed(std::uint64_t seed) {
   if (const char* b = std::getenv("ORACLE_BUDGET")) o.budget_s = std::atof(b);
   if (const char* k = std::getenv("ORACLE_ROUNDS")) o.sampler_rounds = std::atol(k);
   if (const char* j = std::getenv("ORACLE_THREADS")) o.threads = std::atoi(j);
+  // Every certificate of invalidity cfgen wrote is rechecked by the independent checker.
+  oracle::CertificateReport certificates;
+  o.inspect = [&](const oracle::RecallResult& run) {
+    certificates = oracle::check_certificate_files(run.graph_path, run.cert_path);
+  };
   oracle::RecallResult r = oracle::run_recall_seed(seed, o);
   std::cout << r.line() << "\n  sampler: " << r.sampler_stats.str() << "\n"
             << r.details() << std::flush;
@@ -49,6 +55,10 @@ void run_seed(std::uint64_t seed) {
   // that are in the graph, must reach kMinRecallPercent; every miss is printed above with its
   // pose so that it can be chased.
   CHECK(r.recall() >= kMinRecallPercent);
+  std::cout << "  certificates: " << certificates.summary_line() << "\n";
+  for (const std::string& line : certificates.rejection_lines()) std::cout << "  " << line << "\n";
+  CHECK(certificates.passed());
+  CHECK(certificates.sets.size() > 0);
 }
 
 }  // namespace

@@ -1,0 +1,510 @@
+// Certificate checker: the file (header, tolerances against the graph's parameters, summary),
+// the rules, the dispatch of each set and the report. The cells are in certificate_cells.cpp,
+// the pieces and programs in certificate_program.cpp.
+
+#include "certificate_check.hpp"
+
+#include "certificate_internal.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace oracle {
+
+const char* outcome_name(CertOutcome o) {
+  switch (o) {
+    case CertOutcome::Accepted:
+      return "accepted";
+    case CertOutcome::Rejected:
+      return "rejected";
+    case CertOutcome::NotCertified:
+      return "not certified";
+    case CertOutcome::Undecided:
+      return "undecided";
+  }
+  return "?";
+}
+
+namespace cert {
+
+std::string fmt(double x) {
+  char buf[40];
+  const auto res = std::to_chars(buf, buf + sizeof buf, x);  // shortest round-trip text
+  return std::string(buf, res.ptr);
+}
+
+Vec3 get_vec3(const json& j, const char* key) {
+  const json& a = j.at(key);
+  if (!a.is_array() || a.size() != 3)
+    throw std::runtime_error(std::string(key) + " is not 3 numbers");
+  return Vec3(a[0].get<double>(), a[1].get<double>(), a[2].get<double>());
+}
+
+std::vector<int> closure_vertices(const Poly& P, int kind, int index) {
+  if (kind == 0) return {index};
+  if (kind == 1) return {P.E[index].v0, P.E[index].v1};
+  return P.F[index].verts;
+}
+
+std::string pc_text(const SetPc& p) {
+  return std::string(type_name(p.type)) + ":" + std::to_string(p.a) + ":" + std::to_string(p.b);
+}
+
+namespace {
+
+int count_of(const Poly& P, int kind) {
+  return static_cast<int>(kind == 0 ? P.V.size() : kind == 1 ? P.E.size() : P.F.size());
+}
+
+// "f-f:3:5;e-e:0:7" -> PCs, each of a non-degenerate type with indices in range.
+std::vector<SetPc> parse_pcs(const Graph& g, const std::string& text) {
+  std::vector<SetPc> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ';')) {
+    const auto c1 = item.find(':'), c2 = item.rfind(':');
+    PcType t;
+    if (c1 == std::string::npos || c1 == c2 || !parse_type(item.substr(0, c1), &t) ||
+        !nondegenerate(t))
+      throw std::runtime_error("\"" + item + "\" is not a PC type:a:b");
+    SetPc p;
+    p.type = t;
+    p.a = std::stoi(item.substr(c1 + 1, c2 - c1 - 1));
+    p.b = std::stoi(item.substr(c2 + 1));
+    if (p.a < 0 || p.a >= count_of(g.A, kind_a(t)) || p.b < 0 || p.b >= count_of(g.B, kind_b(t)))
+      throw std::runtime_error("\"" + item + "\" names an element the models do not have");
+    out.push_back(p);
+  }
+  if (out.empty() || out.size() > 3) throw std::runtime_error("a set has 1 to 3 PCs");
+  return out;
+}
+
+// ---- tolerances ----
+
+double positive(const json& t, const char* key, std::vector<std::string>& problems) {
+  if (!t.contains(key) || !t[key].is_number()) {
+    problems.push_back(std::string("tolerances.") + key + " is missing");
+    return 0;
+  }
+  const double v = t[key].get<double>();
+  if (!(v > 0) || !std::isfinite(v))
+    problems.push_back(std::string("tolerances.") + key + " = " + fmt(v) + " is not positive");
+  return v;
+}
+
+// The certificate's tolerances, made no stronger than the verifier's (the graph's
+// parameters): a certificate with a smaller touch tolerance, a larger margin or a larger local
+// slack would refute witnesses the verifier accepts. Such a file is a problem; the checks then
+// use the weaker value.
+Tol read_tolerances(const Graph& g, const json& params, const json& cert, CertificateReport& rep) {
+  auto& pr = rep.file_problems;
+  Tol tol;
+  const json t = cert.contains("tolerances") ? cert["tolerances"] : json::object();
+  if (!t.is_object()) pr.push_back("tolerances is not an object");
+  tol.touch = positive(t, "touch_tol_mm", pr);
+  tol.margin = positive(t, "min_margin_mm", pr);
+  tol.slack = positive(t, "local_slack", pr);
+  tol.rounding = positive(t, "rounding_mm", pr);
+  tol.off_circle = positive(t, "off_circle_rad", pr);
+  tol.size = positive(t, "size_mm", pr);
+  double vmax = 0;
+  for (const Poly* P : {&g.A, &g.B})
+    for (const auto& v : P->V) vmax = std::max(vmax, v.p.norm());
+  const double size = std::max(g.A.diag, g.B.diag);
+  tol.scale = size + vmax;
+  if (std::abs(tol.size - size) > 1e-9 * size)
+    pr.push_back("tolerances.size_mm = " + fmt(tol.size) + " is not the larger diagonal " +
+                 fmt(size) + " mm");
+  if (std::abs(tol.rounding - 1e-12 * size) > 1e-6 * 1e-12 * size)
+    rep.warnings.push_back("tolerances.rounding_mm = " + fmt(tol.rounding) +
+                           " is not 1e-12 x size (the checker bounds its own rounding anyway)");
+  if (params.is_object()) {
+    auto num = [&](const char* k) {
+      return params.contains(k) && params[k].is_number() ? params[k].get<double>() : -1.0;
+    };
+    const double gt = num("touch_tol_mm"), gm = num("min_margin_mm"), ga = num("angle_margin_rad");
+    if (gt > 0 && tol.touch < gt * (1 - 1e-12)) {
+      pr.push_back("tolerances.touch_tol_mm " + fmt(tol.touch) + " is below the graph's " +
+                   fmt(gt));
+      tol.touch = gt;
+    }
+    if (gm > 0 && tol.margin > gm * (1 + 1e-12)) {
+      pr.push_back("tolerances.min_margin_mm " + fmt(tol.margin) + " is above the graph's " +
+                   fmt(gm));
+      tol.margin = gm;
+    }
+    const double gs = ga > 0 ? 0.5 * std::sin(ga) : -1;
+    if (gs > 0 && tol.slack > gs * (1 + 1e-12)) {
+      pr.push_back("tolerances.local_slack " + fmt(tol.slack) +
+                   " is above half the sine of the graph's angle_margin_rad (" + fmt(gs) + ")");
+      tol.slack = gs;
+    }
+    if (gt <= 0 || gm <= 0 || ga <= 0)
+      rep.warnings.push_back(
+          "the graph's parameters lack touch_tol_mm, min_margin_mm or "
+          "angle_margin_rad: those tolerances are the certificate's, unchecked");
+  } else {
+    rep.warnings.push_back(
+        "the graph has no parameters: the tolerances are the certificate's, "
+        "unchecked");
+  }
+  return tol;
+}
+
+// ---- rules ----
+
+std::pair<int, int> two_involved(const json& set, std::size_t n) {
+  const auto inv = set.at("pcs_involved").get<std::vector<int>>();
+  if (inv.size() != 2 || inv[0] == inv[1] || inv[0] < 0 || inv[1] < 0 ||
+      inv[0] >= static_cast<int>(n) || inv[1] >= static_cast<int>(n))
+    throw std::runtime_error("pcs_involved is not two distinct PCs of the set");
+  return {inv[0], inv[1]};
+}
+
+std::string vertex_in_two(const std::vector<SetPc>& pcs, int i, int j) {
+  const SetPc &p = pcs[i], &q = pcs[j];
+  if (kind_a(p.type) == 0 && kind_a(q.type) == 0 && p.a == q.a) return "";
+  if (kind_b(p.type) == 0 && kind_b(q.type) == 0 && p.b == q.b) return "";
+  return "PCs " + pc_text(p) + " and " + pc_text(q) + " share no vertex";
+}
+
+// Both elements of one PC in the closures of the other's. The table's wording ("both
+// elements of one PC lie in the closures of the other PC's elements") is symmetric; the
+// parenthesis orders them (the first is the boundary touch). Either order proves the set
+// invalid, so either is accepted.
+std::string dominated(const Graph& g, const std::vector<SetPc>& pcs, int i, int j) {
+  auto dom = [&](const SetPc& x, const SetPc& y) {
+    return g.A.in_closure(kind_a(x.type), x.a, kind_a(y.type), y.a) &&
+           g.B.in_closure(kind_b(x.type), x.b, kind_b(y.type), y.b);
+  };
+  const SetPc &p = pcs[i], &q = pcs[j];
+  if (p.type == q.type && p.a == q.a && p.b == q.b) return "the two PCs are the same";
+  if (dom(p, q) || dom(q, p)) return "";
+  return "neither of " + pc_text(p) + " and " + pc_text(q) + " lies in the other's closures";
+}
+
+// Two faces in one plane: normals parallel and each face's vertices on the other's plane, to
+// 1e-11 of the models' scale (the rounding of coplanar faces written in doubles is ~1e-15 of
+// it; faces that far apart are distinct planes in any reading).
+bool coplanar(const Poly& P, int f1, int f2, double scale) {
+  if (f1 == f2) return true;
+  const Face &a = P.F[f1], &b = P.F[f2];
+  if (a.n.cross(b.n).norm() > 1e-11) return false;
+  for (int v : b.verts)
+    if (std::abs(a.n.dot(P.V[v].p) - a.d) > 1e-11 * scale) return false;
+  for (int v : a.verts)
+    if (std::abs(b.n.dot(P.V[v].p) - b.d) > 1e-11 * scale) return false;
+  return true;
+}
+
+std::string one_plane(const Graph& g, const Tol& tol, const std::vector<SetPc>& pcs, int i, int j) {
+  const SetPc &p = pcs[i], &q = pcs[j];
+  if (kind_b(p.type) == 2 && kind_b(q.type) == 2 && coplanar(g.B, p.b, q.b, tol.scale)) return "";
+  if (kind_a(p.type) == 2 && kind_a(q.type) == 2 && coplanar(g.A, p.a, q.a, tol.scale)) return "";
+  return "PCs " + pc_text(p) + " and " + pc_text(q) + " have no faces of A or of B in one plane";
+}
+
+// With the f-f holding (|R n_a + n_b| <= 1e-8 and its faces within touch_tol), a point x of A
+// at depth h below a's plane is at height h + e over b's plane, |e| <= 1e-8 |x - x0| +
+// touch_tol (x0 a contact point of the f-f); the other PC's points are within touch_tol of
+// each other. So the heights must be more than 1e-8 diag(A) + 2 touch_tol apart. The spec's
+// 1e-9 size + touch_tol is not enough (see the README); the checker uses the sound bound.
+std::string heights(const Graph& g, const Tol& tol, const std::vector<SetPc>& pcs, int i, int j) {
+  const SetPc &ff = pcs[i], &o = pcs[j];
+  if (ff.type != PcType::FF) return "pcs_involved[0] is not an f-f";
+  const Face &fa = g.A.F[ff.a], &fb = g.B.F[ff.b];
+  double amin = kInf, amax = -kInf, bmin = kInf, bmax = -kInf;
+  for (int v : closure_vertices(g.A, kind_a(o.type), o.a)) {
+    const double h = fa.d - fa.n.dot(g.A.V[v].p);
+    amin = std::min(amin, h);
+    amax = std::max(amax, h);
+  }
+  for (int v : closure_vertices(g.B, kind_b(o.type), o.b)) {
+    const double h = fb.n.dot(g.B.V[v].p) - fb.d;
+    bmin = std::min(bmin, h);
+    bmax = std::max(bmax, h);
+  }
+  const double gap = std::max(bmin - amax, amin - bmax);
+  const double need = kAlignTol * g.A.diag + 2 * tol.touch + kRelRound * tol.scale;
+  if (gap > need) return "";
+  return "depths of A's element [" + fmt(amin) + ", " + fmt(amax) + "] and heights of B's [" +
+         fmt(bmin) + ", " + fmt(bmax) + "] are not more than " + fmt(need) + " apart";
+}
+
+// With an f-f (a = n_A, b = n_B) the rotations are R0 Rot(a, theta), R0 a = -b, up to a turn
+// of 1e-8 (the f-f's own alignment). Each other condition is a function of theta with a
+// Lipschitz bound; [-pi, pi] is split until on every interval some condition fails by more
+// than its tolerance (1e-8) plus that turn (1e-8) plus rounding.
+std::string rotational(const Graph& g, const std::vector<SetPc>& pcs, const json& set) {
+  std::vector<int> inv;
+  if (set.contains("pcs_involved")) inv = set["pcs_involved"].get<std::vector<int>>();
+  if (inv.empty())
+    for (std::size_t k = 0; k < pcs.size(); ++k) inv.push_back(static_cast<int>(k));
+  int ff = -1;
+  for (int k : inv) {
+    if (k < 0 || k >= static_cast<int>(pcs.size()))
+      throw std::runtime_error("pcs_involved names no PC of the set");
+    if (ff < 0 && pcs[k].type == PcType::FF) ff = k;
+  }
+  if (ff < 0) return "no f-f among the PCs involved: this rule does not refute sets without one";
+  const Vec3 a = g.A.F[pcs[ff].a].n, b = g.B.F[pcs[ff].b].n;
+  const Vec3 ua = any_perp(a), ub = any_perp(-b);
+  Mat3 Fa, Fb;
+  Fa << a, ua, a.cross(ua);
+  Fb << -b, ub, (-b).cross(ub);
+  const Mat3 R0 = Fb * Fa.transpose();  // a rotation (both frames right-handed), R0 a = -b
+  struct Cond {
+    bool ff;
+    Vec3 v, w;
+    double lip;
+  };
+  std::vector<Cond> conds;
+  for (int k : inv) {
+    const SetPc& p = pcs[k];
+    if (k == ff) continue;
+    if (p.type == PcType::FF)
+      conds.push_back({true, g.A.F[p.a].n, R0.transpose() * g.B.F[p.b].n, 0});
+    else if (p.type == PcType::EF)
+      conds.push_back({false, g.A.E[p.a].dir, R0.transpose() * g.B.F[p.b].n, 0});
+    else if (p.type == PcType::FE)
+      conds.push_back({false, g.A.F[p.a].n, R0.transpose() * g.B.E[p.b].dir, 0});
+  }
+  if (conds.empty()) return "the f-f is the only rotational condition among the PCs involved";
+  for (auto& c : conds) c.lip = c.v.cross(a).norm() * c.w.norm() * (1 + 1e-12);
+  const double tolc = 2 * kAlignTol + 1e-12;
+  std::vector<std::pair<double, double>> stack = {{0.0, kPi + 1e-15}};
+  long budget = 1 << 22;
+  while (!stack.empty()) {
+    auto [c, h] = stack.back();
+    stack.pop_back();
+    const Mat3 Rc = rot_about(a, c);
+    bool refuted = false;
+    for (const auto& k : conds) {
+      const Vec3 rv = Rc * k.v;
+      const double val = k.ff ? (rv + k.w).norm() : std::abs(rv.dot(k.w));
+      refuted = refuted || val - k.lip * h > tolc;
+    }
+    if (refuted) continue;
+    if (--budget < 0 || h < 1e-13)
+      return "the conditions may all hold near theta = " + fmt(c) + " (within 1e-8)";
+    stack.push_back({c - h / 2, h / 2});
+    stack.push_back({c + h / 2, h / 2});
+  }
+  return "";
+}
+
+std::string check_rule(const Ctx& ctx, const std::vector<SetPc>& pcs, const json& set,
+                       const std::string& rule) {
+  const Graph& g = ctx.g;
+  if (rule == "rotational-conditions") return rotational(g, pcs, set);
+  const auto [i, j] = two_involved(set, pcs.size());
+  if (rule == "vertex-in-two-pcs") return vertex_in_two(pcs, i, j);
+  if (rule == "dominated-pc") return dominated(g, pcs, i, j);
+  if (rule == "one-contact-plane") return one_plane(g, ctx.tol, pcs, i, j);
+  if (rule == "heights-over-ff") return heights(g, ctx.tol, pcs, i, j);
+  return "unknown rule \"" + rule + "\"";
+}
+
+// ---- one set ----
+
+CertSetResult check_set(const Ctx& ctx, const json& set, int index,
+                        const std::set<std::vector<std::tuple<int, int, int>>>& cf_keys) {
+  CertSetResult r;
+  r.index = index;
+  r.kind = "malformed";
+  try {
+    r.pcs = set.at("pcs").get<std::string>();
+    const std::vector<SetPc> pcs = parse_pcs(ctx.g, r.pcs);
+    const std::string outcome = set.at("outcome").get<std::string>();
+    if (outcome == "undecided") {
+      r.kind = "undecided";
+      r.outcome = CertOutcome::Undecided;
+      return r;
+    }
+    if (outcome != "invalid") throw std::runtime_error("outcome \"" + outcome + "\"");
+    const bool has_rule = set.contains("rule"), has_cells = set.contains("cells");
+    if (has_rule == has_cells) throw std::runtime_error("an invalid set has a rule or cells");
+    r.kind = has_rule ? set["rule"].get<std::string>() : "cells";
+    std::vector<std::tuple<int, int, int>> key;
+    for (const auto& p : pcs) key.emplace_back(static_cast<int>(p.type), p.a, p.b);
+    std::sort(key.begin(), key.end());
+    if (cf_keys.count(key)) {
+      r.reason = "the graph holds this set as a CF with a witness";
+    } else if (r.kind == "finite-rotations") {
+      r.outcome = CertOutcome::NotCertified;
+      r.reason = "finite-rotations is evidence, not a certificate";
+      return r;
+    } else if (has_rule) {
+      r.reason = check_rule(ctx, pcs, set, r.kind);
+    } else {
+      check_cells(ctx, pcs, set["cells"], r);
+      if (!r.node_fails.empty()) {
+        const auto& f = r.node_fails.front();
+        r.reason = (f.node >= 0 ? "node " + std::to_string(f.node) + ": " : "tree: ") + f.why;
+        if (r.node_fails.size() > 1)
+          r.reason += " (and " + std::to_string(r.node_fails.size() - 1) + " more)";
+      }
+    }
+  } catch (const std::exception& e) {
+    r.reason = std::string("malformed: ") + e.what();
+  }
+  r.outcome = r.reason.empty() ? CertOutcome::Accepted : CertOutcome::Rejected;
+  return r;
+}
+
+void check_summary(const json& cert, CertificateReport& rep) {
+  if (!cert.contains("summary")) {
+    rep.file_problems.push_back("summary is missing");
+    return;
+  }
+  const json& s = cert["summary"];
+  int rule = 0, cells = 0, und = 0;
+  for (const auto& set : cert["sets"]) {
+    if (!set.is_object()) continue;  // rejected as malformed on its own
+    if (set.value("outcome", json()) == "undecided") ++und;
+    if (set.contains("rule")) ++rule;
+    if (set.contains("cells")) ++cells;
+  }
+  const std::pair<const char*, int> want[] = {{"sets", static_cast<int>(cert["sets"].size())},
+                                              {"invalid_by_rule", rule},
+                                              {"invalid_by_cells", cells},
+                                              {"undecided", und}};
+  for (const auto& [k, n] : want)
+    if (!s.contains(k) || !s[k].is_number_integer() || s[k].get<int>() != n)
+      rep.file_problems.push_back(std::string("summary.") + k + " is not " + std::to_string(n));
+}
+
+}  // namespace
+}  // namespace cert
+
+CertificateReport check_certificates(const Graph& g, const nlohmann::json& graph_parameters,
+                                     const nlohmann::json& cert) {
+  using namespace cert;
+  if (!cert.is_object()) throw CertificateInputError("the certificate file is not a JSON object");
+  const std::string format = cert.value("format", std::string("(none)"));
+  if (format != "cf-certificates")
+    throw CertificateInputError("format is \"" + format + "\", expected \"cf-certificates\"");
+  if (!cert.contains("version") || cert["version"] != 1)
+    throw CertificateInputError(
+        "version is " +
+        (cert.contains("version") ? cert["version"].dump() : std::string("missing")) +
+        ", expected 1");
+  if (!cert.contains("sets") || !cert["sets"].is_array())
+    throw CertificateInputError("sets is missing or not an array");
+  CertificateReport rep;
+  rep.graph_path = g.path;
+  const Tol tol = read_tolerances(g, graph_parameters, cert, rep);
+  const PieceTables pieces = check_piece_tables(
+      g, tol, cert.contains("pieces") ? cert["pieces"] : json(), rep.file_problems, rep.warnings);
+  check_summary(cert, rep);
+  std::set<std::vector<std::tuple<int, int, int>>> cf_keys;
+  for (const auto& cf : g.cfs) {
+    std::vector<std::tuple<int, int, int>> k;
+    for (const auto& p : cf.key) k.emplace_back(static_cast<int>(p.type), p.a, p.b);
+    std::sort(k.begin(), k.end());
+    cf_keys.insert(k);
+  }
+  const Ctx ctx{g, tol, pieces};
+  std::set<std::string> seen;
+  const bool tol_ok = tol.touch > 0 && tol.margin > 0 && tol.slack > 0 && tol.off_circle > 0 &&
+                      tol.size > 0 && tol.rounding > 0;
+  int index = 0;
+  for (const auto& set : cert["sets"]) {
+    CertSetResult r;
+    const bool undecided = set.is_object() && set.value("outcome", json()) == "undecided";
+    if (!tol_ok && !undecided) {
+      r.index = index;
+      r.pcs = set.is_object() && set.value("pcs", json()).is_string()
+                  ? set["pcs"].get<std::string>()
+                  : "?";
+      r.kind = set.is_object() && set.contains("cells") ? "cells" : "rule";
+      r.reason = "the file's tolerances are unusable";
+    } else {
+      r = check_set(ctx, set, index, cf_keys);
+    }
+    if (!seen.insert(r.pcs).second && r.outcome != CertOutcome::Rejected) {
+      r.outcome = CertOutcome::Rejected;
+      r.reason = "the set is listed twice";
+    }
+    ++index;
+    switch (r.outcome) {
+      case CertOutcome::Accepted:
+        ++rep.accepted;
+        break;
+      case CertOutcome::Rejected:
+        ++rep.rejected;
+        break;
+      case CertOutcome::NotCertified:
+        ++rep.not_certified;
+        break;
+      case CertOutcome::Undecided:
+        ++rep.undecided;
+        break;
+    }
+    rep.by_kind[r.kind][static_cast<int>(r.outcome)]++;
+    for (const auto& [k, c] : r.leaves) {
+      rep.leaves[k][0] += c[0];
+      rep.leaves[k][1] += c[1];
+    }
+    rep.sets.push_back(std::move(r));
+  }
+  return rep;
+}
+
+CertificateReport check_certificate_files(const std::string& graph_path,
+                                          const std::string& cert_path) {
+  auto read_json = [](const std::string& path, const char* what) {
+    std::ifstream in(path);
+    if (!in) throw CertificateInputError(std::string("cannot open ") + what + " " + path);
+    try {
+      return nlohmann::json::parse(in);
+    } catch (const std::exception& e) {
+      throw CertificateInputError(std::string(what) + " " + path + ": not JSON (" + e.what() + ")");
+    }
+  };
+  Graph g;
+  try {
+    g = read_graph(graph_path);
+  } catch (const std::exception& e) {
+    throw CertificateInputError(e.what());
+  }
+  const nlohmann::json gj = read_json(graph_path, "graph");
+  const nlohmann::json cj = read_json(cert_path, "certificate file");
+  try {
+    CertificateReport rep =
+        check_certificates(g, gj.contains("parameters") ? gj["parameters"] : nlohmann::json(), cj);
+    rep.cert_path = cert_path;
+    return rep;
+  } catch (const CertificateInputError& e) {
+    throw CertificateInputError("certificate file " + cert_path + ": " + e.what());
+  }
+}
+
+std::string CertificateReport::summary_line() const {
+  std::ostringstream o;
+  o << "sets " << sets.size() << ", accepted " << accepted << ", rejected " << rejected
+    << ", not certified " << not_certified << ", undecided " << undecided;
+  if (!file_problems.empty()) o << ", file problems " << file_problems.size();
+  o << " | by kind (accepted/rejected/not certified):";
+  for (const auto& [k, c] : by_kind)
+    if (k != "undecided") o << " " << k << " " << c[0] << "/" << c[1] << "/" << c[2];
+  o << " | leaves (accepted/rejected):";
+  for (const auto& [k, c] : leaves) o << " " << k << " " << c[0] << "/" << c[1];
+  return o.str();
+}
+
+std::vector<std::string> CertificateReport::rejection_lines() const {
+  std::vector<std::string> out;
+  for (const auto& p : file_problems) out.push_back("FILE PROBLEM: " + p);
+  for (const auto& s : sets)
+    if (s.outcome == CertOutcome::Rejected)
+      out.push_back("REJECTED set " + std::to_string(s.index) + " {" + s.pcs + "} " + s.kind +
+                    ": " + s.reason);
+  return out;
+}
+
+}  // namespace oracle

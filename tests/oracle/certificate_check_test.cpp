@@ -1,0 +1,808 @@
+// Catch2: the certificate checker (certificate_check.hpp) on hand-made graphs and
+// certificates with known answers: a 10 mm cube A = [0,10]^3 against an L-block B (the profile
+// (0,0) (30,0) (30,10) (10,10) (10,20) (0,20) in x-y, extruded over z in [0,30]; up is +y).
+// Each claim is accepted as written and rejected after the change that must flip it.
+
+#include "certificate_check.hpp"
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+#include <unistd.h>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+
+using namespace oracle;
+using json = nlohmann::json;
+
+namespace {
+
+const double kPiD = 3.14159265358979323846;
+
+// A's faces: 0 bottom z=0 (-z), 1 top (+z), 2 front y=0 (-y), 3 back (+y), 4 left x=0 (-x),
+// 5 right (+x). Vertex i = (10 (i&1), 10 (i>>1 &1), 10 (i>>2 &1)).
+json cube_model() {
+  json m;
+  for (int i = 0; i < 8; ++i)
+    m["vertices"].push_back({10.0 * (i & 1), 10.0 * ((i >> 1) & 1), 10.0 * ((i >> 2) & 1)});
+  m["faces"] = json::array();
+  for (auto L : std::vector<std::vector<int>>{
+           {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}})
+    m["faces"].push_back({{"loops", {L}}});
+  return m;
+}
+
+// B's faces: 0 bottom cap z=0 (-z), 1 top cap z=30, then the sides of the profile: 2 y=0, 3
+// x=30, 4 the low top y=10, 5 the riser x=10, 6 the tower top y=tower, 7 x=0.
+json lblock_model(double tower) {
+  const std::vector<std::pair<double, double>> prof = {{0, 0},   {30, 0},     {30, 10},
+                                                       {10, 10}, {10, tower}, {0, tower}};
+  json m;
+  for (double z : {0.0, 30.0})
+    for (auto [x, y] : prof) m["vertices"].push_back({x, y, z});
+  m["faces"] = json::array();
+  m["faces"].push_back({{"loops", {{5, 4, 3, 2, 1, 0}}}});
+  m["faces"].push_back({{"loops", {{6, 7, 8, 9, 10, 11}}}});
+  for (int i = 0; i < 6; ++i)
+    m["faces"].push_back({{"loops", {{i, (i + 1) % 6, 6 + (i + 1) % 6, 6 + i}}}});
+  return m;
+}
+
+void add_edges(json& m) {
+  std::set<std::pair<int, int>> es;
+  for (const auto& f : m["faces"])
+    for (const auto& L : f["loops"])
+      for (std::size_t i = 0; i < L.size(); ++i) {
+        int a = L[i], b = L[(i + 1) % L.size()];
+        es.insert({std::min(a, b), std::max(a, b)});
+      }
+  m["edges"] = json::array();
+  for (auto [a, b] : es) m["edges"].push_back({a, b});
+}
+
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() /
+          ("certcheck_" + std::to_string(::getpid()) + "_" + name))
+      .string();
+}
+
+struct Pair {
+  json doc;
+  Graph G;
+  double margin;
+};
+
+// The graph file (no CFs unless given), with the verifier's parameters.
+Pair make_pair(double margin = 0.01, double tower = 20, json cfs = json::array()) {
+  Pair P;
+  P.margin = margin;
+  json A = cube_model(), B = lblock_model(tower);
+  add_edges(A);
+  add_edges(B);
+  P.doc = {{"format", "cf-graph"},           {"version", 1}, {"units", "mm"},
+           {"models", {{"A", A}, {"B", B}}}, {"cfs", cfs},   {"transitions", json::array()}};
+  P.doc["parameters"] = {
+      {"touch_tol_mm", 1e-9}, {"min_margin_mm", margin}, {"angle_margin_rad", 1e-3}};
+  const std::string path = temp_path("graph.json");
+  std::ofstream(path) << P.doc.dump();
+  P.G = read_graph(path);
+  std::filesystem::remove(path);
+  return P;
+}
+
+json cert_for(const Pair& P, json sets, json pieces = json()) {
+  const double size = std::max(P.G.A.diag, P.G.B.diag);
+  json c = {{"format", "cf-certificates"}, {"version", 1}, {"graph", "G.json"}};
+  c["tolerances"] = {{"touch_tol_mm", 1e-9},
+                     {"min_margin_mm", P.margin},
+                     {"local_slack", 0.5 * std::sin(1e-3)},
+                     {"rounding_mm", 1e-12 * size},
+                     {"off_circle_rad", 2e-8},
+                     {"size_mm", size}};
+  if (!pieces.is_null()) c["pieces"] = pieces;
+  int rule = 0, cells = 0, und = 0;
+  for (const auto& s : sets) {
+    rule += s.contains("rule");
+    cells += s.contains("cells");
+    und += s["outcome"] == "undecided";
+  }
+  c["summary"] = {{"sets", sets.size()},
+                  {"invalid_by_rule", rule},
+                  {"invalid_by_cells", cells},
+                  {"undecided", und}};
+  c["sets"] = sets;
+  return c;
+}
+
+CertificateReport run(const Pair& P, const json& cert) {
+  return check_certificates(P.G, P.doc["parameters"], cert);
+}
+
+// One set, checked; the file itself must be fine.
+CertSetResult one(const Pair& P, const json& set, const json& pieces = json()) {
+  const CertificateReport rep = run(P, cert_for(P, json::array({set}), pieces));
+  for (const auto& p : rep.file_problems) INFO("file problem: " << p);
+  CHECK(rep.file_problems.empty());
+  REQUIRE(rep.sets.size() == 1);
+  INFO(rep.sets[0].pcs << ": " << rep.sets[0].reason);
+  return rep.sets[0];
+}
+
+json rule_set(const std::string& pcs, const std::string& rule, std::vector<int> inv) {
+  return {{"pcs", pcs}, {"outcome", "invalid"}, {"rule", rule}, {"pcs_involved", inv}};
+}
+
+std::string pcs_of(const std::string& t1, int a1, int b1, const std::string& t2 = "", int a2 = 0,
+                   int b2 = 0) {
+  std::string s = t1 + ":" + std::to_string(a1) + ":" + std::to_string(b1);
+  if (!t2.empty()) s += ";" + t2 + ":" + std::to_string(a2) + ":" + std::to_string(b2);
+  return s;
+}
+
+// ---- trees ----
+
+json v3(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+struct TreeB {
+  json nodes = json::array();
+  Vec3 lo = Vec3::Constant(-100), hi = Vec3::Constant(100);
+  int add(int parent, const json& rot, const std::string& kind, json extra = json::object(),
+          const Vec3* blo = nullptr, const Vec3* bhi = nullptr) {
+    const int id = static_cast<int>(nodes.size());
+    json n = {{"id", id},
+              {"parent", parent},
+              {"rot", rot},
+              {"t_lo", v3(blo ? *blo : lo)},
+              {"t_hi", v3(bhi ? *bhi : hi)},
+              {"kind", kind}};
+    for (auto& [k, v] : extra.items()) n[k] = v;
+    nodes.push_back(n);
+    return id;
+  }
+};
+
+json cube_rot(const Vec3& c, double h) { return {{"centre", v3(c)}, {"half", h}}; }
+json arc_rot(double c, double h) { return {{"arc", {c, h}}}; }
+
+// The eight children of cube (c, h) under parent; child (bits) gets kind_of(bits), the others
+// "bounds". Returns the ids by bits (bit a set: + side on axis a).
+std::vector<int> split8(TreeB& T, int parent, const Vec3& c, double h,
+                        const std::function<std::string(int)>& kind_of) {
+  std::vector<int> ids(8);
+  for (int bits = 0; bits < 8; ++bits) {
+    Vec3 cc = c;
+    for (int a = 0; a < 3; ++a) cc[a] += ((bits >> a) & 1) ? h / 2 : -h / 2;
+    ids[bits] = T.add(parent, cube_rot(cc, h / 2), kind_of(bits));
+  }
+  return ids;
+}
+
+json cells_set(const std::string& pcs, const Vec3& pivot, const TreeB& T,
+               const json& circle = json()) {
+  json cells = {
+      {"pivot", v3(pivot)}, {"domain", circle.is_null() ? "ball" : "circle"}, {"nodes", T.nodes}};
+  if (!circle.is_null()) cells["circle"] = circle;
+  return {{"pcs", pcs}, {"outcome", "invalid"}, {"cells", cells}};
+}
+
+const CertNodeFailure* failure_of(const CertSetResult& r, int node) {
+  for (const auto& f : r.node_fails)
+    if (f.node == node) return &f;
+  return nullptr;
+}
+
+// The f-f circle of A's bottom face (-z) on B's face n_B = +y: R0 turns -z onto -y.
+json circle_ff(int pc) {
+  return {{"pc", pc}, {"R0", {1, 0, 0, 0, 0, 1, 0, -1, 0}}, {"axis", {0, 0, -1}}};
+}
+
+// A rectangle's piece table entry: corners CCW in (u, v), every side on the boundary.
+json face_entry(int face, const Vec3& n, double offset, const Vec3& U, const Vec3& V,
+                const std::vector<std::vector<std::pair<double, double>>>& pieces,
+                const std::vector<std::vector<bool>>& flags) {
+  json e = {{"face", face}};
+  e["frame"] = {{"n", v3(n)}, {"offset", offset}, {"U", v3(U)}, {"V", v3(V)}};
+  e["pieces"] = json::array();
+  for (std::size_t i = 0; i < pieces.size(); ++i) {
+    json p = {{"points", json::array()}, {"boundary", flags[i]}};
+    for (auto [u, v] : pieces[i]) p["points"].push_back({u, v});
+    e["pieces"].push_back(p);
+  }
+  return e;
+}
+
+// B's tower top (face 6, y = 20): U = z, V = x, so (u, v) = (z, x).
+json tower_top_one_piece() {
+  return face_entry(6, Vec3(0, 1, 0), 20, Vec3(0, 0, 1), Vec3(1, 0, 0),
+                    {{{0, 0}, {30, 0}, {30, 10}, {0, 10}}}, {{true, true, true, true}});
+}
+
+}  // namespace
+
+TEST_CASE("header: format, version and unreadable files are input errors with their text") {
+  Pair P = make_pair();
+  json c = cert_for(P, json::array());
+  c["format"] = "cf-graph";
+  try {
+    run(P, c);
+    FAIL("no error");
+  } catch (const CertificateInputError& e) {
+    CHECK(std::string(e.what()) == "format is \"cf-graph\", expected \"cf-certificates\"");
+  }
+  c["format"] = "cf-certificates";
+  c["version"] = 2;
+  try {
+    run(P, c);
+    FAIL("no error");
+  } catch (const CertificateInputError& e) {
+    CHECK(std::string(e.what()) == "version is 2, expected 1");
+  }
+  try {
+    check_certificate_files("/nonexistent/G.json", "/nonexistent/C.json");
+    FAIL("no error");
+  } catch (const CertificateInputError& e) {
+    CHECK(std::string(e.what()) == "cannot open graph /nonexistent/G.json");
+  }
+  const std::string g = temp_path("g.json"), bad = temp_path("bad.json");
+  std::ofstream(g) << P.doc.dump();
+  std::ofstream(bad) << "{ not json";
+  try {
+    check_certificate_files(g, bad);
+    FAIL("no error");
+  } catch (const CertificateInputError& e) {
+    CHECK_THAT(e.what(), Catch::StartsWith("certificate file " + bad + ": not JSON ("));
+  }
+  std::filesystem::remove(g);
+  std::filesystem::remove(bad);
+}
+
+TEST_CASE("tolerances: missing, non-positive or stronger than the graph's are file problems") {
+  Pair P = make_pair();
+  json c = cert_for(P, json::array());
+  c["tolerances"].erase("min_margin_mm");
+  c["tolerances"]["off_circle_rad"] = 0;
+  c["tolerances"]["touch_tol_mm"] = 1e-10;
+  CertificateReport rep = run(P, c);
+  CHECK_FALSE(rep.passed());
+  std::set<std::string> got(rep.file_problems.begin(), rep.file_problems.end());
+  CHECK(got.count("tolerances.min_margin_mm is missing"));
+  CHECK(got.count("tolerances.off_circle_rad = 0 is not positive"));
+  CHECK(got.count("tolerances.touch_tol_mm 1e-10 is below the graph's 1e-09"));
+  c = cert_for(P, json::array());
+  c["summary"]["sets"] = 3;
+  rep = run(P, c);
+  REQUIRE(rep.file_problems.size() == 1);
+  CHECK(rep.file_problems[0] == "summary.sets is not 0");
+  CHECK(run(P, cert_for(P, json::array())).passed());
+}
+
+TEST_CASE("rule vertex-in-two-pcs") {
+  Pair P = make_pair();
+  CHECK(one(P, rule_set("v-f:0:4;v-f:0:6", "vertex-in-two-pcs", {0, 1})).outcome ==
+        CertOutcome::Accepted);
+  CHECK(one(P, rule_set("f-v:0:3;e-e:0:3", "vertex-in-two-pcs", {0, 1})).outcome ==
+        CertOutcome::Rejected);  // vertex 3 of B and edge 3 of B are different elements
+  auto r = one(P, rule_set("v-f:0:4;v-f:1:6", "vertex-in-two-pcs", {0, 1}));
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK(r.reason == "PCs v-f:0:4 and v-f:1:6 share no vertex");
+  r = one(P, rule_set("v-f:0:4;v-f:0:6", "vertex-in-two-pcs", {0, 0}));
+  CHECK(r.reason == "malformed: pcs_involved is not two distinct PCs of the set");
+  r = one(P, rule_set("v-v:0:4;v-f:0:6", "vertex-in-two-pcs", {0, 1}));
+  CHECK(r.reason == "malformed: \"v-v:0:4\" is not a PC type:a:b");
+  r = one(P, rule_set("v-f:0:4;v-f:0:99", "vertex-in-two-pcs", {0, 1}));
+  CHECK(r.reason == "malformed: \"v-f:0:99\" names an element the models do not have");
+}
+
+TEST_CASE("rule dominated-pc") {
+  Pair P = make_pair();
+  // A's vertex 0 is a corner of A's face 0; both PCs on B's face 4.
+  CHECK(one(P, rule_set("f-f:0:4;v-f:0:4", "dominated-pc", {1, 0})).outcome ==
+        CertOutcome::Accepted);
+  const int e = P.G.A.edge_index(0, 1);  // an edge of A's face 0
+  CHECK(one(P, rule_set(pcs_of("f-f", 0, 4, "e-f", e, 4), "dominated-pc", {1, 0})).outcome ==
+        CertOutcome::Accepted);
+  auto r = one(P, rule_set("f-f:0:4;v-f:7:4", "dominated-pc", {1, 0}));
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK(r.reason == "neither of v-f:7:4 and f-f:0:4 lies in the other's closures");
+}
+
+TEST_CASE("rule one-contact-plane") {
+  Pair P = make_pair();
+  const int e = P.G.A.edge_index(4, 5);
+  CHECK(one(P, rule_set(pcs_of("v-f", 0, 4, "e-f", e, 4), "one-contact-plane", {0, 1})).outcome ==
+        CertOutcome::Accepted);
+  CHECK(one(P, rule_set("f-v:0:3;f-v:0:5", "one-contact-plane", {0, 1})).outcome ==
+        CertOutcome::Accepted);  // A's face 0 in both
+  auto r = one(P, rule_set("v-f:0:4;v-f:1:6", "one-contact-plane", {0, 1}));
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK(r.reason == "PCs v-f:0:4 and v-f:1:6 have no faces of A or of B in one plane");
+}
+
+TEST_CASE("rule heights-over-ff, with the checker's sound separation") {
+  Pair P = make_pair();
+  // A's bottom face on B's low top (y = 10): A's vertex 4 (depth 10 below A's face) cannot
+  // reach B's face 2 (height -10 over the low top), vertex 0 (depth 0) not the tower top (10).
+  CHECK(one(P, rule_set("f-f:0:4;v-f:4:2", "heights-over-ff", {0, 1})).outcome ==
+        CertOutcome::Accepted);
+  CHECK(one(P, rule_set("f-f:0:4;v-f:0:6", "heights-over-ff", {0, 1})).outcome ==
+        CertOutcome::Accepted);
+  // Vertex 4 at depth 10 reaches the tower top at height 10: the rule does not hold.
+  auto r = one(P, rule_set("f-f:0:4;v-f:4:6", "heights-over-ff", {0, 1}));
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK_THAT(r.reason, Catch::StartsWith("depths of A's element [10, 10] and heights of B's "
+                                         "[10, 10] are not more than"));
+  CHECK(one(P, rule_set("f-f:0:4;v-f:4:6", "heights-over-ff", {1, 0})).reason ==
+        "pcs_involved[0] is not an f-f");
+  // A tower 1e-7 mm higher: more than the spec's 1e-9 size + touch_tol apart, but a witness's
+  // f-f may tilt by 1e-8 rad, moving A's far points by 1e-8 diag(A) = 1.7e-7 mm.
+  Pair Q = make_pair(0.01, 20 + 1e-7);
+  r = one(Q, rule_set("f-f:0:4;v-f:4:6", "heights-over-ff", {0, 1}));
+  CHECK(r.outcome == CertOutcome::Rejected);
+  Pair S = make_pair(0.01, 20 + 1e-5);
+  CHECK(one(S, rule_set("f-f:0:4;v-f:4:6", "heights-over-ff", {0, 1})).outcome ==
+        CertOutcome::Accepted);
+}
+
+TEST_CASE("rule rotational-conditions") {
+  Pair P = make_pair();
+  const int ez = P.G.A.edge_index(0, 4), ex = P.G.A.edge_index(0, 1);
+  // A's bottom face on B's low top: A's vertical edge turns to +-y, so it can never lie on the
+  // tower top (normal +y); it always lies parallel to B's bottom cap (normal -z), and a
+  // horizontal edge always lies parallel to the tower top: those rules do not hold.
+  CHECK(one(P, rule_set(pcs_of("f-f", 0, 4, "e-f", ez, 6), "rotational-conditions", {0, 1}))
+            .outcome == CertOutcome::Accepted);
+  auto r = one(P, rule_set(pcs_of("f-f", 0, 4, "e-f", ex, 6), "rotational-conditions", {0, 1}));
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK_THAT(r.reason, Catch::StartsWith("the conditions may all hold near theta ="));
+  r = one(P, rule_set(pcs_of("f-f", 0, 4, "e-f", ez, 0), "rotational-conditions", {0, 1}));
+  CHECK(r.outcome == CertOutcome::Rejected);
+  // Two f-f: A's faces 0 and 1 are opposite, B's faces 4 and 7 perpendicular: impossible; A's
+  // faces 0 and 2 are perpendicular like B's 4 and 7: possible.
+  CHECK(one(P, rule_set("f-f:0:4;f-f:1:7", "rotational-conditions", {0, 1})).outcome ==
+        CertOutcome::Accepted);
+  CHECK(one(P, rule_set("f-f:0:4;f-f:2:7", "rotational-conditions", {0, 1})).outcome ==
+        CertOutcome::Rejected);
+  // f-e: A's top face (its normal turns to +y) against B's edge 1-2 (along y): never parallel;
+  // against B's edge 3-9 (along z): always.
+  CHECK(one(P, rule_set(pcs_of("f-f", 0, 4, "f-e", 1, P.G.B.edge_index(1, 2)),
+                        "rotational-conditions", {0, 1}))
+            .outcome == CertOutcome::Accepted);
+  CHECK(one(P, rule_set(pcs_of("f-f", 0, 4, "f-e", 1, P.G.B.edge_index(3, 9)),
+                        "rotational-conditions", {0, 1}))
+            .outcome == CertOutcome::Rejected);
+  r = one(P, rule_set(pcs_of("e-f", ex, 4, "e-f", ez, 6), "rotational-conditions", {0, 1}));
+  CHECK(r.reason == "no f-f among the PCs involved: this rule does not refute sets without one");
+}
+
+TEST_CASE("finite-rotations is not certified, unknown rules and CFs of the graph are rejected") {
+  json cf = {{"id", 0},
+             {"pcs", {{{"type", "f-f"}, {"a", 0}, {"b", 4}}}},
+             {"witness", {{"R", {{1, 0, 0}, {0, 0, 1}, {0, -1, 0}}}, {"t", {15, 10, 5}}}}};
+  Pair P = make_pair(0.01, 20, json::array({cf}));
+  auto r = one(P, rule_set("f-f:0:4;v-f:4:6", "finite-rotations", {0, 1}));
+  CHECK(r.outcome == CertOutcome::NotCertified);
+  CHECK(one(P, rule_set("f-f:0:4;v-f:4:6", "magic", {0, 1})).reason == "unknown rule \"magic\"");
+  r = one(P, rule_set("f-f:0:4", "rotational-conditions", {0}));
+  CHECK(r.reason == "the graph holds this set as a CF with a witness");
+  CertificateReport rep =
+      run(P, cert_for(P, json::array({rule_set("f-f:0:4;v-f:4:6", "finite-rotations", {0, 1}),
+                                      rule_set("v-f:0:4;v-f:0:6", "vertex-in-two-pcs", {0, 1})})));
+  CHECK(rep.passed());
+  CHECK(rep.accepted == 1);
+  CHECK(rep.not_certified == 1);
+  CHECK(rep.summary_line().find("finite-rotations 0/0/1") != std::string::npos);
+}
+
+TEST_CASE("cells: a rotation leaf over the whole f-f circle") {
+  Pair P = make_pair();
+  const int ez = P.G.A.edge_index(0, 4), ex = P.G.A.edge_index(0, 1);
+  TreeB T;
+  T.add(-1, arc_rot(0, kPiD), "rotation", {{"pc", 1}});
+  // The vertical edge turns about itself: (R e).n_tower = 1 on the whole circle.
+  auto r = one(P, cells_set(pcs_of("f-f", 0, 4, "e-f", ez, 6), Vec3(5, 5, 5), T, circle_ff(0)));
+  CHECK(r.outcome == CertOutcome::Accepted);
+  CHECK(r.leaves.at("rotation")[0] == 1);
+  // A horizontal edge sweeps the circle: the half-width pi is far too wide for the claim.
+  r = one(P, cells_set(pcs_of("f-f", 0, 4, "e-f", ex, 6), Vec3(5, 5, 5), T, circle_ff(0)));
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK_THAT(r.reason, Catch::Contains("node 0: rotation: PC 1 (e-f:"));
+  // An axis that is not A's face normal, or too small an off-circle allowance, leaves
+  // rotations of the f-f out of the circle's cells.
+  json bad = circle_ff(0);
+  bad["axis"] = {0, 1e-6, -1};
+  r = one(P, cells_set(pcs_of("f-f", 0, 4, "e-f", ez, 6), Vec3(5, 5, 5), T, bad));
+  CHECK_THAT(r.reason, Catch::StartsWith("tree: off_circle_rad 2e-08 does not cover"));
+  bad = circle_ff(0);
+  bad["R0"] = {1, 0, 0, 0, 0, 1, 0, 1, 0};  // a reflection that also turns -z onto -y
+  r = one(P, cells_set(pcs_of("f-f", 0, 4, "e-f", ez, 6), Vec3(5, 5, 5), T, bad));
+  CHECK(r.reason == "tree: circle.R0 is not a rotation (det <= 0)");
+  // The root must be the whole circle.
+  TreeB half;
+  half.add(-1, arc_rot(0, kPiD / 2), "rotation", {{"pc", 1}});
+  r = one(P, cells_set(pcs_of("f-f", 0, 4, "e-f", ez, 6), Vec3(5, 5, 5), half, circle_ff(0)));
+  CHECK_THAT(r.reason, Catch::Contains("does not cover the circle"));
+  // The root box must hold every translation the PCs allow.
+  TreeB small;
+  small.lo = Vec3(0, 0, 0);
+  small.hi = Vec3(20, 20, 20);
+  small.add(-1, arc_rot(0, kPiD), "rotation", {{"pc", 1}});
+  r = one(P, cells_set(pcs_of("f-f", 0, 4, "e-f", ez, 6), Vec3(5, 5, 5), small, circle_ff(0)));
+  CHECK_THAT(r.reason, Catch::Contains("does not hold the pivot's reachable translations"));
+}
+
+TEST_CASE("cells: split-rotation tiling, bounds and outside-ball leaves") {
+  Pair P = make_pair();
+  // A's vertices 0 and 1 (10 mm apart) on B's faces x = 0 and x = 30: no translation fits.
+  const std::string pcs = "v-f:0:7;v-f:1:3";
+  const Vec3 pivot(5, 0, 0);
+  TreeB T;
+  const int root = T.add(-1, cube_rot(Vec3::Zero(), kPiD), "split-rotation");
+  auto kids = split8(T, root, Vec3::Zero(), kPiD, [](int b) {
+    return b == 7 ? std::string("split-rotation") : std::string("bounds");
+  });
+  const Vec3 c1 = Vec3::Constant(kPiD / 2);
+  auto g2 = split8(T, kids[7], c1, kPiD / 2, [](int b) {
+    return b == 7 ? std::string("split-rotation") : std::string("bounds");
+  });
+  const Vec3 c2 = Vec3::Constant(3 * kPiD / 4);
+  auto g3 = split8(T, g2[7], c2, kPiD / 4, [](int b) {
+    return b == 0 ? std::string("bounds") : std::string("outside-ball");
+  });
+  auto r = one(P, cells_set(pcs, pivot, T));
+  CHECK(r.outcome == CertOutcome::Accepted);
+  CHECK(r.leaves.at("outside-ball")[0] == 7);
+  // The cube [pi/2, 3 pi/4]^3 reaches the ball: not outside it.
+  TreeB U = T;
+  U.nodes[g3[0]]["kind"] = "outside-ball";
+  r = one(P, cells_set(pcs, pivot, U));
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK_THAT(r.reason, Catch::StartsWith("node " + std::to_string(g3[0]) +
+                                         ": outside-ball: the cube (grown by "));
+  CHECK_THAT(r.reason, Catch::EndsWith(") reaches the ball |r| <= pi"));
+  // A tree missing one child does not tile the domain.
+  TreeB M = T;
+  M.nodes.erase(M.nodes.begin() + kids[3]);
+  r = one(P, cells_set(pcs, pivot, M));
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK(r.reason == "node 0: split-rotation: 7 children, a split-rotation has 8");
+  // A child that is not a dyadic half.
+  TreeB D = T;
+  D.nodes[kids[2]]["rot"]["centre"][0] = 1.0;
+  CHECK_THAT(one(P, cells_set(pcs, pivot, D)).reason, Catch::Contains("is not a dyadic half"));
+  // A bounds leaf where the PCs do fit somewhere is rejected.
+  TreeB B1;
+  B1.add(-1, cube_rot(Vec3::Zero(), kPiD), "bounds");
+  CHECK(one(P, cells_set(pcs, pivot, B1)).outcome == CertOutcome::Accepted);
+  r = one(P, cells_set("v-f:0:7;v-f:1:5", pivot, B1));
+  CHECK(r.reason ==
+        "node 0: bounds: the root box is not empty and no edge of the set is "
+        "shorter than 2 min_margin_mm");
+}
+
+TEST_CASE("cells: split-translation and narrow must tile the box") {
+  Pair P = make_pair();
+  const std::string pcs = "v-f:0:7;v-f:1:3";
+  const Vec3 pivot(5, 0, 0);
+  const json rot = cube_rot(Vec3::Zero(), kPiD);
+  TreeB T;
+  const int root = T.add(-1, rot, "split-translation", {{"axis", 1}, {"at", 3.0}});
+  Vec3 hi1 = T.hi, lo2 = T.lo;
+  hi1.y() = 3;
+  lo2.y() = 3;
+  T.add(root, rot, "bounds", json::object(), &T.lo, &hi1);
+  const int nar = T.add(root, rot, "narrow", json::object(), &lo2, &T.hi);
+  // The narrow node's box [lo2, hi]: a child box and slabs around it.
+  Vec3 clo(-50, 10, -100), chi(50, 100, 100);
+  T.add(nar, rot, "bounds", json::object(), &clo, &chi);
+  Vec3 s1lo = lo2, s1hi(-50, 100, 100);        // x below the child
+  Vec3 s2lo(50, 3, -100), s2hi = T.hi;         // x above
+  Vec3 s3lo(-50, 3, -100), s3hi(50, 10, 100);  // y below
+  T.add(nar, rot, "bounds", json::object(), &s1lo, &s1hi);
+  T.add(nar, rot, "bounds", json::object(), &s2lo, &s2hi);
+  const int s3 = T.add(nar, rot, "bounds", json::object(), &s3lo, &s3hi);
+  CHECK(one(P, cells_set(pcs, pivot, T)).outcome == CertOutcome::Accepted);
+  TreeB M = T;
+  M.nodes.erase(M.nodes.begin() + s3);
+  auto r = one(P, cells_set(pcs, pivot, M));
+  CHECK(r.reason == "node " + std::to_string(nar) +
+                        ": narrow: the children do not cover the box: [-50,50]x[3,10]x[-100,100] "
+                        "is left out");
+  TreeB W = T;
+  W.nodes[root]["at"] = 4.0;
+  CHECK(one(P, cells_set(pcs, pivot, W)).reason ==
+        "node 0: split-translation: the children are not the box cut at 4 across axis 1");
+}
+
+TEST_CASE("cells: a program leaf with hand-derived Farkas multipliers") {
+  // A's vertex 7 on B's tower top (x in [0, 10]) with a 6 mm margin: 2 x 6 > 10, so no contact
+  // point fits. Pivot = the vertex: W = touch + rounding. Rows: n.z <= 20 + W, -n.z <= -20 +
+  // W, then the sides: -x <= -6 + W, z <= 24 + W, x <= 4 + W, -z <= -6 + W. y = 1 on the two
+  // x rows: 0 > -2 + 2 W.
+  Pair P = make_pair(6.0);
+  const json pieces = {{"B", {tower_top_one_piece()}}};
+  TreeB T;
+  T.lo = Vec3(-1, 19, -1);
+  T.hi = Vec3(11, 21, 31);
+  const json y = {0, 0, 1, 0, 1, 0};
+  const int root = T.add(-1, cube_rot(Vec3::Zero(), kPiD), "program",
+                         {{"farkas", {{{"choice", {0}}, {"y", y}}}}});
+  const Vec3 pivot(10, 10, 10);
+  auto r = one(P, cells_set("v-f:7:6", pivot, T), pieces);
+  CHECK(r.outcome == CertOutcome::Accepted);
+  CHECK(r.leaves.at("program")[0] == 1);
+  // One multiplier changed: (-1 + 0.5) x over the box goes down to -5.5, not above -4 + 1.5 W.
+  TreeB C = T;
+  C.nodes[root]["farkas"][0]["y"] = {0, 0, 1, 0, 0.5, 0};
+  r = one(P, cells_set("v-f:7:6", pivot, C), pieces);
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK_THAT(r.reason, Catch::StartsWith("node 0: program: choice [0]: Farkas gap -1.5"));
+  C.nodes[root]["farkas"][0]["y"] = {0, 0, 1, 0, -1, 0};
+  CHECK(one(P, cells_set("v-f:7:6", pivot, C), pieces).reason ==
+        "node 0: program: choice [0]: multiplier 4 is -1 (must be >= 0)");
+  C.nodes[root]["farkas"][0]["y"] = {0, 0, 1, 0, 1};
+  CHECK(one(P, cells_set("v-f:7:6", pivot, C), pieces).reason ==
+        "node 0: program: choice [0]: y has 5 multipliers for 6 rows");
+  C.nodes[root]["farkas"] = json::array();
+  CHECK(one(P, cells_set("v-f:7:6", pivot, C), pieces).reason ==
+        "node 0: program: choice [0] has no multipliers");
+  CHECK(one(P, cells_set("v-f:7:6", pivot, T)).reason ==
+        "node 0: program: no pieces for face 6 of B");
+  // The margin removed (4 mm: 2 x 4 < 10, a contact point fits): the same y fails.
+  Pair Q = make_pair(4.0);
+  r = one(Q, cells_set("v-f:7:6", pivot, T), pieces);
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK_THAT(r.reason, Catch::Contains("Farkas gap -2"));
+}
+
+TEST_CASE("cells: a wrongly flagged diagonal does not make a false program pass") {
+  // The tower top split at x = 5 into two pieces; their shared side at x = 5 is a diagonal.
+  // With a 3 mm margin a contact point fits (x in [3, 7]), but flagging the diagonal as
+  // boundary would give x <= 2 in piece 0 and x >= 8 in piece 1.
+  Pair P = make_pair(3.0);
+  const json face =
+      face_entry(6, Vec3(0, 1, 0), 20, Vec3(0, 0, 1), Vec3(1, 0, 0),
+                 {{{0, 0}, {30, 0}, {30, 5}, {0, 5}}, {{0, 5}, {30, 5}, {30, 10}, {0, 10}}},
+                 {{true, true, true, true}, {true, true, true, true}});
+  const json pieces = {{"B", {face}}};
+  TreeB T;
+  T.lo = Vec3(-1, 19, -1);
+  T.hi = Vec3(11, 21, 31);
+  const json y = {0, 0, 1, 0, 1, 0};
+  T.add(-1, cube_rot(Vec3::Zero(), kPiD), "program",
+        {{"farkas", {{{"choice", {0}}, {"y", y}}, {{"choice", {1}}, {"y", y}}}}});
+  CertificateReport rep =
+      run(P, cert_for(P, json::array({cells_set("v-f:7:6", Vec3(10, 10, 10), T)}), pieces));
+  REQUIRE(rep.sets.size() == 1);
+  CHECK(rep.sets[0].outcome == CertOutcome::Rejected);
+  CHECK_THAT(rep.sets[0].reason, Catch::StartsWith("node 0: program: choice [0]: Farkas gap -"));
+  REQUIRE(rep.warnings.size() == 2);
+  CHECK(rep.warnings[0] ==
+        "face 6 of B: piece 0 side 2 is flagged on the face's boundary but lies off it; the "
+        "checker uses its own decision");
+}
+
+TEST_CASE("pieces: frames, convexity and tiling are checked") {
+  Pair P = make_pair();
+  auto problems = [&](const json& face) {
+    return run(P, cert_for(P, json::array(), {{"B", {face}}})).file_problems;
+  };
+  CHECK(problems(tower_top_one_piece()).empty());
+  json f = tower_top_one_piece();
+  f["frame"]["V"] = {-1, 0, 0};
+  auto p = problems(f);
+  REQUIRE(p.size() == 1);
+  CHECK(p[0] == "pieces: face 6 of B: frame is not orthonormal with U x V = n (defect 2)");
+  f = tower_top_one_piece();
+  f["frame"]["offset"] = 20.5;
+  CHECK(problems(f)[0] == "pieces: face 6 of B: frame offset is 0.5 mm off the face's plane");
+  // One of two pieces missing: the diagonal at x = 5 is not shared.
+  f = face_entry(6, Vec3(0, 1, 0), 20, Vec3(0, 0, 1), Vec3(1, 0, 0),
+                 {{{0, 0}, {30, 0}, {30, 5}, {0, 5}}}, {{true, true, false, true}});
+  CHECK(problems(f)[0] ==
+        "pieces: face 6 of B: side 2 of piece 0 is neither on the face's "
+        "boundary nor shared with another piece");
+  f = face_entry(6, Vec3(0, 1, 0), 20, Vec3(0, 0, 1), Vec3(1, 0, 0),
+                 {{{0, 0}, {30, 0}, {30, 10}, {0, 10}}, {{0, 0}, {30, 0}, {30, 5}, {0, 5}}},
+                 {{true, true, true, true}, {true, true, false, true}});
+  CHECK(problems(f)[0] == "pieces: face 6 of B: pieces 0 and 1 overlap (by 5 mm)");
+  f = face_entry(6, Vec3(0, 1, 0), 20, Vec3(0, 0, 1), Vec3(1, 0, 0),
+                 {{{0, 0}, {0, 10}, {30, 10}, {30, 0}}}, {{true, true, true, true}});
+  CHECK(problems(f)[0] ==
+        "pieces: face 6 of B: piece 0 is not convex and counter-clockwise at corner 1");
+  f = face_entry(6, Vec3(0, 1, 0), 20, Vec3(0, 0, 1), Vec3(1, 0, 0),
+                 {{{0, 0}, {31, 0}, {31, 10}, {0, 10}}}, {{true, true, true, true}});
+  CHECK(problems(f)[0] == "pieces: face 6 of B: piece 0 has a corner 1 mm outside the face");
+}
+
+TEST_CASE("programs: the spec's full margin is not implied at a reflex corner of a face") {
+  // B's bottom cap (face 0, the L) split from the reflex corner (10, 10) to (0, 0). The point
+  // (10 - 0.8 m, 10 - 0.8 m) is 1.13 m from the boundary (its nearest point is the reflex
+  // corner), yet it violates the row y <= 10 - m of piece 0 and x <= 10 - m of piece 1. A
+  // program over a box around it is feasible for a real contact; with the spec's margins the
+  // multipliers below would "prove" otherwise. The checker's margins, reduced near the reflex
+  // corner, do not let them.
+  Pair P = make_pair();
+  const double m = P.margin;
+  // Frame: n = -z, offset 0, U = x, V = -y: (u, v) = (x, -y).
+  const json face = face_entry(
+      0, Vec3(0, 0, -1), 0, Vec3(1, 0, 0), Vec3(0, -1, 0),
+      {{{0, 0}, {10, -10}, {30, -10}, {30, 0}}, {{0, 0}, {0, -20}, {10, -20}, {10, -10}}},
+      {{false, true, true, true}, {true, true, true, false}});
+  const json pieces = {{"B", {face}}};
+  TreeB T;
+  const json rot = cube_rot(Vec3::Zero(), kPiD);
+  const int root = T.add(-1, rot, "narrow");
+  const double c = 10 - 0.8 * m, d = 0.05 * m;
+  const Vec3 lo(c - d, c - d, -d), hi(c + d, c + d, d);
+  // Rows: n.z twice, then piece 0's sides (the second is y <= 10 - m), or piece 1's (the third
+  // is x <= 10 - m).
+  const int prog = T.add(root, rot, "program",
+                         {{"farkas",
+                           {{{"choice", {0}}, {"y", {0, 0, 0, 1, 0, 0}}},
+                            {{"choice", {1}}, {"y", {0, 0, 0, 0, 1, 0}}}}}},
+                         &lo, &hi);
+  const CertSetResult r = one(P, cells_set("v-f:7:0", Vec3(10, 10, 10), T), pieces);
+  const CertNodeFailure* f = failure_of(r, prog);
+  REQUIRE(f);
+  CHECK_THAT(f->why, Catch::StartsWith("program: choice [0]: Farkas gap -"));
+  // The same multipliers over a box 0.9 m.. inside in y (piece 0) are fine: the reduced
+  // margin there is sin(45 deg) m = 0.707 m.
+  TreeB T2;
+  const int root2 = T2.add(-1, rot, "narrow");
+  const Vec3 lo2(20, 10 - 0.5 * m, -d), hi2(20.1, 10 - 0.4 * m, d);
+  const int p2 = T2.add(root2, rot, "program",
+                        {{"farkas",
+                          {{{"choice", {0}}, {"y", {0, 0, 0, 1, 0, 0}}},
+                           {{"choice", {1}}, {"y", {0, 0, 0, 0, 0, 1}}}}}},
+                        &lo2, &hi2);
+  const CertSetResult r2 = one(P, cells_set("v-f:7:0", Vec3(10, 10, 10), T2), pieces);
+  CHECK_FALSE(failure_of(r2, p2));
+}
+
+TEST_CASE("cells: an f-f program over the whole circle (A's face narrower than 2 m)") {
+  // A's bottom face (10 x 10) with a 6 mm margin: u >= 6 and u <= 4 in A's piece.
+  Pair P = make_pair(6.0);
+  const json a0 = face_entry(0, Vec3(0, 0, -1), 0, Vec3(1, 0, 0), Vec3(0, -1, 0),
+                             {{{0, 0}, {0, -10}, {10, -10}, {10, 0}}}, {{true, true, true, true}});
+  const json b4 = face_entry(4, Vec3(0, 1, 0), 10, Vec3(0, 0, 1), Vec3(1, 0, 0),
+                             {{{0, 10}, {30, 10}, {30, 30}, {0, 30}}}, {{true, true, true, true}});
+  const json pieces = {{"A", {a0}}, {"B", {b4}}};
+  TreeB T;
+  // Rows: A's piece (u >= 6, -v <= 4, u <= 4, v <= -6), then B's face (2 + 4 rows).
+  const json y = {1, 0, 1, 0, 0, 0, 0, 0, 0, 0};
+  const int root =
+      T.add(-1, arc_rot(0, kPiD), "program", {{"farkas", {{{"choice", {0, 0}}, {"y", y}}}}});
+  auto r = one(P, cells_set("f-f:0:4", Vec3(5, 5, 5), T, circle_ff(0)), pieces);
+  CHECK(r.outcome == CertOutcome::Accepted);
+  T.nodes[root]["farkas"][0]["y"] = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  r = one(P, cells_set("f-f:0:4", Vec3(5, 5, 5), T, circle_ff(0)), pieces);
+  CHECK(r.outcome == CertOutcome::Rejected);
+}
+
+TEST_CASE("cells: rotation leaves refute only when the turn bound allows") {
+  Pair P = make_pair();
+  const int ex = P.G.A.edge_index(0, 1);
+  const std::string pcs = pcs_of("e-f", ex, 3);  // A's x edge on B's face x = 30
+  // Depth 3 under the corner (+,+,+): the cube of centre (pi/8)(1,1,1), half pi/8:
+  // (R_c x).x = 0.852 > sqrt(3) pi / 8 = 0.680.
+  TreeB T;
+  const int root = T.add(-1, cube_rot(Vec3::Zero(), kPiD), "split-rotation");
+  auto k1 = split8(T, root, Vec3::Zero(), kPiD, [](int b) {
+    return b == 7 ? std::string("split-rotation") : std::string("bounds");
+  });
+  auto k2 = split8(T, k1[7], Vec3::Constant(kPiD / 2), kPiD / 2, [](int b) {
+    return b == 0 ? std::string("split-rotation") : std::string("bounds");
+  });
+  auto k3 = split8(T, k2[0], Vec3::Constant(kPiD / 4), kPiD / 4,
+                   [](int b) { return b == 0 ? std::string("rotation") : std::string("bounds"); });
+  T.nodes[k3[0]]["pc"] = 0;
+  auto r = one(P, cells_set(pcs, Vec3(5, 0, 0), T));
+  CHECK_FALSE(failure_of(r, k3[0]));
+  // Its parent as the leaf (half pi/4): 0.473 < 1.36.
+  TreeB W = T;
+  W.nodes.erase(W.nodes.begin() + k3[0], W.nodes.end());
+  W.nodes[k2[0]]["kind"] = "rotation";
+  W.nodes[k2[0]]["pc"] = 0;
+  r = one(P, cells_set(pcs, Vec3(5, 0, 0), W));
+  const CertNodeFailure* f = failure_of(r, k2[0]);
+  REQUIRE(f);
+  CHECK_THAT(f->why, Catch::StartsWith("rotation: PC 0 (e-f:"));
+}
+
+TEST_CASE("cells: cone and local-slack leaves") {
+  Pair P = make_pair();
+  // A's vertex 0 (rays +x, +y, +z) on B's low top (normal +y), turned by 90 deg about x: the
+  // ray +z points down (-y).
+  TreeB T;
+  const json rot = cube_rot(Vec3(kPiD / 2, 0, 0), 0.1);
+  const int root = T.add(-1, cube_rot(Vec3::Zero(), kPiD), "narrow");
+  const int cone = T.add(root, rot, "cone", {{"pc", 0}, {"direction", {0, 0, 1}}});
+  const int cone_bad = T.add(root, rot, "cone", {{"pc", 0}, {"direction", {0, 1, 0}}});
+  const int cone_odd = T.add(root, rot, "cone", {{"pc", 0}, {"direction", {0.6, 0.8, 0}}});
+  const int slack = T.add(root, rot, "local-slack", {{"pc", 0}});
+  // Turned so that (1,1,1)/sqrt(3) points up: every ray 0.577 up, far above the slack.
+  const Vec3 ax = Vec3(-1, 0, 1).normalized() * std::acos(1 / std::sqrt(3.0));
+  const int slack_bad = T.add(root, cube_rot(ax, 0.01), "local-slack", {{"pc", 0}});
+  auto r = one(P, cells_set("v-f:0:4", Vec3(0, 0, 0), T));
+  CHECK_FALSE(failure_of(r, cone));
+  CHECK_FALSE(failure_of(r, slack));
+  REQUIRE(failure_of(r, cone_bad));
+  CHECK_THAT(failure_of(r, cone_bad)->why, Catch::StartsWith("cone: PC 0 (v-f:0:4): the "
+                                                             "direction's height"));
+  REQUIRE(failure_of(r, cone_odd));
+  CHECK(failure_of(r, cone_odd)->why ==
+        "cone: PC 0 (v-f:0:4): direction 0.6,0.8,0 is not a tangent direction of its element");
+  REQUIRE(failure_of(r, slack_bad));
+  CHECK_THAT(failure_of(r, slack_bad)->why, Catch::Contains("is not below local_slack"));
+}
+
+TEST_CASE("cells: deep leaves") {
+  Pair P = make_pair();
+  // A's vertex 0, pivot A's centre: at the identity with t_c = (25, 10, 20) its image
+  // (20, 5, 15) is 5 mm inside B's lower bar.
+  TreeB T;
+  const int root = T.add(-1, cube_rot(Vec3::Zero(), kPiD), "narrow");
+  const json rot = cube_rot(Vec3::Zero(), 0.01);
+  const Vec3 lo(24.9, 9.9, 19.9), hi(25.1, 10.1, 20.1);
+  const json deep = {{"of", "A"}, {"point", {0, 0, 0}}};
+  const int ok = T.add(root, rot, "deep", deep, &lo, &hi);
+  const Vec3 lo2(24.9, 24.9, 19.9), hi2(25.1, 25.1, 20.1);  // image (20, 20, 15): above B
+  const int out = T.add(root, rot, "deep", deep, &lo2, &hi2);
+  const int centre = T.add(root, rot, "deep", {{"of", "A"}, {"point", {5, 5, 5}}}, &lo, &hi);
+  // B's vertex 0 (the origin), t_c = 0: its preimage is A's centre, 5 mm deep.
+  const Vec3 lo3(-0.1, -0.1, -0.1), hi3(0.1, 0.1, 0.1);
+  const int okb = T.add(root, rot, "deep", {{"of", "B"}, {"point", {0, 0, 0}}}, &lo3, &hi3);
+  auto r = one(P, cells_set("v-f:7:6", Vec3(5, 5, 5), T));
+  CHECK_FALSE(failure_of(r, ok));
+  CHECK_FALSE(failure_of(r, okb));
+  REQUIRE(failure_of(r, out));
+  CHECK_THAT(failure_of(r, out)->why, Catch::StartsWith("deep: the point's image is"));
+  REQUIRE(failure_of(r, centre));
+  CHECK(failure_of(r, centre)->why == "deep: the point is 5 mm from A's boundary");
+}
+
+#ifdef CF_ORACLE_CERTCHECK
+TEST_CASE("oracle_certcheck: summary, rejections and exit codes") {
+  Pair P = make_pair();
+  const std::string g = temp_path("cli_g.json"), c = temp_path("cli_c.json"),
+                    o = temp_path("cli_out.txt");
+  std::ofstream(g) << P.doc.dump();
+  auto run_cli = [&](const json& cert, std::string* out) {
+    std::ofstream(c) << cert.dump();
+    const std::string cmd =
+        std::string(CF_ORACLE_CERTCHECK) + " " + g + " " + c + " > " + o + " 2>&1";
+    const int st = std::system(cmd.c_str());
+    std::ifstream in(o);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    *out = ss.str();
+    return WEXITSTATUS(st);
+  };
+  std::string out;
+  CHECK(
+      run_cli(cert_for(P, json::array({rule_set("v-f:0:4;v-f:0:6", "vertex-in-two-pcs", {0, 1})})),
+              &out) == 0);
+  CHECK_THAT(out, Catch::StartsWith("sets 1, accepted 1, rejected 0, not certified 0, "
+                                    "undecided 0 | by kind"));
+  CHECK(
+      run_cli(cert_for(P, json::array({rule_set("v-f:0:4;v-f:1:6", "vertex-in-two-pcs", {0, 1})})),
+              &out) == 1);
+  CHECK_THAT(out, Catch::Contains("REJECTED set 0 {v-f:0:4;v-f:1:6} vertex-in-two-pcs: PCs "
+                                  "v-f:0:4 and v-f:1:6 share no vertex"));
+  std::ofstream(c) << "[1, 2";
+  const int st = std::system(
+      (std::string(CF_ORACLE_CERTCHECK) + " " + g + " " + c + " > " + o + " 2>&1").c_str());
+  CHECK(WEXITSTATUS(st) == 2);
+  std::ifstream in(o);
+  std::string line;
+  std::getline(in, line);
+  CHECK_THAT(line, Catch::StartsWith("oracle_certcheck: certificate file " + c + ": not JSON"));
+  for (const auto& p : {g, c, o}) std::filesystem::remove(p);
+}
+#endif
