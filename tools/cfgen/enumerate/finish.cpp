@@ -82,7 +82,7 @@ bool has_ff(const PcSet& s) {
 // Cells a set refuted by the finite-rotations rule may take when its certificate is asked
 // for: the rule rests on rotations found in floating point, so the certificate file carries
 // the cells' refutation instead when they give one.
-constexpr std::size_t kCertificateCells = 200;
+constexpr std::size_t kCertificateCells = 4096;
 
 // What the search could not decide: failed candidates that motion did not find either and
 // that no proof rules out (WitnessSearch::refuted). Those on an f-f's circle of rotations go
