@@ -181,7 +181,6 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
       }
     }
     if (r.verdict != CellRelaxation::Verdict::kOpen) {
-      out.refuted_share += circle.on ? c.arc.half / M_PI : std::pow(c.rot.half / M_PI, 3);
       if (tree) leaf().refutation = std::move(r);
       continue;
     }

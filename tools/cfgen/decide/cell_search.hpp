@@ -82,11 +82,8 @@ struct CellSearchResult {
     kWitness,    // a witness was found near a cell's centre (`witness`)
     kUndecided,  // a cell at the resolution, or the budget, was left open
   } outcome = Outcome::kUndecided;
-  Witness witness;        // kWitness: the witness found, verified
-  std::size_t cells = 0;  // cells examined
-  /// The share of the rotations (the arcs' length over the circle's, or the cubes' volume
-  /// over the root cube's) in cells refuted whole, translation box and all.
-  double refuted_share = 0;
+  Witness witness;           // kWitness: the witness found, verified
+  std::size_t cells = 0;     // cells examined
   double smallest_half = 0;  // rad: the half-width of the smallest rotation cell or arc examined
 };
 

@@ -70,9 +70,6 @@ namespace {
 // cells refute 2,304 sets of a 12-gon peg and hole in 8.8 s at 2 threads, 100 cells 3,072
 // in 98 s.
 constexpr std::size_t kDecisionCells = 8;
-// Cells a set may take when its first kDecisionCells refuted at least kProgress of its circle.
-constexpr std::size_t kProgressCells = 128;
-constexpr double kProgress = 0.25;
 
 bool has_ff(const PcSet& s) {
   for (const Pc& pc : s)
@@ -97,7 +94,6 @@ void Enumerator::find_undecided() {
   for (int l = 0; l < 3; ++l)
     for (const auto& [s, w] : valid_[l]) known.insert(s);
   const CellSearchLimits limits = decision_limits(search_, kDecisionCells);
-  const CellSearchLimits more = decision_limits(search_, kProgressCells);
   const bool keep = opt_.certificates;
   enum : char { kDecided, kOpen, kOverCells, kFound, kKnown };
   std::vector<char> state(failed_.size(), kDecided);
@@ -121,11 +117,8 @@ void Enumerator::find_undecided() {
         // A single f-f's relaxation holds wherever its faces overlap: only obstacles refute it.
         if (s.size() < 2 || !has_ff(s)) return;
         auto tree = keep ? std::make_shared<CellTree>() : nullptr;
-        CellSearchResult r =
+        const CellSearchResult r =
             search_cells(search_.a(), search_.b(), s, limits, &search_, tree.get());
-        // Cells that refuted much of the circle may refute the rest: more of them.
-        if (r.outcome == CellSearchResult::Outcome::kUndecided && r.refuted_share >= kProgress)
-          r = search_cells(search_.a(), search_.b(), s, more, &search_, tree.get());
         if (r.outcome == CellSearchResult::Outcome::kRefuted) {
           state[i] = kOverCells;
           if (keep) decisions[i].cells = std::move(tree);
