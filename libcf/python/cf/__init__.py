@@ -72,18 +72,21 @@ def generate(a_path, b_path, output=None, **options):
     symmetries; False is ``--no-symmetry``), ``thorough`` (default False; True is
     ``--thorough``: every set searched, then every image of each CF added), ``quiet`` (default True: no progress on stderr),
     ``checkpoint`` (a directory: ``--checkpoint``, finished work kept there and resumed by the
-    same call; without it no checkpoint is kept, as ``--no-checkpoint``). Ctrl-C stops the run between tasks and raises KeyboardInterrupt; with
-    ``checkpoint``, the chunks finished so far are kept for the next call.
+    same call; without it no checkpoint is kept, as ``--no-checkpoint``), ``certificates`` (a
+    file: ``--certificates``, every failed candidate set with its outcome and evidence,
+    docs/certificates.md). Ctrl-C stops the run between tasks and raises KeyboardInterrupt;
+    with ``checkpoint``, the chunks finished so far are kept for the next call.
     Raises cf.Error for bad models or options.
     """
     if not HAVE_TOOLS:
         raise Error("generate: this build of cf has no generator (configured with CF_WITH_CGAL=OFF)")
     a_path, b_path = _os.fspath(a_path), _os.fspath(b_path)
-    if "checkpoint" in options:
-        if options["checkpoint"] is None:
-            del options["checkpoint"]
-        else:
-            options["checkpoint"] = _os.fspath(options["checkpoint"])
+    for path in ("checkpoint", "certificates"):
+        if path in options:
+            if options[path] is None:
+                del options[path]
+            else:
+                options[path] = _os.fspath(options[path])
     if output is not None:
         _cf.generate(a_path, b_path, _os.fspath(output), **options)
         return load_graph(output)

@@ -120,7 +120,7 @@ void bind_tools(py::module_& m) {
          double good_clearance, double min_margin, double angle_margin, int theta_samples,
          int max_rotations, const std::string& units, const std::string& units_a,
          const std::string& units_b, double coplanar_rel_tol, bool symmetry, bool thorough,
-         const std::string& checkpoint) {
+         const std::string& checkpoint, const std::string& certificates) {
         const std::string where = "generate";
         // The ranges cfgen's options accept.
         check_int(threads, 0, 1024, "threads", where);
@@ -160,6 +160,7 @@ void bind_tools(py::module_& m) {
         check_units(g.load_b.units, "units_b", where);
         g.load_a.coplanar_rel_tol = g.load_b.coplanar_rel_tol = coplanar_rel_tol;
         g.checkpoint_dir = checkpoint;
+        g.certificates_path = certificates;
         // A checkpoint only when asked for: a call without `output` writes into a temporary
         // directory, which would take a default checkpoint with it.
         g.no_checkpoint = checkpoint.empty();
@@ -179,6 +180,7 @@ void bind_tools(py::module_& m) {
       py::arg("units_a") = "", py::arg("units_b") = "",
       py::arg("coplanar_rel_tol") = cf::tools::LoadOptions{}.coplanar_rel_tol,
       py::arg("symmetry") = true, py::arg("thorough") = false, py::arg("checkpoint") = "",
+      py::arg("certificates") = "",
       "cfgen's generation (cf::tools::run_generate) into the graph file `output`; the package's "
       "cf.generate wraps it.");
 #else

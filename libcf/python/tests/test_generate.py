@@ -120,3 +120,18 @@ def test_generate_stops_on_ctrl_c_and_resumes(tmp_path):
                    check=True, capture_output=True)
     assert out.read_bytes() == ref.read_bytes()
     assert len(g.cfs) > 0
+
+
+def test_generate_certificates(tmp_path):
+    # The certificate file cfgen --certificates writes, the same bytes from Python.
+    import json
+    out, cert = tmp_path / "py.json", tmp_path / "py_cert.json"
+    cf.generate(CUBE, DATA / "models" / "l_block.off", out, threads=2, certificates=cert)
+    ref, ref_cert = tmp_path / "c.json", tmp_path / "c_cert.json"
+    subprocess.run([tool("CF_CFGEN"), "--quiet", "-j", "2", str(CUBE), str(DATA / "models" / "l_block.off"),
+                    "-o", str(ref), "--certificates", str(ref_cert)], check=True, capture_output=True)
+    py, cli = json.loads(cert.read_text()), json.loads(ref_cert.read_text())
+    assert py["format"] == "cf-certificates"
+    py.pop("graph"), cli.pop("graph")  # each names its own graph file
+    assert py == cli
+    assert py["summary"] == {"sets": 144, "invalid_by_rule": 0, "invalid_by_cells": 96, "undecided": 48}
