@@ -66,8 +66,9 @@ void obb_of(const std::vector<Vec3>& pts, double inflate, const Vec3& origin, No
   const Vec3 centre_local = 0.5 * (lo + hi);
   const double reach = (0.5 * (hi - lo)).norm() + 1.0;
   Eigen::Vector3f c, h;
-  round_out(axes * centre_local - origin, 0.5 * (hi - lo) + Vec3::Constant(inflate + 1e-6 * reach),
-            c, h);
+  constexpr double kAxisTurn = 1e-6;  // rad: ten times the float axes' own error
+  round_out(axes * centre_local - origin,
+            0.5 * (hi - lo) + Vec3::Constant(inflate + kAxisTurn * reach), c, h);
   o.oc = lanes4(c);
   o.oh = lanes4(h);
 }

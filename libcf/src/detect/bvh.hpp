@@ -7,6 +7,8 @@
 // cannot hold a PC type (vertex against vertex or edge, edge against vertex) without opening
 // them.
 
+#include "tolerances.hpp"
+
 #include <cf/polyhedron.hpp>
 #include <cf/types.hpp>
 
@@ -62,7 +64,8 @@ struct BvhNode {
 inline void round_out(const Vec3& center, const Vec3& half, Eigen::Vector3f& c,
                       Eigen::Vector3f& h) {
   c = center.cast<float>();
-  h = ((half + 1.2e-7 * center.cwiseAbs()).cast<float>() * 1.0000003f);
+  h = ((half + internal::kFloatRounding * center.cwiseAbs()).cast<float>() *
+       internal::kFloatGrowth);
 }
 
 /// A node's boxes (4-lane rows, lane 3 zero), from which the wide nodes' lanes are filled:

@@ -7,6 +7,7 @@
 // kCertify a pair turned away also gets its certificate (exact.hpp, Cert).
 
 #include "exact.hpp"
+#include "tolerances.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -45,7 +46,8 @@ class CheapRejections {
       const Seg& A = posed_seg_a(t, p, ia);
       if (kb == K::kFace) {  // e-f
         const Plane& B = plane_b[static_cast<std::size_t>(ib)];
-        const double tilt = std::abs(A.dir.dot(B.n)) - (t.sin_max_tol + 1e-12);
+        const double tilt =
+            std::abs(A.dir.dot(B.n)) - (t.sin_max_tol + internal::kRelativeRounding);
         if constexpr (!kCertify) {
           return tilt <= 0 && segment_in_band(t, A.p0, A.dir, A.len, B.n, B.off);
         } else {
@@ -63,7 +65,7 @@ class CheapRejections {
       const double sn = n.norm();
       const double parallel = std::max(t.sin_tol_edge_a[static_cast<std::size_t>(ia)],
                                        t.sin_tol_edge_b[static_cast<std::size_t>(ib)]) -
-                              1e-12 - sn;
+                              internal::kRelativeRounding - sn;
       if (parallel >= 0) {
         // n turns by at most as much as A's direction.
         if constexpr (kCertify) ct->rot = parallel - t.geo_tol;
@@ -89,14 +91,15 @@ class CheapRejections {
     }
     const Plane& A = posed_plane_a(t, p, ia);
     if (kb == K::kFace) {  // f-f
-      const double tilt = t.cos_max_tol - 1e-12 + A.n.dot(plane_b[static_cast<std::size_t>(ib)].n);
+      const double tilt = t.cos_max_tol - internal::kRelativeRounding +
+                          A.n.dot(plane_b[static_cast<std::size_t>(ib)].n);
       if (tilt <= 0) return true;
       if constexpr (kCertify) ct->rot = tilt - t.geo_tol;
       return false;
     }
     if (kb == K::kEdge) {  // f-e
       const Seg& B = seg_b[static_cast<std::size_t>(ib)];
-      const double tilt = std::abs(A.n.dot(B.dir)) - (t.sin_max_tol + 1e-12);
+      const double tilt = std::abs(A.n.dot(B.dir)) - (t.sin_max_tol + internal::kRelativeRounding);
       if constexpr (!kCertify) {
         return tilt <= 0 && segment_in_band(t, B.p0, B.dir, B.len, A.n, A.off);
       } else {

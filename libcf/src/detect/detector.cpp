@@ -9,6 +9,7 @@
 #include "coherence.hpp"
 #include "exact.hpp"
 #include "finish_contacts.hpp"
+#include "tolerances.hpp"
 
 #include <algorithm>
 #include <array>
@@ -54,7 +55,8 @@ struct DetectModel {
     bvh_a = Bvh(a, 0.0, 1, tab.origin_A, leaves_for(a));
     // The boxes are single precision: widen B's by far more than the rounding of the
     // overlap test's few float operations on coordinates of this scale.
-    const double float_slack = 1e-5 * std::max(tab.reach, 1.0);
+    constexpr double kFloatTestSlack = 1e-5;  // relative: 80 times a float's rounding
+    const double float_slack = kFloatTestSlack * std::max(tab.reach, 1.0);
     // B's boxes grow by the deepest band and the in-plane allowance, so that every pair the
     // exact tests could accept has overlapping boxes.
     // A pair the tests accept is within max(eps, depth) across the plane and in_plane along
@@ -199,7 +201,9 @@ struct DetectState {
         break;
     }
     P.box.c = 0.5f * (lo + hi);
-    P.box.h = (0.5f * (hi - lo) + 2.4e-7f * P.box.c.abs()) * 1.0000003f +
+    // The midpoint and the half difference each rounded once more: twice the rounding.
+    constexpr float kMidpoint = 2 * static_cast<float>(internal::kFloatRounding);
+    P.box.h = (0.5f * (hi - lo) + kMidpoint * P.box.c.abs()) * internal::kFloatGrowth +
               Eigen::Array4f(grow, grow, grow, 0.0f);
   }
 
@@ -250,7 +254,9 @@ struct DetectState {
       const V lo = (c - h).max(oc - oh), hi = (c + h).min(oc + oh);
       Q.c[i] = 0.5f * (lo + hi);
       // Widened by the rounding of the midpoint and of the half difference.
-      Q.h[i] = ((0.5f * (hi - lo)).max(0.0f) + 2.4e-7f * Q.c[i].abs()) * 1.0000003f + grow;
+      constexpr float kMidpoint = 2 * static_cast<float>(internal::kFloatRounding);
+      Q.h[i] =
+          ((0.5f * (hi - lo)).max(0.0f) + kMidpoint * Q.c[i].abs()) * internal::kFloatGrowth + grow;
       Q.oc[i] = oc;
       Q.oh[i] = N.oh[i] + grow;
     }

@@ -1,4 +1,5 @@
 #include "exact.hpp"
+#include "tolerances.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -22,7 +23,8 @@ std::vector<EdgeWings> wings_of(const Polyhedron& m) {
 
 Mat3 task_frame(const Vec3& y, const Vec3& x_hint) {
   Vec3 x = x_hint - x_hint.dot(y) * y;
-  if (!(x.squaredNorm() > 1e-20)) {
+  constexpr double kParallelSq = 1e-20;  // the hint within 1e-10 rad of y: no direction
+  if (!(x.squaredNorm() > kParallelSq)) {
     // Any tangent: the world axis least aligned with y.
     int axis = 0;
     y.cwiseAbs().minCoeff(&axis);
@@ -164,7 +166,7 @@ bool line_on_face(const PairTables& t, ExactScratch& s, const Polyhedron& m, con
   } else {
     clip_segment(a2, b2, flat.poly(f), t.geo_tol, OnBoundary::kInclude, s.params.data(), piece);
   }
-  if (len > 1e-12) {
+  if (len > internal::kTinyMm) {
     *t_c = moment / len;
     *d = dmin;
     *gap = 0;
@@ -234,12 +236,12 @@ PairTables::PairTables(const Polyhedron& ma, const Polyhedron& mb, const Params&
   depth = prm.deepest_contact_mm;
   in_plane = prm.in_plane_tolerance_mm > 0 ? prm.in_plane_tolerance_mm : eps;
   const double scale = std::max(ma.size(), mb.size());
-  geo_tol = 1e-9 * std::max(scale, 1.0);
-  area_tol = 1e-12 * std::max(scale * scale, 1.0);
+  geo_tol = kGeoTolPerMm * std::max(scale, 1.0);
+  area_tol = kAreaTolPerMm2 * std::max(scale * scale, 1.0);
   reach = ma.size() + mb.size();
   for (const Vertex& v : mb.vertices())
     reach = std::max(reach, v.p.cwiseAbs().maxCoeff() + ma.size());
-  orth_allow = 1e-5 * std::max({reach, origin_A.norm(), 1.0});
+  orth_allow = kOrthAllowPerMm * std::max({reach, origin_A.norm(), 1.0});
   for (const Vertex& v : ma.vertices()) r_a = std::max(r_a, (v.p - origin_A).norm());
   // A face's tilt scale is its size, sqrt(area).
   for (const Face& F : ma.faces()) sin_tol_face_a.push_back(std::sin(tol_for(std::sqrt(F.area))));
@@ -440,7 +442,9 @@ PairOutcome face_face(const PairTables& t, PosedA& P, ExactScratch& s, int fa, i
   // The tilt's direction in B's plane: the overlap's extent along it is what the tilt
   // raises (orientation-independent, unlike a bounding box of the overlap).
   const Vec2 grad(ku, kv);
-  const Vec2 g_dir = grad.norm() > 1e-12 ? Vec2(grad.normalized()) : Vec2(1, 0);
+  // A slope (dimensionless) below the rounding has no direction.
+  const Vec2 g_dir =
+      grad.norm() > internal::kRelativeRounding ? Vec2(grad.normalized()) : Vec2(1, 0);
   double dmin = std::numeric_limits<double>::infinity();
   double s_lo = std::numeric_limits<double>::infinity(), s_hi = -s_lo;
   const auto visit = [&](const Vec2& q) {

@@ -11,6 +11,7 @@
 #include <cf/polyhedron.hpp>
 
 #include "polygon_clipping.hpp"
+#include "tolerances.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -70,6 +71,14 @@ struct PairTables {
   double eps = 1;       ///< mm, Params::epsilon_mm
   double depth = 1;     ///< mm, deepest_contact_mm
   double in_plane = 1;  ///< mm, in_plane_tolerance_mm or epsilon
+  /// mm per mm of the models' size: boundaries this close coincide in 2D (far below any
+  /// feature, far above rounding).
+  static constexpr double kGeoTolPerMm = 1e-9;
+  /// mm^2 per mm^2: an overlap this small (relative to the size squared) is none.
+  static constexpr double kAreaTolPerMm2 = 1e-12;
+  /// mm per mm of the reach: a rotation rounded to float leaves |(R^T R - I) o_A| within
+  /// 1e-7 of it; ten times that is allowed.
+  static constexpr double kOrthAllowPerMm = 1e-5;
   double geo_tol =
       0;  ///< mm, coincidence of boundaries in 2D: far below any feature, above rounding
   double area_tol = 0;  ///< mm^2
@@ -90,7 +99,7 @@ struct PairTables {
   /// rad: the angular tolerance of a contact region of this extent (mm).
   double tol_for(double extent) const {
     if (prm.angular_tolerance_rad > 0) return prm.angular_tolerance_rad;
-    const double t = std::atan(eps / std::max(extent, 1e-12));
+    const double t = std::atan(eps / std::max(extent, internal::kTinyMm));
     return std::clamp(t, prm.min_angular_tolerance_rad, prm.max_angular_tolerance_rad);
   }
   bool in_band(double d) const { return d <= eps && d >= -depth; }

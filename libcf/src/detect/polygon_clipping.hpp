@@ -8,6 +8,7 @@
 // tests/libcf/detector_test.cpp checks this code against boost::geometry::intersection.
 
 #include "model/point_location.hpp"
+#include "tolerances.hpp"
 
 #include <Eigen/Core>
 
@@ -73,10 +74,12 @@ void clip_segment(const Vec2& a, const Vec2& b, const Poly2& P, double tol, OnBo
       const Vec2 qa = c - a;
       const double denom = cross2(r, s);
       const double slen = s.norm();
-      if (std::abs(denom) > 1e-12 * rlen * slen) {
+      if (std::abs(denom) > internal::kRelativeRounding * rlen * slen) {
         const double t = cross2(qa, s) / denom;
         const double u = cross2(qa, r) / denom;
-        if (u >= -1e-12 && u <= 1 + 1e-12 && t > 0 && t < 1) params[n++] = t;
+        if (u >= -internal::kRelativeRounding && u <= 1 + internal::kRelativeRounding && t > 0 &&
+            t < 1)
+          params[n++] = t;
       } else if (std::abs(cross2(qa, r)) / rlen <= tol) {
         // Collinear within tol: the overlap's ends split the segment.
         const double tc = qa.dot(r) / (rlen * rlen);
@@ -96,8 +99,8 @@ void clip_segment(const Vec2& a, const Vec2& b, const Poly2& P, double tol, OnBo
     }
     params[j + 1] = v;
   }
-  const double tmin = 1e-12;
-  double run0 = -1, run1 = -1;  // current run of included pieces, merged
+  const double tmin = internal::kRelativeRounding;  // a segment parameter
+  double run0 = -1, run1 = -1;                      // current run of included pieces, merged
   for (int i = 0; i + 1 < n; ++i) {
     const double t0 = params[i], t1 = params[i + 1];
     if (t1 - t0 <= tmin) continue;
@@ -170,7 +173,7 @@ Overlap2 overlap(const Poly2& P, const Poly2& Q, double tol, double* params, Vis
 /// clip_segment with OnBoundary::kInclude for a convex P (is_convex: one loop, counter-
 /// clockwise): the piece [*t0, *t1] of segment a->b within tol of P, cut by each edge's
 /// line moved out by tol (Cyrus-Beck). False when it is no longer than the general
-/// routine's shortest piece (1e-12).
+/// routine's shortest piece (kRelativeRounding of the segment).
 inline bool clip_segment_convex(const Vec2& a, const Vec2& b, const Poly2& P, double tol,
                                 double* t0, double* t1) {
   const Vec2 r = b - a;
@@ -188,7 +191,7 @@ inline bool clip_segment_convex(const Vec2& a, const Vec2& b, const Poly2& P, do
       hi = std::min(hi, -f0 / fr);
     else if (f0 < 0)
       return false;
-    if (hi - lo <= 1e-12) return false;
+    if (hi - lo <= internal::kRelativeRounding) return false;  // segment parameters
   }
   *t0 = lo;
   *t1 = hi;
@@ -203,7 +206,7 @@ inline bool is_convex(const Poly2& P) {
   for (int i = 0; i < n; ++i) {
     const Vec2 u = P.pts[b + (i + 1) % n] - P.pts[b + i];
     const Vec2 v = P.pts[b + (i + 2) % n] - P.pts[b + (i + 1) % n];
-    if (cross2(u, v) < -1e-12 * u.norm() * v.norm()) return false;
+    if (cross2(u, v) < -internal::kRelativeRounding * u.norm() * v.norm()) return false;
   }
   return true;
 }

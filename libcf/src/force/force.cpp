@@ -6,6 +6,7 @@
 #include "force_step.hpp"
 
 #include "../check.hpp"
+#include "tolerances.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -46,8 +47,8 @@ namespace {
 using Slot = ForceState::Slot;
 constexpr int kMaxPcs = ForceResult::kMaxPcs;
 
-// mm: tangential motions below this have no direction (round-off of poses in mm).
-constexpr double kTinyMm = 1e-12;
+// mm: tangential motions below internal::kTinyMm have no direction (round-off of poses).
+using internal::kTinyMm;
 
 constexpr std::size_t pc_index(int k) { return static_cast<std::size_t>(k); }
 
@@ -314,7 +315,10 @@ void read_pcs(const ForceModel::Fixed& fm, ForceState& s, const Pose& pose, cons
 // ---- The friction regime per motion type (section 4.4) ----
 
 // Eq. (3). The slack absorbs the round-off of an anchor placed exactly at the bound.
-bool sticks(const PcForce& f) { return f.s_mm <= f.s_bound_mm * (1 + 1e-9) + kTinyMm; }
+bool sticks(const PcForce& f) {
+  constexpr double kBoundRounding = 1e-9;  // relative: the anchor's own round-off, and more
+  return f.s_mm <= f.s_bound_mm * (1 + kBoundRounding) + kTinyMm;
+}
 
 Regime stick_or_max(const PcForce& f) { return sticks(f) ? Regime::kStick : Regime::kMaxStatic; }
 

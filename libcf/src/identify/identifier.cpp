@@ -157,8 +157,10 @@ struct IdentifyScratch {
     const ContactSet& cs = res->contacts;
     for (int k = 0; k < count[static_cast<std::size_t>(g)]; ++k) {
       const ContactPc& c = cs[members[static_cast<std::size_t>(g)][static_cast<std::size_t>(k)]];
+      // The misfit (dimensionless) is the distance's own share of epsilon, to rounding.
+      constexpr double kMisfitRounding = 1e-6;
       if (!c.dominated && std::abs(c.distance) <= prm.touch_distance_mm &&
-          c.misfit - std::abs(c.distance) / eps_mm < 1e-6)
+          c.misfit - std::abs(c.distance) / eps_mm < kMisfitRounding)
         return true;
     }
     return false;

@@ -1,5 +1,7 @@
 #include <cf/polyhedron.hpp>
 
+#include "tolerances.hpp"
+
 #include <cf/geometry.hpp>
 
 #include <algorithm>
@@ -184,7 +186,8 @@ void link_edges(const std::string& nm, const std::vector<Face>& faces, std::vect
     const Vec3& nr = faces[E.right.index()].normal;
     const double s = nl.cross(nr).dot(E.dir);
     const double c = std::clamp(nl.dot(nr), -1.0, 1.0);
-    if (std::abs(s) < 1e-12) fail(nm, where + " separates two coplanar faces");
+    if (std::abs(s) < internal::kRelativeRounding)  // a sine of unit normals
+      fail(nm, where + " separates two coplanar faces");
     E.convex = s > 0;
     const double theta = std::acos(c);  // angle between the outward normals
     E.dihedral = E.convex ? M_PI - theta : M_PI + theta;

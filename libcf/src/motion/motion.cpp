@@ -52,7 +52,8 @@ Vec3 line_direction(const ContactPc& c, const Polyhedron& A, const Polyhedron& B
 
 Freedoms compute_freedoms(const ContactPc* pcs, int n, const Polyhedron& A, const Polyhedron& B,
                           const Pose& pose, const Params& params) {
-  const double L = std::max(A.size(), 1e-9);
+  constexpr double kLeastSizeMm = 1e-9;  // a model of no size still gets a length scale
+  const double L = std::max(A.size(), kLeastSizeMm);
   ConstraintPoint pts[Freedoms::kMaxRows];
   int rows = 0;
   auto add = [&](const Vec3& q, const Vec3& nrm) {
@@ -140,7 +141,8 @@ Freedoms freedoms_from_points(const ConstraintPoint* pts, int n, const Vec3& ref
     auto try_alpha = [&](const VecQ& a) {
       if (found) return;
       const Vec3 wl = Zw * a;
-      if (wl.norm() > qtol * std::max(a.norm(), 1e-300)) {
+      constexpr double kNonzero = 1e-300;  // any a that is not exactly zero
+      if (wl.norm() > qtol * std::max(a.norm(), kNonzero)) {
         alpha = a;
         found = true;
       }

@@ -53,7 +53,8 @@ bool is_point_type(PcType t) { return extent(t) == PcExtent::kPoint; }
 // A corner's friction (l1, l2) at its Coulomb bound mu ln (to rounding): where Gauss-Seidel
 // left it, the corner would slip.
 bool at_friction_bound(double l1, double l2, double mu, double ln) {
-  const double cap = mu * ln * (1 - 1e-6);
+  constexpr double kAtBound = 1e-6;  // relative: Gauss-Seidel's round-off at the bound
+  const double cap = mu * ln * (1 - kAtBound);
   return mu > 0 && l1 * l1 + l2 * l2 >= cap * cap;
 }
 
@@ -151,7 +152,8 @@ class ActiveRows {
     }
     const Vec6 Wu = W(u);
     const double n2 = u.dot(Wu);
-    if (!(n2 > 1e-10 * row.G)) return;  // dependent on the rows before
+    constexpr double kDependent = 1e-10;     // relative: what is left of the row is round-off
+    if (!(n2 > kDependent * row.G)) return;  // dependent on the rows before
     const double sc = 1 / std::sqrt(n2);
     const auto q = static_cast<std::size_t>(nq_++);
     Q_[q] = sc * u;
@@ -215,7 +217,8 @@ Vec6 polish(const Vec6& xi_pgs, const Vec6& xi_d, Constraints& c, double k, doub
   for (int round = 0; round <= 6; ++round) {
     const Vec6 xi = active.project(xe);
     int worst = -1;
-    double worst_gap = -1e-9;
+    constexpr double kGapRoundingMm = 1e-9;  // a row violated by less is held, to round-off
+    double worst_gap = -kGapRoundingMm;
     for (int j = 0; j < c.m; ++j) {
       const auto J = static_cast<std::size_t>(j);
       const double gap = c.dist[J] + c.rows[3 * J].a.dot(xi);
@@ -258,7 +261,8 @@ ProxyModel::ProxyModel(const Polyhedron& a, const Polyhedron& b, const Params& p
   const Vec3 r = c - q.grip_point_A;
   J_A = Jc + (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
   // A flat or needle-like A: keep every axis weighted (1e-6 of the largest).
-  const double floor = 1e-6 * std::max(J_A.trace(), 1e-12);
+  constexpr double kAxisFloor = 1e-6, kLeastTrace = 1e-12;  // relative; mm^2 per mm^3
+  const double floor = kAxisFloor * std::max(J_A.trace(), kLeastTrace);
   for (int k = 0; k < 3; ++k) J_A(k, k) = std::max(J_A(k, k), floor);
   Jinv_A = J_A.inverse();
   for (const Vertex& v : a.vertices()) reach_mm = std::max(reach_mm, (v.p - q.grip_point_A).norm());
@@ -650,7 +654,8 @@ void advance_proxy(const ProxyModel& pm, const DetectModel& dm, DetectState& ds,
       // Too long to be sure of: advance by step_len and look again; a translation as far as
       // the lookahead band shows it free. (A turn's contacts in the band would be linearised
       // about points up to the band's width from where they touch: turns advance by step_len.)
-      const bool translation = xi.tail<3>().norm() * pm.reach_mm <= 1e-6 * step_len;
+      constexpr double kTurnShare = 1e-6;  // a turn that moves A this share of a step is none
+      const bool translation = xi.tail<3>().norm() * pm.reach_mm <= kTurnShare * step_len;
       const double f =
           pm.look && translation ? look_ahead(pm, s, X, xi.head<3>(), step_len) : step_len / sweep;
       X = moved(X, g_A, f * xi.head<3>(), f * xi.tail<3>());
