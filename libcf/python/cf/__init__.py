@@ -19,7 +19,7 @@ import os as _os
 import tempfile as _tempfile
 
 from . import _cf
-from ._cf import Cf, CfGraph, Error, FileError, Params, Pc, Polyhedron, Renderer
+from ._cf import Cf, CfGraph, CfModel, CfState, Error, FileError, Params, Pc, Polyhedron, Renderer, step
 from ._cf import __version__, graph_format_version
 from ._replay import ReplayResult, read_trajectory
 from ._networkx import to_networkx as _to_networkx
@@ -27,7 +27,8 @@ from ._networkx import to_networkx as _to_networkx
 HAVE_TOOLS = _cf.HAVE_TOOLS
 
 __all__ = [
-    "Cf", "CfGraph", "Error", "FileError", "Params", "Pc", "Polyhedron", "Renderer", "ReplayResult",
+    "Cf", "CfGraph", "CfModel", "CfState", "Error", "FileError", "Params", "Pc", "Polyhedron",
+    "Renderer", "ReplayResult", "step", "step_many",
     "generate", "load_graph", "load_model", "read_trajectory", "replay", "HAVE_TOOLS",
 ]
 
@@ -129,3 +130,11 @@ def _step_many(self, t, p, q):
 
 
 Renderer.step_many = _step_many
+
+
+def step_many(model, state, t, p, q):
+    """N servo ticks of ``state`` on ``model`` at once, at C++ speed with the GIL released (so
+    that threads, each with its own state of one model, run in parallel): the same values,
+    tick by tick, as N calls of cf.step(). ``t`` (N,) s, increasing and after the state's last
+    tick; ``p`` (N, 3) mm; ``q`` (N, 4) w, x, y, z. Returns a cf.ReplayResult."""
+    return ReplayResult(_cf._step_many(model, state, t, p, q), [])

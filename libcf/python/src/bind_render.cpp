@@ -4,8 +4,11 @@
 #include "common.hpp"
 
 #include <cf/file_io.hpp>
+#include <cf/model.hpp>
 #include <cf/renderer.hpp>
 #include <cf/replay.hpp>
+#include <cf/servo.hpp>
+#include <cf/state.hpp>
 
 #include <Eigen/Geometry>
 
@@ -110,23 +113,88 @@ cf::Params params_arg(const py::object& params, const py::kwargs& kw, const std:
   return params_from_kwargs(base, kw, where);
 }
 
-/// Renderer.step: the arguments checked, then one tick.
-py::dict renderer_step(Renderer& self, double t_s, const py::object& p, const py::object& q) {
+/// One tick's arguments checked (time increasing after `last_t` when `stepped`), as a pose.
+cf::Pose tick_pose(double t_s, const py::object& p, const py::object& q, bool stepped,
+                   double last_t) {
   const Array pa = as_array(p, "p", "step"), qa = as_array(q, "q", "step");
   if (pa.ndim() != 1 || pa.shape(0) != 3) fail("step: p must have shape (3,), got " + shape_of(pa));
   if (qa.ndim() != 1 || qa.shape(0) != 4)
     fail("step: q must have shape (4,) (w, x, y, z), got " + shape_of(qa));
   if (!std::isfinite(t_s)) fail("step: t is not finite");
-  if (self.stepped && !(t_s > self.last_t)) {
+  if (stepped && !(t_s > last_t)) {
     char buf[160];
     std::snprintf(buf, sizeof buf, "step: time %.9g s does not increase (previous step: %.9g s)",
-                  t_s, self.last_t);
+                  t_s, last_t);
     fail(buf);
   }
-  const cf::Pose pose = pose_from(pa.data(), qa.data(), "step");
+  return pose_from(pa.data(), qa.data(), "step");
+}
+
+/// Renderer.step: the arguments checked, then one tick.
+py::dict renderer_step(Renderer& self, double t_s, const py::object& p, const py::object& q) {
+  const cf::Pose pose = tick_pose(t_s, p, q, self.stepped, self.last_t);
   self.stepped = true;
   self.last_t = t_s;
   return step_dict(self.r.step(pose, t_s));
+}
+
+/// cf.CfState: one servo thread's state (cf::CfState) and the time of its last tick.
+struct State {
+  explicit State(const cf::CfModel& model) : s(model), model(&model) {}
+  cf::CfState s;
+  const cf::CfModel* model;
+  bool stepped = false;
+  double last_t = 0;
+};
+
+/// cf.step(model, state, t, p, q): one tick of cf::step, with the GIL released while it runs,
+/// so that threads each holding a state of one model step in parallel.
+py::dict model_step(const cf::CfModel& model, State& state, double t_s, const py::object& p,
+                    const py::object& q) {
+  if (state.model != &model) fail("step: the state was made for another model");
+  const cf::Pose pose = tick_pose(t_s, p, q, state.stepped, state.last_t);
+  const cf::HapticResult* r = nullptr;
+  {
+    py::gil_scoped_release release;
+    r = &cf::step(model, state.s, pose, t_s);
+  }
+  state.stepped = true;
+  state.last_t = t_s;
+  return step_dict(*r);
+}
+
+py::dict state_step_many(const cf::CfModel& model, State& state, const py::object& t,
+                         const py::object& p, const py::object& q);
+
+void bind_model_state(py::module_& m) {
+  py::class_<cf::CfModel>(
+      m, "CfModel",
+      "Everything the servo loop reads and never writes (cf::CfModel): CfModel(graph, "
+      "params=None, **params). One model is shared by every thread; each thread steps its own "
+      "CfState with cf.step().")
+      .def(py::init([](const cf::CfGraph& g, const py::object& params, const py::kwargs& kw) {
+             return std::make_unique<cf::CfModel>(g, params_arg(params, kw, "CfModel"));
+           }),
+           py::arg("graph"), py::arg("params") = py::none(), py::keep_alive<1, 2>())
+      .def_property_readonly("params", [](const cf::CfModel& m) { return m.params(); });
+  py::class_<State>(m, "CfState",
+                    "One servo thread's state for one CfModel (cf::CfState): CfState(model). "
+                    "Not thread-safe: one per thread.")
+      .def(py::init<const cf::CfModel&>(), py::arg("model"), py::keep_alive<1, 2>())
+      .def(
+          "reset",
+          [](State& self) {
+            self.s.reset();
+            self.stepped = false;
+          },
+          "Forgets the history (previous CF, stick anchors, filters) and the last tick's time.");
+  m.def("step", &model_step, py::arg("model"), py::arg("state"), py::arg("t"), py::arg("p"),
+        py::arg("q"),
+        "One servo tick of `state` on `model` (cf::step), the GIL released while it runs: t "
+        "(s, increasing per state), p (3, mm), q (4, unit quaternion w, x, y, z). Returns the "
+        "dict Renderer.step returns.");
+  m.def("_step_many", &state_step_many, py::arg("model"), py::arg("state"), py::arg("t"),
+        py::arg("p"), py::arg("q"), "N ticks of cf.step at once (cf.step_many wraps the result).");
 }
 
 py::dict renderer_step_many(Renderer& self, const py::object& t, const py::object& p,
@@ -305,14 +373,17 @@ py::dict replay_dict(std::unique_ptr<ReplayRows> rows, const ReplayExtras& x) {
 /// Renderer.step_many: N ticks of this renderer, its state carried on from the ticks before,
 /// without the GIL. The renderer is held by this call for its length (a second thread
 /// stepping the same Renderer meanwhile is the caller's race, as with any C++ renderer).
-py::dict renderer_step_many(Renderer& self, const py::object& t, const py::object& p,
-                            const py::object& q) {
+/// N ticks of `tick(pose, t)` (a renderer's or a state's), the GIL released while they run;
+/// the first time after `last_t` when `stepped`, both updated.
+template <class Tick>
+py::dict step_many(const py::object& t, const py::object& p, const py::object& q, bool& stepped,
+                   double& last_t, const Tick& tick) {
   const std::vector<cf::TrajectorySample> samples = replay_samples(t, p, q, "step_many");
-  if (self.stepped && !(samples.front().t_s > self.last_t)) {
+  if (stepped && !(samples.front().t_s > last_t)) {
     char buf[160];
     std::snprintf(buf, sizeof buf,
                   "step_many: time %.9g s does not increase (previous step: %.9g s)",
-                  samples.front().t_s, self.last_t);
+                  samples.front().t_s, last_t);
     fail(buf);
   }
   auto rows = std::make_unique<ReplayRows>();
@@ -321,14 +392,31 @@ py::dict renderer_step_many(Renderer& self, const py::object& t, const py::objec
   {
     py::gil_scoped_release release;
     for (std::size_t i = 0; i < samples.size(); ++i) {
-      const cf::HapticResult& r = self.r.step(samples[i].X_WD, samples[i].t_s);
+      const cf::HapticResult& r = tick(samples[i].X_WD, samples[i].t_s);
       cf::fill_replay_row(r, rows->rows[i]);
       record_extras(r, i, extras);
     }
   }
-  self.stepped = true;
-  self.last_t = samples.back().t_s;
+  stepped = true;
+  last_t = samples.back().t_s;
   return replay_dict(std::move(rows), extras);
+}
+
+py::dict renderer_step_many(Renderer& self, const py::object& t, const py::object& p,
+                            const py::object& q) {
+  return step_many(t, p, q, self.stepped, self.last_t,
+                   [&self](const cf::Pose& X, double t_s) -> const cf::HapticResult& {
+                     return self.r.step(X, t_s);
+                   });
+}
+
+py::dict state_step_many(const cf::CfModel& model, State& state, const py::object& t,
+                         const py::object& p, const py::object& q) {
+  if (state.model != &model) fail("step_many: the state was made for another model");
+  return step_many(t, p, q, state.stepped, state.last_t,
+                   [&](const cf::Pose& X, double t_s) -> const cf::HapticResult& {
+                     return cf::step(model, state.s, X, t_s);
+                   });
 }
 
 py::dict replay(const cf::CfGraph& g, const py::object& t, const py::object& p, const py::object& q,
@@ -346,6 +434,7 @@ py::dict replay(const cf::CfGraph& g, const py::object& t, const py::object& p, 
 
 void bind_render(py::module_& m) {
   bind_renderer(m);
+  bind_model_state(m);
 
   py::class_<ReplayRows>(m, "_ReplayRows")
       .def("__len__", [](const ReplayRows& r) { return r.rows.size(); })
