@@ -225,6 +225,37 @@ void check_outside_checkpoint(const std::string& out_path, const std::string& ch
                 checkpoint_dir + "', which the run rewrites and removes; write it elsewhere");
 }
 
+// An output path checked before the work (docs/spec.md, section 5b): not a device, FIFO or
+// directory, not an input nor one of `others`, not inside the checkpoint directory.
+void check_output(const std::string& path, const std::vector<std::string>& inputs,
+                  const std::string& checkpoint_dir, const char* what,
+                  const std::vector<std::string>& others) {
+  check_output_path(path, inputs, what, others);
+  check_outside_checkpoint(path, checkpoint_dir, what);
+}
+
+// A model small or large against the paper's epsilon, in the unit its option sets.
+void warn_sizes(const Polyhedron& A, const Polyhedron& B) {
+  for (const auto& [m, which, option] :
+       {std::tuple{&A, "A", "--units-a"}, std::tuple{&B, "B", "--units-b"}})
+    if (const std::string w = size_warning(*m, which, option); !w.empty())
+      std::cerr << "cfgen: warning: " << w << '\n';
+}
+
+// What a run that wrote its graph says: a graph without CFs, and unless quiet its counts.
+void report_written(const GenerateArgs& args, const gen::Enumeration& e, const Polyhedron& A,
+                    const Polyhedron& B, std::size_t n_cfs, std::size_t n_tr, double seconds) {
+  if (n_cfs == 0)
+    std::cerr << "cfgen: warning: the graph has no CF: A (" << A.size() << " mm across) and B ("
+              << B.size()
+              << " mm across) never touch in a valid contact formation; are the models' units "
+                 "right (--units)?\n";
+  if (!args.quiet)
+    std::cerr << "cfgen: " << n_cfs << " CFs (" << e.levels[0].valid << " + " << e.levels[1].valid
+              << " + " << e.levels[2].valid << "), " << n_tr << " transitions, " << seconds
+              << " s -> " << args.out_path << '\n';
+}
+
 }  // namespace
 
 int run_generate(const GenerateArgs& args) {
@@ -235,22 +266,16 @@ int run_generate(const GenerateArgs& args) {
   // Of K shards, shard 0 writes the graph.
   const bool writes = !args.estimate && args.shard.index == 0;
   const bool certifies = writes && !args.certificates_path.empty();
-  if (writes) check_output_path(args.out_path, inputs, "writing graph");
-  if (writes) check_outside_checkpoint(args.out_path, args.checkpoint_dir, "writing graph");
-  if (certifies) {
-    check_output_path(args.certificates_path, inputs, "writing certificates", {args.out_path});
-    check_outside_checkpoint(args.certificates_path, args.checkpoint_dir, "writing certificates");
-  }
+  if (writes) check_output(args.out_path, inputs, args.checkpoint_dir, "writing graph", {});
+  if (certifies)
+    check_output(args.certificates_path, inputs, args.checkpoint_dir, "writing certificates",
+                 {args.out_path});
   const MeasuredModel ma = load_measured_model(args.a_path, args.load_a);
   const MeasuredModel mb = load_measured_model(args.b_path, args.load_b);
   const Polyhedron& A = ma.model;
   const Polyhedron& B = mb.model;
   // The other ranks of an MPI run say nothing that rank 0 says.
-  if (!args.share.load || args.shard.index == 0)
-    for (const auto& [m, which, option] :
-         {std::tuple{&A, "A", "--units-a"}, std::tuple{&B, "B", "--units-b"}})
-      if (const std::string w = size_warning(*m, which, option); !w.empty())
-        std::cerr << "cfgen: warning: " << w << '\n';
+  if (!args.share.load || args.shard.index == 0) warn_sizes(A, B);
   const gen::ModelInfo ai = gen::analyse_model(A);
   const gen::ModelInfo bi = gen::analyse_model(B);
 
@@ -341,15 +366,7 @@ int run_generate(const GenerateArgs& args) {
   graph.save(args.out_path);
   if (certifies) write_certificates(args.certificates_path, inputs, args.out_path, e, ws);
   if (default_checkpoint) remove_checkpoint(checkpoint_dir);
-  if (n_cfs == 0)
-    std::cerr << "cfgen: warning: the graph has no CF: A (" << A.size() << " mm across) and B ("
-              << B.size()
-              << " mm across) never touch in a valid contact formation; are the models' units "
-                 "right (--units)?\n";
-  if (!args.quiet)
-    std::cerr << "cfgen: " << n_cfs << " CFs (" << e.levels[0].valid << " + " << e.levels[1].valid
-              << " + " << e.levels[2].valid << "), " << n_tr << " transitions, " << seconds
-              << " s -> " << args.out_path << '\n';
+  report_written(args, e, A, B, n_cfs, n_tr, seconds);
   return 0;
 }
 
