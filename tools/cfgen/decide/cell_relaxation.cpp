@@ -376,16 +376,15 @@ std::vector<CellRelaxation::Slab> CellRelaxation::narrow(const Mat3& R_c, const 
                                                          const Vec3& hi) const {
   std::vector<Slab> out;
   auto cut = [&](int j, bool low) {
-    Slab slab{t_lo, t_hi, {}, true};
+    Slab slab{t_lo, t_hi, {}};
     (low ? slab.hi : slab.lo)[j] = low ? lo[j] : hi[j];
     std::vector<int> choice(slot_sizes_.size(), 0);
-    for (std::size_t c = 0; c < choices() && slab.proven; ++c) {
+    for (std::size_t c = 0; c < choices(); ++c) {
       std::optional<FarkasCertificate> proof = farkas(program(R_c, turn, choice, slab.lo, slab.hi));
-      slab.proven = proof.has_value();
-      if (proof) slab.proofs.push_back(std::move(*proof));
+      if (!proof) return;  // not proven: this side stays
+      slab.proofs.push_back(std::move(*proof));
       next_choice(choice, slot_sizes_);
     }
-    if (!slab.proven) return;
     (low ? t_lo : t_hi)[j] = low ? lo[j] : hi[j];
     out.push_back(std::move(slab));
   };

@@ -50,7 +50,6 @@ class CellRelaxation {
   struct Slab {
     Vec3 lo, hi;                            // mm
     std::vector<FarkasCertificate> proofs;  // one per choice, in choice order
-    bool proven = false;                    // every choice has its proof (else not cut)
   };
   struct Refutation {
     Verdict verdict = Verdict::kOpen;
