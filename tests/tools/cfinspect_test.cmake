@@ -66,7 +66,7 @@ endfunction()
 # Summary and queries on the hand-made cube / L-block graph (see tests/libcf/graph_test.cpp).
 witnesses_checked(_w5 5)
 cfinspect_test(summary ok "${_g}/box_l.json"
-  "valid cf-graph v1 \\(full schema check${_w5}\\).*model A 'cube': 8 vertices, 12 edges \\(0 reflex\\), 6 faces.*model B 'L-block': 12 vertices, 18 edges \\(1 reflex\\), 8 faces.*CFs: 5.*by number of PCs: 1: 4, 2: 1, 3: 0.*f-f 4 \\(3\\), e-f 1 \\(1\\), f-e 0 \\(0\\), v-f 1 \\(1\\).*transitions: 8 \\(gain 2, lose 2, change 4\\), 0 without their reverse.*out-degree: min 1, mean 1.60, max 2.*connected components: 1 \\(largest 5 CFs, 0 isolated CFs\\)")
+  "valid cf-graph v1 \\(schema check, items by the reader's rules${_w5}\\).*model A 'cube': 8 vertices, 12 edges \\(0 reflex\\), 6 faces.*model B 'L-block': 12 vertices, 18 edges \\(1 reflex\\), 8 faces.*CFs: 5.*by number of PCs: 1: 4, 2: 1, 3: 0.*f-f 4 \\(3\\), e-f 1 \\(1\\), f-e 0 \\(0\\), v-f 1 \\(1\\).*transitions: 8 \\(gain 2, lose 2, change 4\\), 0 without their reverse.*out-degree: min 1, mean 1.60, max 2.*connected components: 1 \\(largest 5 CFs, 0 isolated CFs\\)")
 cfinspect_test(summary_sorted_keys ok "${_g}/box_l_sorted.json" "CFs: 5")
 cfinspect_test(summary_json ok "${_g}/box_l.json --json"
   "\"valid\": true.*\"count\": 5.*\"2\": 1.*\"by_kind\": {[^}]*\"gain\": 2,[^}]*\"change\": 4.*\"components\": {[^}]*\"count\": 1")
@@ -87,10 +87,13 @@ cfinspect_test(dot ok "${_g}/box_l.json --dot ${_out}/box_l.dot" "wrote .*box_l.
   "-DFILE_EXPECT=^digraph G {.*2\\[label=\"2: f-f:2:4;f-f:5:5\"\\];.*0->2 \\[label=\"gain\", style=solid\\];.*2->0 \\[label=\"lose\", style=dashed\\];.*3->4 \\[label=\"change\", style=dotted\\];")
 cfinspect_test(print_schema ok "--print-schema" "draft-07" -DSAME_AS=${PROJECT_SOURCE_DIR}/schemas/cf-graph.schema.json)
 cfinspect_test(help ok "--help" "--holding.*--neighbours.*--dot.*--pose.*--json.*--verify")
-cfinspect_test(summary_fast ok "${_g}/box_l.json --fast" "valid cf-graph v1 \\(schema check of the skeleton\\)")
+cfinspect_test(summary_fast ok "${_g}/box_l.json --fast" "valid cf-graph v1 \\(schema check, items by the reader's rules\\)\n")
+cfinspect_test(summary_full_schema ok "${_g}/box_l.json --full-schema --fast"
+  "valid cf-graph v1 \\(full schema check\\)\n")
+cfinspect_test(summary_json_schema ok "${_g}/box_l.json --json --fast" "\"schema_check\": \"reader\"")
 if(CF_WITH_CGAL)
   cfinspect_test(summary_fast_verify ok "${_g}/box_l.json --fast --verify -j 1"
-    "valid cf-graph v1 \\(schema check of the skeleton; 5 witnesses verified\\)")
+    "valid cf-graph v1 \\(schema check, items by the reader's rules; 5 witnesses verified\\)")
   cfinspect_test(summary_json_witnesses ok "${_g}/box_l.json --json" "\"witnesses_verified\": 5")
 else()
   cfinspect_test(verify_without_cgal fail "${_g}/box_l.json --verify"
@@ -120,5 +123,5 @@ file(GLOB _data_graphs ${PROJECT_SOURCE_DIR}/data/graphs/*.json ${PROJECT_SOURCE
 foreach(_graph IN LISTS _data_graphs)
   get_filename_component(_name ${_graph} NAME)
   witnesses_checked(_w "[0-9]+")
-  cfinspect_test(data_${_name} ok "${_graph}" "valid cf-graph v1 \\(full schema check${_w}\\)")
+  cfinspect_test(data_${_name} ok "${_graph} --full-schema" "valid cf-graph v1 \\(full schema check${_w}\\)")
 endforeach()

@@ -1,7 +1,9 @@
 // The CF graph file (docs/spec.md, section 5): writing (deterministic, whole-or-nothing) and
 // reading (JSON or CBOR, schema-validated, every fault named by file and JSON pointer).
 
+#include "byte_input.hpp"
 #include "graph_schema.hpp"
+#include "input_file.hpp"
 #include "json_util.hpp"
 #include "model/graph_impl.hpp"
 #include "polyhedron_json.hpp"
@@ -16,6 +18,8 @@
 #include <functional>
 #include <iterator>
 #include <sstream>
+
+#include <sys/stat.h>
 
 namespace cf {
 
@@ -391,20 +395,27 @@ void CfGraph::save(const std::string& path) const {
 
 CfGraph CfGraph::load(const std::string& path) { return load(path, GraphLoadOptions()); }
 
+// The largest graph file read, as for any input (read_input_file).
+constexpr std::size_t kMaxGraphFileBytes = std::size_t{1} << 31;
+
 CfGraph CfGraph::load(const std::string& path, const GraphLoadOptions& options) {
   // Never blocks on a FIFO; a directory, a device or a FIFO is refused before reading.
-  std::string bytes, why;
-  if (!read_input_file(path, bytes, why))
-    throw FileError("reading '" + path + "': cannot open: " + why);
+  std::string why;
+  const int fd = internal::open_input_file(path, why, kMaxGraphFileBytes);
+  if (fd < 0) throw FileError("reading '" + path + "': cannot open: " + why);
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) st.st_size = 0;
+  const internal::ByteInput in(fd, static_cast<std::size_t>(st.st_size), path);
   CfGraph g;
-  g.impl_ = internal::read_graph(bytes, path, is_cbor_path(path), options);
+  g.impl_ = internal::read_graph(in, is_cbor_path(path), options);
   return g;
 }
 
 CfGraph CfGraph::from_bytes(const std::string& bytes, const std::string& source, bool cbor,
                             const GraphLoadOptions& options) {
+  const internal::ByteInput in(bytes.data(), bytes.size(), source);
   CfGraph g;
-  g.impl_ = internal::read_graph(bytes, source, cbor, options);
+  g.impl_ = internal::read_graph(in, cbor, options);
   return g;
 }
 

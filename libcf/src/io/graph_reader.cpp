@@ -1,14 +1,18 @@
-// Reading a graph file in one streaming pass (nlohmann's SAX interface, JSON or CBOR).
+// Reading a graph file in one streaming pass: JSON through JsonStream (json_stream.hpp), CBOR
+// through nlohmann's reader, both as SAX events into GraphSax, from a ByteInput read in
+// pieces (docs/graph-format.md, "Reading").
 //
-// Why not the DOM: a graph of 100,000 CFs is ~50 MB of JSON, and a std::map-based DOM of it
-// costs seconds in malloc/free alone. Here the `cfs` and `transitions` arrays go straight into
-// CfRecords and Transitions; only the small members (models, metadata) become a DOM, the
-// "skeleton", which is validated against the schema with valijson. The item-level checks
-// below mirror the schema's definitions of a CF, a PC, a pose and a transition (required
-// members, types, ranges, no unknown members in PCs and witnesses); GraphLoadOptions::
-// full_schema_check runs valijson over the whole document as well.
+// The `cfs` and `transitions` arrays go straight into CfRecords and Transitions; only the
+// other members (models, metadata) become a DOM, the "skeleton", at most one value per 32
+// bytes of the file, which is validated against the schema with valijson. The item-level
+// checks below hold whatever the schema's definitions of a CF, a PC, a pose, a plane and a
+// transition say (required members, types, ranges, no unknown members in PCs and witnesses;
+// tests/libcf/graph_reader_test.cpp refuses every schema violation of an item through them);
+// GraphLoadOptions::full_schema_check runs valijson over each item as well, one at a time.
 
+#include "byte_input.hpp"
 #include "graph_schema.hpp"
+#include "json_stream.hpp"
 #include "json_util.hpp"
 #include "model/graph_impl.hpp"
 #include "polyhedron_json.hpp"
@@ -24,10 +28,13 @@
 #include <cstdint>
 #include <cstring>
 #include <functional>
+#include <memory>
 #include <string_view>
+#include <unordered_set>
 #include <utility>
 
 #include <simdjson.h>
+#include <istream>
 #include <sstream>
 
 namespace cf::internal {
@@ -35,8 +42,12 @@ namespace cf::internal {
 namespace {
 
 constexpr std::size_t kNoFault = static_cast<std::size_t>(-1);
-/// Deepest nesting of arrays and objects accepted, in JSON and in CBOR.
-constexpr std::size_t kMaxNesting = 256;
+// The root members other than cfs and transitions (the models, the metadata) are held as a
+// DOM of 16 to 80 bytes a value (32 for a value in an array, counting its growth): at most one
+// value per 32 bytes of the file keeps that near the file's size, and 2^21 values (a model of
+// about 500,000 vertices) are always accepted.
+constexpr std::size_t kBytesPerCapturedValue = 32;
+constexpr std::size_t kMinCapturedValues = std::size_t{1} << 21;
 
 /// A CF's PCs as the file gives them (order kept for error pointers), checked against the
 /// models once those are read.
@@ -91,6 +102,8 @@ enum class Ctx : std::uint8_t {
   kR,            // in witness.R
   kRRow,         // in a row of witness.R
   kT,            // in witness.t
+  kPlanes,       // in a CF's planes array
+  kPlane,        // in one plane, [n_x, n_y, n_z, d]
   kTransitions,  // in the transitions array
   kTransition,   // in a transition object
 };
@@ -107,6 +120,7 @@ enum class Field : std::uint8_t {
   kCfDof,
   kCfTdof,
   kCfPure,
+  kCfPlanes,
   kCfOther,
   kPcType,
   kPcA,
@@ -153,9 +167,60 @@ struct Header {
   }
 };
 
+/// The full schema check (GraphLoadOptions::full_schema_check): each item of cfs and
+/// transitions becomes a DOM of its own, validated against its definition in the schema when
+/// it ends, so that the check holds one item at a time. The first violation is kept, to be
+/// reported after the reader's own faults.
+class ItemSchemaCheck {
+ public:
+  explicit ItemSchemaCheck(const std::string& source) : source_(source) {}
+  bool active() const { return !stack_.empty(); }
+  void start_item(bool object, bool is_cf, std::size_t index) {
+    item_ = object ? json::object() : json::array();
+    stack_.assign(1, &item_);
+    is_cf_ = is_cf;
+    index_ = index;
+  }
+  void start(bool object) { stack_.push_back(add(object ? json::object() : json::array())); }
+  void key(std::string_view k) { key_.assign(k.data(), k.size()); }
+  void value(json v) { add(std::move(v)); }
+  void end() {
+    stack_.pop_back();
+    if (!stack_.empty() || !violation.empty()) return;
+    try {
+      validate_graph_item(item_, is_cf_, index_, source_);
+    } catch (const Error& e) {
+      violation = e.what();
+    }
+  }
+  std::string violation;  ///< the first, as the error to throw
+
+ private:
+  json* add(json v) {
+    json* top = stack_.back();
+    if (top->is_object()) {
+      json& slot = (*top)[key_];
+      slot = std::move(v);
+      return &slot;
+    }
+    top->push_back(std::move(v));
+    return &top->back();
+  }
+  const std::string& source_;
+  json item_;
+  std::vector<json*> stack_;
+  std::string key_;
+  bool is_cf_ = false;
+  std::size_t index_ = 0;
+};
+
 class GraphSax {
  public:
-  GraphSax(const std::string& source, bool cbor) : source_(source), cbor_(cbor) {
+  /// `input_bytes`: the file's size, which bounds what its models and metadata may hold.
+  GraphSax(const std::string& source, bool cbor, std::size_t input_bytes)
+      : source_(source),
+        cbor_(cbor),
+        capture_budget_(std::max(kMinCapturedValues, input_bytes / kBytesPerCapturedValue)) {
     stack_.reserve(16);
     seen_.reserve(16);
     push(Ctx::kDocument);
@@ -206,7 +271,8 @@ class GraphSax {
   bool start_array(std::size_t) { return start(false); }
   bool end_object() { return end(); }
   bool end_array() { return end(); }
-  bool key(std::string& k);
+  bool key(std::string& k) { return key(std::string_view(k)); }
+  bool key(std::string_view k);
   bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) {
     throw Error("reading '" + source_ + "': not valid " + (cbor_ ? "CBOR" : "JSON") + ": " +
                 e.what());
@@ -221,6 +287,8 @@ class GraphSax {
   /// Checks the header when a member other than format and version comes before both
   /// (cfgen writes them first): a scan of the file's root for them, which throws.
   std::function<void()> header_scan;
+  /// Set for the full schema check.
+  std::unique_ptr<ItemSchemaCheck> schema_items;
   std::string fault_pointer;  ///< first item-level fault, reported after the parse
   std::string fault_what;
   bool faulted() const { return !fault_what.empty(); }
@@ -256,11 +324,16 @@ class GraphSax {
   }
   std::string cf_ptr() const { return "/cfs/" + std::to_string(cfs.size() - 1); }
   std::string pc_ptr() const { return cf_ptr() + "/pcs/" + std::to_string(pc_count_ - 1); }
+  std::string plane_ptr() const { return cf_ptr() + "/planes/" + std::to_string(plane_count_ - 1); }
   std::string tr_ptr() const { return "/transitions/" + std::to_string(transitions.size() - 1); }
   std::string field_ptr() const;
   static const char* container_name(bool object) { return object ? "an object" : "an array"; }
 
   void capture_value(json value);
+  /// One more value in the models and metadata, within capture_budget_.
+  void count_captured();
+  std::size_t captured_ = 0;
+  std::size_t capture_budget_;
   bool item_context(Ctx c) const {
     return c != Ctx::kDocument && c != Ctx::kRoot && c != Ctx::kCapture;
   }
@@ -269,9 +342,9 @@ class GraphSax {
   /// (the last wins, the first wins, or, here before, two `cfs` arrays joined), so it is
   /// refused. `seen_` holds, per open item object, a bit per known member read; the root's
   /// names are kept whole; a captured object (models, metadata) is asked itself.
-  void duplicate(std::string pointer, const std::string& name) {
-    fault(std::move(pointer),
-          "member \"" + printable(name) + "\" appears twice in this object (each name once)");
+  void duplicate(std::string pointer, std::string_view name) {
+    fault(std::move(pointer), "member \"" + printable(std::string(name)) +
+                                  "\" appears twice in this object (each name once)");
   }
   void push(Ctx c) {
     stack_.push_back(c);
@@ -288,7 +361,7 @@ class GraphSax {
   bool cbor_;
   std::vector<Ctx> stack_;
   std::vector<std::uint64_t> seen_;  // parallel to stack_
-  std::vector<std::string> root_keys_;
+  std::unordered_set<std::string> root_keys_;
   bool format_ok_ = false, version_ok_ = false, header_scanned_ = false;
   /// A root format or version checked as it is read: a file that is no graph stops here.
   void check_header_member(const json& value) {
@@ -308,7 +381,7 @@ class GraphSax {
   std::vector<json*> capture_;
   std::string capture_key_;
   // Per-item state.
-  int pc_count_ = 0, row_ = 0, col_ = 0, t_count_ = 0;
+  int pc_count_ = 0, row_ = 0, col_ = 0, t_count_ = 0, plane_count_ = 0, plane_col_ = 0;
   bool has_id_ = false, has_pcs_ = false, has_witness_ = false;
   bool has_type_ = false, has_a_ = false, has_b_ = false, has_R_ = false, has_t_ = false;
   bool has_from_ = false, has_to_ = false, has_kind_ = false;
@@ -329,6 +402,8 @@ std::string GraphSax::field_ptr() const {
       return cf_ptr() + "/translation_dof";
     case Field::kCfPure:
       return cf_ptr() + "/pure_rotation";
+    case Field::kCfPlanes:
+      return cf_ptr() + "/planes";
     case Field::kPcType:
       return pc_ptr() + "/type";
     case Field::kPcA:
@@ -354,7 +429,19 @@ std::string GraphSax::field_ptr() const {
   }
 }
 
+void GraphSax::count_captured() {
+  if (++captured_ <= capture_budget_) return;
+  // Refused at once: the members are held as a DOM, several times their size in the file.
+  throw Error("reading '" + source_ + "' at /" + printable(root_key_) +
+              ": the members other than cfs and transitions hold more than " +
+              std::to_string(capture_budget_) +
+              " values; a graph's models and metadata may hold one value per " +
+              std::to_string(kBytesPerCapturedValue) + " bytes of the file (at least " +
+              std::to_string(kMinCapturedValues) + ")");
+}
+
 void GraphSax::capture_value(json value) {
+  count_captured();
   json* top = capture_.back();
   if (top->is_object()) {
     (*top)[capture_key_] = std::move(value);
@@ -363,17 +450,16 @@ void GraphSax::capture_value(json value) {
   }
 }
 
-bool GraphSax::key(std::string& k) {
+bool GraphSax::key(std::string_view k) {
+  if (schema_items && schema_items->active()) schema_items->key(k);
   switch (stack_.back()) {
     case Ctx::kRoot:
       root_key_ = k;
+      count_captured();  // each root member is held
       field_ = k == "cfs"           ? Field::kRootCfs
                : k == "transitions" ? Field::kRootTransitions
                                     : Field::kRootOther;
-      if (std::find(root_keys_.begin(), root_keys_.end(), k) != root_keys_.end())
-        duplicate("/" + k, k);
-      else
-        root_keys_.push_back(k);
+      if (!root_keys_.emplace(k).second) duplicate("/" + std::string(k), k);
       if (k != "format" && k != "version" && !(format_ok_ && version_ok_) && !header_scanned_) {
         header_scanned_ = true;
         if (header_scan) header_scan();
@@ -381,7 +467,7 @@ bool GraphSax::key(std::string& k) {
       break;
     case Ctx::kCapture:
       capture_key_ = k;
-      if (capture_.back()->is_object() && capture_.back()->contains(k))
+      if (capture_.back()->is_object() && capture_.back()->contains(capture_key_))
         duplicate("/" + root_key_, k);
       break;
     case Ctx::kCf:
@@ -391,6 +477,7 @@ bool GraphSax::key(std::string& k) {
                : k == "dof"             ? Field::kCfDof
                : k == "translation_dof" ? Field::kCfTdof
                : k == "pure_rotation"   ? Field::kCfPure
+               : k == "planes"          ? Field::kCfPlanes
                                         : Field::kCfOther;  // CFs may carry extra members
       if (field_ != Field::kCfOther && !first_time(field_)) duplicate(cf_ptr(), k);
       break;
@@ -400,7 +487,8 @@ bool GraphSax::key(std::string& k) {
                : k == "b"  ? Field::kPcB
                            : Field::kPcOther;
       if (field_ == Field::kPcOther)
-        fault(pc_ptr(), "unexpected member \"" + printable(k) + "\" (a PC has type, a and b)");
+        fault(pc_ptr(),
+              "unexpected member \"" + printable(std::string(k)) + "\" (a PC has type, a and b)");
       else if (!first_time(field_))
         duplicate(pc_ptr(), k);
       break;
@@ -408,7 +496,7 @@ bool GraphSax::key(std::string& k) {
       field_ = k == "R" ? Field::kWR : k == "t" ? Field::kWT : Field::kWOther;
       if (field_ == Field::kWOther)
         fault(cf_ptr() + "/witness",
-              "unexpected member \"" + printable(k) + "\" (a witness has R and t)");
+              "unexpected member \"" + printable(std::string(k)) + "\" (a witness has R and t)");
       else if (!first_time(field_))
         duplicate(cf_ptr() + "/witness", k);
       break;
@@ -443,6 +531,7 @@ bool GraphSax::scalar(const Scalar& s) {
     capture_value(s.to_json());
     return true;
   }
+  if (schema_items && schema_items->active()) schema_items->value(s.to_json());
   if (faulted() || c == Ctx::kSkip) return true;
   item_scalar(c, s);
   return true;
@@ -514,6 +603,19 @@ void GraphSax::item_scalar(Ctx c, const Scalar& s) {
         cfs.back().witness.t_BA(t_count_) = s.number();
       ++t_count_;
       break;
+    case Ctx::kPlanes:
+      ++plane_count_;
+      fault(plane_ptr(), "expected 4 numbers, got " + s.shown());
+      break;
+    case Ctx::kPlane:
+      if (!s.is_number())
+        fault(plane_ptr() + "/" + std::to_string(plane_col_),
+              "expected a number, got " + s.shown());
+      else if (plane_count_ <= PcSet::kMaxPcs && plane_col_ < 4)
+        cfs.back().planes[static_cast<std::size_t>(plane_count_ - 1)]
+                         [static_cast<std::size_t>(plane_col_)] = s.number();
+      ++plane_col_;
+      break;
     case Ctx::kTransitions:
       transitions.emplace_back();
       fault(tr_ptr(), "expected a transition object, got " + s.shown());
@@ -551,6 +653,9 @@ void GraphSax::cf_scalar(const Scalar& s) {
       break;
     case Field::kCfTdof:
       read_small_int(s, 0, 3, r.translation_dof);
+      break;
+    case Field::kCfPlanes:
+      fault(field_ptr(), "expected an array, got " + s.shown());
       break;
     case Field::kCfPure:
       if (s.type != Scalar::kBool)
@@ -625,11 +730,16 @@ void GraphSax::transition_scalar(const Scalar& s) {
 
 bool GraphSax::start(bool object) {
   // nlohmann's CBOR reader recurses once per level: without a cap, a few hundred thousand
-  // nested arrays overflow the stack. JSON is capped by JsonWalker at the same depth.
+  // nested arrays overflow the stack. JSON is capped by JsonStream at the same depth.
   if (cbor_ && stack_.size() > kMaxNesting)
     throw Error("reading '" + source_ + "': not valid CBOR: nesting deeper than " +
                 std::to_string(kMaxNesting) + " levels");
   const Ctx c = stack_.back();
+  if (schema_items && schema_items->active())
+    schema_items->start(object);
+  else if (schema_items && !faulted() && (c == Ctx::kCfs || c == Ctx::kTransitions))
+    schema_items->start_item(object, c == Ctx::kCfs,
+                             c == Ctx::kCfs ? cfs.size() : transitions.size());
   if (c == Ctx::kDocument) {
     if (!object) {
       skeleton = json::array();  // reported after the parse; the rest is ignored
@@ -679,6 +789,7 @@ void GraphSax::start_at_root(bool object) {
 }
 
 void GraphSax::start_captured(bool object) {
+  count_captured();
   json* top = capture_.back();
   json* child;
   if (top->is_object()) {
@@ -743,6 +854,19 @@ Ctx GraphSax::start_in_item(Ctx c, bool object) {
       fault(cf_ptr() + "/witness/t/" + std::to_string(t_count_),
             std::string("expected a number, got ") + container_name(object));
       break;
+    case Ctx::kPlanes:
+      ++plane_count_;
+      if (object) {
+        fault(plane_ptr(), "expected 4 numbers, got an object");
+      } else {
+        plane_col_ = 0;
+        next = Ctx::kPlane;
+      }
+      break;
+    case Ctx::kPlane:
+      fault(plane_ptr() + "/" + std::to_string(plane_col_),
+            std::string("expected a number, got ") + container_name(object));
+      break;
     case Ctx::kTransitions:
       transitions.emplace_back();
       if (object) {
@@ -773,12 +897,16 @@ Ctx GraphSax::start_in_cf(bool object) {
     has_R_ = has_t_ = false;
     return Ctx::kWitness;
   }
+  if (field_ == Field::kCfPlanes && !object) {
+    plane_count_ = 0;
+    return Ctx::kPlanes;
+  }
   if (field_ == Field::kCfOther) return Ctx::kSkip;  // extra members of a CF are allowed, ignored
   if (field_ == Field::kCfPcs) has_pcs_ = true;
   if (field_ == Field::kCfWitness) has_witness_ = true;
-  const char* want = field_ == Field::kCfPcs       ? "an array"
-                     : field_ == Field::kCfWitness ? "an object"
-                                                   : "a scalar";
+  const char* want = field_ == Field::kCfPcs || field_ == Field::kCfPlanes ? "an array"
+                     : field_ == Field::kCfWitness                         ? "an object"
+                                                                           : "a scalar";
   fault(field_ptr(), std::string("expected ") + want + ", got " + container_name(object));
   return Ctx::kSkip;
 }
@@ -799,6 +927,7 @@ Ctx GraphSax::start_in_witness(bool object) {
 }
 
 bool GraphSax::end() {
+  if (schema_items && schema_items->active()) schema_items->end();
   const Ctx c = stack_.back();
   stack_.pop_back();
   seen_.pop_back();
@@ -854,6 +983,17 @@ bool GraphSax::end() {
     case Ctx::kT:
       if (t_count_ != 3)
         fault(cf_ptr() + "/witness/t", "expected 3 numbers, got " + std::to_string(t_count_));
+      break;
+    case Ctx::kPlanes:
+      // One per PC, checked against the PCs once both are read (read_graph).
+      if (plane_count_ < 1 || plane_count_ > PcSet::kMaxPcs)
+        fault(cf_ptr() + "/planes", "a CF has 1 to 3 planes, got " + std::to_string(plane_count_));
+      else
+        cfs.back().num_planes = plane_count_;
+      break;
+    case Ctx::kPlane:
+      if (plane_col_ != 4)
+        fault(plane_ptr(), "expected 4 numbers, got " + std::to_string(plane_col_));
       break;
     case Ctx::kTransition:
       missing(at_tr, has_from_, "from");
@@ -918,314 +1058,6 @@ class HeaderSax {
   bool finished_ = false;  ///< the root object was read to its end
 };
 
-/// Drives a SAX handler from simdjson's On-Demand parser: strict RFC 8259 with UTF-8
-/// checked, and every value visited, so the whole document is validated (On Demand checks
-/// what it is asked for). Errors give the line and column of where the parser stopped.
-/// CBOR goes through nlohmann's SAX parser.
-class JsonWalker {
- public:
-  JsonWalker(const std::string& bytes, const std::string& source) : source_(source) {
-    static_assert(kReadSlack >= simdjson::SIMDJSON_PADDING,
-                  "read_input_file's slack must cover simdjson's padding");
-    if (bytes.capacity() - bytes.size() >= simdjson::SIMDJSON_PADDING) {
-      text_ = simdjson::padded_string_view(bytes);  // reads into the string's spare capacity
-    } else {
-      copy_ = simdjson::padded_string(bytes.data(), bytes.size());
-      text_ = copy_;
-    }
-  }
-
-  template <class Sax>
-  void parse(Sax& sax) {
-    // An empty or blank document is refused before simdjson sees it, to say so plainly.
-    const char* first = text_.data();
-    const char* const end = first + text_.size();
-    while (first < end && (*first == ' ' || *first == '\n' || *first == '\r' || *first == '\t'))
-      ++first;
-    if (first == end) fail_at(end, "empty input, expected a JSON value");
-    // Errors of simdjson's first pass (invalid UTF-8, an unclosed string, a raw control
-    // character) come before there is a document to ask for a position.
-    if (const auto e = parser_.iterate(text_).get(doc_); e != simdjson::SUCCESS)
-      throw Error("reading '" + source_ + "': not valid JSON: " + simdjson::error_message(e));
-    iterating_ = true;
-    simdjson::ondemand::json_type type{};
-    check(doc_.type().get(type), first);
-    if (type == simdjson::ondemand::json_type::object ||
-        type == simdjson::ondemand::json_type::array) {
-      simdjson::ondemand::value root;
-      check(doc_.get_value().get(root), first);
-      value(root, sax, 0);
-    } else {
-      scalar(doc_, type, sax, first);
-    }
-    // current_location() is OUT_OF_BOUNDS once every token has been read.
-    if (const char* rest = nullptr; doc_.current_location().get(rest) == simdjson::SUCCESS)
-      fail_at(rest, "unexpected content after the JSON value");
-  }
-
- private:
-  /// Line and column (1-based) of a position in the text, and what is there.
-  [[noreturn]] void fail_at(const char* at, const std::string& what) const {
-    const char* const begin = text_.data();
-    const char* const end = begin + text_.size();
-    if (at == nullptr || at < begin || at > end) at = end;
-    std::size_t line = 1, col = 1;
-    for (const char* q = begin; q < at; ++q) {
-      if (*q == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
-      }
-    }
-    std::string near;
-    if (at < end) {
-      const unsigned char c = static_cast<unsigned char>(*at);
-      near = c >= 0x20 && c < 0x7f ? std::string(" near '") + *at + "'"
-                                   : " near byte " + std::to_string(c);
-    } else {
-      near = " at the end of the input";
-    }
-    throw Error("reading '" + source_ + "': not valid JSON: syntax error at line " +
-                std::to_string(line) + ", column " + std::to_string(col) + near + ": " + what);
-  }
-
- public:
-  /// Reads the root object's format and version into `h` with a parser of its own, stopping
-  /// once both are read; false when a syntax error stops the scan (the walk reports it).
-  bool scan_header(Header& h) {
-    simdjson::ondemand::parser parser;
-    simdjson::ondemand::document doc;
-    simdjson::ondemand::object root;
-    if (parser.iterate(text_).get(doc) != simdjson::SUCCESS ||
-        doc.get_object().get(root) != simdjson::SUCCESS)
-      return false;
-    for (auto item : root) {
-      simdjson::ondemand::field field;
-      std::string_view key;
-      if (std::move(item).get(field) != simdjson::SUCCESS ||
-          field.unescaped_key().get(key) != simdjson::SUCCESS)
-        return false;
-      if (key != "format" && key != "version") continue;  // its value is skipped
-      json& out = key == "format" ? h.format : h.version;
-      if (!scalar_json(field.value(), out)) return false;
-      (key == "format" ? h.has_format : h.has_version) = true;
-      if (h.complete()) return true;
-    }
-    return true;
-  }
-
-  /// A value as nlohmann JSON for the header's messages (containers as empty ones).
-  static bool scalar_json(simdjson::ondemand::value v, json& out) {
-    using simdjson::ondemand::json_type;
-    json_type type{};
-    if (v.type().get(type) != simdjson::SUCCESS) return false;
-    std::string_view str;
-    std::int64_t i = 0;
-    double d = 0;
-    bool b = false;
-    switch (type) {
-      case json_type::string:
-        if (v.get_string().get(str) != simdjson::SUCCESS) return false;
-        out = std::string(str);
-        return true;
-      case json_type::number:
-        if (v.get_int64().get(i) == simdjson::SUCCESS)
-          out = i;
-        else if (v.get_double().get(d) == simdjson::SUCCESS)
-          out = d;
-        else
-          return false;
-        return true;
-      case json_type::boolean:
-        if (v.get_bool().get(b) != simdjson::SUCCESS) return false;
-        out = b;
-        return true;
-      case json_type::object:
-        out = json::object();
-        return true;
-      case json_type::array:
-        out = json::array();
-        return true;
-      default: {  // null, or a literal the walk reports ("nul")
-        bool is_null = false;
-        if (v.is_null().get(is_null) != simdjson::SUCCESS || !is_null) return false;
-        out = nullptr;
-        return true;
-      }
-    }
-  }
-
- private:
-  /// Where the parser stopped; `fallback` when it cannot say.
-  const char* here(const char* fallback) {
-    const char* at = nullptr;
-    if (!iterating_ || doc_.current_location().get(at) != simdjson::SUCCESS) return fallback;
-    return at;
-  }
-
-  /// An error reading the value that starts at `at`, reported there.
-  void check(simdjson::error_code e, const char* at) {
-    if (e != simdjson::SUCCESS) fail_at(at, what(e));
-  }
-  /// An error moving through a container, reported where the parser stopped.
-  void check_step(simdjson::error_code e, const char* fallback) {
-    if (e != simdjson::SUCCESS) fail_at(here(fallback), what(e));
-  }
-  static std::string what(simdjson::error_code e) {
-    switch (e) {
-      case simdjson::T_ATOM_ERROR:
-      case simdjson::F_ATOM_ERROR:
-      case simdjson::N_ATOM_ERROR:
-        return "invalid literal";
-      case simdjson::STRING_ERROR:
-        return "invalid string (an unknown escape or an unpaired UTF-16 surrogate)";
-      case simdjson::NUMBER_ERROR:
-        return "invalid number";
-      default:
-        return simdjson::error_message(e);
-    }
-  }
-
-  template <class Sax>
-  void value(simdjson::ondemand::value v, Sax& sax, std::size_t depth) {
-    using simdjson::ondemand::json_type;
-    const char* at = v.raw_json_token().data();  // the value's first byte
-    json_type type{};
-    check(v.type().get(type), at);
-    switch (type) {
-      case json_type::object: {
-        if (depth >= kMaxNesting)
-          fail_at(at, "nesting deeper than " + std::to_string(kMaxNesting) + " levels");
-        simdjson::ondemand::object object;
-        check(v.get_object().get(object), at);
-        sax.start_object(static_cast<std::size_t>(-1));
-        for (auto item : object) {
-          simdjson::ondemand::field field;
-          check_step(std::move(item).get(field), at);
-          // The key's position first: unescaping consumes it.
-          const char* key_at = field.key().raw();
-          std::string_view key;
-          check(field.unescaped_key().get(key), key_at);
-          key_.assign(key.data(), key.size());
-          sax.key(key_);
-          value(field.value(), sax, depth + 1);
-        }
-        sax.end_object();
-        return;
-      }
-      case json_type::array: {
-        if (depth >= kMaxNesting)
-          fail_at(at, "nesting deeper than " + std::to_string(kMaxNesting) + " levels");
-        simdjson::ondemand::array array;
-        check(v.get_array().get(array), at);
-        sax.start_array(static_cast<std::size_t>(-1));
-        for (auto item : array) {
-          simdjson::ondemand::value element;
-          check_step(std::move(item).get(element), at);
-          value(element, sax, depth + 1);
-        }
-        sax.end_array();
-        return;
-      }
-      default:
-        scalar(v, type, sax, at);
-        return;
-    }
-  }
-
-  /// A scalar value or scalar document (simdjson's value and document share the getters).
-  template <class Node, class Sax>
-  void scalar(Node& node, simdjson::ondemand::json_type type, Sax& sax, const char* at) {
-    using simdjson::ondemand::json_type;
-    switch (type) {
-      case json_type::number: {
-        simdjson::ondemand::number n;
-        if (node.get_number().get(n) != simdjson::SUCCESS)
-          return number_fallback(node.raw_json_token(), sax, at);
-        return emit_number(n, sax);
-      }
-      case json_type::string: {
-        std::string_view str;
-        check(node.get_string().get(str), at);
-        string_.assign(str.data(), str.size());
-        sax.string(string_);
-        return;
-      }
-      case json_type::boolean: {
-        bool b = false;
-        if (node.get_bool().get(b) != simdjson::SUCCESS) fail_at(at, "invalid literal");
-        sax.boolean(b);
-        return;
-      }
-      case json_type::null: {
-        bool is_null = false;
-        if (node.is_null().get(is_null) != simdjson::SUCCESS || !is_null)
-          fail_at(at, "invalid literal");
-        sax.null();
-        return;
-      }
-      default:
-        fail_at(at, "expected a value");
-    }
-  }
-
-  template <class Sax>
-  void emit_number(simdjson::ondemand::number n, Sax& sax) {
-    switch (n.get_number_type()) {
-      case simdjson::ondemand::number_type::signed_integer:
-        sax.number_integer(n.get_int64());
-        return;
-      case simdjson::ondemand::number_type::unsigned_integer:
-        sax.number_unsigned(n.get_uint64());
-        return;
-      default:
-        sax.number_float(n.get_double(), kEmpty);
-        return;
-    }
-  }
-
-  /// simdjson refuses integers past 64 bits, which JSON allows and nlohmann reads as doubles;
-  /// any other number it refuses is reported with its position.
-  template <class Sax>
-  void number_fallback(simdjson::simdjson_result<std::string_view> token, Sax& sax,
-                       const char* at) {
-    std::string_view raw;
-    if (std::move(token).get(raw) != simdjson::SUCCESS) fail_at(at, "invalid number");
-    // The token runs to the next structural character: the number, then at most white space
-    // (anything else, '1e400z' say, is not a number).
-    std::size_t len = 0;
-    while (len < raw.size() && std::strchr("+-.0123456789eE", raw[len]) != nullptr) ++len;
-    if (raw.find_first_not_of(" \t\n\r", len) != std::string_view::npos)
-      fail_at(at, kInvalidNumber);
-    raw = raw.substr(0, len);
-    const std::string_view digits = raw.substr(!raw.empty() && raw[0] == '-' ? 1 : 0);
-    const bool long_integer = digits.size() >= 20 && digits[0] != '0' &&
-                              digits.find_first_not_of("0123456789") == std::string_view::npos;
-    double d = 0;
-    const auto r = std::from_chars(raw.data(), raw.data() + raw.size(), d);
-    if (long_integer && r.ec == std::errc()) {
-      sax.number_float(d, kEmpty);
-      return;
-    }
-    if (r.ec == std::errc::result_out_of_range) fail_at(at, "number out of the range of a double");
-    fail_at(at, kInvalidNumber);
-  }
-
-  inline static const std::string kEmpty;
-  static constexpr const char* kInvalidNumber =
-      "invalid number (RFC 8259: an optional minus, digits without leading zeros, an optional "
-      "fraction and "
-      "exponent)";
-  simdjson::padded_string copy_;       // when the caller's bytes have no padding
-  simdjson::padded_string_view text_;  // simdjson reads up to SIMDJSON_PADDING bytes past the end
-  const std::string& source_;
-  simdjson::ondemand::parser parser_;
-  simdjson::ondemand::document doc_;
-  bool iterating_ = false;  // doc_ is valid
-  std::string key_, string_;
-};
-
 class JsonLocator final : public FaultLocator {
  public:
   explicit JsonLocator(const JsonWhere& root) : root_(root) {}
@@ -1248,6 +1080,20 @@ class JsonLocator final : public FaultLocator {
   const JsonWhere& root_;
 };
 
+/// A CF's planes as the file gives them, one per PC in the file's order, put in the order of
+/// its PcSet.
+void order_planes(CfRecord& r, const RawPcs& raw, const JsonWhere& where) {
+  if (r.num_planes == 0) return;
+  if (r.num_planes != raw.num_pcs)
+    json_fail(where, std::to_string(r.num_planes) + " planes for " + std::to_string(raw.num_pcs) +
+                         " PCs (one per PC, in the PCs' order)");
+  const auto given = r.planes;
+  for (int k = 0; k < raw.num_pcs; ++k)
+    for (int j = 0; j < r.pcs.size(); ++j)
+      if (r.pcs[j] == raw.pcs[static_cast<std::size_t>(k)])
+        r.planes[static_cast<std::size_t>(j)] = given[static_cast<std::size_t>(k)];
+}
+
 bool is_reserved(const std::string& key) {
   return key == "format" || key == "version" || key == "units" || key == "models" || key == "cfs" ||
          key == "transitions";
@@ -1255,26 +1101,32 @@ bool is_reserved(const std::string& key) {
 
 }  // namespace
 
-std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::string& source,
-                                          bool cbor, const GraphLoadOptions& options) {
-  const char* const data = bytes.data();
-  const std::size_t size = bytes.size();
-  GraphSax sax(source, cbor);
+std::unique_ptr<CfGraph::Impl> read_graph(const ByteInput& in, bool cbor,
+                                          const GraphLoadOptions& options) {
+  const std::string& source = in.source();
+  GraphSax sax(source, cbor, in.size());
+  if (options.validate_schema && options.full_schema_check)
+    sax.schema_items = std::make_unique<ItemSchemaCheck>(source);
   if (cbor) {
     sax.header_scan = [&] {
       Header header;
       HeaderSax scan(header);
-      json::sax_parse(data, data + size, &scan, json::input_format_t::cbor, false);
+      ByteInputBuf buf(in);
+      std::istream text(&buf);
+      json::sax_parse(text, &scan, json::input_format_t::cbor, false);
       if (header.complete() || scan.finished_) header.check(source);
     };
-    json::sax_parse(data, data + size, &sax, json::input_format_t::cbor);
+    ByteInputBuf buf(in);
+    std::istream text(&buf);
+    json::sax_parse(text, &sax, json::input_format_t::cbor);
   } else {
-    JsonWalker walker(bytes, source);
+    JsonStream stream(in);
     sax.header_scan = [&] {
       Header header;
-      if (walker.scan_header(header)) header.check(source);
+      if (stream.scan_header(header.format, header.has_format, header.version, header.has_version))
+        header.check(source);
     };
-    walker.parse(sax);
+    stream.parse(sax);
   }
 
   const JsonWhere root{source, ""};
@@ -1314,19 +1166,17 @@ std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::s
         json_fail(root / "cfs" / i / "pcs" / static_cast<std::size_t>(k),
                   "PC " + to_string(pc) + " is repeated in this CF");
     }
+    order_planes(impl->cfs[i], r, root / "cfs" / i / "planes");
   }
   sax.raw_pcs = {};
 
   if (options.validate_schema) {
-    if (options.full_schema_check) {
-      validate_graph_schema(
-          cbor ? json::from_cbor(data, data + size) : json::parse(data, data + size), source);
-    } else {
-      json skeleton = j;
-      skeleton["cfs"] = json::array();
-      skeleton["transitions"] = json::array();
-      validate_graph_schema(skeleton, source);
-    }
+    json skeleton = j;
+    skeleton["cfs"] = json::array();
+    skeleton["transitions"] = json::array();
+    validate_graph_schema(skeleton, source);
+    if (sax.schema_items && !sax.schema_items->violation.empty())
+      throw Error(sax.schema_items->violation);
   }
 
   json meta = json::object();

@@ -18,4 +18,11 @@ const char* model_schema_text();
 ///   schema: <complaint>" for the first (deepest) violation.
 void validate_graph_schema(const nlohmann::json& document, const std::string& source);
 
+/// Validates one item of the graph's `cfs` (is_cf) or `transitions` array, number `index`,
+/// against its definition in the schema: the full check reads the items one at a time.
+/// @throws cf::Error as validate_graph_schema, the pointer starting /cfs/<index> or
+///   /transitions/<index>.
+void validate_graph_item(const nlohmann::json& item, bool is_cf, std::size_t index,
+                         const std::string& source);
+
 }  // namespace cf::internal

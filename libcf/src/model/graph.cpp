@@ -105,27 +105,54 @@ class ChangeRule {
  public:
   ChangeRule(const Polyhedron& a, const Polyhedron& b) : a_(a), b_(b) {}
   bool holds(const PcSet& f, const PcSet& g) {
+    // A file lists a CF's transitions together: the source's neighbour lists are looked up
+    // once for all of them.
+    if (!(f == source_)) {
+      source_ = f;
+      for (int i = 0; i < f.size(); ++i) {
+        auto it = neighbours_of_.find(f[i]);
+        if (it == neighbours_of_.end())
+          it = neighbours_of_.emplace(f[i], neighbouring_pcs(f[i], a_, b_)).first;
+        lists_[static_cast<std::size_t>(i)] = &it->second;  // nodes never move
+      }
+    }
+    // Most changes replace one PC and keep the others; when matching only the replaced ones
+    // fails, every one-for-one matching is tried. Each pair is looked up once.
+    near_ = {};
+    return matches(f, g, true) || matches(f, g, false);
+  }
+
+ private:
+  // Whether f[i] may become g[j]: equal, or g[j] among f[i]'s neighbours.
+  bool may_become(const PcSet& f, const PcSet& g, int i, int j) {
+    signed char& memo = near_[static_cast<std::size_t>(i * PcSet::kMaxPcs + j)];
+    if (memo == 0) {
+      const std::vector<Pc>& near = *lists_[static_cast<std::size_t>(i)];
+      memo = f[i] == g[j] || std::binary_search(near.begin(), near.end(), g[j]) ? 1 : -1;
+    }
+    return memo > 0;
+  }
+
+  bool matches(const PcSet& f, const PcSet& g, bool keep_common) {
     std::array<int, PcSet::kMaxPcs> perm{0, 1, 2};
     do {
       bool ok = true;
       for (int i = 0; i < f.size() && ok; ++i) {
-        const Pc& x = f[i];
-        const Pc& y = g[perm[static_cast<std::size_t>(i)]];
-        if (x == y) continue;
-        auto it = neighbours_of_.find(x);
-        if (it == neighbours_of_.end())
-          it = neighbours_of_.emplace(x, neighbouring_pcs(x, a_, b_)).first;
-        ok = std::binary_search(it->second.begin(), it->second.end(), y);
+        const int j = perm[static_cast<std::size_t>(i)];
+        if (f[i] == g[j]) continue;
+        ok = !(keep_common && (g.contains(f[i]) || f.contains(g[j]))) && may_become(f, g, i, j);
       }
       if (ok) return true;
     } while (std::next_permutation(perm.begin(), perm.begin() + g.size()));
     return false;
   }
 
- private:
   const Polyhedron& a_;
   const Polyhedron& b_;
   std::unordered_map<Pc, std::vector<Pc>, internal::PcHash> neighbours_of_;  // a cache
+  PcSet source_;                                                             // of lists_
+  std::array<const std::vector<Pc>*, PcSet::kMaxPcs> lists_{};
+  std::array<signed char, PcSet::kMaxPcs * PcSet::kMaxPcs> near_{};  // 0 unknown, 1 yes, -1 no
 };
 
 bool one_more(const PcSet& big, const PcSet& small) {
@@ -213,6 +240,9 @@ void CfGraph::Impl::build(const internal::FaultLocator& where) {
     const PcSet& pcs = cfs[i].pcs;
     if (pcs.empty()) where.cf_fault(i, "a CF needs 1 to 3 PCs, this one has none");
     check_distinct_planes(pcs, i, where);
+    if (cfs[i].num_planes != 0 && cfs[i].num_planes != pcs.size())
+      where.cf_fault(i, std::to_string(cfs[i].num_planes) + " contact planes for " +
+                            std::to_string(pcs.size()) + " PCs (one per PC, or none)");
     check_principal_and_freedoms(cfs[i], a, b, i, where);
     for (const Pc& pc : pcs) held.insert(pc);
     const auto [it, inserted] = index.emplace(pcs, CfId(static_cast<std::int32_t>(i)));

@@ -72,10 +72,10 @@ void write_file_atomically(const std::string& path, const std::string& bytes, co
 }  // namespace cf::internal
 
 namespace cf::internal {
-/// Reads a graph file's bytes (io/graph_reader.cpp): one streaming pass, then the checks. JSON
-/// is read in place when `bytes` has kReadSlack bytes of capacity past its end (as
-/// read_input_file leaves), else from a padded copy.
-/// @throws cf::Error naming `source`, the JSON pointer and the problem.
-std::unique_ptr<CfGraph::Impl> read_graph(const std::string& bytes, const std::string& source,
-                                          bool cbor, const GraphLoadOptions& options);
+class ByteInput;
+/// Reads a graph file (io/graph_reader.cpp): one streaming pass, then the checks. The input
+/// is read in pieces, never whole (docs/graph-format.md, "Reading").
+/// @throws cf::Error naming the input's source, the JSON pointer and the problem.
+std::unique_ptr<CfGraph::Impl> read_graph(const ByteInput& in, bool cbor,
+                                          const GraphLoadOptions& options);
 }  // namespace cf::internal
