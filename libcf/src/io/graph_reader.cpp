@@ -218,9 +218,9 @@ class GraphSax {
  public:
   /// `input_bytes`: the file's size, which bounds what its models and metadata may hold.
   GraphSax(const std::string& source, bool cbor, std::size_t input_bytes)
-      : source_(source),
-        cbor_(cbor),
-        capture_budget_(std::max(kMinCapturedValues, input_bytes / kBytesPerCapturedValue)) {
+      : capture_budget_(std::max(kMinCapturedValues, input_bytes / kBytesPerCapturedValue)),
+        source_(source),
+        cbor_(cbor) {
     stack_.reserve(16);
     seen_.reserve(16);
     push(Ctx::kDocument);

@@ -65,10 +65,6 @@ struct CfGraph::Impl {
 namespace cf::internal {
 /// Empty when `meta` is a JSON object without the graph's own members, else the reason.
 std::string check_metadata(const nlohmann::json& meta);
-/// Writes `bytes` to a temporary file next to `path`, then renames it into place: the file
-/// is whole or untouched. `what` starts the error message ("writing graph").
-/// @throws cf::Error naming the file and the system's reason.
-void write_file_atomically(const std::string& path, const std::string& bytes, const char* what);
 }  // namespace cf::internal
 
 namespace cf::internal {
