@@ -16,6 +16,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -102,8 +103,9 @@ class JsonStream {
   void members(Sax& sax, std::size_t depth);
   template <class Sax>
   void items(Sax& sax, std::size_t depth);
+  enum class LineBatch { kNone, kMore, kEnded };
   template <class Sax>
-  bool line_batch(Sax& sax);
+  LineBatch line_batch(Sax& sax);
   template <class Sax>
   bool framed_batch(Sax& sax, std::size_t depth);
   template <class Sax>
@@ -229,14 +231,13 @@ void JsonStream::items(Sax& sax, std::size_t depth) {
   }
   // Line batches know the depth of the graph's items only (the DOM parser's depth limit).
   // A file laid out otherwise (an item over several lines) stops trying them after two
-  // misses in a row; a cfgen file misses only at an array's end.
+  // misses in a row; a cfgen file never misses.
   int misses = depth == 2 ? 0 : 2;
-  const auto line_batch_read = [&] {
-    const bool read = misses < 2 && line_batch(sax);
-    misses = read ? 0 : misses + 1;
-    return read;
-  };
-  while (line_batch_read() || !framed_batch(sax, depth)) {
+  while (true) {
+    const LineBatch read = misses < 2 ? line_batch(sax) : LineBatch::kNone;
+    if (read == LineBatch::kEnded) break;
+    misses = read == LineBatch::kNone ? misses + 1 : 0;
+    if (read == LineBatch::kNone && framed_batch(sax, depth)) break;
     // The cursor is past a ',': an item follows.
     if (!w_.skip_space()) fail_at(nullptr, what(simdjson::TAPE_ERROR));
     if (*w_.cur() == ']') fail_at(w_.cur(), what(simdjson::TAPE_ERROR));
@@ -244,36 +245,47 @@ void JsonStream::items(Sax& sax, std::size_t depth) {
   sax.end_array();
 }
 
-/// The items up to the last line break in the next kBatchBytes, when that break follows an
-/// item and its ',' (as cfgen writes, an item a line): they are parsed by simdjson's DOM
-/// parser as one array, and nothing is emitted unless the whole of it is valid. A raw line
-/// break is never inside a JSON string, so the batch is whole items exactly when it parses.
-/// False (nothing read) otherwise; framed_batch then reads the items.
+/// The items in the next kBatchBytes when they are laid out an item a line, as cfgen writes
+/// them: up to a line that starts with the array's ']' (kEnded, the cursor past it), or else
+/// up to the last line break after an item's ',' (kMore, the cursor past the ','). They are
+/// parsed by simdjson's DOM parser as one array, and nothing is emitted unless the whole of
+/// it is valid. A raw line break is never inside a JSON string, so the batch is whole items
+/// exactly when it parses. kNone (nothing read) otherwise; framed_batch then reads them.
 template <class Sax>
-bool JsonStream::line_batch(Sax& sax) {
+JsonStream::LineBatch JsonStream::line_batch(Sax& sax) {
   w_.fill(kBatchBytes);
   const std::size_t n = std::min(w_.avail(), kBatchBytes);
   char* const p = w_.cur();
-  std::size_t cut = n;
-  while (cut > 0 && p[cut - 1] != '\n') --cut;
-  if (cut == 0) return false;
-  std::size_t e = cut - 1;  // the line break
+  // The first line that starts with ']', else the last line break.
+  std::size_t cut = 0, close = 0;
+  for (const char* q = p; (q = static_cast<const char*>(std::memchr(q, '\n', n - (q - p))));) {
+    cut = static_cast<std::size_t>(q - p);
+    std::size_t j = cut + 1;
+    while (j < w_.avail() && (p[j] == ' ' || p[j] == '\t' || p[j] == '\r')) ++j;
+    if (j < w_.avail() && p[j] == ']') {
+      close = j;
+      break;
+    }
+    if (++q == p + n) break;
+  }
+  if (cut == 0) return LineBatch::kNone;
+  std::size_t e = cut;  // the line break: the items end before it
   while (e > 0 && (p[e - 1] == ' ' || p[e - 1] == '\r' || p[e - 1] == '\t')) --e;
-  if (e == 0 || p[e - 1] != ',') return false;
-  --e;  // the ',' becomes the array's ']', the byte before the cursor its '['
+  if (e == 0 || (p[e - 1] == ',') == (close != 0)) return LineBatch::kNone;
+  if (close == 0) --e;  // the ',' becomes the array's ']', the byte before the cursor its '['
   if (dom_.capacity() == 0 && dom_.allocate(kBatchBytes + 2, kMaxNesting - 2) != simdjson::SUCCESS)
-    return false;
-  const char before = p[-1];
+    return LineBatch::kNone;
+  const char before = p[-1], after = p[e];
   p[-1] = '[';
   p[e] = ']';
   simdjson::dom::element root;
   const auto err = dom_.parse(p - 1, e + 2, false).get(root);
   p[-1] = before;
-  p[e] = ',';
-  if (err != simdjson::SUCCESS || !root.is_array()) return false;
+  p[e] = after;
+  if (err != simdjson::SUCCESS || !root.is_array()) return LineBatch::kNone;
   for (simdjson::dom::element item : simdjson::dom::array(root)) emit(item, sax);
-  w_.advance(cut);
-  return true;
+  w_.advance(close != 0 ? close + 1 : cut);
+  return close != 0 ? LineBatch::kEnded : LineBatch::kMore;
 }
 
 /// The items of one batch, each framed by TextWindow::value_end and then parsed by simdjson's
