@@ -69,16 +69,7 @@ void append_double(std::string& out, double v) {
   }
 }
 
-/// A JSON string: plain printable ASCII as it is, anything else escaped by nlohmann.
-void append_string(std::string& out, std::string_view v) {
-  const bool plain = std::all_of(
-      v.begin(), v.end(), [](char c) { return c >= 0x20 && c < 0x7f && c != '"' && c != '\\'; });
-  if (plain) {
-    out += '"';
-    out.append(v.data(), v.size());
-    out += '"';
-    return;
-  }
+void append_escaped(std::string& out, std::string_view v) {
   out +=
       nlohmann::json(std::string(v)).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }

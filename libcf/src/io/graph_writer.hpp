@@ -22,10 +22,20 @@ namespace cf::internal {
 /// millions of transitions is written without a call per value.
 
 /// Text of a number as nlohmann's dump() lays it out (shortest round-trip digits), of an
-/// integer, and of a JSON string.
+/// integer, and of a JSON string that needs escapes.
 void append_double(std::string& out, double v);
 void append_int(std::string& out, long long v);
-void append_string(std::string& out, std::string_view v);
+void append_escaped(std::string& out, std::string_view v);
+
+/// A JSON string: printable ASCII without '"' and '\\' (every name and kind of a record)
+/// as it is, anything else escaped.
+inline void append_string(std::string& out, std::string_view v) {
+  for (const char c : v)
+    if (c < 0x20 || c >= 0x7f || c == '"' || c == '\\') return append_escaped(out, v);
+  out += '"';
+  out.append(v.data(), v.size());
+  out += '"';
+}
 
 /// JSON text appended to a string, without white space (as nlohmann's dump()).
 class JsonSink {

@@ -163,9 +163,9 @@ bool one_more(const PcSet& big, const PcSet& small) {
 }
 
 // Transition t: its ends are CF ids, distinct, and its kind holds between their PC sets.
-void check_transition(std::size_t t, const Transition& tr, const std::vector<CfRecord>& cfs,
+void check_transition(std::size_t t, const Transition& tr, const std::vector<PcSet>& sets,
                       ChangeRule& change, const internal::FaultLocator& where) {
-  const std::size_t n = cfs.size();
+  const std::size_t n = sets.size();
   const auto in_range = [&](CfId id, const char* field) {
     if (!id.valid() || id.index() >= n)
       where.transition_fault(t, field,
@@ -177,8 +177,8 @@ void check_transition(std::size_t t, const Transition& tr, const std::vector<CfR
   if (tr.from == tr.to)
     where.transition_fault(
         t, "to", "a transition from CF " + std::to_string(tr.from.value()) + " to itself");
-  const PcSet& f = cfs[tr.from.index()].pcs;
-  const PcSet& g = cfs[tr.to.index()].pcs;
+  const PcSet& f = sets[tr.from.index()];
+  const PcSet& g = sets[tr.to.index()];
   bool ok = false;
   const char* rule = "";
   switch (tr.kind) {
@@ -251,9 +251,13 @@ void CfGraph::Impl::build(const internal::FaultLocator& where) {
           i, "PC set {" + to_string(pcs) + "} repeats CF " + std::to_string(it->second.value()));
   }
   ChangeRule change(a, b);
+  // The PC sets side by side: a transition's target is anywhere in the graph, and a whole
+  // CfRecord per lookup would be a cache miss each.
+  std::vector<PcSet> sets(n);
+  for (std::size_t i = 0; i < n; ++i) sets[i] = cfs[i].pcs;
   out.assign(n, {});
   for (std::size_t t = 0; t < transitions.size(); ++t) {
-    check_transition(t, transitions[t], cfs, change, where);
+    check_transition(t, transitions[t], sets, change, where);
     out[transitions[t].from.index()].push_back(transitions[t]);
   }
   sort_out_lists(out, transitions, where);
