@@ -170,6 +170,12 @@ if [[ "$group" == cfinspect ]]; then
   check nulls_without_format 1 "^cfinspect: reading 'nulls.json' at /: missing member \"format\": not a cf-graph file" -- "$CFINSPECT" nulls.json
   python3 -c "import sys; sys.stdout.buffer.write(b'\xa1\x61x\x9b' + (2 * 10**6).to_bytes(8, 'big') + b'\xf6' * (2 * 10**6))" >nulls.cbor
   check nulls_without_format_cbor 1 "^cfinspect: reading 'nulls.cbor' at /: missing member \"format\": not a cf-graph file" -- "$CFINSPECT" nulls.cbor
+  # A graph's header, then a metadata member of 3 million nulls: refused after 2^21 values,
+  # before a DOM of them is built.
+  python3 -c "import sys; sys.stdout.write('{\"format\":\"cf-graph\",\"version\":1,\"x\":[' + ','.join(['null'] * 3000000) + ']}')" >big_meta.json
+  check big_metadata 1 "^cfinspect: reading 'big_meta.json' at /x: the members other than cfs and transitions hold more than 2097152 values" -- "$CFINSPECT" big_meta.json
+  python3 -c "import sys; sys.stdout.buffer.write(b'\xa3\x66format\x68cf-graph\x67version\x01\x61x\x9b' + (3 * 10**6).to_bytes(8, 'big') + b'\xf6' * (3 * 10**6))" >big_meta.cbor
+  check big_metadata_cbor 1 "^cfinspect: reading 'big_meta.cbor' at /x: the members other than cfs and transitions hold more than 2097152 values" -- "$CFINSPECT" big_meta.cbor
   # A member named twice: refused, with the second one's place.
   printf '{"format":"cf-graph","version":1,"format":"x"}' >twice.json
   check member_twice 1 "^cfinspect: reading 'twice.json' at /format: member \"format\" appears twice in this object \(each name once\)" -- "$CFINSPECT" twice.json
