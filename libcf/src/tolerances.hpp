@@ -3,7 +3,10 @@
 // Tolerances a user sets (epsilon, the angular tolerances, the proxy's) are parameters
 // (cf/params.hpp); the geometric tolerances of detection are derived from epsilon and the
 // models' size (detect/exact.hpp, DetectionTables). What is here is rounding: how far a value
-// computed in double or float may be from the exact one, far below any tolerance set.
+// computed in double or float may be from the exact one, far below any tolerance set. A
+// length is round-off below kRelativeRounding times the length scale it is computed at:
+// epsilon, for what detection and the force model measure (it has no direction, and nothing
+// divides by it).
 
 namespace cf::internal {
 
@@ -11,10 +14,6 @@ namespace cf::internal {
 /// computed in double from a few lengths or unit vectors. A double's unit is 1.1e-16 and a few
 /// operations stay within 1e-14; every tolerance a user or a model sets is above 1e-9.
 constexpr double kRelativeRounding = 1e-12;
-
-/// mm: a length below this is round-off (a double's unit at 10 m is 2e-12 mm): it has no
-/// direction, and nothing divides by it.
-constexpr double kTinyMm = 1e-12;
 
 /// Dimensionless: the rounding of a float (single precision) coordinate, 2^-24 relative, taken
 /// up: a box's centre rounded to float errs by less than this times its magnitude.

@@ -166,7 +166,7 @@ bool line_on_face(const PairTables& t, ExactScratch& s, const Polyhedron& m, con
   } else {
     clip_segment(a2, b2, flat.poly(f), t.geo_tol, OnBoundary::kInclude, s.params.data(), piece);
   }
-  if (len > internal::kTinyMm) {
+  if (len > internal::kRelativeRounding * t.eps) {
     *t_c = moment / len;
     *d = dmin;
     *gap = 0;

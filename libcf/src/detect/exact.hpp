@@ -99,7 +99,7 @@ struct PairTables {
   /// rad: the angular tolerance of a contact region of this extent (mm).
   double tol_for(double extent) const {
     if (prm.angular_tolerance_rad > 0) return prm.angular_tolerance_rad;
-    const double t = std::atan(eps / std::max(extent, internal::kTinyMm));
+    const double t = std::atan(eps / std::max(extent, internal::kRelativeRounding * eps));
     return std::clamp(t, prm.min_angular_tolerance_rad, prm.max_angular_tolerance_rad);
   }
   bool in_band(double d) const { return d <= eps && d >= -depth; }

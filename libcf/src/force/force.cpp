@@ -47,16 +47,17 @@ namespace {
 using Slot = ForceState::Slot;
 constexpr int kMaxPcs = ForceResult::kMaxPcs;
 
-// mm: tangential motions below internal::kTinyMm have no direction (round-off of poses).
-using internal::kTinyMm;
+// mm: a tangential motion or stretch shorter than this has no direction: round-off of the
+// poses, relative to epsilon (the length scale of what the force model measures).
+double round_off_mm(const Params& P) { return internal::kRelativeRounding * P.epsilon_mm; }
 
 constexpr std::size_t pc_index(int k) { return static_cast<std::size_t>(k); }
 
 Vec3 tangential(const Vec3& v, const Vec3& n) { return v - n * n.dot(v); }
 
-Vec3 unit_or_zero(const Vec3& v) {
+Vec3 unit_or_zero(const Vec3& v, double tiny_mm) {
   const double l = v.norm();
-  return l > kTinyMm ? Vec3(v / l) : Vec3::Zero();
+  return l > tiny_mm ? Vec3(v / l) : Vec3::Zero();
 }
 
 // The stick anchor's stretch after the anchored material point moves by d (tangential, mm)
@@ -65,7 +66,7 @@ Vec3 unit_or_zero(const Vec3& v) {
 // tractrix does, tan(phi/2) shrinking by e^(-s/L) over a straight travel s (phi: the angle
 // between the stretch and d). Exact for a straight tick, so the anchor, and the friction
 // along it, do not depend on how a path is cut into ticks (docs/force-model.md, "s_pj").
-Vec3 trail(const Vec3& w0, const Vec3& d, double L) {
+Vec3 trail(const Vec3& w0, const Vec3& d, double L, double tiny_mm) {
   const Vec3 chord = w0 + d;
   if (chord.norm() <= L) return chord;
   if (!(L > 0)) return Vec3::Zero();
@@ -79,9 +80,9 @@ Vec3 trail(const Vec3& w0, const Vec3& d, double L) {
     w = w0 + t0 * d;
   }
   const double travel = (1 - t0) * d.norm();
-  const Vec3 u = unit_or_zero(d);
+  const Vec3 u = unit_or_zero(d, tiny_mm);
   const Vec3 w_across = w - u * u.dot(w);  // the stretch's part across the motion
-  const Vec3 across = unit_or_zero(w_across);
+  const Vec3 across = unit_or_zero(w_across, tiny_mm);
   const double phi0 = std::atan2(w_across.norm(), u.dot(w));
   const double phi1 = 2 * std::atan(std::tan(0.5 * phi0) * std::exp(-travel / L));
   return L * (std::cos(phi1) * u + std::sin(phi1) * across);
@@ -258,25 +259,25 @@ double normal_force(const Params& P, Slot& slot, double distance, bool hold, std
 // leaves it (`trail`): p_j's motion over its last eq. (3) bound of travel, which a proxy's
 // sub-micron settling cannot turn as it turns a 1 um tick's own motion at 10 kHz. Per tick
 // (and with no stretch), the tick's tangential motion t_tick.
-void displacement(bool anchor_mode, const Pose& pose, const Pose* prev_pose, const Slot& slot,
-                  const Vec3& nrm, const Vec3& t_tick, PcForce& f, Vec3& dir_static,
-                  Vec3& dir_kinetic, Vec3& stretch_after) {
+void displacement(bool anchor_mode, double tiny_mm, const Pose& pose, const Pose* prev_pose,
+                  const Slot& slot, const Vec3& nrm, const Vec3& t_tick, PcForce& f,
+                  Vec3& dir_static, Vec3& dir_kinetic, Vec3& stretch_after) {
   stretch_after = Vec3::Zero();
   if (anchor_mode) {
     const Vec3 now = pose.apply(slot.anchor_A);
     const Vec3 before = prev_pose != nullptr ? prev_pose->apply(slot.anchor_A) : now;
     const Vec3 w0 = tangential(before - slot.anchor_W, nrm), d = tangential(now - before, nrm);
     f.s_mm = (w0 + d).norm();
-    stretch_after = trail(w0, d, f.s_bound_mm);
-    dir_static = unit_or_zero(stretch_after);
+    stretch_after = trail(w0, d, f.s_bound_mm, tiny_mm);
+    dir_static = unit_or_zero(stretch_after, tiny_mm);
   } else {
     f.s_mm = t_tick.norm();
-    dir_static = unit_or_zero(t_tick);
+    dir_static = unit_or_zero(t_tick, tiny_mm);
   }
-  if (anchor_mode && stretch_after.norm() > kTinyMm)
+  if (anchor_mode && stretch_after.norm() > tiny_mm)
     dir_kinetic = dir_static;
   else
-    dir_kinetic = t_tick.norm() > kTinyMm ? unit_or_zero(t_tick) : dir_static;
+    dir_kinetic = t_tick.norm() > tiny_mm ? unit_or_zero(t_tick, tiny_mm) : dir_static;
 }
 
 // Each rendered PC's geometry, the motion [a b c] of A's material point at p_j over the
@@ -294,7 +295,7 @@ void read_pcs(const ForceModel::Fixed& fm, ForceState& s, const Pose& pose, cons
     const Vec3 nrm = c.R_WT.col(1);
     const Vec3 p_A = pose.inverse_apply(c.p_W);
     const Vec3 d_tick = s.has_prev ? Vec3(c.p_W - s.prev_pose.apply(p_A)) : Vec3::Zero();
-    f.u_T = unit_or_zero(c.R_WT.transpose() * d_tick);
+    f.u_T = unit_or_zero(c.R_WT.transpose() * d_tick, round_off_mm(P));
     const Vec3 t_tick = tangential(d_tick, nrm);
 
     bool fresh = false;
@@ -307,20 +308,22 @@ void read_pcs(const ForceModel::Fixed& fm, ForceState& s, const Pose& pose, cons
 
     f.F_cy = normal_force(P, slot, c.distance, hold && !fresh, r.discontinuities);
     f.s_bound_mm = P.mu_static * f.F_cy / P.kp_N_per_mm;
-    displacement(anchor_mode, pose, s.has_prev ? &s.prev_pose : nullptr, slot, nrm, t_tick, f,
-                 w.dir_static[k], w.dir_kinetic[k], w.trail[k]);
+    displacement(anchor_mode, round_off_mm(P), pose, s.has_prev ? &s.prev_pose : nullptr, slot, nrm,
+                 t_tick, f, w.dir_static[k], w.dir_kinetic[k], w.trail[k]);
   }
 }
 
 // ---- The friction regime per motion type (section 4.4) ----
 
 // Eq. (3). The slack absorbs the round-off of an anchor placed exactly at the bound.
-bool sticks(const PcForce& f) {
+bool sticks(const PcForce& f, double tiny_mm) {
   constexpr double kBoundRounding = 1e-9;  // relative: the anchor's own round-off, and more
-  return f.s_mm <= f.s_bound_mm * (1 + kBoundRounding) + kTinyMm;
+  return f.s_mm <= f.s_bound_mm * (1 + kBoundRounding) + tiny_mm;
 }
 
-Regime stick_or_max(const PcForce& f) { return sticks(f) ? Regime::kStick : Regime::kMaxStatic; }
+Regime stick_or_max(const PcForce& f, double tiny_mm) {
+  return sticks(f, tiny_mm) ? Regime::kStick : Regime::kMaxStatic;
+}
 
 // Eq. (2)'s cone test on [a b c]: moving towards B (b < 0) within the cone.
 bool inside_cone(const PcForce& f, double mu) {
@@ -334,12 +337,13 @@ void set_all(ForceResult& r, int m, Regime g) {
 
 // Case (c) of MT2, also used by MT3 and MT5: the PC with the least s_pj stays static when
 // eq. (3) holds there (a pure compliant rotation about it), the others slide.
-void rotation_rule(ForceResult& r, int m) {
+void rotation_rule(ForceResult& r, int m, double tiny_mm) {
   int i_min = 0;
   for (int k = 1; k < m; ++k)
     if (r.pcs[pc_index(k)].s_mm < r.pcs[pc_index(i_min)].s_mm) i_min = k;
   set_all(r, m, Regime::kKinetic);
-  if (m > 0 && sticks(r.pcs[pc_index(i_min)])) r.pcs[pc_index(i_min)].regime = Regime::kStick;
+  if (m > 0 && sticks(r.pcs[pc_index(i_min)], tiny_mm))
+    r.pcs[pc_index(i_min)].regime = Regime::kStick;
 }
 
 // The freedoms of the current PCs: an SVD-sized eigenproblem, so only when a rule needs
@@ -353,8 +357,9 @@ Freedoms freedoms_of(const ForceModel::Fixed& fm, const ContactPc* pcs, int m, c
 // pose change against them decides between the second situation, (b) and (c).
 void regimes_mt2(const ForceModel::Fixed& fm, const Pose* prev, const Pose& pose,
                  const ContactPc* pcs, int m, ForceResult& r) {
+  const double tiny_mm = round_off_mm(fm.params);
   bool all_stick = true;
-  for (int k = 0; k < m; ++k) all_stick = all_stick && sticks(r.pcs[pc_index(k)]);
+  for (int k = 0; k < m; ++k) all_stick = all_stick && sticks(r.pcs[pc_index(k)], tiny_mm);
   if (all_stick) {
     r.motion = MotionType::kMT2a;  // first situation: every PC static, eq. (4)
     set_all(r, m, Regime::kStick);
@@ -364,13 +369,14 @@ void regimes_mt2(const ForceModel::Fixed& fm, const Pose* prev, const Pose& pose
   if (prev != nullptr) r.check = check_motion(r.freedoms, *prev, pose, fm.params);
   if (!r.check.along) {
     r.motion = MotionType::kMT2a;  // second situation: not a possible motion
-    for (int k = 0; k < m; ++k) r.pcs[pc_index(k)].regime = stick_or_max(r.pcs[pc_index(k)]);
+    for (int k = 0; k < m; ++k)
+      r.pcs[pc_index(k)].regime = stick_or_max(r.pcs[pc_index(k)], tiny_mm);
   } else if (!r.freedoms.pure_rotation) {
     r.motion = MotionType::kMT2b;
     set_all(r, m, Regime::kKinetic);
   } else {
     r.motion = MotionType::kMT2c;
-    rotation_rule(r, m);
+    rotation_rule(r, m, tiny_mm);
   }
 }
 
@@ -379,7 +385,8 @@ void regimes_mt2(const ForceModel::Fixed& fm, const Pose* prev, const Pose& pose
 void regimes_mt4(const Params& P, int g, int m, ForceResult& r) {
   if (g >= 0 && g < m && inside_cone(r.pcs[pc_index(g)], P.mu_static)) {
     for (int k = 0; k < m; ++k)
-      r.pcs[pc_index(k)].regime = k == g ? Regime::kImpactStatic : stick_or_max(r.pcs[pc_index(k)]);
+      r.pcs[pc_index(k)].regime =
+          k == g ? Regime::kImpactStatic : stick_or_max(r.pcs[pc_index(k)], round_off_mm(P));
   } else {
     set_all(r, m, Regime::kKinetic);
   }
@@ -414,13 +421,13 @@ void choose_regimes(const ForceModel::Fixed& fm, const Pose* prev, const Pose& p
       if (!r.freedoms.pure_rotation)
         set_all(r, m, Regime::kKinetic);
       else
-        rotation_rule(r, m);
+        rotation_rule(r, m, round_off_mm(fm.params));
       break;
     case MotionType::kMT4:
       regimes_mt4(fm.params, prior.gained, m, r);
       break;
     case MotionType::kMT5:
-      rotation_rule(r, m);
+      rotation_rule(r, m, round_off_mm(fm.params));
       break;
     case MotionType::kNone:
       set_all(r, m, Regime::kKinetic);
