@@ -185,8 +185,20 @@ std::size_t JsonStream::skip_space_at(std::size_t i) {
   return std::min(i, w_.avail());
 }
 
-void JsonStream::expect(char c) {
+void JsonStream::skip_space_or_fail() {
   if (!w_.skip_space()) fail_at(nullptr, what(simdjson::TAPE_ERROR));
+}
+
+bool JsonStream::opened_empty(char close) {
+  w_.advance(1);
+  skip_space_or_fail();
+  if (*w_.cur() != close) return false;
+  w_.advance(1);
+  return true;
+}
+
+void JsonStream::expect(char c) {
+  skip_space_or_fail();
   if (*w_.cur() != c) fail_at(w_.cur(), what(simdjson::TAPE_ERROR));
   w_.advance(1);
 }

@@ -113,6 +113,10 @@ class JsonStream {
   template <class Sax>
   void parse_span(std::size_t begin, std::size_t end, bool as_items, Sax& sax, std::size_t depth);
   std::string member_name();
+  /// Skips white space; the input ending there is a fault of structure.
+  void skip_space_or_fail();
+  /// Moves past a container's opening bracket; true, and past `close` too, when it is empty.
+  bool opened_empty(char close);
   /// Offset of the first byte at or after `i` (from the cursor) that is not white space.
   std::size_t skip_space_at(std::size_t i);
   void expect(char c);
@@ -191,10 +195,7 @@ void JsonStream::framed_value(Sax& sax, std::size_t depth) {
 template <class Sax>
 void JsonStream::members(Sax& sax, std::size_t depth) {
   sax.start_object(static_cast<std::size_t>(-1));
-  w_.advance(1);
-  if (!w_.skip_space()) fail_at(nullptr, what(simdjson::TAPE_ERROR));
-  if (*w_.cur() == '}') {
-    w_.advance(1);
+  if (opened_empty('}')) {
     sax.end_object();
     return;
   }
@@ -202,17 +203,17 @@ void JsonStream::members(Sax& sax, std::size_t depth) {
     key_ = member_name();
     sax.key(key_);
     expect(':');
-    if (!w_.skip_space()) fail_at(nullptr, what(simdjson::TAPE_ERROR));
+    skip_space_or_fail();
     if (depth == 1 && (key_ == "cfs" || key_ == "transitions") && *w_.cur() == '[')
       items(sax, 2);
     else
       framed_value(sax, depth);
-    if (!w_.skip_space()) fail_at(nullptr, what(simdjson::TAPE_ERROR));
+    skip_space_or_fail();
     const char c = *w_.cur();
     w_.advance(1);
     if (c == '}') break;
     if (c != ',') fail_at(w_.cur() - 1, what(simdjson::TAPE_ERROR));
-    if (!w_.skip_space()) fail_at(nullptr, what(simdjson::TAPE_ERROR));
+    skip_space_or_fail();
   }
   sax.end_object();
 }
@@ -222,10 +223,7 @@ void JsonStream::members(Sax& sax, std::size_t depth) {
 template <class Sax>
 void JsonStream::items(Sax& sax, std::size_t depth) {
   sax.start_array(static_cast<std::size_t>(-1));
-  w_.advance(1);
-  if (!w_.skip_space()) fail_at(nullptr, what(simdjson::TAPE_ERROR));
-  if (*w_.cur() == ']') {
-    w_.advance(1);
+  if (opened_empty(']')) {
     sax.end_array();
     return;
   }
@@ -239,7 +237,7 @@ void JsonStream::items(Sax& sax, std::size_t depth) {
     misses = read == LineBatch::kNone ? misses + 1 : 0;
     if (read == LineBatch::kNone && framed_batch(sax, depth)) break;
     // The cursor is past a ',': an item follows.
-    if (!w_.skip_space()) fail_at(nullptr, what(simdjson::TAPE_ERROR));
+    skip_space_or_fail();
     if (*w_.cur() == ']') fail_at(w_.cur(), what(simdjson::TAPE_ERROR));
   }
   sax.end_array();
@@ -317,7 +315,7 @@ bool JsonStream::framed_batch(Sax& sax, std::size_t depth) {
     // The items before it are read: the long one starts at `i`.
     w_.advance(i);
     framed_value(sax, depth);
-    if (!w_.skip_space()) fail_at(nullptr, what(simdjson::TAPE_ERROR));
+    skip_space_or_fail();
     stop = *w_.cur();
     i = 0;
   }
