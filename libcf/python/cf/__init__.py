@@ -105,7 +105,8 @@ def replay(graph, t, p, q, params=None, **kwargs):
     1e-3). Parameters: a cf.Params and/or keyword arguments with cf::Params' names and
     units (mass_kg, contact_stiffness_N_per_mm, mu_static, epsilon_mm, ...). A fresh renderer steps
     over every pose (cf::Replay, the engine cfreplay runs); the result is a
-    cf.ReplayResult whose arrays are named like cf::HapticResult's fields.
+    cf.ReplayResult whose arrays are named like cf::HapticResult's fields. Ctrl-C raises
+    KeyboardInterrupt within a second.
     """
     inputs = [getattr(graph, "_source_path", None)]
     return ReplayResult(_cf.replay(graph, t, p, q, params, **kwargs), [i for i in inputs if i])
@@ -125,7 +126,8 @@ def _step_many(self, t, p, q):
     """N servo ticks at once, at C++ speed (the GIL released): the renderer's state carries
     on from the ticks before, and on to the next. ``t`` (N,) s, increasing and after the
     last step; ``p`` (N, 3) mm; ``q`` (N, 4) w, x, y, z. Returns a cf.ReplayResult: the same
-    values, tick by tick, as N calls of step()."""
+    values, tick by tick, as N calls of step(). Ctrl-C raises KeyboardInterrupt within a second;
+    the renderer keeps the ticks it took."""
     return ReplayResult(self._step_many(t, p, q), [])
 
 
@@ -136,5 +138,6 @@ def step_many(model, state, t, p, q):
     """N servo ticks of ``state`` on ``model`` at once, at C++ speed with the GIL released (so
     that threads, each with its own state of one model, run in parallel): the same values,
     tick by tick, as N calls of cf.step(). ``t`` (N,) s, increasing and after the state's last
-    tick; ``p`` (N, 3) mm; ``q`` (N, 4) w, x, y, z. Returns a cf.ReplayResult."""
+    tick; ``p`` (N, 3) mm; ``q`` (N, 4) w, x, y, z. Returns a cf.ReplayResult. Ctrl-C raises
+    KeyboardInterrupt within a second; the state keeps the ticks it took."""
     return ReplayResult(_cf._step_many(model, state, t, p, q), [])

@@ -12,6 +12,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -140,7 +141,7 @@ py::dict renderer_step(Renderer& self, double t_s, const py::object& p, const py
 
 /// cf.CfState: one servo thread's state (cf::CfState) and the time of its last tick.
 struct State {
-  explicit State(const cf::CfModel& model) : s(model), model(&model) {}
+  explicit State(const cf::CfModel& m) : s(m), model(&m) {}
   cf::CfState s;
   const cf::CfModel* model;
   bool stepped = false;
@@ -295,15 +296,38 @@ void record_extras(const cf::HapticResult& r, std::size_t i, ReplayExtras& x) {
   }
 }
 
+// Ticks run between two looks for Ctrl-C: about 0.1 s at 100,000 ticks a second.
+constexpr std::size_t kTicksPerSignalCheck = 8192;
+
+/// Runs tick(i) for i from `done` to n, without the GIL but taking it back every
+/// kTicksPerSignalCheck ticks to let a signal's Python handler run (Ctrl-C raises
+/// KeyboardInterrupt within a second). False, with the Python error set, when a handler
+/// raised; `done` is then the ticks run.
+template <class Tick>
+bool run_ticks(std::size_t n, std::size_t& done, const Tick& tick) {
+  while (done < n) {
+    {
+      py::gil_scoped_release release;
+      for (const std::size_t end = std::min(n, done + kTicksPerSignalCheck); done < end; ++done)
+        tick(done);
+    }
+    if (PyErr_CheckSignals() != 0) return false;
+  }
+  return true;
+}
+
 /// libcf's replay engine over the samples, without the GIL.
+/// @throws py::error_already_set (KeyboardInterrupt) on Ctrl-C.
 void run_replay(const cf::CfGraph& g, const std::vector<cf::TrajectorySample>& samples,
                 const cf::Params& P, ReplayRows& rows, ReplayExtras& x) {
-  py::gil_scoped_release release;
   cf::TrajectorySamples source(samples);
   cf::Replay replay(g, P, source);
   rows.rows.resize(samples.size());
-  for (std::size_t i = 0; i < samples.size() && replay.next(rows.rows[i]); ++i)
-    record_extras(replay.result(), i, x);
+  std::size_t done = 0;
+  const bool whole = run_ticks(samples.size(), done, [&](std::size_t i) {
+    if (replay.next(rows.rows[i])) record_extras(replay.result(), i, x);
+  });
+  if (!whole) throw py::error_already_set();
 }
 
 /// replay's result: per-tick arrays and lists by name, and the rows for to_csv.
@@ -389,16 +413,18 @@ py::dict step_many(const py::object& t, const py::object& p, const py::object& q
   auto rows = std::make_unique<ReplayRows>();
   ReplayExtras extras(samples.size());
   rows->rows.resize(samples.size());
-  {
-    py::gil_scoped_release release;
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-      const cf::HapticResult& r = tick(samples[i].X_WD, samples[i].t_s);
-      cf::fill_replay_row(r, rows->rows[i]);
-      record_extras(r, i, extras);
-    }
+  std::size_t done = 0;
+  const bool whole = run_ticks(samples.size(), done, [&](std::size_t i) {
+    const cf::HapticResult& r = tick(samples[i].X_WD, samples[i].t_s);
+    cf::fill_replay_row(r, rows->rows[i]);
+    record_extras(r, i, extras);
+  });
+  // On Ctrl-C the renderer has taken the ticks before it: the next call carries on there.
+  if (done > 0) {
+    stepped = true;
+    last_t = samples[done - 1].t_s;
   }
-  stepped = true;
-  last_t = samples.back().t_s;
+  if (!whole) throw py::error_already_set();
   return replay_dict(std::move(rows), extras);
 }
 

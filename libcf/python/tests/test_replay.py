@@ -225,3 +225,34 @@ def test_replay_errors_carry_messages(l_graph):
         r.step(1.0, p[0], q[0][:3])
     with pytest.raises(cf.Error, match=r"^Renderer: unknown parameter 'K'"):
         cf.Renderer(l_graph, K=2)
+
+
+def test_replay_and_step_many_stop_on_ctrl_c(l_graph):
+    # Ctrl-C (SIGINT from another thread here) during a long replay raises KeyboardInterrupt
+    # part way: the ticks run without the GIL but look for signals every 8,192 ticks (about
+    # 0.1 s). 400,000 ticks of the cube resting take about 4 s whole.
+    import os
+    import signal
+    import threading
+    import time
+
+    n = 400_000
+    t = np.arange(1, n + 1) * 1e-3
+    p = np.tile([20.0, 10.0, 5.0], (n, 1))
+    q = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
+
+    def interrupt_soon():
+        time.sleep(0.3)
+        os.kill(os.getpid(), signal.SIGINT)
+
+    renderer = cf.Renderer(l_graph)
+    for run in (lambda: cf.replay(l_graph, t, p, q), lambda: renderer.step_many(t, p, q)):
+        timer = threading.Thread(target=interrupt_soon)
+        timer.start()
+        with pytest.raises(KeyboardInterrupt):
+            run()
+        timer.join()
+    # The renderer stopped part way, not at the end (where Python would also have raised the
+    # KeyboardInterrupt), and carries on from the ticks it took: a time in the second half of
+    # the trajectory is still ahead of it.
+    renderer.step_many(t[n // 2:n // 2 + 1], p[:1], q[:1])
