@@ -137,6 +137,11 @@ class JsonStream {
     if (e != simdjson::SUCCESS) fail_at(at, what(e));
   }
   void check_step(simdjson::error_code e, const char* fallback);
+  /// A container at nesting `depth` (its first byte at `at`) within kMaxNesting.
+  void check_depth(std::size_t depth, const char* at) {
+    if (depth >= kMaxNesting)
+      fail_at(at, "nesting deeper than " + std::to_string(kMaxNesting) + " levels");
+  }
   static std::string what(simdjson::error_code e);
 
   const ByteInput& in_;
@@ -183,8 +188,7 @@ void JsonStream::framed_value(Sax& sax, std::size_t depth) {
       return;
     }
   }
-  if (depth >= kMaxNesting)
-    fail_at(w_.cur(), "nesting deeper than " + std::to_string(kMaxNesting) + " levels");
+  check_depth(depth, w_.cur());
   if (c == '[')
     items(sax, depth + 1);
   else
@@ -434,8 +438,7 @@ void JsonStream::value(simdjson::ondemand::value v, Sax& sax, std::size_t depth)
   check(v.type().get(type), at);
   switch (type) {
     case json_type::object: {
-      if (depth >= kMaxNesting)
-        fail_at(at, "nesting deeper than " + std::to_string(kMaxNesting) + " levels");
+      check_depth(depth, at);
       simdjson::ondemand::object object;
       check(v.get_object().get(object), at);
       sax.start_object(static_cast<std::size_t>(-1));
@@ -453,8 +456,7 @@ void JsonStream::value(simdjson::ondemand::value v, Sax& sax, std::size_t depth)
       return;
     }
     case json_type::array: {
-      if (depth >= kMaxNesting)
-        fail_at(at, "nesting deeper than " + std::to_string(kMaxNesting) + " levels");
+      check_depth(depth, at);
       simdjson::ondemand::array array;
       check(v.get_array().get(array), at);
       sax.start_array(static_cast<std::size_t>(-1));
