@@ -275,7 +275,9 @@ JsonStream::LineBatch JsonStream::line_batch(Sax& sax) {
   while (e > 0 && (p[e - 1] == ' ' || p[e - 1] == '\r' || p[e - 1] == '\t')) --e;
   if (e == 0 || (p[e - 1] == ',') == (close != 0)) return LineBatch::kNone;
   if (close == 0) --e;  // the ',' becomes the array's ']', the byte before the cursor its '['
-  if (dom_.capacity() == 0 && dom_.allocate(kBatchBytes + 2, kMaxNesting - 2) != simdjson::SUCCESS)
+  // A batch is at most kBatchBytes and the input's size, plus its two brackets.
+  if (dom_.capacity() == 0 &&
+      dom_.allocate(std::min(kBatchBytes, in_.size()) + 2, kMaxNesting - 2) != simdjson::SUCCESS)
     return LineBatch::kNone;
   const char before = p[-1], after = p[e];
   p[-1] = '[';

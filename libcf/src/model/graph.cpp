@@ -213,9 +213,11 @@ void check_transition(std::size_t t, const Transition& tr, const std::vector<PcS
 void sort_out_lists(std::vector<std::vector<Transition>>& out,
                     const std::vector<Transition>& transitions,
                     const internal::FaultLocator& where) {
+  const auto by_target = [](const Transition& x, const Transition& y) { return x.to < y.to; };
   for (auto& list : out) {
-    std::stable_sort(list.begin(), list.end(),
-                     [](const Transition& x, const Transition& y) { return x.to < y.to; });
+    // cfgen writes each CF's transitions in target order: no sort (and no buffer) for them.
+    if (!std::is_sorted(list.begin(), list.end(), by_target))
+      std::stable_sort(list.begin(), list.end(), by_target);
     for (std::size_t k = 1; k < list.size(); ++k)
       if (list[k].to == list[k - 1].to) {
         std::size_t seen = 0, t = 0;
@@ -256,10 +258,14 @@ void CfGraph::Impl::build(const internal::FaultLocator& where) {
   std::vector<PcSet> sets(n);
   for (std::size_t i = 0; i < n; ++i) sets[i] = cfs[i].pcs;
   out.assign(n, {});
+  std::vector<std::uint32_t> out_degree(n, 0);
   for (std::size_t t = 0; t < transitions.size(); ++t) {
     check_transition(t, transitions[t], sets, change, where);
-    out[transitions[t].from.index()].push_back(transitions[t]);
+    ++out_degree[transitions[t].from.index()];
   }
+  // Each list allocated once, at its size.
+  for (std::size_t i = 0; i < n; ++i) out[i].reserve(out_degree[i]);
+  for (const Transition& t : transitions) out[t.from.index()].push_back(t);
   sort_out_lists(out, transitions, where);
 }
 
