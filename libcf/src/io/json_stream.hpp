@@ -2,13 +2,15 @@
 // Private: a JSON text read in windows and handed to a SAX handler (nlohmann's interface), so
 // that a graph file is never held whole nor indexed whole (docs/graph-format.md, "Reading").
 //
-// simdjson's On Demand parser checks and reads every value; it needs a value's whole text and
-// an index of 4 bytes per structural character, which for a graph's 2.8 million transitions is
-// larger than the file. So the root object's members are framed here: each member's value,
-// and each item of `cfs` and `transitions` in batches of about kBatchBytes, is found by a scan
-// of strings and brackets and then parsed by simdjson in place. Every byte is checked by
-// simdjson or by the framing's strict rules (white space, ':', ',', brackets); errors give the
-// line and column.
+// simdjson checks and reads every value, but it needs a value's whole text and an index of 4
+// bytes per structural character, which for a graph's 2.8 million transitions is larger than
+// the file. So the root object is framed here member by member, and an array or object longer
+// than kBatchBytes item by item; simdjson parses at most about kBatchBytes at a time, in place.
+// Items laid out one a line (as cfgen writes them) go in batches to simdjson's DOM parser,
+// which checks a batch whole before anything is emitted (line_batch); any other layout is
+// framed item by item by a scan of strings and brackets and read by the On-Demand parser,
+// which gives a fault's position (framed_batch). Every byte is checked by simdjson or by the
+// framing's strict rules (white space, ':', ',', brackets); errors give the line and column.
 
 #include "byte_input.hpp"
 
