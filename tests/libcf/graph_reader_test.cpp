@@ -193,6 +193,24 @@ TEST_CASE("a fault far into a large file gives its line and column", "[graph][re
       Catch::Contains("syntax error at " + line_col(text, text.rfind(']')) + " near ']'"));
 }
 
+TEST_CASE("brackets the input ends inside, or that close another kind, are refused unread",
+          "[graph][reader][bad]") {
+  // simdjson's On-Demand parser must not walk unbalanced brackets (a fuzzer's input, now
+  // fuzz/regressions/fuzz_graph_json/unbalanced_nested_member.json, made it read past its
+  // index): the framing refuses them first, with the position.
+  const std::string nested = std::string(26, '[');
+  CHECK_THROWS_WITH(CfGraph::from_bytes("{\"x\":" + nested + "\n{\"x\":" + nested, "x.json", false),
+                    Catch::Contains("syntax error at line 2, column 32 at the end of the input"));
+  const std::string head = R"({"format":"cf-graph","version":1,)";
+  CHECK_THROWS_WITH(CfGraph::from_bytes(head + R"("x":[[[1,2}]]})", "x.json", false),
+                    Catch::Contains("syntax error at line 1, column 44 near '}'"));
+  CHECK_THROWS_WITH(
+      CfGraph::from_bytes(head + R"("cfs":[{"id":0,"pcs":[}],"transitions":[]})", "x.json", false),
+      Catch::Contains("syntax error at line 1, column 56 near '}'"));
+  CHECK_THROWS_WITH(CfGraph::from_bytes(head + R"("cfs":[{"id":0},[[[)", "x.json", false),
+                    Catch::Contains("at the end of the input"));
+}
+
 TEST_CASE("a file's models and metadata hold at most one value per 32 bytes of it",
           "[graph][reader][bad]") {
   // 3 million values in a member of its own (6 MB): a DOM of them would take ten times that.

@@ -82,7 +82,7 @@ std::size_t TextWindow::value_end(std::size_t from, bool& complete, std::size_t 
   if (!fill(from + 1)) return avail();
   const char c = cur()[from];
   in_string_ = escaped_ = false;
-  depth_ = 0;
+  opens_.clear();
   if (c == '"') {
     in_string_ = true;
     return scan_string(from + 1, complete);
@@ -145,10 +145,17 @@ std::size_t TextWindow::scan_container(std::size_t i, bool& done) {
     if (c == '"') {
       in_string_ = true;
     } else if (c == '{' || c == '[') {
-      ++depth_;
-    } else if (--depth_ == 0) {
-      done = true;
-      return i;
+      opens_ += c;
+    } else {
+      // A bracket that closes another kind is refused here: simdjson's On-Demand parser
+      // must not walk mismatched brackets.
+      if (opens_.back() != (c == '}' ? '{' : '['))
+        fail_at(cur() + i - 1, simdjson::error_message(simdjson::TAPE_ERROR));
+      opens_.pop_back();
+      if (opens_.empty()) {
+        done = true;
+        return i;
+      }
     }
   }
 }

@@ -73,7 +73,7 @@ class TextWindow {
   std::size_t col_ = 1;
   bool ended_ = false;  // the input has no more bytes
   // Container scan state, kept across refills.
-  std::int64_t depth_ = 0;
+  std::string opens_;  // the open brackets, innermost last
   bool in_string_ = false, escaped_ = false;
   std::size_t stop_at_ = 0;  // the container scan's limit, an offset from the cursor
   bool cut_short_ = false;
@@ -185,6 +185,9 @@ void JsonStream::framed_value(Sax& sax, std::size_t depth) {
     const std::size_t end = w_.value_end(0, complete, container ? kBatchBytes : kNoLimit);
     if (!w_.cut_short()) {
       if (end == 0) fail_at(w_.cur(), what(simdjson::TAPE_ERROR));
+      // A container the input ends inside is refused unread: simdjson's On-Demand parser
+      // must not walk unbalanced brackets (it can read past its index).
+      if (container && !complete) fail_at(nullptr, what(simdjson::TAPE_ERROR));
       parse_span(0, end, false, sax, depth);
       w_.advance(end);
       return;
@@ -301,12 +304,18 @@ template <class Sax>
 bool JsonStream::framed_batch(Sax& sax, std::size_t depth) {
   std::size_t i = 0, end = 0;
   char stop = 0;  // ',' more items, ']' the last, else what stopped the batch (0: the end)
-  bool long_item = false;
+  bool long_item = false, truncated = false;
   while (true) {
     bool complete = false;
     const std::size_t item_end = w_.value_end(i, complete, kBatchBytes);
     if (w_.cut_short()) {
       long_item = true;
+      break;
+    }
+    // An item the input ends inside is not parsed (as in framed_value); those before it are.
+    const char first = i < w_.avail() ? w_.cur()[i] : '\0';
+    if (!complete && (first == '{' || first == '[')) {
+      truncated = true;
       break;
     }
     end = item_end;
@@ -319,6 +328,7 @@ bool JsonStream::framed_batch(Sax& sax, std::size_t depth) {
   }
   // The batch's items first: a fault in them comes before the one that stopped it.
   if (end > 0) parse_span(0, end, true, sax, depth);
+  if (truncated) fail_at(nullptr, what(simdjson::TAPE_ERROR));
   if (long_item) {
     // The items before it are read: the long one starts at `i`.
     w_.advance(i);
