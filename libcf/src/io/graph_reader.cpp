@@ -167,6 +167,25 @@ struct Header {
   }
 };
 
+/// A DOM built from SAX events: the open containers, innermost last, and the name of the
+/// next member of the innermost object.
+struct DomBuilder {
+  std::vector<json*> open;
+  std::string key;
+  /// `v` as the next member or item of the innermost container; where it now is.
+  json* add(json v) {
+    json* top = open.back();
+    if (top->is_object()) {
+      json& slot = (*top)[key];
+      slot = std::move(v);
+      return &slot;
+    }
+    top->push_back(std::move(v));
+    return &top->back();
+  }
+  void start(bool object) { open.push_back(add(object ? json::object() : json::array())); }
+};
+
 /// The full schema check (GraphLoadOptions::full_schema_check): each item of cfs and
 /// transitions becomes a DOM of its own, validated against its definition in the schema when
 /// it ends, so that the check holds one item at a time. The first violation is kept, to be
@@ -174,19 +193,19 @@ struct Header {
 class ItemSchemaCheck {
  public:
   explicit ItemSchemaCheck(const std::string& source) : source_(source) {}
-  bool active() const { return !stack_.empty(); }
+  bool active() const { return !dom_.open.empty(); }
   void start_item(bool object, bool is_cf, std::size_t index) {
     item_ = object ? json::object() : json::array();
-    stack_.assign(1, &item_);
+    dom_.open.assign(1, &item_);
     is_cf_ = is_cf;
     index_ = index;
   }
-  void start(bool object) { stack_.push_back(add(object ? json::object() : json::array())); }
-  void key(std::string_view k) { key_.assign(k.data(), k.size()); }
-  void value(json v) { add(std::move(v)); }
+  void start(bool object) { dom_.start(object); }
+  void key(std::string_view k) { dom_.key.assign(k.data(), k.size()); }
+  void value(json v) { dom_.add(std::move(v)); }
   void end() {
-    stack_.pop_back();
-    if (!stack_.empty() || !violation.empty()) return;
+    dom_.open.pop_back();
+    if (!dom_.open.empty() || !violation.empty()) return;
     try {
       validate_graph_item(item_, is_cf_, index_, source_);
     } catch (const Error& e) {
@@ -196,20 +215,9 @@ class ItemSchemaCheck {
   std::string violation;  ///< the first, as the error to throw
 
  private:
-  json* add(json v) {
-    json* top = stack_.back();
-    if (top->is_object()) {
-      json& slot = (*top)[key_];
-      slot = std::move(v);
-      return &slot;
-    }
-    top->push_back(std::move(v));
-    return &top->back();
-  }
   const std::string& source_;
   json item_;
-  std::vector<json*> stack_;
-  std::string key_;
+  DomBuilder dom_;
   bool is_cf_ = false;
   std::size_t index_ = 0;
 };
@@ -377,9 +385,8 @@ class GraphSax {
   }
   Field field_ = Field::kNone;
   std::string root_key_;
-  // Capture state: the DOM containers being filled and the key inside each object.
-  std::vector<json*> capture_;
-  std::string capture_key_;
+  // Capture state: the DOM being filled (models, metadata).
+  DomBuilder capture_;
   // Per-item state.
   int pc_count_ = 0, row_ = 0, col_ = 0, t_count_ = 0, plane_count_ = 0, plane_col_ = 0;
   bool has_id_ = false, has_pcs_ = false, has_witness_ = false;
@@ -442,12 +449,7 @@ void GraphSax::count_captured() {
 
 void GraphSax::capture_value(json value) {
   count_captured();
-  json* top = capture_.back();
-  if (top->is_object()) {
-    (*top)[capture_key_] = std::move(value);
-  } else {
-    top->push_back(std::move(value));
-  }
+  capture_.add(std::move(value));
 }
 
 bool GraphSax::key(std::string_view k) {
@@ -466,8 +468,8 @@ bool GraphSax::key(std::string_view k) {
       }
       break;
     case Ctx::kCapture:
-      capture_key_ = k;
-      if (capture_.back()->is_object() && capture_.back()->contains(capture_key_))
+      capture_.key = k;
+      if (capture_.open.back()->is_object() && capture_.open.back()->contains(capture_.key))
         duplicate("/" + root_key_, k);
       break;
     case Ctx::kCf:
@@ -770,7 +772,7 @@ void GraphSax::start_at_root(bool object) {
     check_header_member(object ? json::object() : json::array());
     json& slot = skeleton[root_key_];
     slot = object ? json::object() : json::array();
-    capture_.push_back(&slot);
+    capture_.open.push_back(&slot);
     push(Ctx::kCapture);
   } else if (!object && field_ == Field::kRootCfs) {
     have_cfs = true;
@@ -790,17 +792,7 @@ void GraphSax::start_at_root(bool object) {
 
 void GraphSax::start_captured(bool object) {
   count_captured();
-  json* top = capture_.back();
-  json* child;
-  if (top->is_object()) {
-    json& slot = (*top)[capture_key_];
-    slot = object ? json::object() : json::array();
-    child = &slot;
-  } else {
-    top->push_back(object ? json::object() : json::array());
-    child = &top->back();
-  }
-  capture_.push_back(child);
+  capture_.start(object);
   push(Ctx::kCapture);
 }
 
@@ -932,7 +924,7 @@ bool GraphSax::end() {
   stack_.pop_back();
   seen_.pop_back();
   if (c == Ctx::kCapture) {
-    capture_.pop_back();
+    capture_.open.pop_back();
     return true;
   }
   if (faulted() || c == Ctx::kSkip) return true;
