@@ -17,7 +17,7 @@ fi
 if git -C "$root" rev-parse --is-inside-work-tree >/dev/null 2>&1; then
   mapfile -t files < <(git ls-files '*.cpp' '*.hpp' '*.h' '*.cc')
 else
-  mapfile -t files < <(find libcf tools tests bench fuzz examples \
+  mapfile -t files < <(find libcf tools python tests bench fuzz examples \
     \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' -o -name '*.cc' \) | sort)
 fi
 case "${1:-}" in

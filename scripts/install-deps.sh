@@ -30,9 +30,11 @@ CF_APT_PACKAGES=(
   clang-format-14
   # cfinspect --html: the browser test of the viewer (tools/cfinspect/viewer, headless)
   chromium
-  # libcf/python: the Python package cf (pybind11 against Debian's /usr/bin/python3), its
-  # pytest suite, the example's plots, graph.to_networkx()
+  # python/: the Python package cf (pybind11 against Debian's /usr/bin/python3), its
+  # pytest suite, the example's plots, graph.to_networkx(); the virtual environment the
+  # tests install the wheel into (python3-venv), the type check of its stubs (python3-mypy)
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-networkx
+  python3-venv python3-mypy
 )
 # The viewer's bundler and browser driver run on Node.js; Debian's nodejs and npm only when
 # the machine has no node or npm (Debian's npm would conflict with another vendor's nodejs).

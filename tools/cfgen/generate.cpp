@@ -201,8 +201,8 @@ RunPlan plan_run(const gen::WitnessSearch& ws, const gen::EnumerateOptions& opt,
                  const GenerateArgs& args, bool writes) {
   RunPlan plan;
   plan.checkpoint_dir = args.checkpoint_dir;
-  const bool may_keep =
-      writes && plan.checkpoint_dir.empty() && !args.no_checkpoint && args.shard.count == 0;
+  const bool may_keep = writes && plan.checkpoint_dir.empty() && !args.no_checkpoint &&
+                        args.shard.count == 0 && !args.out_path.empty();
   if (writes && (may_keep || !args.quiet))
     plan.predicted = predict(ws, opt, args, gen::kRunPredictionSamples).seconds;
   if (!may_keep) return plan;
@@ -265,11 +265,12 @@ int run_generate(const GenerateArgs& args) {
   const std::vector<std::string> inputs{args.a_path, args.b_path};
   // Of K shards, shard 0 writes the graph.
   const bool writes = !args.estimate && args.shard.index == 0;
+  const bool to_file = writes && !args.out_path.empty();
   const bool certifies = writes && !args.certificates_path.empty();
-  if (writes) check_output(args.out_path, inputs, args.checkpoint_dir, "writing graph", {});
+  if (to_file) check_output(args.out_path, inputs, args.checkpoint_dir, "writing graph", {});
   if (certifies)
     check_output(args.certificates_path, inputs, args.checkpoint_dir, "writing certificates",
-                 {args.out_path});
+                 to_file ? std::vector<std::string>{args.out_path} : std::vector<std::string>{});
   const MeasuredModel ma = load_measured_model(args.a_path, args.load_a);
   const MeasuredModel mb = load_measured_model(args.b_path, args.load_b);
   const Polyhedron& A = ma.model;
@@ -360,11 +361,14 @@ int run_generate(const GenerateArgs& args) {
   const nlohmann::json meta = graph_meta(e, args, search, opt, diag, A, B, ma, mb);
   const std::size_t n_cfs = e.cfs.size(), n_tr = e.transitions.size();
   // Moved, not copied: a large graph's records and transitions are hundreds of MB.
-  const CfGraph graph =
+  CfGraph graph =
       CfGraph::from_parts(A, B, std::move(e.cfs), std::move(e.transitions), meta.dump());
-  check_output_path(args.out_path, inputs, "writing graph");
-  graph.save(args.out_path);
+  if (to_file) {
+    check_output_path(args.out_path, inputs, "writing graph");
+    graph.save(args.out_path);
+  }
   if (certifies) write_certificates(args.certificates_path, inputs, args.out_path, e, ws);
+  if (args.graph_out) *args.graph_out = std::move(graph);
   if (default_checkpoint) remove_checkpoint(checkpoint_dir);
   report_written(args, e, A, B, n_cfs, n_tr, seconds);
   return 0;

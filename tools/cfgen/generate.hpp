@@ -56,10 +56,13 @@ gen::SearchParams scaled_search(const Polyhedron& A, const Polyhedron& B,
 struct GenerateArgs {
   std::string a_path;    ///< model of A, the moving object
   std::string b_path;    ///< model of B, the fixed object (world frame)
-  std::string out_path;  ///< graph file to write, whole or not at all
-  int threads = 0;       ///< worker threads; 0 = hardware concurrency
-  bool quiet = false;    ///< no progress on stderr
-  int max_pcs = 3;       ///< largest CFs to enumerate (1..3)
+  std::string out_path;  ///< graph file to write, whole or not at all; empty: `graph_out` only
+  /// Null, or where the graph is handed over in memory as well (the Python binding):
+  /// with an empty out_path nothing is written and no default checkpoint is kept.
+  CfGraph* graph_out = nullptr;
+  int threads = 0;     ///< worker threads; 0 = hardware concurrency
+  bool quiet = false;  ///< no progress on stderr
+  int max_pcs = 3;     ///< largest CFs to enumerate (1..3)
   bool thorough =
       false;  ///< search every set, then add every image of each CF found (enumerate.hpp)
   bool symmetry = true;      ///< search one set per orbit of the models' symmetries (symmetry.hpp)

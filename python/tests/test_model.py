@@ -1,4 +1,4 @@
-"""cf.load_model: the features of a model file, as the graph stores them."""
+"""cf.gen.load_model: the features of a model file, as the graph stores them."""
 
 import numpy as np
 import pytest
@@ -6,13 +6,13 @@ import pytest
 import cf
 from conftest import DATA
 
-pytestmark = pytest.mark.skipif(not cf.HAVE_TOOLS, reason="built without the CGAL tools")
+gen = pytest.importorskip("cf.gen", reason="built without the CGAL tools")
 
 
 def test_model_features_equal_the_graphs(l_graph):
     for path, stored in ((DATA / "models" / "cube.off", l_graph.model_a), (DATA / "models" / "l_block.off",
                                                                            l_graph.model_b)):
-        m = cf.load_model(path)
+        m = gen.load_model(path)
         assert m.name == stored.name
         np.testing.assert_array_equal(m.vertices, stored.vertices)
         np.testing.assert_array_equal(m.edges, stored.edges)
@@ -20,7 +20,7 @@ def test_model_features_equal_the_graphs(l_graph):
         assert m.vertices.dtype == np.float64 and m.edges.dtype == np.int32
         np.testing.assert_allclose(m.face_normals, stored.face_normals, atol=1e-12)
         assert m.volume == pytest.approx(stored.volume, rel=1e-12)
-    cube = cf.load_model(DATA / "models" / "cube.off")
+    cube = gen.load_model(DATA / "models" / "cube.off")
     assert cube.vertices.shape == (8, 3) and cube.edges.shape == (12, 2) and len(cube.faces) == 6
     assert cube.edge_convex.all() and cube.face_areas == pytest.approx([900.0] * 6)
     # Every edge bounds its two faces; every face loop's sides are edges.
@@ -32,18 +32,18 @@ def test_model_features_equal_the_graphs(l_graph):
 
 
 def test_units_scale_to_mm():
-    mm = cf.load_model(DATA / "models" / "cube.off")
-    cm = cf.load_model(DATA / "models" / "cube.off", units="cm")
+    mm = gen.load_model(DATA / "models" / "cube.off")
+    cm = gen.load_model(DATA / "models" / "cube.off", units="cm")
     np.testing.assert_allclose(cm.vertices, 10 * mm.vertices, rtol=1e-15)
     assert cm.volume == pytest.approx(1000 * mm.volume)
 
 
 def test_model_errors(tmp_path):
     with pytest.raises(cf.Error, match=r"^load_model: units must be 'mm', 'cm', 'm' or 'in', got 'ft'$"):
-        cf.load_model(DATA / "models" / "cube.off", units="ft")
+        gen.load_model(DATA / "models" / "cube.off", units="ft")
     with pytest.raises(cf.Error, match=r"nothing\.off"):
-        cf.load_model(tmp_path / "nothing.off")
+        gen.load_model(tmp_path / "nothing.off")
     open_box = tmp_path / "open.off"
     open_box.write_text("OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n")
     with pytest.raises(cf.Error, match=r"^loading '.*open\.off': "):
-        cf.load_model(open_box)
+        gen.load_model(open_box)

@@ -1,5 +1,5 @@
 #pragma once
-// Shared by the binding units of the Python package cf (libcf/python): conversions between
+// Shared by the binding units of the Python package cf (python/): conversions between
 // numpy arrays and libcf's types, and the checks that turn bad arguments into cf.Error.
 
 #include <cf/graph.hpp>
@@ -40,6 +40,5 @@ py::list pcs_to_py(const cf::PcSet& pcs);
 
 void bind_graph(py::module_& m);
 void bind_render(py::module_& m);
-void bind_tools(py::module_& m);
 
 }  // namespace cfpy

@@ -295,7 +295,7 @@ void bind_cf_graph(py::module_& m) {
       py::class_<cf::CfGraph>(
           m, "CfGraph", py::dynamic_attr(),
           "The CF graph of a model pair (cf::CfGraph): CFs, transitions and the two models. "
-          "Immutable; load it with cf.load_graph or make it with cf.generate.")
+          "Immutable; load it with cf.load_graph or make it with cf.gen.generate.")
           .def_property_readonly("model_a", &cf::CfGraph::model_a,
                                  py::return_value_policy::reference_internal,
                                  "A, the moving polyhedron.")

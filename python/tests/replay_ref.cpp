@@ -1,4 +1,4 @@
-// The C++ reference of the Python tests (libcf/python/tests/test_replay.py): runs libcf's
+// The C++ reference of the Python tests (python/tests/test_replay.py): runs libcf's
 // replay engine (cf::Replay over cf::TrajectoryCsvReader) and prints every tick with 17
 // significant digits, where cfreplay's CSV prints 9.
 //   cf_python_replay_ref GRAPH POSES.csv > OUT.csv

@@ -1,13 +1,12 @@
-// cf.load_model (tools/mesh's loader) and cf._cf.generate (cfgen's run_generate), built when
-// the CGAL tools are (CF_WITH_CGAL).
+// The extension module cf.gen._gen: the model loader (tools/mesh) and cfgen's generator
+// (run_generate), built when the CGAL tools are. It links the tools; cf._cf, whose types
+// (cf.Polyhedron, cf.CfGraph) and errors it returns and raises, links libcf alone.
 
 #include "common.hpp"
 
-#ifdef CF_PYTHON_HAVE_TOOLS
 #include "cfgen/execute/stop.hpp"
 #include "cfgen/generate.hpp"
 #include "mesh/model_loader.hpp"
-#endif
 
 #include <chrono>
 #include <cmath>
@@ -19,7 +18,6 @@
 
 namespace cfpy {
 
-#ifdef CF_PYTHON_HAVE_TOOLS
 namespace {
 
 void check_units(const std::string& units, const char* name, const std::string& where) {
@@ -84,11 +82,13 @@ int generate_stoppable(cf::tools::GenerateArgs& g) {
 }
 
 }  // namespace
-#endif
 
-void bind_tools(py::module_& m) {
-#ifdef CF_PYTHON_HAVE_TOOLS
-  m.attr("HAVE_TOOLS") = true;
+}  // namespace cfpy
+
+PYBIND11_MODULE(_gen, m) {
+  using namespace cfpy;
+  // cf._cf registers the types this module returns and the errors it raises.
+  py::module_::import("cf._cf");
   m.def(
       "load_model",
       [](const std::string& path, const std::string& units, double coplanar_rel_tol,
@@ -161,12 +161,14 @@ void bind_tools(py::module_& m) {
         g.load_a.coplanar_rel_tol = g.load_b.coplanar_rel_tol = coplanar_rel_tol;
         g.checkpoint_dir = checkpoint;
         g.certificates_path = certificates;
-        // A checkpoint only when asked for: a call without `output` writes into a temporary
-        // directory, which would take a default checkpoint with it.
+        // A checkpoint only when asked for (cfgen keeps one by default for long runs).
         g.no_checkpoint = checkpoint.empty();
+        cf::CfGraph graph;
+        g.graph_out = &graph;
         const int status = generate_stoppable(g);
         if (status != 0)
           fail(where + ": cfgen's generator failed with status " + std::to_string(status));
+        return graph;
       },
       py::arg("a_path"), py::arg("b_path"), py::arg("output"), py::arg("threads") = 0,
       py::arg("quiet") = true, py::arg("max_pcs") = 3,
@@ -181,11 +183,6 @@ void bind_tools(py::module_& m) {
       py::arg("coplanar_rel_tol") = cf::tools::LoadOptions{}.coplanar_rel_tol,
       py::arg("symmetry") = true, py::arg("thorough") = false, py::arg("checkpoint") = "",
       py::arg("certificates") = "",
-      "cfgen's generation (cf::tools::run_generate) into the graph file `output`; the package's "
-      "cf.generate wraps it.");
-#else
-  m.attr("HAVE_TOOLS") = false;
-#endif
+      "cfgen's generation (cf::tools::run_generate): the graph, also written to `output` "
+      "unless it is empty; cf.gen.generate wraps it.");
 }
-
-}  // namespace cfpy

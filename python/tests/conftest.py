@@ -1,6 +1,6 @@
 """Shared fixtures of the tests of the Python package cf (run by ctest as python:pytest with
 PYTHONPATH on the build tree's python/ folder, CF_SOURCE_DIR, CF_REPLAY_REF, CF_CFREPLAY,
-CF_CFGEN set by libcf/python/CMakeLists.txt)."""
+CF_CFGEN set by python/CMakeLists.txt)."""
 
 import os
 import pathlib
@@ -9,7 +9,7 @@ import pytest
 
 import cf
 
-SOURCE = pathlib.Path(os.environ.get("CF_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[3]))
+SOURCE = pathlib.Path(os.environ.get("CF_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
 DATA = SOURCE / "data"
 
 # Each bundled trajectory with the graph of its model pair.

@@ -1,6 +1,7 @@
 // The extension module cf._cf: errors, PCs, parameters. The graph and models are bound in
-// bind_graph.cpp, the renderer and the replay in bind_render.cpp, the model loader and the
-// generator in bind_tools.cpp. docs/python.md describes the Python API.
+// bind_graph.cpp, the renderer and the replay in bind_render.cpp. It links libcf alone: the
+// model loader and the generator are the module cf.gen._gen (gen_module.cpp).
+// docs/python.md describes the Python API.
 
 #include "common.hpp"
 
@@ -344,5 +345,4 @@ PYBIND11_MODULE(_cf, m) {
 
   bind_graph(m);
   bind_render(m);
-  bind_tools(m);
 }

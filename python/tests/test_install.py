@@ -38,3 +38,37 @@ def test_version_from_the_module_and_the_command_line():
     assert cf.__version__ == want and cf.graph_format_version == 1
     out = subprocess.run([sys.executable, "-m", "cf", "--version"], check=True, capture_output=True, text=True)
     assert out.stdout == f"cf {want} (graph format 1)\n"
+
+
+def test_runtime_package_links_libcf_alone():
+    # `import cf` loads the run-time extension only; the generator is cf.gen, a module of its
+    # own, so CGAL's code (its names appear in every symbol of its templates) is not in cf._cf.
+    import pathlib
+
+    code = "import cf, sys; print(cf._cf.__file__); print(sorted(m for m in sys.modules if m.startswith('cf')))"
+    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True).stdout
+    so, modules = out.splitlines()
+    assert modules == str(sorted(["cf", "cf._cf", "cf._networkx", "cf._replay"]))
+    data = pathlib.Path(so).read_bytes()
+    assert b"CGAL" not in data and b"WitnessSearch" not in data
+    gen = pytest.importorskip("cf.gen", reason="built without the CGAL tools")
+    assert b"CGAL" in pathlib.Path(gen._gen.__file__).read_bytes()
+
+
+def test_tests_run_against_the_installed_wheel():
+    # ctest runs this suite with the interpreter of the virtual environment python:wheel made
+    # and pip-installed the package into (CF_VENV): cf and cf.gen come from its site-packages,
+    # with the distribution's metadata, not from the build tree.
+    venv = os.environ.get("CF_VENV")
+    if not venv:
+        pytest.skip("CF_VENV is set by ctest")
+    import importlib.metadata
+
+    import cf
+
+    assert os.path.realpath(sys.prefix) == os.path.realpath(venv)
+    site = os.path.realpath(os.path.join(venv, "lib", f"python{sys.version_info.major}.{sys.version_info.minor}",
+                                         "site-packages"))
+    assert os.path.realpath(cf.__file__).startswith(site + os.sep)
+    assert importlib.metadata.version("cf-haptics") == cf.__version__
+    assert "numpy" in " ".join(importlib.metadata.requires("cf-haptics"))
