@@ -13,13 +13,21 @@ q = (w, x, y, z). Bad input raises ``cf.Error`` (a ValueError) with libcf's mess
 that cannot be read or written as such raises ``cf.FileError``, both a cf.Error and an OSError.
 """
 
+from __future__ import annotations
+
 import os as _os
+from typing import TYPE_CHECKING, Any
 
 from . import _cf
 from ._cf import Cf, CfGraph, CfModel, CfState, Error, FileError, Params, Pc, Polyhedron, Renderer, step
 from ._cf import __version__, graph_format_version
 from ._replay import ReplayResult, read_trajectory
 from ._networkx import to_networkx as _to_networkx
+
+if TYPE_CHECKING:
+    import os
+
+    import numpy.typing as npt
 
 __all__ = [
     "Cf", "CfGraph", "CfModel", "CfState", "Error", "FileError", "Params", "Pc", "Polyhedron",
@@ -28,7 +36,8 @@ __all__ = [
 ]
 
 
-def load_graph(path, validate_schema=True, full_schema_check=False):
+def load_graph(path: str | os.PathLike[str], validate_schema: bool = True,
+               full_schema_check: bool = False) -> CfGraph:
     """Loads a CF graph file (JSON, or CBOR when the name ends in .cbor).
 
     The file is checked against the schema (schemas/cf-graph.schema.json) and for internal
@@ -37,11 +46,12 @@ def load_graph(path, validate_schema=True, full_schema_check=False):
     the JSON pointer and the problem.
     """
     g = _cf.load_graph(_os.fspath(path), validate_schema, full_schema_check)
-    g._source_path = _os.fspath(path)  # an input that ReplayResult.to_csv never overwrites
+    setattr(g, "_source_path", _os.fspath(path))  # an input that ReplayResult.to_csv never overwrites
     return g
 
 
-def replay(graph, t, p, q, params=None, **kwargs):
+def replay(graph: CfGraph, t: npt.ArrayLike, p: npt.ArrayLike, q: npt.ArrayLike, params: Params | None = None,
+           **kwargs: Any) -> ReplayResult:
     """Replays a trajectory of A through the renderer: cfreplay's loop, at C++ speed.
 
     ``t`` (N,) times in s, strictly increasing; ``p`` (N, 3) translations in mm; ``q``
@@ -52,21 +62,22 @@ def replay(graph, t, p, q, params=None, **kwargs):
     cf.ReplayResult whose arrays are named like cf::HapticResult's fields. Ctrl-C raises
     KeyboardInterrupt within a second.
     """
-    inputs = [getattr(graph, "_source_path", None)]
-    return ReplayResult(_cf.replay(graph, t, p, q, params, **kwargs), [i for i in inputs if i])
+    source = getattr(graph, "_source_path", None)
+    return ReplayResult(_cf.replay(graph, t, p, q, params, **kwargs), [source] if source else [])
 
 
-def _save(self, path):
+def _save(self: CfGraph, path: str | os.PathLike[str]) -> None:
     """Writes the graph (JSON, or CBOR when the name ends in .cbor) through a temporary file and
     a rename, so that the file is whole or absent (cf::CfGraph::save)."""
     self._save(_os.fspath(path))
 
 
-CfGraph.save = _save
-CfGraph.to_networkx = _to_networkx
+# Methods in Python on the extension's classes (setattr: the stubs declare them).
+setattr(CfGraph, "save", _save)
+setattr(CfGraph, "to_networkx", _to_networkx)
 
 
-def _step_many(self, t, p, q):
+def _step_many(self: Renderer, t: npt.ArrayLike, p: npt.ArrayLike, q: npt.ArrayLike) -> ReplayResult:
     """N servo ticks at once, at C++ speed (the GIL released): the renderer's state carries
     on from the ticks before, and on to the next. ``t`` (N,) s, increasing and after the
     last step; ``p`` (N, 3) mm; ``q`` (N, 4) w, x, y, z. Returns a cf.ReplayResult: the same
@@ -75,10 +86,11 @@ def _step_many(self, t, p, q):
     return ReplayResult(self._step_many(t, p, q), [])
 
 
-Renderer.step_many = _step_many
+setattr(Renderer, "step_many", _step_many)
 
 
-def step_many(model, state, t, p, q):
+def step_many(model: CfModel, state: CfState, t: npt.ArrayLike, p: npt.ArrayLike,
+              q: npt.ArrayLike) -> ReplayResult:
     """N servo ticks of ``state`` on ``model`` at once, at C++ speed with the GIL released (so
     that threads, each with its own state of one model, run in parallel): the same values,
     tick by tick, as N calls of cf.step(). ``t`` (N,) s, increasing and after the state's last

@@ -1,12 +1,14 @@
 """``python -m cf --version``: the package's version and the graph format it reads."""
 
+from __future__ import annotations
+
 import argparse
 import sys
 
 import cf
 
 
-def main(argv=None):
+def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m cf", description=cf.__doc__.splitlines()[0] if cf.__doc__ else None)
     ap.add_argument("--version", action="store_true", help="print the version and exit")
     args = ap.parse_args(argv)

@@ -1,7 +1,14 @@
 """CfGraph.to_networkx (needs networkx, Debian python3-networkx)."""
 
+from __future__ import annotations
 
-def to_networkx(graph):
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from ._cf import CfGraph
+
+
+def to_networkx(graph: CfGraph) -> Any:
     """The graph as a networkx.DiGraph.
 
     Nodes are CF ids with attributes ``pcs`` (the 'type:a:b;...' string), ``num_pcs``,

@@ -38,6 +38,10 @@ cf::PcSet pcset_from_py(const py::handle& h);
 /// The PCs as a list of cf.Pc.
 py::list pcs_to_py(const cf::PcSet& pcs);
 
+/// Gives every function and method of `m` a doc that inspect.signature reads (names and
+/// defaults), keeping pybind11's typed signature below it (signatures.cpp). Call last.
+void add_text_signatures(py::module_& m);
+
 void bind_graph(py::module_& m);
 void bind_render(py::module_& m);
 

@@ -185,4 +185,5 @@ PYBIND11_MODULE(_gen, m) {
       py::arg("certificates") = "",
       "cfgen's generation (cf::tools::run_generate): the graph, also written to `output` "
       "unless it is empty; cf.gen.generate wraps it.");
+  add_text_signatures(m);
 }

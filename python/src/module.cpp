@@ -345,4 +345,5 @@ PYBIND11_MODULE(_cf, m) {
 
   bind_graph(m);
   bind_render(m);
+  add_text_signatures(m);
 }

@@ -12,9 +12,12 @@ Errors are ``cf.Error`` and ``cf.FileError``, with the messages cfgen prints. Im
 module raises ImportError when cf was built without the CGAL tools.
 """
 
-import os as _os
+from __future__ import annotations
 
-from .. import Error, FileError  # noqa: F401  (the errors this module raises)
+import os as _os
+from typing import TYPE_CHECKING, Any
+
+from .. import CfGraph, Error, FileError, Polyhedron  # noqa: F401  (the errors this module raises)
 
 try:
     from . import _gen
@@ -23,22 +26,27 @@ except ImportError as _e:  # pragma: no cover - a build without the tools
         "cf.gen: this build of cf has no generator or model loader (built without the CGAL tools, "
         "CF_BUILD_TOOLS=OFF or CF_WITH_CGAL=OFF)") from _e
 
+if TYPE_CHECKING:
+    import os
+
 __all__ = ["generate", "load_model"]
 
 
-def load_model(path, units="mm", coplanar_rel_tol=None, check_self_intersection=True, name=""):
+def load_model(path: str | os.PathLike[str], units: str = "mm", coplanar_rel_tol: float | None = None,
+               check_self_intersection: bool = True, name: str = "") -> Polyhedron:
     """Reads a polyhedral model (OFF, OBJ, STL or PLY) and extracts its features.
 
     ``units`` is the file's length unit ('mm', 'cm', 'm' or 'in'); the returned
     cf.Polyhedron is in mm, indexed as cfgen indexes it (cfgen --features). Raises cf.Error
     naming the file and the problem (cf.FileError when it cannot be read).
     """
-    kwargs = {} if coplanar_rel_tol is None else {"coplanar_rel_tol": coplanar_rel_tol}
+    kwargs: dict[str, Any] = {} if coplanar_rel_tol is None else {"coplanar_rel_tol": coplanar_rel_tol}
     return _gen.load_model(_os.fspath(path), units=units, check_self_intersection=check_self_intersection,
                            name=name, **kwargs)
 
 
-def generate(a_path, b_path, output=None, **options):
+def generate(a_path: str | os.PathLike[str], b_path: str | os.PathLike[str],
+             output: str | os.PathLike[str] | None = None, **options: Any) -> CfGraph:
     """Generates the CF graph of A (moving) against B (fixed) with cfgen's generator.
 
     Returns the graph as a cf.CfGraph, handed over in memory; with ``output`` it also writes
@@ -57,7 +65,7 @@ def generate(a_path, b_path, output=None, **options):
     tasks and raises KeyboardInterrupt; with ``checkpoint``, the chunks finished so far are
     kept for the next call. Raises cf.Error for bad models or options.
     """
-    a_path, b_path = _os.fspath(a_path), _os.fspath(b_path)
+    a, b = _os.fspath(a_path), _os.fspath(b_path)
     for path in ("checkpoint", "certificates"):
         if path in options:
             if options[path] is None:
@@ -65,7 +73,7 @@ def generate(a_path, b_path, output=None, **options):
             else:
                 options[path] = _os.fspath(options[path])
     out = "" if output is None else _os.fspath(output)
-    g = _gen.generate(a_path, b_path, out, **options)
+    g = _gen.generate(a, b, out, **options)
     if out:
-        g._source_path = out  # an input that ReplayResult.to_csv never overwrites
+        setattr(g, "_source_path", out)  # an input that ReplayResult.to_csv never overwrites
     return g
