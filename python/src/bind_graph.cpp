@@ -2,7 +2,9 @@
 
 #include "common.hpp"
 
+#include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 namespace cfpy {
 
@@ -27,17 +29,37 @@ py::array_t<T> array2(std::size_t rows, std::size_t cols) {
       std::vector<py::ssize_t>{static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(cols)});
 }
 
-py::array_t<double> vec3s(std::size_t n, const std::function<cf::Vec3(std::size_t)>& get) {
-  auto a = array2<double>(n, 3);
-  auto r = a.mutable_unchecked<2>();
-  for (std::size_t i = 0; i < n; ++i) {
-    const cf::Vec3 v = get(i);
-    for (int k = 0; k < 3; ++k) r(static_cast<py::ssize_t>(i), k) = v[k];
-  }
+py::array_t<double> vec(const cf::Vec3& v) { return py::array_t<double>(3, v.data()); }
+
+// A read-only numpy view of memory that `owner` (the Python object holding it) keeps alive:
+// no copy. `first` is the first element; `stride` the bytes from one row to the next (a
+// record's size: the rows are a member of each record); `cols` values per row, `col_stride`
+// bytes apart (0 cols: one value per row, a 1-D view).
+template <class T>
+py::array_t<T> view(const T* first, std::size_t rows, std::size_t stride, std::size_t cols,
+                    std::ptrdiff_t col_stride, const py::handle& owner) {
+  std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(rows)};
+  std::vector<py::ssize_t> strides{static_cast<py::ssize_t>(stride)};
+  if (cols > 0) shape.push_back(static_cast<py::ssize_t>(cols)), strides.push_back(col_stride);
+  if (rows == 0) return py::array_t<T>(shape);  // nothing to share
+  py::array_t<T> a(shape, strides, first, owner);
+  a.attr("setflags")(py::arg("write") = false);
   return a;
 }
 
-py::array_t<double> vec(const cf::Vec3& v) { return py::array_t<double>(3, v.data()); }
+// Bytes from member `a` to member `b` of one record.
+template <class R, class A, class B>
+std::ptrdiff_t member_gap(const R& r, const A& a, const B& b) {
+  (void)r;
+  return reinterpret_cast<const char*>(&b) - reinterpret_cast<const char*>(&a);
+}
+
+// The int32 value of an id, in place: ids are one int32 (cf/types.hpp).
+template <class Id>
+const std::int32_t* id_data(const Id& id) {
+  static_assert(sizeof(Id) == sizeof(std::int32_t) && std::is_standard_layout_v<Id>);
+  return reinterpret_cast<const std::int32_t*>(&id);
+}
 
 py::array_t<double> quaternion_wxyz(const cf::Mat3& R) {
   Eigen::Quaterniond q(R);
@@ -53,36 +75,40 @@ using cf::Polyhedron;
 
 // cf.Polyhedron's faces' planes, areas and centroids, mass properties, JSON and repr.
 void add_polyhedron_faces(py::class_<Polyhedron>& cls) {
+  // Views of the faces' records (no copy), kept alive by the model.
+  auto faces = [](const py::object& self) -> const std::vector<cf::Face>& {
+    return self.cast<const Polyhedron&>().faces();
+  };
   cls.def_property_readonly(
          "face_normals",
-         [](const Polyhedron& P) {
-           return vec3s(P.num_faces(), [&](std::size_t i) { return P.faces()[i].normal; });
+         [faces](const py::object& self) {
+           const auto& F = faces(self);
+           return view(F.empty() ? nullptr : F[0].normal.data(), F.size(), sizeof(cf::Face), 3,
+                       sizeof(double), self);
          },
-         "(F, 3) float64: outward unit normals.")
+         "(F, 3) float64: outward unit normals (a read-only view of the model, no copy).")
       .def_property_readonly(
           "face_offsets",
-          [](const Polyhedron& P) {
-            py::array_t<double> a(static_cast<py::ssize_t>(P.num_faces()));
-            for (std::size_t i = 0; i < P.num_faces(); ++i)
-              a.mutable_at(static_cast<py::ssize_t>(i)) = P.faces()[i].offset;
-            return a;
+          [faces](const py::object& self) {
+            const auto& F = faces(self);
+            return view(F.empty() ? nullptr : &F[0].offset, F.size(), sizeof(cf::Face), 0, 0, self);
           },
-          "(F,) float64: plane offsets, mm (normal . x == offset).")
+          "(F,) float64: plane offsets, mm (normal . x == offset); a read-only view.")
       .def_property_readonly(
           "face_areas",
-          [](const Polyhedron& P) {
-            py::array_t<double> a(static_cast<py::ssize_t>(P.num_faces()));
-            for (std::size_t i = 0; i < P.num_faces(); ++i)
-              a.mutable_at(static_cast<py::ssize_t>(i)) = P.faces()[i].area;
-            return a;
+          [faces](const py::object& self) {
+            const auto& F = faces(self);
+            return view(F.empty() ? nullptr : &F[0].area, F.size(), sizeof(cf::Face), 0, 0, self);
           },
-          "(F,) float64: areas, mm^2, holes excluded.")
+          "(F,) float64: areas, mm^2, holes excluded; a read-only view.")
       .def_property_readonly(
           "face_centroids",
-          [](const Polyhedron& P) {
-            return vec3s(P.num_faces(), [&](std::size_t i) { return P.faces()[i].centroid; });
+          [faces](const py::object& self) {
+            const auto& F = faces(self);
+            return view(F.empty() ? nullptr : F[0].centroid.data(), F.size(), sizeof(cf::Face), 3,
+                        sizeof(double), self);
           },
-          "(F, 3) float64: area centroids, mm.")
+          "(F, 3) float64: area centroids, mm; a read-only view.")
       .def_property_readonly("volume", &Polyhedron::volume, "mm^3")
       .def_property_readonly("size", &Polyhedron::size, "mm, the bounding box's diagonal")
       .def_property_readonly(
@@ -118,22 +144,22 @@ void bind_polyhedron(py::module_& m) {
           .def_property_readonly("num_faces", &Polyhedron::num_faces)
           .def_property_readonly(
               "vertices",
-              [](const Polyhedron& P) {
-                return vec3s(P.num_vertices(), [&](std::size_t i) { return P.vertices()[i].p; });
+              [](const py::object& self) {
+                const auto& V = self.cast<const Polyhedron&>().vertices();
+                return view(V.empty() ? nullptr : V[0].p.data(), V.size(), sizeof(cf::Vertex), 3,
+                            sizeof(double), self);
               },
-              "(V, 3) float64: the feature vertices, mm, model frame.")
+              "(V, 3) float64: the feature vertices, mm, model frame (a read-only view of the "
+              "model, no copy).")
           .def_property_readonly(
               "edges",
-              [](const Polyhedron& P) {
-                auto a = array2<std::int32_t>(P.num_edges(), 2);
-                auto r = a.mutable_unchecked<2>();
-                for (std::size_t i = 0; i < P.num_edges(); ++i) {
-                  r(static_cast<py::ssize_t>(i), 0) = P.edges()[i].v0.value();
-                  r(static_cast<py::ssize_t>(i), 1) = P.edges()[i].v1.value();
-                }
-                return a;
+              [](const py::object& self) {
+                const auto& E = self.cast<const Polyhedron&>().edges();
+                if (E.empty()) return array2<std::int32_t>(0, 2);
+                return view(id_data(E[0].v0), E.size(), sizeof(cf::Edge), 2,
+                            member_gap(E[0], E[0].v0, E[0].v1), self);
               },
-              "(E, 2) int32: each edge's end vertices v0 < v1.")
+              "(E, 2) int32: each edge's end vertices v0 < v1; a read-only view.")
           .def_property_readonly(
               "faces",
               [](const Polyhedron& P) {
@@ -155,34 +181,30 @@ void bind_polyhedron(py::module_& m) {
               "(counter-clockwise seen from outside), then the holes.")
           .def_property_readonly(
               "edge_faces",
-              [](const Polyhedron& P) {
-                auto a = array2<std::int32_t>(P.num_edges(), 2);
-                auto r = a.mutable_unchecked<2>();
-                for (std::size_t i = 0; i < P.num_edges(); ++i) {
-                  r(static_cast<py::ssize_t>(i), 0) = P.edges()[i].left.value();
-                  r(static_cast<py::ssize_t>(i), 1) = P.edges()[i].right.value();
-                }
-                return a;
+              [](const py::object& self) {
+                const auto& E = self.cast<const Polyhedron&>().edges();
+                if (E.empty()) return array2<std::int32_t>(0, 2);
+                return view(id_data(E[0].left), E.size(), sizeof(cf::Edge), 2,
+                            member_gap(E[0], E[0].left, E[0].right), self);
               },
-              "(E, 2) int32: each edge's left face (its loop runs v0 -> v1) and right face.")
+              "(E, 2) int32: each edge's left face (its loop runs v0 -> v1) and right face; a "
+              "read-only view.")
           .def_property_readonly(
               "edge_convex",
-              [](const Polyhedron& P) {
-                py::array_t<bool> a(static_cast<py::ssize_t>(P.num_edges()));
-                for (std::size_t i = 0; i < P.num_edges(); ++i)
-                  a.mutable_at(static_cast<py::ssize_t>(i)) = P.edges()[i].convex;
-                return a;
+              [](const py::object& self) {
+                const auto& E = self.cast<const Polyhedron&>().edges();
+                return view(E.empty() ? nullptr : &E[0].convex, E.size(), sizeof(cf::Edge), 0, 0,
+                            self);
               },
-              "(E,) bool: interior dihedral angle below pi.")
+              "(E,) bool: interior dihedral angle below pi; a read-only view.")
           .def_property_readonly(
               "edge_dihedral",
-              [](const Polyhedron& P) {
-                py::array_t<double> a(static_cast<py::ssize_t>(P.num_edges()));
-                for (std::size_t i = 0; i < P.num_edges(); ++i)
-                  a.mutable_at(static_cast<py::ssize_t>(i)) = P.edges()[i].dihedral;
-                return a;
+              [](const py::object& self) {
+                const auto& E = self.cast<const Polyhedron&>().edges();
+                return view(E.empty() ? nullptr : &E[0].dihedral, E.size(), sizeof(cf::Edge), 0, 0,
+                            self);
               },
-              "(E,) float64: interior dihedral angles, rad.");
+              "(E,) float64: interior dihedral angles, rad; a read-only view.");
   add_polyhedron_faces(cls);
 }
 
@@ -197,11 +219,21 @@ void bind_cf(py::module_& m) {
           "pcs_string", [](const CfEntry& e) { return cf::to_string(e.rec.pcs); },
           "The PCs as 'type:a:b;...' (cfreplay's pcs column).")
       .def_property_readonly(
-          "witness_R", [](const CfEntry& e) { return cf::Mat3(e.rec.witness.R_BA); },
-          "(3, 3): the witness pose's rotation R (x_B = R x_A + t).")
+          "witness_R",
+          [](const py::object& self) {
+            // Eigen stores the matrix by columns: row i, column j at (i + 3 j) doubles.
+            const cf::Mat3& R = self.cast<const CfEntry&>().rec.witness.R_BA;
+            return view(R.data(), 3, sizeof(double), 3, 3 * sizeof(double), self);
+          },
+          "(3, 3): the witness pose's rotation R (x_B = R x_A + t); a read-only view of the "
+          "CF, no copy.")
       .def_property_readonly(
-          "witness_t", [](const CfEntry& e) { return vec(e.rec.witness.t_BA); },
-          "(3,): the witness pose's translation t, mm.")
+          "witness_t",
+          [](const py::object& self) {
+            const cf::Vec3& t = self.cast<const CfEntry&>().rec.witness.t_BA;
+            return view(t.data(), 3, sizeof(double), 0, 0, self);
+          },
+          "(3,): the witness pose's translation t, mm; a read-only view.")
       .def_property_readonly(
           "witness_q", [](const CfEntry& e) { return quaternion_wxyz(e.rec.witness.R_BA); },
           "(4,): the witness rotation as a unit quaternion w, x, y, z (w >= 0).")
@@ -220,16 +252,13 @@ void bind_cf(py::module_& m) {
           "Whether some pure rotation keeps the CF; None when the freedoms are not stored.")
       .def_property_readonly(
           "planes",
-          [](const CfEntry& e) {
-            auto a = array2<double>(static_cast<std::size_t>(e.rec.num_planes), 4);
-            auto r = a.mutable_unchecked<2>();
-            for (int i = 0; i < e.rec.num_planes; ++i)
-              for (int k = 0; k < 4; ++k)
-                r(i, k) = e.rec.planes[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)];
-            return a;
+          [](const py::object& self) {
+            const cf::CfRecord& r = self.cast<const CfEntry&>().rec;
+            return view(r.planes[0].data(), static_cast<std::size_t>(r.num_planes),
+                        sizeof(r.planes[0]), 4, sizeof(double), self);
           },
           "(n, 4): each PC's contact plane at the witness (n_x, n_y, n_z, d), n into A; (0, 4) "
-          "when not stored.")
+          "when not stored. A read-only view.")
       .def("__repr__", [](const CfEntry& e) {
         return "<cf.Cf " + std::to_string(e.id) + ": " + cf::to_string(e.rec.pcs) + ">";
       });

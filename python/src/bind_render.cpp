@@ -21,15 +21,12 @@ namespace cfpy {
 
 namespace {
 
-using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using Array = RealArray;
 
 py::array_t<double> vec(const cf::Vec3& v) { return py::array_t<double>(3, v.data()); }
 
 Array as_array(const py::handle& h, const char* name, const std::string& where) {
-  Array a = Array::ensure(h);
-  if (!a)
-    fail(where + ": " + name + " must be an array of numbers, got " + std::string(py::repr(h)));
-  return a;
+  return real_array(h, name, where);
 }
 
 std::string shape_of(const Array& a) {
@@ -177,7 +174,7 @@ void bind_model_state(py::module_& m) {
              return std::make_unique<cf::CfModel>(g, params_arg(params, kw, "CfModel"));
            }),
            py::arg("graph"), py::arg("params") = py::none(), py::keep_alive<1, 2>())
-      .def_property_readonly("params", [](const cf::CfModel& m) { return m.params(); });
+      .def_property_readonly("params", [](const cf::CfModel& model) { return model.params(); });
   py::class_<State>(m, "CfState",
                     "One servo thread's state for one CfModel (cf::CfState): CfState(model). "
                     "Not thread-safe: one per thread.")

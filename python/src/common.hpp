@@ -22,6 +22,15 @@ namespace py = pybind11;
 /// Raises cf.Error (a ValueError) with the message.
 [[noreturn]] inline void fail(const std::string& message) { throw cf::Error(message); }
 
+/// float64 and C-contiguous: what libcf reads in place.
+using RealArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+/// `h` (an array or a sequence of numbers) as RealArray: a float64, C-contiguous array is used
+/// as it is (no copy); booleans, integers, float32 and strided arrays are converted. Anything
+/// else (complex, strings, objects) raises cf.Error naming `what` and its type, prefixed by
+/// `where`.
+RealArray real_array(const py::handle& h, const char* what, const std::string& where);
+
 /// A pose from a translation (3, mm) and a unit quaternion (4, w x y z), normalised as
 /// cfreplay does. `where` prefixes messages ("step", "replay: row 3").
 cf::Pose pose_from(const double* p, const double* q, const std::string& where);

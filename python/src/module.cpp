@@ -16,6 +16,26 @@
 
 namespace cfpy {
 
+RealArray real_array(const py::handle& h, const char* what, const std::string& where) {
+  // numpy's own reading first (a list becomes an array of the type its items have), so that
+  // the kind can be checked before any cast: a cast to float64 would drop a complex number's
+  // imaginary part and parse strings.
+  py::array in;
+  try {
+    in = py::array::ensure(h);
+  } catch (const py::error_already_set&) {
+  }
+  if (!in)
+    fail(where + ": " + what + " must be an array of numbers, got " + std::string(py::repr(h)));
+  const char kind = in.dtype().kind();
+  if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f')
+    fail(where + ": " + what + " must be real numbers, got an array of " +
+         std::string(py::str(in.dtype())));
+  RealArray a = RealArray::ensure(in);
+  if (!a) throw py::error_already_set();
+  return a;
+}
+
 cf::Pose pose_from(const double* p, const double* q, const std::string& where) {
   for (int i = 0; i < 3; ++i)
     if (!std::isfinite(p[i])) fail(where + ": the translation is not finite");
@@ -98,12 +118,8 @@ double double_value(const DoubleField& f, const py::handle& h, const std::string
 }
 
 cf::Vec3 vec3_value(const char* name, const py::handle& h, const std::string& where) {
-  py::array_t<double, py::array::c_style | py::array::forcecast> a;
-  try {
-    a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(h);
-  } catch (const py::error_already_set&) {
-  }
-  if (!a || a.ndim() != 1 || a.shape(0) != 3)
+  const RealArray a = real_array(h, name, where);
+  if (a.ndim() != 1 || a.shape(0) != 3)
     fail(where + ": " + name + " must be 3 numbers (x, y, z), got " + std::string(py::repr(h)));
   const cf::Vec3 v(a.at(0), a.at(1), a.at(2));
   if (!v.allFinite()) fail(where + ": " + std::string(name) + " must be finite");
