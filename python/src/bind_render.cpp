@@ -13,7 +13,9 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 
@@ -244,19 +246,24 @@ std::vector<cf::TrajectorySample> replay_samples(const py::object& t, const py::
     fail(where + ": q must have shape (N, 4) (w, x, y, z) with N = len(t) = " + std::to_string(n) +
          ", got " + shape_of(qa));
   std::vector<cf::TrajectorySample> samples(static_cast<std::size_t>(n));
-  const double* T = ta.data();
+  const double *T = ta.data(), *P = pa.data(), *Q = qa.data();
+  py::gil_scoped_release release;  // the arrays are held above; errors are C++ exceptions
   for (py::ssize_t i = 0; i < n; ++i) {
-    const std::string row = where + ": row " + std::to_string(i);
-    if (!std::isfinite(T[i])) fail(row + ": time is not finite");
+    auto row = [&] { return where + ": row " + std::to_string(i); };
+    if (!std::isfinite(T[i])) fail(row() + ": time is not finite");
     if (i > 0 && !(T[i] > T[i - 1])) {
       char buf[160];
       std::snprintf(buf, sizeof buf, ": time %.9g s does not increase (previous row: %.9g s)", T[i],
                     T[i - 1]);
-      fail(row + buf);
+      fail(row() + buf);
     }
     cf::TrajectorySample& s = samples[static_cast<std::size_t>(i)];
     s.t_s = T[i];
-    s.X_WD = pose_from(pa.data() + 3 * i, qa.data() + 4 * i, row);
+    // The row's name is spelled out only for the message of a pose that is refused.
+    const double *p_i = P + 3 * i, *q_i = Q + 4 * i;
+    const bool ok = std::isfinite(p_i[0]) && std::isfinite(p_i[1]) && std::isfinite(p_i[2]) &&
+                    cf::quaternion_problem(q_i[0], q_i[1], q_i[2], q_i[3]).empty();
+    s.X_WD = pose_from(p_i, q_i, ok ? where : row());
   }
   return samples;
 }
@@ -327,53 +334,103 @@ void run_replay(const cf::CfGraph& g, const std::vector<cf::TrajectorySample>& s
   if (!whole) throw py::error_already_set();
 }
 
-/// replay's result: per-tick arrays and lists by name, and the rows for to_csv.
+/// A column of text (ASCII: PC lists, motion types, statuses, regimes) as a numpy unicode
+/// array of its longest item's width, allocated here (with the GIL) and filled by fill()
+/// (without it).
+class TextColumn {
+ public:
+  TextColumn(std::size_t n, std::size_t width)
+      : width_(std::max<std::size_t>(1, width)),
+        a_(py::dtype("<U" + std::to_string(width_)), std::vector<py::ssize_t>{py::ssize_t(n)}) {
+    data_ = static_cast<std::uint32_t*>(a_.mutable_data());
+  }
+  /// Row i's text, as UCS-4 code points padded with zeros. No GIL needed.
+  void fill(std::size_t i, const std::string& text) {
+    std::uint32_t* out = data_ + i * width_;
+    for (std::size_t k = 0; k < width_; ++k) {
+      const auto c = k < text.size() ? static_cast<unsigned char>(text[k]) : 0u;
+      if (c >= 0x80) fail("replay: internal error: a text column holds a non-ASCII byte");
+      out[k] = c;  // libcf writes these columns in ASCII
+    }
+  }
+  const py::array& array() const { return a_; }
+
+ private:
+  std::size_t width_;
+  py::array a_;
+  std::uint32_t* data_;
+};
+
+/// The widths of replay's text columns: pcs, motion, status, regimes, identification.
+std::array<std::size_t, 5> text_widths(const ReplayRows& rows, const ReplayExtras& x) {
+  std::array<std::size_t, 5> w{};
+  for (std::size_t i = 0; i < rows.rows.size(); ++i) {
+    const cf::ReplayRow& r = rows.rows[i];
+    const std::size_t len[5] = {r.pcs.size(), r.motion.size(), r.status.size(), r.regimes.size(),
+                                x.identification[i].size()};
+    for (int k = 0; k < 5; ++k) w[k] = std::max(w[k], len[k]);
+  }
+  return w;
+}
+
+/// replay's result: per-tick arrays by name, and the rows for to_csv. The arrays are
+/// allocated with the GIL and filled without it, so that threads stepping their own states
+/// hold it only for the allocations.
 py::dict replay_dict(std::unique_ptr<ReplayRows> rows, const ReplayExtras& x) {
-  const auto n = static_cast<py::ssize_t>(rows->rows.size());
-  py::dict d;
+  const std::size_t N = rows->rows.size();
+  const auto n = static_cast<py::ssize_t>(N);
+  std::array<std::size_t, 5> widths{};
+  {
+    py::gil_scoped_release release;
+    widths = text_widths(*rows, x);
+  }
   const std::vector<py::ssize_t> shape3{n, 3};
   py::array_t<double> tt(n), FW(shape3), MW(shape3), FA(shape3), MA(shape3), FC(shape3), MC(shape3),
       FG(shape3), PP(shape3), PQ(std::vector<py::ssize_t>{n, 4});
   py::array_t<std::int32_t> cfa(n), nd(n), dofa(n);
   py::array_t<bool> cons(n);
-  py::list pcs, motion, status, regimes, ident;
-  for (py::ssize_t i = 0; i < n; ++i) {
-    const auto I = static_cast<std::size_t>(i);
-    const cf::ReplayRow& r = rows->rows[I];
-    tt.mutable_at(i) = r.t_s;
-    cfa.mutable_at(i) = r.cf;
-    nd.mutable_at(i) = x.num_detected[I];
-    dofa.mutable_at(i) = x.dof[I];
-    cons.mutable_at(i) = x.conservative[I] != 0;
-    for (int k = 0; k < 3; ++k) {
-      const auto K = 3 * I + static_cast<std::size_t>(k);
-      FW.mutable_at(i, k) = r.F_W[k];
-      MW.mutable_at(i, k) = r.M_W[k];
-      FA.mutable_at(i, k) = r.F_A[k];
-      MA.mutable_at(i, k) = r.M_A[k];
-      FC.mutable_at(i, k) = x.Fc[K];
-      MC.mutable_at(i, k) = x.Mc[K];
-      PP.mutable_at(i, k) = r.X_WP.t_BA[k];
-      FG.mutable_at(i, k) = x.Fg[K];
+  TextColumn pcs(N, widths[0]), motion(N, widths[1]), status(N, widths[2]), regimes(N, widths[3]),
+      ident(N, widths[4]);
+  double *t_out = tt.mutable_data(), *fw = FW.mutable_data(), *mw = MW.mutable_data(),
+         *fa = FA.mutable_data(), *ma = MA.mutable_data(), *fc = FC.mutable_data(),
+         *mc = MC.mutable_data(), *fg = FG.mutable_data(), *pp = PP.mutable_data(),
+         *pq = PQ.mutable_data();
+  std::int32_t *cf_out = cfa.mutable_data(), *nd_out = nd.mutable_data(),
+               *dof_out = dofa.mutable_data();
+  bool* cons_out = cons.mutable_data();
+  {
+    py::gil_scoped_release release;
+    for (std::size_t i = 0; i < N; ++i) {
+      const cf::ReplayRow& r = rows->rows[i];
+      t_out[i] = r.t_s;
+      cf_out[i] = r.cf;
+      nd_out[i] = x.num_detected[i];
+      dof_out[i] = x.dof[i];
+      cons_out[i] = x.conservative[i] != 0;
+      for (std::size_t k = 0; k < 3; ++k) {
+        const std::size_t K = 3 * i + k;
+        const auto e = static_cast<Eigen::Index>(k);
+        fw[K] = r.F_W[e], mw[K] = r.M_W[e], fa[K] = r.F_A[e], ma[K] = r.M_A[e];
+        fc[K] = x.Fc[K], mc[K] = x.Mc[K], fg[K] = x.Fg[K], pp[K] = r.X_WP.t_BA[e];
+      }
+      Eigen::Quaterniond q_WP(r.X_WP.R_BA);
+      if (q_WP.w() < 0) q_WP.coeffs() = -q_WP.coeffs();
+      const double wxyz[4] = {q_WP.w(), q_WP.x(), q_WP.y(), q_WP.z()};
+      std::copy(wxyz, wxyz + 4, pq + 4 * i);
+      pcs.fill(i, r.pcs);
+      motion.fill(i, r.motion);
+      status.fill(i, r.status);
+      regimes.fill(i, r.regimes);
+      ident.fill(i, x.identification[i]);
     }
-    Eigen::Quaterniond q_WP(r.X_WP.R_BA);
-    if (q_WP.w() < 0) q_WP.coeffs() = -q_WP.coeffs();
-    PQ.mutable_at(i, 0) = q_WP.w();
-    PQ.mutable_at(i, 1) = q_WP.x();
-    PQ.mutable_at(i, 2) = q_WP.y();
-    PQ.mutable_at(i, 3) = q_WP.z();
-    pcs.append(r.pcs);
-    motion.append(r.motion);
-    status.append(r.status);
-    regimes.append(r.regimes);
-    ident.append(x.identification[I]);
   }
+  py::dict d;
   d["t_s"] = tt;
   d["cf"] = cfa;
-  d["pcs"] = pcs;
-  d["motion"] = motion;
-  d["status"] = status;
-  d["identification"] = ident;
+  d["pcs"] = pcs.array();
+  d["motion"] = motion.array();
+  d["status"] = status.array();
+  d["identification"] = ident.array();
   d["num_detected"] = nd;
   d["F_W"] = FW;
   d["M_W"] = MW;
@@ -386,7 +443,7 @@ py::dict replay_dict(std::unique_ptr<ReplayRows> rows, const ReplayExtras& x) {
   d["F_gravity_W"] = FG;
   d["conservative"] = cons;
   d["dof"] = dofa;
-  d["regimes"] = regimes;
+  d["regimes"] = regimes.array();
   d["_rows"] = py::cast(std::move(rows));
   return d;
 }

@@ -215,8 +215,10 @@ def test_replay_errors_carry_messages(l_graph):
         cf.replay(l_graph, t, p, q, friction_displacement="anchor")
     with pytest.raises(cf.Error, match=r"^replay: mass_kg must be a number, got 'heavy'$"):
         cf.replay(l_graph, t, p, q, mass_kg="heavy")
-    with pytest.raises(cf.Error, match=r"^replay: t must be an array of numbers, got"):
+    with pytest.raises(cf.Error, match=r"^replay: t must be real numbers, got an array of <U1$"):
         cf.replay(l_graph, ["a"], p[:1], q[:1])
+    with pytest.raises(cf.Error, match=r"^replay: t must be an array of numbers, got "):
+        cf.replay(l_graph, [[0.0], [0.1, 0.2]], p[:2], q[:2])  # ragged: not an array
     r = cf.Renderer(l_graph)
     r.step(0.0, p[0], q[0])
     with pytest.raises(cf.Error, match=r"^step: time 0 s does not increase \(previous step: 0 s\)$"):

@@ -101,10 +101,12 @@ class Enumerator {
     std::size_t searched = 0;
     double seconds = 0;  // s of CPU, mean a search took
     double found = 0;    // share of the pairs found valid
+    // Of the valid single PCs known (the samples', with their images), the share a
+    // motion-only single makes a candidate pair with, on the mean over those sampled.
+    double partner_share = 0;
   };
   PairSample motion_single_pairs(const std::vector<Discovery>& met, std::size_t count);
-  double after_motion_seconds(const RunEstimate& e, double partners,
-                              const std::vector<Discovery>& met);
+  double after_motion_seconds(const RunEstimate& e, const std::vector<Discovery>& met);
   // motion.cpp
   void motion_closure();
   void more_witnesses(Clock::time_point t0);

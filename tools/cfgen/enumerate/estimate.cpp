@@ -353,6 +353,7 @@ Enumerator::PairSample Enumerator::motion_single_pairs(const std::vector<Discove
     ++j;
   }
   std::vector<Task> tasks;
+  double partners = 0;
   for (const Pc& p : only) {
     std::vector<PcSet> pairs;
     for (const auto& [q, w] : valid_[0]) {
@@ -360,6 +361,7 @@ Enumerator::PairSample Enumerator::motion_single_pairs(const std::vector<Discove
       PcSet t = q;
       if (t.insert(p) && search_.plausible(t)) pairs.push_back(t);
     }
+    partners += double(pairs.size());
     for (std::size_t k : spread(pairs.size(), kPartnersPerSingle)) {
       Task t;
       t.pcs = pairs[k];
@@ -377,6 +379,8 @@ Enumerator::PairSample Enumerator::motion_single_pairs(const std::vector<Discove
   PairSample out;
   out.singles = only.size();
   out.searched = tasks.size();
+  if (!only.empty() && !valid_[0].empty())
+    out.partner_share = partners / double(only.size()) / double(valid_[0].size());
   for (std::size_t j = 0; j < tasks.size(); ++j) out.seconds += sec[j], out.found += found[j];
   if (out.searched) out.seconds /= double(out.searched), out.found /= double(out.searched);
   return out;
@@ -405,22 +409,24 @@ void extrapolate(LevelEstimate& l, const Sample& s, bool by_orbit) {
 }  // namespace
 
 // s of CPU the levels take again after the closure by motion: the single PCs it finds (a
-// share of level 1's failed sets), each with `partners` level-2 candidates, the failed among
-// them searched as a failed level-2 orbit's members are, at the cost sampled on such pairs
-// (none when the sample meets no such single).
-double Enumerator::after_motion_seconds(const RunEstimate& e, double partners,
-                                        const std::vector<Discovery>& met) {
+// share of level 1's failed sets), each paired with the share of the valid single PCs the
+// sample's such singles pair with (they pair with more than a valid single does: about twice
+// as many on CGAL's cross and U), the failed pairs searched as a failed level-2 orbit's
+// members are, at the cost sampled on such pairs (none when the sample meets no such single).
+double Enumerator::after_motion_seconds(const RunEstimate& e, const std::vector<Discovery>& met) {
   if (opt_.max_pcs < 2) return 0;
   const LevelEstimate& l1 = e.levels[0];
   const LevelEstimate& l2 = e.levels[1];
   const double l2_failed = l2.candidates - l2.valid;
   const double tries = l2_failed > 0 ? l2.failed_tries / l2_failed : 0;
   const PairSample ps = motion_single_pairs(met, samples_);
-  const double pairs = kMotionSinglesPerFailed * std::max(0.0, l1.candidates - l1.valid) * partners;
+  const double singles = kMotionSinglesPerFailed * std::max(0.0, l1.candidates - l1.valid);
+  const double pairs = singles * ps.partner_share * l1.valid;
   if (std::getenv("CF_ESTIMATE_DEBUG"))
     std::fprintf(stderr,
-                 "CAL after_motion pairs %g tries %g pair_s %g pair_found %g n %zu singles %zu\n",
-                 pairs, tries, ps.seconds, ps.found, ps.searched, ps.singles);
+                 "CAL after_motion pairs %g tries %g pair_s %g pair_found %g n %zu singles %zu "
+                 "partner_share %g\n",
+                 pairs, tries, ps.seconds, ps.found, ps.searched, ps.singles, ps.partner_share);
   return pairs * (1 - ps.found) * tries * ps.seconds;
 }
 
@@ -446,13 +452,11 @@ RunEstimate Enumerator::estimate(int threads, std::size_t samples) {
   extrapolate(l1, s1, true);
   // Levels 2 and 3: a valid set of the level below and a level-1 candidate the necessary
   // conditions allow with it make a candidate when its subsets one PC smaller are valid.
-  double partners = 0;  // level-2 candidates per valid single PC
   for (int level = 1; level < opt_.max_pcs && level < 3; ++level) {
     const LevelEstimate& below = e.levels[level - 1];
     if (valid_[level - 1].empty() || below.valid <= 0) break;
     double added = 0, fraction = 0;
     const std::vector<PcSet> pool = with_valid_subsets(grown_sets(level, c1, added), fraction);
-    if (level == 1) partners = added * fraction;
     LevelEstimate& l = e.levels[level];
     l.candidates = below.valid * added * fraction / (level + 1);  // each counted by its PCs
     const Sample sample = sample_sets(level, pool, subsets, samples_, kOrbitTries);
@@ -473,7 +477,7 @@ RunEstimate Enumerator::estimate(int threads, std::size_t samples) {
   const double explore_s = explore_seconds(kExploresPerSample * samples_, met_singles);
   if (std::getenv("CF_ESTIMATE_DEBUG"))
     std::fprintf(stderr, "CAL met_singles %zu\n", met_singles.size());
-  const double after_motion = after_motion_seconds(e, partners, met_singles);
+  const double after_motion = after_motion_seconds(e, met_singles);
   e.cfs = kCfsPerLevelCf * found + kCfsPerFailed * failed;
   e.transitions = e.cfs * kTransitionsPerCf;
   e.cpu_seconds =
