@@ -65,8 +65,9 @@ constexpr double kSearchesPerFailed = 0.06;
 constexpr double kSearchesPerFailedTry = 1.5;
 // Single PCs the closure by motion finds per level-1 candidate the level fails: on CGAL's
 // cross against its U (the one pair measured whose levels run again at a cost), about 1,900
-// of 5,300. Their pairs' search cost is sampled (motion_single_pairs); their number is not,
-// as the explorations that meet them are too few in a sample to count them.
+// of 5,200 (1,934 single-PC CFs beyond level 1's 4,368 at b7ecb18). Their pairs' count per
+// single and search cost are sampled (motion_single_pairs); their number is not, as the
+// explorations that meet them are too few in a sample to count them.
 constexpr double kMotionSinglesPerFailed = 0.40;
 // Of a run's time on one thread, the part that runs on one thread whatever the count.
 constexpr double kSerial = 0.25;
