@@ -170,8 +170,8 @@ def module_stub(mod):
             if value.__module__ != here:
                 continue
             lines += [""] + class_stub(key, value, here)
-        elif callable(value):
-            lines += [""] + function_stub(key, value, here if here == "cf._cf" else "cf._cf", False, "")
+        elif callable(value):  # the run-time module's types by their names, as imported above
+            lines += [""] + function_stub(key, value, "cf._cf", False, "")
         elif isinstance(value, (str, int, float, bool)):
             lines.append(f"{key}: {type(value).__name__}")
     return "\n".join(lines) + "\n"
