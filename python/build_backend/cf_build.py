@@ -24,6 +24,7 @@ import shutil
 import subprocess
 import sys
 import sysconfig
+import tarfile
 import tempfile
 import zipfile
 
@@ -188,7 +189,42 @@ def _write_wheel(wheel_path, site, dist_info):
         z.writestr(zipfile.ZipInfo(f"{dist_info}/RECORD", date_time=(2020, 1, 1, 0, 0, 0)), out.getvalue())
 
 
+def _source_files():
+    """The files of the source tree an sdist holds: git's when it is a checkout (tracked files,
+    as a fresh clone has them), else every file outside the build trees and node_modules."""
+    try:
+        out = subprocess.run(["git", "-C", _SOURCE, "ls-files", "-z"], capture_output=True, check=True).stdout
+        return sorted(f for f in out.decode().split("\0") if f and os.path.isfile(os.path.join(_SOURCE, f)))
+    except (OSError, subprocess.CalledProcessError):
+        files = []
+        for root, dirs, names in os.walk(_SOURCE):
+            rel = os.path.relpath(root, _SOURCE)
+            dirs[:] = sorted(d for d in dirs if not (rel == "." and d.startswith("build")) and d not in (".git", "node_modules"))
+            files += [os.path.normpath(os.path.join(rel, n)) for n in sorted(names)]
+        return files
+
+
 # PEP 517 hooks.
+
+def get_requires_for_build_sdist(config_settings=None):
+    return []
+
+
+def build_sdist(sdist_directory, config_settings=None):
+    """The source tree as `cf_haptics-X.Y.Z.tar.gz` (its files under `cf_haptics-X.Y.Z/`, with
+    PKG-INFO), from which `pip install` builds the wheel as from the tree itself."""
+    base = f"{_dist_name()}-{_version()}"
+    name = f"{base}.tar.gz"
+    os.makedirs(sdist_directory, exist_ok=True)
+    with tarfile.open(os.path.join(sdist_directory, name), "w:gz", format=tarfile.PAX_FORMAT) as tar:
+        for rel in _source_files():
+            tar.add(os.path.join(_SOURCE, rel), arcname=f"{base}/{rel}", recursive=False)
+        data = _metadata().encode()
+        info = tarfile.TarInfo(f"{base}/PKG-INFO")
+        info.size, info.mode = len(data), 0o644
+        tar.addfile(info, io.BytesIO(data))
+    return name
+
 
 def get_requires_for_build_wheel(config_settings=None):
     return []

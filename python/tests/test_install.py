@@ -72,3 +72,30 @@ def test_tests_run_against_the_installed_wheel():
     assert os.path.realpath(cf.__file__).startswith(site + os.sep)
     assert importlib.metadata.version("cf-haptics") == cf.__version__
     assert "numpy" in " ".join(importlib.metadata.requires("cf-haptics"))
+
+
+def test_sdist_holds_the_tracked_sources_and_the_metadata(tmp_path):
+    # The backend's build_sdist (PEP 517 requires it; `python -m build` calls it first): the
+    # tracked files under cf_haptics-X.Y.Z/, PKG-INFO with the distribution's metadata, no
+    # build tree.
+    import tarfile
+
+    from conftest import SOURCE
+
+    code = f"import cf_build; print(cf_build.build_sdist({str(tmp_path)!r}))"
+    env = {**os.environ, "PYTHONPATH": str(SOURCE / "python" / "build_backend")}
+    name = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True, env=env,
+                          cwd=SOURCE).stdout.strip()
+    import cf
+
+    base = f"cf_haptics-{cf.__version__}"
+    assert name == f"{base}.tar.gz"
+    with tarfile.open(tmp_path / name) as tar:
+        names = set(tar.getnames())
+        info = tar.extractfile(f"{base}/PKG-INFO").read().decode()
+    for f in ("pyproject.toml", "CMakeLists.txt", "cmake/version.cmake", "python/build_backend/cf_build.py",
+              "python/src/module.cpp", "libcf/include/cf/graph.hpp", "tools/cfgen/generate.cpp"):
+        assert f"{base}/{f}" in names, f
+    assert not any(n.startswith(f"{base}/build/") for n in names)
+    assert "Name: cf-haptics\n" in info and f"Version: {cf.__version__}\n" in info
+    assert "Requires-Dist: numpy>=1.21\n" in info
