@@ -4,6 +4,8 @@
 
 #include <cstdint>
 #include <cstring>
+#include <optional>
+#include <tuple>
 #include <type_traits>
 
 namespace cfpy {
@@ -69,7 +71,8 @@ py::array_t<double> quaternion_wxyz(const cf::Mat3& R) {
   return py::array_t<double>(4, wxyz);
 }
 
-py::object optional_int(int v) { return v < 0 ? py::object(py::none()) : py::object(py::int_(v)); }
+// A stored count, None (std::nullopt) when the file does not store it (-1).
+std::optional<int> optional_int(int v) { return v < 0 ? std::nullopt : std::optional<int>(v); }
 
 using cf::Polyhedron;
 
@@ -162,23 +165,18 @@ void bind_polyhedron(py::module_& m) {
               "(E, 2) int32: each edge's end vertices v0 < v1; a read-only view.")
           .def_property_readonly(
               "faces",
-              [](const Polyhedron& P) {
-                py::list faces;
-                for (const cf::Face& f : P.faces()) {
-                  py::list loops;
-                  for (const auto& loop : f.loops) {
-                    py::array_t<std::int32_t> a(static_cast<py::ssize_t>(loop.size()));
-                    auto r = a.mutable_unchecked<1>();
-                    for (std::size_t k = 0; k < loop.size(); ++k)
-                      r(static_cast<py::ssize_t>(k)) = loop[k].value();
-                    loops.append(a);
-                  }
-                  faces.append(loops);
+              [](const py::object& self) {
+                std::vector<std::vector<py::array_t<std::int32_t>>> faces;
+                for (const cf::Face& f : self.cast<const Polyhedron&>().faces()) {
+                  faces.emplace_back();
+                  for (const auto& loop : f.loops)  // a loop has 3 vertices or more
+                    faces.back().push_back(
+                        view(id_data(loop[0]), loop.size(), sizeof(loop[0]), 0, 0, self));
                 }
                 return faces;
               },
               "Per face, its loops as int32 arrays of vertex indices: the outer boundary first "
-              "(counter-clockwise seen from outside), then the holes.")
+              "(counter-clockwise seen from outside), then the holes; read-only views.")
           .def_property_readonly(
               "edge_faces",
               [](const py::object& self) {
@@ -246,8 +244,7 @@ void bind_cf(py::module_& m) {
       .def_property_readonly(
           "pure_rotation",
           [](const CfEntry& e) {
-            return e.rec.dof < 0 ? py::object(py::none())
-                                 : py::object(py::bool_(e.rec.pure_rotation));
+            return e.rec.dof < 0 ? std::nullopt : std::optional<bool>(e.rec.pure_rotation);
           },
           "Whether some pure rotation keeps the CF; None when the freedoms are not stored.")
       .def_property_readonly(
@@ -313,7 +310,8 @@ void add_graph_transitions(py::class_<cf::CfGraph>& cls) {
               to.mutable_at(i) = t.to.value();
               kinds.append(cf::to_string(t.kind));
             }
-            return py::make_tuple(from, to, py::module_::import("numpy").attr("array")(kinds));
+            return std::make_tuple(from, to,
+                                   py::array(py::module_::import("numpy").attr("array")(kinds)));
           },
           "Every transition in file order as three arrays: from (int32), to (int32), kind (str).");
 }
@@ -343,18 +341,19 @@ void bind_cf_graph(py::module_& m) {
           .def_property_readonly(
               "cfs",
               [](const cf::CfGraph& g) {
-                py::list out;
+                std::vector<CfEntry> out;
+                out.reserve(g.num_cfs());
                 for (std::size_t i = 0; i < g.num_cfs(); ++i)
-                  out.append(
+                  out.push_back(
                       CfEntry{static_cast<int>(i), g.cf(cf::CfId(static_cast<std::int32_t>(i)))});
                 return out;
               },
               "Every CF, in id order.")
           .def(
               "cf_of",
-              [](const cf::CfGraph& g, const py::object& pcs) -> py::object {
+              [](const cf::CfGraph& g, const py::object& pcs) -> std::optional<int> {
                 const std::optional<cf::CfId> id = g.find(pcset_from_py(pcs));
-                return id ? py::object(py::int_(id->value())) : py::object(py::none());
+                return id ? std::optional<int>(id->value()) : std::nullopt;
               },
               py::arg("pcs"),
               "The id of the CF with exactly these PCs ('type:a:b;...', or a list of PCs in any "

@@ -14,6 +14,7 @@
 #include <pybind11/stl.h>
 
 #include <string>
+#include <vector>
 
 namespace cfpy {
 
@@ -44,8 +45,8 @@ cf::Params params_from_kwargs(const cf::Params& base, const py::kwargs& kwargs,
 cf::Pc pc_from_py(const py::handle& h);
 /// A PC set from "type:a:b;..." or a sequence of PCs.
 cf::PcSet pcset_from_py(const py::handle& h);
-/// The PCs as a list of cf.Pc.
-py::list pcs_to_py(const cf::PcSet& pcs);
+/// The PCs, which pybind11 gives Python as a list of cf.Pc.
+std::vector<cf::Pc> pcs_to_py(const cf::PcSet& pcs);
 
 /// Gives every function and method of `m` a doc that inspect.signature reads (names and
 /// defaults), keeping pybind11's typed signature below it (signatures.cpp). Call last.

@@ -261,11 +261,7 @@ cf::PcSet pcset_from_py(const py::handle& h) {
   return cf::PcSet(pcs);  // throws cf::Error for more than 3 or a repeat
 }
 
-py::list pcs_to_py(const cf::PcSet& pcs) {
-  py::list out;
-  for (const cf::Pc& pc : pcs) out.append(pc);
-  return out;
-}
+std::vector<cf::Pc> pcs_to_py(const cf::PcSet& pcs) { return {pcs.begin(), pcs.end()}; }
 
 }  // namespace cfpy
 

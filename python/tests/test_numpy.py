@@ -38,6 +38,13 @@ def test_model_arrays_are_read_only_views(graph, name):
         a[0] = a[0]
 
 
+def test_face_loops_are_views(graph, stored):
+    m = graph.model_b
+    a, b = m.faces[3][0], m.faces[3][0]
+    assert np.shares_memory(a, b) and not a.flags.writeable and a.dtype == np.int32
+    assert [[loop.tolist() for loop in f] for f in m.faces] == [f["loops"] for f in stored["models"]["B"]["faces"]]
+
+
 def test_model_views_hold_the_stored_values(graph, stored):
     m, s = graph.model_b, stored["models"]["B"]
     assert np.array_equal(m.vertices, np.array(s["vertices"], dtype=float))
