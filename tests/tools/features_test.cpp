@@ -425,6 +425,83 @@ TEST_CASE("the coplanarity tolerance decides whether a slightly bent facet joins
   }
 }
 
+TEST_CASE("a coarse coplanarity tolerance merges bent facets into a planar polyhedron",
+          "[features]") {
+  // Every vertex of the result lies on its faces' planes to the polyhedron's own check
+  // (1e-6 of its size; from_features throws otherwise), and moved by less than the bend.
+  cf::tools::LoadOptions coarse;
+  coarse.coplanar_rel_tol = 1e-3;  // 0.017 mm on these 17 mm models
+  SECTION("a box's ridge of 0.005 mm: its corners, three faces each, move onto the new planes") {
+    // The far corners of one roof half are 0.01 mm off the other half's plane: merged.
+    cf::tools::PolygonSoup s;
+    const double delta = 0.005;
+    s.points = {{0, 0, 0},   {10, 0, 0},   {10, 10, 0}, {0, 10, 0},         {0, 0, 10},
+                {10, 0, 10}, {10, 10, 10}, {0, 10, 10}, {5, 0, 10 + delta}, {5, 10, 10 + delta}};
+    s.polygons = {{0, 3, 2, 1},    {4, 8, 9, 7}, {8, 5, 6, 9}, {0, 1, 5, 8, 4},
+                  {2, 3, 7, 9, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
+    const cf::Polyhedron m = cf::tools::model_from_soup(s, "ridge", coarse);
+    CHECK(m.num_faces() == 6);
+    CHECK(m.num_vertices() == 8);
+    CHECK(m.num_edges() == 12);
+    for (std::size_t i = 0; i < 8; ++i) CHECK(find_vertex(m, s.points[i], delta) >= 0);
+    check_invariants(m, 0);
+  }
+  SECTION("a pyramid whose sides fold by 0.01 mm: four merged faces meet at the apex") {
+    // Base 10 x 10, apex (5, 5, 10); each side split in two triangles at its base edge's
+    // midpoint, pushed 0.01 mm outward. Each merged side is planar only to 0.01 mm, and the
+    // four planes fitted through them meet in no one point: the apex is placed by refitting
+    // the planes through the moved corners and moving them again (mesh_features.cpp,
+    // planarize).
+    const double delta = 0.01;
+    cf::tools::PolygonSoup s;
+    s.points = {{0, 0, 0},      {10, 0, 0},         {10, 10, 0},        {0, 10, 0},    {5, 5, 10},
+                {5, -delta, 0}, {10 + delta, 5, 0}, {5, 10 + delta, 0}, {-delta, 5, 0}};
+    s.polygons = {{0, 8, 3, 7, 2, 6, 1, 5},  // base, seen from below
+                  {0, 5, 4},
+                  {5, 1, 4},
+                  {1, 6, 4},
+                  {6, 2, 4},
+                  {2, 7, 4},
+                  {7, 3, 4},
+                  {3, 8, 4},
+                  {8, 0, 4}};
+    cf::tools::LoadOptions coarser;
+    coarser.coplanar_rel_tol = 3e-3;  // 0.05 mm: a side's corners are 0.02 mm off one half's plane
+    const cf::Polyhedron m = cf::tools::model_from_soup(s, "pyramid", coarser);
+    CHECK(m.num_faces() == 5);
+    CHECK(m.num_vertices() == 5);
+    CHECK(m.num_edges() == 8);
+    for (std::size_t i = 0; i < 5; ++i) CHECK(find_vertex(m, s.points[i], delta) >= 0);
+    check_invariants(m, 0);
+    // With the default tolerance the folds stay: four sides of two faces each.
+    CHECK(cf::tools::model_from_soup(s, "pyramid").num_faces() == 9);
+  }
+  SECTION("a 64-gon prism: coarser polygons, then a refusal where the sides bend") {
+    // Radius 10 mm, height 5 mm (diagonal 22.9 mm); neighbouring sides turn by 5.6 degrees.
+    const int n = 64;
+    cf::tools::PolygonSoup s;
+    for (double z : {0.0, 5.0})
+      for (int i = 0; i < n; ++i)
+        s.points.push_back({10 * std::cos(2 * M_PI * i / n), 10 * std::sin(2 * M_PI * i / n), z});
+    std::vector<int> bottom, top;
+    for (int i = 0; i < n; ++i) bottom.push_back(n - 1 - i), top.push_back(n + i);
+    s.polygons = {bottom, top};
+    for (int i = 0; i < n; ++i) s.polygons.push_back({i, (i + 1) % n, n + (i + 1) % n, n + i});
+    CHECK(cf::tools::model_from_soup(s, "prism").num_faces() == 66);
+    cf::tools::LoadOptions o;
+    o.coplanar_rel_tol = 2e-2;  // 0.46 mm: runs of sides merge, a 13-gon prism
+    const cf::Polyhedron m = cf::tools::model_from_soup(s, "prism", o);
+    CHECK(m.num_faces() == 15);
+    check_invariants(m, 0);
+    o.coplanar_rel_tol = 0.1;  // 2.3 mm: a merged side's edge with the top is no longer straight
+    CHECK_THROWS_WITH(
+        cf::tools::model_from_soup(s, "prism", o),
+        Catch::Matches("loading 'prism': the boundary of the face containing facet "
+                       "[0-9]+ bends gradually near vertex [0-9]+ \\([0-9.]+ mm off a "
+                       "straight edge\\); not a polyhedral edge"));
+  }
+}
+
 // --- schema and command line ----------------------------------------------------------------
 
 namespace {

@@ -297,6 +297,60 @@ FacetRegions grow_faces(const PolygonSoup& s, const HalfEdges& he, const std::ve
   return out;
 }
 
+// Moves p onto the planes of `faces` when it is further than `tol` from one of them: the
+// least move, in least squares where the planes meet in no one point. Returns how far p was.
+double snap_onto_planes(Vec3& p, const std::vector<int>& faces, const std::vector<Vec3>& n,
+                        const std::vector<double>& d, double tol) {
+  double dev = 0;
+  Eigen::MatrixXd A(faces.size(), 3);
+  Eigen::VectorXd res(faces.size());
+  for (std::size_t q = 0; q < faces.size(); ++q) {
+    A.row(static_cast<Eigen::Index>(q)) = n[faces[q]].transpose();
+    res[static_cast<Eigen::Index>(q)] = d[faces[q]] - n[faces[q]].dot(p);
+    dev = std::max(dev, std::abs(res[static_cast<Eigen::Index>(q)]));
+  }
+  if (dev > tol) {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    svd.setThreshold(1e-6);
+    p += Vec3(svd.solve(res));
+  }
+  return dev;
+}
+
+// Rounds of planarize: each takes every vertex closer to its faces' planes by a factor (the
+// alternating least squares of planar polygon meshes converge linearly).
+constexpr int kPlanarizeRounds = 200;
+
+// A vertex on four or more faces merged from facets off one plane (a coarse --coplanar-tol)
+// is on no one point of their planes: the planes are refitted through their corners and the
+// corners moved onto them again, until every corner is within `tol` of its faces' planes or
+// kPlanarizeRounds have passed (the polyhedron's own check then says how far one is off).
+void planarize(std::vector<Vec3>& coords, const std::vector<std::vector<int>>& faces_of,
+               const std::vector<std::vector<std::vector<int>>>& face_loops, std::vector<Vec3>& n,
+               std::vector<double>& d, double tol) {
+  for (int round = 0; round < kPlanarizeRounds; ++round) {
+    for (std::size_t r = 0; r < face_loops.size(); ++r) {
+      Vec3 c = Vec3::Zero();
+      int k = 0;
+      for (const auto& loop : face_loops[r])
+        for (int v : loop) c += coords[static_cast<std::size_t>(v)], ++k;
+      c /= k;
+      Mat3 cov = Mat3::Zero();
+      for (const auto& loop : face_loops[r])
+        for (int v : loop)
+          cov += (coords[static_cast<std::size_t>(v)] - c) *
+                 (coords[static_cast<std::size_t>(v)] - c).transpose();
+      Vec3 m = Eigen::SelfAdjointEigenSolver<Mat3>(cov).eigenvectors().col(0);
+      if (m.dot(n[r]) < 0) m = -m;
+      n[r] = m, d[r] = m.dot(c);
+    }
+    double worst = 0;
+    for (std::size_t i = 0; i < coords.size(); ++i)
+      worst = std::max(worst, snap_onto_planes(coords[i], faces_of[i], n, d, tol));
+    if (worst <= tol) return;
+  }
+}
+
 }  // namespace
 
 cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
@@ -360,19 +414,16 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
         rays[a].push_back(b);  // each boundary edge is seen once from each side
       }
   // A boundary edge a-b is run a -> b by one face and b -> a by the other, so the heads of
-  // the outgoing boundary half-edges are all the rays of a vertex.
+  // the outgoing boundary half-edges are all the rays of a vertex. A corner has three rays
+  // or more (three faces meet there). A vertex with two lies between two faces only, on the
+  // line their planes meet in, so it is no corner: the run of boundary through it must be
+  // straight within tol (checked below), however its facets were rounded or merged.
   std::vector<char> is_feature(np, 0);
   for (int v = 0; v < np; ++v) {
     auto& r = rays[v];
     std::sort(r.begin(), r.end());
     r.erase(std::unique(r.begin(), r.end()), r.end());
-    if (r.size() >= 3) {
-      is_feature[v] = 1;
-    } else if (r.size() == 2) {
-      const Vec3& p = P[v];
-      const bool opposite = (P[r[0]] - p).dot(P[r[1]] - p) < 0;
-      is_feature[v] = !(opposite && point_segment_distance(p, P[r[0]], P[r[1]]) <= tol);
-    }
+    is_feature[v] = r.size() >= 3;
   }
 
   // Loops: follow boundary half-edges; from the end of one, turn around its end vertex
@@ -482,34 +533,25 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
   std::sort(edges.begin(), edges.end());
 
   // Coordinates: the input points, moved onto the intersection of their faces' planes only
-  // when they are off by more than rounding (input written with fewer digits).
+  // when they are off by more than rounding (input written with fewer digits, or facets
+  // merged across a coarse --coplanar-tol).
   double largest = 0;
   for (const Vec3& p : P) largest = std::max(largest, p.cwiseAbs().maxCoeff());
-  const double rounding = std::numeric_limits<double>::epsilon() * largest;
+  const double snap_tol = kSnapRoundings * std::numeric_limits<double>::epsilon() * largest;
   std::vector<Vec3> coords;
   coords.reserve(feature_points.size());
+  bool snapped = false;
   for (std::size_t i = 0; i < feature_points.size(); ++i) {
-    const Vec3 p = P[feature_points[i]];
     auto& fs = faces_of[i];
     std::sort(fs.begin(), fs.end());
     fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
-    double dev = 0;
-    Eigen::MatrixXd A(fs.size(), 3);
-    Eigen::VectorXd res(fs.size());
-    for (std::size_t q = 0; q < fs.size(); ++q) {
-      A.row(q) = plane_n[fs[q]].transpose();
-      res[q] = plane_d[fs[q]] - plane_n[fs[q]].dot(p);
-      dev = std::max(dev, std::abs(res[q]));
-    }
+    Vec3 p = P[feature_points[i]];
+    const double dev = snap_onto_planes(p, fs, plane_n, plane_d, snap_tol);
     if (off_plane) *off_plane = std::max(*off_plane, dev);
-    if (dev <= kSnapRoundings * rounding) {
-      coords.push_back(p);
-    } else {
-      Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
-      svd.setThreshold(1e-6);
-      coords.push_back(p + Vec3(svd.solve(res)));
-    }
+    snapped = snapped || dev > snap_tol;
+    coords.push_back(p);
   }
+  if (snapped) planarize(coords, faces_of, face_loops, plane_n, plane_d, snap_tol);
 
   try {
     return Polyhedron::from_features(name, std::move(coords), edges, face_loops);
