@@ -320,6 +320,9 @@ double snap_onto_planes(Vec3& p, const std::vector<int>& faces, const std::vecto
 // Rounds of planarize: each takes every vertex closer to its faces' planes by a factor (the
 // alternating least squares of planar polygon meshes converge linearly).
 constexpr int kPlanarizeRounds = 200;
+// A round that does not bring the worst vertex this much closer ends them (a model whose
+// merged faces no planes fit converges no further, and a large one would pay every round).
+constexpr double kPlanarizeStall = 0.9;
 
 // A vertex on four or more faces merged from facets off one plane (a coarse --coplanar-tol)
 // is on no one point of their planes: the planes are refitted through their corners and the
@@ -328,6 +331,7 @@ constexpr int kPlanarizeRounds = 200;
 void planarize(std::vector<Vec3>& coords, const std::vector<std::vector<int>>& faces_of,
                const std::vector<std::vector<std::vector<int>>>& face_loops, std::vector<Vec3>& n,
                std::vector<double>& d, double tol) {
+  double last = std::numeric_limits<double>::infinity();
   for (int round = 0; round < kPlanarizeRounds; ++round) {
     for (std::size_t r = 0; r < face_loops.size(); ++r) {
       Vec3 c = Vec3::Zero();
@@ -347,7 +351,9 @@ void planarize(std::vector<Vec3>& coords, const std::vector<std::vector<int>>& f
     double worst = 0;
     for (std::size_t i = 0; i < coords.size(); ++i)
       worst = std::max(worst, snap_onto_planes(coords[i], faces_of[i], n, d, tol));
-    if (worst <= tol) return;
+    // Done, or stalled (a model no planes fit): the polyhedron's check says how far off.
+    if (worst <= tol || worst > kPlanarizeStall * last) return;
+    last = worst;
   }
 }
 
