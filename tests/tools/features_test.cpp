@@ -386,19 +386,25 @@ TEST_CASE("single-precision STL input of a rotated model gives the exact feature
   check_invariants(m, 0);
 }
 
+namespace {
+
+// A 10 mm cube whose top is two quads meeting at a ridge x = 5 raised by delta; the front
+// and back faces run through the ridge points 8 and 9.
+cf::tools::PolygonSoup soup_with_ridge(double delta) {
+  cf::tools::PolygonSoup s;
+  s.points = {{0, 0, 0},   {10, 0, 0},   {10, 10, 0}, {0, 10, 0},         {0, 0, 10},
+              {10, 0, 10}, {10, 10, 10}, {0, 10, 10}, {5, 0, 10 + delta}, {5, 10, 10 + delta}};
+  s.polygons = {{0, 3, 2, 1},    {4, 8, 9, 7}, {8, 5, 6, 9}, {0, 1, 5, 8, 4},
+                {2, 3, 7, 9, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
+  return s;
+}
+
+}  // namespace
+
 TEST_CASE("the coplanarity tolerance decides whether a slightly bent facet joins a face",
           "[features]") {
-  // A 10 mm cube whose top is two quads meeting at a ridge x = 5 raised by delta; the front
-  // and back faces run through the ridge points 8 and 9. The tolerance is 1e-5 of the
-  // diagonal (17.3 mm), i.e. 1.7e-4 mm.
-  auto soup_with_ridge = [](double delta) {
-    cf::tools::PolygonSoup s;
-    s.points = {{0, 0, 0},   {10, 0, 0},   {10, 10, 0}, {0, 10, 0},         {0, 0, 10},
-                {10, 0, 10}, {10, 10, 10}, {0, 10, 10}, {5, 0, 10 + delta}, {5, 10, 10 + delta}};
-    s.polygons = {{0, 3, 2, 1},    {4, 8, 9, 7}, {8, 5, 6, 9}, {0, 1, 5, 8, 4},
-                  {2, 3, 7, 9, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
-    return s;
-  };
+  // The ridge box (soup_with_ridge). The tolerance is 1e-5 of the diagonal (17.3 mm), i.e.
+  // 1.7e-4 mm.
   const double diag = std::sqrt(300.0);
   SECTION("below the tolerance: one top face, the ridge points are not features") {
     const double delta = 1e-7 * diag;
@@ -433,12 +439,8 @@ TEST_CASE("a coarse coplanarity tolerance merges bent facets into a planar polyh
   coarse.coplanar_rel_tol = 1e-3;  // 0.017 mm on these 17 mm models
   SECTION("a box's ridge of 0.005 mm: its corners, three faces each, move onto the new planes") {
     // The far corners of one roof half are 0.01 mm off the other half's plane: merged.
-    cf::tools::PolygonSoup s;
     const double delta = 0.005;
-    s.points = {{0, 0, 0},   {10, 0, 0},   {10, 10, 0}, {0, 10, 0},         {0, 0, 10},
-                {10, 0, 10}, {10, 10, 10}, {0, 10, 10}, {5, 0, 10 + delta}, {5, 10, 10 + delta}};
-    s.polygons = {{0, 3, 2, 1},    {4, 8, 9, 7}, {8, 5, 6, 9}, {0, 1, 5, 8, 4},
-                  {2, 3, 7, 9, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
+    const cf::tools::PolygonSoup s = soup_with_ridge(delta);
     const cf::Polyhedron m = cf::tools::model_from_soup(s, "ridge", coarse);
     CHECK(m.num_faces() == 6);
     CHECK(m.num_vertices() == 8);
