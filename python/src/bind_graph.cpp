@@ -50,9 +50,8 @@ py::array_t<T> view(const T* first, std::size_t rows, std::size_t stride, std::s
 }
 
 // Bytes from member `a` to member `b` of one record.
-template <class R, class A, class B>
-std::ptrdiff_t member_gap(const R& r, const A& a, const B& b) {
-  (void)r;
+template <class A, class B>
+std::ptrdiff_t member_gap(const A& a, const B& b) {
   return reinterpret_cast<const char*>(&b) - reinterpret_cast<const char*>(&a);
 }
 
@@ -160,7 +159,7 @@ void bind_polyhedron(py::module_& m) {
                 const auto& E = self.cast<const Polyhedron&>().edges();
                 if (E.empty()) return array2<std::int32_t>(0, 2);
                 return view(id_data(E[0].v0), E.size(), sizeof(cf::Edge), 2,
-                            member_gap(E[0], E[0].v0, E[0].v1), self);
+                            member_gap(E[0].v0, E[0].v1), self);
               },
               "(E, 2) int32: each edge's end vertices v0 < v1; a read-only view.")
           .def_property_readonly(
@@ -183,7 +182,7 @@ void bind_polyhedron(py::module_& m) {
                 const auto& E = self.cast<const Polyhedron&>().edges();
                 if (E.empty()) return array2<std::int32_t>(0, 2);
                 return view(id_data(E[0].left), E.size(), sizeof(cf::Edge), 2,
-                            member_gap(E[0], E[0].left, E[0].right), self);
+                            member_gap(E[0].left, E[0].right), self);
               },
               "(E, 2) int32: each edge's left face (its loop runs v0 -> v1) and right face; a "
               "read-only view.")

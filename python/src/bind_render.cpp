@@ -27,10 +27,6 @@ using Array = RealArray;
 
 py::array_t<double> vec(const cf::Vec3& v) { return py::array_t<double>(3, v.data()); }
 
-Array as_array(const py::handle& h, const char* name, const std::string& where) {
-  return real_array(h, name, where);
-}
-
 std::string shape_of(const Array& a) {
   std::string s = "(";
   for (py::ssize_t i = 0; i < a.ndim(); ++i) s += (i ? ", " : "") + std::to_string(a.shape(i));
@@ -116,7 +112,7 @@ cf::Params params_arg(const py::object& params, const py::kwargs& kw, const std:
 /// One tick's arguments checked (time increasing after `last_t` when `stepped`), as a pose.
 cf::Pose tick_pose(double t_s, const py::object& p, const py::object& q, bool stepped,
                    double last_t) {
-  const Array pa = as_array(p, "p", "step"), qa = as_array(q, "q", "step");
+  const Array pa = real_array(p, "p", "step"), qa = real_array(q, "q", "step");
   if (pa.ndim() != 1 || pa.shape(0) != 3) fail("step: p must have shape (3,), got " + shape_of(pa));
   if (qa.ndim() != 1 || qa.shape(0) != 4)
     fail("step: q must have shape (4,) (w, x, y, z), got " + shape_of(qa));
@@ -234,8 +230,8 @@ void bind_renderer(py::module_& m) {
 /// replay's poses from its arrays t (N,), p (N, 3), q (N, 4), checked.
 std::vector<cf::TrajectorySample> replay_samples(const py::object& t, const py::object& p,
                                                  const py::object& q, const std::string& where) {
-  const Array ta = as_array(t, "t", where), pa = as_array(p, "p", where),
-              qa = as_array(q, "q", where);
+  const Array ta = real_array(t, "t", where), pa = real_array(p, "p", where),
+              qa = real_array(q, "q", where);
   if (ta.ndim() != 1) fail(where + ": t must have shape (N,), got " + shape_of(ta));
   const py::ssize_t n = ta.shape(0);
   if (n == 0) fail(where + ": no poses (t is empty)");

@@ -81,6 +81,65 @@ int generate_stoppable(cf::tools::GenerateArgs& g) {
   return status;
 }
 
+// cfgen's run (run_generate) from the binding's arguments, checked as the command line checks
+// its options; the graph handed over in memory, and written to out_path unless it is empty.
+cf::CfGraph generate(const std::string& a_path, const std::string& b_path,
+                     const std::string& out_path, int threads, bool quiet, int max_pcs,
+                     double touch_tol, double min_clearance, double good_clearance,
+                     double min_margin, double angle_margin, int theta_samples, int max_rotations,
+                     const std::string& units, const std::string& units_a,
+                     const std::string& units_b, double coplanar_rel_tol, bool symmetry,
+                     bool thorough, const std::string& checkpoint,
+                     const std::string& certificates) {
+  const std::string where = "generate";
+  // The ranges cfgen's options accept.
+  check_int(threads, 0, 1024, "threads", where);
+  check_int(max_pcs, 1, 3, "max_pcs", where);
+  check_range(touch_tol, 1e-15, 1e-5, "touch_tol", where);
+  check_range(min_clearance, 1e-9, 0.1, "min_clearance", where);
+  check_range(good_clearance, 1e-9, 1.0, "good_clearance", where);
+  check_range(min_margin, 1e-9, 0.1, "min_margin", where);
+  check_range(angle_margin, 1e-9, 0.5, "angle_margin", where);
+  check_int(theta_samples, 1, 1000, "theta_samples", where);
+  check_int(max_rotations, 1, 10000, "max_rotations", where);
+  check_range(coplanar_rel_tol, cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol,
+              "coplanar_rel_tol", where);
+  check_units(units, "units", where);
+  cf::tools::GenerateArgs g;
+  g.a_path = a_path;
+  g.b_path = b_path;
+  g.out_path = out_path;
+  g.threads = threads;
+  g.quiet = quiet;
+  g.max_pcs = max_pcs;
+  g.symmetry = symmetry;
+  if (thorough && !symmetry) fail(where + ": symmetry=False excludes thorough=True");
+  g.thorough = thorough;
+  g.rel.touch_tol = touch_tol;
+  g.rel.min_clearance = min_clearance;
+  g.rel.good_clearance = good_clearance;
+  g.rel.min_margin = min_margin;
+  if (const std::string why = cf::tools::conflicting_lengths(g.rel, true); !why.empty())
+    fail(where + ": " + why);
+  g.search.angle_margin = angle_margin;
+  g.search.theta_samples = theta_samples;
+  g.search.max_rotations = max_rotations;
+  g.load_a.units = units_a.empty() ? units : units_a;
+  g.load_b.units = units_b.empty() ? units : units_b;
+  check_units(g.load_a.units, "units_a", where);
+  check_units(g.load_b.units, "units_b", where);
+  g.load_a.coplanar_rel_tol = g.load_b.coplanar_rel_tol = coplanar_rel_tol;
+  g.checkpoint_dir = checkpoint;
+  g.certificates_path = certificates;
+  // A checkpoint only when asked for (cfgen keeps one by default for long runs).
+  g.no_checkpoint = checkpoint.empty();
+  cf::CfGraph graph;
+  g.graph_out = &graph;
+  const int status = generate_stoppable(g);
+  if (status != 0) fail(where + ": cfgen's generator failed with status " + std::to_string(status));
+  return graph;
+}
+
 }  // namespace
 
 }  // namespace cfpy
@@ -113,77 +172,20 @@ PYBIND11_MODULE(_gen, m) {
       "unit ('mm', 'cm', 'm', 'in'); the model is in mm. Raises cf.Error naming the file and the "
       "problem.");
 
-  m.def(
-      "generate",
-      [](const std::string& a_path, const std::string& b_path, const std::string& out_path,
-         int threads, bool quiet, int max_pcs, double touch_tol, double min_clearance,
-         double good_clearance, double min_margin, double angle_margin, int theta_samples,
-         int max_rotations, const std::string& units, const std::string& units_a,
-         const std::string& units_b, double coplanar_rel_tol, bool symmetry, bool thorough,
-         const std::string& checkpoint, const std::string& certificates) {
-        const std::string where = "generate";
-        // The ranges cfgen's options accept.
-        check_int(threads, 0, 1024, "threads", where);
-        check_int(max_pcs, 1, 3, "max_pcs", where);
-        check_range(touch_tol, 1e-15, 1e-5, "touch_tol", where);
-        check_range(min_clearance, 1e-9, 0.1, "min_clearance", where);
-        check_range(good_clearance, 1e-9, 1.0, "good_clearance", where);
-        check_range(min_margin, 1e-9, 0.1, "min_margin", where);
-        check_range(angle_margin, 1e-9, 0.5, "angle_margin", where);
-        check_int(theta_samples, 1, 1000, "theta_samples", where);
-        check_int(max_rotations, 1, 10000, "max_rotations", where);
-        check_range(coplanar_rel_tol, cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol,
-                    "coplanar_rel_tol", where);
-        check_units(units, "units", where);
-        cf::tools::GenerateArgs g;
-        g.a_path = a_path;
-        g.b_path = b_path;
-        g.out_path = out_path;
-        g.threads = threads;
-        g.quiet = quiet;
-        g.max_pcs = max_pcs;
-        g.symmetry = symmetry;
-        if (thorough && !symmetry) fail(where + ": symmetry=False excludes thorough=True");
-        g.thorough = thorough;
-        g.rel.touch_tol = touch_tol;
-        g.rel.min_clearance = min_clearance;
-        g.rel.good_clearance = good_clearance;
-        g.rel.min_margin = min_margin;
-        if (const std::string why = cf::tools::conflicting_lengths(g.rel, true); !why.empty())
-          fail(where + ": " + why);
-        g.search.angle_margin = angle_margin;
-        g.search.theta_samples = theta_samples;
-        g.search.max_rotations = max_rotations;
-        g.load_a.units = units_a.empty() ? units : units_a;
-        g.load_b.units = units_b.empty() ? units : units_b;
-        check_units(g.load_a.units, "units_a", where);
-        check_units(g.load_b.units, "units_b", where);
-        g.load_a.coplanar_rel_tol = g.load_b.coplanar_rel_tol = coplanar_rel_tol;
-        g.checkpoint_dir = checkpoint;
-        g.certificates_path = certificates;
-        // A checkpoint only when asked for (cfgen keeps one by default for long runs).
-        g.no_checkpoint = checkpoint.empty();
-        cf::CfGraph graph;
-        g.graph_out = &graph;
-        const int status = generate_stoppable(g);
-        if (status != 0)
-          fail(where + ": cfgen's generator failed with status " + std::to_string(status));
-        return graph;
-      },
-      py::arg("a_path"), py::arg("b_path"), py::arg("output"), py::arg("threads") = 0,
-      py::arg("quiet") = true, py::arg("max_pcs") = 3,
-      py::arg("touch_tol") = cf::tools::RelativeLengths{}.touch_tol,
-      py::arg("min_clearance") = cf::tools::RelativeLengths{}.min_clearance,
-      py::arg("good_clearance") = cf::tools::RelativeLengths{}.good_clearance,
-      py::arg("min_margin") = cf::tools::RelativeLengths{}.min_margin,
-      py::arg("angle_margin") = cf::gen::SearchParams{}.angle_margin,
-      py::arg("theta_samples") = cf::gen::SearchParams{}.theta_samples,
-      py::arg("max_rotations") = cf::gen::SearchParams{}.max_rotations, py::arg("units") = "mm",
-      py::arg("units_a") = "", py::arg("units_b") = "",
-      py::arg("coplanar_rel_tol") = cf::tools::LoadOptions{}.coplanar_rel_tol,
-      py::arg("symmetry") = true, py::arg("thorough") = false, py::arg("checkpoint") = "",
-      py::arg("certificates") = "",
-      "cfgen's generation (cf::tools::run_generate): the graph, also written to `output` "
-      "unless it is empty; cf.gen.generate wraps it.");
+  m.def("generate", &generate, py::arg("a_path"), py::arg("b_path"), py::arg("output"),
+        py::arg("threads") = 0, py::arg("quiet") = true, py::arg("max_pcs") = 3,
+        py::arg("touch_tol") = cf::tools::RelativeLengths{}.touch_tol,
+        py::arg("min_clearance") = cf::tools::RelativeLengths{}.min_clearance,
+        py::arg("good_clearance") = cf::tools::RelativeLengths{}.good_clearance,
+        py::arg("min_margin") = cf::tools::RelativeLengths{}.min_margin,
+        py::arg("angle_margin") = cf::gen::SearchParams{}.angle_margin,
+        py::arg("theta_samples") = cf::gen::SearchParams{}.theta_samples,
+        py::arg("max_rotations") = cf::gen::SearchParams{}.max_rotations, py::arg("units") = "mm",
+        py::arg("units_a") = "", py::arg("units_b") = "",
+        py::arg("coplanar_rel_tol") = cf::tools::LoadOptions{}.coplanar_rel_tol,
+        py::arg("symmetry") = true, py::arg("thorough") = false, py::arg("checkpoint") = "",
+        py::arg("certificates") = "",
+        "cfgen's generation (cf::tools::run_generate): the graph, also written to `output` "
+        "unless it is empty; cf.gen.generate wraps it.");
   add_text_signatures(m);
 }

@@ -297,6 +297,23 @@ FacetRegions grow_faces(const PolygonSoup& s, const HalfEdges& he, const std::ve
   return out;
 }
 
+// The least-squares plane n . x = d through the points P[i], i in `idx` (the smallest
+// eigenvector of their covariance), with n turned to the side of `side`.
+void fit_plane(const std::vector<Vec3>& P, const std::vector<int>& idx, const Vec3& side, Vec3& n,
+               double& d) {
+  Vec3 c = Vec3::Zero();
+  for (int i : idx) c += P[static_cast<std::size_t>(i)];
+  c /= static_cast<double>(idx.size());
+  Mat3 cov = Mat3::Zero();
+  for (int i : idx) {
+    const Vec3 q = P[static_cast<std::size_t>(i)] - c;
+    cov += q * q.transpose();
+  }
+  n = Eigen::SelfAdjointEigenSolver<Mat3>(cov).eigenvectors().col(0);  // smallest first
+  if (n.dot(side) < 0) n = -n;
+  d = n.dot(c);
+}
+
 // Moves p onto the planes of `faces` when it is further than `tol` from one of them: the
 // least move, in least squares where the planes meet in no one point. Returns how far p was.
 double snap_onto_planes(Vec3& p, const std::vector<int>& faces, const std::vector<Vec3>& n,
@@ -334,19 +351,10 @@ void planarize(std::vector<Vec3>& coords, const std::vector<std::vector<int>>& f
   double last = std::numeric_limits<double>::infinity();
   for (int round = 0; round < kPlanarizeRounds; ++round) {
     for (std::size_t r = 0; r < face_loops.size(); ++r) {
-      Vec3 c = Vec3::Zero();
-      int k = 0;
+      std::vector<int> corners;
       for (const auto& loop : face_loops[r])
-        for (int v : loop) c += coords[static_cast<std::size_t>(v)], ++k;
-      c /= k;
-      Mat3 cov = Mat3::Zero();
-      for (const auto& loop : face_loops[r])
-        for (int v : loop)
-          cov += (coords[static_cast<std::size_t>(v)] - c) *
-                 (coords[static_cast<std::size_t>(v)] - c).transpose();
-      Vec3 m = Eigen::SelfAdjointEigenSolver<Mat3>(cov).eigenvectors().col(0);
-      if (m.dot(n[r]) < 0) m = -m;
-      n[r] = m, d[r] = m.dot(c);
+        corners.insert(corners.end(), loop.begin(), loop.end());
+      fit_plane(coords, corners, Vec3(n[r]), n[r], d[r]);
     }
     double worst = 0;
     for (std::size_t i = 0; i < coords.size(); ++i)
@@ -355,6 +363,90 @@ void planarize(std::vector<Vec3>& coords, const std::vector<std::vector<int>>& f
     if (worst <= tol || worst > kPlanarizeStall * last) return;
     last = worst;
   }
+}
+
+// Each face's loops in feature vertex ids (the outer loop first, then the holes in order, each
+// from its smallest id), the faces of each feature vertex, and the edges (v0 < v1, sorted).
+struct FaceLoops {
+  std::vector<std::vector<std::vector<int>>> loops;
+  std::vector<std::vector<int>> faces_of;
+  std::vector<std::array<int, 2>> edges;
+};
+
+// FaceLoops from the loops of mesh vertices found per face (loop_area: each one's signed
+// area about its face's normal) and the feature id of each mesh vertex (vid).
+FaceLoops face_loops_of(const std::vector<std::vector<std::vector<int>>>& loops,
+                        const std::vector<std::vector<double>>& loop_area,
+                        const std::vector<int>& vid, std::size_t n_features,
+                        const std::vector<int>& seed, const std::string& src) {
+  const int nr = static_cast<int>(loops.size());
+  FaceLoops f;
+  f.loops.resize(loops.size());
+  f.faces_of.resize(n_features);
+  for (int r = 0; r < nr; ++r) {
+    int outer = -1, outers = 0;
+    for (std::size_t l = 0; l < loops[r].size(); ++l)
+      if (loop_area[r][l] > 0) {
+        ++outers;
+        outer = static_cast<int>(l);
+      }
+    if (outers != 1)
+      fail(src, "the face containing facet " + std::to_string(seed[r]) + " has " +
+                    std::to_string(outers) +
+                    " outer boundaries (counter-clockwise loops); expected 1");
+    std::vector<std::vector<int>> out;
+    auto convert = [&](const std::vector<int>& loop) {
+      std::vector<int> ids;
+      for (int v : loop) ids.push_back(vid[v]);
+      std::rotate(ids.begin(), std::min_element(ids.begin(), ids.end()), ids.end());
+      return ids;
+    };
+    out.push_back(convert(loops[r][outer]));
+    std::vector<std::vector<int>> holes;
+    for (std::size_t l = 0; l < loops[r].size(); ++l)
+      if (static_cast<int>(l) != outer) holes.push_back(convert(loops[r][l]));
+    std::sort(holes.begin(), holes.end());
+    for (auto& h : holes) out.push_back(std::move(h));
+    for (const auto& loop : out)
+      for (std::size_t q = 0; q < loop.size(); ++q) {
+        const int a = loop[q], b = loop[(q + 1) % loop.size()];
+        f.faces_of[a].push_back(r);
+        if (a < b) f.edges.push_back({a, b});  // each edge is run a -> b by exactly one face
+      }
+    f.loops[r] = std::move(out);
+  }
+  std::sort(f.edges.begin(), f.edges.end());
+  return f;
+}
+
+// The feature vertices' coordinates: the input points, moved onto the intersection of their
+// faces' planes only when they are off by more than rounding (input written with fewer
+// digits, or facets merged across a coarse --coplanar-tol), then made consistent with the
+// planes refitted through them (planarize). off_plane: the largest distance before.
+std::vector<Vec3> feature_coordinates(const std::vector<Vec3>& P,
+                                      const std::vector<int>& feature_points,
+                                      std::vector<std::vector<int>>& faces_of,
+                                      const std::vector<std::vector<std::vector<int>>>& face_loops,
+                                      std::vector<Vec3>& plane_n, std::vector<double>& plane_d,
+                                      double* off_plane) {
+  double largest = 0;
+  for (const Vec3& p : P) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+  const double snap_tol = kSnapRoundings * std::numeric_limits<double>::epsilon() * largest;
+  std::vector<Vec3> coords;
+  coords.reserve(feature_points.size());
+  bool snapped = false;
+  for (std::size_t i = 0; i < feature_points.size(); ++i) {
+    auto& fs = faces_of[i];
+    std::sort(fs.begin(), fs.end());
+    fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
+    Vec3 p = P[static_cast<std::size_t>(feature_points[i])];
+    const double dev = snap_onto_planes(p, fs, plane_n, plane_d, snap_tol);
+    if (off_plane) *off_plane = std::max(*off_plane, dev);
+    snapped = snapped || dev > snap_tol;
+    coords.push_back(p);
+  }
+  if (snapped) planarize(coords, faces_of, face_loops, plane_n, plane_d, snap_tol);
+  return coords;
 }
 
 }  // namespace
@@ -398,16 +490,7 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
     auto& vs = region_vertices[r];
     std::sort(vs.begin(), vs.end());
     vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
-    Vec3 c = Vec3::Zero();
-    for (int i : vs) c += P[i];
-    c /= static_cast<double>(vs.size());
-    Mat3 cov = Mat3::Zero();
-    for (int i : vs) cov += (P[i] - c) * (P[i] - c).transpose();
-    Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
-    Vec3 n = es.eigenvectors().col(0);  // smallest eigenvalue first
-    if (n.dot(region_area[r]) < 0) n = -n;
-    plane_n[r] = n;
-    plane_d[r] = n.dot(c);
+    fit_plane(P, vs, region_area[r], plane_n[r], plane_d[r]);
   }
 
   // Boundary rays: mesh edges between facets of different faces.
@@ -502,62 +585,13 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
       feature_points.push_back(v);
     }
 
-  std::vector<std::vector<std::vector<int>>> face_loops(nr);
-  std::vector<std::vector<int>> faces_of(feature_points.size());
-  std::vector<std::array<int, 2>> edges;
-  for (int r = 0; r < nr; ++r) {
-    int outer = -1, outers = 0;
-    for (std::size_t l = 0; l < loops[r].size(); ++l)
-      if (loop_area[r][l] > 0) {
-        ++outers;
-        outer = static_cast<int>(l);
-      }
-    if (outers != 1)
-      fail(src, face_desc(r) + " has " + std::to_string(outers) +
-                    " outer boundaries (counter-clockwise loops); expected 1");
-    std::vector<std::vector<int>> out;
-    auto convert = [&](const std::vector<int>& loop) {
-      std::vector<int> ids;
-      for (int v : loop) ids.push_back(vid[v]);
-      std::rotate(ids.begin(), std::min_element(ids.begin(), ids.end()), ids.end());
-      return ids;
-    };
-    out.push_back(convert(loops[r][outer]));
-    std::vector<std::vector<int>> holes;
-    for (std::size_t l = 0; l < loops[r].size(); ++l)
-      if (static_cast<int>(l) != outer) holes.push_back(convert(loops[r][l]));
-    std::sort(holes.begin(), holes.end());
-    for (auto& h : holes) out.push_back(std::move(h));
-    for (const auto& loop : out)
-      for (std::size_t q = 0; q < loop.size(); ++q) {
-        const int a = loop[q], b = loop[(q + 1) % loop.size()];
-        faces_of[a].push_back(r);
-        if (a < b) edges.push_back({a, b});  // each edge is run a -> b by exactly one face
-      }
-    face_loops[r] = std::move(out);
-  }
-  std::sort(edges.begin(), edges.end());
+  FaceLoops fl = face_loops_of(loops, loop_area, vid, feature_points.size(), seed, src);
+  std::vector<std::vector<std::vector<int>>>& face_loops = fl.loops;
+  std::vector<std::vector<int>>& faces_of = fl.faces_of;
+  const std::vector<std::array<int, 2>>& edges = fl.edges;
 
-  // Coordinates: the input points, moved onto the intersection of their faces' planes only
-  // when they are off by more than rounding (input written with fewer digits, or facets
-  // merged across a coarse --coplanar-tol).
-  double largest = 0;
-  for (const Vec3& p : P) largest = std::max(largest, p.cwiseAbs().maxCoeff());
-  const double snap_tol = kSnapRoundings * std::numeric_limits<double>::epsilon() * largest;
-  std::vector<Vec3> coords;
-  coords.reserve(feature_points.size());
-  bool snapped = false;
-  for (std::size_t i = 0; i < feature_points.size(); ++i) {
-    auto& fs = faces_of[i];
-    std::sort(fs.begin(), fs.end());
-    fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
-    Vec3 p = P[feature_points[i]];
-    const double dev = snap_onto_planes(p, fs, plane_n, plane_d, snap_tol);
-    if (off_plane) *off_plane = std::max(*off_plane, dev);
-    snapped = snapped || dev > snap_tol;
-    coords.push_back(p);
-  }
-  if (snapped) planarize(coords, faces_of, face_loops, plane_n, plane_d, snap_tol);
+  std::vector<Vec3> coords =
+      feature_coordinates(P, feature_points, faces_of, face_loops, plane_n, plane_d, off_plane);
 
   try {
     return Polyhedron::from_features(name, std::move(coords), edges, face_loops);
