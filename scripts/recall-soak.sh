@@ -38,7 +38,7 @@ mkdir -p "$OUT"
 
 printf '%-8s %-40s %7s %8s %7s %8s %8s %8s\n' seed pairing graph sampled misses recall unsound cfgen_s
 tot_s=0 tot_m=0 tot_u=0 tot_marg=0 failed=0
-declare -A sig
+declare -A sig=()  # set, so that ${#sig[@]} is 0 under set -u when nothing was missed
 for ((seed = START; seed < START + N; ++seed)); do
   log="$OUT/seed_$seed.txt"
   "$BIN" --seed "$seed" "$@" >"$log" 2>&1
