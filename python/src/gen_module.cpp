@@ -88,8 +88,8 @@ cf::CfGraph generate(const std::string& a_path, const std::string& b_path,
                      double touch_tol, double min_clearance, double good_clearance,
                      double min_margin, double angle_margin, int theta_samples, int max_rotations,
                      const std::string& units, const std::string& units_a,
-                     const std::string& units_b, double coplanar_rel_tol, bool symmetry,
-                     bool thorough, const std::string& checkpoint,
+                     const std::string& units_b, double coplanar_rel_tol, double crease_angle_deg,
+                     bool symmetry, bool thorough, const std::string& checkpoint,
                      const std::string& certificates) {
   const std::string where = "generate";
   // The ranges cfgen's options accept.
@@ -104,6 +104,8 @@ cf::CfGraph generate(const std::string& a_path, const std::string& b_path,
   check_int(max_rotations, 1, 10000, "max_rotations", where);
   check_range(coplanar_rel_tol, cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol,
               "coplanar_rel_tol", where);
+  check_range(crease_angle_deg, cf::tools::kMinCreaseAngle, cf::tools::kMaxCreaseAngle,
+              "crease_angle_deg", where);
   check_units(units, "units", where);
   cf::tools::GenerateArgs g;
   g.a_path = a_path;
@@ -129,6 +131,7 @@ cf::CfGraph generate(const std::string& a_path, const std::string& b_path,
   check_units(g.load_a.units, "units_a", where);
   check_units(g.load_b.units, "units_b", where);
   g.load_a.coplanar_rel_tol = g.load_b.coplanar_rel_tol = coplanar_rel_tol;
+  g.load_a.crease_angle_deg = g.load_b.crease_angle_deg = crease_angle_deg;
   g.checkpoint_dir = checkpoint;
   g.certificates_path = certificates;
   // A checkpoint only when asked for (cfgen keeps one by default for long runs).
@@ -151,13 +154,16 @@ PYBIND11_MODULE(_gen, m) {
   m.def(
       "load_model",
       [](const std::string& path, const std::string& units, double coplanar_rel_tol,
-         bool check_self_intersection, const std::string& name) {
+         double crease_angle_deg, bool check_self_intersection, const std::string& name) {
         check_units(units, "units", "load_model");
         check_range(coplanar_rel_tol, cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol,
                     "coplanar_rel_tol", "load_model");
+        check_range(crease_angle_deg, cf::tools::kMinCreaseAngle, cf::tools::kMaxCreaseAngle,
+                    "crease_angle_deg", "load_model");
         cf::tools::LoadOptions o;
         o.units = units;
         o.coplanar_rel_tol = coplanar_rel_tol;
+        o.crease_angle_deg = crease_angle_deg;
         o.check_self_intersection = check_self_intersection;
         o.name = name;
         py::gil_scoped_release release;
@@ -165,12 +171,13 @@ PYBIND11_MODULE(_gen, m) {
       },
       py::arg("path"), py::arg("units") = "mm",
       py::arg("coplanar_rel_tol") = cf::tools::LoadOptions{}.coplanar_rel_tol,
+      py::arg("crease_angle_deg") = cf::tools::LoadOptions{}.crease_angle_deg,
       py::arg("check_self_intersection") = true, py::arg("name") = "",
       "Reads a closed, outward-oriented polyhedral model (OFF, OBJ, STL or PLY), validates it and "
       "extracts its features (cf::tools::load_model, as cfgen --features). units: the file's "
-      "length "
-      "unit ('mm', 'cm', 'm', 'in'); the model is in mm. Raises cf.Error naming the file and the "
-      "problem.");
+      "length unit ('mm', 'cm', 'm', 'in'); the model is in mm. coplanar_rel_tol and "
+      "crease_angle_deg (degrees): which facets merge into one face, as cfgen's --coplanar-tol "
+      "and --crease-angle. Raises cf.Error naming the file and the problem.");
 
   m.def("generate", &generate, py::arg("a_path"), py::arg("b_path"), py::arg("output"),
         py::arg("threads") = 0, py::arg("quiet") = true, py::arg("max_pcs") = 3,
@@ -183,6 +190,7 @@ PYBIND11_MODULE(_gen, m) {
         py::arg("max_rotations") = cf::gen::SearchParams{}.max_rotations, py::arg("units") = "mm",
         py::arg("units_a") = "", py::arg("units_b") = "",
         py::arg("coplanar_rel_tol") = cf::tools::LoadOptions{}.coplanar_rel_tol,
+        py::arg("crease_angle_deg") = cf::tools::LoadOptions{}.crease_angle_deg,
         py::arg("symmetry") = true, py::arg("thorough") = false, py::arg("checkpoint") = "",
         py::arg("certificates") = "",
         "cfgen's generation (cf::tools::run_generate): the graph, also written to `output` "

@@ -26,6 +26,8 @@ def test_generate_equals_cfgen(tmp_path):
     out = tmp_path / "py.json"
     g = gen.generate(a, b, out, max_pcs=1, threads=2)
     assert out.read_bytes() == cfgen_bytes(tmp_path)
+    # The options that made the models' faces are recorded (docs/features.md, "Creases").
+    assert '"crease_angle_deg": {"A":10.0,"B":10.0}' in out.read_text()
     # Every face, edge and vertex pair of the cube that can touch alone: f-f 6 x 6, e-f and
     # f-e 12 x 6 each, v-f and f-v 8 x 6 each, e-e between the 12 x 12 edges (non-parallel).
     types = {}
@@ -75,6 +77,8 @@ def test_generate_errors(tmp_path):
     # Each in its range, together no witness would be kept: refused before any work.
     with pytest.raises(cf.Error, match=r"^generate: good_clearance 0\.0001 is below min_clearance 0\.0002: "):
         gen.generate(a, a, good_clearance=1e-4)
+    with pytest.raises(cf.Error, match=r"^generate: crease_angle_deg must be a finite number in \[0, 180\], got -1$"):
+        gen.generate(a, a, crease_angle_deg=-1.0)
     with pytest.raises(cf.Error, match=r"missing\.off"):
         gen.generate(a, tmp_path / "missing.off")
     with pytest.raises(TypeError):

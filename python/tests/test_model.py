@@ -47,3 +47,28 @@ def test_model_errors(tmp_path):
     open_box.write_text("OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n")
     with pytest.raises(cf.Error, match=r"^loading '.*open\.off': "):
         gen.load_model(open_box)
+
+
+def _prism(path, n=64, r=10.0, h=5.0):
+    """An n-gon prism as OFF, each side one quad: neighbouring sides turn by 360/n degrees."""
+    import math
+    pts = [(r * math.cos(2 * math.pi * i / n), r * math.sin(2 * math.pi * i / n), z) for z in (0.0, h) for i in range(n)]
+    faces = [list(range(n - 1, -1, -1)), list(range(n, 2 * n))]
+    faces += [[i, (i + 1) % n, n + (i + 1) % n, n + i] for i in range(n)]
+    lines = ["OFF", f"{len(pts)} {len(faces)} 0"] + [f"{x!r} {y!r} {z!r}" for x, y, z in pts]
+    lines += [" ".join(map(str, [len(f)] + f)) for f in faces]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_crease_angle_bounds_merged_faces(tmp_path):
+    prism = _prism(tmp_path / "prism.off")
+    assert len(gen.load_model(prism).faces) == 66  # the default tolerance merges no sides
+    # At a coarse tolerance, runs of sides merge; the crease angle bounds how far a face turns.
+    wide = gen.load_model(prism, coplanar_rel_tol=2e-2, crease_angle_deg=180)
+    bounded = gen.load_model(prism, coplanar_rel_tol=2e-2)  # the default, 10 degrees
+    assert len(wide.faces) == 15
+    assert 15 < len(bounded.faces) < 66
+    assert len(gen.load_model(prism, coplanar_rel_tol=2e-2, crease_angle_deg=5).faces) == 66
+    with pytest.raises(cf.Error, match=r"^load_model: crease_angle_deg must be a finite number in \[0, 180\], got 200$"):
+        gen.load_model(prism, crease_angle_deg=200)

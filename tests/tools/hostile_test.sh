@@ -105,7 +105,7 @@ if [[ "$group" == cfgen ]]; then
   check model_directory 1 "dir.off': cannot open file: is a directory, not a regular file" -- "$CFGEN" --features dir.off
 
   # Options: finite and in range, the range in --help.
-  for opt in --touch-tol --min-clearance --good-clearance --min-margin --angle-margin --coplanar-tol; do
+  for opt in --touch-tol --min-clearance --good-clearance --min-margin --angle-margin --coplanar-tol --crease-angle; do
     check "cfgen${opt}_nan" 2 "^cfgen: ${opt}: 'nan' is not a finite number" -- "$CFGEN" "$M/cube.off" "$M/l_block.off" -o nan.json "$opt" nan
     check "cfgen${opt}_inf" 2 "^cfgen: ${opt}: 'inf' is not a finite number" -- "$CFGEN" "$M/cube.off" "$M/l_block.off" -o nan.json "$opt" inf
   done
@@ -122,6 +122,8 @@ if [[ "$group" == cfgen ]]; then
   fi
   # The largest tolerance --help allows is one the loader takes.
   check cfgen_coplanar_tol_max 0 "^$" -- "$CFGEN" --features "$M/cube.off" --coplanar-tol 0.1
+  check cfgen_crease_angle_range 2 "^cfgen: --crease-angle: '181' is outside \[0, 180\]" -- "$CFGEN" --features "$M/cube.off" --crease-angle 181
+  check cfgen_crease_angle_ends 0 "^$" -- "$CFGEN" --features "$M/cube.off" --crease-angle 0 --coplanar-tol 0.1
   check cfgen_units_unknown 2 "^cfgen: --units: .*furlong" -- "$CFGEN" --features "$M/cube.off" --units furlong
 
   # Units: a 30 mm cube written in metres.

@@ -15,6 +15,7 @@
 #include "safe_stderr.hpp"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <exception>
 #include <iostream>
@@ -24,10 +25,16 @@
 namespace {
 
 int print_features(const std::string& path, const cf::tools::LoadOptions& opt) {
-  const cf::Polyhedron model = cf::tools::load_model(path, opt);
-  if (const std::string w = cf::tools::size_warning(model, "", "--units"); !w.empty())
+  const cf::tools::MeasuredModel m = cf::tools::load_measured_model(path, opt);
+  if (const std::string w = cf::tools::size_warning(m.model, "", "--units"); !w.empty())
     std::cerr << "cfgen: warning: " << w << '\n';
-  std::cout << cf::to_json(model) << '\n';
+  nlohmann::json j = nlohmann::json::parse(cf::to_json(m.model));
+  j["measures"] = {{"precision_mm", m.precision_mm},
+                   {"rounding_mm", m.rounding_mm},
+                   {"deviation_mm", m.deviation_mm},
+                   {"coplanar_rel_tol", opt.coplanar_rel_tol},
+                   {"crease_angle_deg", opt.crease_angle_deg}};
+  std::cout << j.dump(2) << '\n';
   std::cout.flush();
   if (!std::cout) throw cf::Error("writing the features to stdout failed");
   return 0;
@@ -138,6 +145,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> models;
   cf::tools::GenerateArgs gen;
   double coplanar_tol = cf::tools::LoadOptions{}.coplanar_rel_tol;
+  double crease_angle = cf::tools::LoadOptions{}.crease_angle_deg;
   std::string units = "mm", units_a, units_b;
 
   auto* features = app.add_option("--features", features_path,
@@ -172,6 +180,12 @@ int main(int argc, char** argv) {
   app.add_option("--coplanar-tol", coplanar_tol,
                  "coplanarity tolerance relative to the model's bounding-box diagonal")
       ->check(cf::cli::finite_range(cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol));
+  app.add_option("--crease-angle", crease_angle,
+                 "degrees: a facet joins a face only when its normal is within this angle of the "
+                 "face's (docs/features.md, \"Creases\")")
+      ->type_name("DEG")
+      ->check(cf::cli::finite_range(cf::tools::kMinCreaseAngle, cf::tools::kMaxCreaseAngle))
+      ->capture_default_str();
   // Model units (docs/spec.md, section 2): files carry none; mm unless said otherwise.
   const auto unit_names = CLI::IsMember({"mm", "cm", "m", "in"});
   app.add_option("--units", units,
@@ -205,6 +219,7 @@ int main(int argc, char** argv) {
   try {
     cf::tools::LoadOptions load;
     load.coplanar_rel_tol = coplanar_tol;
+    load.crease_angle_deg = crease_angle;
     load.units = units;
     if (!features_path.empty()) return print_features(features_path, load);
     if (models.size() != 2) {

@@ -16,11 +16,21 @@ namespace cf::tools::detail {
 /// zero-area and non-planar facets, several solids, negative volume. Throws cf::Error.
 void check_soup(const PolygonSoup& soup, const std::string& source, const LoadOptions& options);
 
+/// How far the features are from the soup they were extracted from.
+struct FeatureMeasures {
+  /// mm: the largest distance of a feature vertex from the fitted plane of one of its faces
+  /// as read (before the snap): the file's precision as its data show it.
+  double off_plane = 0;
+  /// mm: the largest distance of a vertex of the soup from the final plane of a face its
+  /// facets are part of, or of a feature vertex from where the soup had it: how far the file's
+  /// facets are from the polyhedron's faces (faces merged at a coarse tolerance, rounding).
+  double deviation = 0;
+};
+
 /// Faces, edges and vertices of section 3 of docs/spec.md from a soup that passed check_soup.
-/// off_plane, when given: mm, the largest distance of a feature vertex from the fitted plane
-/// of one of its faces as read (before the snap): the file's precision as its data show it.
+/// measures, when given: how far they are from the soup.
 cf::Polyhedron extract_features(const PolygonSoup& soup, const std::string& source,
                                 const std::string& name, const LoadOptions& options,
-                                double* off_plane = nullptr);
+                                FeatureMeasures* measures = nullptr);
 
 }  // namespace cf::tools::detail

@@ -32,6 +32,13 @@ constexpr double kDegenerateRelTol = 1e-7;
 // rounding (exact or 17-digit input) are left untouched.
 constexpr double kSnapRoundings = 64;
 
+// mm: kSnapRoundings units of rounding of the points' largest coordinate.
+double snap_tolerance(const std::vector<Vec3>& P) {
+  double largest = 0;
+  for (const Vec3& p : P) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+  return kSnapRoundings * std::numeric_limits<double>::epsilon() * largest;
+}
+
 std::string num(double x) {
   std::ostringstream os;
   os.precision(6);
@@ -235,20 +242,31 @@ void check_soup(const PolygonSoup& s, const std::string& src, const LoadOptions&
 
 namespace {
 
+// How closely a neighbouring facet must lie to a face's plane to join it, by tier (a facet's
+// tier, extract_features: 0 at first, raised where the faces it forms fail). Tier 0: within
+// coarse when its normal is within the crease angle of the face's (cos_crease: its cosine), or
+// within fine whatever its normal; tier 1: within fine; tier 2: within exact (rounding).
+struct JoinTolerances {
+  double coarse = 0, fine = 0, exact = 0;  // mm
+  double cos_crease = 1;
+};
+
 // The faces: maximal edge-connected regions of coplanar facets (docs/features.md), grown
-// breadth first over shared edges. A neighbour joins when it faces the same way and all its
-// vertices lie within tol of the region's current plane (area-weighted normal and centroid of
-// the facets so far). Regions grow from the largest facets first: a thin facet's own normal
-// is off by its corners' rounding over its height (a triangle of a file written at 6 digits),
-// and a region started from it could refuse its coplanar neighbours. They are numbered by
-// their lowest facet afterwards, the order of growing them in facet order.
+// breadth first over shared edges. A neighbour facing the same way joins when all its vertices
+// lie close enough to the region's current plane (area-weighted normal and centroid of the
+// facets so far): JoinTolerances at the higher tier of it and the region's seed. Regions grow
+// from the largest facets first: a thin facet's own normal is off by its corners' rounding over
+// its height (a triangle of a file written at 6 digits), and a region started from it could
+// refuse its coplanar neighbours. They are numbered by their lowest facet afterwards, the order
+// of growing them in facet order.
 struct FacetRegions {
   std::vector<int> region;  // of each facet
   std::vector<int> seed;    // of each region, its lowest facet
 };
 
 FacetRegions grow_faces(const PolygonSoup& s, const HalfEdges& he, const std::vector<Vec3>& area2,
-                        const std::vector<Vec3>& centre, double tol) {
+                        const std::vector<Vec3>& centre, const JoinTolerances& tol,
+                        const std::vector<char>& tier) {
   const auto& P = s.points;
   const auto& F = s.polygons;
   const int nf = static_cast<int>(F.size());
@@ -276,9 +294,14 @@ FacetRegions grow_faces(const PolygonSoup& s, const HalfEdges& he, const std::ve
         const Vec3 n = N.normalized();
         const Vec3 c = C / W;
         if (!(n.dot(area2[g]) > 0)) continue;
-        bool flat = true;
-        for (int i : F[g]) flat = flat && std::abs(n.dot(P[i] - c)) <= tol;
-        if (!flat) continue;
+        double off = 0;  // how far g's corners are from the region's plane
+        for (int i : F[g]) off = std::max(off, std::abs(n.dot(P[i] - c)));
+        const int level = std::max(tier[s0], tier[g]);
+        const bool joins = level == 2        ? off <= tol.exact
+                           : off <= tol.fine ? true
+                                             : level == 0 && off <= tol.coarse &&
+                                                   n.dot(area2[g].normalized()) >= tol.cos_crease;
+        if (!joins) continue;
         region[g] = r;
         N += area2[g];
         C += area2[g].norm() * centre[g];
@@ -429,9 +452,7 @@ std::vector<Vec3> feature_coordinates(const std::vector<Vec3>& P,
                                       const std::vector<std::vector<std::vector<int>>>& face_loops,
                                       std::vector<Vec3>& plane_n, std::vector<double>& plane_d,
                                       double* off_plane) {
-  double largest = 0;
-  for (const Vec3& p : P) largest = std::max(largest, p.cwiseAbs().maxCoeff());
-  const double snap_tol = kSnapRoundings * std::numeric_limits<double>::epsilon() * largest;
+  const double snap_tol = snap_tolerance(P);
   std::vector<Vec3> coords;
   coords.reserve(feature_points.size());
   bool snapped = false;
@@ -449,75 +470,95 @@ std::vector<Vec3> feature_coordinates(const std::vector<Vec3>& P,
   return coords;
 }
 
-}  // namespace
+// The faces' planes, corners and boundary loops for one assignment of facets to faces.
+struct Boundaries {
+  std::vector<Vec3> plane_n;  // of each face: least squares through its mesh vertices
+  std::vector<double> plane_d;
+  std::vector<char> is_feature;                      // of each mesh vertex: a corner
+  std::vector<std::vector<std::vector<int>>> loops;  // of each face: corners, in mesh ids
+  std::vector<std::vector<double>> loop_area;        // each loop's signed area
+  // Faces that cannot be planar as grown, each with why: a loop of fewer than 3 corners, a
+  // boundary with another face bending by more than tol where those two faces alone meet.
+  std::vector<std::pair<int, std::string>> troubles;
+};
 
-cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
-                                const std::string& name, const LoadOptions& opt,
-                                double* off_plane) {
-  const auto& P = s.points;
-  const auto& F = s.polygons;
-  const int nf = static_cast<int>(F.size());
-  const int np = static_cast<int>(P.size());
-  const double diag = diagonal(s);
-  const double tol = opt.coplanar_rel_tol * diag;
-  const HalfEdges he = half_edges(s);
-  auto twin = [&](int f, int k) {
-    const auto& poly = F[f];
-    return he.at(key(poly[(k + 1) % poly.size()], poly[k]));
-  };
-
-  std::vector<Vec3> area2(nf), centre(nf);
-  for (int f = 0; f < nf; ++f) {
-    area2[f] = newell(P, F[f]);
-    centre[f] = mean_point(P, F[f]);
-  }
-
-  const FacetRegions faces = grow_faces(s, he, area2, centre, tol);
-  const std::vector<int>& region = faces.region;
-  const std::vector<int>& seed = faces.seed;
-  const int nr = static_cast<int>(seed.size());
-
-  // Plane of each face: least squares through all its mesh vertices, oriented like the facets.
+// Planes of the faces: least squares through all their mesh vertices, oriented like the
+// facets.
+void fit_face_planes(const PolygonSoup& s, const FacetRegions& faces, Boundaries& b) {
+  const std::size_t nr = faces.seed.size();
   std::vector<std::vector<int>> region_vertices(nr);
   std::vector<Vec3> region_area(nr, Vec3::Zero());
-  for (int f = 0; f < nf; ++f) {
-    region_area[region[f]] += area2[f];
-    for (int i : F[f]) region_vertices[region[f]].push_back(i);
+  for (std::size_t f = 0; f < s.polygons.size(); ++f) {
+    const int r = faces.region[f];
+    region_area[r] += newell(s.points, s.polygons[f]);
+    for (int i : s.polygons[f]) region_vertices[r].push_back(i);
   }
-  std::vector<Vec3> plane_n(nr);
-  std::vector<double> plane_d(nr);
-  for (int r = 0; r < nr; ++r) {
+  b.plane_n.resize(nr);
+  b.plane_d.resize(nr);
+  for (std::size_t r = 0; r < nr; ++r) {
     auto& vs = region_vertices[r];
     std::sort(vs.begin(), vs.end());
     vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
-    fit_plane(P, vs, region_area[r], plane_n[r], plane_d[r]);
+    fit_plane(s.points, vs, region_area[r], b.plane_n[r], b.plane_d[r]);
   }
+}
 
-  // Boundary rays: mesh edges between facets of different faces.
-  auto on_boundary = [&](int f, int k) { return region[twin(f, k).first] != region[f]; };
-  std::vector<std::vector<int>> rays(np);
-  for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < static_cast<int>(F[f].size()); ++k)
-      if (on_boundary(f, k)) {
-        const int a = F[f][k], b = F[f][(k + 1) % F[f].size()];
-        rays[a].push_back(b);  // each boundary edge is seen once from each side
-      }
-  // A boundary edge a-b is run a -> b by one face and b -> a by the other, so the heads of
-  // the outgoing boundary half-edges are all the rays of a vertex. A corner has three rays
-  // or more (three faces meet there). A vertex with two lies between two faces only, on the
-  // line their planes meet in, so it is no corner: the run of boundary through it must be
-  // straight within tol (checked below), however its facets were rounded or merged.
-  std::vector<char> is_feature(np, 0);
-  for (int v = 0; v < np; ++v) {
+// Corners: a boundary edge a-b is run a -> b by one face and b -> a by the other, so the heads
+// of the outgoing boundary half-edges are all the rays of a vertex. A corner has three rays
+// or more (three faces meet there). A vertex with two lies between two faces only, on the
+// line their planes meet in, so it is no corner: the run of boundary through it must be
+// straight within tol, however its facets were rounded or merged (trace_boundaries).
+std::vector<char> corners_of(const PolygonSoup& s, const HalfEdges& he,
+                             const std::vector<int>& region) {
+  const auto& F = s.polygons;
+  std::vector<std::vector<int>> rays(s.points.size());
+  for (std::size_t f = 0; f < F.size(); ++f)
+    for (std::size_t k = 0; k < F[f].size(); ++k) {
+      const int a = F[f][k], b = F[f][(k + 1) % F[f].size()];
+      if (region[he.at(key(b, a)).first] != region[f]) rays[a].push_back(b);
+    }
+  std::vector<char> is_feature(s.points.size(), 0);
+  for (std::size_t v = 0; v < rays.size(); ++v) {
     auto& r = rays[v];
     std::sort(r.begin(), r.end());
     r.erase(std::unique(r.begin(), r.end()), r.end());
     is_feature[v] = r.size() >= 3;
   }
+  return is_feature;
+}
 
-  // Loops: follow boundary half-edges; from the end of one, turn around its end vertex
-  // through facets of the same face until the next boundary half-edge.
-  std::unordered_map<std::uint64_t, char> visited;
+// Empty when every run of one loop's mesh vertices between consecutive corners (at: their
+// positions in mesh_loop) lies within tol of the straight segment between the two corners,
+// else why not.
+std::string bend_in(const std::vector<Vec3>& P, const std::vector<int>& mesh_loop,
+                    const std::vector<std::size_t>& at, double tol) {
+  const std::size_t m = mesh_loop.size(), nc = at.size();
+  for (std::size_t c = 0; c < nc; ++c) {
+    const Vec3& a = P[mesh_loop[at[c]]];
+    const Vec3& b = P[mesh_loop[at[(c + 1) % nc]]];
+    for (std::size_t q = (at[c] + 1) % m; q != at[(c + 1) % nc]; q = (q + 1) % m)
+      if (const double d = point_segment_distance(P[mesh_loop[q]], a, b); d > tol)
+        return "bends gradually near vertex " + std::to_string(mesh_loop[q]) + " (" + num(d) +
+               " mm off a straight edge); not a polyhedral edge";
+  }
+  return {};
+}
+
+// Loops: follow boundary half-edges; from the end of one, turn around its end vertex
+// through facets of the same face until the next boundary half-edge. Only corners are kept.
+Boundaries trace_boundaries(const PolygonSoup& s, const HalfEdges& he, const FacetRegions& faces,
+                            double tol, const std::string& src) {
+  const auto& P = s.points;
+  const auto& F = s.polygons;
+  const std::vector<int>& region = faces.region;
+  const int nf = static_cast<int>(F.size());
+  Boundaries b;
+  fit_face_planes(s, faces, b);
+  b.is_feature = corners_of(s, he, region);
+  b.loops.resize(faces.seed.size());
+  b.loop_area.resize(faces.seed.size());
+  auto twin = [&](int f, int k) { return he.at(key(F[f][(k + 1) % F[f].size()], F[f][k])); };
+  auto on_boundary = [&](int f, int k) { return region[twin(f, k).first] != region[f]; };
   auto next_boundary = [&](int f, int k) {
     int g = f;
     int j = static_cast<int>((k + 1) % F[f].size());
@@ -529,9 +570,10 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
     }
     return std::make_pair(g, j);
   };
-  std::vector<std::vector<std::vector<int>>> loops(nr);  // feature mesh vertices per loop
-  std::vector<std::vector<double>> loop_area(nr);
-  auto face_desc = [&](int r) { return "the face containing facet " + std::to_string(seed[r]); };
+  auto face_desc = [&](int r) {
+    return "the face containing facet " + std::to_string(faces.seed[r]);
+  };
+  std::unordered_map<std::uint64_t, char> visited;
   for (int f = 0; f < nf; ++f)
     for (int k = 0; k < static_cast<int>(F[f].size()); ++k) {
       if (!on_boundary(f, k) || visited.count(key(f, k))) continue;
@@ -542,61 +584,207 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
         visited[key(g, j)] = 1;
         mesh_loop.push_back(F[g][j]);
         std::tie(g, j) = next_boundary(g, j);
-        if (mesh_loop.size() > static_cast<std::size_t>(np) * 2)
+        if (mesh_loop.size() > P.size() * 2)
           fail(src, "internal error: a boundary loop of " + face_desc(r) + " does not close");
       } while (!(g == f && j == k));
       std::vector<int> corners;
       std::vector<std::size_t> at;
       for (std::size_t q = 0; q < mesh_loop.size(); ++q)
-        if (is_feature[mesh_loop[q]]) {
+        if (b.is_feature[mesh_loop[q]]) {
           corners.push_back(mesh_loop[q]);
           at.push_back(q);
         }
       if (corners.size() < 3)
-        fail(src, "a boundary loop of " + face_desc(r) + " has " + std::to_string(corners.size()) +
-                      " corners; a curved boundary tessellated finer than the collinearity "
-                      "tolerance (" +
-                      num(tol) + " mm) is not a polyhedron");
-      // Every run of non-feature vertices between two corners must be one straight edge.
+        b.troubles.emplace_back(r, "a boundary loop of " + face_desc(r) + " has " +
+                                       std::to_string(corners.size()) +
+                                       " corners; a curved boundary tessellated finer than the "
+                                       "collinearity tolerance (" +
+                                       num(tol) + " mm) is not a polyhedron");
+      else if (std::string why = bend_in(P, mesh_loop, at, tol); !why.empty())
+        b.troubles.emplace_back(r, "the boundary of " + face_desc(r) + " " + why);
       const std::size_t m = mesh_loop.size();
-      for (std::size_t c = 0; c < corners.size(); ++c) {
-        const Vec3& a = P[corners[c]];
-        const Vec3& b = P[corners[(c + 1) % corners.size()]];
-        for (std::size_t q = (at[c] + 1) % m; q != at[(c + 1) % corners.size()]; q = (q + 1) % m) {
-          const double d = point_segment_distance(P[mesh_loop[q]], a, b);
-          if (d > tol)
-            fail(src, "the boundary of " + face_desc(r) + " bends gradually near vertex " +
-                          std::to_string(mesh_loop[q]) + " (" + num(d) +
-                          " mm off a straight edge); not a polyhedral edge");
-        }
-      }
       Vec3 n2 = Vec3::Zero();
       for (std::size_t q = 0; q < m; ++q) n2 += P[mesh_loop[q]].cross(P[mesh_loop[(q + 1) % m]]);
-      loops[r].push_back(std::move(corners));
-      loop_area[r].push_back(0.5 * n2.dot(plane_n[r]));
+      b.loops[r].push_back(std::move(corners));
+      b.loop_area[r].push_back(0.5 * n2.dot(b.plane_n[r]));
     }
+  return b;
+}
 
-  // Feature vertex ids: by input vertex index.
-  std::vector<int> vid(np, -1);
-  std::vector<int> feature_points;
-  for (int v = 0; v < np; ++v)
-    if (is_feature[v]) {
-      vid[v] = static_cast<int>(feature_points.size());
-      feature_points.push_back(v);
+// Faces next to each other whose planes are parallel once their corners are placed: the
+// polyhedron would have an edge between two coplanar faces (faces merged at a coarse
+// tolerance around a facet that is not, or two faces sharing two edges that meet at a
+// corner). Sines below 1e-9 (far above the arithmetic's rounding) count.
+std::vector<std::pair<int, std::string>> coplanar_neighbours(const FaceLoops& fl,
+                                                             const std::vector<Vec3>& n,
+                                                             const std::vector<int>& seed) {
+  std::map<std::array<int, 2>, int> first_face;
+  std::vector<std::pair<int, std::string>> out;
+  for (std::size_t r = 0; r < fl.loops.size(); ++r)
+    for (const auto& loop : fl.loops[r])
+      for (std::size_t q = 0; q < loop.size(); ++q) {
+        std::array<int, 2> e{loop[q], loop[(q + 1) % loop.size()]};
+        if (e[0] > e[1]) std::swap(e[0], e[1]);
+        const auto [it, fresh] = first_face.emplace(e, static_cast<int>(r));
+        if (fresh || n[static_cast<std::size_t>(it->second)].cross(n[r]).norm() >= 1e-9) continue;
+        const std::string why = "the faces containing facets " + std::to_string(seed[r]) + " and " +
+                                std::to_string(seed[it->second]) +
+                                " meet at an edge but lie in one plane";
+        out.emplace_back(static_cast<int>(r), why);
+        out.emplace_back(it->second, why);
+      }
+  return out;
+}
+
+// Faces whose corners, once placed, are further than kPlanarCheck x diag from the plane
+// through them: planarize could not make them planar (faces merged at a coarse tolerance from
+// facets no planes fit), and libcf would refuse them (1e-6 of its size, twice this; the
+// diagonal of the used points is at least the polyhedron's size).
+constexpr double kPlanarCheck = 5e-7;
+
+std::vector<std::pair<int, std::string>> unplanar_faces(const std::vector<Vec3>& coords,
+                                                        const FaceLoops& fl, double diag,
+                                                        const std::vector<int>& seed) {
+  std::vector<std::pair<int, std::string>> out;
+  for (std::size_t r = 0; r < fl.loops.size(); ++r) {
+    std::vector<int> corners;
+    for (const auto& loop : fl.loops[r]) corners.insert(corners.end(), loop.begin(), loop.end());
+    Vec3 n;
+    double d = 0, off = 0;
+    fit_plane(coords, corners, Vec3::UnitZ(), n, d);
+    for (int v : corners)
+      off = std::max(off, std::abs(n.dot(coords[static_cast<std::size_t>(v)]) - d));
+    if (off > kPlanarCheck * diag)
+      out.emplace_back(static_cast<int>(r), "the face containing facet " + std::to_string(seed[r]) +
+                                                " is not planar (a corner " + num(off) +
+                                                " mm off its plane)");
+  }
+  return out;
+}
+
+// mm, of each face of the polyhedron m extracted with these regions (face r of m is region r):
+// the largest distance of a vertex of one of its facets from its polygon
+// (FeatureMeasures::deviation is the largest of them).
+std::vector<double> face_deviations(const PolygonSoup& s, const std::vector<int>& region,
+                                    const Polyhedron& m) {
+  std::vector<double> worst(m.num_faces(), 0.0);
+  for (std::size_t f = 0; f < s.polygons.size(); ++f) {
+    const FaceId face(region[f]);
+    const Face& F = m.face(face);
+    for (int i : s.polygons[f]) {
+      const Vec3& p = s.points[static_cast<std::size_t>(i)];
+      const double h = F.normal.dot(p) - F.offset;
+      const double out = std::max(0.0, -m.face_inset(face, p));  // beyond the face's boundary
+      double& w = worst[static_cast<std::size_t>(face.index())];
+      w = std::max(w, std::sqrt(h * h + out * out));
     }
+  }
+  return worst;
+}
 
-  FaceLoops fl = face_loops_of(loops, loop_area, vid, feature_points.size(), seed, src);
-  std::vector<std::vector<std::vector<int>>>& face_loops = fl.loops;
-  std::vector<std::vector<int>>& faces_of = fl.faces_of;
-  const std::vector<std::array<int, 2>>& edges = fl.edges;
+// A face may lie at most this many times the coplanarity tolerance from the file's facets it
+// was merged from (FeatureMeasures::deviation): a facet joins within the tolerance of the face's
+// plane so far, the plane fitted at the end moves by up to as much again.
+constexpr double kMaxDeviation = 2;
 
-  std::vector<Vec3> coords =
-      feature_coordinates(P, feature_points, faces_of, face_loops, plane_n, plane_d, off_plane);
+// Raises the tier (JoinTolerances) of every facet of the faces in `troubles`; where they are
+// all at the last tier already, of the faces next to them, and so on outward (the corners of a
+// face are placed with its neighbours' planes, and planarize refits them all). False when
+// every facet is at the last tier: nothing is left to change.
+bool raise_tiers(const PolygonSoup& s, const HalfEdges& he, const FacetRegions& faces,
+                 const std::vector<std::pair<int, std::string>>& troubles,
+                 std::vector<char>& tier) {
+  const std::size_t nr = faces.seed.size(), nf = s.polygons.size();
+  std::vector<char> mark(nr, 0);
+  for (const auto& t : troubles) mark[static_cast<std::size_t>(t.first)] = 1;
+  for (;;) {
+    bool changed = false, grew = false;
+    for (std::size_t f = 0; f < nf; ++f)
+      if (mark[static_cast<std::size_t>(faces.region[f])] && tier[f] < 2) ++tier[f], changed = true;
+    if (changed) return true;
+    std::vector<char> next = mark;
+    for (std::size_t f = 0; f < nf; ++f) {
+      if (!mark[static_cast<std::size_t>(faces.region[f])]) continue;
+      const auto& poly = s.polygons[f];
+      for (std::size_t k = 0; k < poly.size(); ++k) {
+        const auto r = static_cast<std::size_t>(
+            faces.region[he.at(key(poly[(k + 1) % poly.size()], poly[k])).first]);
+        grew = grew || !next[r];
+        next[r] = 1;
+      }
+    }
+    if (!grew) return false;
+    mark = std::move(next);
+  }
+}
 
-  try {
-    return Polyhedron::from_features(name, std::move(coords), edges, face_loops);
-  } catch (const Error& e) {
-    fail(src, std::string("the extracted features do not form a valid polyhedron: ") + e.what());
+}  // namespace
+
+cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
+                                const std::string& name, const LoadOptions& opt,
+                                FeatureMeasures* measures) {
+  const auto& P = s.points;
+  const int nf = static_cast<int>(s.polygons.size());
+  const double tol = opt.coplanar_rel_tol * diagonal(s);
+  const HalfEdges he = half_edges(s);
+  std::vector<Vec3> area2(nf), centre(nf);
+  for (int f = 0; f < nf; ++f) {
+    area2[f] = newell(P, s.polygons[f]);
+    centre[f] = mean_point(P, s.polygons[f]);
+  }
+  // A coarse tolerance can merge facets into faces no planar polyhedron has: a boundary
+  // between two faces bending where they alone meet, a loop of fewer than 3 corners, two
+  // neighbouring faces in one plane, a face planarize cannot make planar. The facets of such
+  // faces are grown again a tier stricter (JoinTolerances: the default tolerance, then
+  // rounding), until no face fails or every facet is at the last tier; that failure is
+  // reported.
+  JoinTolerances join;
+  join.coarse = tol;
+  join.fine = std::min(tol, LoadOptions{}.coplanar_rel_tol * diagonal(s));
+  join.exact = std::min(join.fine, snap_tolerance(P));
+  join.cos_crease = std::cos(opt.crease_angle_deg * M_PI / 180);
+  std::vector<char> tier(nf, tol <= join.fine ? 1 : 0);
+  for (;;) {
+    const FacetRegions faces = grow_faces(s, he, area2, centre, join, tier);
+    Boundaries b = trace_boundaries(s, he, faces, tol, src);
+    std::vector<int> vid(P.size(), -1), feature_points;
+    for (std::size_t v = 0; v < P.size(); ++v)
+      if (b.is_feature[v]) {
+        vid[v] = static_cast<int>(feature_points.size());
+        feature_points.push_back(static_cast<int>(v));
+      }
+    FaceLoops fl;
+    std::vector<Vec3> coords;
+    double off = 0;
+    if (b.troubles.empty()) {
+      fl = face_loops_of(b.loops, b.loop_area, vid, feature_points.size(), faces.seed, src);
+      coords =
+          feature_coordinates(P, feature_points, fl.faces_of, fl.loops, b.plane_n, b.plane_d, &off);
+      b.troubles = coplanar_neighbours(fl, b.plane_n, faces.seed);
+      for (auto& t : unplanar_faces(coords, fl, diagonal(s), faces.seed))
+        b.troubles.push_back(std::move(t));
+    }
+    if (!b.troubles.empty()) {
+      if (!raise_tiers(s, he, faces, b.troubles, tier)) fail(src, b.troubles.front().second);
+      continue;
+    }
+    Polyhedron m;
+    try {
+      m = Polyhedron::from_features(name, std::move(coords), fl.edges, fl.loops);
+    } catch (const Error& e) {
+      fail(src, std::string("the extracted features do not form a valid polyhedron: ") + e.what());
+    }
+    // A face placed further than twice the tolerance from its facets (corners moved onto
+    // planes meeting at shallow angles) is grown again finer too.
+    const std::vector<double> dev = face_deviations(s, faces.region, m);
+    for (std::size_t r = 0; r < dev.size(); ++r)
+      if (dev[r] > kMaxDeviation * tol)
+        b.troubles.emplace_back(static_cast<int>(r), "the face containing facet " +
+                                                         std::to_string(faces.seed[r]) + " lies " +
+                                                         num(dev[r]) + " mm from its facets");
+    if (!b.troubles.empty() && raise_tiers(s, he, faces, b.troubles, tier)) continue;
+    if (measures) *measures = {off, dev.empty() ? 0.0 : *std::max_element(dev.begin(), dev.end())};
+    return m;
   }
 }
 

@@ -287,6 +287,13 @@ MeasuredModel measured_model_from_soup(const PolygonSoup& soup, const std::strin
                   options.coplanar_rel_tol, kMinCoplanarTol, kMaxCoplanarTol);
     fail(source, buf);
   }
+  if (!(options.crease_angle_deg >= kMinCreaseAngle &&
+        options.crease_angle_deg <= kMaxCreaseAngle)) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "crease angle %g degrees is outside [%g, %g]",
+                  options.crease_angle_deg, kMinCreaseAngle, kMaxCreaseAngle);
+    fail(source, buf);
+  }
   for (std::size_t i = 0; i < soup.points.size(); ++i) {
     const Vec3& p = soup.points[i];
     for (int k = 0; k < 3; ++k)
@@ -302,11 +309,11 @@ MeasuredModel measured_model_from_soup(const PolygonSoup& soup, const std::strin
   detail::check_soup(soup, source, options);
   if (options.check_self_intersection) check_self_intersection(soup, source);
   const std::string name = options.name.empty() ? fs::path(source).stem().string() : options.name;
-  double off_plane = 0;
-  cf::Polyhedron model = detail::extract_features(soup, source, name, options, &off_plane);
-  const double precision = std::max(off_plane, model_precision(model));
+  detail::FeatureMeasures measures;
+  cf::Polyhedron model = detail::extract_features(soup, source, name, options, &measures);
+  const double precision = std::max(measures.off_plane, model_precision(model));
   // The soup's points as given (load_measured_model measures them before scaling to mm).
-  return {std::move(model), precision, coordinate_rounding(soup.points)};
+  return {std::move(model), precision, coordinate_rounding(soup.points), measures.deviation};
 }
 
 cf::Polyhedron model_from_soup(const PolygonSoup& soup, const std::string& source,

@@ -15,6 +15,9 @@ namespace cf::tools {
 /// Coplanarity tolerances accepted (LoadOptions::coplanar_rel_tol, cfgen --coplanar-tol).
 constexpr double kMinCoplanarTol = 1e-12;
 constexpr double kMaxCoplanarTol = 0.1;
+/// Crease angles accepted, degrees (LoadOptions::crease_angle_deg, cfgen --crease-angle).
+constexpr double kMinCreaseAngle = 0;
+constexpr double kMaxCreaseAngle = 180;
 /// Largest |coordinate| of a model, in mm after the unit conversion (1000 km): beyond it
 /// areas and volumes lose all precision, and no haptic scene is that large.
 constexpr double kMaxCoordinateMm = 1e9;
@@ -33,6 +36,12 @@ struct LoadOptions {
   /// neighbours is not a feature vertex. Default 1e-5: 100x above single-precision (STL)
   /// rounding, far below any intended feature of a model.
   double coplanar_rel_tol = 1e-5;
+  /// Degrees: a facet joins a face only when its normal is within this angle of the face's
+  /// normal so far, so a face merged at a coarse coplanar_rel_tol never spans more than twice
+  /// it (a finely tessellated cylinder becomes a prism, not one face). The default is above
+  /// the normal noise of thin facets written as float32 and below the bends of curved parts
+  /// (docs/features.md, "Creases").
+  double crease_angle_deg = 10;
   /// Run the (slowest) self-intersection check.
   bool check_self_intersection = true;
   /// The length unit of the file's coordinates: "mm" (the default), "cm", "m" or "in".
@@ -111,6 +120,11 @@ struct MeasuredModel {
   /// mm: coordinate_rounding() of the file's points, in mm. The generator's symmetry
   /// tolerance is a multiple of it, within bounds (tools/cfgen/generate.hpp).
   double rounding_mm = 0;
+  /// mm: how far the file's facets are from the model's faces: the largest distance of a
+  /// vertex of the file from the plane of a face its facets became part of, or of a corner
+  /// from where the file had it. Facets merged at a coarse coplanar_rel_tol make it up to
+  /// about that tolerance; otherwise it is the file's rounding (docs/features.md, "Creases").
+  double deviation_mm = 0;
 };
 
 /// Empty when `model` is a reasonable size against the contact threshold `epsilon_mm` (the

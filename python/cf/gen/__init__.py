@@ -33,14 +33,19 @@ __all__ = ["generate", "load_model"]
 
 
 def load_model(path: str | os.PathLike[str], units: str = "mm", coplanar_rel_tol: float | None = None,
-               check_self_intersection: bool = True, name: str = "") -> Polyhedron:
+               check_self_intersection: bool = True, name: str = "",
+               crease_angle_deg: float | None = None) -> Polyhedron:
     """Reads a polyhedral model (OFF, OBJ, STL or PLY) and extracts its features.
 
     ``units`` is the file's length unit ('mm', 'cm', 'm' or 'in'); the returned
-    cf.Polyhedron is in mm, indexed as cfgen indexes it (cfgen --features). Raises cf.Error
-    naming the file and the problem (cf.FileError when it cannot be read).
+    cf.Polyhedron is in mm, indexed as cfgen indexes it (cfgen --features).
+    ``coplanar_rel_tol`` and ``crease_angle_deg`` (degrees) decide which facets merge into one
+    face, as cfgen's ``--coplanar-tol`` and ``--crease-angle`` (None: their defaults). Raises
+    cf.Error naming the file and the problem (cf.FileError when it cannot be read).
     """
     kwargs: dict[str, Any] = {} if coplanar_rel_tol is None else {"coplanar_rel_tol": coplanar_rel_tol}
+    if crease_angle_deg is not None:
+        kwargs["crease_angle_deg"] = crease_angle_deg
     return _gen.load_model(_os.fspath(path), units=units, check_self_intersection=check_self_intersection,
                            name=name, **kwargs)
 
@@ -55,7 +60,7 @@ def generate(a_path: str | os.PathLike[str], b_path: str | os.PathLike[str],
     cores), ``max_pcs`` (1..3), ``touch_tol``, ``min_clearance``, ``good_clearance``,
     ``min_margin`` (relative to the smaller model's bounding-box diagonal), ``angle_margin``
     (rad), ``theta_samples``, ``max_rotations``, ``units``, ``units_a``, ``units_b``,
-    ``coplanar_rel_tol``, ``symmetry`` (default True: one search per orbit of the models'
+    ``coplanar_rel_tol``, ``crease_angle_deg``, ``symmetry`` (default True: one search per orbit of the models'
     symmetries; False is ``--no-symmetry``), ``thorough`` (default False; True is
     ``--thorough``: every set searched, then every image of each CF added), ``quiet`` (default
     True: no progress on stderr), ``checkpoint`` (a directory: ``--checkpoint``, finished work

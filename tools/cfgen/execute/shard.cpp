@@ -41,7 +41,9 @@ nlohmann::json options_json(const GenerateArgs& a) {
                       {"units_a", a.load_a.units},
                       {"units_b", a.load_b.units},
                       {"coplanar_tol_a", a.load_a.coplanar_rel_tol},
-                      {"coplanar_tol_b", a.load_b.coplanar_rel_tol}};
+                      {"coplanar_tol_b", a.load_b.coplanar_rel_tol},
+                      {"crease_angle_a", a.load_a.crease_angle_deg},
+                      {"crease_angle_b", a.load_b.crease_angle_deg}};
   // Only when set, so that the fingerprints of runs without it are those of earlier builds.
   if (a.thorough) o["thorough"] = true;
   return o;
