@@ -627,6 +627,45 @@ TEST_CASE("any coplanarity tolerance and crease angle give a polyhedron near the
       }
 }
 
+#ifdef CF_PUBLIC_MODELS
+TEST_CASE("the public curved models: faces at three crease angles", "[features][public]") {
+  // docs/features.md, "Creases": faces/edges/vertices and reflex edges of the three.js emerald
+  // and CGAL's U at the default tolerance and at 1e-2 with crease angles of 2, 10 and 30
+  // degrees. The counts are the loader's exact output (a change to the merging rules changes
+  // them, and the table with them).
+  struct Row {
+    const char* file;
+    double tol, crease;
+    std::size_t faces, edges, vertices;
+    int reflex;
+  };
+  const Row rows[] = {{"threejs_emerald.obj", 1e-5, 10, 94, 164, 72, 18},
+                      {"threejs_emerald.obj", 1e-2, 2, 84, 152, 70, 14},
+                      {"threejs_emerald.obj", 1e-2, 10, 63, 125, 64, 6},
+                      {"threejs_emerald.obj", 1e-2, 30, 39, 89, 52, 0},
+                      {"cgal_u.off", 1e-5, 10, 78, 160, 84, 63},
+                      {"cgal_u.off", 1e-2, 2, 64, 142, 80, 52},
+                      {"cgal_u.off", 1e-2, 10, 26, 72, 48, 17},
+                      {"cgal_u.off", 1e-2, 30, 19, 51, 34, 10}};
+  for (const Row& r : rows) {
+    CAPTURE(r.file, r.tol, r.crease);
+    cf::tools::LoadOptions o;
+    o.coplanar_rel_tol = r.tol;
+    o.crease_angle_deg = r.crease;
+    const std::string path = std::string(CF_PUBLIC_MODELS) + "/" + r.file;
+    const cf::tools::MeasuredModel mm = cf::tools::load_measured_model(path, o);
+    CHECK(mm.model.num_faces() == r.faces);
+    CHECK(mm.model.num_edges() == r.edges);
+    CHECK(mm.model.num_vertices() == r.vertices);
+    CHECK(count_reflex(mm.model) == r.reflex);
+    check_invariants(mm.model, 0);
+    // Within twice the tolerance of the file's facets (docs/features.md, "Creases").
+    const double diag = soup_diagonal(cf::tools::read_polygon_soup(path));
+    CHECK(mm.deviation_mm <= 2 * r.tol * diag);
+  }
+}
+#endif
+
 TEST_CASE("a finely tessellated sphere loads: faces that would bend a boundary keep their facets",
           "[features]") {
   // 20,000 facets; near the poles neighbouring triangles are within the default tolerance of
