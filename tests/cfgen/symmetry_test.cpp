@@ -153,6 +153,54 @@ TEST_CASE("symmetry: a model with no symmetry has only the identity", "[symmetry
   CHECK(pair.size() == 4);
 }
 
+TEST_CASE("symmetry: a model written as float32 is made symmetric to the exact file's tolerance",
+          "[symmetry]") {
+  // The hexagonal hole block (24 maps) with every coordinate rounded to float32, as a binary
+  // STL holds it: symmetric only to about 1e-6 mm, so most maps are missed at 1e-13 of its size.
+  const cf::Polyhedron exact = cf::tools::load_model(
+      cf::test::write_file("sym_hole.off", cf::test::ngon_off(6, 25, 10.5, 0, 20)));
+  cf::tools::PolygonSoup soup;
+  // Through a volatile float: GCC 12.2 at -O2/-O3 (SLP vectorization) dropped the rounding of
+  // (double)(float)x for two of the three coordinates when written inline.
+  auto f32 = [](double x) {
+    volatile float f = static_cast<float>(x);
+    return static_cast<double>(f);
+  };
+  for (const cf::Vertex& v : exact.vertices())
+    soup.points.push_back({f32(v.p.x()), f32(v.p.y()), f32(v.p.z())});
+  for (const cf::Face& f : exact.faces()) {
+    // Fan triangles from each loop's first corner would cross the hole: each face as its loops,
+    // which the soup takes as one polygon per loop only for faces without holes.
+    if (f.loops.size() > 1) continue;
+    std::vector<int> poly;
+    for (cf::VertexId u : f.loops[0]) poly.push_back(static_cast<int>(u.index()));
+    soup.polygons.push_back(poly);
+  }
+  // The two annular faces: as quads between the rings (the loader merges them again).
+  const int n = 6;
+  for (int i = 0, j = 1; i < n; ++i, j = (i + 1) % n) {
+    soup.polygons.push_back({i, j, 2 * n + j, 2 * n + i});
+    soup.polygons.push_back({n + i, 3 * n + i, 3 * n + j, n + j});
+  }
+  const cf::tools::MeasuredModel rounded = cf::tools::measured_model_from_soup(soup, "f32 hole");
+  const double strict = cf::gen::kSymmetryTol * rounded.model.size();
+  REQUIRE(symmetries(exact, 1e-13 * exact.size()).size() == 24);
+  CHECK(symmetries(rounded.model, strict).size() < 24);
+  double moved = 0;
+  const cf::Polyhedron sym = cf::gen::symmetrized(
+      rounded.model, cf::gen::kSymmetryRoundings * rounded.rounding_mm, strict, &moved);
+  CHECK(symmetries(sym, strict).size() == 24);
+  // Each vertex moves by about the rounding: to the mean of its images, each a rounding away.
+  CHECK(moved > 0);
+  CHECK(moved <= 4 * rounded.rounding_mm);
+  CHECK(sym.num_faces() == rounded.model.num_faces());
+  // An exact model is returned as it is.
+  double none = 1;
+  const cf::Polyhedron same = cf::gen::symmetrized(exact, 1e-6, 1e-13 * exact.size(), &none);
+  CHECK(none == 0);
+  CHECK(same.vertices()[3].p == exact.vertices()[3].p);
+}
+
 TEST_CASE("symmetry: the image of a pose puts each image element where the symmetry puts it",
           "[symmetry]") {
   const cf::Polyhedron A = cf::test::box(10, 20, 30, "A");

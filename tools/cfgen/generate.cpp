@@ -2,6 +2,7 @@
 
 #include "cfgen/certificate_file.hpp"
 #include "cfgen/enumerate/enumerate.hpp"
+#include "cfgen/enumerate/symmetry.hpp"
 #include "cfgen/execute/progress.hpp"
 #include "cfgen/execute/shard.hpp"
 #include "cfgen/execute/stop.hpp"
@@ -44,6 +45,15 @@ std::string conflicting_lengths(const RelativeLengths& rel, bool python_names) {
 
 double length_scale(const Polyhedron& A, const Polyhedron& B) {
   return std::min((A.bbox_max() - A.bbox_min()).norm(), (B.bbox_max() - B.bbox_min()).norm());
+}
+
+void symmetrize(MeasuredModel& a, MeasuredModel& b) {
+  const double strict = gen::kSymmetryTol * std::max(a.model.size(), b.model.size());
+  for (MeasuredModel* m : {&a, &b}) {
+    double moved = 0;
+    m->model = gen::symmetrized(m->model, gen::kSymmetryRoundings * m->rounding_mm, strict, &moved);
+    m->deviation_mm += moved;  // the faces moved by at most as much as their corners
+  }
 }
 
 gen::SearchParams scaled_search(const Polyhedron& A, const Polyhedron& B,
@@ -277,8 +287,9 @@ int run_generate(const GenerateArgs& args) {
   if (certifies)
     check_output(args.certificates_path, inputs, args.checkpoint_dir, "writing certificates",
                  to_file ? std::vector<std::string>{args.out_path} : std::vector<std::string>{});
-  const MeasuredModel ma = load_measured_model(args.a_path, args.load_a);
-  const MeasuredModel mb = load_measured_model(args.b_path, args.load_b);
+  MeasuredModel ma = load_measured_model(args.a_path, args.load_a);
+  MeasuredModel mb = load_measured_model(args.b_path, args.load_b);
+  symmetrize(ma, mb);  // whether or not the search uses the maps: one model, one graph
   const Polyhedron& A = ma.model;
   const Polyhedron& B = mb.model;
   // The other ranks of an MPI run say nothing that rank 0 says.

@@ -46,6 +46,11 @@ constexpr double kTouchPerPrecision = 4;
 /// D in mm: the smaller model's bounding-box diagonal, the unit of RelativeLengths.
 double length_scale(const Polyhedron& A, const Polyhedron& B);
 
+/// Models read from files rounded coarser than the symmetry tolerance (float32, a few digits)
+/// made exactly symmetric where they are symmetric to their rounding (gen::symmetrized), their
+/// deviation from the files grown by the corners' moves (docs/features.md, "Precision").
+void symmetrize(MeasuredModel& a, MeasuredModel& b);
+
 /// `base` with its lengths set to `rel` times length_scale(A, B), the touch tolerance at
 /// least kTouchPerPrecision times the models' planarities summed (model_precision): the
 /// search cfgen runs.

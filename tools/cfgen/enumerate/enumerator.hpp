@@ -18,11 +18,6 @@
 
 namespace cf::gen::internal {
 
-// Vertices within this fraction of the length scale D match under a symmetry: far below the
-// touch tolerance (2e-11 D by default), so an image witness verifies as the witness did. A
-// file rounded coarser than that (float32, few digits) is symmetric only to its rounding;
-// maps found to 16 times it are not used (docs/features.md, "Precision").
-constexpr double kSymmetryTol = 1e-13;
 // Members of an orbit searched before it counts as failed: each meets the search's fixed
 // samples differently. On the hexagonal peg and hole 2 find 13 orbits more than 1 (4 no more
 // than 2); on the square pair 4 find 2 more than 2.

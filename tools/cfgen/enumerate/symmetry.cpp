@@ -165,6 +165,52 @@ std::vector<Symmetry> symmetries(const Polyhedron& m, double tol) {
   return out;
 }
 
+namespace {
+
+// m with each vertex at the mean of its preimages under `maps` (a group): c + mean over g of
+// R_g^T (v_{g(i)} - c). With maps that compose exactly the result is exactly symmetric; with
+// maps fitted to a rounded model, to about the square of their error.
+Polyhedron mean_over(const Polyhedron& m, const std::vector<Symmetry>& maps) {
+  const Vec3 c = m.vertex_centroid();
+  std::vector<Vec3> v(m.num_vertices(), Vec3::Zero());
+  for (const Symmetry& g : maps)
+    for (std::size_t i = 0; i < v.size(); ++i)
+      v[i] += g.R.transpose() * (m.vertices()[static_cast<std::size_t>(g.vertex[i])].p - c);
+  for (Vec3& x : v) x = c + x / static_cast<double>(maps.size());
+  std::vector<std::array<int, 2>> edges;
+  for (const Edge& e : m.edges())
+    edges.push_back({static_cast<int>(e.v0.index()), static_cast<int>(e.v1.index())});
+  std::vector<std::vector<std::vector<int>>> loops;
+  for (const Face& f : m.faces()) {
+    loops.emplace_back();
+    for (const auto& loop : f.loops) {
+      loops.back().emplace_back();
+      for (VertexId u : loop) loops.back().back().push_back(static_cast<int>(u.index()));
+    }
+  }
+  return Polyhedron::from_features(m.name(), std::move(v), edges, loops);
+}
+
+}  // namespace
+
+Polyhedron symmetrized(const Polyhedron& m, double loose_tol, double strict_tol, double* moved) {
+  if (moved) *moved = 0;
+  const std::size_t exact = symmetries(m, strict_tol).size();
+  const std::vector<Symmetry> loose = symmetries(m, loose_tol);
+  if (loose.size() <= exact) return m;
+  // Twice: the second mean uses maps refitted to the first, exact to the square of the
+  // rounding (docs/features.md, "Precision").
+  Polyhedron s = mean_over(m, loose);
+  const std::vector<Symmetry> refit = symmetries(s, loose_tol);
+  if (refit.size() != loose.size()) return m;
+  s = mean_over(s, refit);
+  if (symmetries(s, strict_tol).size() != loose.size()) return m;
+  if (moved)
+    for (std::size_t i = 0; i < m.num_vertices(); ++i)
+      *moved = std::max(*moved, (s.vertices()[i].p - m.vertices()[i].p).norm());
+  return s;
+}
+
 PairSymmetries::PairSymmetries(const Polyhedron& A, const Polyhedron& B, double tol, bool enabled) {
   a_ = enabled ? symmetries(A, tol) : std::vector<Symmetry>{identity(A)};
   b_ = enabled ? symmetries(B, tol) : std::vector<Symmetry>{identity(B)};

@@ -12,6 +12,13 @@
 
 namespace cf::gen {
 
+/// Vertices within this fraction of the larger model's size match under a symmetry: far below
+/// the touch tolerance (2e-11 D by default), so an image witness verifies as the witness did.
+constexpr double kSymmetryTol = 1e-13;
+/// A file rounded coarser than kSymmetryTol (float32, few digits) is symmetric only to its
+/// rounding: maps to within this many times its rounding (symmetrized) make it symmetric.
+constexpr double kSymmetryRoundings = 16;
+
 /// A map x -> R (x - c) + c that takes a model onto itself, as permutations of its elements.
 struct Symmetry {
   Mat3 R = Mat3::Identity();  // orthogonal; det -1 for a reflection
@@ -27,6 +34,14 @@ struct Symmetry {
 /// each face to a face with the image normal. Only the identity when the maps found are not closed
 /// under composition (a model symmetric only to about `tol`). Deterministic.
 std::vector<Symmetry> symmetries(const Polyhedron& m, double tol);
+
+/// A model read from a file rounded coarser than kSymmetryTol (float32, a few digits) and
+/// symmetric to within `loose_tol` (mm, a multiple of its rounding): the same model with every
+/// vertex replaced by the mean of its preimages under those maps, twice, so that it is
+/// symmetric to within `strict_tol` (mm) as an exact file is, and its maps are found there. `m`
+/// itself when it has no more maps at loose_tol than at strict_tol, or when the mean does not
+/// give them all at strict_tol. moved: mm, how far a vertex moved (0 for `m` itself).
+Polyhedron symmetrized(const Polyhedron& m, double loose_tol, double strict_tol, double* moved);
 
 /// The pairs (h of A, g of B) of like handedness (both rotations, or both reflections, whose
 /// product with the pose is again a rotation), the identity pair first.
