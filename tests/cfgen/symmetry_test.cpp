@@ -36,18 +36,7 @@ constexpr double kTol = 1e-9;  // mm
 cf::Polyhedron moved(const cf::Polyhedron& m, const Eigen::Matrix3d& R, const Vec3& t) {
   std::vector<Vec3> v;
   for (const auto& x : m.vertices()) v.push_back(R * x.p + t);
-  std::vector<std::array<int, 2>> e;
-  for (const auto& x : m.edges())
-    e.push_back({static_cast<int>(x.v0.index()), static_cast<int>(x.v1.index())});
-  std::vector<std::vector<std::vector<int>>> f;
-  for (const auto& x : m.faces()) {
-    f.emplace_back();
-    for (const auto& loop : x.loops) {
-      f.back().emplace_back();
-      for (auto id : loop) f.back().back().push_back(static_cast<int>(id.index()));
-    }
-  }
-  return cf::Polyhedron::from_features(m.name(), v, e, f);
+  return m.with_vertices(std::move(v));
 }
 
 // The PC sets of an enumeration's CFs, as text.

@@ -41,3 +41,22 @@ TEST_CASE("a model with an inward orientation is rejected", "[polyhedron]") {
       cf::Polyhedron::from_features("t", v, e, inward),
       Catch::Contains("model 't': encloses a non-positive volume: faces are oriented inward"));
 }
+
+TEST_CASE("with_vertices keeps the features and derives the rest at the new coordinates",
+          "[polyhedron]") {
+  const cf::Polyhedron m = box(20, 10, 30);
+  std::vector<cf::Vec3> v;
+  for (const cf::Vertex& x : m.vertices()) v.push_back(2 * x.p + cf::Vec3(1, 2, 3));
+  const cf::Polyhedron big = m.with_vertices(v);
+  CHECK(big.name() == m.name());
+  CHECK(big.num_edges() == m.num_edges());
+  CHECK(big.num_faces() == m.num_faces());
+  CHECK(big.volume() == Approx(8 * 6000).epsilon(kExact));
+  CHECK((big.volume_centroid() - cf::Vec3(21, 12, 33)).norm() < kExact * 100);
+  CHECK(big.face(cf::FaceId(1)).offset == Approx(63));
+  CHECK(big.face(cf::FaceId(1)).loops == m.face(cf::FaceId(1)).loops);
+  // A corner moved off its faces' planes, or a wrong count, is refused by name.
+  v[0] += cf::Vec3(0, 0, 5);
+  CHECK_THROWS_WITH(m.with_vertices(v), Catch::Contains("is not planar"));
+  CHECK_THROWS_WITH(m.with_vertices({}), Catch::Contains("with_vertices: 0 vertices given for 8"));
+}

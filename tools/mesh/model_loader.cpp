@@ -276,24 +276,22 @@ void check_self_intersection(const PolygonSoup& s, const std::string& src) {
                 " intersect (" + std::to_string(pairs.size()) + " intersecting triangle pairs)");
 }
 
+// Refuses an option outside [lo, hi] (or NaN), `format` saying which with the value and range.
+void check_option(double v, double lo, double hi, const char* format, const std::string& source) {
+  if (v >= lo && v <= hi) return;
+  char buf[160];
+  std::snprintf(buf, sizeof buf, format, v, lo, hi);
+  fail(source, buf);
+}
+
 }  // namespace
 
 MeasuredModel measured_model_from_soup(const PolygonSoup& soup, const std::string& source,
                                        const LoadOptions& options) {
-  if (!(options.coplanar_rel_tol >= kMinCoplanarTol &&
-        options.coplanar_rel_tol <= kMaxCoplanarTol)) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "coplanarity tolerance %g is outside [%g, %g]",
-                  options.coplanar_rel_tol, kMinCoplanarTol, kMaxCoplanarTol);
-    fail(source, buf);
-  }
-  if (!(options.crease_angle_deg >= kMinCreaseAngle &&
-        options.crease_angle_deg <= kMaxCreaseAngle)) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "crease angle %g degrees is outside [%g, %g]",
-                  options.crease_angle_deg, kMinCreaseAngle, kMaxCreaseAngle);
-    fail(source, buf);
-  }
+  check_option(options.coplanar_rel_tol, kMinCoplanarTol, kMaxCoplanarTol,
+               "coplanarity tolerance %g is outside [%g, %g]", source);
+  check_option(options.crease_angle_deg, kMinCreaseAngle, kMaxCreaseAngle,
+               "crease angle %g degrees is outside [%g, %g]", source);
   for (std::size_t i = 0; i < soup.points.size(); ++i) {
     const Vec3& p = soup.points[i];
     for (int k = 0; k < 3; ++k)

@@ -67,6 +67,13 @@ class Polyhedron {
                                   const std::vector<std::array<int, 2>>& edges,
                                   const std::vector<std::vector<std::vector<int>>>& face_loops);
 
+  /// The same name, edges and face loops at other vertex coordinates (a moved or reshaped
+  /// copy), everything else derived again as from_features does.
+  /// @param vertices one per vertex of this polyhedron, mm, in its order.
+  /// @throws cf::Error as from_features (a face no longer planar, an inward orientation), or
+  ///   when the count differs from num_vertices().
+  Polyhedron with_vertices(std::vector<Vec3> vertices) const;
+
   const std::string& name() const { return name_; }
   const std::vector<Vertex>& vertices() const { return vertices_; }
   const std::vector<Edge>& edges() const { return edges_; }

@@ -226,6 +226,22 @@ void mass_properties(const std::vector<Face>& faces, const std::vector<Vec3>& ve
 
 }  // namespace
 
+Polyhedron Polyhedron::with_vertices(std::vector<Vec3> vertices) const {
+  if (vertices.size() != vertices_.size())
+    fail(name_, "with_vertices: " + std::to_string(vertices.size()) + " vertices given for " +
+                    std::to_string(vertices_.size()));
+  std::vector<std::array<int, 2>> edges;
+  edges.reserve(edges_.size());
+  for (const Edge& e : edges_) edges.push_back({e.v0.value(), e.v1.value()});
+  std::vector<std::vector<std::vector<int>>> loops(faces_.size());
+  for (std::size_t f = 0; f < faces_.size(); ++f)
+    for (const auto& loop : faces_[f].loops) {
+      loops[f].emplace_back();
+      for (VertexId u : loop) loops[f].back().push_back(u.value());
+    }
+  return from_features(name_, std::move(vertices), edges, loops);
+}
+
 Polyhedron Polyhedron::from_features(std::string name, std::vector<Vec3> vertices,
                                      const std::vector<std::array<int, 2>>& edges,
                                      const std::vector<std::vector<std::vector<int>>>& face_loops) {

@@ -177,18 +177,7 @@ Polyhedron mean_over(const Polyhedron& m, const std::vector<Symmetry>& maps) {
     for (std::size_t i = 0; i < v.size(); ++i)
       v[i] += g.R.transpose() * (m.vertices()[static_cast<std::size_t>(g.vertex[i])].p - c);
   for (Vec3& x : v) x = c + x / static_cast<double>(maps.size());
-  std::vector<std::array<int, 2>> edges;
-  for (const Edge& e : m.edges())
-    edges.push_back({static_cast<int>(e.v0.index()), static_cast<int>(e.v1.index())});
-  std::vector<std::vector<std::vector<int>>> loops;
-  for (const Face& f : m.faces()) {
-    loops.emplace_back();
-    for (const auto& loop : f.loops) {
-      loops.back().emplace_back();
-      for (VertexId u : loop) loops.back().back().push_back(static_cast<int>(u.index()));
-    }
-  }
-  return Polyhedron::from_features(m.name(), std::move(v), edges, loops);
+  return m.with_vertices(std::move(v));
 }
 
 }  // namespace
