@@ -485,9 +485,12 @@ double farkas_gap(const LinearProgram& lp, const std::vector<double>& y) {
   for (int j = 0; j < lp.num_vars; ++j)
     gap -= std::min(r[j] * lp.lower[j].second, r[j] * lp.upper[j].second);
   // Each term is rounded a few times and each sum adds at most (number of terms) units of
-  // roundoff of its largest partial sum: 1e-12 of the terms' magnitude covers programs of
-  // thousands of terms with a wide margin (double's unit roundoff is 1.1e-16).
-  return gap + 1e-12 * size;
+  // roundoff of its largest partial sum: 1e-12 of the terms' magnitude would cover that. The
+  // margin is 1e-10: a certificate is rechecked on rows rebuilt from the models, each widened
+  // by how far the face frames it was given lie from the faces' vertices (the models'
+  // planarity), and a refutation by less than that is not one the checker can accept (oracle
+  // seed 7402 had one short by 9.4e-11 mm at 1e-12). Such a cell stays open and is split.
+  return gap + kFarkasMargin * size;
 }
 
 std::optional<FarkasCertificate> farkas(const LinearProgram& lp) {

@@ -97,8 +97,13 @@ struct FarkasCertificate {
 /// bounds; @throws std::invalid_argument otherwise.
 std::optional<FarkasCertificate> farkas(const LinearProgram& lp);
 
-/// y . b - min over the box of (A^T y) . x plus a bound on its rounding error in double:
-/// negative proves the program (kLessEq rows, finite bounds) has no solution.
+/// Fraction of the terms' magnitude a Farkas gap must clear (farkas_gap): rounding, and the
+/// deviation of the rows an independent checker rebuilds from the models (lp.cpp).
+constexpr double kFarkasMargin = 1e-10;
+
+/// y . b - min over the box of (A^T y) . x plus kFarkasMargin of its terms' magnitude:
+/// negative proves the program (kLessEq rows, finite bounds) has no solution, with a margin
+/// over rounding and over rows rebuilt from the models by an independent checker.
 /// Preconditions: y.size() == lp.rows.size(); @throws std::invalid_argument otherwise.
 double farkas_gap(const LinearProgram& lp, const std::vector<double>& y);
 
