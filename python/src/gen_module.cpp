@@ -40,6 +40,20 @@ void check_int(int v, int lo, int hi, const char* name, const std::string& where
          std::to_string(hi) + "], got " + std::to_string(v));
 }
 
+// LoadOptions with the options that decide which facets merge into one face, each checked
+// against the ranges cfgen's --coplanar-tol and --crease-angle accept.
+cf::tools::LoadOptions merge_options(double coplanar_rel_tol, double crease_angle_deg,
+                                     const std::string& where) {
+  check_range(coplanar_rel_tol, cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol,
+              "coplanar_rel_tol", where);
+  check_range(crease_angle_deg, cf::tools::kMinCreaseAngle, cf::tools::kMaxCreaseAngle,
+              "crease_angle_deg", where);
+  cf::tools::LoadOptions o;
+  o.coplanar_rel_tol = coplanar_rel_tol;
+  o.crease_angle_deg = crease_angle_deg;
+  return o;
+}
+
 // run_generate on a thread of its own while this one, the caller's, checks Python's signals:
 // Ctrl-C (KeyboardInterrupt) sets the run's stop flag, the run stops between tasks (keeping
 // its finished chunks when it keeps a checkpoint), and the KeyboardInterrupt is raised here.
@@ -102,10 +116,7 @@ cf::CfGraph generate(const std::string& a_path, const std::string& b_path,
   check_range(angle_margin, 1e-9, 0.5, "angle_margin", where);
   check_int(theta_samples, 1, 1000, "theta_samples", where);
   check_int(max_rotations, 1, 10000, "max_rotations", where);
-  check_range(coplanar_rel_tol, cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol,
-              "coplanar_rel_tol", where);
-  check_range(crease_angle_deg, cf::tools::kMinCreaseAngle, cf::tools::kMaxCreaseAngle,
-              "crease_angle_deg", where);
+  const cf::tools::LoadOptions merge = merge_options(coplanar_rel_tol, crease_angle_deg, where);
   check_units(units, "units", where);
   cf::tools::GenerateArgs g;
   g.a_path = a_path;
@@ -130,8 +141,8 @@ cf::CfGraph generate(const std::string& a_path, const std::string& b_path,
   g.load_b.units = units_b.empty() ? units : units_b;
   check_units(g.load_a.units, "units_a", where);
   check_units(g.load_b.units, "units_b", where);
-  g.load_a.coplanar_rel_tol = g.load_b.coplanar_rel_tol = coplanar_rel_tol;
-  g.load_a.crease_angle_deg = g.load_b.crease_angle_deg = crease_angle_deg;
+  g.load_a.coplanar_rel_tol = g.load_b.coplanar_rel_tol = merge.coplanar_rel_tol;
+  g.load_a.crease_angle_deg = g.load_b.crease_angle_deg = merge.crease_angle_deg;
   g.checkpoint_dir = checkpoint;
   g.certificates_path = certificates;
   // A checkpoint only when asked for (cfgen keeps one by default for long runs).
@@ -156,14 +167,8 @@ PYBIND11_MODULE(_gen, m) {
       [](const std::string& path, const std::string& units, double coplanar_rel_tol,
          double crease_angle_deg, bool check_self_intersection, const std::string& name) {
         check_units(units, "units", "load_model");
-        check_range(coplanar_rel_tol, cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol,
-                    "coplanar_rel_tol", "load_model");
-        check_range(crease_angle_deg, cf::tools::kMinCreaseAngle, cf::tools::kMaxCreaseAngle,
-                    "crease_angle_deg", "load_model");
-        cf::tools::LoadOptions o;
+        cf::tools::LoadOptions o = merge_options(coplanar_rel_tol, crease_angle_deg, "load_model");
         o.units = units;
-        o.coplanar_rel_tol = coplanar_rel_tol;
-        o.crease_angle_deg = crease_angle_deg;
         o.check_self_intersection = check_self_intersection;
         o.name = name;
         py::gil_scoped_release release;

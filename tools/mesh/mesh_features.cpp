@@ -725,7 +725,8 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
                                 FeatureMeasures* measures) {
   const auto& P = s.points;
   const int nf = static_cast<int>(s.polygons.size());
-  const double tol = opt.coplanar_rel_tol * diagonal(s);
+  const double diag = diagonal(s);
+  const double tol = opt.coplanar_rel_tol * diag;
   const HalfEdges he = half_edges(s);
   std::vector<Vec3> area2(nf), centre(nf);
   for (int f = 0; f < nf; ++f) {
@@ -740,7 +741,7 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
   // reported.
   JoinTolerances join;
   join.coarse = tol;
-  join.fine = std::min(tol, LoadOptions{}.coplanar_rel_tol * diagonal(s));
+  join.fine = std::min(tol, LoadOptions{}.coplanar_rel_tol * diag);
   join.exact = std::min(join.fine, snap_tolerance(P));
   join.cos_crease = std::cos(opt.crease_angle_deg * M_PI / 180);
   std::vector<char> tier(nf, tol <= join.fine ? 1 : 0);
@@ -761,7 +762,7 @@ cf::Polyhedron extract_features(const PolygonSoup& s, const std::string& src,
       coords =
           feature_coordinates(P, feature_points, fl.faces_of, fl.loops, b.plane_n, b.plane_d, &off);
       b.troubles = coplanar_neighbours(fl, b.plane_n, faces.seed);
-      for (auto& t : unplanar_faces(coords, fl, diagonal(s), faces.seed))
+      for (auto& t : unplanar_faces(coords, fl, diag, faces.seed))
         b.troubles.push_back(std::move(t));
     }
     if (!b.troubles.empty()) {
