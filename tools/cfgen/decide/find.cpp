@@ -128,7 +128,11 @@ bool FindRun::cut_obstacles(const Mat3& R, const std::vector<int>& choice, Vec3 
       double clearance = -1;
       if (&tt == &ts.front()) {
         FailedPair f;
-        clearance = verify_remembering(pose, nullptr, f);
+        std::string why;
+        clearance = verify_remembering(pose, s_.debug_ ? &why : nullptr, f);
+        if (s_.debug_)
+          std::cerr << "    t " << tt.transpose() << " clearance " << clearance << " " << why
+                    << "\n";
         obstacle = f.obstacle();
         t = tt;
       } else {
@@ -433,9 +437,7 @@ std::vector<Mat3> FindRun::family_ends() const {
 Witness FindRun::run() {
   if (!s_.plausible(pcs_)) return best_;
   const std::vector<Mat3> rots = s_.rotation_candidates(pcs_, seeds_, !seeds_only_);
-  if (s_.debug_)
-    std::cerr << "find " << to_string(pcs_[0]) << (pcs_.size() > 1 ? " +" : "") << ": "
-              << rots.size() << " rotations\n";
+  if (s_.debug_) std::cerr << "find " << to_string(pcs_) << ": " << rots.size() << " rotations\n";
   if (try_all(rots) || best_.found) return best_;
   if (seeds_only_) {
     // The neighbours' witnesses are a few hundredths of a radian from where the set holds:
