@@ -101,7 +101,8 @@ WitnessResult check_witness(const Classifier& nominal, const Classifier& lo, con
   return r;
 }
 
-CheckReport check_graph(const Graph& G, const Tolerances& tol) {
+CheckReport check_graph(const Graph& G, const Tolerances& tol,
+                        const std::function<bool(const GraphCf&)>& which) {
   Tolerances tlo = tol, thi = tol;
   tlo.len /= 100;
   tlo.ang /= 100;
@@ -110,6 +111,7 @@ CheckReport check_graph(const Graph& G, const Tolerances& tol) {
   Classifier C(G.A, G.B, tol), Clo(G.A, G.B, tlo), Chi(G.A, G.B, thi);
   CheckReport rep;
   for (const GraphCf& cf : G.cfs) {
+    if (which && !which(cf)) continue;
     WitnessResult w = check_witness(C, Clo, Chi, cf);
     ++rep.total;
     if (w.verdict == 0) ++rep.sound;

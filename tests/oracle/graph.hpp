@@ -4,6 +4,7 @@
 
 #include "classify.hpp"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,8 @@ struct CheckReport {
 /// but passes at tol/100 or tol*100 is marginal; one that fails at all three is unsound.
 WitnessResult check_witness(const Classifier& nominal, const Classifier& lo, const Classifier& hi,
                             const GraphCf& cf);
-CheckReport check_graph(const Graph& G, const Tolerances& tol);
+/// Every witness of G, or those of the CFs `which` accepts.
+CheckReport check_graph(const Graph& G, const Tolerances& tol,
+                        const std::function<bool(const GraphCf&)>& which = {});
 
 }  // namespace oracle

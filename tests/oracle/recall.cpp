@@ -153,40 +153,34 @@ std::string RecallResult::details() const {
 
 namespace {
 
-std::string fmt17(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
-
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-// Runs cfgen, writing the graph g and its certificate file c; returns its exit status (-1
-// when it could not start); output to log.
-int run_cfgen(const std::string& cfgen, const std::string& a, const std::string& b,
-              const std::string& g, const std::string& c, int threads, const std::string& log,
-              double timeout_s) {
-  pid_t pid = fork();
+}  // namespace
+
+int run_program(const std::vector<std::string>& args, const std::string& log, double timeout_s) {
+  std::vector<std::string> copy = args;
+  std::vector<char*> argv;
+  for (std::string& x : copy) argv.push_back(x.data());
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
   if (pid < 0) return -1;
   if (pid == 0) {
-    int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (fd >= 0) {
       dup2(fd, 1);
       dup2(fd, 2);
       close(fd);
     }
-    std::string j = std::to_string(threads);
-    execl(cfgen.c_str(), cfgen.c_str(), a.c_str(), b.c_str(), "-o", g.c_str(), "--certificates",
-          c.c_str(), "-q", "-j", j.c_str(), static_cast<char*>(nullptr));
+    execv(argv[0], argv.data());
     _exit(127);
   }
   int st = 0;
   if (timeout_s > 0) {
     const double t0 = now_s();
     for (;;) {
-      pid_t w = waitpid(pid, &st, WNOHANG);
+      const pid_t w = waitpid(pid, &st, WNOHANG);
       if (w == pid) break;
       if (w < 0) return -1;
       if (now_s() - t0 > timeout_s) {
@@ -200,6 +194,24 @@ int run_cfgen(const std::string& cfgen, const std::string& a, const std::string&
     return -1;
   }
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+namespace {
+
+std::string fmt17(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+// Runs cfgen, writing the graph g and its certificate file c; returns its exit status (-1
+// when it could not start); output to log.
+int run_cfgen(const std::string& cfgen, const std::string& a, const std::string& b,
+              const std::string& g, const std::string& c, int threads, const std::string& log,
+              double timeout_s) {
+  return run_program(
+      {cfgen, a, b, "-o", g, "--certificates", c, "-q", "-j", std::to_string(threads)}, log,
+      timeout_s);
 }
 
 std::string slurp(const std::string& p) {

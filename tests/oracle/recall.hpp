@@ -71,6 +71,11 @@ bool parse_pose_arg(const std::string& a, Pose* X);
 /// Signature of a CF for grouping: "2:e-f+v-f".
 std::string signature(const CfKey& k);
 
+/// Runs a program (args[0], its path) with its standard output and error to `log`; returns its
+/// exit status: -1 when it could not start or did not exit normally, -2 when it was killed
+/// after timeout_s seconds (timeout_s > 0).
+int run_program(const std::vector<std::string>& args, const std::string& log, double timeout_s = 0);
+
 RecallResult run_recall_seed(std::uint64_t seed, const RecallOptions& o);
 /// The pair make_extra_pair(which, seed) (kept as DIR/extra_<which>_seed_<seed>).
 RecallResult run_recall_extra(int which, std::uint64_t seed, const RecallOptions& o);

@@ -1,0 +1,183 @@
+#include "invariance.hpp"
+#include "recall.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <unistd.h>
+
+namespace oracle {
+
+namespace fs = std::filesystem;
+
+Mesh moved_renumbered(const Mesh& m, const Pose& X, std::mt19937_64& rng) {
+  std::vector<int> order(m.V.size());  // new vertex k is old vertex order[k]
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), rng);
+  std::vector<int> new_index(m.V.size());
+  for (std::size_t k = 0; k < order.size(); ++k) new_index[order[k]] = static_cast<int>(k);
+  Mesh out;
+  out.name = m.name + " (moved, renumbered)";
+  for (int old : order) out.V.push_back(X.apply(m.V[old]));
+  for (const auto& f : m.F) {
+    std::vector<int> g;
+    for (int v : f) g.push_back(new_index[v]);
+    const auto start = std::uniform_int_distribution<std::size_t>(0, g.size() - 1)(rng);
+    std::rotate(g.begin(), g.begin() + static_cast<std::ptrdiff_t>(start), g.end());
+    out.F.push_back(g);
+  }
+  std::shuffle(out.F.begin(), out.F.end(), rng);
+  return out;
+}
+
+ElementMap map_elements(const Poly& moved, const Poly& first, const Pose& X) {
+  ElementMap m;
+  const double tol = 1e-7 * first.diag;
+  for (std::size_t i = 0; i < moved.V.size(); ++i) {
+    const Vec3 p = X.inv(moved.V[i].p);
+    int best = -1;
+    double best_d = tol;
+    for (std::size_t j = 0; j < first.V.size(); ++j) {
+      const double d = (first.V[j].p - p).norm();
+      if (d <= best_d) best = static_cast<int>(j), best_d = d;
+    }
+    if (best < 0) {
+      m.problem = "vertex " + std::to_string(i) + " of the moved model has no vertex of the first";
+      return m;
+    }
+    m.vertex.push_back(best);
+  }
+  for (std::size_t i = 0; i < moved.E.size(); ++i) {
+    const int e = first.edge_index(m.vertex[moved.E[i].v0], m.vertex[moved.E[i].v1]);
+    if (e < 0) {
+      m.problem = "edge " + std::to_string(i) + " of the moved model has no edge of the first";
+      return m;
+    }
+    m.edge.push_back(e);
+  }
+  auto vertex_set = [](const Face& f, const std::vector<int>* map) {
+    std::set<int> s;
+    for (int v : f.verts) s.insert(map ? (*map)[v] : v);
+    return s;
+  };
+  for (std::size_t i = 0; i < moved.F.size(); ++i) {
+    const std::set<int> s = vertex_set(moved.F[i], &m.vertex);
+    int found = -1;
+    for (std::size_t j = 0; j < first.F.size() && found < 0; ++j)
+      if (vertex_set(first.F[j], nullptr) == s) found = static_cast<int>(j);
+    if (found < 0) {
+      m.problem = "face " + std::to_string(i) + " of the moved model has no face of the first";
+      return m;
+    }
+    m.face.push_back(found);
+  }
+  return m;
+}
+
+CfKey map_key(const CfKey& key, const ElementMap& a, const ElementMap& b) {
+  // Element kinds of each side of a PC type (f-f, e-f, f-e, v-f, f-v, e-e).
+  auto side = [](const ElementMap& m, char kind, int i) {
+    return kind == 'v' ? m.vertex[i] : kind == 'e' ? m.edge[i] : m.face[i];
+  };
+  CfKey out;
+  for (const Pc& pc : key) {
+    const std::string t = type_name(pc.type);
+    out.push_back(Pc{pc.type, side(a, t[0], pc.a), side(b, t[2], pc.b)});
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+namespace {
+
+// Runs cfgen on a and b writing g, its output to log; returns the exit status (-1: no start).
+int run(const InvarianceOptions& o, const std::string& a, const std::string& b,
+        const std::string& g, const std::string& log) {
+  std::vector<std::string> args{o.cfgen, a, b, "-o", g, "-q", "-j", std::to_string(o.threads)};
+  args.insert(args.end(), o.cfgen_args.begin(), o.cfgen_args.end());
+  return run_program(args, log);
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::vector<CfKey> difference(const std::set<CfKey>& x, const std::set<CfKey>& y) {
+  std::vector<CfKey> out;
+  std::set_difference(x.begin(), x.end(), y.begin(), y.end(), std::back_inserter(out));
+  return out;
+}
+
+// How many CFs of g whose keys, mapped by `key_of`, are in `only` have a witness the oracle
+// finds sound.
+template <typename KeyOf>
+int count_sound(const Graph& g, const std::vector<CfKey>& only, KeyOf key_of) {
+  const std::set<CfKey> wanted(only.begin(), only.end());
+  return check_graph(g, default_tolerances(g.A, g.B),
+                     [&](const GraphCf& cf) { return wanted.count(key_of(cf.key)) > 0; })
+      .sound;
+}
+
+}  // namespace
+
+InvarianceResult run_invariance(const ShapePair& pair, const InvarianceOptions& o) {
+  InvarianceResult r;
+  r.desc = pair.desc;
+  const bool temporary = o.keep_dir.empty();
+  const fs::path dir =
+      temporary ? fs::temp_directory_path() / ("oracle_invariance_" + std::to_string(::getpid()))
+                : fs::path(o.keep_dir);
+  fs::create_directories(dir);
+  std::mt19937_64 rng(o.motion_seed);
+  const Pose XA = random_rigid(rng), XB = random_rigid(rng);
+  write_off(pair.A, (dir / "A.off").string());
+  write_off(pair.B, (dir / "B.off").string());
+  write_off(moved_renumbered(pair.A, XA, rng), (dir / "A_moved.off").string());
+  write_off(moved_renumbered(pair.B, XB, rng), (dir / "B_moved.off").string());
+  try {
+    auto generate = [&](const std::string& suffix, double& seconds) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const std::string g = (dir / ("G" + suffix + ".json")).string();
+      const int rc =
+          run(o, (dir / ("A" + suffix + ".off")).string(), (dir / ("B" + suffix + ".off")).string(),
+              g, (dir / ("cfgen" + suffix + ".log")).string());
+      seconds = seconds_since(t0);
+      if (rc != 0)
+        throw std::runtime_error("cfgen exited with status " + std::to_string(rc) + " (see " +
+                                 (dir / ("cfgen" + suffix + ".log")).string() + ")");
+      return read_graph(g);
+    };
+    const Graph first = generate("", r.first_s), moved = generate("_moved", r.moved_s);
+    const ElementMap ma = map_elements(moved.A, first.A, XA);
+    const ElementMap mb = map_elements(moved.B, first.B, XB);
+    if (!ma.problem.empty() || !mb.problem.empty())
+      throw std::runtime_error("the graphs' models differ: A: " + ma.problem +
+                               "; B: " + mb.problem);
+    std::set<CfKey> a, b;
+    for (const GraphCf& cf : first.cfs) a.insert(cf.key);
+    for (const GraphCf& cf : moved.cfs) b.insert(map_key(cf.key, ma, mb));
+    r.first_cfs = static_cast<int>(first.cfs.size());
+    r.moved_cfs = static_cast<int>(moved.cfs.size());
+    r.only_first = difference(a, b);
+    r.only_moved = difference(b, a);
+    r.sound_first = count_sound(first, r.only_first, [](const CfKey& k) { return k; });
+    r.sound_moved =
+        count_sound(moved, r.only_moved, [&](const CfKey& k) { return map_key(k, ma, mb); });
+    r.ok = true;
+  } catch (const std::exception& e) {
+    r.error = e.what();
+  }
+  if (temporary && r.ok) {  // a failed run's files stay, for its log
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+  return r;
+}
+
+}  // namespace oracle
