@@ -8,11 +8,13 @@
 #include "analysed_pair.hpp"
 #include "fixtures.hpp"
 #include "mesh/model_loader.hpp"
+#include "scratch.hpp"
 
 #include <cf/graph.hpp>
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -234,4 +236,64 @@ TEST_CASE(
   const int slab_top = cf::test::face_with_plane(p.B, Vec3(0, 1, 0), 20);
   const int wall_side = cf::test::face_with_plane(p.B, Vec3(1, 0, 0), 20);
   CHECK(inside.compatible(Pc{PcType::kFF, a_bottom, slab_top}, Pc{PcType::kFF, a_left, wall_side}));
+}
+
+TEST_CASE(
+    "an e-e whose normal another PC's rotational condition fixes: refuted where that normal "
+    "is on the boundary of an edge's cone, kept where it is inside") {
+  // The cube's two edges along z: an e-f puts the first on a face of normal +y (R keeps the
+  // edges perpendicular to y), so the second edge, crossing an edge of B along z, has the
+  // contact normal +y or -y. On the L-block that edge is the wall's top edge, one of whose faces
+  // (the wall's top) has normal +y: the normal lies on its cone's boundary, never the local
+  // slack inside it. On a roof-shaped block the ridge's cone holds +y 45 degrees inside.
+  const Polyhedron cube = cf::tools::load_model(model("cube.off"));
+  const int a1 = cf::test::edge_between(cube, cf::test::vertex_at(cube, Vec3(-15, -15, -15)),
+                                        cf::test::vertex_at(cube, Vec3(-15, -15, 15)));
+  const int a2 = cf::test::edge_between(cube, cf::test::vertex_at(cube, Vec3(15, 15, -15)),
+                                        cf::test::vertex_at(cube, Vec3(15, 15, 15)));
+  const int a3 = cf::test::edge_between(cube, cf::test::vertex_at(cube, Vec3(-15, 15, -15)),
+                                        cf::test::vertex_at(cube, Vec3(15, 15, -15)));
+  const int a_bottom = cf::test::face_with_plane(cube, Vec3(0, -1, 0), 15);
+  REQUIRE(std::min({a1, a2, a3, a_bottom}) >= 0);
+  // As enumerate/levels.cpp builds them for the default --angle-margin (1e-3 rad).
+  const double cone_margin = std::asin(0.5 * std::sin(1e-3)) - kAngleTol;
+  {
+    const Pair p(cube, cf::tools::load_model(model("l_block.off")));
+    const cf::gen::PairConditions pc(p.ai, p.bi, kLengthTol, kAngleTol, cone_margin);
+    const int slab_top = cf::test::face_with_plane(p.B, Vec3(0, 1, 0), 20);
+    const int wall_top = cf::test::edge_between(p.B, cf::test::vertex_at(p.B, Vec3(20, 80, 0)),
+                                                cf::test::vertex_at(p.B, Vec3(20, 80, 80)));
+    REQUIRE(std::min(slab_top, wall_top) >= 0);
+    const Pc on_slab{PcType::kEF, a1, slab_top}, across{PcType::kEE, a2, wall_top};
+    CHECK(pc.forced_normal_fails(on_slab, across));
+    CHECK_FALSE(pc.compatible(on_slab, across));
+    CHECK_FALSE(pc.compatible(across, on_slab));
+    // The cube's bottom flat on the slab and an edge of it along x across the wall's top
+    // edge: the face-face PC holds that edge perpendicular to y as well.
+    const Pc flat{PcType::kFF, a_bottom, slab_top}, across_x{PcType::kEE, a3, wall_top};
+    CHECK(pc.forced_normal_fails(flat, across_x));
+    // An edge along x with the e-f's edge along z: R keeps it off y only by chance, no rule.
+    CHECK_FALSE(pc.forced_normal_fails(on_slab, across_x));
+    // Without the slack (the exact cones), nothing is forced out.
+    const cf::gen::PairConditions exact(p.ai, p.bi, kLengthTol, kAngleTol);
+    CHECK_FALSE(exact.forced_normal_fails(on_slab, across));
+  }
+  {
+    // Cross-section (0,0) (40,0) (40,10) (30,20) (20,10) (0,10), extruded 40 along z: a flat
+    // top at y = 10 and a ridge along z at (30, 20), its faces' normals (+-1, 1, 0) / sqrt 2.
+    const std::string roof = cf::test::write_file(
+        "roof.off",
+        "OFF\n12 8 0\n"
+        "0 0 0\n40 0 0\n40 10 0\n30 20 0\n20 10 0\n0 10 0\n"
+        "0 0 40\n40 0 40\n40 10 40\n30 20 40\n20 10 40\n0 10 40\n"
+        "6 5 4 3 2 1 0\n6 6 7 8 9 10 11\n4 0 1 7 6\n4 1 2 8 7\n4 2 3 9 8\n4 3 4 10 9\n"
+        "4 4 5 11 10\n4 5 0 6 11\n");
+    const Pair p(cube, cf::tools::load_model(roof));
+    const cf::gen::PairConditions pc(p.ai, p.bi, kLengthTol, kAngleTol, cone_margin);
+    const int flat_top = cf::test::face_with_plane(p.B, Vec3(0, 1, 0), 10);
+    const int ridge = cf::test::edge_between(p.B, cf::test::vertex_at(p.B, Vec3(30, 20, 0)),
+                                             cf::test::vertex_at(p.B, Vec3(30, 20, 40)));
+    REQUIRE(std::min(flat_top, ridge) >= 0);
+    CHECK_FALSE(pc.forced_normal_fails(Pc{PcType::kEF, a1, flat_top}, Pc{PcType::kEE, a2, ridge}));
+  }
 }

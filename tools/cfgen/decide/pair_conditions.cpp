@@ -1,4 +1,5 @@
 #include "cfgen/decide/pair_conditions.hpp"
+#include "cfgen/verify/rotation_conditions.hpp"
 
 #include <cf/geometry.hpp>
 
@@ -247,10 +248,59 @@ PairConditions::Side PairConditions::build(const ModelInfo& info, double cone_ma
 
 PairConditions::PairConditions(const ModelInfo& A, const ModelInfo& B, double length_tol,
                                double angle_tol, double cone_margin, double contact_margin)
-    : a_(build(A, cone_margin, angle_tol, contact_margin)),
+    : A_(A),
+      B_(B),
+      a_(build(A, cone_margin, angle_tol, contact_margin)),
       b_(build(B, cone_margin, angle_tol, contact_margin)),
       length_tol_(length_tol),
-      angle_tol_(angle_tol) {}
+      angle_tol_(angle_tol),
+      slack_(std::sin(cone_margin)) {}
+
+bool PairConditions::forced_normal_fails(const Pc& x, const Pc& e) const {
+  if (e.type != PcType::kEE || slack_ <= 0) return false;
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  const Vec3& da = A.edges()[e.a].dir;
+  const Vec3& db = B.edges()[e.b].dir;
+  // At a witness the rotational condition holds to kRotAccepted and the e-e's edges are at
+  // least the slack (a sine) from parallel, so the contact plane's normal N is within
+  // 1.5 (kRotAccepted + 2 kParallel) / slack of the direction (its component in the plane
+  // of the two edges is at most their residuals over the sine between them).
+  const double off = 2 * (kRotAccepted + 2 * kParallel) / slack_;
+  const double need = slack_ - off;
+  // verify's e-e terms with N = m (B's frame; B's edge's faces on the far side of it) and
+  // with R^T N = u (A's frame; A's edge's faces on the near side).
+  const EdgeWedge& wa = A_.wedges[e.a];
+  const EdgeWedge& wb = B_.wedges[e.b];
+  auto b_side = [&](const Vec3& m) {
+    return std::min(-wb.into_left.dot(m), -wb.into_right.dot(m)) >= need;
+  };
+  auto a_side = [&](const Vec3& u) {
+    return std::min(wa.into_left.dot(u), wa.into_right.dot(u)) >= need;
+  };
+  switch (x.type) {
+    case PcType::kEF: {  // R d_x . n = 0 with d_x along da and db . n = 0: N = +-n
+      const Vec3& n = B.faces()[x.b].normal;
+      if (A.edges()[x.a].dir.cross(da).norm() > kParallel || std::abs(db.dot(n)) > kParallel)
+        return false;
+      return !b_side(n) && !b_side(-n);
+    }
+    case PcType::kFE: {  // (R n) . d_x = 0 with d_x along db and da . n = 0: N = +-R n
+      const Vec3& n = A.faces()[x.a].normal;
+      if (B.edges()[x.b].dir.cross(db).norm() > kParallel || std::abs(da.dot(n)) > kParallel)
+        return false;
+      return !a_side(n) && !a_side(-n);
+    }
+    case PcType::kFF: {  // R n_a = -n_b, da . n_a = 0, db . n_b = 0: N = +-n_b, R^T N = -+n_a
+      const Vec3& na = A.faces()[x.a].normal;
+      const Vec3& nb = B.faces()[x.b].normal;
+      if (std::abs(da.dot(na)) > kParallel || std::abs(db.dot(nb)) > kParallel) return false;
+      return !(b_side(nb) && a_side(-na)) && !(b_side(-nb) && a_side(na));
+    }
+    default:
+      return false;
+  }
+}
 
 const NormalCone& PairConditions::cone(bool of_a, ElementKind k, int i) const {
   return (of_a ? a_ : b_).cones[static_cast<int>(k)][static_cast<std::size_t>(i)];
@@ -263,6 +313,7 @@ bool PairConditions::compatible(const Pc& x, const Pc& y) const {
   const Allowed& b = b_.at(kbx, x.b, kby, y.b);
   // An element with no direction inside its cone cannot take part in a verified contact.
   if (!a.usable || !b.usable) return false;
+  if (forced_normal_fails(x, y) || forced_normal_fails(y, x)) return false;
   // Distance between the two contact points, the same measured in A and in B.
   if (a.dist_lo > b.dist_hi + length_tol_ || b.dist_lo > a.dist_hi + length_tol_) return false;
   // Angle between the contact normals: R maps A's outward normal u at each contact onto

@@ -37,14 +37,29 @@ class PairConditions {
   /// distances and heights range over those points (inset_closure_points); pass at most
   /// min_margin, less to allow for the LP's rounding.
   /// Precomputes what each model allows for every ordered pair of its elements (memory and
-  /// time quadratic in the number of elements), so `compatible` is a few comparisons.
+  /// time quadratic in the number of elements), so `compatible` is a few comparisons. A and
+  /// B must outlive this object.
   PairConditions(const ModelInfo& A, const ModelInfo& B, double length_tol, double angle_tol,
                  double cone_margin = 0, double contact_margin = 0);
 
   /// False when x and y cannot hold at one pose: the distance between the contact points,
   /// the angle between the contact normals, or the height of one contact point over the
-  /// other's contact plane has no value both A and B allow.
+  /// other's contact plane has no value both A and B allow; or one is an e-e whose contact
+  /// normal the other's rotational condition fixes (forced_normal_fails).
   bool compatible(const Pc& x, const Pc& y) const;
+
+  /// True when `e` is an e-e PC whose two edges the rotational condition of `x` (an f-f, e-f
+  /// or f-e) holds perpendicular to one direction, so that its contact normal is that
+  /// direction or its opposite (docs/generator.md, "Enumeration"), and neither lies as far
+  /// inside the two edges' normal cones as verify's local slack asks: an e-f edge parallel
+  /// to the e-e's edge of A with B's edge parallel to the face (normal: the face's), an f-e
+  /// edge parallel to the e-e's edge of B with A's edge parallel to the face, or an f-f with
+  /// each edge parallel to its solid's face. The directions are within kParallel of parallel
+  /// or perpendicular; the slack then bounds how far the normal can be from the direction.
+  bool forced_normal_fails(const Pc& x, const Pc& e) const;
+
+  /// Edges within this sine of parallel, or of perpendicular to a normal, in forced_normal_fails.
+  static constexpr double kParallel = 1e-9;
 
   /// The normal cone of element i of kind k (of A when of_a, else of B), shrunk by the cone
   /// margin; no generators for elements no PC can use (non-convex edges, vertices that are
@@ -74,8 +89,11 @@ class PairConditions {
   static Side build(const ModelInfo& m, double cone_margin, double angle_tol,
                     double contact_margin);
 
+  const ModelInfo& A_;
+  const ModelInfo& B_;
   Side a_, b_;
   double length_tol_, angle_tol_;
+  double slack_;  // sine: the cone margin's, at most verify's local slack
 };
 
 /// Spherical distance (rad) from unit p to a normal cone (0 inside, within `tol`).
