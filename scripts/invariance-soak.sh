@@ -15,36 +15,14 @@
 # CF_CFGEN_PATH (the cfgen binary it runs; default: the one it was built with).
 set -uo pipefail
 
-usage() { echo "usage: bash scripts/invariance-soak.sh N [START] [-- oracle_invariance options]" >&2; exit 2; }
-[[ $# -ge 1 ]] || usage
-N=$1
-shift
-START=1
-if [[ $# -ge 1 && $1 != "--" ]]; then
-  START=$1
-  shift
-fi
-[[ $# -ge 1 && $1 == "--" ]] && shift
-[[ $N =~ ^[0-9]+$ && $START =~ ^[0-9]+$ ]] || usage
-
-ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BIN="${ORACLE_INVARIANCE:-$ROOT/build/tests/oracle/oracle_invariance}"
-OUT="${ORACLE_INVARIANCE_DIR:-$ROOT/build/oracle-invariance}"
-if [[ ! -x $BIN ]]; then
-  echo "invariance-soak: $BIN not found; build it with: cmake --build build --target oracle_invariance" >&2
-  exit 2
-fi
-mkdir -p "$OUT"
+# shellcheck source=scripts/soak-args.sh
+source "$(dirname "${BASH_SOURCE[0]}")/soak-args.sh"
+soak_args invariance-soak.sh oracle_invariance 1 "${ORACLE_INVARIANCE:-}" "${ORACLE_INVARIANCE_DIR:-}" oracle-invariance "$@"
 
 printf '%-6s %-34s %8s %8s %10s %10s %9s %9s\n' seed pairing cfs moved only_first only_moved sound verdict
 tot_cfs=0 tot_first=0 tot_moved=0 tot_sound=0 same=0 differ=0 failed=0
 for ((seed = START; seed < START + N; ++seed)); do
-  log="$OUT/seed_$seed.txt"
-  "$BIN" --seed "$seed" "$@" >"$log" 2>&1
-  rc=$?
-  line=$(head -n 1 "$log")
-  get() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<" $line"; }
-  pairing=$(sed -n 's/^[^|]*| \([^:]*\):.*/\1/p' <<<"$line")
+  soak_run "$seed"
   if [[ $rc -eq 2 || -z $(get cfs) ]]; then
     printf '%-6s %-34s %s\n' "$seed" "${pairing:0:34}" "ERROR (see $log)"
     failed=$((failed + 1))

@@ -15,37 +15,15 @@
 # CF_CFGEN_PATH (the cfgen binary oracle_recall runs; default: the one it was built with).
 set -uo pipefail
 
-usage() { echo "usage: bash scripts/recall-soak.sh N [START] [-- oracle_recall options]" >&2; exit 2; }
-[[ $# -ge 1 ]] || usage
-N=$1
-shift
-START=1000
-if [[ $# -ge 1 && $1 != "--" ]]; then
-  START=$1
-  shift
-fi
-[[ $# -ge 1 && $1 == "--" ]] && shift
-[[ $N =~ ^[0-9]+$ && $START =~ ^[0-9]+$ ]] || usage
-
-ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BIN="${ORACLE_RECALL:-$ROOT/build/tests/oracle/oracle_recall}"
-OUT="${ORACLE_SOAK_DIR:-$ROOT/build/oracle-soak}"
-if [[ ! -x $BIN ]]; then
-  echo "recall-soak: $BIN not found; build it with: cmake --build build --target oracle_recall" >&2
-  exit 2
-fi
-mkdir -p "$OUT"
+# shellcheck source=scripts/soak-args.sh
+source "$(dirname "${BASH_SOURCE[0]}")/soak-args.sh"
+soak_args recall-soak.sh oracle_recall 1000 "${ORACLE_RECALL:-}" "${ORACLE_SOAK_DIR:-}" oracle-soak "$@"
 
 printf '%-8s %-40s %7s %8s %7s %8s %8s %8s\n' seed pairing graph sampled misses recall unsound cfgen_s
 tot_s=0 tot_m=0 tot_u=0 tot_marg=0 failed=0
 declare -A sig=()  # set, so that ${#sig[@]} is 0 under set -u when nothing was missed
 for ((seed = START; seed < START + N; ++seed)); do
-  log="$OUT/seed_$seed.txt"
-  "$BIN" --seed "$seed" "$@" >"$log" 2>&1
-  rc=$?
-  line=$(head -n 1 "$log")
-  get() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<" $line"; }
-  pairing=$(sed -n 's/^[^|]*| \([^:]*\):.*/\1/p' <<<"$line")
+  soak_run "$seed"
   if [[ $rc -eq 2 || -z $(get graph) ]]; then
     printf '%-8s %-40s %s\n' "$seed" "${pairing:0:40}" "ERROR (see $log)"
     failed=$((failed + 1))

@@ -49,9 +49,8 @@ int main(int argc, char** argv) {
   oracle::InvarianceOptions o;
   o.cfgen = CF_CFGEN;
   if (const char* e = std::getenv("CF_CFGEN_PATH")) o.cfgen = e;
-  bool have_seed = false;
-  int extra = -1, list = 10;
-  std::uint64_t seed = 0;
+  oracle::PairArgs pair;
+  int list = 10;
   try {
     for (int i = 1; i < argc; ++i) {
       const std::string a = argv[i];
@@ -62,13 +61,7 @@ int main(int argc, char** argv) {
       if (a == "-h" || a == "--help") {
         usage();
         return 0;
-      } else if (a == "--seed") {
-        seed = std::stoull(val());
-        have_seed = true;
-      } else if (a == "--extra") {
-        extra = std::stoi(val());
-        if (extra < 0 || extra >= oracle::kExtraPairings)
-          throw std::runtime_error("--extra out of range");
+      } else if (pair.take(a, val)) {  // --seed, --extra
       } else if (a == "--motion-seed") {
         o.motion_seed = std::stoull(val());
       } else if (a == "--cfgen") {
@@ -86,15 +79,17 @@ int main(int argc, char** argv) {
         throw std::runtime_error("unknown argument " + a);
       }
     }
-    if (!have_seed) throw std::runtime_error("give --seed N");
+    if (!pair.have_seed) throw std::runtime_error("give --seed N");
+    pair.check();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oracle_invariance: %s\n", e.what());
     return 2;
   }
-  const oracle::ShapePair pair =
-      extra >= 0 ? oracle::make_extra_pair(extra, seed) : oracle::make_pair(seed);
-  const oracle::InvarianceResult r = oracle::run_invariance(pair, o);
-  std::printf("seed=%llu %s", static_cast<unsigned long long>(seed),
+  const oracle::InvarianceResult r =
+      oracle::run_invariance(pair.extra >= 0 ? oracle::make_extra_pair(pair.extra, pair.seed)
+                                             : oracle::make_pair(pair.seed),
+                             o);
+  std::printf("seed=%llu %s", static_cast<unsigned long long>(pair.seed),
               !r.ok      ? "FAILED"
               : r.same() ? "same"
                          : "DIFFERENT");

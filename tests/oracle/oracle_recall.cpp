@@ -53,9 +53,8 @@ int main(int argc, char** argv) {
   oracle::RecallOptions o;
   o.cfgen = CF_CFGEN;
   if (const char* e = std::getenv("CF_CFGEN_PATH")) o.cfgen = e;
-  bool have_seed = false, quiet = false;
-  int extra = -1;
-  std::uint64_t seed = 0;
+  bool quiet = false;
+  oracle::PairArgs pair;
   std::vector<std::string> files;
   try {
     for (int i = 1; i < argc; ++i) {
@@ -67,9 +66,7 @@ int main(int argc, char** argv) {
       if (a == "-h" || a == "--help") {
         usage();
         return 0;
-      } else if (a == "--seed") {
-        seed = std::stoull(val());
-        have_seed = true;
+      } else if (pair.take(a, val)) {  // --seed, --extra
       } else if (a == "--cfgen") {
         o.cfgen = val();
       } else if (a == "--budget") {
@@ -91,10 +88,6 @@ int main(int argc, char** argv) {
         if (!oracle::parse_pose_arg(val(), &X))
           throw std::runtime_error("--pose needs 12 numbers R00,...,R22,tx,ty,tz (R a rotation)");
         o.check_poses.push_back(X);
-      } else if (a == "--extra") {
-        extra = std::stoi(val());
-        if (extra < 0 || extra >= oracle::kExtraPairings)
-          throw std::runtime_error("--extra out of range");
       } else if (a == "--quiet" || a == "-q") {
         quiet = true;
       } else if (!a.empty() && a[0] == '-') {
@@ -103,9 +96,9 @@ int main(int argc, char** argv) {
         files.push_back(a);
       }
     }
-    if (have_seed == !files.empty() || (!files.empty() && files.size() != 2))
+    if (pair.have_seed == !files.empty() || (!files.empty() && files.size() != 2))
       throw std::runtime_error("give either --seed N or two model files");
-    if (extra >= 0 && !have_seed) throw std::runtime_error("--extra needs --seed N");
+    pair.check();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oracle_recall: %s\n", e.what());
     return 2;
@@ -120,9 +113,9 @@ int main(int argc, char** argv) {
       certificate_error = e.what();
     }
   };
-  oracle::RecallResult r = !have_seed   ? oracle::run_recall_files(files[0], files[1], o)
-                           : extra >= 0 ? oracle::run_recall_extra(extra, seed, o)
-                                        : oracle::run_recall_seed(seed, o);
+  oracle::RecallResult r = !pair.have_seed   ? oracle::run_recall_files(files[0], files[1], o)
+                           : pair.extra >= 0 ? oracle::run_recall_extra(pair.extra, pair.seed, o)
+                                             : oracle::run_recall_seed(pair.seed, o);
   std::cout << r.line() << "\n";
   if (r.ok)
     std::cout << "  certificates: "

@@ -831,4 +831,20 @@ ShapePair make_extra_pair(int which, std::uint64_t seed) {
   return P;
 }
 
+bool PairArgs::take(const std::string& option, const std::function<std::string()>& value) {
+  if (option == "--seed") {
+    seed = std::stoull(value());
+    have_seed = true;
+    return true;
+  }
+  if (option != "--extra") return false;
+  extra = std::stoi(value());
+  if (extra < 0 || extra >= kExtraPairings) throw std::runtime_error("--extra out of range");
+  return true;
+}
+
+void PairArgs::check() const {
+  if (extra >= 0 && !have_seed) throw std::runtime_error("--extra needs --seed N");
+}
+
 }  // namespace oracle

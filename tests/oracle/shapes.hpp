@@ -7,6 +7,7 @@
 #include "classify.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -91,5 +92,17 @@ const char* pairing_name(int pairing);
 constexpr int kExtraPairings = 3;
 ShapePair make_extra_pair(int which, std::uint64_t seed);
 const char* extra_pairing_name(int which);
+
+/// The pair a command line names with `--seed N` and `--extra K` (the oracle's tools).
+struct PairArgs {
+  bool have_seed = false;
+  std::uint64_t seed = 0;
+  int extra = -1;  // >= 0: make_extra_pair(extra, seed)
+  /// True when `option` is --seed or --extra, its value read with `value`; throws
+  /// std::runtime_error naming the option when the value is out of range.
+  bool take(const std::string& option, const std::function<std::string()>& value);
+  /// Throws std::runtime_error when --extra came without --seed.
+  void check() const;
+};
 
 }  // namespace oracle
