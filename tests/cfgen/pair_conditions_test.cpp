@@ -245,7 +245,8 @@ TEST_CASE(
   // edges perpendicular to y), so the second edge, crossing an edge of B along z, has the
   // contact normal +y or -y. On the L-block that edge is the wall's top edge, one of whose faces
   // (the wall's top) has normal +y: the normal lies on its cone's boundary, never the local
-  // slack inside it. On a roof-shaped block the ridge's cone holds +y 45 degrees inside.
+  // slack inside it. On a roof-shaped block the ridge's cone holds +y 45 degrees inside, and
+  // the cube's own cones decide.
   const Polyhedron cube = cf::tools::load_model(model("cube.off"));
   const int a1 = cf::test::edge_between(cube, cf::test::vertex_at(cube, Vec3(-15, -15, -15)),
                                         cf::test::vertex_at(cube, Vec3(-15, -15, 15)));
@@ -294,6 +295,20 @@ TEST_CASE(
     const int ridge = cf::test::edge_between(p.B, cf::test::vertex_at(p.B, Vec3(30, 20, 0)),
                                              cf::test::vertex_at(p.B, Vec3(30, 20, 40)));
     REQUIRE(std::min(flat_top, ridge) >= 0);
-    CHECK_FALSE(pc.forced_normal_fails(Pc{PcType::kEF, a1, flat_top}, Pc{PcType::kEE, a2, ridge}));
+    const int bottom = cf::test::face_with_plane(p.B, Vec3(0, -1, 0), 0);
+    const int a4 = cf::test::edge_between(cube, cf::test::vertex_at(cube, Vec3(15, -15, -15)),
+                                          cf::test::vertex_at(cube, Vec3(15, -15, 15)));
+    REQUIRE(std::min(bottom, a4) >= 0);
+    // B's side passes (N = +y lies inside the ridge's cone), A's cannot: the e-f keeps R^T y
+    // in the quadrant x, y > 0 of the cube's frame (the cube's faces at a1 above the top),
+    // where the opposite edge a2 (faces at -x and -y) would lie below the contact plane, and
+    // so would the bottom face at a4, the bottom's other edge along z (a cube leaning from the
+    // flat top onto the ridge: the ridge, crossing a4, pokes through that face).
+    CHECK(pc.forced_normal_fails(Pc{PcType::kEF, a1, flat_top}, Pc{PcType::kEE, a2, ridge}));
+    CHECK(pc.forced_normal_fails(Pc{PcType::kEF, a1, flat_top}, Pc{PcType::kEE, a4, ridge}));
+    // Against B's underside (normal -y) the ridge would touch a2 from above (N = -n), which
+    // both cones allow with a1 on that face: the rule keeps the pair (the other conditions
+    // judge where the solids are).
+    CHECK_FALSE(pc.forced_normal_fails(Pc{PcType::kEF, a1, bottom}, Pc{PcType::kEE, a2, ridge}));
   }
 }

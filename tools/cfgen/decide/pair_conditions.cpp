@@ -168,6 +168,29 @@ Range height_range(const std::vector<Vec3>& xs, const std::vector<Vec3>& ys, con
   return r;
 }
 
+// Whether some unit v perpendicular to the unit d has w . v >= c for every (w, c) of `conds`,
+// each w perpendicular to d: each condition holds on an arc of the circle of such v, and
+// arcs that meet share an end of one of them or a centre (when one covers the circle).
+bool arcs_meet(const Vec3& d, const std::vector<std::pair<Vec3, double>>& conds) {
+  const Vec3 e1 = (std::abs(d.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(d).normalized();
+  const Vec3 e2 = d.cross(e1);
+  std::vector<double> at{0.0};
+  for (const auto& [w, c] : conds) {
+    const double a = w.dot(e1), b = w.dot(e2), r = std::hypot(a, b);
+    if (r < c) return false;
+    const double centre = std::atan2(b, a), half = std::acos(std::clamp(c / r, -1.0, 1.0));
+    at.insert(at.end(), {centre, centre - half, centre + half});
+  }
+  constexpr double kRound = 1e-12;  // an arc's own end meets its condition to rounding
+  for (double t : at) {
+    const Vec3 v = std::cos(t) * e1 + std::sin(t) * e2;
+    if (std::all_of(conds.begin(), conds.end(),
+                    [&](const auto& wc) { return wc.first.dot(v) >= wc.second - kRound; }))
+      return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 double cone_distance(const Vec3& p, const NormalCone& c, double tol) {
@@ -283,13 +306,31 @@ bool PairConditions::forced_normal_fails(const Pc& x, const Pc& e) const {
       const Vec3& n = B.faces()[x.b].normal;
       if (A.edges()[x.a].dir.cross(da).norm() > kParallel || std::abs(db.dot(n)) > kParallel)
         return false;
-      return !b_side(n) && !b_side(-n);
+      // v = R^T n, perpendicular to the edges (to kRotAccepted): the e-f's own local margin
+      // (its wedge on n's side) and the e-e's terms of A with N = sg n.
+      const EdgeWedge& wx = A_.wedges[x.a];
+      auto turn_exists = [&](double sg) {
+        return arcs_meet(da, {{wx.into_left, slack_ - kRotAccepted},
+                              {wx.into_right, slack_ - kRotAccepted},
+                              {sg * wa.into_left, need},
+                              {sg * wa.into_right, need}});
+      };
+      return !(b_side(n) && turn_exists(1)) && !(b_side(-n) && turn_exists(-1));
     }
     case PcType::kFE: {  // (R n) . d_x = 0 with d_x along db and da . n = 0: N = +-R n
       const Vec3& n = A.faces()[x.a].normal;
       if (B.edges()[x.b].dir.cross(db).norm() > kParallel || std::abs(da.dot(n)) > kParallel)
         return false;
-      return !a_side(n) && !a_side(-n);
+      // u = R n, perpendicular to the edges: the f-e's local margin and the e-e's terms of B
+      // with N = sg u.
+      const EdgeWedge& wx = B_.wedges[x.b];
+      auto turn_exists = [&](double sg) {
+        return arcs_meet(db, {{wx.into_left, slack_ - kRotAccepted},
+                              {wx.into_right, slack_ - kRotAccepted},
+                              {-sg * wb.into_left, need},
+                              {-sg * wb.into_right, need}});
+      };
+      return !(a_side(n) && turn_exists(1)) && !(a_side(-n) && turn_exists(-1));
     }
     case PcType::kFF: {  // R n_a = -n_b, da . n_a = 0, db . n_b = 0: N = +-n_b, R^T N = -+n_a
       const Vec3& na = A.faces()[x.a].normal;

@@ -54,8 +54,11 @@ class PairConditions {
   /// inside the two edges' normal cones as verify's local slack asks: an e-f edge parallel
   /// to the e-e's edge of A with B's edge parallel to the face (normal: the face's), an f-e
   /// edge parallel to the e-e's edge of B with A's edge parallel to the face, or an f-f with
-  /// each edge parallel to its solid's face. The directions are within kParallel of parallel
-  /// or perpendicular; the slack then bounds how far the normal can be from the direction.
+  /// each edge parallel to its solid's face. The cone in the frame the normal is fixed in is
+  /// checked directly; for an e-f or f-e the other one over every turn about the parallel
+  /// edges that the PC's own local margin allows. The directions are within kParallel of
+  /// parallel or perpendicular; the slack then bounds how far the normal can be from the
+  /// direction.
   bool forced_normal_fails(const Pc& x, const Pc& e) const;
 
   /// Edges within this sine of parallel, or of perpendicular to a normal, in forced_normal_fails.
