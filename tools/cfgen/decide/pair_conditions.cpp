@@ -4,6 +4,7 @@
 #include <cf/geometry.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -168,27 +169,35 @@ Range height_range(const std::vector<Vec3>& xs, const std::vector<Vec3>& ys, con
   return r;
 }
 
-// Whether some unit v perpendicular to the unit d has w . v >= c for every (w, c) of `conds`,
-// each w perpendicular to d: each condition holds on an arc of the circle of such v, and
-// arcs that meet share an end of one of them or a centre (when one covers the circle).
-bool arcs_meet(const Vec3& d, const std::vector<std::pair<Vec3, double>>& conds) {
+// Whether some unit v perpendicular to the unit d keeps the wedge `own` at least own_need on
+// v's side (w . v >= own_need for both its into-vectors) and the wedge `other` at least
+// `need` on sg v's side, each into-vector perpendicular to d (to rounding). Each of the four
+// conditions holds on an arc of the circle of such v, and arcs that meet share an end of one
+// of them, or a centre when one covers the circle.
+bool turn_allows(const Vec3& d, const EdgeWedge& own, double own_need, const EdgeWedge& other,
+                 double sg, double need) {
+  const std::array<std::pair<Vec3, double>, 4> conds{{{own.into_left, own_need},
+                                                      {own.into_right, own_need},
+                                                      {sg * other.into_left, need},
+                                                      {sg * other.into_right, need}}};
   const Vec3 e1 = (std::abs(d.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(d).normalized();
   const Vec3 e2 = d.cross(e1);
-  std::vector<double> at{0.0};
+  std::array<double, 1 + 3 * conds.size()> at{};  // 0, then each arc's centre and ends
+  std::size_t n = 1;
   for (const auto& [w, c] : conds) {
     const double a = w.dot(e1), b = w.dot(e2), r = std::hypot(a, b);
     if (r < c) return false;
     const double centre = std::atan2(b, a), half = std::acos(std::clamp(c / r, -1.0, 1.0));
-    at.insert(at.end(), {centre, centre - half, centre + half});
+    at[n++] = centre;
+    at[n++] = centre - half;
+    at[n++] = centre + half;
   }
   constexpr double kRound = 1e-12;  // an arc's own end meets its condition to rounding
-  for (double t : at) {
+  return std::any_of(at.begin(), at.end(), [&](double t) {
     const Vec3 v = std::cos(t) * e1 + std::sin(t) * e2;
-    if (std::all_of(conds.begin(), conds.end(),
-                    [&](const auto& wc) { return wc.first.dot(v) >= wc.second - kRound; }))
-      return true;
-  }
-  return false;
+    return std::all_of(conds.begin(), conds.end(),
+                       [&](const auto& wc) { return wc.first.dot(v) >= wc.second - kRound; });
+  });
 }
 
 }  // namespace
@@ -308,29 +317,21 @@ bool PairConditions::forced_normal_fails(const Pc& x, const Pc& e) const {
         return false;
       // v = R^T n, perpendicular to the edges (to kRotAccepted): the e-f's own local margin
       // (its wedge on n's side) and the e-e's terms of A with N = sg n.
-      const EdgeWedge& wx = A_.wedges[x.a];
-      auto turn_exists = [&](double sg) {
-        return arcs_meet(da, {{wx.into_left, slack_ - kRotAccepted},
-                              {wx.into_right, slack_ - kRotAccepted},
-                              {sg * wa.into_left, need},
-                              {sg * wa.into_right, need}});
+      auto turn = [&](double sg) {
+        return turn_allows(da, A_.wedges[x.a], slack_ - kRotAccepted, wa, sg, need);
       };
-      return !(b_side(n) && turn_exists(1)) && !(b_side(-n) && turn_exists(-1));
+      return !(b_side(n) && turn(1)) && !(b_side(-n) && turn(-1));
     }
     case PcType::kFE: {  // (R n) . d_x = 0 with d_x along db and da . n = 0: N = +-R n
       const Vec3& n = A.faces()[x.a].normal;
       if (B.edges()[x.b].dir.cross(db).norm() > kParallel || std::abs(da.dot(n)) > kParallel)
         return false;
       // u = R n, perpendicular to the edges: the f-e's local margin and the e-e's terms of B
-      // with N = sg u.
-      const EdgeWedge& wx = B_.wedges[x.b];
-      auto turn_exists = [&](double sg) {
-        return arcs_meet(db, {{wx.into_left, slack_ - kRotAccepted},
-                              {wx.into_right, slack_ - kRotAccepted},
-                              {-sg * wb.into_left, need},
-                              {-sg * wb.into_right, need}});
+      // with N = sg u (B's faces on the far side).
+      auto turn = [&](double sg) {
+        return turn_allows(db, B_.wedges[x.b], slack_ - kRotAccepted, wb, -sg, need);
       };
-      return !(a_side(n) && turn_exists(1)) && !(a_side(-n) && turn_exists(-1));
+      return !(a_side(n) && turn(1)) && !(a_side(-n) && turn(-1));
     }
     case PcType::kFF: {  // R n_a = -n_b, da . n_a = 0, db . n_b = 0: N = +-n_b, R^T N = -+n_a
       const Vec3& na = A.faces()[x.a].normal;
@@ -354,7 +355,6 @@ bool PairConditions::compatible(const Pc& x, const Pc& y) const {
   const Allowed& b = b_.at(kbx, x.b, kby, y.b);
   // An element with no direction inside its cone cannot take part in a verified contact.
   if (!a.usable || !b.usable) return false;
-  if (forced_normal_fails(x, y) || forced_normal_fails(y, x)) return false;
   // Distance between the two contact points, the same measured in A and in B.
   if (a.dist_lo > b.dist_hi + length_tol_ || b.dist_lo > a.dist_hi + length_tol_) return false;
   // Angle between the contact normals: R maps A's outward normal u at each contact onto
@@ -369,7 +369,9 @@ bool PairConditions::compatible(const Pc& x, const Pc& y) const {
     return !(hb.height_lo > -ha.height_lo + length_tol_ ||
              -ha.height_hi > hb.height_hi + length_tol_);
   };
-  return heights_meet(a, b) && heights_meet(a_.at(kay, y.a, kax, x.a), b_.at(kby, y.b, kbx, x.b));
+  // Last, a normal the rotation cannot choose: a few products, where the above are look-ups.
+  return heights_meet(a, b) && heights_meet(a_.at(kay, y.a, kax, x.a), b_.at(kby, y.b, kbx, x.b)) &&
+         !forced_normal_fails(x, y) && !forced_normal_fails(y, x);
 }
 
 }  // namespace cf::gen
