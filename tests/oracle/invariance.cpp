@@ -5,6 +5,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <numeric>
 #include <set>
 #include <sstream>
@@ -61,21 +62,20 @@ ElementMap map_elements(const Poly& moved, const Poly& first, const Pose& X) {
     }
     m.edge.push_back(e);
   }
-  auto vertex_set = [](const Face& f, const std::vector<int>* map) {
-    std::set<int> s;
-    for (int v : f.verts) s.insert(map ? (*map)[v] : v);
-    return s;
-  };
+  // Faces by their vertex sets, the first model's indexed once.
+  std::map<std::set<int>, int> first_faces;
+  for (std::size_t j = 0; j < first.F.size(); ++j)
+    first_faces.emplace(std::set<int>(first.F[j].verts.begin(), first.F[j].verts.end()),
+                        static_cast<int>(j));
   for (std::size_t i = 0; i < moved.F.size(); ++i) {
-    const std::set<int> s = vertex_set(moved.F[i], &m.vertex);
-    int found = -1;
-    for (std::size_t j = 0; j < first.F.size() && found < 0; ++j)
-      if (vertex_set(first.F[j], nullptr) == s) found = static_cast<int>(j);
-    if (found < 0) {
+    std::set<int> s;
+    for (int v : moved.F[i].verts) s.insert(m.vertex[static_cast<std::size_t>(v)]);
+    const auto it = first_faces.find(s);
+    if (it == first_faces.end()) {
       m.problem = "face " + std::to_string(i) + " of the moved model has no face of the first";
       return m;
     }
-    m.face.push_back(found);
+    m.face.push_back(it->second);
   }
   return m;
 }
