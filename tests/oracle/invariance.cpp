@@ -124,6 +124,36 @@ int count_sound(const Graph& g, const std::vector<CfKey>& only, KeyOf key_of) {
       .sound;
 }
 
+// One line per set only one graph holds: "first"/"moved", the set in the first graph's
+// numbering, and its witness in the first files' frames (R row by row, then t), so that a
+// missed CF can be examined against the run that missed it.
+void write_differences(const std::string& path, const Graph& first, const Graph& moved,
+                       const InvarianceResult& r, const ElementMap& ma, const ElementMap& mb,
+                       const Pose& XA, const Pose& XB) {
+  std::ofstream out(path);
+  out.precision(17);
+  auto line = [&](const char* which, const CfKey& key, const Pose& X) {
+    out << which << " " << key_string(key) << " |";
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) out << " " << X.R(i, j);
+    for (int i = 0; i < 3; ++i) out << " " << X.t(i);
+    out << "\n";
+  };
+  const std::set<CfKey> only_first(r.only_first.begin(), r.only_first.end());
+  const std::set<CfKey> only_moved(r.only_moved.begin(), r.only_moved.end());
+  for (const GraphCf& cf : first.cfs)
+    if (only_first.count(cf.key)) line("first", cf.key, cf.witness);
+  for (const GraphCf& cf : moved.cfs) {
+    const CfKey key = map_key(cf.key, ma, mb);
+    if (!only_moved.count(key)) continue;
+    // A's point x sits at XB.inv(Xw(XA(x))) in the first files' frame of B.
+    Pose X;
+    X.R = XB.R.transpose() * cf.witness.R * XA.R;
+    X.t = XB.R.transpose() * (cf.witness.R * XA.t + cf.witness.t - XB.t);
+    line("moved", key, X);
+  }
+}
+
 }  // namespace
 
 InvarianceResult run_invariance(const ShapePair& pair, const InvarianceOptions& o) {
@@ -169,6 +199,8 @@ InvarianceResult run_invariance(const ShapePair& pair, const InvarianceOptions& 
     r.sound_first = count_sound(first, r.only_first, [](const CfKey& k) { return k; });
     r.sound_moved =
         count_sound(moved, r.only_moved, [&](const CfKey& k) { return map_key(k, ma, mb); });
+    if (!temporary)
+      write_differences((dir / "differences.txt").string(), first, moved, r, ma, mb, XA, XB);
     r.ok = true;
   } catch (const std::exception& e) {
     r.error = e.what();
