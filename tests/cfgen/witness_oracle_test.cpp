@@ -92,3 +92,41 @@ TEST_CASE("verify: the oracle's clearance and penetrations, near contact", "[wit
   CHECK(too_close > 50);
   CHECK(penetrating > 200);
 }
+
+TEST_CASE(
+    "find: two point PCs that hold only in a narrow range of spins, or with a contact near an "
+    "element's end, are found from no seed, and the oracle reads the witness as that CF",
+    "[witness][oracle]") {
+  // Sets a run missed while the same pair, moved and renumbered, had them (oracle_invariance):
+  // a box on stairs with one corner on a tread and one against a riser the anchors' circle
+  // only grazes (seed 15); a wedge's two vertices on the two walls of an L, locally admissible
+  // in spins a degree or two wide (seed 7); a box's edges crossing a stair's nosing and an end
+  // of the next riser within 0.3 mm of the box's corner (seed 3).
+  struct Case {
+    std::uint64_t seed;
+    std::vector<const char*> pcs;
+  };
+  const std::vector<Case> cases{
+      {15, {"v-f:0:4", "v-f:5:7"}}, {7, {"v-f:0:7", "v-f:4:4"}},   {7, {"v-f:1:4", "v-f:3:7"}},
+      {3, {"f-v:5:4", "e-e:0:16"}}, {3, {"e-e:0:16", "e-e:4:10"}},
+  };
+  for (const Case& c : cases) {
+    const cf::test::OraclePair p = cf::test::make_oracle_pair(c.seed);
+    const cf::gen::ModelInfo ai = cf::gen::analyse_model(p.A), bi = cf::gen::analyse_model(p.B);
+    const cf::gen::WitnessSearch search(
+        ai, bi, cf::tools::scaled_search(p.A, p.B, cf::tools::RelativeLengths{}));
+    cf::PcSet pcs;
+    for (const char* text : c.pcs) pcs.insert(*cf::pc_from_string(text));
+    INFO("seed " << c.seed << ", " << cf::to_string(pcs));
+    const cf::gen::Witness w = search.find(pcs, {});
+    REQUIRE(w.found);
+    cf::PcSet at;
+    REQUIRE(search.contacts_at(w.pose, at));
+    CHECK(at == pcs);
+    const oracle::Classifier oracle_at(p.oA, p.oB, oracle::default_tolerances(p.oA, p.oB));
+    const oracle::Verdict v = oracle_at.classify(cf::test::to_oracle(w.pose));
+    INFO("oracle: " << v.describe());
+    CHECK(v.valid_cf());
+    CHECK(v.key() == cf::test::to_oracle(pcs));
+  }
+}

@@ -1,5 +1,7 @@
 #include "cfgen/decide/rotation_family.hpp"
 
+#include "cfgen/verify/verifier.hpp"
+
 #include <cf/geometry.hpp>
 
 #include <Eigen/SVD>
@@ -198,6 +200,29 @@ std::vector<Mat3> project_onto(const RotConstraints& c, const Mat3& R) {
   Mat3 out = R;
   if (!c.perp.empty() && !project_perp(c, out)) return {};
   return {out};
+}
+
+std::vector<double> admissible_spins(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs,
+                                     const Vec3& axis, const Mat3& R0, int samples,
+                                     double min_local) {
+  constexpr double kSpinResolution = 2e-3;  // rad: the narrowest arc halved
+  std::vector<double> out;
+  std::vector<std::pair<double, double>> arcs;  // centre, half-width (rad)
+  for (int k = samples - 1; k >= 0; --k) arcs.push_back({2 * M_PI * k / samples, M_PI / samples});
+  while (!arcs.empty()) {
+    const auto [phi, half] = arcs.back();
+    arcs.pop_back();
+    const Mat3 R = R0 * axis_angle(axis, phi);
+    // The bound first: most arcs hold no admissible spin, and it rules them out alone.
+    if (local_margin_bound(a, b, pcs, R, TurnBound{0, half, axis}) <= min_local) continue;
+    if (local_margin_bound(a, b, pcs, R, TurnBound{}) > min_local) {
+      out.push_back(phi);
+    } else if (half >= 2 * kSpinResolution) {
+      arcs.push_back({phi + half / 2, half / 2});
+      arcs.push_back({phi - half / 2, half / 2});
+    }
+  }
+  return out;
 }
 
 }  // namespace cf::gen::internal

@@ -39,4 +39,15 @@ std::vector<Mat3> project_onto(const RotConstraints& c, const Mat3& R);
 /// Empty for other families.
 std::vector<std::vector<Mat3>> walk_family(const RotConstraints& c, const Mat3& R, double h, int n);
 
+/// Spins phi (rad) at which R0 Rot(axis, phi) (axis: unit, A's frame) holds every PC of `pcs`
+/// locally admissible, its local margin (Verifier::local_margin) above min_local: the centres
+/// 2 pi k / samples of equal arcs of the whole turn, and where a centre is not admissible but
+/// the margin's bound over its arc (local_margin_bound) leaves room, the centres of its halves,
+/// down to arcs of 2e-3 rad. A range of admissible spins narrower than the samples' spacing
+/// (a vertex whose cone fits a face only just) is found wherever it is at least that wide.
+/// Ascending, from -pi / samples; empty when no spin is admissible.
+std::vector<double> admissible_spins(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs,
+                                     const Vec3& axis, const Mat3& R0, int samples,
+                                     double min_local);
+
 }  // namespace cf::gen::internal

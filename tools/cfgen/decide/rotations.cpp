@@ -109,18 +109,22 @@ namespace {
 
 bool point_pc(PcType t) { return t == PcType::kVF || t == PcType::kFV || t == PcType::kEE; }
 
-// Sample points of an element's interior: a vertex itself; an edge at its eighths; a face at its
-// centroid and toward the corners and sides of its outer loop (kept when inside).
+// Sample points of an element's interior: a vertex itself; an edge at its eighths and 1% from
+// each end; a face at its centroid and toward the corners and sides of its outer loop (kept
+// when inside). Points near the ends matter: a CF whose contact sits within a few tenths of a
+// millimetre of a corner (a box's edge crossing a nosing just past the box's corner) holds
+// only at rotations close to the ones they anchor.
 std::vector<Vec3> interior_samples(const Polyhedron& m, ElementKind k, int i) {
   std::vector<Vec3> out;
   if (k == ElementKind::kVertex) {
     out.push_back(m.vertices()[i].p);
   } else if (k == ElementKind::kEdge) {
     const Vec3 &a = m.edge_point(EdgeId(i), 0), &b = m.edge_point(EdgeId(i), 1);
-    for (double f : {0.5, 0.25, 0.75, 0.125, 0.375, 0.625, 0.875}) out.push_back(a + f * (b - a));
+    for (double f : {0.5, 0.25, 0.75, 0.125, 0.375, 0.625, 0.875, 0.01, 0.99})
+      out.push_back(a + f * (b - a));
   } else {
-    // Toward each corner and each side's midpoint, halfway and nine tenths of the way:
-    // contacts near a face's boundary matter (a peg's corner just inside a hole's rim).
+    // Toward each corner and each side's midpoint, 50%, 90% and 98% of the way: contacts
+    // near a face's boundary matter (a peg's corner just inside a hole's rim).
     const Face& F = m.faces()[i];
     std::vector<Vec3> targets;
     for (std::size_t j = 0; j < F.loops.front().size(); ++j) {
@@ -130,12 +134,34 @@ std::vector<Vec3> interior_samples(const Polyhedron& m, ElementKind k, int i) {
       targets.push_back(0.5 * (a + b));
     }
     if (m.face_inset(FaceId(i), F.centroid) > 0) out.push_back(F.centroid);
-    for (double f : {0.5, 0.9})
+    for (double f : {0.5, 0.9, 0.98})
       for (const Vec3& c : targets) {
         const Vec3 q = F.centroid + f * (c - F.centroid);
         if (m.face_inset(FaceId(i), q) > 0) out.push_back(q);
       }
   }
+  return out;
+}
+
+// Angles (rad, ascending, in (-pi, pi]) at which the circle of radius r about c (the face's
+// (u, v) frame) crosses the boundary of face F.
+std::vector<double> circle_crossings(const Face& F, const Eigen::Vector2d& c, double r) {
+  std::vector<double> out;
+  for (const std::vector<Eigen::Vector2d>& loop : F.loops_2d)
+    for (std::size_t j = 0; j < loop.size(); ++j) {
+      const Eigen::Vector2d a = loop[j] - c, d = loop[(j + 1) % loop.size()] - loop[j];
+      // |a + s d|^2 = r^2: quadratic in s.
+      const double qa = d.squaredNorm(), qb = 2 * d.dot(a), qc = a.squaredNorm() - r * r;
+      const double disc = qb * qb - 4 * qa * qc;
+      if (qa <= 0 || disc < 0) continue;
+      for (double sg : {-1.0, 1.0}) {
+        const double s = (-qb + sg * std::sqrt(disc)) / (2 * qa);
+        if (s < 0 || s > 1) continue;
+        const Eigen::Vector2d x = a + s * d;
+        out.push_back(std::atan2(x.y(), x.x()));
+      }
+    }
+  std::sort(out.begin(), out.end());
   return out;
 }
 
@@ -150,19 +176,29 @@ std::vector<Vec3> at_distance(const Polyhedron& m, ElementKind k, int i, const V
     if (qa <= 0 || disc < 0) return out;
     for (double sg : {-1.0, 1.0}) {
       const double u = (-qb + sg * std::sqrt(disc)) / (2 * qa);
-      if (u > 0.02 && u < 0.98) out.push_back(a + u * d);
+      if (u > 0.005 && u < 0.995) out.push_back(a + u * d);  // inside, as the samples' ends
     }
   } else if (k == ElementKind::kFace) {
+    // The circle where the sphere meets the face's plane, cut into arcs where it crosses the
+    // face's boundary: each arc inside the face gets points spread along it, at least one,
+    // so that a narrow face (a riser, a rim) that the circle only grazes is still reached.
     const Face& F = m.faces()[i];
     const double h = F.normal.dot(c) - F.offset;
     const double r2 = L * L - h * h;
     if (r2 <= 0) return out;
+    const double r = std::sqrt(r2);
     const Vec3 c0 = c - h * F.normal;
-    constexpr int kAngles = 8;  // points on the circle where the sphere meets the face plane
-    for (int j = 0; j < kAngles; ++j) {
-      const double th = 2 * M_PI * (j + 0.5) / kAngles;
-      const Vec3 x = c0 + std::sqrt(r2) * (std::cos(th) * F.u + std::sin(th) * F.v);
-      if (m.face_inset(FaceId(i), x) > 0) out.push_back(x);
+    constexpr double kSpacing = 2 * M_PI / 16;  // rad: the most between two points of an arc
+    std::vector<double> cuts = circle_crossings(F, {F.u.dot(c0), F.v.dot(c0)}, r);
+    if (cuts.empty()) cuts.push_back(0);
+    for (std::size_t j = 0; j < cuts.size(); ++j) {
+      const double lo = cuts[j], hi = j + 1 < cuts.size() ? cuts[j + 1] : cuts[0] + 2 * M_PI;
+      const int n = std::max(1, static_cast<int>(std::ceil((hi - lo) / kSpacing)));
+      for (int q = 0; q < n; ++q) {
+        const double th = lo + (hi - lo) * (q + 0.5) / n;
+        const Vec3 x = c0 + r * (std::cos(th) * F.u + std::sin(th) * F.v);
+        if (m.face_inset(FaceId(i), x) > 0) out.push_back(x);
+      }
     }
   }
   return out;
@@ -237,10 +273,11 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs) const {
   };
   // Solve for the free point on the side where y's element is not a vertex.
   const bool solve_on_b = b_kind(y.type) != ElementKind::kVertex;
+  const std::vector<Vec3> fixed = solve_on_b ? interior_samples(A, a_kind(y.type), y.a)
+                                             : interior_samples(B, b_kind(y.type), y.b);
+  const std::vector<Vec3> on_b = interior_samples(B, b_kind(x.type), x.b);
   for (const Vec3& pa : interior_samples(A, a_kind(x.type), x.a))
-    for (const Vec3& qb : interior_samples(B, b_kind(x.type), x.b)) {
-      const std::vector<Vec3> fixed = solve_on_b ? interior_samples(A, a_kind(y.type), y.a)
-                                                 : interior_samples(B, b_kind(y.type), y.b);
+    for (const Vec3& qb : on_b) {
       for (const Vec3& f : fixed) {
         const double L = (f - (solve_on_b ? pa : qb)).norm();
         if (L < 1e-9 * scale_) continue;
@@ -250,8 +287,8 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs) const {
           const Vec3 dB = ((solve_on_b ? g : f) - qb).normalized();
           const Mat3 R0 = align(dA, dB);
           auto spun = [&](double phi) { return Mat3(axis_angle(dB, phi) * R0); };
-          for (int k = 0; k < p_.theta_samples; ++k)
-            consider(spun(2 * M_PI * k / p_.theta_samples), false);
+          for (double phi : admissible_spins(A_, B_, pcs, dA, R0, p_.theta_samples, min_local))
+            consider(spun(phi), false);
           if (!third) continue;
           // A third point PC: also the spins where its contact holds, the first contact held
           // at (pa, qb); tried first.
