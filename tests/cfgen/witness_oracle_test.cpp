@@ -94,21 +94,25 @@ TEST_CASE("verify: the oracle's clearance and penetrations, near contact", "[wit
 }
 
 TEST_CASE(
-    "find: two point PCs that hold only in a narrow range of spins, or with a contact near an "
-    "element's end, are found from no seed, and the oracle reads the witness as that CF",
+    "find: two point PCs that hold only in a narrow range of spins, with a contact near an "
+    "element's end, or in a sliver beside the nearest anchored miss are found from no seed, and "
+    "the oracle reads the witness as that CF",
     "[witness][oracle]") {
   // Sets a run missed while the same pair, moved and renumbered, had them (oracle_invariance):
   // a box on stairs with one corner on a tread and one against a riser the anchors' circle
   // only grazes (seed 15); a wedge's two vertices on the two walls of an L, locally admissible
   // in spins a degree or two wide (seed 7); a box's edges crossing a stair's nosing and an end
-  // of the next riser within 0.3 mm of the box's corner (seed 3).
+  // of the next riser within 0.3 mm of the box's corner (seed 3); two other vertices of the
+  // wedge on the L's walls, admissible in a sliver no anchored rotation reaches, found by the
+  // climb from the nearest miss (seed 7).
   struct Case {
     std::uint64_t seed;
     std::vector<const char*> pcs;
   };
   const std::vector<Case> cases{
       {15, {"v-f:0:4", "v-f:5:7"}}, {7, {"v-f:0:7", "v-f:4:4"}},   {7, {"v-f:1:4", "v-f:3:7"}},
-      {3, {"f-v:5:4", "e-e:0:16"}}, {3, {"e-e:0:16", "e-e:4:10"}},
+      {3, {"f-v:5:4", "e-e:0:16"}}, {3, {"e-e:0:16", "e-e:4:10"}}, {7, {"v-f:0:7", "v-f:5:4"}},
+      {7, {"v-f:2:4", "v-f:3:7"}},
   };
   for (const Case& c : cases) {
     const cf::test::OraclePair p = cf::test::make_oracle_pair(c.seed);

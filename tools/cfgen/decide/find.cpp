@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -51,7 +53,11 @@ class FindRun {
   bool climb_past(const Blocked& b);
   Score score(const Mat3& R) const;
   std::vector<std::pair<Score, Mat3>> climb_starts(const std::vector<Mat3>& rots) const;
+  int climb(Mat3& R, Score& m, const std::function<Score(const Mat3&)>& score_of,
+            const std::function<bool(const Score&)>& done, double first_step, double last_step,
+            int max_evals) const;
   bool climb_margin(const std::vector<Mat3>& rots);
+  bool climb_local(const Mat3& start);
   std::vector<Mat3> family_ends() const;
 
   const WitnessSearch& s_;
@@ -370,6 +376,32 @@ std::vector<std::pair<FindRun::Score, Mat3>> FindRun::climb_starts(
   return starts;
 }
 
+// A pattern search over rotations: from R, scored m, the steps of +-h about each axis the
+// rotational conditions leave free (rotation_steps), taking the first that raises the score,
+// h halving after a round without one down to last_step; at most max_evals scores, or until
+// done. R and m receive where it ended; returns the scores evaluated.
+int FindRun::climb(Mat3& R, Score& m, const std::function<Score(const Mat3&)>& score_of,
+                   const std::function<bool(const Score&)>& done, double first_step,
+                   double last_step, int max_evals) const {
+  double h = first_step;
+  int evals = 0;
+  while (evals < max_evals && h >= last_step && !done(m)) {
+    bool moved = false;
+    for (const Mat3& Q : s_.rotation_steps(pcs_, R, h)) {
+      const Score mq = score_of(Q);
+      ++evals;
+      if (mq > m) {
+        m = mq;
+        R = Q;
+        moved = true;
+        break;
+      }
+    }
+    if (!moved) h *= 0.5;
+  }
+  return evals;
+}
+
 // Where no rotation tried could place the contacts, climb the margin: from the rotations that
 // came closest, step along the rotations the conditions leave free while the (possibly
 // negative) margin grows, and try each rotation that reaches min_margin. Narrow CFs, e.g. a
@@ -379,33 +411,45 @@ bool FindRun::climb_margin(const std::vector<Mat3>& rots) {
   constexpr int kMaxSteps = 32;       // evaluations per climb
   constexpr double kFirstStep = 0.2;  // rad
   constexpr double kLastStep = 1e-2;  // rad
+  const auto done = [&](const Score& m) { return m.first == 1 && m.second >= p_.min_margin; };
   for (auto [m, R] : climb_starts(rots)) {
     if (!std::isfinite(m.second)) continue;
     if (s_.debug_) std::cerr << "  climb from " << m.first << " / " << m.second << "\n";
-    double h = kFirstStep;
-    const auto done = [&] { return m.first == 1 && m.second >= p_.min_margin; };
-    int evals = 0;
-    for (; evals < kMaxSteps && h >= kLastStep && !done();) {
-      bool moved = false;
-      for (const Mat3& Q : s_.rotation_steps(pcs_, R, h)) {
-        const auto mq = score(Q);
-        ++evals;
-        if (mq > m) {
-          m = mq;
-          R = Q;
-          moved = true;
-          break;
-        }
-      }
-      if (!moved) h *= 0.5;
-    }
+    const int evals = climb(
+        R, m, [&](const Mat3& Q) { return score(Q); }, done, kFirstStep, kLastStep, kMaxSteps);
     if (s_.debug_)
       std::cerr << "  climbed to " << m.first << " / " << m.second << " in " << evals
                 << " evaluations\n";
-    if (done() && try_rotation(R)) return true;
+    if (done(m) && try_rotation(R)) return true;
     if (best_.found) return true;
   }
   return false;
+}
+
+// Where no anchored rotation was locally admissible, climb from the nearest miss, a rotation
+// that places the contacts with some PC locally penetrating by a little: first keep the
+// contacts placed (their margin, while below min_margin), then raise the local margin, and
+// try the rotation once it is admissible. Two vertices of a wedge on two walls of an L hold
+// in a sliver of rotations a few hundredths of a radian across, beside such a miss. True
+// when it found a witness.
+bool FindRun::climb_local(const Mat3& start) {
+  constexpr int kMaxSteps = 64;        // evaluations
+  constexpr double kFirstStep = 0.05;  // rad: about the slivers' width
+  constexpr double kLastStep = 1e-3;   // rad
+  const std::vector<int> first_pieces(slot_sizes_.size(), 0);
+  auto placed = [&](const Mat3& R) -> Score {
+    const double m = s_.signed_margin(pcs_, R, first_pieces);
+    if (m < p_.min_margin) return {0, m};
+    return {1, s_.local_margin(pcs_, R)};
+  };
+  const auto done = [&](const Score& m) { return m.first == 1 && m.second > min_local_; };
+  Mat3 R = start;
+  Score m = placed(R);
+  const int evals = climb(R, m, placed, done, kFirstStep, kLastStep, kMaxSteps);
+  if (s_.debug_)
+    std::cerr << "  local climb to " << m.first << " / " << m.second << " in " << evals
+              << " evaluations\n";
+  return done(m) && (try_rotation(R) || best_.found);
 }
 
 // A one-parameter family: a part leaning in a gap (a peg tilted in a hole, an edge resting on
@@ -450,7 +494,9 @@ Witness FindRun::run() {
   // Two point PCs: rotations built to place both contacts inside their elements, where the
   // spread above left too few locally admissible ones (two e-e crossings) or none that fits
   // (a peg's corner just inside a hole's rim).
-  if (try_all(s_.anchored_rotations(pcs_)) || best_.found) return best_;
+  std::optional<Mat3> miss;
+  if (try_all(s_.anchored_rotations(pcs_, &miss)) || best_.found) return best_;
+  if (miss && climb_local(*miss)) return best_;
   if (near_.empty() && climb_margin(rots)) return best_;
   if (best_.found || near_.empty()) return best_;
   // The contacts could be placed but the pose touched something else: look closer around

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace cf::gen::internal {
 namespace {
@@ -204,9 +205,10 @@ std::vector<Mat3> project_onto(const RotConstraints& c, const Mat3& R) {
 
 std::vector<double> admissible_spins(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs,
                                      const Vec3& axis, const Mat3& R0, int samples,
-                                     double min_local) {
+                                     double min_local, std::pair<double, double>* best) {
   constexpr double kSpinResolution = 2e-3;  // rad: the narrowest arc halved
   std::vector<double> out;
+  if (best) *best = {0.0, -std::numeric_limits<double>::infinity()};
   std::vector<std::pair<double, double>> arcs;  // centre, half-width (rad)
   for (int k = samples - 1; k >= 0; --k) arcs.push_back({2 * M_PI * k / samples, M_PI / samples});
   while (!arcs.empty()) {
@@ -215,7 +217,9 @@ std::vector<double> admissible_spins(const ModelInfo& a, const ModelInfo& b, con
     const Mat3 R = R0 * axis_angle(axis, phi);
     // The bound first: most arcs hold no admissible spin, and it rules them out alone.
     if (local_margin_bound(a, b, pcs, R, TurnBound{0, half, axis}) <= min_local) continue;
-    if (local_margin_bound(a, b, pcs, R, TurnBound{}) > min_local) {
+    const double margin = local_margin_bound(a, b, pcs, R, TurnBound{});
+    if (best && margin > best->second) *best = {phi, margin};
+    if (margin > min_local) {
       out.push_back(phi);
     } else if (half >= 2 * kSpinResolution) {
       arcs.push_back({phi + half / 2, half / 2});

@@ -6,6 +6,7 @@
 #include "cfgen/verify/rotation_conditions.hpp"
 
 #include <initializer_list>
+#include <utility>
 #include <vector>
 
 namespace cf::gen::internal {
@@ -45,9 +46,11 @@ std::vector<std::vector<Mat3>> walk_family(const RotConstraints& c, const Mat3& 
 /// the margin's bound over its arc (local_margin_bound) leaves room, the centres of its halves,
 /// down to arcs of 2e-3 rad. A range of admissible spins narrower than the samples' spacing
 /// (a vertex whose cone fits a face only just) is found wherever it is at least that wide.
-/// Ascending, from -pi / samples; empty when no spin is admissible.
+/// Ascending, from -pi / samples; empty when no spin is admissible. best: when given, the
+/// spin of the largest local margin evaluated and that margin (-inf when the bound ruled out
+/// every arc), admissible or not.
 std::vector<double> admissible_spins(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs,
                                      const Vec3& axis, const Mat3& R0, int samples,
-                                     double min_local);
+                                     double min_local, std::pair<double, double>* best = nullptr);
 
 }  // namespace cf::gen::internal

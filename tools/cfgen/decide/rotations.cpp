@@ -228,7 +228,8 @@ std::vector<Mat3> take_spread(const std::vector<Mat3>& rots,
 
 }  // namespace
 
-std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs) const {
+std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs,
+                                                    std::optional<Mat3>* near_miss) const {
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
   std::vector<Pc> pts;
@@ -246,6 +247,9 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs) const {
     order.push_back({exact ? -2.0 - m : -m, cands.size()});
     cands.push_back(R);
   };
+  // The anchored rotation with the largest local margin short of min_local: the contacts
+  // placed, some PC locally penetrating by a little.
+  std::pair<double, Mat3> miss{-std::numeric_limits<double>::infinity(), Mat3::Identity()};
   const Pc& x = pts[0];
   const Pc& y = pts[1];
   const Pc* third = pts.size() >= 3 ? &pts[2] : nullptr;
@@ -287,8 +291,12 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs) const {
           const Vec3 dB = ((solve_on_b ? g : f) - qb).normalized();
           const Mat3 R0 = align(dA, dB);
           auto spun = [&](double phi) { return Mat3(axis_angle(dB, phi) * R0); };
-          for (double phi : admissible_spins(A_, B_, pcs, dA, R0, p_.theta_samples, min_local))
+          std::pair<double, double> best;
+          for (double phi :
+               admissible_spins(A_, B_, pcs, dA, R0, p_.theta_samples, min_local, &best))
             consider(spun(phi), false);
+          if (best.second <= min_local && best.second > miss.first)
+            miss = {best.second, spun(best.first)};
           if (!third) continue;
           // A third point PC: also the spins where its contact holds, the first contact held
           // at (pa, qb); tried first.
@@ -322,7 +330,10 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs) const {
     }
   // Spread apart, at most max_rotations.
   std::stable_sort(order.begin(), order.end());
-  if (debug_) std::cerr << "  anchored: " << order.size() << " locally admissible rotations\n";
+  if (debug_)
+    std::cerr << "  anchored: " << order.size() << " locally admissible rotations, nearest miss "
+              << miss.first << "\n";
+  if (near_miss && order.empty() && std::isfinite(miss.first)) *near_miss = miss.second;
   return take_spread(cands, order, p_.max_rotations, true);
 }
 

@@ -12,6 +12,7 @@
 
 #include <cf/graph.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -104,8 +105,11 @@ class WitnessSearch : public Verifier {
   // For a set with two point PCs (v-f, f-v, e-e): rotations that place both contacts at
   // sampled points inside their elements, i.e. take the segment between the two points on A
   // onto a segment of the same length between the two points on B, spun about it. Locally
-  // penetrating ones dropped, at most max_rotations, spread apart.
-  std::vector<Mat3> anchored_rotations(const PcSet& pcs) const;
+  // penetrating ones dropped, at most max_rotations, spread apart. near_miss: when none is
+  // locally admissible, receives the one nearest to it (the largest local margin evaluated),
+  // if any was evaluated.
+  std::vector<Mat3> anchored_rotations(const PcSet& pcs,
+                                       std::optional<Mat3>* near_miss = nullptr) const;
   // Number of convex pieces of each face slot of the LP (build_lp's `pieces`), in its order.
   std::vector<int> piece_slots(const PcSet& pcs) const;
   // extra_vars: variables after the program's own, for the caller (no rows use them).
