@@ -296,7 +296,7 @@ bool PairConditions::forced_normal_fails(const Pc& x, const Pc& e) const {
   const Vec3& db = B.edges()[e.b].dir;
   // At a witness the rotational condition holds to kRotAccepted and the e-e's edges are at
   // least the slack (a sine) from parallel, so the contact plane's normal N is within
-  // 1.5 (kRotAccepted + 2 kParallel) / slack of the direction (its component in the plane
+  // 2 (kRotAccepted + 2 kParallel) / slack of the direction (its component in the plane
   // of the two edges is at most their residuals over the sine between them).
   const double off = 2 * (kRotAccepted + 2 * kParallel) / slack_;
   const double need = slack_ - off;

@@ -49,7 +49,7 @@ std::vector<Mat3> WitnessSearch::spread_rotations(const PcSet& pcs,
   std::vector<Mat3> prefs;
   const int n = std::max(4, p_.theta_samples / std::max(1, pcs.size()));
   for (const Pc& pc : pcs) {
-    Vec3 x, y;  // align A-frame x to world y, then spin about y
+    Vec3 x = Vec3::Zero(), y = Vec3::Zero();  // align A-frame x to world y, spin about y
     switch (pc.type) {
       case PcType::kFF:
         x = A.faces()[pc.a].normal;
@@ -226,6 +226,59 @@ std::vector<Mat3> take_spread(const std::vector<Mat3>& rots,
   return out;
 }
 
+// Signed distance between the elements of point PC z (their lines or planes) at pose (R, t);
+// NaN for an e-e whose lines are parallel.
+double third_residual(const Polyhedron& A, const Polyhedron& B, const Pc& z, const Mat3& R,
+                      const Vec3& t, double scale) {
+  switch (z.type) {
+    case PcType::kVF: {
+      const Face& F = B.faces()[z.b];
+      return F.normal.dot(R * A.vertices()[z.a].p + t) - F.offset;
+    }
+    case PcType::kFV: {
+      const Face& F = A.faces()[z.a];
+      return (R * F.normal).dot(B.vertices()[z.b].p - t) - F.offset;
+    }
+    default: {  // e-e
+      const Vec3 a0 = R * A.edge_point(EdgeId(z.a), 0) + t;
+      const Vec3 da = R * (A.edge_point(EdgeId(z.a), 1) - A.edge_point(EdgeId(z.a), 0));
+      const Vec3 b0 = B.edge_point(EdgeId(z.b), 0);
+      const Vec3 n = da.cross(B.edge_point(EdgeId(z.b), 1) - b0);
+      const double len = n.norm();
+      if (len < 1e-12 * scale * scale) return std::numeric_limits<double>::quiet_NaN();
+      return (a0 - b0).dot(n) / len;
+    }
+  }
+}
+
+// Roots phi in [0, 2 pi) of f: sign changes between 96 equal steps of the turn, refined by
+// bisection; a sign change across a jump of f (an e-e's lines turning parallel), where |f|
+// stays above `small`, is no root.
+template <class F>
+std::vector<double> turn_roots(const F& f, double small) {
+  constexpr int kSpinSamples = 96;
+  std::vector<double> out;
+  double f0 = f(0);
+  for (int k = 1; k <= kSpinSamples; ++k) {
+    double lo = 2 * M_PI * (k - 1) / kSpinSamples, hi = 2 * M_PI * k / kSpinSamples;
+    const double f1 = f(hi);
+    if (std::isfinite(f0) && std::isfinite(f1) && (f0 < 0) != (f1 < 0)) {
+      double flo = f0;
+      for (int it = 0; it < 40; ++it) {
+        const double mid = 0.5 * (lo + hi), fm = f(mid);
+        if (!std::isfinite(fm)) break;
+        if ((fm < 0) == (flo < 0))
+          lo = mid, flo = fm;
+        else
+          hi = mid;
+      }
+      if (std::abs(f(0.5 * (lo + hi))) < small) out.push_back(0.5 * (lo + hi));
+    }
+    f0 = f1;
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs,
@@ -253,28 +306,6 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs,
   const Pc& x = pts[0];
   const Pc& y = pts[1];
   const Pc* third = pts.size() >= 3 ? &pts[2] : nullptr;
-  // Signed distance between the third PC's elements (their lines or planes) at pose (R, t).
-  auto third_residual = [&](const Pc& z, const Mat3& R, const Vec3& t) {
-    switch (z.type) {
-      case PcType::kVF: {
-        const Face& F = B.faces()[z.b];
-        return F.normal.dot(R * A.vertices()[z.a].p + t) - F.offset;
-      }
-      case PcType::kFV: {
-        const Face& F = A.faces()[z.a];
-        return (R * F.normal).dot(B.vertices()[z.b].p - t) - F.offset;
-      }
-      default: {  // e-e
-        const Vec3 a0 = R * A.edge_point(EdgeId(z.a), 0) + t;
-        const Vec3 da = R * (A.edge_point(EdgeId(z.a), 1) - A.edge_point(EdgeId(z.a), 0));
-        const Vec3 b0 = B.edge_point(EdgeId(z.b), 0);
-        const Vec3 n = da.cross(B.edge_point(EdgeId(z.b), 1) - b0);
-        const double len = n.norm();
-        if (len < 1e-12 * scale_ * scale_) return std::numeric_limits<double>::quiet_NaN();
-        return (a0 - b0).dot(n) / len;
-      }
-    }
-  };
   // Solve for the free point on the side where y's element is not a vertex.
   const bool solve_on_b = b_kind(y.type) != ElementKind::kVertex;
   const std::vector<Vec3> fixed = solve_on_b ? interior_samples(A, a_kind(y.type), y.a)
@@ -302,29 +333,9 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs,
           // at (pa, qb); tried first.
           auto residual = [&](double phi) {
             const Mat3 R = spun(phi);
-            return third_residual(*third, R, qb - R * pa);
+            return third_residual(A, B, *third, R, qb - R * pa, scale_);
           };
-          constexpr int kSpinSamples = 96;
-          double f0 = residual(0);
-          for (int k = 1; k <= kSpinSamples; ++k) {
-            double lo = 2 * M_PI * (k - 1) / kSpinSamples, hi = 2 * M_PI * k / kSpinSamples;
-            const double f1 = residual(hi);
-            if (std::isfinite(f0) && std::isfinite(f1) && (f0 < 0) != (f1 < 0)) {
-              double flo = f0;
-              for (int it = 0; it < 40; ++it) {
-                const double mid = 0.5 * (lo + hi), fm = residual(mid);
-                if (!std::isfinite(fm)) break;
-                if ((fm < 0) == (flo < 0))
-                  lo = mid, flo = fm;
-                else
-                  hi = mid;
-              }
-              // A sign change across the e-e residual's jump (lines turning parallel) is no root.
-              if (std::abs(residual(0.5 * (lo + hi))) < 1e-6 * scale_)
-                consider(spun(0.5 * (lo + hi)), true);
-            }
-            f0 = f1;
-          }
+          for (double phi : turn_roots(residual, 1e-6 * scale_)) consider(spun(phi), true);
         }
       }
     }
