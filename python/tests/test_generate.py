@@ -138,7 +138,9 @@ def test_generate_certificates(tmp_path):
     assert py["format"] == "cf-certificates"
     py.pop("graph"), cli.pop("graph")  # each names its own graph file
     assert py == cli
-    assert py["summary"] == {"sets": 144, "invalid_by_rule": 0, "invalid_by_cells": 96, "undecided": 48}
+    assert py["summary"] == {
+        "sets": 144, "invalid_by_rule": 0, "invalid_by_cells": 96, "thin": 0, "undecided": 48
+    }
 
 
 def test_generated_graph_reaches_the_runtime_in_memory(tmp_path):

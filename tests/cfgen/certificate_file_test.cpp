@@ -13,8 +13,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <fstream>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -118,6 +120,105 @@ TEST_CASE(
     if (s["outcome"] == "undecided" && undecided.size() < g["stats"]["undecided_sets"].size())
       undecided.push_back(s["pcs"]);
   CHECK(json(undecided) == g["stats"]["undecided_sets"]);
+}
+
+namespace {
+
+// The 30 mm cube against a U-channel whose slot is 30 + gap wide (profile in x-y, slot walls at
+// x = 30 and 60 + gap, floor y = 10, extruded over z in [0, 60]); graph and certificate file.
+struct SlotRun {
+  json g, c;                  // the graph and the certificate file
+  std::set<std::string> cfs;  // the graph's CFs' PC lists
+};
+
+SlotRun cube_in_slot(double gap, const std::string& name) {
+  std::string b_path = std::string(CF_SOURCE_DIR) + "/tests/data/models/tight_slot.off";
+  if (gap != 0.004) {
+    const double w = 60 + gap, o = 90 + gap;
+    std::ostringstream os;
+    os.precision(17);
+    os << "OFF\n16 10 0\n";
+    const double prof[8][2] = {{0, 0},  {o, 0},   {o, 30},  {w, 30},
+                               {w, 10}, {30, 10}, {30, 30}, {0, 30}};
+    for (double z : {0.0, 60.0})
+      for (const auto& p : prof) os << p[0] << ' ' << p[1] << ' ' << z << '\n';
+    os << "8 7 6 5 4 3 2 1 0\n8 8 9 10 11 12 13 14 15\n";
+    for (int i = 0; i < 8; ++i)
+      os << "4 " << i << ' ' << (i + 1) % 8 << ' ' << 8 + (i + 1) % 8 << ' ' << 8 + i << '\n';
+    b_path = cf::test::write_file(name + ".off", os.str());
+  }
+  cf::tools::GenerateArgs args = cube_and_corner(name + ".json", name + "_c.json");
+  args.b_path = b_path;
+  REQUIRE(cf::tools::run_generate(args) == 0);
+  SlotRun r{read_json(args.out_path), read_json(args.certificates_path), {}};
+  const cf::CfGraph graph = cf::CfGraph::load(args.out_path);
+  for (std::size_t i = 0; i < graph.num_cfs(); ++i)
+    r.cfs.insert(cf::to_string(graph.cf(cf::CfId(static_cast<int>(i))).pcs));
+  return r;
+}
+
+// "f-f:i:w" for each face i of A and each face w of B in the plane x = wall_x.
+std::set<std::string> faces_on_walls(const json& g, std::vector<double> walls_x) {
+  std::set<std::string> out;
+  const json& B = g["models"]["B"];
+  for (std::size_t w = 0; w < B["faces"].size(); ++w) {
+    const json& loop = B["faces"][w]["loops"][0];
+    for (double x : walls_x) {
+      bool on = true;
+      for (const json& v : loop)
+        on = on && std::abs(B["vertices"][v.get<int>()][0].get<double>() - x) < 1e-9;
+      if (!on) continue;
+      for (int i = 0; i < 6; ++i) out.insert("f-f:" + std::to_string(i) + ":" + std::to_string(w));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("THIN sets: realised only below the witnesses' clearance, listed, not CFs",
+          "[certificates]") {
+  // 4 um to spare: a face of the cube on a wall of the slot has the other wall 4 um away, below
+  // the default min_clearance (2e-4 x D = 0.0104 mm); with 0.4 mm the same sets are CFs.
+  const SlotRun tight = cube_in_slot(0.004, "tight_slot");
+  const json &g = tight.g, &c = tight.c;
+  const std::set<std::string> on_walls = faces_on_walls(g, {30.0, 60.004});
+  REQUIRE(on_walls.size() == 12);
+  std::set<std::string> thin;
+  const double min_clearance = g["parameters"]["min_clearance_mm"];
+  const double touch_tol = g["parameters"]["touch_tol_mm"];
+  const json& listed = g["stats"]["thin_sets"];
+  CHECK(g["stats"]["thin"] == listed.size());
+  for (const json& t : listed) {
+    const std::string pcs = t["pcs"];
+    INFO(pcs);
+    CHECK(tight.cfs.count(pcs) == 0);
+    CHECK(t["clearance_mm"].get<double>() < min_clearance);
+    CHECK(t["clearance_mm"].get<double>() >= 4 * touch_tol);
+    thin.insert(pcs);
+  }
+  for (const std::string& s : on_walls) {
+    INFO(s);
+    CHECK(thin.count(s) == 1);
+  }
+  // The certificate file lists the same sets as "thin", with the same poses.
+  json from_file = json::array();
+  for (json s : c["sets"])
+    if (s["outcome"] == "thin") {
+      s.erase("outcome");
+      from_file.push_back(s);
+    }
+  CHECK(from_file == listed);
+  CHECK(c["summary"]["thin"] == listed.size());
+
+  const SlotRun wide = cube_in_slot(0.4, "wide_slot");
+  const std::set<std::string> wide_walls = faces_on_walls(wide.g, {30.0, 60.4});
+  REQUIRE(wide_walls.size() == 12);
+  for (const std::string& s : wide_walls) {
+    INFO(s);
+    CHECK(wide.cfs.count(s) == 1);
+  }
+  for (const json& t : wide.g["stats"]["thin_sets"]) CHECK(wide_walls.count(t["pcs"]) == 0);
 }
 
 TEST_CASE("the graph does not depend on whether certificates are written", "[certificates]") {

@@ -63,21 +63,13 @@ int count_of(const Poly& P, int kind) {
 // "f-f:3:5;e-e:0:7" -> PCs, each of a non-degenerate type with indices in range.
 std::vector<SetPc> parse_pcs(const Graph& g, const std::string& text) {
   std::vector<SetPc> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ';')) {
-    const auto c1 = item.find(':'), c2 = item.rfind(':');
-    PcType t;
-    if (c1 == std::string::npos || c1 == c2 || !parse_type(item.substr(0, c1), &t) ||
-        !nondegenerate(t))
-      throw std::runtime_error("\"" + item + "\" is not a PC type:a:b");
-    SetPc p;
-    p.type = t;
-    p.a = std::stoi(item.substr(c1 + 1, c2 - c1 - 1));
-    p.b = std::stoi(item.substr(c2 + 1));
-    if (p.a < 0 || p.a >= count_of(g.A, kind_a(t)) || p.b < 0 || p.b >= count_of(g.B, kind_b(t)))
+  for (const Pc& pc : parse_pc_list(text)) {
+    const std::string item =
+        type_name(pc.type) + (":" + std::to_string(pc.a)) + ":" + std::to_string(pc.b);
+    if (pc.a < 0 || pc.a >= count_of(g.A, kind_a(pc.type)) || pc.b < 0 ||
+        pc.b >= count_of(g.B, kind_b(pc.type)))
       throw std::runtime_error("\"" + item + "\" names an element the models do not have");
-    out.push_back(p);
+    out.push_back({pc.type, pc.a, pc.b});
   }
   if (out.empty() || out.size() > 3) throw std::runtime_error("a set has 1 to 3 PCs");
   return out;
@@ -309,6 +301,38 @@ std::string check_rule(const Ctx& ctx, const std::vector<SetPc>& pcs, const json
   return "unknown rule \"" + rule + "\"";
 }
 
+// ---- a thin set ----
+
+// A THIN set's claim: its pose realises exactly these PCs, without penetration, every other
+// pair apart. The oracle's classifier reads the pose with the file's touch tolerance (the
+// pose's contacts are within it; its clearance, at least four times it, is not).
+std::string check_thin(const Ctx& ctx, const std::vector<SetPc>& pcs, const json& set) {
+  const json& pose = set.at("pose");
+  Pose X;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) X.R(r, c) = pose.at("R").at(r).at(c).get<double>();
+  for (int c = 0; c < 3; ++c) X.t(c) = pose.at("t").at(c).get<double>();
+  const double claimed = set.at("clearance_mm").get<double>();
+  if ((X.R.transpose() * X.R - Mat3::Identity()).norm() > 1e-9 || X.R.determinant() <= 0)
+    return "the pose's R is not a rotation";
+  Tolerances t = default_tolerances(ctx.g.A, ctx.g.B);
+  t.len = ctx.tol.touch + ctx.tol.rounding;
+  const Classifier C(ctx.g.A, ctx.g.B, t);
+  const Verdict v = C.classify(X);
+  CfKey want;
+  for (const SetPc& p : pcs) want.push_back({p.type, p.a, p.b});
+  std::sort(want.begin(), want.end());
+  if (v.penetrating) return "the pose penetrates: " + v.why;
+  if (!v.valid_cf() || v.key() != want) return "the pose realises " + v.describe();
+  const double clearance = C.clearance_outside(X, want);
+  if (clearance <= ctx.tol.touch) return "another pair touches at the pose";
+  // The generator measures the same distance with other arithmetic.
+  if (std::abs(clearance - claimed) > 1e-6 * ctx.tol.size)
+    return "clearance " + std::to_string(clearance) + " mm, not the " + std::to_string(claimed) +
+           " mm claimed";
+  return "";
+}
+
 // ---- one set ----
 
 CertSetResult check_set(const Ctx& ctx, const json& set, int index,
@@ -323,6 +347,12 @@ CertSetResult check_set(const Ctx& ctx, const json& set, int index,
     if (outcome == "undecided") {
       r.kind = "undecided";
       r.outcome = CertOutcome::Undecided;
+      return r;
+    }
+    if (outcome == "thin") {
+      r.kind = "thin";
+      r.reason = check_thin(ctx, pcs, set);
+      r.outcome = r.reason.empty() ? CertOutcome::Accepted : CertOutcome::Rejected;
       return r;
     }
     if (outcome != "invalid") throw std::runtime_error("outcome \"" + outcome + "\"");
@@ -362,16 +392,18 @@ void check_summary(const json& cert, CertificateReport& rep) {
     return;
   }
   const json& s = cert["summary"];
-  int rule = 0, cells = 0, und = 0;
+  int rule = 0, cells = 0, und = 0, thin = 0;
   for (const auto& set : cert["sets"]) {
     if (!set.is_object()) continue;  // rejected as malformed on its own
     if (set.value("outcome", json()) == "undecided") ++und;
+    if (set.value("outcome", json()) == "thin") ++thin;
     if (set.contains("rule")) ++rule;
     if (set.contains("cells")) ++cells;
   }
   const std::pair<const char*, int> want[] = {{"sets", static_cast<int>(cert["sets"].size())},
                                               {"invalid_by_rule", rule},
                                               {"invalid_by_cells", cells},
+                                              {"thin", thin},
                                               {"undecided", und}};
   for (const auto& [k, n] : want)
     if (!s.contains(k) || !s[k].is_number_integer() || s[k].get<int>() != n)

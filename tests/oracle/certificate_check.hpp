@@ -6,7 +6,8 @@
 //
 // A set is
 //  - accepted when its evidence is rechecked and proves it invalid (a rule that holds, or a
-//    tree of cells that tiles the domain and whose every leaf claim holds);
+//    tree of cells that tiles the domain and whose every leaf claim holds), or, for a THIN
+//    set, when its pose realises exactly the set, as clear as claimed;
 //  - rejected when the evidence is malformed or a claim does not hold (the reason names the
 //    set's PCs, the node and what failed);
 //  - not certified when its rule is evidence the checker does not accept (`finite-rotations`);

@@ -106,15 +106,17 @@ json cert_for(const Pair& P, json sets, json pieces = json()) {
                      {"off_circle_rad", 2e-8},
                      {"size_mm", size}};
   if (!pieces.is_null()) c["pieces"] = pieces;
-  int rule = 0, cells = 0, und = 0;
+  int rule = 0, cells = 0, thin = 0, und = 0;
   for (const auto& s : sets) {
     rule += s.contains("rule");
     cells += s.contains("cells");
+    thin += s["outcome"] == "thin";
     und += s["outcome"] == "undecided";
   }
   c["summary"] = {{"sets", sets.size()},
                   {"invalid_by_rule", rule},
                   {"invalid_by_cells", cells},
+                  {"thin", thin},
                   {"undecided", und}};
   c["sets"] = sets;
   return c;
@@ -397,6 +399,37 @@ TEST_CASE("finite-rotations is not certified, unknown rules and CFs of the graph
   CHECK(rep.accepted == 1);
   CHECK(rep.not_certified == 1);
   CHECK(rep.summary_line().find("finite-rotations 0/0/1") != std::string::npos);
+}
+
+// A THIN row: A's front face (2) on B's low top (4), its left face (4) a given gap from the
+// riser (5). Identity rotation, so x_B = x_A + t.
+json thin_set(double gap, double claimed, double lift = 0) {
+  json R = json::array(
+      {json::array({1.0, 0.0, 0.0}), json::array({0.0, 1.0, 0.0}), json::array({0.0, 0.0, 1.0})});
+  return {{"pcs", "f-f:2:4"},
+          {"outcome", "thin"},
+          {"clearance_mm", claimed},
+          {"margin_mm", 0.5},
+          {"pose", {{"R", R}, {"t", {10.0 + gap, 10.0 + lift, 5.0}}}}};
+}
+
+TEST_CASE("thin: the pose must realise exactly the set, as clear as claimed") {
+  Pair P = make_pair();
+  CHECK(one(P, thin_set(1e-3, 1e-3)).outcome == CertOutcome::Accepted);
+  auto r = one(P, thin_set(0, 0));  // A's left face on the riser too
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK(r.reason.rfind("the pose realises ", 0) == 0);
+  CHECK(r.reason.find("f-f:4:5") != std::string::npos);
+  r = one(P, thin_set(1e-3, 1e-3, -0.01));  // 0.01 mm into the low top
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK(r.reason.rfind("the pose penetrates: ", 0) == 0);
+  r = one(P, thin_set(1e-3, 0.5));
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK(r.reason == "clearance 0.001000 mm, not the 0.500000 mm claimed");
+  const CertificateReport rep = run(P, cert_for(P, json::array({thin_set(1e-3, 1e-3)})));
+  CHECK(rep.passed());
+  CHECK(rep.accepted == 1);
+  CHECK(rep.by_kind.at("thin")[static_cast<int>(CertOutcome::Accepted)] == 1);
 }
 
 TEST_CASE("cells: a rotation leaf over the whole f-f circle") {

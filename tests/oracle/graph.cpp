@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace oracle {
@@ -28,6 +29,21 @@ Poly poly_from_json(const nlohmann::json& m, const std::string& name) {
 }
 
 }  // namespace
+
+std::vector<Pc> parse_pc_list(const std::string& text) {
+  std::vector<Pc> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ';')) {
+    const auto c1 = item.find(':'), c2 = item.rfind(':');
+    PcType t;
+    if (c1 == std::string::npos || c1 == c2 || !parse_type(item.substr(0, c1), &t) ||
+        !nondegenerate(t))
+      throw std::runtime_error("\"" + item + "\" is not a PC type:a:b");
+    out.push_back({t, std::stoi(item.substr(c1 + 1, c2 - c1 - 1)), std::stoi(item.substr(c2 + 1))});
+  }
+  return out;
+}
 
 Graph read_graph(const std::string& path) {
   std::ifstream in(path);
@@ -60,6 +76,14 @@ Graph read_graph(const std::string& path) {
       cf.witness.t = Vec3(t.at(0).get<double>(), t.at(1).get<double>(), t.at(2).get<double>());
       G.cfs.push_back(cf);
     }
+    if (j.contains("stats") && j["stats"].contains("thin_sets"))
+      for (const auto& t : j["stats"]["thin_sets"]) {
+        CfKey k = parse_pc_list(t.at("pcs").get<std::string>());
+        std::sort(k.begin(), k.end());
+        G.thin.push_back(k);
+      }
+    if (j.contains("parameters"))
+      G.min_clearance_mm = j["parameters"].value("min_clearance_mm", 0.0);
   } catch (const std::exception& e) {
     throw std::runtime_error("graph " + path + ": " + e.what());
   }

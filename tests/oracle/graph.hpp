@@ -20,7 +20,14 @@ struct Graph {
   std::string path;
   Poly A, B;  // rebuilt from models.A / models.B (vertices, edges, faces only)
   std::vector<GraphCf> cfs;
+  /// stats.thin_sets: sets the generator found realised only below its witnesses' margins.
+  std::vector<CfKey> thin;
+  double min_clearance_mm = 0;  // parameters.min_clearance_mm (0 when absent)
 };
+
+/// A PC list as the generator writes it ("f-f:3:5;e-e:6:16"), in its order; non-degenerate
+/// types only. Throws std::runtime_error naming the item that is not `type:a:b`.
+std::vector<Pc> parse_pc_list(const std::string& text);
 
 /// Throws std::runtime_error naming the file and the problem.
 Graph read_graph(const std::string& path);

@@ -73,15 +73,16 @@ bool parse_pose_arg(const std::string& a, Pose* X) {
 std::string RecallResult::line() const {
   char buf[512];
   std::snprintf(buf, sizeof buf,
-                "%s graph=%d sampled=%d misses=%zu recall=%.1f%% unsound=%d marginal=%d dropped=%d "
+                "%s graph=%d sampled=%d misses=%zu thin=%zu recall=%.1f%% unsound=%d marginal=%d "
+                "dropped=%d "
                 "cfgen=%.1fs "
                 "sampler=%.1fs",
                 from_seed ? ((extra >= 0 ? "extra=" + std::to_string(extra) + " " : std::string()) +
                              "seed=" + std::to_string(seed))
                                 .c_str()
                           : "files",
-                graph_cfs, sampled, misses.size(), recall(), check.unsound, check.marginal,
-                unstable + suspect, cfgen_s, sampler_s);
+                graph_cfs, sampled, misses.size(), thin.size(), recall(), check.unsound,
+                check.marginal, unstable + suspect, cfgen_s, sampler_s);
   std::string s = buf;
   if (!ok) s += " ERROR: " + error;
   if (!model_problems.empty()) s += " MODEL-MISMATCH";
@@ -124,6 +125,12 @@ std::string RecallResult::details() const {
   for (const auto& m : suspects)
     o << "  SUSPECT (not counted: the Monte-Carlo check found points of A inside B) " << who << " {"
       << key_string(m.key) << "}\n    pose " << pose_string(m.sample.pose) << "\n";
+  for (const auto& m : thin) {
+    char cl[64];
+    std::snprintf(cl, sizeof cl, "%.4g", m.sample.clearance);
+    o << "  THIN (listed in the graph's stats.thin_sets, not a miss) " << who << " {"
+      << key_string(m.key) << "} clearance " << cl << " mm\n";
+  }
   std::map<std::string, int> groups;
   for (const auto& m : misses) groups[signature(m.key)]++;
   if (!misses.empty()) {
@@ -352,6 +359,7 @@ RecallResult run_pair(const Mesh& A, const Mesh& B, const std::string& dir, cons
     tlo.len /= 10;
     thi.len *= 10;
     Classifier Clo(G.A, G.B, tlo), Chi(G.A, G.B, thi);
+    const std::set<CfKey> thin(G.thin.begin(), G.thin.end());
     for (const auto& [k, s] : S.samples()) {
       Verdict a = Clo.classify(s.pose, false), b = Chi.classify(s.pose, false);
       if (!a.valid_cf() || !b.valid_cf() || a.key() != k || b.key() != k) {
@@ -380,7 +388,10 @@ RecallResult run_pair(const Mesh& A, const Mesh& B, const std::string& dir, cons
         r.suspects.push_back(Miss{k, s});
         continue;
       }
-      r.misses.push_back(Miss{k, s});
+      if (s.clearance < G.min_clearance_mm && thin.count(k))
+        r.thin.push_back(Miss{k, s});
+      else
+        r.misses.push_back(Miss{k, s});
     }
     r.ok = true;
     if (o.inspect) o.inspect(r);  // while the files are there

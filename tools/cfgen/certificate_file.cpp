@@ -1,6 +1,7 @@
 #include "cfgen/certificate_file.hpp"
 
 #include "cfgen/decide/deep_points.hpp"
+#include "cfgen/enumerate/symmetry.hpp"
 
 #include <cf/file_io.hpp>
 
@@ -132,8 +133,22 @@ json pieces_json(const gen::ModelInfo& m, const std::set<int>& faces) {
   return out;
 }
 
-json set_json(const gen::SetDecision& d, const gen::WitnessSearch& search,
-              const gen::CellSearchLimits& limits, const gen::DeepPoints& deep) {
+// The THIN set `pcs` of e.thin (sorted), or null.
+const gen::Witness* thin_of(const gen::Enumeration& e, const PcSet& pcs) {
+  auto it = std::lower_bound(e.thin.begin(), e.thin.end(), pcs, [](const auto& x, const PcSet& s) {
+    return gen::pcset_less(x.first, s);
+  });
+  return it != e.thin.end() && it->first == pcs ? &it->second : nullptr;
+}
+
+json set_json(const gen::SetDecision& d, const gen::Enumeration& e,
+              const gen::WitnessSearch& search, const gen::CellSearchLimits& limits,
+              const gen::DeepPoints& deep) {
+  if (const gen::Witness* w = d.thin ? thin_of(e, d.pcs) : nullptr) {
+    json j = thin_set_json(d.pcs, *w);
+    j["outcome"] = "thin";
+    return j;
+  }
   json j = {{"pcs", to_string(d.pcs)}, {"outcome", d.invalid ? "invalid" : "undecided"}};
   if (!d.invalid) return j;
   if (d.cells) {
@@ -156,10 +171,13 @@ json head_json(const std::string& graph_path, const gen::Enumeration& e,
                const gen::WitnessSearch& search, const gen::CellSearchLimits& limits, double size) {
   std::set<int> faces_a, faces_b;
   std::map<std::string, std::size_t> counts{
-      {"invalid_by_rule", 0}, {"invalid_by_cells", 0}, {"undecided", 0}};
+      {"invalid_by_rule", 0}, {"invalid_by_cells", 0}, {"thin", 0}, {"undecided", 0}};
   for (const gen::SetDecision& d : e.decisions) {
     if (d.cells) add_faces(d.pcs, faces_a, faces_b);
-    ++counts[!d.invalid ? "undecided" : d.cells ? "invalid_by_cells" : "invalid_by_rule"];
+    ++counts[d.thin       ? "thin"
+             : !d.invalid ? "undecided"
+             : d.cells    ? "invalid_by_cells"
+                          : "invalid_by_rule"];
   }
   json summary = {{"sets", e.decisions.size()}};
   for (const auto& [k, v] : counts) summary[k] = v;
@@ -179,6 +197,16 @@ json head_json(const std::string& graph_path, const gen::Enumeration& e,
 }
 
 }  // namespace
+
+json thin_set_json(const PcSet& pcs, const gen::Witness& w) {
+  json R = json::array();
+  for (int r = 0; r < 3; ++r)
+    R.push_back({w.pose.R_BA(r, 0), w.pose.R_BA(r, 1), w.pose.R_BA(r, 2)});
+  return {{"pcs", to_string(pcs)},
+          {"clearance_mm", w.clearance},
+          {"margin_mm", w.margin},
+          {"pose", {{"R", std::move(R)}, {"t", vec(w.pose.t_BA)}}}};
+}
 
 void write_certificates(const std::string& path, const std::vector<std::string>& inputs,
                         const std::string& graph_path, const gen::Enumeration& e,
@@ -200,7 +228,7 @@ void write_certificates(const std::string& path, const std::vector<std::string>&
                              text += ",\n \"sets\": [";
                              for (std::size_t i = 0; i < e.decisions.size(); ++i) {
                                text += i ? ",\n  " : "\n  ";
-                               text += set_json(e.decisions[i], search, limits, deep).dump();
+                               text += set_json(e.decisions[i], e, search, limits, deep).dump();
                                if (text.size() > (1u << 20)) {
                                  sink(text.data(), text.size());
                                  text.clear();

@@ -7,10 +7,16 @@
 #include "cfgen/decide/witness.hpp"
 #include "cfgen/enumerate/enumerate.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <string>
 #include <vector>
 
 namespace cf::tools {
+
+/// A THIN set (gen::Enumeration::thin) as the graph's `stats.thin_sets` and the certificate
+/// file list it: {"pcs", "clearance_mm", "margin_mm", "pose": {"R": rows, "t": mm}}.
+nlohmann::json thin_set_json(const PcSet& pcs, const gen::Witness& w);
 
 /// Writes `e.decisions` (a run with EnumerateOptions::certificates) as the certificate file at
 /// `path`, whole or not at all, never over one of `inputs`. graph_path: the graph written

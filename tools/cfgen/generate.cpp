@@ -118,6 +118,9 @@ nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args,
   nlohmann::json undecided = nlohmann::json::array();
   for (std::size_t i = 0; i < e.undecided.size() && i < kUndecidedListed; ++i)
     undecided.push_back(to_string(e.undecided[i]));
+  // Every THIN set, with its pose: they are few (about 2% of the CFs of an n-gon peg and hole).
+  nlohmann::json thin = nlohmann::json::array();
+  for (const auto& [pcs, w] : e.thin) thin.push_back(thin_set_json(pcs, w));
   meta["stats"] = {{"cfs", e.cfs.size()},
                    {"cfs_by_pc_count", by_count},
                    {"pcs_by_type", by_type},
@@ -129,7 +132,9 @@ nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args,
                    {"min_witness_margin_mm", e.cfs.empty() ? 0.0 : e.min_margin},
                    {"refuted_over_cells", e.refuted_over_cells},
                    {"undecided", e.undecided.size()},
-                   {"undecided_sets", undecided}};
+                   {"undecided_sets", undecided},
+                   {"thin", e.thin.size()},
+                   {"thin_sets", thin}};
   // Timing goes to stderr, not into the file, so that the same input gives the same bytes.
   meta["parameters"] = {
       {"length_scale_mm", diag},

@@ -42,6 +42,9 @@ struct SetDecision {
   bool invalid = false;             // false: undecided
   RuleVerdict rule;                 // invalid by this rule, or (kNone) by `cells`
   std::shared_ptr<CellTree> cells;  // invalid by cells: the complete tree
+  /// A THIN set (Enumeration::thin): realised only with a smaller clearance or margin than a
+  /// witness has; invalid is false.
+  bool thin = false;
   /// A set a rule refuted whose cells found a witness (a rule that failed): kept invalid, as
   /// the graph has it, and reported.
   bool contradicted = false;
@@ -65,7 +68,10 @@ struct Enumeration {
   double min_margin = 0;                           // mm, smallest LP margin of a witness's contacts
   std::size_t symmetries_a = 1, symmetries_b = 1;  // the models' symmetries, identity included
   std::vector<PcSet> undecided;                    // failed candidates with no proof of invalidity
-  std::size_t refuted_over_cells = 0;              // failed candidates refuted by search_cells
+  /// Failed candidates a pose realises exactly, though only with a clearance or margin below
+  /// the witnesses' (thin_params), with that pose; canonical order.
+  std::vector<std::pair<PcSet, Witness>> thin;
+  std::size_t refuted_over_cells = 0;  // failed candidates refuted by search_cells
   /// With EnumerateOptions::certificates: every failed set, in canonical order.
   std::vector<SetDecision> decisions;
 };

@@ -129,19 +129,33 @@ void Enumerator::find_undecided() {
         }
       },
       &ev, t0);
+  std::vector<PcSet> open;
   for (std::size_t i = 0; i < failed_.size(); ++i) {
-    if (state[i] == kOpen) out_.undecided.push_back(failed_[i]);
+    if (state[i] == kOpen) open.push_back(failed_[i]);
     if (state[i] == kOverCells) ++out_.refuted_over_cells;
     if (state[i] == kFound) add_with_images(failed_[i], found[i], known);
   }
-  finished(ev, t0, std::to_string(out_.undecided.size()) + " undecided");
-  std::sort(out_.undecided.begin(), out_.undecided.end(), pcset_less);
+  std::sort(open.begin(), open.end(), pcset_less);
+  finished(ev, t0, std::to_string(open.size()) + " without a proof");
+  PcSetSet thin_sets;
+  for (auto& [s, w] : find_thin(open)) {
+    if (w.clearance >= search_.params().min_clearance && w.margin >= search_.params().min_margin) {
+      add_with_images(s, w, known);  // as clear as a witness: valid after all
+      continue;
+    }
+    thin_sets.insert(s);
+    out_.thin.push_back({s, w});
+  }
+  for (const PcSet& s : open)
+    if (!thin_sets.count(s) && !known.count(s)) out_.undecided.push_back(s);
+
   if (!keep) return;
   // Sets the cells found witnesses for, or made CFs as their images, are in the graph.
   for (std::size_t i = 0; i < failed_.size(); ++i) {
     if (known.count(failed_[i])) continue;
     decisions[i].pcs = failed_[i];
     decisions[i].invalid = state[i] != kOpen;
+    if (thin_sets.count(failed_[i])) decisions[i].thin = true;
     out_.decisions.push_back(std::move(decisions[i]));
   }
   auto less = [](const SetDecision& x, const SetDecision& y) { return pcset_less(x.pcs, y.pcs); };
@@ -150,6 +164,58 @@ void Enumerator::find_undecided() {
       std::unique(out_.decisions.begin(), out_.decisions.end(),
                   [](const SetDecision& x, const SetDecision& y) { return x.pcs == y.pcs; }),
       out_.decisions.end());
+}
+
+// THIN sets (docs/generator.md, "Thin sets"): of the open sets (sorted), those a pose
+// realises exactly, though only with a smaller clearance or margin than a witness has. One
+// set of each orbit of the pair's symmetries is searched with thin_params; the others are
+// taken at the images of its pose, and searched on their own where an image does not verify.
+// Returns the sets found with their poses, in canonical order.
+std::vector<std::pair<PcSet, Witness>> Enumerator::find_thin(const std::vector<PcSet>& open) {
+  const WitnessSearch thin(search_.a(), search_.b(), thin_params(search_.params()));
+  std::vector<std::pair<PcSet, Witness>> out;
+  std::vector<PcSet> todo;  // one set per orbit, then the members no image reached
+  PcSetSet first_of_orbit;
+  const PcSetSet open_set(open.begin(), open.end());
+  for (const PcSet& s : open)
+    if (first_of_orbit.insert(sym_.canonical(s)).second) todo.push_back(s);
+  const auto t0 = Clock::now();
+  ProgressEvent ev{"thin sets", "open candidate sets", 0, todo.size(), 0, false, {}};
+  PcSetSet done;
+  for (int pass = 0; pass < 2 && !todo.empty(); ++pass) {
+    std::vector<Witness> w(todo.size());
+    runner_.for_each(
+        todo.size(), [&](std::size_t i) { w[i] = thin.find(todo[i], {}); },
+        pass == 0 ? &ev : nullptr, t0);
+    for (std::size_t i = 0; i < todo.size(); ++i) done.insert(todo[i]);
+    std::vector<std::pair<PcSet, Witness>> images;
+    for (std::size_t i = 0; i < todo.size(); ++i) {
+      if (!w[i].found) continue;
+      out.push_back({todo[i], w[i]});
+      for (std::size_t k = 1; k < sym_.size() && pass == 0; ++k) {
+        const PcSet t = sym_.image(todo[i], k);
+        if (!open_set.count(t) || !done.insert(t).second) continue;
+        Witness v = w[i];
+        v.pose = sym_.image(w[i].pose, k);
+        images.push_back({t, v});
+      }
+    }
+    runner_.for_each(images.size(), [&](std::size_t i) {
+      auto& [t, v] = images[i];
+      const Witness image = thin.image_witness(t, v.pose);
+      v = image.found ? image : Witness{};
+    });
+    todo.clear();
+    for (auto& [t, v] : images)
+      if (v.found)
+        out.push_back({t, v});
+      else
+        todo.push_back(t);
+  }
+  finished(ev, t0, std::to_string(out.size()) + " realised thin");
+  std::sort(out.begin(), out.end(),
+            [](const auto& x, const auto& y) { return pcset_less(x.first, y.first); });
+  return out;
 }
 
 // The evidence for a set `rule` decided: the rule, or for the finite-rotations rule (rotations

@@ -29,6 +29,21 @@ struct SearchParams {
   int max_piece_combinations = 4;
 };
 
+/// The floor, in touch tolerances, of a THIN pose's clearance and contact margin: above the
+/// touch tolerance with room for the rounding of the pose as written, so that the pose
+/// realises exactly its PCs, yet far below any margin a witness is asked for.
+inline constexpr double kThinFloorTouchTols = 4.0;
+
+/// The tolerances a THIN pose verifies with (docs/generator.md, "Thin sets"): those of `p`
+/// with min_clearance and min_margin lowered to kThinFloorTouchTols x touch_tol, and a search
+/// that stops at the first pose as clear as `p` asks.
+inline SearchParams thin_params(const SearchParams& p) {
+  SearchParams t = p;
+  t.min_clearance = t.min_margin = kThinFloorTouchTols * p.touch_tol;
+  t.good_clearance = p.min_clearance;
+  return t;
+}
+
 /// Whether a PC of `pcs` covers the pair (element a of A, element b of B): each element lies
 /// in the closure of that PC's element on its side (a PC covers its own pair). Touching such
 /// a pair does not change the contact set.
