@@ -121,7 +121,7 @@ CellSearchLimits decision_limits(const WitnessSearch& search, std::size_t max_ce
   CellSearchLimits limits;
   limits.max_cells = max_cells;
   limits.touch_tol = search.params().touch_tol;
-  limits.margin = search.params().min_margin;
+  limits.margin = thin_params(search.params()).min_margin;
   limits.local_slack = search.verified_local_slack();
   return limits;
 }

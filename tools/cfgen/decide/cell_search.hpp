@@ -31,8 +31,9 @@ struct CellSearchLimits {
 };
 
 /// The limits a run's decision uses (docs/generator.md, "What the search could not decide"):
-/// the verifier's touch tolerance, margin and local slack, so that a refutation shows that no
-/// witness exists; at most max_cells cells.
+/// the verifier's touch tolerance and local slack, and the contact margin of a THIN pose
+/// (thin_params), so that a refutation shows that no pose realises the set with any room, a
+/// witness or a THIN pose; at most max_cells cells.
 CellSearchLimits decision_limits(const WitnessSearch& search, std::size_t max_cells);
 
 /// Angles [centre - half, centre + half] (rad) of the rotations R0 Rot(n_A, theta) that

@@ -218,7 +218,7 @@ RuleVerdict WitnessSearch::refuted_by(const PcSet& pcs) const {
     std::vector<int> choice(slot_sizes.size(), 0);
     for (std::size_t k = 0; k < combos; ++k) {
       const LpResult r = solve(build_lp(pcs, R, choice));
-      if (r.status == LpResult::Status::kOptimal && r.x[3] >= p_.min_margin) return {};
+      if (r.status == LpResult::Status::kOptimal && r.x[3] >= thin_params(p_).min_margin) return {};
       for (std::size_t i = 0; i < choice.size() && ++choice[i] == slot_sizes[i]; ++i) choice[i] = 0;
     }
   }

@@ -80,7 +80,8 @@ class WitnessSearch : public Verifier {
   /// For a set `find` found no witness for: true when it is proven invalid within the
   /// search's tolerances (a necessary condition fails, or its rotational conditions leave
   /// finitely many rotations and at each the PCs are locally penetrating or cannot be placed
-  /// inside their elements). False means undecided: the search gave up without a proof.
+  /// inside their elements with a THIN pose's margin, thin_params). False means undecided:
+  /// the search gave up without a proof.
   bool refuted(const PcSet& pcs) const { return refuted_by(pcs).rule != Rule::kNone; }
   /// The rule that proves `pcs` invalid, as refuted() decides it; kNone: undecided.
   RuleVerdict refuted_by(const PcSet& pcs) const;
