@@ -1,6 +1,7 @@
 // Tests of the one-parameter rotation families the witness search samples
 // (tools/cfgen/decide/rotation_family.cpp): the spins about an axis that keep a set's PCs
-// locally admissible (admissible_spins).
+// locally admissible (admissible_spins), and the residual that makes the PCs' planes meet
+// where their normals are dependent (translation_residual).
 
 #include "cfgen/decide/rotation_family.hpp"
 #include "analysed_pair.hpp"
@@ -12,6 +13,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <optional>
 #include <vector>
 
 namespace {
@@ -101,4 +103,51 @@ TEST_CASE("admissible spins: the samples' centres where they are admissible, non
   // The diagonal pointing down: every ray below the face at every spin.
   const Mat3 down = cf::gen::align(d, -Vec3::UnitZ());
   CHECK(cf::gen::internal::admissible_spins(p.ai, p.bi, pcs, d, down, 24, min_local).empty());
+}
+
+TEST_CASE(
+    "translation residual: two parallel edges on two parallel faces meet only where the edges' "
+    "height difference is the faces'; independent planes leave no residual",
+    "[rotation_family][cfgen]") {
+  // A 40 x 10 x 10 box turned by theta about z: its edges along z at x = 0 and x = 40 rise
+  // 40 sin(theta) apart. On the small L-block's floor top (y = 10) and wall top (y = 40), 30
+  // apart, the two contact planes are parallel, so with any third PC the planes meet only
+  // where 40 sin(theta) = 30; the residual is the offsets' difference over sqrt(2) (the rows'
+  // left null vector (1, -1, 0) / sqrt(2)).
+  const cf::Polyhedron A = cf::test::box(40, 10, 10, "A");
+  const cf::Polyhedron B = cf::test::small_l_block();
+  const int e_near = cf::test::edge_between(A, 0, 4), e_far = cf::test::edge_between(A, 1, 5);
+  const int floor_top = cf::test::face_with_plane(B, Vec3::UnitY(), 10);
+  const int wall_top = cf::test::face_with_plane(B, Vec3::UnitY(), 40);
+  const int wall = cf::test::face_with_plane(B, Vec3::UnitX(), 10);
+  REQUIRE(e_near >= 0);
+  REQUIRE(e_far >= 0);
+  REQUIRE(floor_top >= 0);
+  REQUIRE(wall_top >= 0);
+  REQUIRE(wall >= 0);
+  cf::PcSet pcs;
+  pcs.insert(cf::Pc{cf::PcType::kEF, e_near, floor_top});
+  pcs.insert(cf::Pc{cf::PcType::kEF, e_far, wall_top});
+  pcs.insert(cf::Pc{cf::PcType::kVF, 3, wall});  // any third PC
+  auto residual = [&](double theta) {
+    const std::optional<double> r = cf::gen::internal::translation_residual(
+        A, B, pcs, cf::gen::axis_angle(Vec3::UnitZ(), theta));
+    REQUIRE(r.has_value());
+    return *r;
+  };
+  constexpr double kRounding = 1e-12;  // mm: a few operations on tens of mm
+  const double root = std::asin(0.75);
+  for (double theta : {0.0, 0.3, root, 1.2})
+    CHECK(std::abs(std::abs(residual(theta)) - std::abs(40 * std::sin(theta) - 30) / std::sqrt(2)) <
+          kRounding);
+  CHECK((residual(root - 0.01) > 0) != (residual(root + 0.01) > 0));
+
+  // Three faces of B at right angles: the planes always meet.
+  const int bottom = cf::test::face_with_plane(B, -Vec3::UnitZ(), 0);
+  REQUIRE(bottom >= 0);
+  cf::PcSet corner;
+  corner.insert(cf::Pc{cf::PcType::kFF, 2, floor_top});
+  corner.insert(cf::Pc{cf::PcType::kFF, 5, wall});
+  corner.insert(cf::Pc{cf::PcType::kFF, 0, bottom});
+  CHECK(!cf::gen::internal::translation_residual(A, B, corner, Mat3::Identity()).has_value());
 }

@@ -59,6 +59,7 @@ class FindRun {
   bool climb_margin(const std::vector<Mat3>& rots);
   bool climb_local(const Mat3& start);
   std::vector<Mat3> family_ends() const;
+  std::vector<Mat3> consistent_rotations() const;
 
   const WitnessSearch& s_;
   const SearchParams& p_;
@@ -478,6 +479,46 @@ std::vector<Mat3> FindRun::family_ends() const {
   return ends;
 }
 
+// Where the PCs' planes are dependent at every rotation of the family (translation_residual:
+// two parallel edges of A on two parallel faces of B, and an e-e), the LP is infeasible
+// except on a curve of rotations where the planes meet, which samples never hit. Projects the
+// family's samples onto that curve, walks it from the first locally admissible ones, and
+// returns along each walk the locally admissible rotation that places the contacts deepest,
+// where that reaches min_margin.
+std::vector<Mat3> FindRun::consistent_rotations() const {
+  constexpr std::size_t kStarts = 4;  // projected rotations walked from
+  constexpr double kWalkStep = 0.01;  // rad: below the admissible arcs' width
+  constexpr int kWalkSteps = 200;     // up to 2 rad each way
+  const Polyhedron& A = *s_.a().model;
+  const Polyhedron& B = *s_.b().model;
+  std::vector<Mat3> out;
+  const RotConstraints c = rotation_constraints(pcs_, A, B);
+  const std::vector<Mat3> samples =
+      s_.family_samples(pcs_, s_.spread_rotations(pcs_, seeds_), p_.theta_samples);
+  if (!c.align.empty() || samples.empty() || !translation_residual(A, B, pcs_, samples.front()))
+    return out;
+  std::vector<Mat3> starts;
+  for (Mat3 R : samples)
+    if (starts.size() < kStarts && project_consistent(A, B, pcs_, c, R) &&
+        s_.local_margin(pcs_, R) > min_local_)
+      add_unique(starts, R);
+  const std::vector<int> first_pieces(slot_sizes_.size(), 0);
+  for (const Mat3& R0 : starts)
+    for (const std::vector<Mat3>& path :
+         walk_consistent(A, B, pcs_, c, R0, kWalkStep, kWalkSteps)) {
+      double best = p_.min_margin;
+      std::optional<Mat3> best_R;
+      for (const Mat3& R : path) {
+        if (s_.local_margin(pcs_, R) <= min_local_) continue;
+        const double m = s_.signed_margin(pcs_, R, first_pieces);
+        if (m >= best) best = m, best_R = R;
+      }
+      if (best_R) add_unique(out, *best_R);
+    }
+  if (s_.debug_) std::cerr << "  " << out.size() << " rotations where the planes meet\n";
+  return out;
+}
+
 Witness FindRun::run() {
   if (!s_.plausible(pcs_)) return best_;
   const std::vector<Mat3> rots = s_.rotation_candidates(pcs_, seeds_, !seeds_only_);
@@ -498,6 +539,7 @@ Witness FindRun::run() {
   if (try_all(s_.anchored_rotations(pcs_, &miss)) || best_.found) return best_;
   if (miss && climb_local(*miss)) return best_;
   if (near_.empty() && climb_margin(rots)) return best_;
+  if (near_.empty() && (try_all(consistent_rotations()) || best_.found)) return best_;
   if (best_.found || near_.empty()) return best_;
   // The contacts could be placed but the pose touched something else: look closer around
   // those rotations, where valid sets with a narrow range of orientations live.

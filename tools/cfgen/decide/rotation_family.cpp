@@ -229,4 +229,140 @@ std::vector<double> admissible_spins(const ModelInfo& a, const ModelInfo& b, con
   return out;
 }
 
+std::optional<double> translation_residual(const Polyhedron& A, const Polyhedron& B,
+                                           const PcSet& pcs, const Mat3& R) {
+  constexpr double kDependent = 1e-9;  // |det| of unit normals: dependent up to rounding
+  if (pcs.size() != 3) return std::nullopt;
+  Vec3 n[3];
+  double h[3];
+  int i = 0;
+  for (const Pc& pc : pcs) {
+    const auto face_a = [&](const Vec3& p_B) {  // A's face through the point p_B of B
+      const Face& f = A.faces()[pc.a];
+      n[i] = R * f.normal;
+      h[i] = n[i].dot(p_B) - f.offset;
+    };
+    const auto face_b = [&](const Vec3& p_A) {  // B's face through the point R p_A + t
+      const Face& f = B.faces()[pc.b];
+      n[i] = f.normal;
+      h[i] = f.offset - n[i].dot(R * p_A);
+    };
+    switch (pc.type) {
+      case PcType::kFF:
+        face_b(A.faces()[pc.a].centroid);
+        break;
+      case PcType::kVF:
+        face_b(A.vertices()[pc.a].p);
+        break;
+      case PcType::kEF:
+        face_b(A.vertices()[A.edges()[pc.a].v0.index()].p);
+        break;
+      case PcType::kFV:
+        face_a(B.vertices()[pc.b].p);
+        break;
+      case PcType::kFE:
+        face_a(B.vertices()[B.edges()[pc.b].v0.index()].p);
+        break;
+      case PcType::kEE: {
+        const Edge& ea = A.edges()[pc.a];
+        const Edge& eb = B.edges()[pc.b];
+        const Vec3 m = (R * ea.dir).cross(eb.dir);
+        if (m.norm() < 1e-9) return std::nullopt;  // parallel edges: not a PC
+        n[i] = m.normalized();
+        h[i] = n[i].dot(B.vertices()[eb.v0.index()].p - R * A.vertices()[ea.v0.index()].p);
+        break;
+      }
+    }
+    ++i;
+  }
+  if (std::abs(n[0].cross(n[1]).dot(n[2])) > kDependent) return std::nullopt;
+  // The plane of the normals, from the first pair not near parallel: the same pair all along
+  // a family, so that the residual's sign is continuous there.
+  Vec3 m = n[0].cross(n[1]);
+  if (m.norm() < 1e-3) m = n[1].cross(n[2]);
+  if (m.norm() < 1e-3) m = n[2].cross(n[0]);
+  if (m.norm() < 1e-3) return std::nullopt;  // all three near parallel
+  m.normalize();
+  const Vec3 z(n[1].cross(n[2]).dot(m), n[2].cross(n[0]).dot(m), n[0].cross(n[1]).dot(m));
+  return z.dot(Vec3(h[0], h[1], h[2])) / z.norm();
+}
+
+namespace {
+
+// The perpendicularity conditions' residuals and the planes' (scaled by 1 / size), and their
+// Jacobian in a turn of R (numerical).
+bool consistency_rows(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs,
+                      const RotConstraints& c, const Mat3& R, Eigen::VectorXd& r,
+                      Eigen::MatrixXd* J) {
+  const double size = std::max((A.bbox_max() - A.bbox_min()).norm(), 1e-9);
+  auto rows = [&](const Mat3& Q, Eigen::VectorXd& out) {
+    const std::optional<double> t = translation_residual(A, B, pcs, Q);
+    if (!t) return false;
+    out.resize(static_cast<Eigen::Index>(c.perp.size()) + 1);
+    for (std::size_t i = 0; i < c.perp.size(); ++i)
+      out[static_cast<Eigen::Index>(i)] = (Q * c.perp[i].first).dot(c.perp[i].second);
+    out[out.size() - 1] = *t / size;
+    return true;
+  };
+  if (!rows(R, r)) return false;
+  if (!J) return true;
+  constexpr double kH = 1e-7;  // rad: a forward difference's step
+  J->resize(r.size(), 3);
+  Eigen::VectorXd rq;
+  for (int a = 0; a < 3; ++a) {
+    if (!rows(axis_angle(Vec3::Unit(a), kH) * R, rq)) return false;
+    J->col(a) = (rq - r) / kH;
+  }
+  return true;
+}
+
+// The direction of the curve at R: the Jacobian's null vector.
+Vec3 consistent_tangent(const Eigen::MatrixXd& J) {
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
+  return svd.matrixV().col(2);
+}
+
+}  // namespace
+
+bool project_consistent(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs,
+                        const RotConstraints& c, Mat3& R) {
+  if (!c.align.empty()) return false;
+  Eigen::VectorXd r;
+  Eigen::MatrixXd J;
+  for (int it = 0; it < 40; ++it) {
+    if (!consistency_rows(A, B, pcs, c, R, r, &J)) return false;
+    if (r.cwiseAbs().maxCoeff() < 1e-13) return true;
+    const Eigen::Vector3d d = -J.completeOrthogonalDecomposition().solve(r);
+    if (!d.allFinite() || d.norm() < 1e-16) return false;
+    R = axis_angle(d.normalized(), std::min(d.norm(), 0.3)) * R;
+  }
+  return false;
+}
+
+std::vector<std::vector<Mat3>> walk_consistent(const Polyhedron& A, const Polyhedron& B,
+                                               const PcSet& pcs, const RotConstraints& c,
+                                               const Mat3& R, double h, int n) {
+  std::vector<std::vector<Mat3>> paths;
+  Eigen::VectorXd r;
+  Eigen::MatrixXd J;
+  if (!consistency_rows(A, B, pcs, c, R, r, &J)) return paths;
+  const Vec3 t0 = consistent_tangent(J);
+  for (double sg : {1.0, -1.0}) {
+    std::vector<Mat3> path;
+    Mat3 Q = R;
+    Vec3 dir = sg * t0;
+    for (int k = 0; k < n; ++k) {
+      Mat3 next = axis_angle(dir, h) * Q;
+      if (!project_consistent(A, B, pcs, c, next) || !consistency_rows(A, B, pcs, c, next, r, &J))
+        break;
+      Vec3 t = consistent_tangent(J);
+      dir = t.dot(dir) < 0 ? Vec3(-t) : t;  // keep going the same way
+      path.push_back(next);
+      Q = next;
+    }
+    paths.push_back(std::move(path));
+  }
+  return paths;
+}
+
 }  // namespace cf::gen::internal

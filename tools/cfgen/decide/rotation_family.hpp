@@ -6,6 +6,7 @@
 #include "cfgen/verify/rotation_conditions.hpp"
 
 #include <initializer_list>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -39,6 +40,26 @@ std::vector<Mat3> project_onto(const RotConstraints& c, const Mat3& R);
 /// is entered by a small turn about a coordinate axis projected back onto the conditions.
 /// Empty for other families.
 std::vector<std::vector<Mat3>> walk_family(const RotConstraints& c, const Mat3& R, double h, int n);
+
+/// Each PC of `pcs` asks the translation t of A (x_B = R x_A + t) to put its contact on one
+/// plane, n_i . t = h_i (R): the plane of its face, or for an e-e the plane through B's edge
+/// parallel to both edges. Where three such normals lie in one plane at every rotation of a
+/// family (two PCs on the faces beside an edge of B and an e-e on that edge), the planes meet
+/// only where z . h = 0, z the left null vector of the rows oriented by n_1 x n_2: a condition
+/// on the rotation alone, met at isolated points of the family. Returns z . h (mm) at R, or
+/// nothing when the set has not three PCs or the normals are independent at R.
+std::optional<double> translation_residual(const Polyhedron& A, const Polyhedron& B,
+                                           const PcSet& pcs, const Mat3& R);
+
+/// Rotations that meet the perpendicularity conditions of `c` (no alignment) and make the
+/// PCs' planes meet (translation_residual == 0), where the residual is defined: R projected
+/// onto them by Gauss-Newton (false when that fails), and the curve of such rotations walked
+/// from R by steps of h rad, at most n each way (both ways, R excluded).
+bool project_consistent(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs,
+                        const RotConstraints& c, Mat3& R);
+std::vector<std::vector<Mat3>> walk_consistent(const Polyhedron& A, const Polyhedron& B,
+                                               const PcSet& pcs, const RotConstraints& c,
+                                               const Mat3& R, double h, int n);
 
 /// Spins phi (rad) at which R0 Rot(axis, phi) (axis: unit, A's frame) holds every PC of `pcs`
 /// locally admissible, its local margin (Verifier::local_margin) above min_local: the centres
