@@ -59,7 +59,7 @@ class FindRun {
   bool climb_margin(const std::vector<Mat3>& rots);
   bool climb_local(const Mat3& start);
   std::vector<Mat3> family_ends() const;
-  std::vector<Mat3> consistent_rotations() const;
+  std::vector<Mat3> consistent_rotations(const std::vector<Mat3>& rots) const;
 
   const WitnessSearch& s_;
   const SearchParams& p_;
@@ -485,7 +485,7 @@ std::vector<Mat3> FindRun::family_ends() const {
 // family's samples onto that curve, walks it from the first locally admissible ones, and
 // returns along each walk the locally admissible rotation that places the contacts deepest,
 // where that reaches min_margin.
-std::vector<Mat3> FindRun::consistent_rotations() const {
+std::vector<Mat3> FindRun::consistent_rotations(const std::vector<Mat3>& rots) const {
   constexpr std::size_t kStarts = 4;  // projected rotations walked from
   constexpr double kWalkStep = 0.01;  // rad: below the admissible arcs' width
   constexpr int kWalkSteps = 200;     // up to 2 rad each way
@@ -493,10 +493,13 @@ std::vector<Mat3> FindRun::consistent_rotations() const {
   const Polyhedron& B = *s_.b().model;
   std::vector<Mat3> out;
   const RotConstraints c = rotation_constraints(pcs_, A, B);
+  // Whether the planes are dependent holds along the whole family: the rotations tried
+  // already tell, before the samples are made again.
+  if (!c.align.empty() || (!rots.empty() && !translation_residual(A, B, pcs_, rots.front())))
+    return out;
   const std::vector<Mat3> samples =
       s_.family_samples(pcs_, s_.spread_rotations(pcs_, seeds_), p_.theta_samples);
-  if (!c.align.empty() || samples.empty() || !translation_residual(A, B, pcs_, samples.front()))
-    return out;
+  if (samples.empty() || !translation_residual(A, B, pcs_, samples.front())) return out;
   std::vector<Mat3> starts;
   for (Mat3 R : samples)
     if (starts.size() < kStarts && project_consistent(A, B, pcs_, c, R) &&
@@ -539,7 +542,7 @@ Witness FindRun::run() {
   if (try_all(s_.anchored_rotations(pcs_, &miss)) || best_.found) return best_;
   if (miss && climb_local(*miss)) return best_;
   if (near_.empty() && climb_margin(rots)) return best_;
-  if (near_.empty() && (try_all(consistent_rotations()) || best_.found)) return best_;
+  if (near_.empty() && (try_all(consistent_rotations(rots)) || best_.found)) return best_;
   if (best_.found || near_.empty()) return best_;
   // The contacts could be placed but the pose touched something else: look closer around
   // those rotations, where valid sets with a narrow range of orientations live.
