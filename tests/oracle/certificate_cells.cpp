@@ -438,6 +438,107 @@ std::string cone_leaf(const Tree& T, const CNode& n, const Turn& tu) {
   return pc_label(T, k) + ": the direction's height " + fmt(v) + " is not below " + fmt(need);
 }
 
+}  // namespace
+
+// ---- the e-e margin by the range of its normal ----
+// At every R of the node the e-e's normal n is a unit vector perpendicular to e_B with
+// |n . M e_A| <= beta(e_A) (n is perpendicular to R e_A); with n = cos(phi) u1 + sin(phi) u2
+// each term of the margin, widened by the turn bound, is a sinusoid of phi. The largest of
+// their least over the allowed arcs of phi is at an arc's end, a term's maximum or a crossing
+// of two terms. Each candidate angle is computed with an error d, so the value taken there is
+// a bound of the least over [phi - d, phi + d], which holds the exact candidate.
+
+namespace {
+
+/// Error of an angle the checker computes (atan2, asin, acos and a sum of two: a few ulps of
+/// 2 pi, ~2e-15), taken ~5 times larger.
+constexpr double kAngle = 1e-14;
+
+// f(phi) = p . (cos phi, sin phi) + c.
+struct Sinusoid {
+  Vec2 p;
+  double c = 0;
+  double at(double phi) const { return p.x() * std::cos(phi) + p.y() * std::sin(phi) + c; }
+  double slope(double phi) const { return -p.x() * std::sin(phi) + p.y() * std::cos(phi); }
+};
+
+// An upper bound of the least of the terms over [phi - d, phi + d]: each term is at most its
+// value plus |slope| d plus |p| d^2 / 2 there (its second derivative is at most |p|).
+double least_near(const std::vector<Sinusoid>& f, double phi, double d) {
+  double m = kInf;
+  for (const Sinusoid& t : f)
+    m = std::min(m, t.at(phi) + std::abs(t.slope(phi)) * d + t.p.norm() * d * d / 2);
+  return m;
+}
+
+bool in_arc(double phi, double centre, double half, double tol) {
+  return std::abs(std::remainder(phi - centre, 2 * kPi)) <= half + tol;
+}
+
+// The angles where terms i and j are equal: (p_i - p_j) . (cos, sin) = c_j - c_i, i.e.
+// phi = atan2(B, A) +- acos(x), x = (c_j - c_i) / r. x carries ~5 ulps of relative error ex
+// (the differences, the hypot, the quotient); acos moves by at most ex / sqrt(1 - x^2), and by
+// at most acos(1 - ex) <= 1.01 sqrt(2 ex) wherever x lies. Appends {phi, error} pairs.
+void crossings(const Sinusoid& fi, const Sinusoid& fj,
+               std::vector<std::pair<double, double>>* out) {
+  const double A = fi.p.x() - fj.p.x(), B = fi.p.y() - fj.p.y();
+  const double r = std::hypot(A, B);
+  if (!(r > 0)) return;  // the terms differ by a constant: they cross nowhere or everywhere
+  const double x = (fj.c - fi.c) / r, ex = 1e-15 * std::abs(x);
+  if (std::abs(x) > 1 + ex) return;
+  const double xc = std::clamp(x, -1.0, 1.0), xm = std::min(1.0, std::abs(xc) + ex);
+  double d = 1.01 * std::sqrt(2 * ex);
+  if (xm < 1) d = std::min(d, ex / std::sqrt(1 - xm * xm));
+  const double base = std::atan2(B, A), t = std::acos(xc);
+  out->push_back({base + t, d + kAngle});
+  out->push_back({base - t, d + kAngle});
+}
+
+}  // namespace
+
+// The allowed n: |k cos(phi - psi)| <= beta(e_A) (k cos(phi - psi) = n . M e_A, k = s_c), the
+// whole circle when k is at most that, else two arcs centred on psi +- pi/2 of half-width
+// asin(beta(e_A) / k). The tolerance kUnitEval covers the rounding of the basis and the dot
+// products (the circle of computed n(phi) is within a few ulps of the true one), and asin's
+// argument is taken upwards, asin being increasing.
+double ee_normal_bound(const EeNode& g) {
+  const Vec3 a = g.M * g.eA;
+  const double sc = a.cross(g.eB).norm();
+  const Vec3 u1 = g.eB.unitOrthogonal(), u2 = g.eB.cross(u1);
+  std::vector<Sinusoid> f;
+  for (const Vec3& w : g.wB) f.push_back({Vec2(-w.dot(u1), -w.dot(u2)), 0.0});
+  for (int k = 0; k < 2; ++k) {
+    const Vec3 w = g.M * g.wA[k];
+    f.push_back({Vec2(w.dot(u1), w.dot(u2)), g.beta_w[k]});
+  }
+  const double k1 = a.dot(u1), k2 = a.dot(u2), k = std::hypot(k1, k2);
+  const double b = g.beta_e + kUnitEval;
+  std::vector<std::pair<double, double>> arcs;  // {centre, half-width}
+  if (k <= b) {
+    arcs.push_back({0.0, kPi});
+  } else {
+    const double psi = std::atan2(k2, k1);
+    const double half = std::asin(std::min(1.0, b / k * (1 + 1e-15))) + 2 * kAngle;
+    arcs = {{psi + kPi / 2, half}, {psi - kPi / 2, half}};
+  }
+  std::vector<std::pair<double, double>> cand;  // {angle, error}
+  for (const Sinusoid& t : f)
+    if (t.p.norm() > 0) cand.push_back({std::atan2(t.p.y(), t.p.x()), kAngle});
+  for (std::size_t i = 0; i < f.size(); ++i)
+    for (std::size_t j = i + 1; j < f.size(); ++j) crossings(f[i], f[j], &cand);
+  double G = -kInf;
+  for (const auto& [c, h] : arcs) {
+    G = std::max(G, least_near(f, c, kAngle));  // a point of the arc: G is never left -inf
+    if (h < kPi)
+      for (double e : {c - h, c + h}) G = std::max(G, least_near(f, e, kAngle));
+    for (const auto& [phi, d] : cand)
+      if (in_arc(phi, c, h, d + kAngle)) G = std::max(G, least_near(f, phi, d));
+  }
+  return std::min(sc + g.beta_e, G);
+}
+
+namespace {
+
 // The checker's upper bound of the local margin over the node (docs: "The local margin"),
 // each term widened by how far the node turns its vector.
 double margin_bound(const Tree& T, const SetPc& pc, const Turn& tu) {
@@ -477,7 +578,19 @@ double margin_bound(const Tree& T, const SetPc& pc, const Turn& tu) {
           m = std::min(m, (tu.M * w).dot(sg * nu) + tu.beta(w) + dn * (1 + 1e-12));
         best = std::max(best, m);
       }
-      u = std::min(s + dN, best);
+      // The first bound widens the normal by 2 beta / s, without limit as the edges turn
+      // parallel; the second bounds the normal's range instead, and holds there.
+      EeNode g;
+      g.M = tu.M;
+      g.eA = ea.dir;
+      g.eB = eb.dir;
+      for (int i = 0; i < 2; ++i) {
+        g.wA[i] = ea.m[i];
+        g.wB[i] = eb.m[i];
+        g.beta_w[i] = tu.beta(ea.m[i]);
+      }
+      g.beta_e = dN;
+      u = std::min(std::min(s + dN, best), ee_normal_bound(g));
       break;
     }
     default:

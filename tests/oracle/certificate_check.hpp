@@ -78,4 +78,25 @@ CertificateReport check_certificates(const Graph& g, const nlohmann::json& graph
 CertificateReport check_certificate_files(const std::string& graph_path,
                                           const std::string& cert_path);
 
+namespace cert {
+
+/// An e-e PC over a node, for ee_normal_bound: A's edge direction e_A and into-face directions
+/// w_A (A's frame), B's e_B and w_B (B's frame), the node's central rotation M and the turn
+/// bounds beta(e_A), beta(w_A1), beta(w_A2) of the node (docs/certificates.md, "Cells").
+struct EeNode {
+  Mat3 M = Mat3::Identity();
+  Vec3 eA = Vec3::Zero(), eB = Vec3::Zero();
+  Vec3 wA[2] = {Vec3::Zero(), Vec3::Zero()}, wB[2] = {Vec3::Zero(), Vec3::Zero()};
+  double beta_e = 0;
+  double beta_w[2] = {0, 0};
+};
+
+/// The e-e local margin's bound by the range of the normal (docs/certificates.md, "The local
+/// margin"): min(s_c + beta(e_A), G), an upper bound of the margin at every rotation of the
+/// node, before the checker's final rounding allowance. Used by local-slack leaves; declared
+/// here for its test.
+double ee_normal_bound(const EeNode& g);
+
+}  // namespace cert
+
 }  // namespace oracle

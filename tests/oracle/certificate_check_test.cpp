@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <random>
 #include <set>
 #include <sstream>
 
@@ -773,6 +774,155 @@ TEST_CASE("cells: cone and local-slack leaves") {
         "cone: PC 0 (v-f:0:4): direction 0.6,0.8,0 is not a tangent direction of its element");
   REQUIRE(failure_of(r, slack_bad));
   CHECK_THAT(failure_of(r, slack_bad)->why, Catch::Contains("is not below local_slack"));
+}
+
+namespace {
+
+// The verifier's e-e local margin at R (docs/certificates.md, "The local margin"), both edges
+// taken as convex.
+double ee_margin(const Mat3& R, const cert::EeNode& g) {
+  const Vec3 N = (R * g.eA).cross(g.eB);
+  const double s = N.norm();
+  if (s < 1e-9) return -1;
+  double best = -1e300;
+  for (double sg : {1.0, -1.0}) {
+    const Vec3 n = sg * N / s;
+    best = std::max(best, std::min({-g.wB[0].dot(n), -g.wB[1].dot(n), (R * g.wA[0]).dot(n),
+                                    (R * g.wA[1]).dot(n)}));
+  }
+  return std::min(s, best);
+}
+
+Mat3 rot_of(const Vec3& r) {
+  const double th = r.norm();
+  return th > 0 ? Mat3(Eigen::AngleAxisd(th, r / th)) : Mat3::Identity();
+}
+
+// An e-e of the test's models over the cube of axis-angle vectors (c, h), with the turn bound
+// of a cube, min(sqrt(3) h, 2) per unit length.
+cert::EeNode ee_node(const Graph& G, int ea, int eb, const Vec3& c, double h) {
+  cert::EeNode g;
+  g.M = rot_of(c);
+  g.eA = G.A.E[ea].dir;
+  g.eB = G.B.E[eb].dir;
+  const double bu = std::min(std::sqrt(3.0) * h, 2.0);
+  for (int i = 0; i < 2; ++i) {
+    g.wA[i] = G.A.E[ea].m[i];
+    g.wB[i] = G.B.E[eb].m[i];
+    g.beta_w[i] = bu;
+  }
+  g.beta_e = bu;
+  return g;
+}
+
+}  // namespace
+
+TEST_CASE("cells: an e-e local-slack leaf where the edges turn parallel") {
+  Pair P = make_pair();
+  const double slack = 0.5 * std::sin(1e-3), h = 0.01;
+  // A's edge 0-1 and B's edge 0-1 both run along x at the identity, each solid's wedge on the
+  // +y +z side: the solids overlap along the edges at every rotation near the identity.
+  const int a01 = P.G.A.edge_index(0, 1), b01 = P.G.B.edge_index(0, 1);
+  // A's edge 6-7 (top back, along x) has its wedge on the -y -z side: a real contact.
+  const int a67 = P.G.A.edge_index(6, 7);
+  const std::string same = pcs_of("e-e", a01, b01), facing = pcs_of("e-e", a67, b01);
+  const Vec3 off(0.004, -0.003, 0.002);  // the cube (off, h) holds the identity too
+  TreeB T;
+  const int root = T.add(-1, cube_rot(Vec3::Zero(), kPiD), "narrow");
+  const int at_id = T.add(root, cube_rot(Vec3::Zero(), h), "local-slack", {{"pc", 0}});
+  const int near_id = T.add(root, cube_rot(off, h), "local-slack", {{"pc", 0}});
+  auto r = one(P, cells_set(same, Vec3(5, 5, 5), T));
+  CHECK_FALSE(failure_of(r, at_id));
+  CHECK_FALSE(failure_of(r, near_id));
+  // Without the normal's range the checker's bound at s_c = 0 is s_c + beta(e_A) = sqrt(3) h
+  // whatever the wedges (the normal's direction is not bounded there), above the slack: the
+  // facing pair, whose range bound is large, reports exactly that.
+  CHECK(std::sqrt(3.0) * h > slack);
+  r = one(P, cells_set(facing, Vec3(5, 5, 5), T));
+  REQUIRE(failure_of(r, at_id));
+  CHECK_THAT(failure_of(r, at_id)->why,
+             Catch::Contains("bound of the local margin over the node, 0.01732050807") &&
+                 Catch::Contains("is not below local_slack"));
+  // The bound, and the verifier's margin at rotations of the nodes (none is non-penetrating).
+  for (const Vec3& c : {Vec3(Vec3::Zero()), off}) {
+    const cert::EeNode g = ee_node(P.G, a01, b01, c, h);
+    const double u = cert::ee_normal_bound(g);
+    CHECK(u < -0.6);
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> U(-1, 1);
+    for (int k = 0; k < 200; ++k) {
+      const Vec3 rr = c + h * Vec3(U(rng), U(rng), U(rng));
+      CHECK(ee_margin(rot_of(rr), g) <= u + 1e-12);
+    }
+  }
+  CHECK(cert::ee_normal_bound(ee_node(P.G, a67, b01, Vec3::Zero(), h)) > slack);
+}
+
+TEST_CASE("e-e bound by the normal's range: never below the verifier's margin in random cells") {
+  std::mt19937_64 rng(20240611);
+  std::uniform_real_distribution<double> U(-1, 1), U01(0, 1);
+  auto unit = [&] {
+    Vec3 v;
+    do v = Vec3(U(rng), U(rng), U(rng));
+    while (v.norm() < 0.1 || v.norm() > 1);
+    return v.normalized();
+  };
+  auto perp = [&](const Vec3& e) {  // a random unit vector perpendicular to e
+    Vec3 v;
+    do {
+      v = unit();
+      v -= e * e.dot(v);
+    } while (v.norm() < 0.1);
+    return v.normalized();
+  };
+  int samples = 0, parallel = 0, tight = 0;
+  double worst = -1e300;
+  for (int cell = 0; cell < 400; ++cell) {
+    const Vec3 c = kPiD * Vec3(U(rng), U(rng), U(rng));
+    const double h = 1e-3 * std::pow(300.0, U01(rng));  // 1e-3 .. 0.3, log-uniform
+    cert::EeNode g;
+    g.M = rot_of(c);
+    g.eA = unit();
+    // Half of the cells: B's edge within about h of M e_A (a quarter: exactly M e_A), so that
+    // the edges turn parallel in or near the cell.
+    g.eB = cell % 2 ? Vec3((g.M * g.eA + 2 * h * U01(rng) * unit()).normalized()) : unit();
+    if (cell % 4 == 3) g.eB = g.M * g.eA;
+    for (int i = 0; i < 2; ++i) {
+      g.wA[i] = perp(g.eA);
+      g.wB[i] = perp(g.eB);
+    }
+    const double bu = std::min(std::sqrt(3.0) * h, 2.0);
+    g.beta_e = g.beta_w[0] = g.beta_w[1] = bu;
+    const double u = cert::ee_normal_bound(g);
+    parallel += (g.M * g.eA).cross(g.eB).norm() <= bu;
+    // The cube's 8 corners and 12 points inside it, then a climb from the highest of them
+    // towards the cube's largest margin.
+    double top = -1e300;
+    Vec3 at = Vec3::Zero();
+    auto sample = [&](const Vec3& d) {
+      const double m = ee_margin(rot_of(c + h * d), g);
+      if (m > top) top = m, at = d;
+      worst = std::max(worst, m - u);
+      ++samples;
+      INFO("cell " << cell << " h " << h << " d " << d.transpose());
+      REQUIRE(m <= u + 1e-12);
+    };
+    for (int k = 0; k < 20; ++k) {
+      Vec3 d;
+      for (int a = 0; a < 3; ++a) d[a] = k < 8 ? ((k >> a) & 1 ? 1.0 : -1.0) : U(rng);
+      sample(d);
+    }
+    for (int k = 0; k < 40; ++k) {
+      const double step = 0.5 * std::pow(0.85, k);
+      sample((at + step * Vec3(U(rng), U(rng), U(rng))).cwiseMax(-1).cwiseMin(1));
+    }
+    tight += u - top < 2 * bu;  // the bound within 2 beta of the highest margin found
+  }
+  INFO("samples " << samples << ", cells with s_c <= beta " << parallel << ", tight " << tight
+                  << ", largest margin - bound " << worst);
+  CHECK(samples == 24000);
+  CHECK(parallel > 50);
+  CHECK(tight > 200);
 }
 
 TEST_CASE("cells: deep leaves") {

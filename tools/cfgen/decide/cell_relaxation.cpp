@@ -316,7 +316,7 @@ CellRelaxation::Refutation CellRelaxation::refute(const RotationCell& cell, Vec3
 
 CellRelaxation::Refutation CellRelaxation::refute(const Mat3& R_c, const TurnBound& turn,
                                                   Vec3& t_lo, Vec3& t_hi, bool with_certificates,
-                                                  std::size_t max_choices) const {
+                                                  std::size_t max_choices, bool narrow_box) const {
   Refutation out;
   if (empty_) {
     out.verdict = Verdict::kBounds;
@@ -333,6 +333,10 @@ CellRelaxation::Refutation CellRelaxation::refute(const Mat3& R_c, const TurnBou
     LinearProgram lp = program(R_c, turn, choice, t_lo, t_hi);
     if (solve(lp).status == LpResult::Status::kOptimal) {
       open = true;
+      if (!narrow_box) {  // kOpen, the box as given
+        out.certificates.clear();
+        return out;
+      }
       // The translations this choice allows: each coordinate's least and greatest value.
       for (int j = 0; j < 3; ++j)
         for (double sign : {1.0, -1.0}) {

@@ -73,8 +73,11 @@ class CellRelaxation {
   Refutation refute(const RotationCell& cell, Vec3& t_lo, Vec3& t_hi, bool with_certificates,
                     std::size_t max_choices = 4096) const;
   /// The same for the rotations that turn A's vectors at most `turn` from where R_c does.
+  /// narrow_box = false: an open cell keeps [t_lo, t_hi] as given (one program a choice
+  /// instead of thirteen), for a cell that will be split over its rotations anyway.
   Refutation refute(const Mat3& R_c, const TurnBound& turn, Vec3& t_lo, Vec3& t_hi,
-                    bool with_certificates, std::size_t max_choices = 4096) const;
+                    bool with_certificates, std::size_t max_choices = 4096,
+                    bool narrow_box = true) const;
 
   /// True when at rotation R (meeting the rotational conditions to 10 kRotTol) the contacts
   /// can hold in their closed elements without local penetration: the relaxation holds at a

@@ -216,7 +216,9 @@ std::vector<double> admissible_spins(const ModelInfo& a, const ModelInfo& b, con
     arcs.pop_back();
     const Mat3 R = R0 * axis_angle(axis, phi);
     // The bound first: most arcs hold no admissible spin, and it rules them out alone.
-    if (local_margin_bound(a, b, pcs, R, TurnBound{0, half, axis}) <= min_local) continue;
+    if (local_margin_bound(a, b, pcs, R, TurnBound{0, half, axis}, nullptr, EeBound::kDirect) <=
+        min_local)
+      continue;
     const double margin = local_margin_bound(a, b, pcs, R, TurnBound{});
     if (best && margin > best->second) *best = {phi, margin};
     if (margin > min_local) {

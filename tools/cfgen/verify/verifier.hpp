@@ -54,9 +54,14 @@ bool covered_by(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs, Elem
 /// turn(x) from where R turns it, of the PCs' local non-penetration margin
 /// (Verifier::local_margin: a sine, negative when a contact is penetrating or degenerate).
 /// turn = {} gives the margin at R. which: when given, the index in `pcs` of the PC whose
-/// term is smallest (-1 when none is below 1).
+/// term is smallest (-1 when none is below 1). An e-e's term is the lesser of two bounds
+/// (docs/certificates.md, "The local margin") where the turn moves its contact normal's
+/// direction far, e.g. near parallel edges; kDirect keeps the first, cheaper one, for a
+/// search that only prunes with the bound.
+enum class EeBound { kTightest, kDirect };
 double local_margin_bound(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs, const Mat3& R,
-                          const TurnBound& turn, int* which = nullptr);
+                          const TurnBound& turn, int* which = nullptr,
+                          EeBound ee = EeBound::kTightest);
 
 class Verifier {
  public:
