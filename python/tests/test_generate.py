@@ -68,6 +68,17 @@ def test_generate_thorough(tmp_path):
         gen.generate(a, b, max_pcs=1, symmetry=False, thorough=True)
 
 
+def test_generate_cube_cells(tmp_path):
+    # cube_cells is cfgen --cube-cells: failed sets without an f-f searched over cubes of
+    # rotation space; recorded in the graph's parameters, absent when 0.
+    out = tmp_path / "cubes.json"
+    gen.generate(CUBE, CUBE, out, max_pcs=1, threads=2, cube_cells=64)
+    assert out.read_bytes() == cfgen_bytes(tmp_path, "--cube-cells", "64")
+    assert '"cube_cells": 64' in out.read_text()
+    with pytest.raises(cf.Error, match=r"^generate: cube_cells -1 is not in \[0, 10000000\]$"):
+        gen.generate(CUBE, CUBE, max_pcs=1, cube_cells=-1)
+
+
 def test_generate_errors(tmp_path):
     a = DATA / "models" / "cube.off"
     with pytest.raises(cf.Error, match=r"^generate: max_pcs must be an integer in \[1, 3\], got 4$"):

@@ -715,6 +715,9 @@ std::string leaf_claim(const Tree& T, const CNode& n) {
   if (n.kind == "cone") return cone_leaf(T, n, tu);
   if (n.kind == "local-slack") return slack_leaf(T, n, tu);
   if (n.kind == "deep") return deep_leaf(T, n, tu);
+  if (n.kind == "first-order")
+    return T.arc ? "a first-order leaf needs a cube of rotations (domain \"ball\"), not an arc"
+                 : check_first_order(T.ctx, T.pcs, tu, n.j->at("farkas"));
   if (n.kind == "program")
     return check_program(T.ctx, T.pcs, T.pivot, tu, n.lo, n.hi, n.j->at("farkas"));
   return "unknown kind \"" + n.kind + "\"";

@@ -26,18 +26,21 @@ namespace {
 
 const double kPiD = 3.14159265358979323846;
 
-// A's faces: 0 bottom z=0 (-z), 1 top (+z), 2 front y=0 (-y), 3 back (+y), 4 left x=0 (-x),
-// 5 right (+x). Vertex i = (10 (i&1), 10 (i>>1 &1), 10 (i>>2 &1)).
-json cube_model() {
+// A box [0,sx]x[0,sy]x[0,sz]: faces 0 bottom z=0 (-z), 1 top (+z), 2 front y=0 (-y), 3 back
+// (+y), 4 left x=0 (-x), 5 right (+x). Vertex i = (sx (i&1), sy (i>>1 &1), sz (i>>2 &1)).
+json box_model(double sx, double sy, double sz) {
   json m;
   for (int i = 0; i < 8; ++i)
-    m["vertices"].push_back({10.0 * (i & 1), 10.0 * ((i >> 1) & 1), 10.0 * ((i >> 2) & 1)});
+    m["vertices"].push_back({sx * (i & 1), sy * ((i >> 1) & 1), sz * ((i >> 2) & 1)});
   m["faces"] = json::array();
   for (auto L : std::vector<std::vector<int>>{
            {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}})
     m["faces"].push_back({{"loops", {L}}});
   return m;
 }
+
+// A's cube [0,10]^3.
+json cube_model() { return box_model(10, 10, 10); }
 
 // B's faces: 0 bottom cap z=0 (-z), 1 top cap z=30, then the sides of the profile: 2 y=0, 3
 // x=30, 4 the low top y=10, 5 the riser x=10, 6 the tower top y=tower, 7 x=0.
@@ -79,11 +82,10 @@ struct Pair {
   double margin;
 };
 
-// The graph file (no CFs unless given), with the verifier's parameters.
-Pair make_pair(double margin = 0.01, double tower = 20, json cfs = json::array()) {
+// The graph file of A and B (no CFs unless given), with the verifier's parameters.
+Pair pair_of(json A, json B, double margin, json cfs = json::array()) {
   Pair P;
   P.margin = margin;
-  json A = cube_model(), B = lblock_model(tower);
   add_edges(A);
   add_edges(B);
   P.doc = {{"format", "cf-graph"},           {"version", 1}, {"units", "mm"},
@@ -95,6 +97,11 @@ Pair make_pair(double margin = 0.01, double tower = 20, json cfs = json::array()
   P.G = read_graph(path);
   std::filesystem::remove(path);
   return P;
+}
+
+// The cube against the L-block.
+Pair make_pair(double margin = 0.01, double tower = 20, json cfs = json::array()) {
+  return pair_of(cube_model(), lblock_model(tower), margin, cfs);
 }
 
 json cert_for(const Pair& P, json sets, json pieces = json()) {
@@ -923,6 +930,161 @@ TEST_CASE("e-e bound by the normal's range: never below the verifier's margin in
   CHECK(samples == 24000);
   CHECK(parallel > 50);
   CHECK(tight > 200);
+}
+
+namespace {
+
+// A = the 10 mm cube, B = a 40 x 40 x 10 slab (box_model: face 1 is its top, z = 10).
+Pair cube_on_slab() { return pair_of(cube_model(), box_model(40, 40, 10), 0.01); }
+
+json fo_entry(const std::vector<int>& signs, const std::vector<double>& y) {
+  return {{"signs", signs}, {"y", y}};
+}
+
+// The verifier's v-f local margin at R: the least of (R d) . n_B over A's vertex's rays, and 1.
+double vf_margin(const Mat3& R, const Poly& A, int v, const Vec3& nB) {
+  double m = 1;
+  for (int e : A.V[v].edges) {
+    const int o = A.E[e].v0 == v ? A.E[e].v1 : A.E[e].v0;
+    m = std::min(m, (R * (A.V[o].p - A.V[v].p).normalized()).dot(nB));
+  }
+  return m;
+}
+
+const char* const kFarkasFails =
+    "Farkas gap 0 <= 0 (min over the box of (sum y a).z does not exceed sum y b)";
+
+}  // namespace
+
+TEST_CASE("cells: first-order leaves: two corners' rays along one edge on a slab") {
+  Pair P = cube_on_slab();
+  const double slack = 0.5 * std::sin(1e-3), h = 0.01 / std::sqrt(3.0);
+  // A's vertices 0 and 1 on B's top (n_B = +z). Their rays in ascending order of edge index:
+  // vertex 0 +x, +y, +z (edges 0-1, 0-2, 0-4); vertex 1 -x, +y, +z (edges 0-1, 1-3, 1-5). At
+  // R_c = I, "turned at least (d, z, s)" is the row -(d x z).v <= d.z + gamma - s: rows 0
+  // (d = +x) v_y <= gamma - s and 3 (d = -x) -v_y <= gamma - s, whose sum 0 <= 2 (gamma - s)
+  // fails while gamma = 1 - cos(sqrt(3) h) is below s. Rows 1 and 4 are -v_x <= gamma - s,
+  // rows 2 and 5 (d = +z) 0 <= 1 + gamma - s.
+  REQUIRE(1 - std::cos(0.01) < slack);
+  const std::string pcs = "v-f:0:1;v-f:1:1";
+  TreeB T;
+  const int root = T.add(-1, cube_rot(Vec3::Zero(), kPiD), "narrow");
+  auto leaf = [&](double half, const json& farkas) {
+    return T.add(root, cube_rot(Vec3::Zero(), half), "first-order", {{"farkas", farkas}});
+  };
+  const std::vector<double> y = {1, 0, 0, 1, 0, 0};
+  const int ok = leaf(h, json::array({fo_entry({}, y)}));
+  const int zeros = leaf(h, json::array({fo_entry({}, {0, 0, 0, 0, 0, 0})}));
+  const int one_row = leaf(h, json::array({fo_entry({}, {1, 0, 0, 0, 0, 0})}));
+  const int rays_x = leaf(h, json::array({fo_entry({}, {0, 1, 0, 0, 1, 0})}));
+  const int short_y = leaf(h, json::array({fo_entry({}, {1, 0, 0, 1, 0})}));
+  const int negative = leaf(h, json::array({fo_entry({}, {1, 0, 0, 1, -1, 0})}));
+  const int extra_entry = leaf(h, json::array({fo_entry({}, y), fo_entry({}, y)}));
+  const int signs_for_none = leaf(h, json::array({fo_entry({1}, y)}));
+  // gamma = 1 - cos(0.05) = 1.25e-3 is above s: the same rows no longer contradict.
+  const int coarse = leaf(0.05 / std::sqrt(3.0), json::array({fo_entry({}, y)}));
+  // theta_max = sqrt(3) 0.5 = 0.866 >= pi/4 = 0.785: no leaf may be written there.
+  const int wide = leaf(0.5, json::array({fo_entry({}, y)}));
+  // Just below pi/4 the first-order rows are weak (gamma = 0.29): refuted by the Farkas check.
+  const int near_limit = leaf(0.45, json::array({fo_entry({}, y)}));
+  auto r = one(P, cells_set(pcs, Vec3(5, 5, 0), T));
+  CHECK_FALSE(failure_of(r, ok));
+  CHECK(r.leaves.at("first-order")[0] == 1);
+  auto why = [&](int id) {
+    const CertNodeFailure* f = failure_of(r, id);
+    return f ? f->why : std::string("(accepted)");
+  };
+  CHECK(why(zeros) == std::string("first-order: signs []: ") + kFarkasFails);
+  // v_y >= -rho = -0.01 over the box, not above gamma - s = -4.5e-4.
+  CHECK_THAT(why(one_row), Catch::StartsWith("first-order: signs []: Farkas gap -0.0095"));
+  CHECK_THAT(why(rays_x), Catch::StartsWith("first-order: signs []: Farkas gap -0.019"));
+  CHECK(why(short_y) == "first-order: signs []: y has 5 multipliers for 6 rows");
+  CHECK(why(negative) == "first-order: signs []: multiplier 4 is -1 (must be >= 0)");
+  CHECK(why(extra_entry) ==
+        "first-order: farkas has 2 entries, the set's 0 e-e PCs make 1 choices of signs");
+  CHECK(why(signs_for_none) ==
+        "first-order: entry 0: signs [1], expected [] (one per e-e PC, the first counting "
+        "fastest, +1 first)");
+  CHECK_THAT(why(coarse), Catch::StartsWith("first-order: signs []: Farkas gap -0.00149"));
+  CHECK_THAT(why(wide), Catch::StartsWith("first-order: theta_max = sqrt(3) h = 0.866025") &&
+                            Catch::EndsWith(" is not below pi/4"));
+  CHECK_THAT(why(near_limit), Catch::StartsWith("first-order: signs []: Farkas gap -"));
+  CHECK(r.leaves.at("first-order")[1] == 10);
+
+  // Only cube nodes: an arc of the f-f circle of A's bottom on B's top (R0 = I, axis n_A).
+  const json circle = {{"pc", 0}, {"R0", {1, 0, 0, 0, 1, 0, 0, 0, 1}}, {"axis", {0, 0, -1}}};
+  TreeB C;
+  C.add(-1, arc_rot(0, kPiD), "first-order", {{"farkas", json::array({fo_entry({}, {})})}});
+  r = one(P, cells_set("f-f:0:1", Vec3(5, 5, 0), C, circle));
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK(r.reason ==
+        "node 0: first-order: a first-order leaf needs a cube of rotations (domain \"ball\"), "
+        "not an arc");
+}
+
+TEST_CASE("cells: first-order leaves with an e-e: one program per sign of its normal") {
+  Pair P = cube_on_slab();
+  const double slack = 0.5 * std::sin(1e-3), h = 0.01 / std::sqrt(3.0);
+  const int ea = P.G.A.edge_index(0, 1), eb = P.G.B.edge_index(4, 6);
+  // The into-face directions toward each edge's left face (its loop runs the edge from
+  // edges[e][0] to edges[e][1]), then its right face. B's edge 4-6 (x = 0, z = 10, along +y):
+  // left face 4 (x = 0), w_B1 = -z; right face 1 (top), w_B2 = +x. A's edge 0-1 (along +x):
+  // left face 2 (front), w_A1 = +z; right face 0 (bottom), w_A2 = +y.
+  REQUIRE(P.G.B.E[eb].face[0] == 4);
+  REQUIRE(P.G.B.E[eb].face[1] == 1);
+  REQUIRE(P.G.A.E[ea].face[0] == 2);
+  REQUIRE(P.G.A.E[ea].face[1] == 0);
+  CHECK((P.G.B.E[eb].m[0] - Vec3(0, 0, -1)).norm() < 1e-15);
+  CHECK((P.G.A.E[ea].m[0] - Vec3(0, 0, 1)).norm() < 1e-15);
+  const std::string ee = pcs_of("e-e", ea, eb);
+  const std::string pcs = "v-f:1:1;" + ee;
+  // Rows at R_c = I (b' = +y, m = e_A x b' = +z, c = 0, tau = s (1 - rho - gamma)): the v-f
+  // (rays -x, +y, +z) 0: -v_y <= gamma - s, 1: -v_x <= gamma - s, 2: 0 <= 1 + gamma - s; the
+  // e-e's B rows 3 (w = -z): 0 <= sigma + gamma - tau, 4 (w = +x): sigma v_y <= gamma - tau;
+  // its A rows 5 (w = +z): 0 <= sigma + K - tau, 6 (w = +y): -sigma v_x <= K - tau. sigma = +1:
+  // rows 0 and 4 add up to 0 <= 2 gamma - s - tau; sigma = -1: row 3 alone is 0 <= -1 + ...
+  const std::vector<double> y_plus = {1, 0, 0, 0, 1, 0, 0}, y_minus = {0, 0, 0, 1, 0, 0, 0};
+  TreeB T;
+  const int root = T.add(-1, cube_rot(Vec3::Zero(), kPiD), "narrow");
+  auto leaf = [&](const json& farkas) {
+    return T.add(root, cube_rot(Vec3::Zero(), h), "first-order", {{"farkas", farkas}});
+  };
+  const int ok = leaf(json::array({fo_entry({1}, y_plus), fo_entry({-1}, y_minus)}));
+  const int swapped = leaf(json::array({fo_entry({-1}, y_minus), fo_entry({1}, y_plus)}));
+  const int too_long = leaf(json::array({fo_entry({1, 1}, y_plus), fo_entry({-1, 1}, y_minus)}));
+  const int one_entry = leaf(json::array({fo_entry({1}, y_plus)}));
+  const int zeros =
+      leaf(json::array({fo_entry({1}, y_plus), fo_entry({-1}, std::vector<double>(7, 0))}));
+  // With B's directions in the other order (right face first) the same sums would pair row 0
+  // with the -z row: the checker's order is the left face's first.
+  const int right_first =
+      leaf(json::array({fo_entry({1}, {1, 0, 0, 1, 0, 0, 0}), fo_entry({-1}, y_minus)}));
+  auto r = one(P, cells_set(pcs, Vec3(5, 5, 0), T));
+  auto why = [&](int id) {
+    const CertNodeFailure* f = failure_of(r, id);
+    return f ? f->why : std::string("(accepted)");
+  };
+  CHECK(why(ok) == "(accepted)");
+  const std::string order =
+      "(one per e-e PC [PC 1 (" + ee + ")], the first counting fastest, +1 first)";
+  CHECK(why(swapped) == "first-order: entry 0: signs [-1], expected [1] " + order);
+  CHECK(why(too_long) == "first-order: entry 0: signs [1,1], expected [1] " + order);
+  CHECK(why(one_entry) ==
+        "first-order: farkas has 1 entries, the set's 1 e-e PCs make 2 choices of signs");
+  CHECK(why(zeros) == std::string("first-order: signs [-1]: ") + kFarkasFails);
+  CHECK_THAT(why(right_first), Catch::StartsWith("first-order: signs [1]: Farkas gap -"));
+
+  // The claim itself: at no rotation of the node do both PCs keep the slack (the e-e's
+  // normal may point either way; its margin takes the better one).
+  const cert::EeNode g = ee_node(P.G, ea, eb, Vec3::Zero(), h);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> U(-1, 1);
+  double best = -1;
+  for (int k = 0; k < 2000; ++k) {
+    const Mat3 R = rot_of(h * Vec3(U(rng), U(rng), U(rng)));
+    best = std::max(best, std::min(vf_margin(R, P.G.A, 1, Vec3(0, 0, 1)), ee_margin(R, g)));
+  }
+  CHECK(best < slack);
 }
 
 TEST_CASE("cells: deep leaves") {

@@ -138,6 +138,13 @@ struct Ctx {
 std::string check_program(const Ctx& ctx, const std::vector<SetPc>& pcs, const Vec3& pivot,
                           const Turn& turn, const Vec3& lo, const Vec3& hi, const json& farkas);
 
+/// Checks a first-order leaf (docs/certificates.md, "First-order leaves"): a cube node with
+/// theta_max = sqrt(3) h below pi/4, one entry per choice of the e-e PCs' signs in order, and
+/// each entry's multipliers proving its program infeasible over the box of v. Returns "" when
+/// the claim holds, else why not.
+std::string check_first_order(const Ctx& ctx, const std::vector<SetPc>& pcs, const Turn& turn,
+                              const json& farkas);
+
 /// Checks a set's `cells`; fills out.node_fails and out.leaves.
 void check_cells(const Ctx& ctx, const std::vector<SetPc>& pcs, const json& cells,
                  CertSetResult& out);

@@ -639,6 +639,23 @@ Rational farkas_gap(const Program& P, const std::vector<double>& y) {
   return mn - rhs;
 }
 
+// Farkas' lemma over the variables' box: y >= 0, one per row, and the least value of
+// (sum y_i a_i).z over the box above sum y_i b_i, in exact rationals on the rows widened by
+// the checker's error bounds. Returns "" when y proves P infeasible, else why not.
+std::string check_multipliers(Program P, const std::vector<double>& y, double rounding) {
+  if (y.size() != P.rows.size())
+    return "y has " + std::to_string(y.size()) + " multipliers for " +
+           std::to_string(P.rows.size()) + " rows";
+  for (std::size_t i = 0; i < y.size(); ++i)
+    if (!(y[i] >= 0) || !std::isfinite(y[i]))
+      return "multiplier " + std::to_string(i) + " is " + fmt(y[i]) + " (must be >= 0)";
+  widen(P, rounding);
+  const Rational gap = farkas_gap(P, y);
+  if (gap > 0) return "";
+  return "Farkas gap " + fmt(to_double(gap)) +
+         " <= 0 (min over the box of (sum y a).z does not exceed sum y b)";
+}
+
 std::string choice_text(const std::vector<int>& c) {
   std::string s = "[";
   for (std::size_t i = 0; i < c.size(); ++i) s += (i ? "," : "") + std::to_string(c[i]);
@@ -654,17 +671,7 @@ std::string check_choice(const Ctx& ctx, const std::vector<SetPc>& pcs, const Ve
   if (!why.empty()) return why;
   for (std::size_t j = 0; j < P.lo.size(); ++j)
     if (P.lo[j] > P.hi[j]) return "";  // an empty variable box: no solution whatever y says
-  if (y.size() != P.rows.size())
-    return "y has " + std::to_string(y.size()) + " multipliers for " +
-           std::to_string(P.rows.size()) + " rows";
-  for (std::size_t i = 0; i < y.size(); ++i)
-    if (!(y[i] >= 0) || !std::isfinite(y[i]))
-      return "multiplier " + std::to_string(i) + " is " + fmt(y[i]) + " (must be >= 0)";
-  widen(P, ctx.tol.rounding);
-  const Rational gap = farkas_gap(P, y);
-  if (gap > 0) return "";
-  return "Farkas gap " + fmt(to_double(gap)) +
-         " <= 0 (min over the box of (sum y a).z does not exceed sum y b)";
+  return check_multipliers(P, y, ctx.tol.rounding);
 }
 
 }  // namespace
@@ -705,6 +712,186 @@ std::string check_program(const Ctx& ctx, const std::vector<SetPc>& pcs, const V
     std::size_t k = 0;
     while (k < choice.size() && ++choice[k] == counts[k]) choice[k++] = 0;
     if (k == choice.size()) break;
+  }
+  return "";
+}
+
+// ---- first-order leaves (docs/certificates.md, "First-order leaves") ----
+
+namespace {
+
+// A cube node's rotations as R = R_c Q, Q a turn by theta <= theta_max about a unit axis w:
+// with v = sin(theta) w, |v_k| <= rho, Q x = x + v x x + E(x) and |E(x)| <= gamma |x|. rho and
+// gamma are taken upwards: a larger box and larger remainders only loosen the rows (tau, the
+// only term that shrinks as they grow, is subtracted).
+struct FirstOrder {
+  Mat3 M = Mat3::Identity();  // R_c as the checker computes it (within kRcErr of the exact)
+  double rho = 0, gamma = 0;
+  double slack = 0;
+};
+
+// "at least (beta, alpha, r, tau)": the row -beta.v <= alpha + r - tau. `amag` bounds the
+// magnitudes each coefficient was computed from and `alpha_mag` alpha's (the checker's own
+// rounding, widen()); `extra` bounds how far the row's data (R_c^T y, the model's unit
+// directions) move it over the box of v.
+void at_least(Program& P, const Vec3& beta, double alpha, double r, double tau, double amag,
+              double alpha_mag, double extra) {
+  Row row = P.row();
+  for (int j = 0; j < 3; ++j) {
+    row.a[j] = -beta[j];
+    row.amag[j] = amag;
+  }
+  row.b = alpha + r - tau;
+  row.bmag = alpha_mag + r + std::abs(tau);
+  row.extra = extra;
+  P.rows.push_back(row);
+}
+
+// y' = M^T y is within kRcErr |y| of R_c^T y, so beta = x cross y' moves by kRcErr |x| |y|,
+// which |v| <= sqrt(3) rho < 1.23 scales, and alpha = x . y' by as much: 3 kRcErr |x| |y|.
+// kUnitEval covers the checker's unit directions (normalised, crossed), as in its other leaves.
+double turned_extra(double xy) { return 3 * kRcErr * xy + kUnitEval; }
+
+// "turned at least (x, y, tau)": (R x) . y >= tau.
+void turned_at_least(Program& P, const FirstOrder& F, const Vec3& x, const Vec3& y, double tau) {
+  const Vec3 yp = F.M.transpose() * y;
+  const double xy = x.norm() * y.norm();
+  at_least(P, x.cross(yp), x.dot(yp), F.gamma * xy, tau, 2 * xy, 2 * xy, turned_extra(xy));
+}
+
+// "turned within (x, y, eps)": |(R x) . y| <= eps, two rows.
+void turned_within(Program& P, const FirstOrder& F, const Vec3& x, const Vec3& y, double eps) {
+  const Vec3 yp = F.M.transpose() * y;
+  const double xy = x.norm() * y.norm();
+  const Vec3 beta = x.cross(yp);
+  const double alpha = x.dot(yp), r = F.gamma * xy;
+  at_least(P, beta, alpha, r, -eps, 2 * xy, 2 * xy, turned_extra(xy));
+  at_least(P, -beta, -alpha, r, -eps, 2 * xy, 2 * xy, turned_extra(xy));
+}
+
+// The unit directions from vertex v along its edges, in ascending order of edge index.
+std::vector<Vec3> edge_rays(const Poly& P, int v) {
+  std::vector<int> es = P.V[v].edges;
+  std::sort(es.begin(), es.end());
+  std::vector<Vec3> d;
+  for (int e : es) {
+    const int o = P.E[e].v0 == v ? P.E[e].v1 : P.E[e].v0;
+    d.push_back((P.V[o].p - P.V[v].p).normalized());
+  }
+  return d;
+}
+
+// An e-e's four rows for the sign sigma. w_1, w_2 are the into-face directions toward the
+// edge's left then right face: the left face is the one whose loop runs the edge from
+// edges[e][0] to edges[e][1] (`edge_info[].left`, schemas/model.schema.json), the checker's
+// face[0], and m[0] points into it; m[1] into face[1], the right face.
+// Data error: b', w' (unit, within kRcErr of R_c^T e_B, R_c^T w) enter B's coefficients at
+// most four times and A's three, alpha twice and tau once (tau <= slack <= 1 per unit):
+// 16 kRcErr bounds each row over the box (|v| < 1.23).
+void ee_rows(Program& P, const FirstOrder& F, const Edge& ea, const Edge& eb, double sigma) {
+  const Vec3 eA = ea.dir, bp = F.M.transpose() * eb.dir;
+  const Vec3 m = eA.cross(bp);
+  const double c = eA.dot(bp);
+  const double tau = F.slack * std::max(0.0, m.norm() - F.rho - F.gamma);
+  const double extra = 16 * kRcErr + kUnitEval;
+  for (const Vec3& w : {eb.m[0], eb.m[1]}) {
+    const Vec3 wp = F.M.transpose() * w;
+    at_least(P, sigma * (c * wp - wp.dot(eA) * bp), -sigma * wp.dot(m), F.gamma, tau, 4, 2, extra);
+  }
+  const double g = F.gamma, rho = F.rho;
+  const double rA = 2 * g + rho * rho + 2 * rho * g + g * g;
+  for (const Vec3& w : {ea.m[0], ea.m[1]})
+    at_least(P, sigma * (w.dot(eA) * bp - c * w + w.cross(m)), sigma * w.dot(m), rA, tau, 6, 2,
+             extra);
+}
+
+// The rows of one choice of signs, PCs in order.
+Program first_order_rows(const Ctx& ctx, const std::vector<SetPc>& pcs, const FirstOrder& F,
+                         const std::vector<double>& signs) {
+  const Poly &A = ctx.g.A, &B = ctx.g.B;
+  const double s = F.slack;
+  Program P;
+  for (int j = 0; j < 3; ++j) P.add_var(-F.rho, F.rho);
+  std::size_t next = 0;  // next sign
+  for (const SetPc& pc : pcs) {
+    switch (pc.type) {
+      case PcType::VF:
+        for (const Vec3& d : edge_rays(A, pc.a)) turned_at_least(P, F, d, B.F[pc.b].n, s);
+        break;
+      case PcType::FV:
+        for (const Vec3& d : edge_rays(B, pc.b)) turned_at_least(P, F, A.F[pc.a].n, d, s);
+        break;
+      case PcType::EF: {
+        const Edge& e = A.E[pc.a];
+        const Vec3& n = B.F[pc.b].n;
+        turned_at_least(P, F, e.m[0], n, s);
+        turned_at_least(P, F, e.m[1], n, s);
+        turned_within(P, F, e.dir, n, kAlignTol);
+        break;
+      }
+      case PcType::FE: {
+        const Edge& e = B.E[pc.b];
+        const Vec3& n = A.F[pc.a].n;
+        turned_at_least(P, F, n, e.m[0], s);
+        turned_at_least(P, F, n, e.m[1], s);
+        turned_within(P, F, n, e.dir, kAlignTol);
+        break;
+      }
+      case PcType::EE:
+        ee_rows(P, F, A.E[pc.a], B.E[pc.b], signs[next++]);
+        break;
+      default:  // f-f: no rows (fewer rows only make the claim harder to prove)
+        break;
+    }
+  }
+  return P;
+}
+
+std::string signs_text(const std::vector<double>& s) {
+  std::string t = "[";
+  for (std::size_t i = 0; i < s.size(); ++i) t += (i ? "," : "") + fmt(s[i]);
+  return t + "]";
+}
+
+}  // namespace
+
+std::string check_first_order(const Ctx& ctx, const std::vector<SetPc>& pcs, const Turn& turn,
+                              const json& farkas) {
+  if (turn.arc) return "a first-order leaf needs a cube of rotations (domain \"ball\"), not an arc";
+  // theta_max = sqrt(3) h with the node's grown half-width, taken upwards.
+  const double theta = std::sqrt(3.0) * turn.h * (1 + 1e-14);
+  if (!(theta < kPi / 4)) return "theta_max = sqrt(3) h = " + fmt(theta) + " is not below pi/4";
+  FirstOrder F;
+  F.M = turn.M;
+  F.rho = std::sin(theta) * (1 + 1e-14);
+  const double hs = std::sin(theta / 2);
+  F.gamma = 2 * hs * hs * (1 + 1e-14);  // 1 - cos(theta) without the cancellation
+  F.slack = ctx.tol.slack;
+  std::string ee_names;
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < pcs.size(); ++i)
+    if (pcs[i].type == PcType::EE) {
+      ee_names +=
+          std::string(k++ ? ", " : "") + "PC " + std::to_string(i) + " (" + pc_text(pcs[i]) + ")";
+    }
+  if (!farkas.is_array()) return "farkas is not an array";
+  const std::size_t choices = std::size_t(1) << k;
+  if (farkas.size() != choices)
+    return "farkas has " + std::to_string(farkas.size()) + " entries, the set's " +
+           std::to_string(k) + " e-e PCs make " + std::to_string(choices) + " choices of signs";
+  for (std::size_t i = 0; i < choices; ++i) {
+    std::vector<double> want(k);
+    for (std::size_t j = 0; j < k; ++j) want[j] = (i >> j) & 1 ? -1.0 : 1.0;
+    const json& f = farkas[i];
+    const auto got = f.at("signs").get<std::vector<double>>();
+    if (got != want)
+      return "entry " + std::to_string(i) + ": signs " + signs_text(got) + ", expected " +
+             signs_text(want) + " (one per e-e PC" + (k ? " [" + ee_names + "]" : "") +
+             ", the first counting fastest, +1 first)";
+    const std::string why =
+        check_multipliers(first_order_rows(ctx, pcs, F, want), f.at("y").get<std::vector<double>>(),
+                          ctx.tol.rounding);
+    if (!why.empty()) return "signs " + signs_text(want) + ": " + why;
   }
   return "";
 }

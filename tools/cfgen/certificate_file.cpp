@@ -51,6 +51,8 @@ const char* kind_name(const CellNode& n) {
       return "cone";
     case Verdict::kSlack:
       return "local-slack";
+    case Verdict::kFirstOrder:
+      return "first-order";
     case Verdict::kProgram:
       return "program";
     case Verdict::kDeep:
@@ -61,9 +63,21 @@ const char* kind_name(const CellNode& n) {
   return "open";  // never in a complete tree
 }
 
+// The signs of the e-e normals of first-order program k (first_order_programs' order: the
+// first e-e counting fastest, +1 first), one per e-e of the set in PC order.
+std::vector<int> ee_signs(const PcSet& pcs, std::size_t k) {
+  std::vector<int> out;
+  for (const Pc& pc : pcs)
+    if (pc.type == PcType::kEE) {
+      out.push_back((k & 1) ? -1 : 1);
+      k >>= 1;
+    }
+  return out;
+}
+
 // What one node claims, with the data a checker needs to recheck it.
 json node_json(const CellNode& n, int id, bool circle, const std::vector<std::vector<int>>& choices,
-               const gen::DeepPoints& deep) {
+               const gen::DeepPoints& deep, const PcSet& pcs) {
   json j = {{"id", id}, {"parent", n.parent}};
   j["rot"] = circle ? json{{"arc", {n.arc.centre, n.arc.half}}}
                     : json{{"centre", vec(n.cell.centre)}, {"half", n.cell.half}};
@@ -90,11 +104,17 @@ json node_json(const CellNode& n, int id, bool circle, const std::vector<std::ve
       f.push_back({{"choice", choices[k]}, {"y", r.certificates[k].y}});
     j["farkas"] = std::move(f);
   }
+  if (r.verdict == Verdict::kFirstOrder) {
+    json f = json::array();
+    for (std::size_t k = 0; k < r.certificates.size(); ++k)
+      f.push_back({{"signs", ee_signs(pcs, k)}, {"y", r.certificates[k].y}});
+    j["farkas"] = std::move(f);
+  }
   return j;
 }
 
 json cells_json(const gen::CellTree& tree, const CellRelaxation& relaxation,
-                const gen::DeepPoints& deep) {
+                const gen::DeepPoints& deep, const PcSet& pcs) {
   const bool circle = tree.circle_pc >= 0;
   json j = {{"pivot", vec(tree.pivot)}, {"domain", circle ? "circle" : "ball"}};
   if (circle)
@@ -102,7 +122,7 @@ json cells_json(const gen::CellTree& tree, const CellRelaxation& relaxation,
   const std::vector<std::vector<int>> choices = relaxation.choice_list();
   json nodes = json::array();
   for (std::size_t i = 0; i < tree.nodes.size(); ++i)
-    nodes.push_back(node_json(tree.nodes[i], static_cast<int>(i), circle, choices, deep));
+    nodes.push_back(node_json(tree.nodes[i], static_cast<int>(i), circle, choices, deep, pcs));
   j["nodes"] = std::move(nodes);
   return j;
 }
@@ -154,7 +174,7 @@ json set_json(const gen::SetDecision& d, const gen::Enumeration& e,
   if (d.cells) {
     const CellRelaxation relaxation(search.a(), search.b(), d.pcs, limits.touch_tol, limits.margin,
                                     limits.local_slack);
-    j["cells"] = cells_json(*d.cells, relaxation, deep);
+    j["cells"] = cells_json(*d.cells, relaxation, deep, d.pcs);
   } else {
     j["rule"] = gen::rule_name(d.rule.rule);
     json involved = json::array();

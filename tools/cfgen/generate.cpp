@@ -161,6 +161,7 @@ nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args,
       {"symmetry", opt.use_symmetry}};
   if (args.thorough)
     meta["parameters"]["thorough"] = true;  // absent otherwise: the same bytes as before
+  if (args.cube_cells > 0) meta["parameters"]["cube_cells"] = args.cube_cells;  // likewise
   meta["generator"] = {{"name", "cfgen"}, {"a_model", args.a_path}, {"b_model", args.b_path}};
   // Coordinates are stored in mm; the unit each model file was read in (docs/spec.md, section 2).
   meta["source_units"] = {{"A", args.load_a.units}, {"B", args.load_b.units}};
@@ -309,6 +310,7 @@ int run_generate(const GenerateArgs& args) {
   opt.max_pcs = args.max_pcs;
   opt.use_symmetry = args.symmetry && !args.thorough;
   opt.close_orbits = args.thorough;
+  opt.cube_cells = args.cube_cells;
   opt.records = writes;  // the other shards stop after the last stage
   opt.certificates = certifies;
   const gen::WitnessSearch ws(ai, bi, search);

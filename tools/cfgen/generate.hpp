@@ -70,9 +70,13 @@ struct GenerateArgs {
   int max_pcs = 3;     ///< largest CFs to enumerate (1..3)
   bool thorough =
       false;  ///< search every set, then add every image of each CF found (enumerate.hpp)
-  bool symmetry = true;      ///< search one set per orbit of the models' symmetries (symmetry.hpp)
-  gen::SearchParams search;  ///< angular tolerances and search limits (lengths: `rel`)
-  RelativeLengths rel;       ///< lengths of the search, relative to the models' size
+  bool symmetry = true;  ///< search one set per orbit of the models' symmetries (symmetry.hpp)
+  /// Cells of rotation space each failed candidate without an f-f PC may take in the decision
+  /// (docs/generator.md, "Refuting a set over cells of poses"); 0: such sets are not searched
+  /// over cells.
+  std::size_t cube_cells = 0;
+  gen::SearchParams search;    ///< angular tolerances and search limits (lengths: `rel`)
+  RelativeLengths rel;         ///< lengths of the search, relative to the models' size
   LoadOptions load_a, load_b;  ///< units and coplanarity tolerance of each model
   /// With shard.count > 0 (checkpoint_dir or share required, a directory on storage every
   /// shard sees): compute this shard's chunks of every stage and take the others' from the

@@ -66,7 +66,9 @@ def generate(a_path: str | os.PathLike[str], b_path: str | os.PathLike[str],
     True: no progress on stderr), ``checkpoint`` (a directory: ``--checkpoint``, finished work
     kept there and resumed by the same call; without it no checkpoint is kept, as
     ``--no-checkpoint``), ``certificates`` (a file: ``--certificates``, every failed candidate
-    set with its outcome and evidence, docs/certificates.md). Ctrl-C stops the run between
+    set with its outcome and evidence, docs/certificates.md), ``cube_cells`` (default 0:
+    ``--cube-cells``, the cells of rotation space each failed set without an f-f PC may take to
+    be refuted). Ctrl-C stops the run between
     tasks and raises KeyboardInterrupt; with ``checkpoint``, the chunks finished so far are
     kept for the next call. Raises cf.Error for bad models or options.
     """

@@ -1,5 +1,6 @@
 #include "cfgen/decide/cell_relaxation.hpp"
 
+#include "cfgen/decide/first_order.hpp"
 #include "cfgen/verify/rotation_conditions.hpp"
 #include "cfgen/verify/verifier.hpp"
 
@@ -324,6 +325,13 @@ CellRelaxation::Refutation CellRelaxation::refute(const Mat3& R_c, const TurnBou
   }
   out.verdict = rotation_test(R_c, turn, out.pc, out.direction);
   if (out.verdict != Verdict::kOpen) return out;
+  // A cube of rotations (no arc): its turn bound is an angle.
+  if (local_slack_ > 0 && turn.about == 0 && turn.any > 0 &&
+      first_order_refutes(A_, B_, pcs_, R_c, turn.any, local_slack_, kRotAccepted,
+                          with_certificates ? &out.certificates : nullptr)) {
+    out.verdict = Verdict::kFirstOrder;
+    return out;
+  }
   const std::size_t choices = this->choices();
   if (choices > max_choices) return out;
   std::vector<int> choice(slot_sizes_.size(), 0);

@@ -37,13 +37,15 @@ class CellRelaxation {
 
   /// Why a cell holds no pose of the set.
   enum class Verdict {
-    kOpen,      // not refuted: some pose of the relaxation may have its rotation here
-    kBounds,    // the PCs' contact points cannot be near enough for any rotation
-    kRotation,  // a PC's rotational condition misses by more than the turn bound (pc)
-    kCone,      // a PC is locally penetrating for every rotation of the cell (pc, direction)
-    kSlack,     // a PC's local margin is below local_slack for every rotation of the cell (pc)
-    kProgram,   // the translation programs of every choice of convex pieces are infeasible
-    kDeep,      // a point of one solid lies inside the other at every pose (DeepPoints)
+    kOpen,        // not refuted: some pose of the relaxation may have its rotation here
+    kBounds,      // the PCs' contact points cannot be near enough for any rotation
+    kRotation,    // a PC's rotational condition misses by more than the turn bound (pc)
+    kCone,        // a PC is locally penetrating for every rotation of the cell (pc, direction)
+    kSlack,       // a PC's local margin is below local_slack for every rotation of the cell (pc)
+    kFirstOrder,  // the PCs' local margins to first order (first_order.hpp) cannot all reach
+                  // local_slack in the cube: `certificates`, one per choice of e-e signs
+    kProgram,     // the translation programs of every choice of convex pieces are infeasible
+    kDeep,        // a point of one solid lies inside the other at every pose (DeepPoints)
   };
   /// A part of the given translation box cut off when an open cell's box is narrowed, with
   /// the proof that no choice of pieces has a solution there.

@@ -34,6 +34,9 @@ struct EnumerateOptions {
   /// Keep each failed set's outcome and evidence (Enumeration::decisions) for the certificate
   /// file (docs/certificates.md).
   bool certificates = false;
+  /// Cells of rotation space each failed set without an f-f PC may take in the decision
+  /// (cfgen --cube-cells); 0: not searched over cells.
+  std::size_t cube_cells = 0;
 };
 
 /// A failed candidate set: how it was decided, and the evidence (docs/certificates.md).

@@ -94,6 +94,7 @@ void Enumerator::find_undecided() {
   for (int l = 0; l < 3; ++l)
     for (const auto& [s, w] : valid_[l]) known.insert(s);
   const CellSearchLimits limits = decision_limits(search_, kDecisionCells);
+  const CellSearchLimits cube_limits = decision_limits(search_, opt_.cube_cells);
   const bool keep = opt_.certificates;
   enum : char { kDecided, kOpen, kOverCells, kFound, kKnown };
   std::vector<char> state(failed_.size(), kDecided);
@@ -115,10 +116,12 @@ void Enumerator::find_undecided() {
         if (rule.rule != Rule::kNone) return;
         state[i] = kOpen;
         // A single f-f's relaxation holds wherever its faces overlap: only obstacles refute it.
-        if (s.size() < 2 || !has_ff(s)) return;
+        // Sets without an f-f search cubes of rotation space, when asked to.
+        const bool ff = has_ff(s);
+        if (ff ? s.size() < 2 : opt_.cube_cells == 0) return;
         auto tree = keep ? std::make_shared<CellTree>() : nullptr;
-        const CellSearchResult r =
-            search_cells(search_.a(), search_.b(), s, limits, &search_, tree.get());
+        const CellSearchResult r = search_cells(search_.a(), search_.b(), s,
+                                                ff ? limits : cube_limits, &search_, tree.get());
         if (r.outcome == CellSearchResult::Outcome::kRefuted) {
           state[i] = kOverCells;
           if (keep) decisions[i].cells = std::move(tree);
