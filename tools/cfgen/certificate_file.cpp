@@ -1,6 +1,7 @@
 #include "cfgen/certificate_file.hpp"
 
 #include "cfgen/decide/deep_points.hpp"
+#include "cfgen/decide/first_order.hpp"
 #include "cfgen/enumerate/symmetry.hpp"
 
 #include <cf/file_io.hpp>
@@ -63,18 +64,6 @@ const char* kind_name(const CellNode& n) {
   return "open";  // never in a complete tree
 }
 
-// The signs of the e-e normals of first-order program k (first_order_programs' order: the
-// first e-e counting fastest, +1 first), one per e-e of the set in PC order.
-std::vector<int> ee_signs(const PcSet& pcs, std::size_t k) {
-  std::vector<int> out;
-  for (const Pc& pc : pcs)
-    if (pc.type == PcType::kEE) {
-      out.push_back((k & 1) ? -1 : 1);
-      k >>= 1;
-    }
-  return out;
-}
-
 // What one node claims, with the data a checker needs to recheck it.
 json node_json(const CellNode& n, int id, bool circle, const std::vector<std::vector<int>>& choices,
                const gen::DeepPoints& deep, const PcSet& pcs) {
@@ -107,7 +96,7 @@ json node_json(const CellNode& n, int id, bool circle, const std::vector<std::ve
   if (r.verdict == Verdict::kFirstOrder) {
     json f = json::array();
     for (std::size_t k = 0; k < r.certificates.size(); ++k)
-      f.push_back({{"signs", ee_signs(pcs, k)}, {"y", r.certificates[k].y}});
+      f.push_back({{"signs", gen::first_order_signs(pcs, k)}, {"y", r.certificates[k].y}});
     j["farkas"] = std::move(f);
   }
   return j;

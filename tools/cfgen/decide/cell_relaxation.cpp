@@ -142,7 +142,8 @@ CellRelaxation::CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcS
 }
 
 CellRelaxation::Verdict CellRelaxation::rotation_test(const Mat3& R_c, const TurnBound& turn,
-                                                      int& pc, Vec3& direction) const {
+                                                      int& pc, Vec3& direction,
+                                                      double* slack_bound) const {
   const Polyhedron& mA = *A_.model;
   const Polyhedron& mB = *B_.model;
   for (pc = 0; pc < pcs_.size(); ++pc) {
@@ -199,8 +200,11 @@ CellRelaxation::Verdict CellRelaxation::rotation_test(const Mat3& R_c, const Tur
   // The slack a witness keeps at every contact: an e-e whose edges turn parallel, or a
   // tangent direction lying in the face, is degenerate there, and the cells near such a
   // limit pose are refuted once they are small against the slack.
-  if (local_slack_ > 0 && local_margin_bound(A_, B_, pcs_, R_c, turn, &pc) < local_slack_)
-    return Verdict::kSlack;
+  if (local_slack_ > 0) {
+    const double bound = local_margin_bound(A_, B_, pcs_, R_c, turn, &pc);
+    if (slack_bound) *slack_bound = bound;
+    if (bound < local_slack_) return Verdict::kSlack;
+  }
   pc = -1;
   return Verdict::kOpen;
 }
@@ -317,14 +321,20 @@ CellRelaxation::Refutation CellRelaxation::refute(const RotationCell& cell, Vec3
 
 CellRelaxation::Refutation CellRelaxation::refute(const Mat3& R_c, const TurnBound& turn,
                                                   Vec3& t_lo, Vec3& t_hi, bool with_certificates,
-                                                  std::size_t max_choices, bool narrow_box) const {
+                                                  std::size_t max_choices,
+                                                  bool may_keep_box) const {
   Refutation out;
   if (empty_) {
     out.verdict = Verdict::kBounds;
     return out;
   }
-  out.verdict = rotation_test(R_c, turn, out.pc, out.direction);
+  double bound = HUGE_VAL;
+  out.verdict = rotation_test(R_c, turn, out.pc, out.direction, &bound);
   if (out.verdict != Verdict::kOpen) return out;
+  if (may_keep_box && local_slack_ > 0) {
+    const double centre = local_margin_bound(A_, B_, pcs_, R_c, TurnBound{});
+    out.unsettled = centre - (bound - centre) < local_slack_;
+  }
   // A cube of rotations (no arc): its turn bound is an angle.
   if (local_slack_ > 0 && turn.about == 0 && turn.any > 0 &&
       first_order_refutes(A_, B_, pcs_, R_c, turn.any, local_slack_, kRotAccepted,
@@ -341,7 +351,7 @@ CellRelaxation::Refutation CellRelaxation::refute(const Mat3& R_c, const TurnBou
     LinearProgram lp = program(R_c, turn, choice, t_lo, t_hi);
     if (solve(lp).status == LpResult::Status::kOptimal) {
       open = true;
-      if (!narrow_box) {  // kOpen, the box as given
+      if (out.unsettled) {  // kOpen, the box as given
         out.certificates.clear();
         return out;
       }

@@ -65,6 +65,10 @@ class CellRelaxation {
     /// kOpen with certificates asked for: the slabs the narrowing cut off, tiling the given
     /// box with the narrowed one.
     std::vector<Slab> slabs;
+    /// kOpen: the local margin is unsettled over the cell (its bound exceeds its value at the
+    /// centre by at least as much as the centre exceeds local_slack), so the box was kept as
+    /// given; only when refute's may_keep_box allowed it.
+    bool unsettled = false;
   };
   /// Whether some pose with its rotation in the cell and A's pivot at a translation in
   /// [t_lo, t_hi] (mm, B's frame) can meet the relaxation. When the cell stays open, t_lo and
@@ -75,11 +79,12 @@ class CellRelaxation {
   Refutation refute(const RotationCell& cell, Vec3& t_lo, Vec3& t_hi, bool with_certificates,
                     std::size_t max_choices = 4096) const;
   /// The same for the rotations that turn A's vectors at most `turn` from where R_c does.
-  /// narrow_box = false: an open cell keeps [t_lo, t_hi] as given (one program a choice
-  /// instead of thirteen), for a cell that will be split over its rotations anyway.
+  /// may_keep_box: an open cell whose local margin is unsettled keeps [t_lo, t_hi] as given
+  /// (one program a choice instead of thirteen) and says so (Refutation::unsettled), for a
+  /// caller that splits such a cell over its rotations anyway.
   Refutation refute(const Mat3& R_c, const TurnBound& turn, Vec3& t_lo, Vec3& t_hi,
                     bool with_certificates, std::size_t max_choices = 4096,
-                    bool narrow_box = true) const;
+                    bool may_keep_box = false) const;
 
   /// True when at rotation R (meeting the rotational conditions to 10 kRotTol) the contacts
   /// can hold in their closed elements without local penetration: the relaxation holds at a
@@ -111,7 +116,9 @@ class CellRelaxation {
     ElementKind kind;
     int index;
   };
-  Verdict rotation_test(const Mat3& R_c, const TurnBound& turn, int& pc, Vec3& direction) const;
+  // slack_bound: when given and the slack is tested, the local margin's bound over the cell.
+  Verdict rotation_test(const Mat3& R_c, const TurnBound& turn, int& pc, Vec3& direction,
+                        double* slack_bound = nullptr) const;
   std::vector<Slab> narrow(const Mat3& R_c, const TurnBound& turn, Vec3& t_lo, Vec3& t_hi,
                            const Vec3& lo, const Vec3& hi) const;
   void add_contact(LinearProgram& lp, int pc, const Mat3& R_c, const TurnBound& turn, int& slot,

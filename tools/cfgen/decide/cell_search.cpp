@@ -64,19 +64,9 @@ double reach_of(const Polyhedron& A, const Vec3& pivot) {
   return r;
 }
 
-// Whether the local margin may fall below the slack somewhere in the cell while it holds at
-// other rotations of it: its bound over the cell exceeds the margin at the centre by as much
-// as the margin may fall below it, estimated from that excess. Such a cell is split over
-// its rotations, where the slack decides, not over translations: the boxes' halves would
-// each be split over their rotations again.
-bool slack_unsettled(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs, const Mat3& R_c,
-                     const TurnBound& turn, double slack) {
-  const double upper = local_margin_bound(a, b, pcs, R_c, turn);
-  const double centre = local_margin_bound(a, b, pcs, R_c, TurnBound{});
-  return centre - (upper - centre) < slack;
-}
-
-// Splits the rotations when the local margin is unsettled over them (slack_unsettled) or
+// Splits the rotations when the local margin is unsettled over them (CellRelaxation's
+// Refutation::unsettled: the slack decides there, and the box's halves would each be split
+// over their rotations again) or
 // they move A's points more than the box's spread, else the box along its longest side; the
 // children's parent is `node`. The kind of split made.
 CellNode::Kind split_into(const PoseBox& c, const Circle& circle, double reach, int node,
@@ -181,12 +171,10 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
       if (tree) leaf().kind = CellNode::Kind::kOutsideBall;
       continue;
     }
-    // A cell whose local margin is unsettled is split over its rotations whatever its box:
-    // narrowing the box would cost twelve programs and change nothing.
-    const bool unsettled = limits.local_slack > 0 && half >= limits.resolution &&
-                           slack_unsettled(a, b, pcs, R_c, turn, limits.local_slack);
-    CellRelaxation::Refutation r =
-        relaxation.refute(R_c, turn, c.t_lo, c.t_hi, tree != nullptr, 4096, !unsettled);
+    // A cell whose local margin is unsettled is split over its rotations whatever its box
+    // (above the resolution): narrowing the box would cost twelve programs and change nothing.
+    CellRelaxation::Refutation r = relaxation.refute(R_c, turn, c.t_lo, c.t_hi, tree != nullptr,
+                                                     4096, half >= limits.resolution);
     if (tree && !r.slabs.empty())
       node = record_narrowing(*tree, node, c.t_lo, c.t_hi, std::move(r.slabs));
     if (r.verdict == CellRelaxation::Verdict::kOpen) {
@@ -217,7 +205,7 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
       return out;  // kUndecided
     int axis = -1;
     double at = 0;
-    const CellNode::Kind kind = split_into(c, circle, reach, node, stack, axis, at, unsettled);
+    const CellNode::Kind kind = split_into(c, circle, reach, node, stack, axis, at, r.unsettled);
     if (tree) {
       leaf().kind = kind;
       leaf().axis = axis;

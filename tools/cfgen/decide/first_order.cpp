@@ -71,19 +71,6 @@ void ee_rows(const ModelInfo& A, const ModelInfo& B, const Pc& pc, double sign, 
     rows.at_least(sign * (w.dot(a) * bp - ab * w + w.cross(m)), sign * w.dot(m), rem_a, thr);
 }
 
-// The unit directions from vertex v along its edges, in ascending order of edge index (the
-// order the certificate file's rows follow).
-std::vector<Vec3> edge_rays(const Polyhedron& m, int v) {
-  std::vector<EdgeId> edges = m.vertices()[static_cast<std::size_t>(v)].edges;
-  std::sort(edges.begin(), edges.end());
-  std::vector<Vec3> out;
-  for (EdgeId e : edges) {
-    const Edge& E = m.edge(e);
-    out.push_back(E.v0.value() == v ? E.dir : Vec3(-E.dir));
-  }
-  return out;
-}
-
 // The rows of every PC but the e-e ones (ee_rows) and the f-f ones (not tested).
 void pc_rows(const ModelInfo& A, const ModelInfo& B, const Pc& pc, double slack, double rot_tol,
              Rows& rows) {
@@ -91,13 +78,13 @@ void pc_rows(const ModelInfo& A, const ModelInfo& B, const Pc& pc, double slack,
   const Polyhedron& mB = *B.model;
   const auto ia = static_cast<std::size_t>(pc.a), ib = static_cast<std::size_t>(pc.b);
   switch (pc.type) {
+    // A vertex's edge rays, as the analysis lists them: in the order of the vertex's edges,
+    // ascending edge index (the order the certificate file's rows follow).
     case PcType::kVF:
-      for (const Vec3& d : edge_rays(mA, pc.a))
-        rows.turned_at_least(d, mB.faces()[ib].normal, slack);
+      for (const Vec3& d : A.cones[ia].rays) rows.turned_at_least(d, mB.faces()[ib].normal, slack);
       break;
     case PcType::kFV:
-      for (const Vec3& d : edge_rays(mB, pc.b))
-        rows.turned_at_least(mA.faces()[ia].normal, d, slack);
+      for (const Vec3& d : B.cones[ib].rays) rows.turned_at_least(mA.faces()[ia].normal, d, slack);
       break;
     case PcType::kEF:
       for (const Vec3& w : {A.wedges[ia].into_left, A.wedges[ia].into_right})
@@ -151,6 +138,16 @@ std::optional<FarkasCertificate> pair_proof(const LinearProgram& lp) {
 
 }  // namespace
 
+std::vector<int> first_order_signs(const PcSet& pcs, std::size_t choice) {
+  std::vector<int> out;
+  for (const Pc& pc : pcs)
+    if (pc.type == PcType::kEE) {
+      out.push_back((choice & 1) ? -1 : 1);
+      choice >>= 1;
+    }
+  return out;
+}
+
 std::vector<LinearProgram> first_order_programs(const ModelInfo& a, const ModelInfo& b,
                                                 const PcSet& pcs, const Mat3& R_c, double theta_max,
                                                 double slack, double rot_tol) {
@@ -162,16 +159,15 @@ std::vector<LinearProgram> first_order_programs(const ModelInfo& a, const ModelI
     if (pcs[k].type == PcType::kEE) ee.push_back(k);
   }
   std::vector<LinearProgram> out;
-  for (unsigned signs = 0; signs < (1u << ee.size()); ++signs) {
+  for (std::size_t choice = 0; choice < (std::size_t{1} << ee.size()); ++choice) {
     LinearProgram lp(3);
     Rows rows(R_c, theta_max, lp);
+    const std::vector<int> signs = first_order_signs(pcs, choice);
     for (int k = 0, e = 0; k < pcs.size(); ++k) {
-      if (pcs[k].type != PcType::kEE) {
+      if (pcs[k].type == PcType::kEE)
+        ee_rows(a, b, pcs[k], signs[static_cast<std::size_t>(e++)], slack, rows);
+      else
         pc_rows(a, b, pcs[k], slack, rot_tol, rows);
-        continue;
-      }
-      ee_rows(a, b, pcs[k], (signs >> e & 1) ? -1.0 : 1.0, slack, rows);
-      ++e;
     }
     out.push_back(std::move(lp));
   }

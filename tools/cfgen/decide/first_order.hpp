@@ -34,6 +34,10 @@ std::vector<LinearProgram> first_order_programs(const ModelInfo& a, const ModelI
                                                 const PcSet& pcs, const Mat3& R_c, double theta_max,
                                                 double slack, double rot_tol);
 
+/// The signs (+1 or -1) of the set's e-e normals, in PC order, of program `choice` of
+/// first_order_programs: the first e-e counting fastest, +1 first.
+std::vector<int> first_order_signs(const PcSet& pcs, std::size_t choice);
+
 /// True when every program of first_order_programs is proven infeasible; its certificates
 /// (one per program, in order) go to `proofs` when given. False when the test does not apply
 /// or some program is feasible or not proven infeasible.
