@@ -601,6 +601,43 @@ TEST_CASE("cells: a program leaf with hand-derived Farkas multipliers") {
   CHECK_THAT(r.reason, Catch::Contains("Farkas gap -2"));
 }
 
+TEST_CASE("programs: an A edge's widening is beta's chord, not its largest end") {
+  // A's edge 0-1 (x = (10 s, 0, 0)) on B's tower top (y = 20, x in [0, 10]), pivot vertex 0,
+  // a cube of half 1 / (10 sqrt 3) at the identity: beta(x_0 - p) = 0, beta(x_1 - p) = 1, so
+  // W = touch + rounding + s (the old rows: + 1 for every s). With t_y >= 20.5 and t_x >= 8,
+  // row 0 is t_y - s <= 20 + W0 and row 4 (x <= 10 - m) t_x + 9 s <= 10 - m + W0: 9 row 0 +
+  // row 4 leaves 0 s and 192.5 > 189.99 + 10 W0. With W the largest end the same sum is 192.5
+  // + 10 s > 199.99 + 10 W0, not a contradiction (a contact point needs s >= 0.5 here, where
+  // the turn moves it by 0.5, and then lies past x = 10 - m).
+  Pair P = make_pair();
+  const json pieces = {{"B", {tower_top_one_piece()}}};
+  const int ex = P.G.A.edge_index(0, 1);
+  const std::string pcs = pcs_of("e-f", ex, 6);
+  const json rot = cube_rot(Vec3::Zero(), 1 / (10 * std::sqrt(3.0)));
+  const Vec3 lo(8, 20.5, 5), hi(9, 21, 6);
+  const json y = {9, 0, 0, 0, 1, 0};
+  TreeB T;
+  const int root = T.add(-1, cube_rot(Vec3::Zero(), kPiD), "narrow");
+  const int prog =
+      T.add(root, rot, "program", {{"farkas", {{{"choice", {0}}, {"y", y}}}}}, &lo, &hi);
+  auto r = one(P, cells_set(pcs, Vec3(0, 0, 0), T), pieces);
+  CHECK_FALSE(failure_of(r, prog));
+  // The chord runs from x_0 (s = 0) to x_1: about vertex 1 the widening is 1 - s, and the
+  // same multipliers leave 20 s - 17.5 of the gap.
+  r = one(P, cells_set(pcs, Vec3(10, 0, 0), T), pieces);
+  const CertNodeFailure* f = failure_of(r, prog);
+  REQUIRE(f);
+  CHECK_THAT(f->why, Catch::StartsWith("program: choice [0]: Farkas gap -17.4"));
+  // Row 0 alone carries the chord's slope: t_y - s goes down to 20.5 - 0.999 over the box,
+  // 0.499 below 20 + W0 (with the largest end, t_y <= 21 + W0: 0.5 below).
+  TreeB U = T;
+  U.nodes[prog]["farkas"][0]["y"] = {1, 0, 0, 0, 0, 0};
+  r = one(P, cells_set(pcs, Vec3(0, 0, 0), U), pieces);
+  f = failure_of(r, prog);
+  REQUIRE(f);
+  CHECK_THAT(f->why, Catch::StartsWith("program: choice [0]: Farkas gap -0.499"));
+}
+
 TEST_CASE("cells: a wrongly flagged diagonal does not make a false program pass") {
   // The tower top split at x = 5 into two pieces; their shared side at x = 5 is a diagonal.
   // With a 3 mm margin a contact point fits (x in [3, 7]), but flagging the diagonal as

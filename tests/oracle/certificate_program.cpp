@@ -451,13 +451,18 @@ struct Program {
   }
 };
 
-// The image of A's contact point: z = cz + sum_k col_k var_k + t.
+// The image of A's contact point: z = cz + sum_k col_k var_k + t, widened by
+// W + ws * var_is (an A edge's chord of beta in its parameter; otherwise ws = 0, is = -1).
 struct Image {
   Vec3 cz;
   std::vector<std::pair<int, Vec3>> cols;
   double czmag = 0;    // |cz| as computed
   double e_frame = 0;  // A's face: reconstruction error of the contact point
-  double W = 0;
+  double W = 0;        // the widening at var_is = 0, with touch and rounding
+  int is = -1;         // A's edge parameter, which the chord's slope multiplies
+  double ws = 0;       // the chord's slope beta(x_1 - p) - beta(x_0 - p), as computed
+  double wsmag = 0;    // beta(x_0 - p) + beta(x_1 - p): what ws was computed from
+  double Wmax = 0;     // the largest widening over the parameter's [0, 1]
 };
 
 const FaceTable* table(const Ctx& ctx, char solid, int f, std::string* why) {
@@ -507,9 +512,18 @@ Row dot_row(const Program& P, const Image& im, const Vec3& n, double sign, doubl
     r.a[k] += sign * n.dot(col);
     r.amag[k] += n.norm() * col.norm();
   }
+  // The widening's s term on the left, times |a| = 1 (the spec's unit row vectors). Its
+  // slope is one rounded subtraction of the two betas: off by at most an ulp of |ws|, which
+  // kRelRound of wsmag times |s| <= 1 covers in widen().
+  if (im.is >= 0) {
+    r.a[im.is] -= im.ws;
+    r.amag[im.is] += im.wsmag;
+  }
   r.b = sign * (c - n.dot(im.cz)) + im.W;
   r.bmag = cmag + n.norm() * im.czmag + im.W;
-  r.extra = n.norm() * im.e_frame;
+  // The contact implies n.z <= n.y + |n| W(s): where the checker's n (a frame's, to its
+  // defect) is longer than 1, the excess of |n| over the spec's 1 times the widening.
+  r.extra = n.norm() * im.e_frame + std::max(0.0, n.norm() - 1) * im.Wmax;
   r.has_w = true;
   return r;
 }
@@ -533,7 +547,8 @@ std::string build_rows(const Ctx& ctx, const std::vector<SetPc>& pcs, const Vec3
       const Vec3 x0 = A.V[E.v0].p, x1 = A.V[E.v1].p;
       im.cz = turn.M * (x0 - p);
       auto [l, h] = edge_bounds(tol.margin, E.len);
-      im.cols.push_back({P.add_var(l, h), turn.M * (x1 - x0)});
+      im.is = P.add_var(l, h);
+      im.cols.push_back({im.is, turn.M * (x1 - x0)});
     } else {
       if (!(TA = table(ctx, 'A', pc.a, &why))) return why;
       if (choice[next] < 0 || choice[next] >= static_cast<int>(TA->pieces.size()))
@@ -559,10 +574,20 @@ std::string build_rows(const Ctx& ctx, const std::vector<SetPc>& pcs, const Vec3
         wmax = std::max(wmax, turn.beta(corner - p));
       }
       wmax += turn.unit() * (TA->rho + kRelRound * tol.scale + TA->e_frame);
+    } else if (ka == 1) {
+      // The chord of beta between the edge's ends, W0 + s ws: beta is convex (a norm, or a
+      // sum of norms of linear maps of x), so on the segment it lies below its chord; each
+      // end's computed beta bounds the exact one (kRcErr), and s is in [0, 1].
+      const Edge& E = A.E[pc.a];
+      const double b0 = turn.beta(A.V[E.v0].p - p), b1 = turn.beta(A.V[E.v1].p - p);
+      wmax = b0;
+      im.ws = b1 - b0;
+      im.wsmag = b0 + b1;
     } else {
-      for (int v : closure_vertices(A, ka, pc.a)) wmax = std::max(wmax, turn.beta(A.V[v].p - p));
+      wmax = turn.beta(A.V[pc.a].p - p);
     }
     im.W = wmax + tol.touch + tol.rounding;
+    im.Wmax = im.W + std::max(0.0, im.ws);
     if (pa) piece_rows(P, *TA, *pa, iu);
     if (kb == 0 || kb == 1) {
       Vec3 y0 = kb == 0 ? B.V[pc.b].p : B.V[B.E[pc.b].v0].p;
@@ -605,10 +630,11 @@ std::string build_rows(const Ctx& ctx, const std::vector<SetPc>& pcs, const Vec3
 }
 
 // Widens each row by a bound on the checker's own error. The row the models imply is
-// a_exact.z <= b_exact with W_exact = beta + touch (no rounding_mm); the checker's double row
-// differs by |da|.|z| + |db| <= kRelRound (sum amag_j max|z_j| + bmag), plus the deviations of
-// frames and tiling. rounding_mm, which the spec adds to every row that carries W, covers that
-// much of it; the rest (and all of it on rows without W) is added to b.
+// a_exact.z <= b_exact with W_exact = beta + touch (no rounding_mm; on an A edge W_exact is
+// beta's chord, its s term in a_exact); the checker's double row differs by |da|.|z| + |db| <=
+// kRelRound (sum amag_j max|z_j| + bmag), plus the deviations of frames and tiling.
+// rounding_mm, which the spec adds to every row that carries W, covers that much of it; the
+// rest (and all of it on rows without W) is added to b.
 void widen(Program& P, double rounding) {
   for (auto& r : P.rows) {
     double err = r.bmag;

@@ -70,6 +70,25 @@ Vec3 face_point(const Face& f, const Eigen::Vector2d& q) {
   return f.offset * f.normal + q.x() * f.u + q.y() * f.v;
 }
 
+// The point A turns about: the one vertex in the closure of every element of A the set uses
+// when there is exactly one (the corner two contact edges share), where the programs' rows
+// widen least, down to nothing (add_contact), so that contacts that can only meet there are
+// refuted at any cell size; else the mean of the elements' closure points `pts`.
+Vec3 pivot_of(const Polyhedron& A, const PcSet& pcs, const std::vector<Vec3>& pts) {
+  std::vector<Vec3> common = closure_points(A, a_kind(pcs[0].type), pcs[0].a);
+  for (int k = 1; k < pcs.size(); ++k) {
+    const std::vector<Vec3> c = closure_points(A, a_kind(pcs[k].type), pcs[k].a);
+    common.erase(
+        std::remove_if(common.begin(), common.end(),
+                       [&](const Vec3& p) { return std::find(c.begin(), c.end(), p) == c.end(); }),
+        common.end());
+  }
+  if (common.size() == 1) return common[0];
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& p : pts) mean += p;
+  return mean / static_cast<double>(pts.size());
+}
+
 // The next choice of convex pieces (an index per face slot, the first slot counting fastest).
 void next_choice(std::vector<int>& choice, const std::vector<int>& slot_sizes) {
   for (std::size_t k = 0; k < choice.size() && ++choice[k] == slot_sizes[k]; ++k) choice[k] = 0;
@@ -110,8 +129,7 @@ CellRelaxation::CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcS
     if (b_kind(pc.type) == ElementKind::kFace)
       slot_sizes_.push_back(static_cast<int>(B_.pieces[static_cast<std::size_t>(pc.b)].size()));
   }
-  for (const Vec3& p : pts) pivot_ += p;
-  pivot_ /= static_cast<double>(pts.size());
+  pivot_ = pivot_of(mA, pcs, pts);
   // The translation t puts the pivot at t: a contact point x of A goes to R (x - pivot) + t,
   // which must be a point y of B's element, so t = y - R (x - pivot) lies in the box of B's
   // element grown by the largest |x - pivot|.
@@ -252,18 +270,28 @@ void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, cons
       lp.upper[var + k] = {true, hi[k]};
     }
   }
+  // How far the cell's rotations move the image of A's contact point from where R_c puts
+  // it: at most turn(x - pivot), a convex function of x. On an edge it is bounded by its
+  // chord between the ends, widen + chord s, which vanishes towards an end at the pivot;
+  // on a face piece, by its largest value at the corners.
   double moved = 0;
   for (const Vec3& x : pts) moved = std::max(moved, turn.of(x - pivot_));
+  double chord = 0;
+  if (a_kind(pc.type) == ElementKind::kEdge) {
+    moved = turn.of(pts[0] - pivot_);
+    chord = turn.of(pts[1] - pivot_) - moved;
+  }
   const double widen = moved + touch_tol_ + 1e-12 * size_;
   const Vec3 p0 = R_c * (x0 - pivot_);
   std::vector<Vec3> Rg;
   for (const Vec3& d : g) Rg.push_back(R_c * d);
-  // a . (image of x(s)) <= b, the image R (x(s) - pivot) + t known within `widen` of
-  // R_c (x(s) - pivot) + t; `extra`: one more term (a B edge's parameter).
+  // a . (image of x(s)) <= b, the image R (x(s) - pivot) + t known within `widen` (+ `chord`
+  // s) of R_c (x(s) - pivot) + t; `extra`: one more term (a B edge's parameter).
   auto row = [&](const Vec3& a, double b, int extra_var = -1, double extra = 0) {
     LinearProgram::Coefs c;
     for (int j = 0; j < 3; ++j) c.push_back({j, a[j]});
-    for (std::size_t k = 0; k < Rg.size(); ++k) c.push_back({var + int(k), a.dot(Rg[k])});
+    for (std::size_t k = 0; k < Rg.size(); ++k)
+      c.push_back({var + int(k), a.dot(Rg[k]) - (k == 0 ? a.norm() * chord : 0.0)});
     if (extra_var >= 0) c.push_back({extra_var, extra});
     lp.add(c, Rel::kLessEq, b + a.norm() * widen - a.dot(p0));
   };
