@@ -346,3 +346,69 @@ TEST_CASE(
   CHECK(orbit_missing == 0);
   CHECK(thorough.cfs.size() > orbit.cfs.size());
 }
+
+TEST_CASE(
+    "symmetry: error() bounds how far every map moves a vertex and turns a direction off "
+    "its image element's",
+    "[symmetry]") {
+  // A box and the L-block turned and moved by a rigid motion: their coordinates are rounded,
+  // so the maps miss by a few ulps, not by nothing.
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.4, Vec3(1, -2, 2).normalized()).toRotationMatrix();
+  const cf::Polyhedron A = moved(cf::test::box(10, 20, 30, "A"), R, Vec3(3.3, -7.1, 11.9));
+  const cf::Polyhedron B = moved(cf::test::small_l_block(), R, Vec3(-0.7, 2.9, 5.3));
+  const double size = 50;
+  const PairSymmetries sym(A, B, 1e-13 * size, true);
+  REQUIRE(sym.size() == 16);
+  // Measured here on their own: the largest over A's maps plus the largest over B's.
+  auto measure = [](const cf::Polyhedron& m, const cf::gen::Symmetry& s, double& length,
+                    double& angle) {
+    for (std::size_t i = 0; i < m.num_vertices(); ++i)
+      length = std::max(length, (s.R * (m.vertices()[i].p - s.c) + s.c -
+                                 m.vertices()[static_cast<std::size_t>(s.vertex[i])].p)
+                                    .norm());
+    // The angle from the chord: acos of a dot product near 1 loses half the digits.
+    for (std::size_t f = 0; f < m.num_faces(); ++f)
+      angle = std::max(angle,
+                       2 * std::asin(0.5 * (s.R * m.faces()[f].normal -
+                                            m.faces()[static_cast<std::size_t>(s.face[f])].normal)
+                                               .norm()));
+  };
+  double la = 0, aa = 0, lb = 0, ab = 0;
+  for (std::size_t k = 0; k < sym.size(); ++k) {
+    measure(A, sym.map_a(k), la, aa);
+    measure(B, sym.map_b(k), lb, ab);
+  }
+  const cf::gen::MapError& e = sym.error();
+  CHECK(e.length >= la + lb);
+  CHECK(e.angle >= std::max(aa, ab));
+  // Rounding of coordinates of tens of mm, with the allowance error() adds for its own
+  // arithmetic (1e-14 of each model's size): far below the touch tolerance (1e-9 mm here).
+  CHECK(e.length > 0);
+  CHECK(e.length < 1e-11);
+  CHECK(e.angle < 1e-12);
+  // No symmetry: no error.
+  CHECK(PairSymmetries(A, B, 1e-13 * size, false).error().length == 0);
+}
+
+TEST_CASE("symmetry: limits loosened by a map's error take in every pose of an image",
+          "[symmetry][cells]") {
+  cf::gen::CellSearchLimits l;
+  l.touch_tol = 1e-9;
+  l.margin = 4e-9;
+  l.local_slack = 5e-4;
+  const cf::gen::MapError e{2e-12, 3e-12};
+  const cf::gen::CellSearchLimits m = cf::gen::loosened(l, e);
+  // docs/certificates.md, "Images": each by at least what the checker asks.
+  CHECK(m.touch_tol >= l.touch_tol + e.length);
+  CHECK(m.margin <= l.margin - e.length);
+  CHECK(m.rot_tol >= l.rot_tol + e.angle);
+  CHECK(m.local_slack <= l.local_slack - 2 * e.angle * (1 + 1 / l.local_slack));
+  CHECK(m.deep_extra >= e.length);
+  CHECK(m.max_cells == l.max_cells);
+  // Nothing to loosen without an error, and a margin never below 0.
+  const cf::gen::CellSearchLimits same = cf::gen::loosened(l, {});
+  CHECK(same.touch_tol == l.touch_tol);
+  CHECK(same.local_slack == l.local_slack);
+  CHECK(same.deep_extra == 0);
+  CHECK(cf::gen::loosened(l, {1e-6, 0}).margin == 0);
+}

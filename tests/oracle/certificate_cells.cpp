@@ -130,11 +130,11 @@ Turn Tree::turn(const CNode& n) const {
 }
 
 // The circle: R0 must turn n_A onto -n_B and axis be n_A, closely enough that off_circle_rad
-// covers every rotation the f-f allows. A rotation R with |R n_A + n_B| <= kAlignTol is
+// covers every rotation the f-f allows. A rotation R with |R n_A + n_B| <= rot_tol_rad is
 // R0' P Rot(a, theta) with R0' the rotation nearest R0 (|R0 - R0'| <= eta) and P the least
 // turn taking a to R0'^T R a, whose chord is at most
 // |R n_A + n_B| + |R0 n_A + n_B| + eta + 2 |a - n_A|; the node's bound then needs
-// off >= kAlignTol + |R0 n_A + n_B| + 2 eta + 2 |a - n_A| (plus rounding).
+// off >= rot_tol_rad + |R0 n_A + n_B| + 2 eta + 2 |a - n_A| (plus rounding).
 std::string parse_circle(Tree& T, const json& cj) {
   Circle& c = T.circ;
   c.pc = cj.at("pc").get<int>();
@@ -152,11 +152,11 @@ std::string parse_circle(Tree& T, const json& cj) {
   const Vec3 nA = T.ctx.g.A.F[T.pcs[c.pc].a].n, nB = T.ctx.g.B.F[T.pcs[c.pc].b].n;
   c.eta = (c.R0.transpose() * c.R0 - Mat3::Identity()).norm() + 1e-15;
   const double e0 = (c.R0 * nA + nB).norm(), da = (c.axis - nA).norm();
-  const double need = kAlignTol + e0 + 2 * c.eta + 2 * da + kUnitEval;
+  const double need = T.ctx.tol.rot + e0 + 2 * c.eta + 2 * da + kUnitEval;
   if (T.ctx.tol.off_circle < need)
     return "off_circle_rad " + fmt(T.ctx.tol.off_circle) +
-           " does not cover the f-f's circle: " + "needs " + fmt(need) +
-           " (alignment 1e-8, |R0 n_A + n_B| " + fmt(e0) + ", R0's defect " + fmt(c.eta) +
+           " does not cover the f-f's circle: " + "needs " + fmt(need) + " (rot_tol_rad " +
+           fmt(T.ctx.tol.rot) + ", |R0 n_A + n_B| " + fmt(e0) + ", R0's defect " + fmt(c.eta) +
            ", |axis - n_A| " + fmt(da) + ")";
   return "";
 }
@@ -384,8 +384,7 @@ std::string pc_label(const Tree& T, int k) {
 }
 
 // A rotational condition fails at every rotation of the node by more than the alignment a
-// witness is allowed (the spec's claim compares with beta alone; a witness meets the
-// conditions to kAlignTol, not exactly).
+// witness is allowed (rot_tol_rad: a witness meets the conditions to it, not exactly).
 std::string rotation_leaf(const Tree& T, const CNode& n, const Turn& tu) {
   const int k = leaf_pc(T, n);
   const SetPc& pc = T.pcs[k];
@@ -403,10 +402,10 @@ std::string rotation_leaf(const Tree& T, const CNode& n, const Turn& tu) {
   } else {
     return pc_label(T, k) + " has no rotational condition";
   }
-  need += kAlignTol + kUnitEval;
+  need += T.ctx.tol.rot + kUnitEval;
   if (v > need) return "";
   return pc_label(T, k) + ": the condition's value " + fmt(v) + " at the centre is not above " +
-         fmt(need) + " (turn bound + 1e-8 alignment)";
+         fmt(need) + " (turn bound + rot_tol_rad " + fmt(T.ctx.tol.rot) + ")";
 }
 
 std::string cone_leaf(const Tree& T, const CNode& n, const Turn& tu) {
@@ -695,6 +694,9 @@ std::string deep_leaf(const Tree& T, const CNode& n, const Turn& tu) {
     img = tu.M.transpose() * (pt - tc) + T.pivot;
     need = bu * ((pt - tc).norm() + spread + delta) + spread * (1 + tu.eta + 1e-12) + delta + err;
   }
+  // deep_extra_mm: a tree that also refutes its set's images needs the point deeper by how far
+  // the symmetries miss (docs/certificates.md, "Images").
+  need += T.ctx.tol.deep_extra;
   const double depth = dist_to_surface(other, img);
   if (depth <= need)
     return "the point's image is " + fmt(depth) + " mm from " + (of == "A" ? "B" : "A") +

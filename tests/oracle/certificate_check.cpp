@@ -60,7 +60,8 @@ int count_of(const Poly& P, int kind) {
   return static_cast<int>(kind == 0 ? P.V.size() : kind == 1 ? P.E.size() : P.F.size());
 }
 
-// "f-f:3:5;e-e:0:7" -> PCs, each of a non-degenerate type with indices in range.
+}  // namespace
+
 std::vector<SetPc> parse_pcs(const Graph& g, const std::string& text) {
   std::vector<SetPc> out;
   for (const Pc& pc : parse_pc_list(text)) {
@@ -74,6 +75,60 @@ std::vector<SetPc> parse_pcs(const Graph& g, const std::string& text) {
   if (out.empty() || out.size() > 3) throw std::runtime_error("a set has 1 to 3 PCs");
   return out;
 }
+
+SetKey set_key(const std::vector<SetPc>& pcs) {
+  SetKey key;
+  for (const auto& p : pcs) key.emplace_back(static_cast<int>(p.type), p.a, p.b);
+  std::sort(key.begin(), key.end());
+  return key;
+}
+
+// A tree's tolerances replace the file's for its own claims only; each must be at least as
+// loose as the file's (compared exactly), so that refuting the tree's looser poses refutes
+// the file's too. Keys the spec does not list are refused rather than ignored: a tree that
+// relies on one would be checked with another value than it was built with.
+std::string tree_tolerances(const Tol& file, const json& cells, Tol* out) {
+  *out = file;
+  out->deep_extra = 0;
+  if (!cells.is_object() || !cells.contains("tolerances")) return "";
+  const json& t = cells["tolerances"];
+  if (!t.is_object()) return "cells.tolerances is not an object";
+  static const std::set<std::string> keys = {"touch_tol_mm", "min_margin_mm",  "local_slack",
+                                             "rot_tol_rad",  "off_circle_rad", "deep_extra_mm"};
+  for (const auto& [k, v] : t.items()) {
+    if (!keys.count(k)) return "cells.tolerances." + k + " is not a tree tolerance";
+    if (!v.is_number() || !std::isfinite(v.get<double>()))
+      return "cells.tolerances." + k + " is not a finite number";
+  }
+  auto get = [&](const char* k, double def) { return t.contains(k) ? t[k].get<double>() : def; };
+  out->touch = get("touch_tol_mm", file.touch);
+  out->margin = get("min_margin_mm", file.margin);
+  out->slack = get("local_slack", file.slack);
+  out->rot = get("rot_tol_rad", file.rot);
+  out->off_circle = get("off_circle_rad", file.off_circle);
+  out->deep_extra = get("deep_extra_mm", 0.0);
+  auto tighter = [](const char* k, double mine, double theirs, const char* rule) {
+    return "cells.tolerances." + std::string(k) + " " + fmt(mine) + " is tighter than the file's " +
+           fmt(theirs) + " (it must be " + rule + ")";
+  };
+  if (out->touch < file.touch) return tighter("touch_tol_mm", out->touch, file.touch, "no smaller");
+  if (out->rot < file.rot) return tighter("rot_tol_rad", out->rot, file.rot, "no smaller");
+  if (out->off_circle < file.off_circle)
+    return tighter("off_circle_rad", out->off_circle, file.off_circle, "no smaller");
+  if (out->margin > file.margin)
+    return tighter("min_margin_mm", out->margin, file.margin, "no larger");
+  if (out->slack > file.slack) return tighter("local_slack", out->slack, file.slack, "no larger");
+  if (out->margin < 0) return "cells.tolerances.min_margin_mm " + fmt(out->margin) + " is negative";
+  if (out->deep_extra < 0)
+    return "cells.tolerances.deep_extra_mm " + fmt(out->deep_extra) + " is negative";
+  // The spec's off_circle_rad is at least twice the alignment accepted (2 x is exact).
+  if (out->off_circle < 2 * out->rot)
+    return "cells.tolerances: off_circle_rad " + fmt(out->off_circle) +
+           " is less than twice rot_tol_rad " + fmt(out->rot);
+  return "";
+}
+
+namespace {
 
 // ---- tolerances ----
 
@@ -101,8 +156,23 @@ Tol read_tolerances(const Graph& g, const json& params, const json& cert, Certif
   tol.margin = positive(t, "min_margin_mm", pr);
   tol.slack = positive(t, "local_slack", pr);
   tol.rounding = positive(t, "rounding_mm", pr);
+  // Files that predate rot_tol_rad were built with the fixed 1e-8 it replaces.
+  tol.rot = t.is_object() && t.contains("rot_tol_rad") ? positive(t, "rot_tol_rad", pr) : kAlignTol;
   tol.off_circle = positive(t, "off_circle_rad", pr);
   tol.size = positive(t, "size_mm", pr);
+  // Below the verifier's alignment a tree would refute witnesses the verifier accepts.
+  if (tol.rot > 0 && tol.rot < kAlignTol) {
+    pr.push_back("tolerances.rot_tol_rad " + fmt(tol.rot) + " is below the verifier's " +
+                 fmt(kAlignTol));
+    tol.rot = kAlignTol;
+  }
+  if (tol.rot > kAlignTol)
+    rep.warnings.push_back("tolerances.rot_tol_rad " + fmt(tol.rot) +
+                           " is above the 1e-8 the rules are stated with: a rule proves its "
+                           "set at 1e-8 only");
+  if (tol.off_circle > 0 && tol.off_circle < 2 * tol.rot)
+    pr.push_back("tolerances.off_circle_rad " + fmt(tol.off_circle) +
+                 " is less than twice rot_tol_rad " + fmt(tol.rot));
   double vmax = 0;
   for (const Poly* P : {&g.A, &g.B})
     for (const auto& v : P->V) vmax = std::max(vmax, v.p.norm());
@@ -335,8 +405,38 @@ std::string check_thin(const Ctx& ctx, const std::vector<SetPc>& pcs, const json
 
 // ---- one set ----
 
-CertSetResult check_set(const Ctx& ctx, const json& set, int index,
-                        const std::set<std::vector<std::tuple<int, int, int>>>& cf_keys) {
+// What every set's check shares: the file's context, the graph's CFs, the piece tables of
+// trees with their own min_margin_mm (a side's margin depends on it), and, for image entries
+// (checked after every other set), the other sets' verdicts and the maps seen.
+struct Run {
+  const Ctx& ctx;
+  const json& pieces_json;
+  std::set<SetKey> cf_keys;
+  std::map<double, PieceTables> by_margin;
+  std::map<SetKey, DecidedSet> decided;
+  SymmetryCache symmetries;
+
+  const PieceTables& pieces_for(const Tol& t) {
+    if (t.margin == ctx.tol.margin) return ctx.pieces;
+    auto it = by_margin.find(t.margin);
+    if (it == by_margin.end()) {
+      // The file's tables were checked already: only the sides' margins differ here.
+      std::vector<std::string> problems, warnings;
+      it =
+          by_margin.emplace(t.margin, check_piece_tables(ctx.g, t, pieces_json, problems, warnings))
+              .first;
+    }
+    return it->second;
+  }
+};
+
+bool is_image_entry(const json& set) {
+  return set.is_object() && set.contains("image_of") && set.value("outcome", json()) == "invalid";
+}
+
+// `tree`, when not null, receives a cells set's tree tolerances.
+CertSetResult check_set(Run& run, const json& set, int index, Tol* tree) {
+  const Ctx& ctx = run.ctx;
   CertSetResult r;
   r.index = index;
   r.kind = "malformed";
@@ -356,13 +456,12 @@ CertSetResult check_set(const Ctx& ctx, const json& set, int index,
       return r;
     }
     if (outcome != "invalid") throw std::runtime_error("outcome \"" + outcome + "\"");
-    const bool has_rule = set.contains("rule"), has_cells = set.contains("cells");
-    if (has_rule == has_cells) throw std::runtime_error("an invalid set has a rule or cells");
-    r.kind = has_rule ? set["rule"].get<std::string>() : "cells";
-    std::vector<std::tuple<int, int, int>> key;
-    for (const auto& p : pcs) key.emplace_back(static_cast<int>(p.type), p.a, p.b);
-    std::sort(key.begin(), key.end());
-    if (cf_keys.count(key)) {
+    const bool has_rule = set.contains("rule"), has_cells = set.contains("cells"),
+               has_image = set.contains("image_of");
+    if (has_rule + has_cells + has_image != 1)
+      throw std::runtime_error("an invalid set has one of rule, cells or image_of");
+    r.kind = has_rule ? set["rule"].get<std::string>() : has_cells ? "cells" : "image";
+    if (run.cf_keys.count(set_key(pcs))) {
       r.reason = "the graph holds this set as a CF with a witness";
     } else if (r.kind == "finite-rotations") {
       r.outcome = CertOutcome::NotCertified;
@@ -370,8 +469,18 @@ CertSetResult check_set(const Ctx& ctx, const json& set, int index,
       return r;
     } else if (has_rule) {
       r.reason = check_rule(ctx, pcs, set, r.kind);
+    } else if (has_image) {
+      r.reason = check_image(ctx, pcs, set["image_of"], run.decided, run.symmetries);
     } else {
-      check_cells(ctx, pcs, set["cells"], r);
+      Tol t;
+      const std::string why = tree_tolerances(ctx.tol, set["cells"], &t);
+      if (tree) *tree = t;
+      if (!why.empty()) {
+        r.node_fails.push_back({-1, why});
+      } else {
+        const Ctx mine{ctx.g, t, run.pieces_for(t)};
+        check_cells(mine, pcs, set["cells"], r);
+      }
       if (!r.node_fails.empty()) {
         const auto& f = r.node_fails.front();
         r.reason = (f.node >= 0 ? "node " + std::to_string(f.node) + ": " : "tree: ") + f.why;
@@ -392,14 +501,20 @@ void check_summary(const json& cert, CertificateReport& rep) {
     return;
   }
   const json& s = cert["summary"];
-  int rule = 0, cells = 0, und = 0, thin = 0;
+  int rule = 0, cells = 0, und = 0, thin = 0, images = 0;
   for (const auto& set : cert["sets"]) {
     if (!set.is_object()) continue;  // rejected as malformed on its own
     if (set.value("outcome", json()) == "undecided") ++und;
     if (set.value("outcome", json()) == "thin") ++thin;
     if (set.contains("rule")) ++rule;
     if (set.contains("cells")) ++cells;
+    if (set.contains("image_of")) ++images;
   }
+  // The spec's summary does not list the image entries; cfgen counts them in
+  // `invalid_as_image`, checked when present.
+  if (s.contains("invalid_as_image") &&
+      (!s["invalid_as_image"].is_number_integer() || s["invalid_as_image"].get<int>() != images))
+    rep.file_problems.push_back("summary.invalid_as_image is not " + std::to_string(images));
   const std::pair<const char*, int> want[] = {{"sets", static_cast<int>(cert["sets"].size())},
                                               {"invalid_by_rule", rule},
                                               {"invalid_by_cells", cells},
@@ -430,22 +545,24 @@ CertificateReport check_certificates(const Graph& g, const nlohmann::json& graph
   CertificateReport rep;
   rep.graph_path = g.path;
   const Tol tol = read_tolerances(g, graph_parameters, cert, rep);
-  const PieceTables pieces = check_piece_tables(
-      g, tol, cert.contains("pieces") ? cert["pieces"] : json(), rep.file_problems, rep.warnings);
+  static const json kNoPieces;
+  const json& pieces_json = cert.contains("pieces") ? cert["pieces"] : kNoPieces;
+  const PieceTables pieces =
+      check_piece_tables(g, tol, pieces_json, rep.file_problems, rep.warnings);
   check_summary(cert, rep);
-  std::set<std::vector<std::tuple<int, int, int>>> cf_keys;
-  for (const auto& cf : g.cfs) {
-    std::vector<std::tuple<int, int, int>> k;
-    for (const auto& p : cf.key) k.emplace_back(static_cast<int>(p.type), p.a, p.b);
-    std::sort(k.begin(), k.end());
-    cf_keys.insert(k);
-  }
   const Ctx ctx{g, tol, pieces};
-  std::set<std::string> seen;
+  Run run{ctx, pieces_json, {}, {}, {}, {}};
+  for (const auto& cf : g.cfs) {
+    std::vector<SetPc> k;
+    for (const auto& p : cf.key) k.push_back({p.type, p.a, p.b});
+    run.cf_keys.insert(set_key(k));
+  }
   const bool tol_ok = tol.touch > 0 && tol.margin > 0 && tol.slack > 0 && tol.off_circle > 0 &&
-                      tol.size > 0 && tol.rounding > 0;
-  int index = 0;
-  for (const auto& set : cert["sets"]) {
+                      tol.size > 0 && tol.rounding > 0 && tol.rot > 0;
+  const json& sets = cert["sets"];
+  std::vector<CertSetResult> results(sets.size());
+  auto check_one = [&](int index, Tol* tree) {
+    const json& set = sets[index];
     CertSetResult r;
     const bool undecided = set.is_object() && set.value("outcome", json()) == "undecided";
     if (!tol_ok && !undecided) {
@@ -453,16 +570,43 @@ CertificateReport check_certificates(const Graph& g, const nlohmann::json& graph
       r.pcs = set.is_object() && set.value("pcs", json()).is_string()
                   ? set["pcs"].get<std::string>()
                   : "?";
-      r.kind = set.is_object() && set.contains("cells") ? "cells" : "rule";
+      r.kind = !set.is_object()           ? "rule"
+               : set.contains("cells")    ? "cells"
+               : set.contains("image_of") ? "image"
+                                          : "rule";
       r.reason = "the file's tolerances are unusable";
-    } else {
-      r = check_set(ctx, set, index, cf_keys);
+      return r;
     }
+    return check_set(run, set, index, tree);
+  };
+  // Two passes: an image entry needs its decided set's verdict, and the file (sorted by PC
+  // list) may list it before that set.
+  for (int i = 0; i < static_cast<int>(sets.size()); ++i) {
+    if (is_image_entry(sets[i])) continue;
+    Tol tree = tol;
+    results[i] = check_one(i, &tree);
+    try {
+      const SetKey key = set_key(parse_pcs(g, results[i].pcs));
+      run.decided.insert({key, {i, results[i].kind, results[i].outcome, tree}});
+    } catch (const std::exception&) {  // malformed: rejected on its own, decides nothing
+    }
+  }
+  for (int i = 0; i < static_cast<int>(sets.size()); ++i)  // so that images of images are named
+    if (is_image_entry(sets[i])) {
+      try {
+        const SetKey key = set_key(parse_pcs(g, sets[i].at("pcs").get<std::string>()));
+        run.decided.insert({key, {i, "image", CertOutcome::Rejected, tol}});
+      } catch (const std::exception&) {
+      }
+    }
+  for (int i = 0; i < static_cast<int>(sets.size()); ++i)
+    if (is_image_entry(sets[i])) results[i] = check_one(i, nullptr);
+  std::set<std::string> seen;
+  for (CertSetResult& r : results) {
     if (!seen.insert(r.pcs).second && r.outcome != CertOutcome::Rejected) {
       r.outcome = CertOutcome::Rejected;
       r.reason = "the set is listed twice";
     }
-    ++index;
     switch (r.outcome) {
       case CertOutcome::Accepted:
         ++rep.accepted;

@@ -5,9 +5,11 @@
 // Farkas multipliers. No code is shared with tools/ or libcf/.
 //
 // A set is
-//  - accepted when its evidence is rechecked and proves it invalid (a rule that holds, or a
-//    tree of cells that tiles the domain and whose every leaf claim holds), or, for a THIN
-//    set, when its pose realises exactly the set, as clear as claimed;
+//  - accepted when its evidence is rechecked and proves it invalid (a rule that holds, a
+//    tree of cells that tiles the domain and whose every leaf claim holds, or the image under
+//    a symmetry of the models of a set accepted by cells whose tree's tolerances absorb how
+//    far the symmetry misses), or, for a THIN set, when its pose realises exactly the set, as
+//    clear as claimed;
 //  - rejected when the evidence is malformed or a claim does not hold (the reason names the
 //    set's PCs, the node and what failed);
 //  - not certified when its rule is evidence the checker does not accept (`finite-rotations`);
@@ -36,7 +38,7 @@ struct CertNodeFailure {
 struct CertSetResult {
   int index = 0;     // position in the file's `sets`
   std::string pcs;   // the file's PC list, e.g. "f-f:0:2;e-f:5:1"
-  std::string kind;  // the rule's name, "cells", "undecided", or "malformed"
+  std::string kind;  // the rule's name, "cells", "image", "thin", "undecided", or "malformed"
   CertOutcome outcome = CertOutcome::Rejected;
   std::string reason;                                // one line (rejected and not certified sets)
   std::vector<CertNodeFailure> node_fails;           // cells: every node whose check failed

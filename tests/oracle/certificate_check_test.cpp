@@ -1147,6 +1147,276 @@ TEST_CASE("cells: deep leaves") {
   CHECK_THAT(failure_of(r, out)->why, Catch::StartsWith("deep: the point's image is"));
   REQUIRE(failure_of(r, centre));
   CHECK(failure_of(r, centre)->why == "deep: the point is 5 mm from A's boundary");
+  // A tree's deep_extra_mm: 5 mm deep is not deeper than 6 mm more than the node's reach.
+  json deeper = cells_set("v-f:7:6", Vec3(5, 5, 5), T);
+  deeper["cells"]["tolerances"] = {{"deep_extra_mm", 6.0}};
+  r = one(P, deeper);
+  REQUIRE(failure_of(r, ok));
+  CHECK_THAT(failure_of(r, ok)->why, Catch::StartsWith("deep: the point's image is"));
+  deeper["cells"]["tolerances"] = {{"deep_extra_mm", 1.0}};
+  CHECK_FALSE(failure_of(one(P, deeper), ok));
+}
+
+TEST_CASE("tolerances: rot_tol_rad, 1e-8 when absent, never below it, half off_circle_rad") {
+  Pair P = make_pair();
+  json c = cert_for(P, json::array());
+  CHECK(run(P, c).passed());  // an older file, without rot_tol_rad
+  c["tolerances"]["rot_tol_rad"] = 1e-8;
+  CHECK(run(P, c).passed());
+  c["tolerances"]["rot_tol_rad"] = 1e-9;
+  CertificateReport rep = run(P, c);
+  REQUIRE(rep.file_problems.size() == 1);
+  CHECK(rep.file_problems[0] == "tolerances.rot_tol_rad 1e-09 is below the verifier's 1e-08");
+  c["tolerances"]["rot_tol_rad"] = 2e-8;
+  rep = run(P, c);
+  REQUIRE(rep.file_problems.size() == 1);
+  CHECK(rep.file_problems[0] ==
+        "tolerances.off_circle_rad 2e-08 is less than twice rot_tol_rad 2e-08");
+}
+
+namespace {
+
+// The f-f circle set whose e-f edge stays vertical: one rotation leaf refutes the whole circle
+// (as in "cells: a rotation leaf over the whole f-f circle"); edge (0, 4) by default.
+json vertical_edge_set(const Pair& P, int v0 = 0, int v1 = 4, const json& tolerances = json()) {
+  TreeB T;
+  T.add(-1, arc_rot(0, kPiD), "rotation", {{"pc", 1}});
+  json s = cells_set(pcs_of("f-f", 0, 4, "e-f", P.G.A.edge_index(v0, v1), 6), Vec3(5, 5, 5), T,
+                     circle_ff(0));
+  if (!tolerances.is_null()) s["cells"]["tolerances"] = tolerances;
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("cells: a tree's own tolerances, at least as loose as the file's") {
+  Pair P = make_pair();
+  CHECK(one(P, vertical_edge_set(P, 0, 4, json::object())).outcome == CertOutcome::Accepted);
+  // Tighter than the file's, each way: refused before the tree is looked at.
+  auto r = one(P, vertical_edge_set(P, 0, 4, {{"touch_tol_mm", 1e-10}}));
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK(r.reason ==
+        "tree: cells.tolerances.touch_tol_mm 1e-10 is tighter than the file's 1e-09 (it must be "
+        "no smaller)");
+  r = one(P, vertical_edge_set(P, 0, 4, {{"min_margin_mm", 0.02}}));
+  CHECK(r.reason ==
+        "tree: cells.tolerances.min_margin_mm 0.02 is tighter than the file's 0.01 (it must be "
+        "no larger)");
+  r = one(P, vertical_edge_set(P, 0, 4, {{"local_slack", 0.1}}));
+  CHECK_THAT(r.reason, Catch::StartsWith("tree: cells.tolerances.local_slack 0.1 is tighter"));
+  r = one(P, vertical_edge_set(P, 0, 4, {{"rot_tol_rad", 5e-9}}));
+  CHECK_THAT(r.reason, Catch::StartsWith("tree: cells.tolerances.rot_tol_rad 5e-09 is tighter"));
+  r = one(P, vertical_edge_set(P, 0, 4, {{"off_circle_rad", 1e-8}}));
+  CHECK_THAT(r.reason, Catch::StartsWith("tree: cells.tolerances.off_circle_rad 1e-08 is tighter"));
+  r = one(P, vertical_edge_set(P, 0, 4, {{"deep_extra_mm", -1}}));
+  CHECK(r.reason == "tree: cells.tolerances.deep_extra_mm -1 is negative");
+  r = one(P, vertical_edge_set(P, 0, 4, {{"rot_tol_rad", 0.1}, {"off_circle_rad", 0.15}}));
+  CHECK(r.reason ==
+        "tree: cells.tolerances: off_circle_rad 0.15 is less than twice rot_tol_rad 0.1");
+  r = one(P, vertical_edge_set(P, 0, 4, {{"rounding_mm", 1}}));
+  CHECK(r.reason == "tree: cells.tolerances.rounding_mm is not a tree tolerance");
+  // The leaves use the tree's values: the edge's condition, 1 on the whole circle, exceeds
+  // off_circle 0.2 + rot_tol 0.1 but not 1.2 + 0.6.
+  CHECK(
+      one(P, vertical_edge_set(P, 0, 4, {{"rot_tol_rad", 0.1}, {"off_circle_rad", 0.2}})).outcome ==
+      CertOutcome::Accepted);
+  r = one(P, vertical_edge_set(P, 0, 4, {{"rot_tol_rad", 0.6}, {"off_circle_rad", 1.2}}));
+  CHECK_THAT(r.reason, Catch::Contains("(turn bound + rot_tol_rad 0.6)"));
+  // The file's rot_tol_rad too.
+  json c = cert_for(P, json::array({vertical_edge_set(P)}));
+  c["tolerances"]["rot_tol_rad"] = 0.6;
+  c["tolerances"]["off_circle_rad"] = 1.2;
+  CHECK(run(P, c).rejected == 1);
+}
+
+TEST_CASE("cells: a tree's min_margin_mm replaces the file's in its programs") {
+  // As in "cells: a program leaf with hand-derived Farkas multipliers": a 6 mm margin leaves no
+  // contact point on the 10 mm wide face; the tree's 4 mm does, and the same y fails.
+  Pair P = make_pair(6.0);
+  const json pieces = {{"B", {tower_top_one_piece()}}};
+  TreeB T;
+  T.lo = Vec3(-1, 19, -1);
+  T.hi = Vec3(11, 21, 31);
+  T.add(-1, cube_rot(Vec3::Zero(), kPiD), "program",
+        {{"farkas", {{{"choice", {0}}, {"y", {0, 0, 1, 0, 1, 0}}}}}});
+  json s = cells_set("v-f:7:6", Vec3(10, 10, 10), T);
+  CHECK(one(P, s, pieces).outcome == CertOutcome::Accepted);
+  s["cells"]["tolerances"] = {{"min_margin_mm", 4.0}};
+  auto r = one(P, s, pieces);
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK_THAT(r.reason, Catch::Contains("Farkas gap -2"));
+}
+
+namespace {
+
+json map_json(const Mat3& R, const Vec3& c) {
+  json r = json::array();
+  for (int i = 0; i < 9; ++i) r.push_back(R(i / 3, i % 3));
+  return {{"R", r}, {"c", v3(c)}};
+}
+
+json image_set(const std::string& pcs, const std::string& of, const Mat3& H, const Vec3& cA,
+               const Mat3& G = Mat3::Identity(), const Vec3& cB = Vec3::Zero()) {
+  return {{"pcs", pcs},
+          {"outcome", "invalid"},
+          {"image_of", {{"pcs", of}, {"A", map_json(H, cA)}, {"B", map_json(G, cB)}}}};
+}
+
+// A turn about z by theta (the cube's quarter turn about its centre maps (x, y) to (10 - y, x)).
+Mat3 turn_z(double theta) {
+  Mat3 R;
+  R << std::cos(theta), -std::sin(theta), 0, std::sin(theta), std::cos(theta), 0, 0, 0, 1;
+  return R;
+}
+
+Mat3 quarter_z() {
+  Mat3 R;
+  R << 0, -1, 0, 1, 0, 0, 0, 0, 1;  // exactly
+  return R;
+}
+
+const CertSetResult& result_of(const CertificateReport& rep, const std::string& pcs) {
+  for (const auto& s : rep.sets)
+    if (s.pcs == pcs) return s;
+  throw std::runtime_error("no set " + pcs);
+}
+
+}  // namespace
+
+TEST_CASE("images: an exact symmetry's image of an accepted set is accepted, in either order") {
+  Pair P = make_pair();
+  const Vec3 cA(5, 5, 5);
+  const std::string D = pcs_of("f-f", 0, 4, "e-f", P.G.A.edge_index(0, 4), 6);
+  // The quarter turn takes vertex 0 to 1 and 4 to 5: the vertical edge (0, 4) to (1, 5).
+  const std::string E = pcs_of("f-f", 0, 4, "e-f", P.G.A.edge_index(1, 5), 6);
+  for (bool image_first : {true, false}) {
+    json sets = json::array({vertical_edge_set(P)});
+    sets.insert(image_first ? sets.begin() : sets.end(), image_set(E, D, quarter_z(), cA));
+    const CertificateReport rep = run(P, cert_for(P, sets));
+    for (const auto& l : rep.rejection_lines()) INFO(l);
+    CHECK(rep.passed());
+    CHECK(rep.accepted == 2);
+    CHECK(result_of(rep, E).kind == "image");
+    CHECK(rep.by_kind.at("image")[static_cast<int>(CertOutcome::Accepted)] == 1);
+    CHECK_THAT(rep.summary_line(), Catch::Contains(" image 1/0/0"));
+  }
+  // A reflection of each model: A's bottom face to its top, B onto itself by z -> 30 - z.
+  const Mat3 M = Vec3(1, 1, -1).asDiagonal();
+  const std::string F = pcs_of("f-f", 1, 4, "e-f", P.G.A.edge_index(0, 4), 6);
+  CertificateReport rep = run(
+      P,
+      cert_for(P, json::array({vertical_edge_set(P), image_set(F, D, M, cA, M, Vec3(0, 0, 15))})));
+  for (const auto& l : rep.rejection_lines()) INFO(l);
+  CHECK(rep.accepted == 2);
+  // One reflection and one rotation: g X h^-1 would not be a rotation.
+  rep = run(P, cert_for(P, json::array({vertical_edge_set(P),
+                                        image_set(F, D, M, cA, Mat3::Identity(), Vec3::Zero())})));
+  CHECK(result_of(rep, F).reason ==
+        "A.R and B.R are not both rotations or both reflections (det signs -1, 1)");
+  // The summary's image count, when the file gives one.
+  json c = cert_for(P, json::array({vertical_edge_set(P), image_set(E, D, quarter_z(), cA)}));
+  c["summary"]["invalid_as_image"] = 1;
+  CHECK(run(P, c).passed());
+  c["summary"]["invalid_as_image"] = 2;
+  rep = run(P, c);
+  REQUIRE(rep.file_problems.size() == 1);
+  CHECK(rep.file_problems[0] == "summary.invalid_as_image is not 1");
+}
+
+TEST_CASE("images: maps that are not symmetries, wrong images and decided sets are rejected") {
+  Pair P = make_pair();
+  const Vec3 cA(5, 5, 5);
+  const int e04 = P.G.A.edge_index(0, 4), e15 = P.G.A.edge_index(1, 5),
+            e37 = P.G.A.edge_index(3, 7);
+  const std::string D = pcs_of("f-f", 0, 4, "e-f", e04, 6);
+  const std::string E = pcs_of("f-f", 0, 4, "e-f", e15, 6);
+  auto check = [&](json sets, const std::string& pcs) {
+    const CertificateReport rep = run(P, cert_for(P, sets));
+    const CertSetResult& r = result_of(rep, pcs);
+    INFO(pcs << ": " << r.reason);
+    CHECK(r.outcome == CertOutcome::Rejected);
+    return r.reason;
+  };
+  // An eighth turn takes no vertex of the cube near a vertex.
+  CHECK_THAT(check({vertical_edge_set(P), image_set(E, D, turn_z(kPiD / 4), cA)}, E),
+             Catch::StartsWith("not a symmetry: A"));
+  // The quarter turn about another centre moves the cube off itself.
+  CHECK_THAT(check({vertical_edge_set(P), image_set(E, D, quarter_z(), Vec3(5, 6, 5))}, E),
+             Catch::Contains("mm from its nearest vertex, more than"));
+  // A matrix that is not orthogonal.
+  CHECK_THAT(check({vertical_edge_set(P), image_set(E, D, 1.001 * quarter_z(), cA)}, E),
+             Catch::StartsWith("not a symmetry: A.R is not orthogonal (|R^T R - I| = 0.003465"));
+  // A set that is not the image: the quarter turn takes (0, 4) to (1, 5), not (3, 7).
+  const std::string W = pcs_of("f-f", 0, 4, "e-f", e37, 6);
+  CHECK(check({vertical_edge_set(P), image_set(W, D, quarter_z(), cA)}, W) ==
+        "the set is not the image of {" + D + "}: the maps take it to {" + E + "}");
+  // The decided set missing, rejected, invalid by a rule or itself an image.
+  CHECK(check({image_set(E, D, quarter_z(), cA)}, E) ==
+        "the decided set {" + D + "} is not listed in the file");
+  json bad = vertical_edge_set(P);
+  bad["cells"]["tolerances"] = {{"touch_tol_mm", 1e-10}};
+  CHECK(check({bad, image_set(E, D, quarter_z(), cA)}, E) ==
+        "the decided set {" + D + "} (set 0) is not accepted");
+  CHECK(check({rule_set(D, "heights-over-ff", {0, 1}), image_set(E, D, quarter_z(), cA)}, E) ==
+        "the decided set {" + D + "} (set 0) is not invalid by cells (heights-over-ff)");
+  CHECK(check({vertical_edge_set(P), image_set(E, D, quarter_z(), cA),
+               image_set(W, E, quarter_z(), cA)},
+              W) == "the decided set {" + E +
+                        "} (set 1) is itself an image: an image of an "
+                        "image is refused");
+}
+
+TEST_CASE("images: the decided tree must be looser by what the maps miss") {
+  Pair P = make_pair();
+  const Vec3 cA(5, 5, 5);
+  const std::string D = pcs_of("f-f", 0, 4, "e-f", P.G.A.edge_index(0, 4), 6);
+  const std::string E = pcs_of("f-f", 0, 4, "e-f", P.G.A.edge_index(1, 5), 6);
+  // A quarter turn off by 1e-10 rad: the cube's corners miss by 5 sqrt(2) 1e-10 = 7.07e-10 mm
+  // and its side faces' normals and edges turn by 1e-10 rad. The file's off_circle_rad is 3e-8
+  // here, so that twice rot_tol_rad does not imply its loosening.
+  const json img = image_set(E, D, turn_z(kPiD / 2 + 1e-10), cA);
+  const double slack = 0.5 * std::sin(1e-3);
+  const json loose = {{"touch_tol_mm", 1.8e-9},      {"min_margin_mm", 0.0099},
+                      {"rot_tol_rad", 1.02e-8},      {"off_circle_rad", 3.03e-8},
+                      {"local_slack", slack - 1e-6}, {"deep_extra_mm", 8e-10}};
+  auto verdict = [&](const json& tolerances) {
+    json c = cert_for(P, json::array({vertical_edge_set(P, 0, 4, tolerances), img}));
+    c["tolerances"]["off_circle_rad"] = 3e-8;
+    const CertificateReport rep = run(P, c);
+    CHECK(result_of(rep, D).outcome == CertOutcome::Accepted);
+    return result_of(rep, E);
+  };
+  CHECK(verdict(loose).outcome == CertOutcome::Accepted);
+  // Without loosening, or too little on any one tolerance.
+  CHECK_THAT(verdict(json()).reason, Catch::StartsWith("the decided set {" + D +
+                                                       "} (set 0)'s tree has touch_tol_mm 1e-09, "
+                                                       "not >= 1.707"));
+  const std::vector<std::pair<std::string, double>> tight = {
+      {"touch_tol_mm", 1.7e-9},    {"min_margin_mm", 0.01 - 7e-10}, {"rot_tol_rad", 1.0099e-8},
+      {"off_circle_rad", 3.01e-8}, {"local_slack", slack - 3e-7},   {"deep_extra_mm", 7e-10}};
+  for (const auto& [key, value] : tight) {
+    json t = loose;
+    t[key] = value;
+    const CertSetResult r = verdict(t);
+    INFO(key << ": " << r.reason);
+    CHECK(r.outcome == CertOutcome::Rejected);
+    CHECK_THAT(r.reason, Catch::Contains("'s tree has " + key + " "));
+  }
+  // The spec's "(or 0)": no margin at all is loose enough.
+  json t = loose;
+  t["min_margin_mm"] = 0;
+  CHECK(verdict(t).outcome == CertOutcome::Accepted);
+  // With a file margin below eps, 0 leaves contact points up to eps - margin outside their
+  // elements: the checker then asks for touch_tol_mm + 2 eps.
+  Pair Q = make_pair(1e-10);
+  json c = cert_for(Q, json::array({vertical_edge_set(Q, 0, 4, t), img}));
+  c["tolerances"]["off_circle_rad"] = 3e-8;
+  CHECK_THAT(result_of(run(Q, c), E).reason,
+             Catch::Contains("'s tree has touch_tol_mm 1.8e-09, not >= 2.414"));
+  t["touch_tol_mm"] = 2.5e-9;
+  c = cert_for(Q, json::array({vertical_edge_set(Q, 0, 4, t), img}));
+  c["tolerances"]["off_circle_rad"] = 3e-8;
+  CHECK(run(Q, c).passed());
 }
 
 #ifdef CF_ORACLE_CERTCHECK

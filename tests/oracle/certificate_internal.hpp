@@ -1,7 +1,8 @@
 #pragma once
-// Internals of the certificate checker (certificate_check.hpp), shared by its three sources:
+// Internals of the certificate checker (certificate_check.hpp), shared by its four sources:
 // certificate_check.cpp (file, tolerances, rules, report), certificate_cells.cpp (the tree
-// of cells and its leaf claims) and certificate_program.cpp (piece tables, programs, Farkas).
+// of cells and its leaf claims), certificate_program.cpp (piece tables, programs, Farkas) and
+// certificate_images.cpp (sets invalid as the image of another under a symmetry).
 
 #include "certificate_check.hpp"
 #include "classify.hpp"
@@ -15,8 +16,10 @@
 #include <boost/multiprecision/cpp_int.hpp>
 #endif
 
+#include <array>
 #include <map>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace oracle::cert {
@@ -40,7 +43,9 @@ Rational pi_upper();
 // ---- named tolerances (each justified where it is used) ----
 
 /// The alignment every witness meets: an f-f's |R n_A + n_B|, an e-f's |(R e_A).n_B| and an
-/// f-e's |(R n_A).e_B| are at most this (docs/certificates.md, "Rules"; generator.md).
+/// f-e's |(R n_A).e_B| are at most this (docs/certificates.md, "Rules"; generator.md). The
+/// rules keep this constant; trees use `rot_tol_rad` (Tol::rot), 1e-8 in files that predate
+/// it, and never below this (a smaller one would refute witnesses the verifier accepts).
 constexpr double kAlignTol = 1e-8;
 /// Error, per unit length, of the central rotation the checker computes (Rodrigues' formula or
 /// R0 Rot(axis, c), each entry a few ulps) applied to a vector, plus the rounding of the turn
@@ -62,16 +67,23 @@ constexpr double kRelRound = 1e-14;
 constexpr double kGross = 1e-9;
 
 /// Tolerances the checks use: the certificate's, each made no stronger than the graph's
-/// parameters (the weaker of the two).
+/// parameters (the weaker of the two); in a tree with its own `tolerances`, those.
 struct Tol {
-  double touch = 0;       // mm
-  double margin = 0;      // mm, min_margin_mm
-  double slack = 0;       // local_slack
-  double rounding = 0;    // mm, rounding_mm
-  double off_circle = 0;  // rad
-  double size = 0;        // mm, the larger bounding-box diagonal
-  double scale = 0;       // mm: size + the largest |vertex| of either model (rounding scale)
+  double touch = 0;        // mm
+  double margin = 0;       // mm, min_margin_mm
+  double slack = 0;        // local_slack
+  double rounding = 0;     // mm, rounding_mm
+  double rot = kAlignTol;  // rad, rot_tol_rad
+  double off_circle = 0;   // rad
+  double deep_extra = 0;   // mm, a tree's deep_extra_mm (0 for the file's)
+  double size = 0;         // mm, the larger bounding-box diagonal
+  double scale = 0;        // mm: size + the largest |vertex| of either model (rounding scale)
 };
+
+/// A tree's tolerances (docs/certificates.md, "Cells", `tolerances`): `file` with the values
+/// `cells.tolerances` gives, each required to be at least as loose as the file's. Returns ""
+/// and sets *out, else why the tree's tolerances are not acceptable.
+std::string tree_tolerances(const Tol& file, const json& cells, Tol* out);
 
 struct SetPc {
   PcType type;
@@ -148,6 +160,44 @@ std::string check_first_order(const Ctx& ctx, const std::vector<SetPc>& pcs, con
 /// Checks a set's `cells`; fills out.node_fails and out.leaves.
 void check_cells(const Ctx& ctx, const std::vector<SetPc>& pcs, const json& cells,
                  CertSetResult& out);
+
+// ---- images (certificate_images.cpp) ----
+
+/// A set as a sorted list of (type, a, b): the same set whatever the order of its PC list.
+using SetKey = std::vector<std::tuple<int, int, int>>;
+SetKey set_key(const std::vector<SetPc>& pcs);
+
+/// "f-f:3:5;e-e:0:7" -> PCs, each of a non-degenerate type with indices in range; throws
+/// std::runtime_error naming the problem.
+std::vector<SetPc> parse_pcs(const Graph& g, const std::string& text);
+
+/// One model's map h(x) = H (x - c) + c matched onto the model (docs/certificates.md,
+/// "Images", steps 1 to 3). eps and delta are upper bounds for the orthogonal matrix nearest H.
+struct SolidMap {
+  std::string problem;       // "" when the map is a symmetry of the model
+  int det_sign = 0;          // the sign of det H
+  std::vector<int> v, e, f;  // the image of each vertex, edge and face
+  double eps = 0;            // mm: the largest distance from a vertex's image to its match
+  double delta = 0;          // rad: the largest angle an edge direction or face normal turns by
+};
+SolidMap match_symmetry(const Poly& P, const std::string& name, const Mat3& H, const Vec3& c,
+                        double scale);
+
+/// What the checker concluded about a set another one may be the image of.
+struct DecidedSet {
+  int index = -1;
+  std::string kind;  // "cells", "image", a rule's name, ...
+  CertOutcome outcome = CertOutcome::Rejected;
+  Tol tree;  // cells: the tree's tolerances
+};
+
+/// The maps of the entries seen so far, by (solid, H, c): entries of one orbit share them.
+using SymmetryCache = std::map<std::pair<char, std::array<double, 12>>, SolidMap>;
+
+/// Checks an image entry (docs/certificates.md, "Images", steps 1 to 5) given every other
+/// set's verdict (by key, first listing). Returns "" when the claim holds, else why not.
+std::string check_image(const Ctx& ctx, const std::vector<SetPc>& pcs, const json& image_of,
+                        const std::map<SetKey, DecidedSet>& decided, SymmetryCache& cache);
 
 // ---- small helpers ----
 Vec3 get_vec3(const json& j, const char* key);

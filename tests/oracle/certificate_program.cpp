@@ -852,7 +852,7 @@ Program first_order_rows(const Ctx& ctx, const std::vector<SetPc>& pcs, const Fi
         const Vec3& n = B.F[pc.b].n;
         turned_at_least(P, F, e.m[0], n, s);
         turned_at_least(P, F, e.m[1], n, s);
-        turned_within(P, F, e.dir, n, kAlignTol);
+        turned_within(P, F, e.dir, n, ctx.tol.rot);
         break;
       }
       case PcType::FE: {
@@ -860,7 +860,7 @@ Program first_order_rows(const Ctx& ctx, const std::vector<SetPc>& pcs, const Fi
         const Vec3& n = A.F[pc.a].n;
         turned_at_least(P, F, n, e.m[0], s);
         turned_at_least(P, F, n, e.m[1], s);
-        turned_within(P, F, n, e.dir, kAlignTol);
+        turned_within(P, F, n, e.dir, ctx.tol.rot);
         break;
       }
       case PcType::EE:

@@ -150,6 +150,17 @@ const gen::Witness* thin_of(const gen::Enumeration& e, const PcSet& pcs) {
   return it != e.thin.end() && it->first == pcs ? &it->second : nullptr;
 }
 
+// The tolerances of a decision (the file's, or a tree's own).
+json tolerances_json(const gen::CellSearchLimits& l) {
+  json j = {{"touch_tol_mm", l.touch_tol},
+            {"min_margin_mm", l.margin},
+            {"local_slack", l.local_slack},
+            {"rot_tol_rad", l.rot_tol},
+            {"off_circle_rad", gen::off_circle(l.rot_tol)}};
+  if (l.deep_extra != 0) j["deep_extra_mm"] = l.deep_extra;
+  return j;
+}
+
 json set_json(const gen::SetDecision& d, const gen::Enumeration& e,
               const gen::WitnessSearch& search, const gen::CellSearchLimits& limits,
               const gen::DeepPoints& deep) {
@@ -160,10 +171,18 @@ json set_json(const gen::SetDecision& d, const gen::Enumeration& e,
   }
   json j = {{"pcs", to_string(d.pcs)}, {"outcome", d.invalid ? "invalid" : "undecided"}};
   if (!d.invalid) return j;
-  if (d.cells) {
-    const CellRelaxation relaxation(search.a(), search.b(), d.pcs, limits.touch_tol, limits.margin,
-                                    limits.local_slack);
+  if (!d.image_of.empty()) {
+    j["image_of"] = {{"pcs", to_string(d.image_of)},
+                     {"A", {{"R", mat(d.H)}, {"c", vec(d.c_A)}}},
+                     {"B", {{"R", mat(d.G)}, {"c", vec(d.c_B)}}}};
+  } else if (d.cells) {
+    const gen::CellSearchLimits& l = d.cell_limits;
+    const CellRelaxation relaxation(search.a(), search.b(), d.pcs, l.touch_tol, l.margin,
+                                    l.local_slack, l.rot_tol);
     j["cells"] = cells_json(*d.cells, relaxation, deep, d.pcs);
+    if (l.touch_tol != limits.touch_tol || l.margin != limits.margin ||
+        l.local_slack != limits.local_slack || l.rot_tol != limits.rot_tol || l.deep_extra != 0)
+      j["cells"]["tolerances"] = tolerances_json(l);
   } else {
     j["rule"] = gen::rule_name(d.rule.rule);
     json involved = json::array();
@@ -179,27 +198,28 @@ json set_json(const gen::SetDecision& d, const gen::Enumeration& e,
 json head_json(const std::string& graph_path, const gen::Enumeration& e,
                const gen::WitnessSearch& search, const gen::CellSearchLimits& limits, double size) {
   std::set<int> faces_a, faces_b;
-  std::map<std::string, std::size_t> counts{
-      {"invalid_by_rule", 0}, {"invalid_by_cells", 0}, {"thin", 0}, {"undecided", 0}};
+  std::map<std::string, std::size_t> counts{{"invalid_by_rule", 0},
+                                            {"invalid_by_cells", 0},
+                                            {"invalid_as_image", 0},
+                                            {"thin", 0},
+                                            {"undecided", 0}};
   for (const gen::SetDecision& d : e.decisions) {
-    if (d.cells) add_faces(d.pcs, faces_a, faces_b);
-    ++counts[d.thin       ? "thin"
-             : !d.invalid ? "undecided"
-             : d.cells    ? "invalid_by_cells"
-                          : "invalid_by_rule"];
+    if (d.cells && d.image_of.empty()) add_faces(d.pcs, faces_a, faces_b);
+    ++counts[d.thin                ? "thin"
+             : !d.invalid          ? "undecided"
+             : !d.image_of.empty() ? "invalid_as_image"
+             : d.cells             ? "invalid_by_cells"
+                                   : "invalid_by_rule"];
   }
   json summary = {{"sets", e.decisions.size()}};
   for (const auto& [k, v] : counts) summary[k] = v;
+  json tolerances = tolerances_json(limits);
+  tolerances["rounding_mm"] = 1e-12 * size;
+  tolerances["size_mm"] = size;
   return {{"format", "cf-certificates"},
           {"version", 1},
           {"graph", graph_path},
-          {"tolerances",
-           {{"touch_tol_mm", limits.touch_tol},
-            {"min_margin_mm", limits.margin},
-            {"local_slack", limits.local_slack},
-            {"rounding_mm", 1e-12 * size},
-            {"off_circle_rad", gen::kOffCircle},
-            {"size_mm", size}}},
+          {"tolerances", tolerances},
           {"pieces",
            {{"A", pieces_json(search.a(), faces_a)}, {"B", pieces_json(search.b(), faces_b)}}},
           {"summary", std::move(summary)}};

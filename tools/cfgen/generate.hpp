@@ -71,9 +71,9 @@ struct GenerateArgs {
   bool thorough =
       false;  ///< search every set, then add every image of each CF found (enumerate.hpp)
   bool symmetry = true;  ///< search one set per orbit of the models' symmetries (symmetry.hpp)
-  /// Cells of rotation space each failed candidate without an f-f PC may take in the decision
-  /// (docs/generator.md, "Refuting a set over cells of poses"); 0: such sets are not searched
-  /// over cells.
+  /// Cells of rotation space each orbit of failed candidates without an f-f PC may take in the
+  /// decision (docs/generator.md, "Refuting a set over cells of poses"); 0: such sets are not
+  /// searched over cells.
   std::size_t cube_cells = 0;
   gen::SearchParams search;    ///< angular tolerances and search limits (lengths: `rel`)
   RelativeLengths rel;         ///< lengths of the search, relative to the models' size

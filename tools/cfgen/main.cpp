@@ -179,9 +179,9 @@ int main(int argc, char** argv) {
   add_search_options(app, gen, gen_opts);
   gen_opts.push_back(
       app.add_option("--cube-cells", gen.cube_cells,
-                     "cells of rotation space each failed candidate without an f-f PC may take "
-                     "to be refuted (docs/generator.md, \"Refuting a set over cells of poses\"; "
-                     "0: not searched)")
+                     "cells of rotation space each orbit of failed candidates without an f-f PC "
+                     "may take to be refuted (docs/generator.md, \"Refuting a set over cells of "
+                     "poses\"; 0: not searched)")
           ->check(CLI::Range(std::size_t{0}, std::size_t{10000000}))
           ->capture_default_str());
   app.add_option("--coplanar-tol", coplanar_tol,

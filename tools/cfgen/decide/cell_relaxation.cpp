@@ -113,8 +113,14 @@ std::vector<std::vector<int>> CellRelaxation::choice_list() const {
 }
 
 CellRelaxation::CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs,
-                               double touch_tol, double margin, double local_slack)
-    : A_(a), B_(b), pcs_(pcs), touch_tol_(touch_tol), margin_(margin), local_slack_(local_slack) {
+                               double touch_tol, double margin, double local_slack, double rot_tol)
+    : A_(a),
+      B_(b),
+      pcs_(pcs),
+      touch_tol_(touch_tol),
+      margin_(margin),
+      local_slack_(local_slack),
+      rot_tol_(rot_tol) {
   if (pcs.empty() || num_vars(pcs) > LinearProgram::kMaxVars)
     throw std::invalid_argument("CellRelaxation: a set of 1 to 3 PCs");
   const Polyhedron& mA = *A_.model;
@@ -169,20 +175,20 @@ CellRelaxation::Verdict CellRelaxation::rotation_test(const Mat3& R_c, const Tur
     const ElementKind ka = a_kind(x.type), kb = b_kind(x.type);
     // Opposite normals (f-f), an edge parallel to the face (e-f, f-e): A's vector moves by at
     // most turn(vector) over the cell.
-    // A witness meets each condition to kRotAccepted, not exactly.
+    // A pose meets each condition to rot_tol_, not exactly.
     if (x.type == PcType::kFF) {
       const Vec3& na = mA.face(FaceId(x.a)).normal;
-      if ((R_c * na + mB.face(FaceId(x.b)).normal).norm() > turn.of(na) + kRotAccepted)
+      if ((R_c * na + mB.face(FaceId(x.b)).normal).norm() > turn.of(na) + rot_tol_)
         return Verdict::kRotation;
     }
     if (x.type == PcType::kEF) {
       const Vec3& ea = mA.edge(EdgeId(x.a)).dir;
-      if (std::abs((R_c * ea).dot(mB.face(FaceId(x.b)).normal)) > turn.of(ea) + kRotAccepted)
+      if (std::abs((R_c * ea).dot(mB.face(FaceId(x.b)).normal)) > turn.of(ea) + rot_tol_)
         return Verdict::kRotation;
     }
     if (x.type == PcType::kFE) {
       const Vec3& na = mA.face(FaceId(x.a)).normal;
-      if (std::abs((R_c * na).dot(mB.edge(EdgeId(x.b)).dir)) > turn.of(na) + kRotAccepted)
+      if (std::abs((R_c * na).dot(mB.edge(EdgeId(x.b)).dir)) > turn.of(na) + rot_tol_)
         return Verdict::kRotation;
     }
     // Local non-penetration against a face: the other solid's tangent directions at the
@@ -365,7 +371,7 @@ CellRelaxation::Refutation CellRelaxation::refute(const Mat3& R_c, const TurnBou
   }
   // A cube of rotations (no arc): its turn bound is an angle.
   if (local_slack_ > 0 && turn.about == 0 && turn.any > 0 &&
-      first_order_refutes(A_, B_, pcs_, R_c, turn.any, local_slack_, kRotAccepted,
+      first_order_refutes(A_, B_, pcs_, R_c, turn.any, local_slack_, rot_tol_,
                           with_certificates ? &out.certificates : nullptr)) {
     out.verdict = Verdict::kFirstOrder;
     return out;
@@ -448,7 +454,7 @@ std::vector<CellRelaxation::Slab> CellRelaxation::narrow(const Mat3& R_c, const 
 bool CellRelaxation::holds_at(const Mat3& R) const {
   int pc = -1;
   Vec3 direction;
-  if (empty_ || rotation_test(R, TurnBound{kRotAccepted}, pc, direction) != Verdict::kOpen)
+  if (empty_ || rotation_test(R, TurnBound{rot_tol_}, pc, direction) != Verdict::kOpen)
     return false;
   std::vector<int> choice(slot_sizes_.size(), 0);
   for (std::size_t c = 0; c < choices(); ++c) {

@@ -11,6 +11,7 @@
 #include "cfgen/decide/rotation_cells.hpp"
 #include "cfgen/verify/analysis.hpp"
 #include "cfgen/verify/lp.hpp"
+#include "cfgen/verify/rotation_conditions.hpp"
 
 #include <cf/pc.hpp>
 
@@ -32,8 +33,10 @@ class CellRelaxation {
   /// local_slack (a sine): the local non-penetration margin each pose must keep
   /// (local_margin_bound); with the verifier's verified_local_slack(), as with min_margin, a
   /// refutation shows that no witness exists. 0: only penetration refutes.
+  /// rot_tol (rad): what a pose may leave of a rotational condition (kRotAccepted for a
+  /// witness; more for a set decided for its images under the models' symmetries).
   CellRelaxation(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs, double touch_tol,
-                 double margin = 0, double local_slack = 0);
+                 double margin = 0, double local_slack = 0, double rot_tol = kRotAccepted);
 
   /// Why a cell holds no pose of the set.
   enum class Verdict {
@@ -133,6 +136,7 @@ class CellRelaxation {
   double touch_tol_ = 0;    // mm
   double margin_ = 0;       // mm
   double local_slack_ = 0;  // sine
+  double rot_tol_ = 0;      // rad
   Vec3 t_lo_, t_hi_;        // mm: bounds of the translation every PC allows
   bool empty_ = false;
 };

@@ -48,8 +48,8 @@ Mat3 centre_of(const PoseBox& c, const Circle& circle) {
   return circle.on ? circle.at(c.arc.centre) : rotation_at(c.rot.centre);
 }
 
-TurnBound turn_of(const PoseBox& c, const Circle& circle) {
-  if (circle.on) return {kOffCircle, c.arc.half, circle.axis};
+TurnBound turn_of(const PoseBox& c, const Circle& circle, double rot_tol) {
+  if (circle.on) return {off_circle(rot_tol), c.arc.half, circle.axis};
   return {turn_bound(c.rot)};
 }
 
@@ -69,10 +69,11 @@ double reach_of(const Polyhedron& A, const Vec3& pivot) {
 // over their rotations again) or
 // they move A's points more than the box's spread, else the box along its longest side; the
 // children's parent is `node`. The kind of split made.
-CellNode::Kind split_into(const PoseBox& c, const Circle& circle, double reach, int node,
-                          std::vector<PoseBox>& stack, int& axis, double& at, bool unsettled) {
+CellNode::Kind split_into(const PoseBox& c, const Circle& circle, const TurnBound& turn,
+                          double reach, int node, std::vector<PoseBox>& stack, int& axis,
+                          double& at, bool unsettled) {
   const Vec3 ext = c.t_hi - c.t_lo;
-  if (unsettled || turn_of(c, circle).unit() * reach >= 0.5 * ext.norm()) {
+  if (unsettled || turn.unit() * reach >= 0.5 * ext.norm()) {
     if (circle.on) {
       const double h = 0.5 * c.arc.half;
       for (double side : {-1.0, 1.0})
@@ -129,10 +130,24 @@ CellSearchLimits decision_limits(const WitnessSearch& search, std::size_t max_ce
   return limits;
 }
 
+CellSearchLimits loosened(CellSearchLimits limits, const MapError& e) {
+  if (e.length == 0 && e.angle == 0) return limits;
+  limits.touch_tol += e.length;
+  limits.margin = std::max(0.0, limits.margin - e.length);
+  limits.rot_tol += e.angle;
+  // An e-e's normal N / |N| turns by at most 2 angle / |N|, |N| >= local_slack at a witness.
+  if (limits.local_slack > 0)
+    limits.local_slack =
+        std::max(0.0, limits.local_slack - 2 * e.angle * (1 + 1 / limits.local_slack));
+  limits.deep_extra = std::max(limits.deep_extra, e.length);
+  return limits;
+}
+
 CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs,
                               const CellSearchLimits& limits, const WitnessSearch* search,
                               CellTree* tree) {
-  const CellRelaxation relaxation(a, b, pcs, limits.touch_tol, limits.margin, limits.local_slack);
+  const CellRelaxation relaxation(a, b, pcs, limits.touch_tol, limits.margin, limits.local_slack,
+                                  limits.rot_tol);
   const DeepPoints deep(a, b);
   const RotConstraints conditions = rotation_constraints(pcs, *a.model, *b.model);
   const double size = std::max((a.model->bbox_max() - a.model->bbox_min()).norm(),
@@ -152,7 +167,7 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
     const double half = half_of(c, circle);
     out.smallest_half = std::min(out.smallest_half, half);
     const Mat3 R_c = centre_of(c, circle);
-    const TurnBound turn = turn_of(c, circle);
+    const TurnBound turn = turn_of(c, circle, limits.rot_tol);
     int node = -1;
     if (tree) {
       CellNode n;
@@ -178,7 +193,8 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
     if (tree && !r.slabs.empty())
       node = record_narrowing(*tree, node, c.t_lo, c.t_hi, std::move(r.slabs));
     if (r.verdict == CellRelaxation::Verdict::kOpen) {
-      if (const auto hit = deep.find({R_c, turn.unit(), relaxation.pivot(), c.t_lo, c.t_hi})) {
+      if (const auto hit = deep.find(
+              {R_c, turn.unit(), relaxation.pivot(), c.t_lo, c.t_hi, limits.deep_extra})) {
         r.verdict = CellRelaxation::Verdict::kDeep;
         if (tree) {
           leaf().deep_of_a = hit->of_a;
@@ -205,7 +221,8 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
       return out;  // kUndecided
     int axis = -1;
     double at = 0;
-    const CellNode::Kind kind = split_into(c, circle, reach, node, stack, axis, at, r.unsettled);
+    const CellNode::Kind kind =
+        split_into(c, circle, turn, reach, node, stack, axis, at, r.unsettled);
     if (tree) {
       leaf().kind = kind;
       leaf().axis = axis;

@@ -15,10 +15,10 @@
 
 namespace cf::gen {
 
-/// rad: how far a rotation of an arc cell may be from the f-f's circle. A witness meets the
-/// f-f's alignment to kRotAccepted: its rotation is within that angle of the circle (a turn
-/// by a moves a unit vector by at most a); twice it for rounding.
-constexpr double kOffCircle = 2 * kRotAccepted;
+/// rad: how far a rotation of an arc cell may be from the f-f's circle, for a pose that meets
+/// the f-f's alignment to rot_tol: its rotation is within that angle of the circle (a turn by
+/// a moves a unit vector by at most a); twice it for rounding.
+inline double off_circle(double rot_tol) { return 2 * rot_tol; }
 
 struct CellSearchLimits {
   double resolution = 1.5e-5;     // rad, and times the models' size in mm: cells are not split
@@ -27,8 +27,23 @@ struct CellSearchLimits {
   double touch_tol = 1e-9;        // mm: elements this close touch (SearchParams::touch_tol)
   double margin = 0;       // mm: contacts at least this far inside their elements (CellRelaxation)
   double local_slack = 0;  // sine: local non-penetration margin at every contact (CellRelaxation)
-  double search_below = 0.05;  // rad: open rotation cells this small are searched for a witness
+  double search_below = 0.05;     // rad: open rotation cells this small are searched for a witness
+  double rot_tol = kRotAccepted;  // rad: what a pose may leave of a rotational condition
+  double deep_extra = 0;  // mm: a deep point must lie this much deeper than the cell lets it move
 };
+
+/// How far the maps of a pair's symmetries miss (PairSymmetries::error): elements of A
+/// and B are moved at most `length` (mm, both models' errors added) from the image elements,
+/// and their directions turned at most `angle` (rad).
+struct MapError {
+  double length = 0;
+  double angle = 0;
+};
+
+/// `limits` loosened so that a refutation of a set also refutes its images under maps that
+/// miss by `e` (docs/certificates.md, "Images"): the image of a pose of an image within the
+/// tolerances of `limits` is a pose of the set within those returned.
+CellSearchLimits loosened(CellSearchLimits limits, const MapError& e);
 
 /// The limits a run's decision uses (docs/generator.md, "What the search could not decide"):
 /// the verifier's touch tolerance and local slack, and the contact margin of a THIN pose

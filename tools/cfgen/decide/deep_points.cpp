@@ -54,7 +54,7 @@ std::optional<DeepPoints::Hit> DeepPoints::find(const PoseCell& c) const {
   for (std::size_t i = 0; i < a_points_.size(); ++i) {
     const Vec3 arm = a_points_[i] - c.pivot;
     const Vec3 y = c.R_c * arm + t_mid;
-    const double reach = c.beta * arm.norm() + spread;
+    const double reach = c.beta * arm.norm() + spread + c.extra;
     const double depth = depth_inside(*B_.model, y);
     if (depth > reach) return Hit{true, static_cast<int>(i), depth, reach};
   }
@@ -64,7 +64,7 @@ std::optional<DeepPoints::Hit> DeepPoints::find(const PoseCell& c) const {
   for (std::size_t i = 0; i < b_points_.size(); ++i) {
     const Vec3 arm = b_points_[i] - t_mid;
     const Vec3 x = Rt * arm + c.pivot;
-    const double reach = c.beta * (arm.norm() + spread) + spread;
+    const double reach = c.beta * (arm.norm() + spread) + spread + c.extra;
     const double depth = depth_inside(*A_.model, x);
     if (depth > reach) return Hit{false, static_cast<int>(i), depth, reach};
   }

@@ -24,6 +24,7 @@ struct PoseCell {
   double beta = 0;
   Vec3 pivot = Vec3::Zero();                      // mm, A's frame
   Vec3 t_lo = Vec3::Zero(), t_hi = Vec3::Zero();  // mm, B's frame
+  double extra = 0;  // mm: a point must lie this much deeper than the cell lets it move
 };
 
 class DeepPoints {

@@ -34,7 +34,7 @@ struct EnumerateOptions {
   /// Keep each failed set's outcome and evidence (Enumeration::decisions) for the certificate
   /// file (docs/certificates.md).
   bool certificates = false;
-  /// Cells of rotation space each failed set without an f-f PC may take in the decision
+  /// Cells of rotation space each orbit of failed sets without an f-f PC may take in the decision
   /// (cfgen --cube-cells); 0: not searched over cells.
   std::size_t cube_cells = 0;
 };
@@ -45,6 +45,14 @@ struct SetDecision {
   bool invalid = false;             // false: undecided
   RuleVerdict rule;                 // invalid by this rule, or (kNone) by `cells`
   std::shared_ptr<CellTree> cells;  // invalid by cells: the complete tree
+  /// Invalid by cells: the tolerances the tree was built with, looser than the run's for a set
+  /// decided for its images under the pair's symmetries (loosened()).
+  CellSearchLimits cell_limits;
+  /// Invalid as the image of `image_of` (a set invalid by cells; empty otherwise) under the
+  /// pair's symmetry x -> H (x - c_A) + c_A of A and y -> G (y - c_B) + c_B of B.
+  PcSet image_of;
+  Mat3 H = Mat3::Identity(), G = Mat3::Identity();
+  Vec3 c_A = Vec3::Zero(), c_B = Vec3::Zero();  // mm
   /// A THIN set (Enumeration::thin): realised only with a smaller clearance or margin than a
   /// witness has; invalid is false.
   bool thin = false;

@@ -151,6 +151,8 @@ class Enumerator {
   // finish.cpp
   void close_orbits();
   void find_undecided();
+  void decide_over_cells(std::vector<char>& state, std::vector<Witness>& found,
+                         std::vector<SetDecision>& decisions);
   std::vector<std::pair<PcSet, Witness>> find_thin(const std::vector<PcSet>& open);
   SetDecision certified(const PcSet& s, const RuleVerdict& rule, CellSearchLimits limits) const;
   void add_with_images(const PcSet& s, const Witness& w, PcSetSet& known);

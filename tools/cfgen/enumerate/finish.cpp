@@ -64,12 +64,16 @@ void Enumerator::close_orbits() {
 
 namespace {
 
-// Cells one set may take. Most sets refuted over arcs fail their rotational conditions or
-// local slack in the first cells; a set whose relaxation holds over a face's worth of
-// translations (refuted, if at all, by an obstacle) takes them all, and there are many: 8
-// cells refute 2,304 sets of a 12-gon peg and hole in 8.8 s at 2 threads, 100 cells 3,072
-// in 98 s.
-constexpr std::size_t kDecisionCells = 8;
+// Cells the set searched for each orbit over arcs may take. Most sets refuted over arcs fail
+// their rotational conditions or local slack in the first cells; a set whose relaxation holds
+// over a face's worth of translations (refuted, if at all, by an obstacle) takes them all,
+// and the n-gon pairs have many: searched once an orbit, 4,000 cells refute 432 sets of the
+// hexagonal peg and hole and 14,400 of the 12-gon one for 2 s and 3 s at 2 threads
+// (docs/generator.md, "What the search could not decide").
+constexpr std::size_t kDecisionCells = 4000;
+
+// What became of a failed set in find_undecided.
+enum : char { kDecided, kOpen, kOverCells, kFound, kKnown, kImage };
 
 bool has_ff(const PcSet& s) {
   for (const Pc& pc : s)
@@ -86,23 +90,23 @@ constexpr std::size_t kCertificateCells = 4096;
 
 // What the search could not decide: failed candidates that motion did not find either and
 // that no proof rules out (WitnessSearch::refuted). Those on an f-f's circle of rotations go
-// to the branch and bound over its arcs (search_cells), with the verifier's margins: it
-// refutes a set (no witness exists) or finds a witness. With opt_.certificates, every failed
-// set's decision and evidence go to out_.decisions.
+// to the branch and bound over its arcs (search_cells), and with opt_.cube_cells the others
+// over cubes of rotation space, with the verifier's margins: it refutes a set (no witness
+// exists) or finds a witness. One set of each orbit of the pair's symmetries is searched, with
+// tolerances loosened by how far the maps miss, so that its refutation covers the others
+// (docs/certificates.md, "Images"). With opt_.certificates, every failed set's decision and
+// evidence go to out_.decisions.
 void Enumerator::find_undecided() {
   PcSetSet known;
   for (int l = 0; l < 3; ++l)
     for (const auto& [s, w] : valid_[l]) known.insert(s);
-  const CellSearchLimits limits = decision_limits(search_, kDecisionCells);
-  const CellSearchLimits cube_limits = decision_limits(search_, opt_.cube_cells);
   const bool keep = opt_.certificates;
-  enum : char { kDecided, kOpen, kOverCells, kFound, kKnown };
   std::vector<char> state(failed_.size(), kDecided);
-  std::vector<Witness> found(failed_.size());
   std::vector<SetDecision> decisions(keep ? failed_.size() : 0);
   const auto t0 = Clock::now();
   ProgressEvent ev{
       "proofs of invalidity", "failed candidate sets", 0, failed_.size(), 0, false, {}};
+  const CellSearchLimits limits = decision_limits(search_, kDecisionCells);
   runner_.for_each(
       failed_.size(),
       [&](std::size_t i) {
@@ -113,29 +117,15 @@ void Enumerator::find_undecided() {
         }
         const RuleVerdict rule = search_.refuted_by(s);
         if (keep) decisions[i] = certified(s, rule, limits);
-        if (rule.rule != Rule::kNone) return;
-        state[i] = kOpen;
-        // A single f-f's relaxation holds wherever its faces overlap: only obstacles refute it.
-        // Sets without an f-f search cubes of rotation space, when asked to.
-        const bool ff = has_ff(s);
-        if (ff ? s.size() < 2 : opt_.cube_cells == 0) return;
-        auto tree = keep ? std::make_shared<CellTree>() : nullptr;
-        const CellSearchResult r = search_cells(search_.a(), search_.b(), s,
-                                                ff ? limits : cube_limits, &search_, tree.get());
-        if (r.outcome == CellSearchResult::Outcome::kRefuted) {
-          state[i] = kOverCells;
-          if (keep) decisions[i].cells = std::move(tree);
-        }
-        if (r.outcome == CellSearchResult::Outcome::kWitness) {
-          state[i] = kFound;
-          found[i] = r.witness;
-        }
+        if (rule.rule == Rule::kNone) state[i] = kOpen;
       },
       &ev, t0);
+  std::vector<Witness> found(failed_.size());
+  decide_over_cells(state, found, decisions);
   std::vector<PcSet> open;
   for (std::size_t i = 0; i < failed_.size(); ++i) {
     if (state[i] == kOpen) open.push_back(failed_[i]);
-    if (state[i] == kOverCells) ++out_.refuted_over_cells;
+    if (state[i] == kOverCells || state[i] == kImage) ++out_.refuted_over_cells;
     if (state[i] == kFound) add_with_images(failed_[i], found[i], known);
   }
   std::sort(open.begin(), open.end(), pcset_less);
@@ -167,6 +157,75 @@ void Enumerator::find_undecided() {
       std::unique(out_.decisions.begin(), out_.decisions.end(),
                   [](const SetDecision& x, const SetDecision& y) { return x.pcs == y.pcs; }),
       out_.decisions.end());
+}
+
+// The open sets (state kOpen) the cells take: those with an f-f and another PC over arcs of
+// its circle (a single f-f's relaxation holds wherever its faces overlap: only obstacles
+// refute it), the others over cubes when opt_.cube_cells asks. The first set of each orbit
+// in failed_'s order is searched; the other open members of its orbit follow it: kImage
+// when it is refuted, CFs when it has a witness (add_with_images, later), else open.
+void Enumerator::decide_over_cells(std::vector<char>& state, std::vector<Witness>& found,
+                                   std::vector<SetDecision>& decisions) {
+  const CellSearchLimits arcs = decision_limits(search_, kDecisionCells);
+  const CellSearchLimits cubes = decision_limits(search_, opt_.cube_cells);
+  auto takes_cells = [&](std::size_t i) {
+    const PcSet& s = failed_[i];
+    return state[i] == kOpen && (has_ff(s) ? s.size() >= 2 : opt_.cube_cells > 0);
+  };
+  PcSetMap<std::size_t> first;        // orbit (canonical set) -> its first open member
+  PcSetMap<std::size_t> members;      // orbit -> how many open members take cells
+  std::vector<std::size_t> searched;  // the first members
+  for (std::size_t i = 0; i < failed_.size(); ++i) {
+    if (!takes_cells(i)) continue;
+    const PcSet c = sym_.canonical(failed_[i]);
+    if (first.emplace(c, i).second) searched.push_back(i);
+    ++members[c];
+  }
+  const auto t0 = Clock::now();
+  ProgressEvent ev{"cells", "orbits of open sets", 0, searched.size(), 0, false, {}};
+  runner_.for_each(
+      searched.size(),
+      [&](std::size_t j) {
+        const std::size_t i = searched[j];
+        const PcSet& s = failed_[i];
+        CellSearchLimits lim = has_ff(s) ? arcs : cubes;
+        if (members.at(sym_.canonical(s)) > 1) lim = loosened(lim, sym_.error());
+        auto tree = decisions.empty() ? nullptr : std::make_shared<CellTree>();
+        const CellSearchResult r =
+            search_cells(search_.a(), search_.b(), s, lim, &search_, tree.get());
+        if (r.outcome == CellSearchResult::Outcome::kRefuted) {
+          state[i] = kOverCells;
+          if (tree) {
+            decisions[i].cells = std::move(tree);
+            decisions[i].cell_limits = lim;
+          }
+        }
+        if (r.outcome == CellSearchResult::Outcome::kWitness) {
+          state[i] = kFound;
+          found[i] = r.witness;
+        }
+      },
+      &ev, t0);
+  std::size_t refuted = 0;
+  for (std::size_t i : searched) refuted += state[i] == kOverCells;
+  finished(ev, t0, std::to_string(refuted) + " refuted");
+  for (std::size_t i = 0; i < failed_.size(); ++i) {
+    if (!takes_cells(i)) continue;
+    const std::size_t rep = first.at(sym_.canonical(failed_[i]));
+    if (rep == i || state[rep] != kOverCells) continue;
+    state[i] = kImage;
+    if (decisions.empty()) continue;
+    SetDecision& d = decisions[i];
+    d.image_of = failed_[rep];
+    for (std::size_t k = 0; k < sym_.size(); ++k)
+      if (sym_.image(failed_[rep], k) == failed_[i]) {
+        d.H = sym_.map_a(k).R;
+        d.c_A = sym_.map_a(k).c;
+        d.G = sym_.map_b(k).R;
+        d.c_B = sym_.map_b(k).c;
+        break;
+      }
+  }
 }
 
 // THIN sets (docs/generator.md, "Thin sets"): of the open sets (sorted), those a pose
@@ -236,6 +295,7 @@ SetDecision Enumerator::certified(const PcSet& s, const RuleVerdict& rule,
   if (r.outcome == CellSearchResult::Outcome::kRefuted) {
     d.rule = {};
     d.cells = std::move(tree);
+    d.cell_limits = limits;
   }
   d.contradicted = r.outcome == CellSearchResult::Outcome::kWitness;
   return d;

@@ -200,9 +200,63 @@ Polyhedron symmetrized(const Polyhedron& m, double loose_tol, double strict_tol,
   return s;
 }
 
+namespace {
+
+// The angle between unit vectors u and w, from their chord (exact for any angle).
+double angle_between(const Vec3& u, const Vec3& w) {
+  return 2 * std::asin(std::min(1.0, 0.5 * (u - w).norm()));
+}
+
+// How far map s of m misses: each vertex's image from the vertex it is taken to, each edge's
+// turned direction from its image edge's (the sign following the ends), each face's turned
+// normal from its image face's. Rounded up by a few units of rounding of the arithmetic.
+MapError map_error(const Polyhedron& m, const Symmetry& s) {
+  MapError e;
+  for (std::size_t i = 0; i < m.num_vertices(); ++i) {
+    const Vec3 image = s.R * (m.vertices()[i].p - s.c) + s.c;
+    e.length =
+        std::max(e.length, (image - m.vertices()[static_cast<std::size_t>(s.vertex[i])].p).norm());
+  }
+  for (std::size_t k = 0; k < m.num_edges(); ++k) {
+    const Edge& E = m.edges()[k];
+    const Edge& F = m.edges()[static_cast<std::size_t>(s.edge[k])];
+    const double sign = s.vertex[E.v0.index()] == static_cast<int>(F.v0.index()) ? 1.0 : -1.0;
+    e.angle = std::max(e.angle, angle_between(s.R * E.dir, sign * F.dir));
+  }
+  for (std::size_t f = 0; f < m.num_faces(); ++f)
+    e.angle =
+        std::max(e.angle, angle_between(s.R * m.faces()[f].normal,
+                                        m.faces()[static_cast<std::size_t>(s.face[f])].normal));
+  const double size = (m.bbox_max() - m.bbox_min()).norm();
+  e.length += 1e-14 * size;
+  e.angle += 1e-14;
+  return e;
+}
+
+}  // namespace
+
+const Symmetry& PairSymmetries::map_a(std::size_t k) const {
+  return a_[static_cast<std::size_t>(pairs_[k].first)];
+}
+const Symmetry& PairSymmetries::map_b(std::size_t k) const {
+  return b_[static_cast<std::size_t>(pairs_[k].second)];
+}
+
 PairSymmetries::PairSymmetries(const Polyhedron& A, const Polyhedron& B, double tol, bool enabled) {
   a_ = enabled ? symmetries(A, tol) : std::vector<Symmetry>{identity(A)};
   b_ = enabled ? symmetries(B, tol) : std::vector<Symmetry>{identity(B)};
+  if (a_.size() * b_.size() > 1) {
+    MapError ea, eb;
+    for (const Symmetry& h : a_) {
+      const MapError e = map_error(A, h);
+      ea = {std::max(ea.length, e.length), std::max(ea.angle, e.angle)};
+    }
+    for (const Symmetry& g : b_) {
+      const MapError e = map_error(B, g);
+      eb = {std::max(eb.length, e.length), std::max(eb.angle, e.angle)};
+    }
+    error_ = {ea.length + eb.length, ea.angle + eb.angle};
+  }
   for (std::size_t i = 0; i < a_.size(); ++i) {
     a_first_.push_back(pairs_.size());
     for (std::size_t j = 0; j < b_.size(); ++j)

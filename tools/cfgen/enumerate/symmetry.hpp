@@ -4,6 +4,7 @@
 // (h of A's element, g of B's element), so the graph is a union of such orbits: the search
 // needs one member of each, and every member's witness follows from one.
 
+#include "cfgen/decide/cell_search.hpp"
 #include "cfgen/verify/analysis.hpp"
 
 #include <cf/pc.hpp>
@@ -59,11 +60,19 @@ class PairSymmetries {
   Pose image(const Pose& pose, std::size_t k) const;
   /// The smallest image of s (PCs compared in order): one set per orbit.
   PcSet canonical(const PcSet& s) const;
+  /// The maps of pair k: of A, and of B.
+  const Symmetry& map_a(std::size_t k) const;
+  const Symmetry& map_b(std::size_t k) const;
+  /// How far the maps miss, at most, over every pair: the image of a vertex from the vertex
+  /// it is taken to (A's and B's added), and the image of an edge's direction or a face's
+  /// normal from the image element's.
+  const MapError& error() const { return error_; }
 
  private:
   std::vector<Symmetry> a_, b_;
   std::vector<std::pair<int, int>> pairs_;  // (map of A, map of B), by map of A
   std::vector<std::size_t> a_first_;        // pairs_[a_first_[i], a_first_[i + 1]): h = a_[i]
+  MapError error_;
 };
 
 /// Lexicographic order of PC sets of one size (then by size).
