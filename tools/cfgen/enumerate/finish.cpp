@@ -64,13 +64,15 @@ void Enumerator::close_orbits() {
 
 namespace {
 
-// Cells the set searched for each orbit over arcs may take. Most sets refuted over arcs fail
-// their rotational conditions or local slack in the first cells; a set whose relaxation holds
-// over a face's worth of translations (refuted, if at all, by an obstacle) takes them all,
-// and the n-gon pairs have many: searched once an orbit, 4,000 cells refute 432 sets of the
-// hexagonal peg and hole and 14,400 of the 12-gon one for 2 s and 3 s at 2 threads
-// (docs/generator.md, "What the search could not decide").
-constexpr std::size_t kDecisionCells = 4000;
+// Cells the set searched for an orbit over arcs may take: kArcCellsPerSet for each open
+// member of the orbit, at most kArcCellsPerOrbit, so that the search costs about what 64
+// cells a set would while a set of a symmetric pair gets up to 4,000. Most sets refuted over
+// arcs fail their rotational conditions or local slack in the first cells; a set whose
+// relaxation holds over a face's worth of translations (refuted, if at all, by an obstacle)
+// takes many more, and the n-gon pairs have many (docs/generator.md, "What the search could
+// not decide").
+constexpr std::size_t kArcCellsPerSet = 64;
+constexpr std::size_t kArcCellsPerOrbit = 4000;
 
 // What became of a failed set in find_undecided.
 enum : char { kDecided, kOpen, kOverCells, kFound, kKnown, kImage };
@@ -106,7 +108,7 @@ void Enumerator::find_undecided() {
   const auto t0 = Clock::now();
   ProgressEvent ev{
       "proofs of invalidity", "failed candidate sets", 0, failed_.size(), 0, false, {}};
-  const CellSearchLimits limits = decision_limits(search_, kDecisionCells);
+  const CellSearchLimits limits = decision_limits(search_, kArcCellsPerSet);
   runner_.for_each(
       failed_.size(),
       [&](std::size_t i) {
@@ -166,7 +168,7 @@ void Enumerator::find_undecided() {
 // when it is refuted, CFs when it has a witness (add_with_images, later), else open.
 void Enumerator::decide_over_cells(std::vector<char>& state, std::vector<Witness>& found,
                                    std::vector<SetDecision>& decisions) {
-  const CellSearchLimits arcs = decision_limits(search_, kDecisionCells);
+  const CellSearchLimits arcs = decision_limits(search_, kArcCellsPerOrbit);
   const CellSearchLimits cubes = decision_limits(search_, opt_.cube_cells);
   auto takes_cells = [&](std::size_t i) {
     const PcSet& s = failed_[i];
@@ -188,8 +190,10 @@ void Enumerator::decide_over_cells(std::vector<char>& state, std::vector<Witness
       [&](std::size_t j) {
         const std::size_t i = searched[j];
         const PcSet& s = failed_[i];
+        const std::size_t m = members.at(sym_.canonical(s));
         CellSearchLimits lim = has_ff(s) ? arcs : cubes;
-        if (members.at(sym_.canonical(s)) > 1) lim = loosened(lim, sym_.error());
+        if (has_ff(s)) lim.max_cells = std::min(kArcCellsPerOrbit, kArcCellsPerSet * m);
+        if (m > 1) lim = loosened(lim, sym_.error());
         auto tree = decisions.empty() ? nullptr : std::make_shared<CellTree>();
         const CellSearchResult r =
             search_cells(search_.a(), search_.b(), s, lim, &search_, tree.get());
