@@ -180,9 +180,8 @@ json set_json(const gen::SetDecision& d, const gen::Enumeration& e,
     const CellRelaxation relaxation(search.a(), search.b(), d.pcs, l.touch_tol, l.margin,
                                     l.local_slack, l.rot_tol);
     j["cells"] = cells_json(*d.cells, relaxation, deep, d.pcs);
-    if (l.touch_tol != limits.touch_tol || l.margin != limits.margin ||
-        l.local_slack != limits.local_slack || l.rot_tol != limits.rot_tol || l.deep_extra != 0)
-      j["cells"]["tolerances"] = tolerances_json(l);
+    if (json own = tolerances_json(l); own != tolerances_json(limits))
+      j["cells"]["tolerances"] = std::move(own);
   } else {
     j["rule"] = gen::rule_name(d.rule.rule);
     json involved = json::array();

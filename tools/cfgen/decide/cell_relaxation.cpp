@@ -280,12 +280,12 @@ void CellRelaxation::add_contact(LinearProgram& lp, int i, const Mat3& R_c, cons
   // it: at most turn(x - pivot), a convex function of x. On an edge it is bounded by its
   // chord between the ends, widen + chord s, which vanishes towards an end at the pivot;
   // on a face piece, by its largest value at the corners.
-  double moved = 0;
-  for (const Vec3& x : pts) moved = std::max(moved, turn.of(x - pivot_));
-  double chord = 0;
+  double moved = 0, chord = 0;
   if (a_kind(pc.type) == ElementKind::kEdge) {
     moved = turn.of(pts[0] - pivot_);
     chord = turn.of(pts[1] - pivot_) - moved;
+  } else {
+    for (const Vec3& x : pts) moved = std::max(moved, turn.of(x - pivot_));
   }
   const double widen = moved + touch_tol_ + 1e-12 * size_;
   const Vec3 p0 = R_c * (x0 - pivot_);

@@ -174,14 +174,19 @@ void Enumerator::decide_over_cells(std::vector<char>& state, std::vector<Witness
     const PcSet& s = failed_[i];
     return state[i] == kOpen && (has_ff(s) ? s.size() >= 2 : opt_.cube_cells > 0);
   };
-  PcSetMap<std::size_t> first;        // orbit (canonical set) -> its first open member
-  PcSetMap<std::size_t> members;      // orbit -> how many open members take cells
-  std::vector<std::size_t> searched;  // the first members
+  // Each open set that takes cells, with the first member of its orbit; the first members.
+  std::vector<std::pair<std::size_t, std::size_t>> member_of;  // (set, its orbit's first)
+  std::vector<std::size_t> searched, members;                  // first members, orbit sizes
+  PcSetMap<std::size_t> orbit;                                 // canonical set -> in searched
   for (std::size_t i = 0; i < failed_.size(); ++i) {
     if (!takes_cells(i)) continue;
-    const PcSet c = sym_.canonical(failed_[i]);
-    if (first.emplace(c, i).second) searched.push_back(i);
-    ++members[c];
+    const auto [it, fresh] = orbit.emplace(sym_.canonical(failed_[i]), searched.size());
+    if (fresh) {
+      searched.push_back(i);
+      members.push_back(0);
+    }
+    ++members[it->second];
+    member_of.push_back({i, searched[it->second]});
   }
   const auto t0 = Clock::now();
   ProgressEvent ev{"cells", "orbits of open sets", 0, searched.size(), 0, false, {}};
@@ -190,10 +195,10 @@ void Enumerator::decide_over_cells(std::vector<char>& state, std::vector<Witness
       [&](std::size_t j) {
         const std::size_t i = searched[j];
         const PcSet& s = failed_[i];
-        const std::size_t m = members.at(sym_.canonical(s));
-        CellSearchLimits lim = has_ff(s) ? arcs : cubes;
-        if (has_ff(s)) lim.max_cells = std::min(kArcCellsPerOrbit, kArcCellsPerSet * m);
-        if (m > 1) lim = loosened(lim, sym_.error());
+        const bool ff = has_ff(s);
+        CellSearchLimits lim = ff ? arcs : cubes;
+        if (ff) lim.max_cells = std::min(kArcCellsPerOrbit, kArcCellsPerSet * members[j]);
+        if (members[j] > 1) lim = loosened(lim, sym_.error());
         auto tree = decisions.empty() ? nullptr : std::make_shared<CellTree>();
         const CellSearchResult r =
             search_cells(search_.a(), search_.b(), s, lim, &search_, tree.get());
@@ -213,9 +218,7 @@ void Enumerator::decide_over_cells(std::vector<char>& state, std::vector<Witness
   std::size_t refuted = 0;
   for (std::size_t i : searched) refuted += state[i] == kOverCells;
   finished(ev, t0, std::to_string(refuted) + " refuted");
-  for (std::size_t i = 0; i < failed_.size(); ++i) {
-    if (!takes_cells(i)) continue;
-    const std::size_t rep = first.at(sym_.canonical(failed_[i]));
+  for (const auto& [i, rep] : member_of) {
     if (rep == i || state[rep] != kOverCells) continue;
     state[i] = kImage;
     if (decisions.empty()) continue;

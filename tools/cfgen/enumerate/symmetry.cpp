@@ -233,6 +233,16 @@ MapError map_error(const Polyhedron& m, const Symmetry& s) {
   return e;
 }
 
+// The largest misses over a model's maps.
+MapError worst_error(const Polyhedron& m, const std::vector<Symmetry>& maps) {
+  MapError out;
+  for (const Symmetry& s : maps) {
+    const MapError e = map_error(m, s);
+    out = {std::max(out.length, e.length), std::max(out.angle, e.angle)};
+  }
+  return out;
+}
+
 }  // namespace
 
 const Symmetry& PairSymmetries::map_a(std::size_t k) const {
@@ -246,15 +256,7 @@ PairSymmetries::PairSymmetries(const Polyhedron& A, const Polyhedron& B, double 
   a_ = enabled ? symmetries(A, tol) : std::vector<Symmetry>{identity(A)};
   b_ = enabled ? symmetries(B, tol) : std::vector<Symmetry>{identity(B)};
   if (a_.size() * b_.size() > 1) {
-    MapError ea, eb;
-    for (const Symmetry& h : a_) {
-      const MapError e = map_error(A, h);
-      ea = {std::max(ea.length, e.length), std::max(ea.angle, e.angle)};
-    }
-    for (const Symmetry& g : b_) {
-      const MapError e = map_error(B, g);
-      eb = {std::max(eb.length, e.length), std::max(eb.angle, e.angle)};
-    }
+    const MapError ea = worst_error(A, a_), eb = worst_error(B, b_);
     error_ = {ea.length + eb.length, ea.angle + eb.angle};
   }
   for (std::size_t i = 0; i < a_.size(); ++i) {
@@ -267,8 +269,8 @@ PairSymmetries::PairSymmetries(const Polyhedron& A, const Polyhedron& B, double 
 }
 
 Pc PairSymmetries::image(const Pc& pc, std::size_t k) const {
-  const Symmetry& h = a_[static_cast<std::size_t>(pairs_[k].first)];
-  const Symmetry& g = b_[static_cast<std::size_t>(pairs_[k].second)];
+  const Symmetry& h = map_a(k);
+  const Symmetry& g = map_b(k);
   return Pc{pc.type, h.of(a_kind(pc.type))[static_cast<std::size_t>(pc.a)],
             g.of(b_kind(pc.type))[static_cast<std::size_t>(pc.b)]};
 }
@@ -280,8 +282,8 @@ PcSet PairSymmetries::image(const PcSet& s, std::size_t k) const {
 }
 
 Pose PairSymmetries::image(const Pose& pose, std::size_t k) const {
-  const Symmetry& h = a_[static_cast<std::size_t>(pairs_[k].first)];
-  const Symmetry& g = b_[static_cast<std::size_t>(pairs_[k].second)];
+  const Symmetry& h = map_a(k);
+  const Symmetry& g = map_b(k);
   // x_B = g(X(h^-1(x_A))), with h(x) = H (x - c_A) + c_A and g(y) = G (y - c_B) + c_B.
   Pose out;
   out.R_BA = g.R * pose.R_BA * h.R.transpose();
