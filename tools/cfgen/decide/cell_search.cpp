@@ -163,7 +163,9 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
   while (!stack.empty()) {
     PoseBox c = stack.back();
     stack.pop_back();
-    if (++out.cells > limits.max_cells) return out;  // kUndecided
+    // A cube outside the ball of rotations costs no program: it is not counted.
+    const bool outside = !circle.on && outside_rotation_ball(c.rot);
+    if (!outside && ++out.cells > limits.max_cells) return out;  // kUndecided
     const double half = half_of(c, circle);
     out.smallest_half = std::min(out.smallest_half, half);
     const Mat3 R_c = centre_of(c, circle);
@@ -182,7 +184,7 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
       node = static_cast<int>(tree->nodes.size()) - 1;
     }
     auto leaf = [&]() -> CellNode& { return tree->nodes[static_cast<std::size_t>(node)]; };
-    if (!circle.on && outside_rotation_ball(c.rot)) {
+    if (outside) {
       if (tree) leaf().kind = CellNode::Kind::kOutsideBall;
       continue;
     }

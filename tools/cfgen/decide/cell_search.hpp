@@ -99,7 +99,7 @@ struct CellSearchResult {
     kUndecided,  // a cell at the resolution, or the budget, was left open
   } outcome = Outcome::kUndecided;
   Witness witness;           // kWitness: the witness found, verified
-  std::size_t cells = 0;     // cells examined
+  std::size_t cells = 0;     // cells examined, those outside the ball of rotations not counted
   double smallest_half = 0;  // rad: the half-width of the smallest rotation cell or arc examined
 };
 
