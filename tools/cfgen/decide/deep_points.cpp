@@ -29,18 +29,38 @@ bool in_box(const Vec3& p, const Vec3& lo, const Vec3& hi) {
   return (p.array() > lo.array()).all() && (p.array() < hi.array()).all();
 }
 
+// mm: p's distance to face f's closed polygon.
+double face_distance(const Polyhedron& m, std::size_t f, const Vec3& p) {
+  const Face& F = m.faces()[f];
+  const double h = F.normal.dot(p) - F.offset;
+  const double out = std::max(0.0, -m.face_inset(FaceId(static_cast<int>(f)), p));
+  return std::sqrt(h * h + out * out);
+}
+
+// depth_inside(m, p) when it exceeds `need`, else 0; most points tried are not that deep, and
+// are turned away without the point-in-solid test: the depth is at most the distance to the
+// bounding box's sides (m lies inside it) and to any face, and a face's plane is no farther
+// than the face.
+double depth_beyond(const Polyhedron& m, const Vec3& p, double need) {
+  const Vec3 lo = m.bbox_min(), hi = m.bbox_max();
+  if (std::min((p - lo).minCoeff(), (hi - p).minCoeff()) <= need) return 0;
+  double d = HUGE_VAL;
+  for (std::size_t f = 0; f < m.num_faces(); ++f) {
+    const Face& F = m.faces()[f];
+    if (std::abs(F.normal.dot(p) - F.offset) >= d) continue;
+    d = std::min(d, face_distance(m, f, p));
+    if (d <= need) return 0;
+  }
+  return point_inside(m, p, 0.0) ? d : 0;
+}
+
 }  // namespace
 
 double depth_inside(const Polyhedron& m, const Vec3& p) {
   if (!in_box(p, m.bbox_min(), m.bbox_max()) || !point_inside(m, p, 0.0)) return 0;
-  double d2 = HUGE_VAL;
-  for (std::size_t f = 0; f < m.num_faces(); ++f) {
-    const Face& F = m.faces()[f];
-    const double h = F.normal.dot(p) - F.offset;
-    const double out = std::max(0.0, -m.face_inset(FaceId(static_cast<int>(f)), p));
-    d2 = std::min(d2, h * h + out * out);
-  }
-  return std::sqrt(d2);
+  double d = HUGE_VAL;
+  for (std::size_t f = 0; f < m.num_faces(); ++f) d = std::min(d, face_distance(m, f, p));
+  return d;
 }
 
 DeepPoints::DeepPoints(const ModelInfo& a, const ModelInfo& b)
@@ -55,7 +75,7 @@ std::optional<DeepPoints::Hit> DeepPoints::find(const PoseCell& c) const {
     const Vec3 arm = a_points_[i] - c.pivot;
     const Vec3 y = c.R_c * arm + t_mid;
     const double reach = c.beta * arm.norm() + spread + c.extra;
-    const double depth = depth_inside(*B_.model, y);
+    const double depth = depth_beyond(*B_.model, y, reach);
     if (depth > reach) return Hit{true, static_cast<int>(i), depth, reach};
   }
   // B's points in A: R^T (w - t) + pivot moves by at most beta |w - t| + |t - t_mid|, with
@@ -65,7 +85,7 @@ std::optional<DeepPoints::Hit> DeepPoints::find(const PoseCell& c) const {
     const Vec3 arm = b_points_[i] - t_mid;
     const Vec3 x = Rt * arm + c.pivot;
     const double reach = c.beta * (arm.norm() + spread) + spread + c.extra;
-    const double depth = depth_inside(*A_.model, x);
+    const double depth = depth_beyond(*A_.model, x, reach);
     if (depth > reach) return Hit{false, static_cast<int>(i), depth, reach};
   }
   return std::nullopt;
