@@ -104,7 +104,7 @@ cf::CfGraph generate(const std::string& a_path, const std::string& b_path,
                      const std::string& units, const std::string& units_a,
                      const std::string& units_b, double coplanar_rel_tol, double crease_angle_deg,
                      bool symmetry, bool thorough, const std::string& checkpoint,
-                     const std::string& certificates, long long cube_cells) {
+                     const std::string& certificates, long long cube_cells, double resolution) {
   const std::string where = "generate";
   // The ranges cfgen's options accept.
   check_int(threads, 0, 1024, "threads", where);
@@ -118,6 +118,7 @@ cf::CfGraph generate(const std::string& a_path, const std::string& b_path,
   check_int(max_rotations, 1, 10000, "max_rotations", where);
   if (cube_cells < 0 || cube_cells > 10000000)
     fail(where + ": cube_cells " + std::to_string(cube_cells) + " is not in [0, 10000000]");
+  check_range(resolution, 1e-9, 0.1, "resolution", where);
   const cf::tools::LoadOptions merge = merge_options(coplanar_rel_tol, crease_angle_deg, where);
   check_units(units, "units", where);
   cf::tools::GenerateArgs g;
@@ -131,6 +132,7 @@ cf::CfGraph generate(const std::string& a_path, const std::string& b_path,
   if (thorough && !symmetry) fail(where + ": symmetry=False excludes thorough=True");
   g.thorough = thorough;
   g.cube_cells = static_cast<std::size_t>(cube_cells);
+  g.resolution = resolution;
   g.rel.touch_tol = touch_tol;
   g.rel.min_clearance = min_clearance;
   g.rel.good_clearance = good_clearance;
@@ -201,6 +203,7 @@ PYBIND11_MODULE(_gen, m) {
         py::arg("crease_angle_deg") = cf::tools::LoadOptions{}.crease_angle_deg,
         py::arg("symmetry") = true, py::arg("thorough") = false, py::arg("checkpoint") = "",
         py::arg("certificates") = "", py::arg("cube_cells") = 0,
+        py::arg("resolution") = cf::gen::kResolution,
         "cfgen's generation (cf::tools::run_generate): the graph, also written to `output` "
         "unless it is empty; cf.gen.generate wraps it.");
   add_text_signatures(m);

@@ -70,13 +70,18 @@ def test_generate_thorough(tmp_path):
 
 def test_generate_cube_cells(tmp_path):
     # cube_cells is cfgen --cube-cells: failed sets without an f-f searched over cubes of
-    # rotation space; recorded in the graph's parameters, absent when 0.
+    # rotation space; resolution is --resolution, below which the cells are not split. Both
+    # are recorded in the graph's parameters, absent at their defaults.
     out = tmp_path / "cubes.json"
-    gen.generate(CUBE, CUBE, out, max_pcs=1, threads=2, cube_cells=64)
-    assert out.read_bytes() == cfgen_bytes(tmp_path, "--cube-cells", "64")
+    gen.generate(CUBE, CUBE, out, max_pcs=1, threads=2, cube_cells=64, resolution=1e-3)
+    assert out.read_bytes() == cfgen_bytes(tmp_path, "--cube-cells", "64", "--resolution", "1e-3")
     assert '"cube_cells": 64' in out.read_text()
+    assert '"resolution_rad": 0.001' in out.read_text()
     with pytest.raises(cf.Error, match=r"^generate: cube_cells -1 is not in \[0, 10000000\]$"):
         gen.generate(CUBE, CUBE, max_pcs=1, cube_cells=-1)
+    with pytest.raises(cf.Error, match=r"^generate: resolution must be a finite number in "
+                                       r"\[1e-09, 0\.1\], got 0\.5$"):
+        gen.generate(CUBE, CUBE, max_pcs=1, resolution=0.5)
 
 
 def test_generate_errors(tmp_path):

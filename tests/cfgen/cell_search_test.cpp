@@ -7,7 +7,9 @@
 #include "analysed_pair.hpp"
 #include "cfgen/decide/deep_points.hpp"
 #include "cfgen/decide/witness.hpp"
+#include "cfgen/generate.hpp"
 #include "fixtures.hpp"
+#include "mesh/model_loader.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -17,6 +19,8 @@
 #include <cmath>
 #include <iostream>
 #include <random>
+#include <sstream>
+#include <string>
 
 namespace {
 
@@ -351,4 +355,51 @@ TEST_CASE(
   const PcSet apart({Pc{PcType::kEE, ea, eb}});
   CHECK(cf::gen::search_cells(p.ai, p.bi, apart, limits, &search).outcome !=
         CellSearchResult::Outcome::kRefuted);
+}
+
+TEST_CASE(
+    "cell search: a coarser resolution refutes only sets the default resolution refutes, and "
+    "leaves open those that need smaller cells",
+    "[cells]") {
+  // The bundled peg and block with a hole, with the decision's limits (cfgen --resolution).
+  const std::string dir = std::string(CF_SOURCE_DIR) + "/data/models/";
+  cf::test::AnalysedPair p(cf::tools::load_model(dir + "peg.off"),
+                           cf::tools::load_model(dir + "hole_block.off"));
+  const cf::gen::WitnessSearch search(
+      p.ai, p.bi, cf::tools::scaled_search(p.A, p.B, cf::tools::RelativeLengths{}));
+  const cf::gen::CellSearchLimits fine = cf::gen::decision_limits(search, 3000);
+  const cf::gen::CellSearchLimits coarse = cf::gen::decision_limits(search, 3000, 1e-2);
+  // The translation's resolution is in units of D, the smaller model's diagonal.
+  CHECK(fine.resolution == cf::gen::kResolution);
+  CHECK(fine.scale == search.scale());
+  CHECK(coarse.resolution == 1e-2);
+  auto parse = [](const std::string& text) {
+    PcSet s;
+    std::istringstream in(text);
+    for (std::string tok; in >> tok;) s.insert(*cf::pc_from_string(tok));
+    return s;
+  };
+  // Refuted with cells down to 1.5e-3 and 7.7e-4 rad: left open by cells of 1e-2 rad.
+  for (const char* text : {"v-f:5:7 e-e:3:20 e-e:9:13", "v-f:0:7 e-e:3:22 e-e:9:12"}) {
+    INFO(text);
+    const PcSet s = parse(text);
+    const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, fine);
+    CHECK(r.outcome == CellSearchResult::Outcome::kRefuted);
+    CHECK(r.smallest_half < 1e-2);
+    const CellSearchResult rc = cf::gen::search_cells(p.ai, p.bi, s, coarse);
+    CHECK(rc.outcome == CellSearchResult::Outcome::kUndecided);
+    CHECK(rc.smallest_half < 1e-2);
+  }
+  // Refuted at both: the coarse search's tree is the fine one's (the resolution only ends a
+  // search), so it takes as many cells.
+  for (const char* text : {"e-e:1:23 e-e:11:15", "e-e:7:13 e-e:10:23", "e-f:5:9 f-e:4:17 v-f:7:3",
+                           "e-e:5:20 e-e:9:23 e-e:10:15"}) {
+    INFO(text);
+    const PcSet s = parse(text);
+    const CellSearchResult rc = cf::gen::search_cells(p.ai, p.bi, s, coarse);
+    REQUIRE(rc.outcome == CellSearchResult::Outcome::kRefuted);
+    const CellSearchResult r = cf::gen::search_cells(p.ai, p.bi, s, fine);
+    CHECK(r.outcome == CellSearchResult::Outcome::kRefuted);
+    CHECK(r.cells == rc.cells);
+  }
 }

@@ -105,11 +105,12 @@ if [[ "$group" == cfgen ]]; then
   check model_directory 1 "dir.off': cannot open file: is a directory, not a regular file" -- "$CFGEN" --features dir.off
 
   # Options: finite and in range, the range in --help.
-  for opt in --touch-tol --min-clearance --good-clearance --min-margin --angle-margin --coplanar-tol --crease-angle; do
+  for opt in --touch-tol --min-clearance --good-clearance --min-margin --angle-margin --resolution --coplanar-tol --crease-angle; do
     check "cfgen${opt}_nan" 2 "^cfgen: ${opt}: 'nan' is not a finite number" -- "$CFGEN" "$M/cube.off" "$M/l_block.off" -o nan.json "$opt" nan
     check "cfgen${opt}_inf" 2 "^cfgen: ${opt}: 'inf' is not a finite number" -- "$CFGEN" "$M/cube.off" "$M/l_block.off" -o nan.json "$opt" inf
   done
   check cfgen_touch_tol_range 2 "^cfgen: --touch-tol: '1' is outside \[[-+.e0-9]+, [-+.e0-9]+\]" -- "$CFGEN" "$M/cube.off" "$M/l_block.off" -o nan.json --touch-tol 1
+  check cfgen_resolution_range 2 "^cfgen: --resolution: '1' is outside \[1e-09, 0.1\]" -- "$CFGEN" "$M/cube.off" "$M/l_block.off" -o nan.json --resolution 1
   check cfgen_threads_range 2 "^cfgen: --threads: Value 100000 not in range 0 to 1024" -- "$CFGEN" "$M/cube.off" "$M/l_block.off" -o nan.json -j 100000
   check cfgen_good_below_min_clearance 2 "^cfgen: --good-clearance 0.0001 is below --min-clearance 0.0002: a witness is kept only when its clearance reaches --min-clearance" -- "$CFGEN" "$M/cube.off" "$M/l_block.off" -o nan.json --good-clearance 1e-4
   check cfgen_min_above_good_clearance 2 "^cfgen: --good-clearance 0.02 is below --min-clearance 0.03" -- "$CFGEN" "$M/cube.off" "$M/l_block.off" -o nan.json --min-clearance 0.03

@@ -162,6 +162,8 @@ nlohmann::json graph_meta(const gen::Enumeration& e, const GenerateArgs& args,
   if (args.thorough)
     meta["parameters"]["thorough"] = true;  // absent otherwise: the same bytes as before
   if (args.cube_cells > 0) meta["parameters"]["cube_cells"] = args.cube_cells;  // likewise
+  if (args.resolution != gen::kResolution)  // likewise; the default is gen::kResolution
+    meta["parameters"]["resolution_rad"] = args.resolution;
   meta["generator"] = {{"name", "cfgen"}, {"a_model", args.a_path}, {"b_model", args.b_path}};
   // Coordinates are stored in mm; the unit each model file was read in (docs/spec.md, section 2).
   meta["source_units"] = {{"A", args.load_a.units}, {"B", args.load_b.units}};
@@ -311,6 +313,7 @@ int run_generate(const GenerateArgs& args) {
   opt.use_symmetry = args.symmetry && !args.thorough;
   opt.close_orbits = args.thorough;
   opt.cube_cells = args.cube_cells;
+  opt.resolution = args.resolution;
   opt.records = writes;  // the other shards stop after the last stage
   opt.certificates = certifies;
   const gen::WitnessSearch ws(ai, bi, search);

@@ -75,6 +75,9 @@ struct GenerateArgs {
   /// decision (docs/generator.md, "Refuting a set over cells of poses"); 0: such sets are not
   /// searched over cells.
   std::size_t cube_cells = 0;
+  /// The decision's resolution: cells are not split below this many rad in rotation nor this
+  /// many D in translation; a set left with such a cell open is undecided.
+  double resolution = gen::kResolution;
   gen::SearchParams search;    ///< angular tolerances and search limits (lengths: `rel`)
   RelativeLengths rel;         ///< lengths of the search, relative to the models' size
   LoadOptions load_a, load_b;  ///< units and coplanarity tolerance of each model

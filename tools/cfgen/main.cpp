@@ -184,6 +184,13 @@ int main(int argc, char** argv) {
                      "poses\"; 0: not searched)")
           ->check(CLI::Range(std::size_t{0}, std::size_t{10000000}))
           ->capture_default_str());
+  gen_opts.push_back(
+      app.add_option("--resolution", gen.resolution,
+                     "rad, and in units of D in translation: the decision's cells of poses are not "
+                     "split below it, and a set left with such a cell open is undecided "
+                     "(docs/generator.md, \"What the search could not decide\")")
+          ->check(cf::cli::finite_range(1e-9, 0.1))
+          ->capture_default_str());
   app.add_option("--coplanar-tol", coplanar_tol,
                  "coplanarity tolerance relative to the model's bounding-box diagonal")
       ->check(cf::cli::finite_range(cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol));

@@ -68,7 +68,8 @@ def generate(a_path: str | os.PathLike[str], b_path: str | os.PathLike[str],
     ``--no-checkpoint``), ``certificates`` (a file: ``--certificates``, every failed candidate
     set with its outcome and evidence, docs/certificates.md), ``cube_cells`` (default 0:
     ``--cube-cells``, the cells of rotation space each failed set without an f-f PC may take to
-    be refuted). Ctrl-C stops the run between
+    be refuted), ``resolution`` (default 1.5e-5: ``--resolution``, rad, and in units of D in
+    translation, below which the decision's cells are not split). Ctrl-C stops the run between
     tasks and raises KeyboardInterrupt; with ``checkpoint``, the chunks finished so far are
     kept for the next call. Raises cf.Error for bad models or options.
     """

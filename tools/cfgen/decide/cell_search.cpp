@@ -121,9 +121,12 @@ int record_narrowing(CellTree& tree, int node, const Vec3& t_lo, const Vec3& t_h
 
 }  // namespace
 
-CellSearchLimits decision_limits(const WitnessSearch& search, std::size_t max_cells) {
+CellSearchLimits decision_limits(const WitnessSearch& search, std::size_t max_cells,
+                                 double resolution) {
   CellSearchLimits limits;
   limits.max_cells = max_cells;
+  limits.resolution = resolution;
+  limits.scale = search.scale();
   limits.touch_tol = search.params().touch_tol;
   limits.margin = thin_params(search.params()).min_margin;
   limits.local_slack = search.verified_local_slack();
@@ -150,8 +153,10 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
                                   limits.rot_tol);
   const DeepPoints deep(a, b);
   const RotConstraints conditions = rotation_constraints(pcs, *a.model, *b.model);
-  const double size = std::max((a.model->bbox_max() - a.model->bbox_min()).norm(),
-                               (b.model->bbox_max() - b.model->bbox_min()).norm());
+  const double size = limits.scale > 0
+                          ? limits.scale
+                          : std::max((a.model->bbox_max() - a.model->bbox_min()).norm(),
+                                     (b.model->bbox_max() - b.model->bbox_min()).norm());
   const double reach = reach_of(*a.model, relaxation.pivot());
   const Circle circle = circle_of(pcs, *a.model, *b.model);
   if (tree) *tree = {relaxation.pivot(), circle.pc, circle.R0, circle.axis, {}};

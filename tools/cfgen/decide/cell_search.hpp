@@ -20,9 +20,14 @@ namespace cf::gen {
 /// a moves a unit vector by at most a); twice it for rounding.
 inline double off_circle(double rot_tol) { return 2 * rot_tol; }
 
+/// The decision's default resolution (cfgen --resolution): rad in rotation, and in units of D
+/// (the smaller model's bounding-box diagonal) in translation.
+constexpr double kResolution = 1.5e-5;
+
 struct CellSearchLimits {
-  double resolution = 1.5e-5;     // rad, and times the models' size in mm: cells are not split
-                                  // below this in rotation and in translation
+  double resolution = kResolution;  // rad, and times `scale` in mm: cells are not split below
+                                    // this in rotation and in translation
+  double scale = 0;  // mm: the translation resolution's unit, D; 0: the larger model's diagonal
   std::size_t max_cells = 20000;  // cells examined before the search gives up
   double touch_tol = 1e-9;        // mm: elements this close touch (SearchParams::touch_tol)
   double margin = 0;       // mm: contacts at least this far inside their elements (CellRelaxation)
@@ -48,8 +53,10 @@ CellSearchLimits loosened(CellSearchLimits limits, const MapError& e);
 /// The limits a run's decision uses (docs/generator.md, "What the search could not decide"):
 /// the verifier's touch tolerance and local slack, and the contact margin of a THIN pose
 /// (thin_params), so that a refutation shows that no pose realises the set with any room, a
-/// witness or a THIN pose; at most max_cells cells.
-CellSearchLimits decision_limits(const WitnessSearch& search, std::size_t max_cells);
+/// witness or a THIN pose; at most max_cells cells; cells not split below `resolution` rad,
+/// and `resolution` times the search's length scale D in translation.
+CellSearchLimits decision_limits(const WitnessSearch& search, std::size_t max_cells,
+                                 double resolution = kResolution);
 
 /// Angles [centre - half, centre + half] (rad) of the rotations R0 Rot(n_A, theta) that
 /// turn the face of the set's first f-f PC against its face of B (R0 n_A = -n_B, the

@@ -37,6 +37,9 @@ struct EnumerateOptions {
   /// Cells of rotation space each orbit of failed sets without an f-f PC may take in the decision
   /// (cfgen --cube-cells); 0: not searched over cells.
   std::size_t cube_cells = 0;
+  /// rad, and in units of D in translation: the decision's cells are not split below it
+  /// (cfgen --resolution).
+  double resolution = kResolution;
 };
 
 /// A failed candidate set: how it was decided, and the evidence (docs/certificates.md).

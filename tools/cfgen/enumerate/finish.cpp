@@ -108,7 +108,7 @@ void Enumerator::find_undecided() {
   const auto t0 = Clock::now();
   ProgressEvent ev{
       "proofs of invalidity", "failed candidate sets", 0, failed_.size(), 0, false, {}};
-  const CellSearchLimits limits = decision_limits(search_, kArcCellsPerSet);
+  const CellSearchLimits limits = decision_limits(search_, kArcCellsPerSet, opt_.resolution);
   runner_.for_each(
       failed_.size(),
       [&](std::size_t i) {
@@ -168,8 +168,8 @@ void Enumerator::find_undecided() {
 // when it is refuted, CFs when it has a witness (add_with_images, later), else open.
 void Enumerator::decide_over_cells(std::vector<char>& state, std::vector<Witness>& found,
                                    std::vector<SetDecision>& decisions) {
-  const CellSearchLimits arcs = decision_limits(search_, kArcCellsPerOrbit);
-  const CellSearchLimits cubes = decision_limits(search_, opt_.cube_cells);
+  const CellSearchLimits arcs = decision_limits(search_, kArcCellsPerOrbit, opt_.resolution);
+  const CellSearchLimits cubes = decision_limits(search_, opt_.cube_cells, opt_.resolution);
   auto takes_cells = [&](std::size_t i) {
     const PcSet& s = failed_[i];
     return state[i] == kOpen && (has_ff(s) ? s.size() >= 2 : opt_.cube_cells > 0);
