@@ -126,6 +126,26 @@ void add_run_options(CLI::App& app, cf::tools::GenerateArgs& gen, std::string& s
     added.push_back(o);
 }
 
+// The decision's options (docs/generator.md, "What the search could not decide"), added to
+// `added`.
+void add_decision_options(CLI::App& app, cf::tools::GenerateArgs& gen,
+                          std::vector<CLI::Option*>& added) {
+  added.push_back(
+      app.add_option("--cube-cells", gen.cube_cells,
+                     "cells of rotation space each orbit of failed candidates without an f-f PC "
+                     "may take to be refuted (docs/generator.md, \"Refuting a set over cells of "
+                     "poses\"; 0: not searched)")
+          ->check(CLI::Range(std::size_t{0}, std::size_t{10000000}))
+          ->capture_default_str());
+  added.push_back(
+      app.add_option("--resolution", gen.resolution,
+                     "rad, and in units of D in translation: the decision's cells of poses are not "
+                     "split below it, and a set left with such a cell open is undecided "
+                     "(docs/generator.md, \"What the search could not decide\")")
+          ->check(cf::cli::finite_range(1e-9, 0.1))
+          ->capture_default_str());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -177,20 +197,7 @@ int main(int argc, char** argv) {
              "found under the models' symmetries: the most complete graph, at --no-symmetry's cost")
           ->excludes(no_sym_opt));
   add_search_options(app, gen, gen_opts);
-  gen_opts.push_back(
-      app.add_option("--cube-cells", gen.cube_cells,
-                     "cells of rotation space each orbit of failed candidates without an f-f PC "
-                     "may take to be refuted (docs/generator.md, \"Refuting a set over cells of "
-                     "poses\"; 0: not searched)")
-          ->check(CLI::Range(std::size_t{0}, std::size_t{10000000}))
-          ->capture_default_str());
-  gen_opts.push_back(
-      app.add_option("--resolution", gen.resolution,
-                     "rad, and in units of D in translation: the decision's cells of poses are not "
-                     "split below it, and a set left with such a cell open is undecided "
-                     "(docs/generator.md, \"What the search could not decide\")")
-          ->check(cf::cli::finite_range(1e-9, 0.1))
-          ->capture_default_str());
+  add_decision_options(app, gen, gen_opts);
   app.add_option("--coplanar-tol", coplanar_tol,
                  "coplanarity tolerance relative to the model's bounding-box diagonal")
       ->check(cf::cli::finite_range(cf::tools::kMinCoplanarTol, cf::tools::kMaxCoplanarTol));
