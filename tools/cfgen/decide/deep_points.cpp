@@ -25,10 +25,6 @@ std::vector<Vec3> boundary_points(const ModelInfo& info) {
   return out;
 }
 
-bool in_box(const Vec3& p, const Vec3& lo, const Vec3& hi) {
-  return (p.array() > lo.array()).all() && (p.array() < hi.array()).all();
-}
-
 // mm: p's distance to face f's closed polygon.
 double face_distance(const Polyhedron& m, std::size_t f, const Vec3& p) {
   const Face& F = m.faces()[f];
@@ -56,12 +52,7 @@ double depth_beyond(const Polyhedron& m, const Vec3& p, double need) {
 
 }  // namespace
 
-double depth_inside(const Polyhedron& m, const Vec3& p) {
-  if (!in_box(p, m.bbox_min(), m.bbox_max()) || !point_inside(m, p, 0.0)) return 0;
-  double d = HUGE_VAL;
-  for (std::size_t f = 0; f < m.num_faces(); ++f) d = std::min(d, face_distance(m, f, p));
-  return d;
-}
+double depth_inside(const Polyhedron& m, const Vec3& p) { return depth_beyond(m, p, 0); }
 
 DeepPoints::DeepPoints(const ModelInfo& a, const ModelInfo& b)
     : A_(a), B_(b), a_points_(boundary_points(a)), b_points_(boundary_points(b)) {}
