@@ -1,9 +1,11 @@
 // Catch2: the certificate checker (certificate_check.hpp) on hand-made graphs and
 // certificates with known answers: a 10 mm cube A = [0,10]^3 against an L-block B (the profile
 // (0,0) (30,0) (30,10) (10,10) (10,20) (0,20) in x-y, extruded over z in [0,30]; up is +y).
-// Each claim is accepted as written and rejected after the change that must flip it.
+// Each claim is accepted as written and rejected after the change that must flip it. The rule
+// mirror-corners is tested on data/models' 30 mm cube and L-block and on prisms made here.
 
 #include "certificate_check.hpp"
+#include "shapes.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -233,6 +235,81 @@ json tower_top_one_piece() {
                     {{{0, 0}, {30, 0}, {30, 10}, {0, 10}}}, {{true, true, true, true}});
 }
 
+// ---- mirror-corners: the cube and L-block of data/models ----
+
+json mesh_model(const Mesh& m) {
+  json j;
+  for (const Vec3& p : m.V) j["vertices"].push_back({p.x(), p.y(), p.z()});
+  j["faces"] = json::array();
+  for (const auto& f : m.F) j["faces"].push_back({{"loops", {f}}});
+  return j;
+}
+
+// data/models/<file> (each facet one face), each vertex at `move` of its place when given.
+json off_model(const std::string& file, const std::function<Vec3(const Vec3&)>& move = {}) {
+  Mesh m = read_off(std::string(CF_SOURCE_DIR) + "/data/models/" + file);
+  if (move)
+    for (Vec3& p : m.V) p = move(p);
+  return mesh_model(m);
+}
+
+// The polygon `profile` (counter-clockwise in x-y) extruded over z in [0, depth]: faces 0 the
+// bottom cap, 1 the top cap, then the sides.
+json prism_model(const std::vector<Vec2>& profile, double depth) {
+  Mesh m;
+  const int n = static_cast<int>(profile.size());
+  for (double z : {0.0, depth})
+    for (const Vec2& p : profile) m.V.emplace_back(p.x(), p.y(), z);
+  m.F.emplace_back();
+  m.F.emplace_back();
+  for (int i = 0; i < n; ++i) {
+    m.F[0].push_back(n - 1 - i);
+    m.F[1].push_back(n + i);
+    m.F.push_back({i, (i + 1) % n, n + (i + 1) % n, n + i});
+  }
+  return mesh_model(m);
+}
+
+int vertex_at(const Poly& P, const Vec3& x) {
+  for (std::size_t v = 0; v < P.V.size(); ++v)
+    if (P.V[v].p == x) return static_cast<int>(v);
+  FAIL("no vertex at (" << x.transpose() << ") in " << P.name);
+  return -1;
+}
+
+// The edge from vertex v towards `dir`.
+int edge_along(const Poly& P, int v, const Vec3& dir) {
+  for (int e : P.V[v].edges) {
+    const int o = P.E[e].v0 == v ? P.E[e].v1 : P.E[e].v0;
+    if ((P.V[o].p - P.V[v].p).normalized().dot(dir.normalized()) > 1 - 1e-12) return e;
+  }
+  FAIL("no edge of " << P.name << " from vertex " << v << " along (" << dir.transpose() << ")");
+  return -1;
+}
+
+// The rule on the set {e-e:a1:b1; e-e:a2:b2}, pcs_involved {0, 1}.
+CertSetResult mirror_rule(const Pair& P, int a1, int b1, int a2, int b2) {
+  return one(P, rule_set(pcs_of("e-e", a1, b1, "e-e", a2, b2), "mirror-corners", {0, 1}));
+}
+
+// The 30 mm cube (vertices (+-15, +-15, +-15)) against the L-block, whose reflex corner
+// w = (20, 20, 80) has its rims along +x (on the slab top y = 20) and +y (on the wall x = 20),
+// both on the end face z = 80. v = (15, 15, 15) is a corner of the cube; its edges along -x and
+// -y lie on the top face z = 15. B may be another L-block, its rim `rim_y` in place of +y.
+struct CubeL {
+  Pair P;
+  int v, w, ax, ay, az, bx, by;  // v, w; A's edges from v along -x, -y, -z; B's rims +x, +y
+  explicit CubeL(json B = off_model("l_block.off"), const Vec3& rim_y = Vec3(0, 1, 0))
+      : P(pair_of(off_model("cube.off"), B, 0.01)) {
+    v = vertex_at(P.G.A, Vec3(15, 15, 15));
+    w = vertex_at(P.G.B, Vec3(20, 20, 80));
+    ax = edge_along(P.G.A, v, Vec3(-1, 0, 0));
+    ay = edge_along(P.G.A, v, Vec3(0, -1, 0));
+    az = edge_along(P.G.A, v, Vec3(0, 0, -1));
+    bx = edge_along(P.G.B, w, Vec3(1, 0, 0));
+    by = edge_along(P.G.B, w, rim_y);
+  }
+};
 }  // namespace
 
 TEST_CASE("header: format, version and unreadable files are input errors with their text") {
@@ -388,6 +465,142 @@ TEST_CASE("rule rotational-conditions") {
             .outcome == CertOutcome::Rejected);
   r = one(P, rule_set(pcs_of("e-f", ex, 4, "e-f", ez, 6), "rotational-conditions", {0, 1}));
   CHECK(r.reason == "no f-f among the PCs involved: this rule does not refute sets without one");
+}
+
+TEST_CASE("rule mirror-corners: the cube's corner against the L's reflex corner, mirror order") {
+  CubeL C;
+  // a_1 = -y against b_1 = +x, a_2 = -x against b_2 = +y: det(a_1, a_2, +z) = -1 on the cube's
+  // top face, det(b_1, b_2, +z) = +1 on the L's end face: no pose (mirror_corners_theorem_test).
+  CHECK(mirror_rule(C.P, C.ay, C.bx, C.ax, C.by).outcome == CertOutcome::Accepted);
+  CHECK(mirror_rule(C.P, C.ax, C.by, C.ay, C.bx).outcome == CertOutcome::Accepted);
+  CHECK(one(C.P, rule_set(pcs_of("e-e", C.ax, C.by, "e-e", C.ay, C.bx), "mirror-corners", {1, 0}))
+            .outcome == CertOutcome::Accepted);
+  // Every corner of the cube, every ordered pair of its edges, against both reflex corners of
+  // the L (rims +x, +y): half of the 48 pairs at each are mirror images.
+  for (const double z : {80.0, 0.0}) {
+    const int w = vertex_at(C.P.G.B, Vec3(20, 20, z));
+    const int bx = edge_along(C.P.G.B, w, Vec3(1, 0, 0)),
+              by = edge_along(C.P.G.B, w, Vec3(0, 1, 0));
+    int accepted = 0, handed = 0, pairs = 0;
+    for (const auto& vert : C.P.G.A.V)
+      for (int e1 : vert.edges)
+        for (int e2 : vert.edges) {
+          if (e1 == e2) continue;
+          const CertSetResult r = mirror_rule(C.P, e1, bx, e2, by);
+          ++pairs;
+          accepted += r.outcome == CertOutcome::Accepted;
+          handed += r.reason.find("same handedness (condition 6)") != std::string::npos;
+        }
+    INFO("w at z = " << z);
+    CHECK(pairs == 48);
+    CHECK(accepted == 24);
+    CHECK(handed == 24);
+  }
+}
+
+TEST_CASE("rule mirror-corners: the same-handed order, which has poses, is rejected") {
+  CubeL C;
+  // a_1 = -x against b_1 = +x, a_2 = -y against b_2 = +y: the cube's corner up in the notch
+  // (docs/generator.md, "Two e-e PCs at mirror corners").
+  const CertSetResult r = mirror_rule(C.P, C.ax, C.bx, C.ay, C.by);
+  CHECK(r.outcome == CertOutcome::Rejected);
+  CHECK(r.reason ==
+        "the corners have the same handedness (condition 6): det(a_1, a_2, n(G)) det(b_1, b_2, "
+        "n(F)) > 0");
+}
+
+TEST_CASE("rule mirror-corners: unequal corner angles are rejected") {
+  // The L's wall leans: its inner top corner (20, 80) moved to (30, 80), so the rims at w make
+  // 80.5 degrees (cosine 1/sqrt(37)), the cube's corner 90.
+  const json leaning = off_model("l_block.off", [](const Vec3& p) {
+    return p.x() == 20 && p.y() == 80 ? Vec3(30, 80, p.z()) : p;
+  });
+  CubeL C(leaning, Vec3(10, 60, 0));
+  CHECK(mirror_rule(C.P, C.ay, C.bx, C.ax, C.by).reason ==
+        "the corners' angles differ (condition 5): a_1 . a_2 = 0 but b_1 . b_2 > 0 (90 and "
+        "80.53767779197439 degrees)");
+  // A triangular prism's corner of 53.13 degrees (cosine 3/5) at v = (0, 0, 30), its edges along
+  // +x and (3, 4, 0) on the top face: against the leaning L, both cosines positive, their
+  // squares different.
+  const json prism = prism_model({{0, 0}, {30, 0}, {18, 24}}, 30);
+  const Pair Q = pair_of(prism, leaning, 0.01);
+  const int v = vertex_at(Q.G.A, Vec3(0, 0, 30));
+  const int a1 = edge_along(Q.G.A, v, Vec3(1, 0, 0)), a2 = edge_along(Q.G.A, v, Vec3(3, 4, 0));
+  CHECK(mirror_rule(Q, a1, C.bx, a2, C.by).reason ==
+        "the corners' angles differ (condition 5): (a_1 . a_2)^2 |b_1|^2 |b_2|^2 != (b_1 . b_2)^2 "
+        "|a_1|^2 |a_2|^2 (53.13010235415598 and 80.53767779197439 degrees)");
+  // Equal squares, opposite signs: against a slanted L whose notch at w = (40, 20, 80) is
+  // 126.87 degrees (cosine -3/5).
+  const Pair S = pair_of(
+      prism, prism_model({{-60, 0}, {120, 0}, {120, 20}, {40, 20}, {-5, 80}, {-25, 80}}, 80), 0.01);
+  const int w = vertex_at(S.G.B, Vec3(40, 20, 80));
+  const int b1 = edge_along(S.G.B, w, Vec3(1, 0, 0)), b2 = edge_along(S.G.B, w, Vec3(-3, 4, 0));
+  CHECK(mirror_rule(S, a1, b1, a2, b2).reason ==
+        "the corners' angles differ (condition 5): a_1 . a_2 > 0 but b_1 . b_2 < 0 "
+        "(53.13010235415598 and 126.86989764584402 degrees)");
+  // The prism's vertical edge at v instead of (3, 4, 0): its dihedral angle is 53.13 degrees.
+  const int az = edge_along(S.G.A, v, Vec3(0, 0, -1));
+  CHECK(mirror_rule(S, a1, b1, az, b2).reason ==
+        "the dihedral angle at a_2 (edge " + std::to_string(az) +
+            " of A) is below 90 degrees (condition 4): n(G) . n(G_2) < 0");
+}
+
+TEST_CASE("rule mirror-corners: a convex w, a reflex edge and a reflex v are rejected") {
+  CubeL C;
+  // The L's convex corner (120, 20, 80): rims along -x and -y on the end face.
+  const int w = vertex_at(C.P.G.B, Vec3(120, 20, 80));
+  const int b1 = edge_along(C.P.G.B, w, Vec3(-1, 0, 0)),
+            b2 = edge_along(C.P.G.B, w, Vec3(0, -1, 0));
+  CHECK(mirror_rule(C.P, C.ay, b1, C.ax, b2).reason ==
+        "w (vertex " + std::to_string(w) +
+            " of B) is not a saddle (condition 3): n(F_1) . b_2 < 0");
+  CHECK(mirror_rule(C.P, C.ax, b1, C.ay, b2).reason ==
+        "w (vertex " + std::to_string(w) +
+            " of B) is not a saddle (condition 3): n(F_1) . b_2 < 0");
+  // The L's reflex edge from w down (-z), with the rim +x on the slab top (their common face).
+  const int br = edge_along(C.P.G.B, C.w, Vec3(0, 0, -1));
+  CHECK(mirror_rule(C.P, C.ay, C.bx, C.az, br).reason ==
+        "b_2 (edge " + std::to_string(br) +
+            " of B) is not convex (condition 1): (n(L) x n(R)) . d < 0");
+  // The roles swapped: the L moves (its reflex corner as v), the cube is fixed.
+  const Pair S = pair_of(off_model("l_block.off"), off_model("cube.off"), 0.01);
+  const int v = vertex_at(S.G.A, Vec3(20, 20, 80));
+  const int wc = vertex_at(S.G.B, Vec3(15, 15, 15));
+  CHECK(mirror_rule(S, edge_along(S.G.A, v, Vec3(1, 0, 0)), edge_along(S.G.B, wc, Vec3(0, -1, 0)),
+                    edge_along(S.G.A, v, Vec3(0, 1, 0)), edge_along(S.G.B, wc, Vec3(-1, 0, 0)))
+            .reason ==
+        "v (vertex " + std::to_string(v) + " of A) is not convex (condition 2): n(G_1) . a_2 > 0");
+}
+
+TEST_CASE("rule mirror-corners: non-planar faces and malformed claims are rejected") {
+  // The L's end face z = 80 bent by 1e-7 mm at (0, 0, 80): far inside the oracle's planarity
+  // tolerance (1e-6 of the diagonal), but not exactly planar.
+  CubeL C(off_model("l_block.off",
+                    [](const Vec3& p) { return p == Vec3(0, 0, 80) ? Vec3(0, 0, 80 + 1e-7) : p; }));
+  int F = -1;
+  for (int f : C.P.G.B.E[C.bx].face)
+    if (C.P.G.B.edge_on_face(C.by, f)) F = f;
+  CHECK_THAT(
+      mirror_rule(C.P, C.ay, C.bx, C.ax, C.by).reason,
+      Catch::StartsWith("face F (face " + std::to_string(F) + " of B) is not planar: vertex "));
+  // Not e-e, no shared vertex, no common face, one edge twice.
+  CubeL D;
+  auto r = one(D.P, rule_set(pcs_of("e-e", D.ay, D.bx, "e-f", D.ax, 1), "mirror-corners", {0, 1}));
+  CHECK(r.reason == "PC e-f:" + std::to_string(D.ax) + ":1 (pcs_involved[1]) is not an e-e");
+  const int far = D.P.G.A.edge_index(vertex_at(D.P.G.A, Vec3(-15, -15, -15)),
+                                     vertex_at(D.P.G.A, Vec3(15, -15, -15)));
+  CHECK(mirror_rule(D.P, D.ay, D.bx, far, D.by).reason == "A's edges " + std::to_string(D.ay) +
+                                                              " and " + std::to_string(far) +
+                                                              " share no end vertex");
+  CHECK(mirror_rule(D.P, D.ay, D.bx, D.ay, D.by).reason ==
+        "the two PCs have the same edge " + std::to_string(D.ay) + " of A");
+  // A pyramid's apex has four edges: opposite ones share no face.
+  const Pair Y =
+      pair_of(mesh_model(make_pyramid(30, 30, 20, 0, 0)), off_model("l_block.off"), 0.01);
+  const int apex = 4, e0 = Y.G.A.edge_index(apex, 0), e2 = Y.G.A.edge_index(apex, 2);
+  CHECK(mirror_rule(Y, e0, D.bx, e2, D.by).reason == "A's edges " + std::to_string(e0) + " and " +
+                                                         std::to_string(e2) +
+                                                         " lie on no common face");
 }
 
 TEST_CASE("finite-rotations is not certified, unknown rules and CFs of the graph are rejected") {

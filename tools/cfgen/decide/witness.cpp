@@ -1,5 +1,6 @@
 #include "cfgen/decide/witness.hpp"
 
+#include "cfgen/decide/mirror_corners.hpp"
 #include "cfgen/decide/rotation_family.hpp"
 #include "cfgen/verify/touch.hpp"
 
@@ -43,6 +44,8 @@ const char* rule_name(Rule rule) {
       return "rotational-conditions";
     case Rule::kFiniteRotations:
       return "finite-rotations";
+    case Rule::kMirrorCorners:
+      return "mirror-corners";
   }
   return "";
 }
@@ -196,6 +199,9 @@ std::vector<int> WitnessSearch::piece_slots(const PcSet& pcs) const {
 
 RuleVerdict WitnessSearch::refuted_by(const PcSet& pcs) const {
   if (const RuleVerdict v = implausible_by(pcs); v.rule != Rule::kNone) return v;
+  for (int i = 0; i < pcs.size(); ++i)
+    for (int j = i + 1; j < pcs.size(); ++j)
+      if (mirror_corners(*A_.model, *B_.model, pcs[i], pcs[j])) return {Rule::kMirrorCorners, i, j};
   const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
   if (c.align.empty()) return {};  // a continuous family of rotations: not decided here
   bool finite = false;

@@ -41,6 +41,7 @@ enum class Rule {
   kHeightsOverFf,         // another PC's elements cannot meet at one height over an f-f
   kRotationalConditions,  // no rotation meets the rotational conditions
   kFiniteRotations,       // finitely many rotations, none with room for the contacts
+  kMirrorCorners,         // two e-e PCs at mirror corners (mirror_corners.hpp)
 };
 
 /// The rule's name in the certificate file: "vertex-in-two-pcs", ... ("" for kNone).
