@@ -312,3 +312,60 @@ TEST_CASE(
     CHECK_FALSE(pc.forced_normal_fails(Pc{PcType::kEF, a1, bottom}, Pc{PcType::kEE, a2, ridge}));
   }
 }
+
+namespace {
+
+// The edge of m from p0 to p1 (either way round), or -1.
+int edge_at(const Polyhedron& m, const Vec3& p0, const Vec3& p1) {
+  for (std::size_t e = 0; e < m.num_edges(); ++e) {
+    const Vec3 &q0 = m.edge_point(cf::EdgeId(static_cast<int>(e)), 0),
+               &q1 = m.edge_point(cf::EdgeId(static_cast<int>(e)), 1);
+    if ((q0 == p0 && q1 == p1) || (q0 == p1 && q1 == p0)) return static_cast<int>(e);
+  }
+  return -1;
+}
+
+}  // namespace
+
+TEST_CASE("two e-e PCs on parallel edges of both models need parallel or opposite normals") {
+  // Each e-e's normal is perpendicular to both of its edges: with A's two edges parallel and
+  // B's two parallel, the two normals are parallel or opposite at every rotation.
+  const double cone_margin = std::asin(0.5 * std::sin(1e-3)) - kAngleTol;  // verify's slack
+  {
+    // The peg's end-face edges along x at z = -10 and z = 10 across the hole's rims along x at
+    // z = 28 and z = 52 (y = 0). B's normal cones run from -y towards +z and from -y towards
+    // -z: shrunk by the slack they hold no common direction and no opposite pair.
+    const Pair p(cf::tools::load_model(model("peg.off")),
+                 cf::tools::load_model(model("hole_block.off")));
+    const int a1 = edge_at(p.A, Vec3(-10, -30, -10), Vec3(10, -30, -10));
+    const int a2 = edge_at(p.A, Vec3(-10, -30, 10), Vec3(10, -30, 10));
+    const int b1 = edge_at(p.B, Vec3(28, 0, 28), Vec3(52, 0, 28));
+    const int b2 = edge_at(p.B, Vec3(28, 0, 52), Vec3(52, 0, 52));
+    REQUIRE(std::min({a1, a2, b1, b2}) >= 0);
+    const cf::gen::PairConditions pc(p.ai, p.bi, kLengthTol, kAngleTol, cone_margin);
+    const Pc x{PcType::kEE, a1, b1}, y{PcType::kEE, a2, b2};
+    CHECK(pc.parallel_normals_fail(x, y));
+    CHECK(pc.parallel_normals_fail(y, x));
+    CHECK_FALSE(pc.compatible(x, y));
+    // Only pairs of e-e PCs are judged so.
+    CHECK_FALSE(pc.parallel_normals_fail(
+        Pc{PcType::kEE, a1, b1},
+        Pc{PcType::kVF, 0, cf::test::face_with_plane(p.B, Vec3(0, -1, 0), 0)}));
+  }
+  {
+    // The cube's edges along z at (15, 15) and (-15, -15), cones from +x to +y and from -x to
+    // -y, against the L-block's at (0, 0) and (120, 20), cones from -x to -y and from +x to
+    // +y: opposite normals (a diagonal and its opposite) lie inside all four.
+    const Pair p(cf::tools::load_model(model("cube.off")),
+                 cf::tools::load_model(model("l_block.off")));
+    const int a1 = edge_at(p.A, Vec3(15, 15, -15), Vec3(15, 15, 15));
+    const int a2 = edge_at(p.A, Vec3(-15, -15, -15), Vec3(-15, -15, 15));
+    const int b1 = edge_at(p.B, Vec3(0, 0, 0), Vec3(0, 0, 80));
+    const int b2 = edge_at(p.B, Vec3(120, 20, 0), Vec3(120, 20, 80));
+    REQUIRE(std::min({a1, a2, b1, b2}) >= 0);
+    const cf::gen::PairConditions pc(p.ai, p.bi, kLengthTol, kAngleTol, cone_margin);
+    CHECK_FALSE(pc.parallel_normals_fail(Pc{PcType::kEE, a1, b1}, Pc{PcType::kEE, a2, b2}));
+    // The other assignment asks the same angle of each model: it passes too.
+    CHECK_FALSE(pc.parallel_normals_fail(Pc{PcType::kEE, a1, b2}, Pc{PcType::kEE, a2, b1}));
+  }
+}

@@ -348,6 +348,23 @@ const NormalCone& PairConditions::cone(bool of_a, ElementKind k, int i) const {
   return (of_a ? a_ : b_).cones[static_cast<int>(k)][static_cast<std::size_t>(i)];
 }
 
+bool PairConditions::parallel_normals_fail(const Pc& x, const Pc& y) const {
+  if (x.type != PcType::kEE || y.type != PcType::kEE || slack_ <= 0) return false;
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  if (A.edges()[x.a].dir.cross(A.edges()[y.a].dir).norm() > kParallel ||
+      B.edges()[x.b].dir.cross(B.edges()[y.b].dir).norm() > kParallel)
+    return false;
+  // Each normal is its edges' cross product over its length, at least the slack at a
+  // witness: edges kParallel from parallel on each side turn the two normals at most
+  // 2 (2 kParallel) / slack from parallel.
+  const double off = 4 * kParallel / slack_ + 2 * angle_tol_;
+  const Allowed& a = a_.at(ElementKind::kEdge, x.a, ElementKind::kEdge, y.a);
+  const Allowed& b = b_.at(ElementKind::kEdge, x.b, ElementKind::kEdge, y.b);
+  const double lo = std::max(a.angle_lo, b.angle_lo), hi = std::min(a.angle_hi, b.angle_hi);
+  return lo > off && hi < M_PI - off;
+}
+
 bool PairConditions::compatible(const Pc& x, const Pc& y) const {
   const ElementKind kax = a_kind(x.type), kay = a_kind(y.type), kbx = b_kind(x.type),
                     kby = b_kind(y.type);
@@ -371,7 +388,7 @@ bool PairConditions::compatible(const Pc& x, const Pc& y) const {
   };
   // Last, a normal the rotation cannot choose: a few products, where the above are look-ups.
   return heights_meet(a, b) && heights_meet(a_.at(kay, y.a, kax, x.a), b_.at(kby, y.b, kbx, x.b)) &&
-         !forced_normal_fails(x, y) && !forced_normal_fails(y, x);
+         !forced_normal_fails(x, y) && !forced_normal_fails(y, x) && !parallel_normals_fail(x, y);
 }
 
 }  // namespace cf::gen

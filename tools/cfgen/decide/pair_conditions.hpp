@@ -61,6 +61,12 @@ class PairConditions {
   /// direction.
   bool forced_normal_fails(const Pc& x, const Pc& e) const;
 
+  /// True when x and y are e-e PCs whose edges of A are parallel and whose edges of B are
+  /// parallel (within kParallel), so that their contact normals, each perpendicular to both
+  /// of its edges, are parallel or opposite, and neither angle (0 or pi, within what the
+  /// edges' residuals over verify's slack allow) is one both models' cones allow.
+  bool parallel_normals_fail(const Pc& x, const Pc& y) const;
+
   /// Edges within this sine of parallel, or of perpendicular to a normal, in forced_normal_fails.
   static constexpr double kParallel = 1e-9;
 
