@@ -5,6 +5,7 @@
 // mirror-corners is tested on data/models' 30 mm cube and L-block and on prisms made here.
 
 #include "certificate_check.hpp"
+#include "poly_lookup.hpp"
 #include "shapes.hpp"
 
 #include <catch2/catch.hpp>
@@ -23,6 +24,8 @@
 
 using namespace oracle;
 using json = nlohmann::json;
+using oracle::test::edge_along;
+using oracle::test::vertex_at;
 
 namespace {
 
@@ -268,23 +271,6 @@ json prism_model(const std::vector<Vec2>& profile, double depth) {
     m.F.push_back({i, (i + 1) % n, n + (i + 1) % n, n + i});
   }
   return mesh_model(m);
-}
-
-int vertex_at(const Poly& P, const Vec3& x) {
-  for (std::size_t v = 0; v < P.V.size(); ++v)
-    if (P.V[v].p == x) return static_cast<int>(v);
-  FAIL("no vertex at (" << x.transpose() << ") in " << P.name);
-  return -1;
-}
-
-// The edge from vertex v towards `dir`.
-int edge_along(const Poly& P, int v, const Vec3& dir) {
-  for (int e : P.V[v].edges) {
-    const int o = P.E[e].v0 == v ? P.E[e].v1 : P.E[e].v0;
-    if ((P.V[o].p - P.V[v].p).normalized().dot(dir.normalized()) > 1 - 1e-12) return e;
-  }
-  FAIL("no edge of " << P.name << " from vertex " << v << " along (" << dir.transpose() << ")");
-  return -1;
 }
 
 // The rule on the set {e-e:a1:b1; e-e:a2:b2}, pcs_involved {0, 1}.

@@ -17,6 +17,7 @@
 // at least 90 degrees) the mirror order has poses.
 
 #include "certificate_check.hpp"
+#include "poly_lookup.hpp"
 #include "shapes.hpp"
 
 #include <catch2/catch.hpp>
@@ -30,6 +31,8 @@
 
 using namespace oracle;
 using json = nlohmann::json;
+using oracle::test::edge_along;
+using oracle::test::vertex_at;
 
 namespace {
 
@@ -64,22 +67,6 @@ Poly off_poly(const std::string& file, const std::function<Vec3(const Vec3&)>& m
   if (move)
     for (Vec3& p : m.V) p = move(p);
   return mesh_poly(m);
-}
-
-int vertex_at(const Poly& P, const Vec3& x) {
-  for (std::size_t v = 0; v < P.V.size(); ++v)
-    if (P.V[v].p == x) return static_cast<int>(v);
-  FAIL("no vertex at (" << x.transpose() << ") in " << P.name);
-  return -1;
-}
-
-int edge_along(const Poly& P, int v, const Vec3& dir) {
-  for (int e : P.V[v].edges) {
-    const int o = P.E[e].v0 == v ? P.E[e].v1 : P.E[e].v0;
-    if ((P.V[o].p - P.V[v].p).normalized().dot(dir.normalized()) > 1 - 1e-12) return e;
-  }
-  FAIL("no edge of " << P.name << " from vertex " << v << " along (" << dir.transpose() << ")");
-  return -1;
 }
 
 // One solid's side of the two contacts: from the corner, the unit direction of edge k and the
