@@ -14,6 +14,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -347,6 +349,23 @@ TEST_CASE("two e-e PCs on parallel edges of both models need parallel or opposit
     CHECK(pc.parallel_normals_fail(x, y));
     CHECK(pc.parallel_normals_fail(y, x));
     CHECK_FALSE(pc.compatible(x, y));
+    // The same pair on both models moved by generic motions (coordinates rounded, edges
+    // parallel only to about 1e-16): still rejected, as the rule allows 1e-9.
+    const Eigen::Matrix3d Ra =
+        Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+    const Eigen::Matrix3d Rb =
+        Eigen::AngleAxisd(-1.3, Vec3(-2, 0.5, 1).normalized()).toRotationMatrix();
+    auto move = [](const Polyhedron& m, const Eigen::Matrix3d& R, const Vec3& t) {
+      std::vector<Vec3> v;
+      for (const cf::Vertex& x : m.vertices()) v.push_back(R * x.p + t);
+      return m.with_vertices(v);
+    };
+    const Vec3 ta(3.1, -7.7, 0.3), tb(-40.2, 11.9, 5.5);
+    const Pair q(move(p.A, Ra, ta), move(p.B, Rb, tb));
+    const cf::gen::PairConditions qc(q.ai, q.bi, kLengthTol, kAngleTol, cone_margin);
+    // Moving keeps the elements' indices.
+    REQUIRE(q.A.edge_point(cf::EdgeId(a1), 0) == Ra * p.A.edge_point(cf::EdgeId(a1), 0) + ta);
+    CHECK(qc.parallel_normals_fail(x, y));
     // Only pairs of e-e PCs are judged so.
     CHECK_FALSE(pc.parallel_normals_fail(
         Pc{PcType::kEE, a1, b1},
