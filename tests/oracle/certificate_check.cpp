@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -359,52 +360,34 @@ std::string rotational(const Graph& g, const std::vector<SetPc>& pcs, const json
   return "";
 }
 
-// ---- mirror-corners: two e-e PCs at mirror-image corners (exact) ----
+// ---- mirror-corners: two e-e PCs at nearly mirror-image corners (robust, in doubles) ----
 
-// Exact vectors on the graph's coordinates (the doubles read from the file; each is a rational,
-// and sums, products and comparisons of rationals are exact, so each condition's sign is the
-// true one for the solids those doubles describe).
-using Q3 = std::array<Rational, 3>;
+// Every quantity below is a product of the checker's unit vectors (edge directions, Newell
+// face normals), computed in double: its error is a few ulps, far below kUnitEval. Condition 1
+// must hold by more than kUnitEval. Condition 7 bounds each face normal's tilt off the corner's
+// edges on that face by kMirrorTilt (t = 1e-9, + kUnitEval); such a tilt turns an edge's cone
+// by at most about 2 t, so conditions 2, 3 and 6 must hold by more than kMirrorMargin = 4 t
+// (+ kUnitEval), and 4 and 5 are evaluated with x raised by 4 t: a bound holds with kUnitEval
+// added to its left side, and the threshold T is taken below its computed value.
+constexpr double kMirrorTilt = 1e-9;
+constexpr double kMirrorMargin = 4 * kMirrorTilt;
 
-Q3 exact(const Vec3& x) { return {Rational(x.x()), Rational(x.y()), Rational(x.z())}; }
-Q3 qsub(const Q3& a, const Q3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Q3 qcross(const Q3& a, const Q3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-Rational qdot(const Q3& a, const Q3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Rational qdet(const Q3& a, const Q3& b, const Q3& c) { return qdot(qcross(a, b), c); }
-std::string sign_text(const Rational& x) { return x > 0 ? "> 0" : x < 0 ? "< 0" : "= 0"; }
-
-// Newell's sum over every loop of face f, exactly. The face must be exactly planar (every
-// vertex on the plane through its first vertex with that normal): then the sum is twice the
-// face's area times its outward unit normal, so its signs are the normal's. "" or why not.
-std::string exact_normal(const Poly& P, char solid, int f, const std::string& label, Q3* n) {
-  Q3 s = {Rational(0), Rational(0), Rational(0)};
-  for (const auto& L : P.F[f].loops)
-    for (std::size_t i = 0; i < L.size(); ++i) {
-      const Q3 c = qcross(exact(P.V[L[i]].p), exact(P.V[L[(i + 1) % L.size()]].p));
-      for (int k = 0; k < 3; ++k) s[k] += c[k];
-    }
-  const std::string name = label + " (face " + std::to_string(f) + " of " + solid + ")";
-  if (s[0] == 0 && s[1] == 0 && s[2] == 0) return name + " has a zero Newell normal";
-  const Rational d = qdot(s, exact(P.V[P.F[f].loops[0][0]].p));
-  for (int v : P.F[f].verts)
-    if (qdot(s, exact(P.V[v].p)) != d)
-      return name + " is not planar: vertex " + std::to_string(v) +
-             " is off the plane of its Newell normal";
-  *n = s;
-  return "";
+// Short text of a measured value (3 significant digits).
+std::string sci(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
 }
 
 // One solid's corner: the shared end `vertex` (v or w) of the two PCs' edges, their common
-// face (G or F), each edge's other face (G_k or F_k), the vectors a_k (b_k) from the vertex
-// along edge k and the exact normals.
-struct ExactCorner {
+// face (G or F), each edge's other face (G_k or F_k), the unit vectors a_k (b_k) from the
+// vertex along edge k and the faces' outward unit normals.
+struct MirrorCorner {
   char solid = 'A';
   std::string v, f, e;  // "v", "G", "a" on A; "w", "F", "b" on B
   int vertex = -1, face = -1;
   int edge[2] = {-1, -1}, other[2] = {-1, -1};
-  Q3 d[2], n, nk[2];
+  Vec3 d[2], n, nk[2];
   std::string edge_name(int k) const {
     return e + "_" + std::to_string(k + 1) + " (edge " + std::to_string(edge[k]) + " of " + solid +
            ")";
@@ -412,11 +395,12 @@ struct ExactCorner {
   std::string vertex_name() const {
     return v + " (vertex " + std::to_string(vertex) + " of " + solid + ")";
   }
+  std::string face_k(int k) const { return f + "_" + std::to_string(k + 1); }
 };
 
-// The structure the rule needs: two edges with one shared end and exactly one common face,
-// the three faces planar. "" and *c filled, else why not.
-std::string exact_corner(const Poly& P, char solid, int e1, int e2, ExactCorner* c) {
+// The structure the rule needs: two edges with one shared end and exactly one common face.
+// "" and *c filled, else why not.
+std::string mirror_corner(const Poly& P, char solid, int e1, int e2, MirrorCorner* c) {
   const std::string who =
       std::string(1, solid) + "'s edges " + std::to_string(e1) + " and " + std::to_string(e2);
   if (e1 == e2) return "the two PCs have the same edge " + std::to_string(e1) + " of " + solid;
@@ -431,106 +415,139 @@ std::string exact_corner(const Poly& P, char solid, int e1, int e2, ExactCorner*
       if (f1 == f2) common.push_back(f1);
   if (common.size() != 1)
     return who + (common.empty() ? " lie on no common face" : " lie on two common faces");
-  c->face = common[0];
   const bool a = solid == 'A';
   c->solid = solid;
   c->v = a ? "v" : "w";
   c->f = a ? "G" : "F";
   c->e = a ? "a" : "b";
-  c->edge[0] = e1;
-  c->edge[1] = e2;
-  std::string why = exact_normal(P, solid, c->face, "face " + c->f, &c->n);
+  c->face = common[0];
+  c->n = P.F[c->face].n;
   for (int k = 0; k < 2; ++k) {
-    const Edge& E = P.E[c->edge[k]];
+    const Edge& E = P.E[k == 0 ? e1 : e2];
+    c->edge[k] = k == 0 ? e1 : e2;
     c->other[k] = E.face[0] == c->face ? E.face[1] : E.face[0];
-    const int end = E.v0 == c->vertex ? E.v1 : E.v0;
-    c->d[k] = qsub(exact(P.V[end].p), exact(P.V[c->vertex].p));
-    if (why.empty())
-      why = exact_normal(P, solid, c->other[k], "face " + c->f + "_" + std::to_string(k + 1),
-                         &c->nk[k]);
+    c->nk[k] = P.F[c->other[k]].n;
+    c->d[k] = E.v0 == c->vertex ? E.dir : Vec3(-E.dir);
   }
-  return why;
+  return "";
 }
 
 // (1): each edge convex, (n(L) x n(R)) . d > 0 with L the face whose loop runs the edge along
-// d (face[0] runs it v0 -> v1) and R its other face.
-std::string convex_edges(const Poly& P, const ExactCorner& c) {
+// d (face[0] runs it v0 -> v1, d = dir) and R its other face.
+std::string convex_edges(const Poly& P, const MirrorCorner& c) {
   for (int k = 0; k < 2; ++k) {
     const Edge& E = P.E[c.edge[k]];
-    const Q3& nl = E.face[0] == c.face ? c.n : c.nk[k];
-    const Q3& nr = E.face[0] == c.face ? c.nk[k] : c.n;
-    const Rational s = qdot(qcross(nl, nr), qsub(exact(P.V[E.v1].p), exact(P.V[E.v0].p)));
-    if (!(s > 0))
-      return c.edge_name(k) + " is not convex (condition 1): (n(L) x n(R)) . d " + sign_text(s);
+    const double s = P.F[E.face[0]].n.cross(P.F[E.face[1]].n).dot(E.dir);
+    if (!(s > kUnitEval))
+      return c.edge_name(k) + " is not convex (condition 1): (n(L) x n(R)) . d = " + sci(s) +
+             " (needs > " + sci(kUnitEval) + ")";
   }
   return "";
 }
 
-// (2) on A (sign -1: n(G_1) . a_2 < 0 and n(G_2) . a_1 < 0) and (3) on B (sign +1: the
-// saddle), then (4): n(G) . n(G_k) >= 0.
-std::string corner_kind(const ExactCorner& c, int sign) {
+// (7): every normal the rule uses within kMirrorTilt of perpendicular to the corner's edges on
+// its face, |n(G) . a_k| and |n(G_k) . a_k| (|n(F) . b_k|, |n(F_k) . b_k|) at most t.
+std::string normals_perpendicular(const MirrorCorner& c) {
+  for (int k = 0; k < 2; ++k)
+    for (int other = 0; other < 2; ++other) {
+      const double p = (other ? c.nk[k] : c.n).dot(c.d[k]);
+      if (!(std::abs(p) <= kMirrorTilt + kUnitEval))
+        return "n(" + (other ? c.face_k(k) : c.f) + ") . " + c.e + "_" + std::to_string(k + 1) +
+               " = " + sci(p) +
+               " (condition 7: a face normal more than 1e-9 from perpendicular to the edge)";
+    }
+  return "";
+}
+
+// (2) on A (sign -1: n(G_1) . a_2 < 0 and n(G_2) . a_1 < 0) and (3) on B (sign +1: the saddle),
+// each by more than kMirrorMargin.
+std::string corner_kind(const MirrorCorner& c, int sign) {
   const char* kind =
       sign < 0 ? " is not convex (condition 2): " : " is not a saddle (condition 3): ";
   for (int k = 0; k < 2; ++k) {
-    const Rational s = qdot(c.nk[k], c.d[1 - k]);
-    if (!(sign < 0 ? s < 0 : s > 0))
-      return c.vertex_name() + kind + "n(" + c.f + "_" + std::to_string(k + 1) + ") . " + c.e +
-             "_" + std::to_string(2 - k) + " " + sign_text(s);
-  }
-  for (int k = 0; k < 2; ++k) {
-    const Rational s = qdot(c.n, c.nk[k]);
-    if (s < 0)
-      return "the dihedral angle at " + c.edge_name(k) + " is below 90 degrees (condition 4): n(" +
-             c.f + ") . n(" + c.f + "_" + std::to_string(k + 1) + ") < 0";
+    const double s = c.nk[k].dot(c.d[1 - k]);
+    if (!(sign * s > kMirrorMargin + kUnitEval))
+      return c.vertex_name() + kind + "n(" + c.face_k(k) + ") . " + c.e + "_" +
+             std::to_string(2 - k) + " = " + sci(s) + " (needs " + (sign < 0 ? "< " : "> ") +
+             sci(sign * (kMirrorMargin + kUnitEval)) + ")";
   }
   return "";
 }
 
-double angle_deg(const Q3& x, const Q3& y) {
-  const Vec3 p(to_double(x[0]), to_double(x[1]), to_double(x[2]));
-  const Vec3 q(to_double(y[0]), to_double(y[1]), to_double(y[2]));
-  return std::acos(std::clamp(p.dot(q) / (p.norm() * q.norm()), -1.0, 1.0)) * 180 / kPi;
+// (4): x = max(0, -n(G) . n(G_k), -n(F) . n(F_k)), the sine by which the widest of the four
+// normal cones exceeds pi/2, must be below the slack s, with x raised by kMirrorMargin. "" and
+// *x set (not raised), else why not.
+std::string cone_excess(const MirrorCorner& A, const MirrorCorner& B, double s, double* x) {
+  *x = 0;
+  for (const MirrorCorner* c : {&A, &B})
+    for (int k = 0; k < 2; ++k) {
+      const double xk = -c->n.dot(c->nk[k]);
+      if (!(xk + kMirrorMargin + kUnitEval < s))
+        return "the dihedral angle at " + c->edge_name(k) +
+               " is below 90 degrees by as much as the slack (condition 4): x = -n(" + c->f +
+               ") . n(" + c->face_k(k) + ") = " + sci(xk) +
+               " >= s - 4e-09 = " + sci(s - kMirrorMargin);
+      *x = std::max(*x, xk);
+    }
+  return "";
 }
 
-// (5) equal angles, (a_1 . a_2) |b_1| |b_2| = (b_1 . b_2) |a_1| |a_2|, as equal signs and
-// equal squares; (6) opposite handedness, det(a_1, a_2, n(G)) det(b_1, b_2, n(F)) < 0.
-std::string mirror_image(const ExactCorner& A, const ExactCorner& B) {
-  const Rational ca = qdot(A.d[0], A.d[1]), cb = qdot(B.d[0], B.d[1]);
-  const std::string angles = " (" + fmt(angle_deg(A.d[0], A.d[1])) + " and " +
-                             fmt(angle_deg(B.d[0], B.d[1])) + " degrees)";
-  if ((ca > 0) != (cb > 0) || (ca < 0) != (cb < 0))
-    return "the corners' angles differ (condition 5): a_1 . a_2 " + sign_text(ca) +
-           " but b_1 . b_2 " + sign_text(cb) + angles;
-  const Rational lhs = ca * ca * qdot(B.d[0], B.d[0]) * qdot(B.d[1], B.d[1]);
-  const Rational rhs = cb * cb * qdot(A.d[0], A.d[0]) * qdot(A.d[1], A.d[1]);
-  if (lhs != rhs)
-    return "the corners' angles differ (condition 5): (a_1 . a_2)^2 |b_1|^2 |b_2|^2 != (b_1 . "
-           "b_2)^2 |a_1|^2 |a_2|^2" +
-           angles;
-  const Rational h = qdet(A.d[0], A.d[1], A.n) * qdet(B.d[0], B.d[1], B.n);
-  if (!(h < 0))
+// Theorem R's threshold T = (s/2) E sigma mu2 (docs/certificates.md, "Rules"), from below: x
+// raised by kMirrorMargin (condition 7's allowance) and kUnitEval, each cosine moved by kUnitEval
+// towards a smaller T, kUnitEval taken off E (its subtraction may cancel), and the product's
+// remaining rounding (a few ulps of each factor) covered by the factor 1 - 1e-9.
+double mirror_threshold(double s, double x, double ca, double cb) {
+  const double xe = std::min(1.0, x + kMirrorMargin + kUnitEval);
+  const double E = s * std::sqrt(1 - xe * xe) - xe * std::sqrt(1 - s * s) - kUnitEval;
+  const double cmax = std::max(ca, cb) + kUnitEval;
+  const double cabs = std::max(std::abs(ca), std::abs(cb)) + kUnitEval;
+  const double cneg = std::min({ca, cb, 0.0}) < 0 ? std::min(ca, cb) - kUnitEval : 0.0;
+  const double sigma = std::sqrt(std::max(0.0, 1 - cabs * cabs));
+  const double mu2 = std::min((1 - cmax) / 2, 1 - cneg * cneg);
+  if (!(E > 0 && mu2 > 0)) return 0;
+  return s / 2 * E * sigma * mu2 * (1 - 1e-9);
+}
+
+// (5) nearly equal angles, |c_A - c_B| < T; (6) opposite handedness,
+// det(a_1, a_2, n(G)) det(b_1, b_2, n(F)) < 0 by more than kMirrorMargin.
+std::string mirror_image(const MirrorCorner& A, const MirrorCorner& B, double s, double x) {
+  const double ca = A.d[0].dot(A.d[1]), cb = B.d[0].dot(B.d[1]);
+  const double T = mirror_threshold(s, x, ca, cb), diff = std::abs(ca - cb);
+  if (!(diff + kUnitEval < T))
+    return "the corners' angles differ by more than the tolerance (condition 5): |c_A - c_B| = " +
+           sci(diff) + " >= T = " + sci(T);
+  const double h = A.d[0].cross(A.d[1]).dot(A.n) * B.d[0].cross(B.d[1]).dot(B.n);
+  if (!(h < -(kMirrorMargin + kUnitEval)))
     return "the corners have the same handedness (condition 6): det(a_1, a_2, n(G)) det(b_1, "
-           "b_2, n(F)) " +
-           sign_text(h);
+           "b_2, n(F)) = " +
+           sci(h) + " (needs < " + sci(-(kMirrorMargin + kUnitEval)) + ")";
   return "";
 }
 
-// Two e-e PCs at a convex corner v of A and a saddle corner w of B that are mirror images,
-// every edge's dihedral angle at least 90 degrees: no pose realises both (the theorem behind
-// the rule; docs/certificates.md, "Rules"). Only the conditions are checked here, exactly.
-std::string mirror_corners(const Graph& g, const std::vector<SetPc>& pcs, int i, int j) {
+// Two e-e PCs at a convex corner v of A and a saddle corner w of B that are mirror images to
+// within Theorem R's tolerance, no edge's dihedral angle below 90 degrees by the slack: no
+// pose realises both with local margins of at least the slack (docs/certificates.md, "Rules";
+// the theorem behind the rule). Only the conditions are checked here.
+std::string mirror_corners(const Graph& g, const Tol& tol, const std::vector<SetPc>& pcs, int i,
+                           int j) {
   for (int k : {i, j})
     if (pcs[k].type != PcType::EE)
       return "PC " + pc_text(pcs[k]) + " (pcs_involved[" + std::to_string(k == i ? 0 : 1) +
              "]) is not an e-e";
-  ExactCorner A, B;
-  std::string why = exact_corner(g.A, 'A', pcs[i].a, pcs[j].a, &A);
-  if (why.empty()) why = exact_corner(g.B, 'B', pcs[i].b, pcs[j].b, &B);
+  const double s = tol.slack;
+  if (!(s > 0 && s < 1)) return "local_slack " + fmt(s) + " is not between 0 and 1";
+  MirrorCorner A, B;
+  double x = 0;
+  std::string why = mirror_corner(g.A, 'A', pcs[i].a, pcs[j].a, &A);
+  if (why.empty()) why = mirror_corner(g.B, 'B', pcs[i].b, pcs[j].b, &B);
   if (why.empty()) why = convex_edges(g.A, A);
   if (why.empty()) why = convex_edges(g.B, B);
+  if (why.empty()) why = normals_perpendicular(A);
+  if (why.empty()) why = normals_perpendicular(B);
   if (why.empty()) why = corner_kind(A, -1);
   if (why.empty()) why = corner_kind(B, +1);
-  if (why.empty()) why = mirror_image(A, B);
+  if (why.empty()) why = cone_excess(A, B, s, &x);
+  if (why.empty()) why = mirror_image(A, B, s, x);
   return why;
 }
 
@@ -543,7 +560,7 @@ std::string check_rule(const Ctx& ctx, const std::vector<SetPc>& pcs, const json
   if (rule == "dominated-pc") return dominated(g, pcs, i, j);
   if (rule == "one-contact-plane") return one_plane(g, ctx.tol, pcs, i, j);
   if (rule == "heights-over-ff") return heights(g, ctx.tol, pcs, i, j);
-  if (rule == "mirror-corners") return mirror_corners(g, pcs, i, j);
+  if (rule == "mirror-corners") return mirror_corners(g, ctx.tol, pcs, i, j);
   return "unknown rule \"" + rule + "\"";
 }
 

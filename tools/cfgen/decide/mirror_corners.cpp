@@ -1,33 +1,27 @@
 #include "cfgen/decide/mirror_corners.hpp"
 
-// GCC 12 reports a static zero in cpp_int.hpp as maybe uninitialized (a false positive in
-// Boost's header, not in this file).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <boost/multiprecision/cpp_int.hpp>
-#pragma GCC diagnostic pop
-
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <optional>
 
 namespace cf::gen {
 namespace {
 
-// Exact rationals: a double converts to the rational of exactly its value, so every
-// condition below is decided on the coordinates as the model holds them.
-using Q = boost::multiprecision::cpp_rational;
+// Every quantity below is a product of unit vectors computed in floating point (a few ulps of
+// error); the oracle's checker, which rebuilds the normals its own way, allows 1e-13 on top
+// of the margins below: the generator claims only what it accepts.
+constexpr double kRounding = 1e-12;
+// Condition (7): a face normal at most this far from perpendicular to the corner's edges on
+// its face (a file's rounding leaves ~1e-16). It turns an edge's cone by at most about twice
+// as much, so the sign conditions need 4 kTilt more and the cones' excess x gets 4 kTilt added.
+constexpr double kTilt = 1e-9;
+constexpr double kSign = 4 * kTilt + kRounding;
 
-struct QVec {
-  Q x, y, z;
-};
-QVec exact(const Vec3& p) { return {Q(p.x()), Q(p.y()), Q(p.z())}; }
-QVec operator-(const QVec& a, const QVec& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-QVec operator+(const QVec& a, const QVec& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-Q dot(const QVec& a, const QVec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-QVec cross(const QVec& a, const QVec& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+template <class Id>
+int ix(Id id) {
+  return static_cast<int>(id.index());
 }
-int sign(const Q& q) { return q > 0 ? 1 : q < 0 ? -1 : 0; }
 
 // One model's side of the pair: two edges from a shared vertex v along a common face, and
 // the other face at each edge.
@@ -36,11 +30,6 @@ struct Corner {
   std::array<int, 2> edge{}, other{};
   int face = -1;
 };
-
-template <class Id>
-int ix(Id id) {
-  return static_cast<int>(id.index());
-}
 
 int other_end(const Polyhedron& m, int e, int v) {
   const Edge& E = m.edges()[e];
@@ -64,104 +53,65 @@ std::optional<Corner> corner(const Polyhedron& m, int e1, int e2) {
   return c;
 }
 
-Vec3 leg(const Polyhedron& m, const Corner& c, int k) {
-  return (m.vertices()[other_end(m, c.edge[k], c.v)].p - m.vertices()[c.v].p).normalized();
-}
-
-// The conditions in floating point, each allowed 1e-9 of slack (unit vectors, so a few ulps of
-// rounding at most): a pair that fails one by more cannot pass it exactly.
-bool screen(const Polyhedron& A, const Corner& ca, const Polyhedron& B, const Corner& cb) {
-  constexpr double kSlack = 1e-9;
-  const Vec3 a1 = leg(A, ca, 0), a2 = leg(A, ca, 1), b1 = leg(B, cb, 0), b2 = leg(B, cb, 1);
-  auto n = [](const Polyhedron& m, int f) -> const Vec3& { return m.faces()[f].normal; };
-  const Vec3 &G = n(A, ca.face), &F = n(B, cb.face);
-  return n(A, ca.other[0]).dot(a2) < kSlack && n(A, ca.other[1]).dot(a1) < kSlack &&
-         n(B, cb.other[0]).dot(b2) > -kSlack && n(B, cb.other[1]).dot(b1) > -kSlack &&
-         G.dot(n(A, ca.other[0])) > -kSlack && G.dot(n(A, ca.other[1])) > -kSlack &&
-         F.dot(n(B, cb.other[0])) > -kSlack && F.dot(n(B, cb.other[1])) > -kSlack &&
-         std::abs(a1.dot(a2) - b1.dot(b2)) < kSlack &&
-         a1.cross(a2).dot(G) * b1.cross(b2).dot(F) < kSlack;
-}
-
-// Newell's normal of face f (outward: its loops run counter-clockwise seen from outside),
-// exact; nullopt when a vertex of the face lies off that normal's plane.
-std::optional<QVec> face_normal(const Polyhedron& m, int f) {
-  const Face& F = m.faces()[f];
-  QVec n{0, 0, 0};
-  for (const auto& loop : F.loops)
-    for (std::size_t i = 0; i < loop.size(); ++i)
-      n = n + cross(exact(m.vertices()[loop[i].index()].p),
-                    exact(m.vertices()[loop[(i + 1) % loop.size()].index()].p));
-  const QVec p0 = exact(m.vertices()[F.loops[0][0].index()].p);
-  for (VertexId v : F.vertices)
-    if (sign(dot(n, exact(m.vertices()[v.index()].p) - p0)) != 0) return std::nullopt;
-  return n;
-}
-
-// The corner's exact legs a_1, a_2: from v to the other ends of its edges.
-std::array<QVec, 2> exact_legs(const Polyhedron& m, const Corner& c) {
-  const QVec v = exact(m.vertices()[c.v].p);
-  return {exact(m.vertices()[other_end(m, c.edge[0], c.v)].p) - v,
-          exact(m.vertices()[other_end(m, c.edge[1], c.v)].p) - v};
-}
-
-// Condition (5): the angles between the legs are equal (their cosines' squares and signs).
-bool equal_angles(const std::array<QVec, 2>& a, const std::array<QVec, 2>& b) {
-  const Q ca = dot(a[0], a[1]), cb = dot(b[0], b[1]);
-  return sign(ca) == sign(cb) &&
-         ca * ca * dot(b[0], b[0]) * dot(b[1], b[1]) == cb * cb * dot(a[0], a[0]) * dot(a[1], a[1]);
-}
-
-// The corner's exact vectors: its legs, the common face's normal and the other faces'.
-struct ExactCorner {
-  std::array<QVec, 2> leg;
-  QVec face;
-  std::array<QVec, 2> other;
+// The corner's unit vectors: its legs along the edges from v, the common face's normal and
+// the other faces' normals.
+struct Frame {
+  std::array<Vec3, 2> leg, other;
+  Vec3 face;
 };
 
-// nullopt when a face is not exactly planar or an edge is not convex (condition 1).
-std::optional<ExactCorner> exact_corner(const Polyhedron& m, const Corner& c,
-                                        const std::array<QVec, 2>& legs) {
-  const auto nf = face_normal(m, c.face), n1 = face_normal(m, c.other[0]),
-             n2 = face_normal(m, c.other[1]);
-  if (!nf || !n1 || !n2) return std::nullopt;
-  ExactCorner x{legs, *nf, {*n1, *n2}};
-  for (int k = 0; k < 2; ++k) {
-    // Convex edge: (n(L) x n(R)) . d > 0, d the edge's direction along its left face's loop.
-    const Edge& E = m.edges()[c.edge[k]];
-    const QVec& nl = ix(E.left) == c.face ? x.face : x.other[k];
-    const QVec& nr = ix(E.left) == c.face ? x.other[k] : x.face;
-    const QVec d = exact(m.vertices()[ix(E.v1)].p) - exact(m.vertices()[ix(E.v0)].p);
-    if (sign(dot(cross(nl, nr), d)) <= 0) return std::nullopt;
-  }
-  return x;
+Frame frame(const Polyhedron& m, const Corner& c) {
+  const Vec3& p = m.vertices()[c.v].p;
+  auto leg = [&](int k) { return (m.vertices()[other_end(m, c.edge[k], c.v)].p - p).normalized(); };
+  auto n = [&](int f) { return m.faces()[f].normal; };
+  return {{leg(0), leg(1)}, {n(c.other[0]), n(c.other[1])}, n(c.face)};
 }
 
-// Conditions (2), (3), (4) and (6) of docs/certificates.md, `mirror-corners`, exactly.
-bool mirror(const ExactCorner& a, const ExactCorner& b) {
-  if (!(dot(a.other[0], a.leg[1]) < 0 && dot(a.other[1], a.leg[0]) < 0)) return false;
-  if (!(dot(b.other[0], b.leg[1]) > 0 && dot(b.other[1], b.leg[0]) > 0)) return false;
+// Condition (7): the normals perpendicular to the corner's edges on their faces.
+bool perpendicular(const Frame& c) {
   for (int k = 0; k < 2; ++k)
-    if (dot(a.face, a.other[k]) < 0 || dot(b.face, b.other[k]) < 0) return false;
-  return sign(dot(cross(a.leg[0], a.leg[1]), a.face)) *
-             sign(dot(cross(b.leg[0], b.leg[1]), b.face)) <
-         0;
+    if (std::abs(c.face.dot(c.leg[k])) > kTilt || std::abs(c.other[k].dot(c.leg[k])) > kTilt)
+      return false;
+  return true;
+}
+
+// Conditions (2), (3) and (6) of docs/certificates.md, `mirror-corners`, each by more than
+// kSign: v convex, w a saddle, opposite handedness.
+bool shapes_hold(const Frame& a, const Frame& b) {
+  if (!(a.other[0].dot(a.leg[1]) < -kSign && a.other[1].dot(a.leg[0]) < -kSign)) return false;
+  if (!(b.other[0].dot(b.leg[1]) > kSign && b.other[1].dot(b.leg[0]) > kSign)) return false;
+  const double ha = a.leg[0].cross(a.leg[1]).dot(a.face);
+  const double hb = b.leg[0].cross(b.leg[1]).dot(b.face);
+  return std::abs(ha) > kSign && std::abs(hb) > kSign && ha * hb < 0;
+}
+
+// Conditions (4) and (5): the cones at most the slack wider than pi/2, the angles within the
+// tolerance T of docs/certificates.md (the bound of the theorem with rounded hypotheses).
+bool nearly_congruent(const Frame& a, const Frame& b, double s) {
+  double x = 0;
+  for (int k = 0; k < 2; ++k) x = std::max({x, -a.face.dot(a.other[k]), -b.face.dot(b.other[k])});
+  x += 4 * kTilt + kRounding;
+  if (!(x < s)) return false;
+  const double ca = a.leg[0].dot(a.leg[1]), cb = b.leg[0].dot(b.leg[1]);
+  const double e = s * std::sqrt(1 - x * x) - x * std::sqrt(1 - s * s);
+  const double sigma = std::sqrt(std::max(0.0, 1 - std::max(ca * ca, cb * cb)));
+  const double lo = std::min({ca, cb, 0.0});
+  const double mu2 = std::min((1 - std::max(ca, cb)) / 2, 1 - lo * lo);
+  const double t = 0.5 * s * e * sigma * mu2 * (1 - 1e-9);
+  return std::abs(ca - cb) + kRounding < t;
 }
 
 }  // namespace
 
-bool mirror_corners(const Polyhedron& A, const Polyhedron& B, const Pc& p, const Pc& q) {
-  if (p.type != PcType::kEE || q.type != PcType::kEE) return false;
+bool mirror_corners(const Polyhedron& A, const Polyhedron& B, const Pc& p, const Pc& q,
+                    double slack) {
+  if (p.type != PcType::kEE || q.type != PcType::kEE || !(slack > 0)) return false;
   const auto ca = corner(A, p.a, q.a);
   const auto cb = corner(B, p.b, q.b);
-  if (!ca || !cb || !screen(A, *ca, B, *cb)) return false;
-  // Exact arithmetic from here: the angles first, the cheapest test that the files' rounding
-  // fails (corners of irrational angle, as regular polygons have).
-  const auto la = exact_legs(A, *ca), lb = exact_legs(B, *cb);
-  if (!equal_angles(la, lb)) return false;
-  const auto xa = exact_corner(A, *ca, la);
-  const auto xb = exact_corner(B, *cb, lb);
-  return xa && xb && mirror(*xa, *xb);
+  if (!ca || !cb) return false;
+  const Frame fa = frame(A, *ca), fb = frame(B, *cb);
+  return perpendicular(fa) && perpendicular(fb) && shapes_hold(fa, fb) &&
+         nearly_congruent(fa, fb, slack);
 }
 
 }  // namespace cf::gen

@@ -201,7 +201,8 @@ RuleVerdict WitnessSearch::refuted_by(const PcSet& pcs) const {
   if (const RuleVerdict v = implausible_by(pcs); v.rule != Rule::kNone) return v;
   for (int i = 0; i < pcs.size(); ++i)
     for (int j = i + 1; j < pcs.size(); ++j)
-      if (mirror_corners(*A_.model, *B_.model, pcs[i], pcs[j])) return {Rule::kMirrorCorners, i, j};
+      if (mirror_corners(*A_.model, *B_.model, pcs[i], pcs[j], verified_local_slack()))
+        return {Rule::kMirrorCorners, i, j};
   const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
   if (c.align.empty()) return {};  // a continuous family of rotations: not decided here
   bool finite = false;
