@@ -6,6 +6,7 @@
 // than the theorem's tolerance none.
 
 #include "cfgen/decide/mirror_corners.hpp"
+#include "fixtures.hpp"
 #include "mesh/model_loader.hpp"
 
 #include <cf/graph.hpp>
@@ -22,6 +23,7 @@ using cf::Pc;
 using cf::PcType;
 using cf::Polyhedron;
 using cf::Vec3;
+using cf::test::moved;
 
 namespace {
 
@@ -59,12 +61,6 @@ std::vector<std::array<Pc, 2>> refuted(const Polyhedron& A, const Polyhedron& B)
         if (mirror(A, B, p, q)) out.push_back({p, q});
       }
   return out;
-}
-
-Polyhedron moved(const Polyhedron& m, const Eigen::Matrix3d& R, const Vec3& t) {
-  std::vector<Vec3> v;
-  for (const cf::Vertex& x : m.vertices()) v.push_back(R * x.p + t);
-  return m.with_vertices(v);
 }
 
 }  // namespace

@@ -355,13 +355,8 @@ TEST_CASE("two e-e PCs on parallel edges of both models need parallel or opposit
         Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
     const Eigen::Matrix3d Rb =
         Eigen::AngleAxisd(-1.3, Vec3(-2, 0.5, 1).normalized()).toRotationMatrix();
-    auto move = [](const Polyhedron& m, const Eigen::Matrix3d& R, const Vec3& t) {
-      std::vector<Vec3> v;
-      for (const cf::Vertex& x : m.vertices()) v.push_back(R * x.p + t);
-      return m.with_vertices(v);
-    };
     const Vec3 ta(3.1, -7.7, 0.3), tb(-40.2, 11.9, 5.5);
-    const Pair q(move(p.A, Ra, ta), move(p.B, Rb, tb));
+    const Pair q(cf::test::moved(p.A, Ra, ta), cf::test::moved(p.B, Rb, tb));
     const cf::gen::PairConditions qc(q.ai, q.bi, kLengthTol, kAngleTol, cone_margin);
     // Moving keeps the elements' indices.
     REQUIRE(q.A.edge_point(cf::EdgeId(a1), 0) == Ra * p.A.edge_point(cf::EdgeId(a1), 0) + ta);

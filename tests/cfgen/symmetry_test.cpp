@@ -27,17 +27,13 @@ using cf::Vec3;
 using cf::gen::PairSymmetries;
 using cf::gen::symmetries;
 
+using cf::test::moved;
+
 namespace {
 
 // Vertices of the test models are given to 1e-15 relative; rigid maps and their images are
 // exact to a few ulps of coordinates of tens of mm.
 constexpr double kTol = 1e-9;  // mm
-
-cf::Polyhedron moved(const cf::Polyhedron& m, const Eigen::Matrix3d& R, const Vec3& t) {
-  std::vector<Vec3> v;
-  for (const auto& x : m.vertices()) v.push_back(R * x.p + t);
-  return m.with_vertices(std::move(v));
-}
 
 // The PC sets of an enumeration's CFs, as text.
 std::set<std::string> cf_sets(const cf::gen::Enumeration& e) {

@@ -95,4 +95,11 @@ inline int vertex_at(const Polyhedron& m, const Vec3& x) {
   return -1;
 }
 
+/// m with every vertex moved by x -> R x + t (same elements and numbering).
+inline Polyhedron moved(const Polyhedron& m, const Eigen::Matrix3d& R, const Vec3& t) {
+  std::vector<Vec3> v;
+  for (const auto& x : m.vertices()) v.push_back(R * x.p + t);
+  return m.with_vertices(std::move(v));
+}
+
 }  // namespace cf::test

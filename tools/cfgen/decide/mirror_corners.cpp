@@ -18,11 +18,6 @@ constexpr double kRounding = 1e-12;
 constexpr double kTilt = 1e-9;
 constexpr double kSign = 4 * kTilt + kRounding;
 
-template <class Id>
-int ix(Id id) {
-  return static_cast<int>(id.index());
-}
-
 // One model's side of the pair: two edges from a shared vertex v along a common face, and
 // the other face at each edge.
 struct Corner {
@@ -33,7 +28,7 @@ struct Corner {
 
 int other_end(const Polyhedron& m, int e, int v) {
   const Edge& E = m.edges()[e];
-  return ix(E.v0) == v ? ix(E.v1) : ix(E.v0);
+  return E.v0.value() == v ? E.v1.value() : E.v0.value();
 }
 
 std::optional<Corner> corner(const Polyhedron& m, int e1, int e2) {
@@ -41,15 +36,15 @@ std::optional<Corner> corner(const Polyhedron& m, int e1, int e2) {
   const Edge &E1 = m.edges()[e1], &E2 = m.edges()[e2];
   if (!E1.convex || !E2.convex) return std::nullopt;
   Corner c;
-  for (int v : {ix(E1.v0), ix(E1.v1)})
-    if (v == ix(E2.v0) || v == ix(E2.v1)) c.v = v;
+  for (int v : {E1.v0.value(), E1.v1.value()})
+    if (v == E2.v0.value() || v == E2.v1.value()) c.v = v;
   if (c.v < 0) return std::nullopt;
-  for (int f : {ix(E1.left), ix(E1.right)})
-    if (f == ix(E2.left) || f == ix(E2.right)) c.face = f;
+  for (int f : {E1.left.value(), E1.right.value()})
+    if (f == E2.left.value() || f == E2.right.value()) c.face = f;
   if (c.face < 0) return std::nullopt;
   c.edge = {e1, e2};
-  c.other[0] = ix(E1.left) == c.face ? ix(E1.right) : ix(E1.left);
-  c.other[1] = ix(E2.left) == c.face ? ix(E2.right) : ix(E2.left);
+  c.other[0] = E1.left.value() == c.face ? E1.right.value() : E1.left.value();
+  c.other[1] = E2.left.value() == c.face ? E2.right.value() : E2.left.value();
   return c;
 }
 
