@@ -1,7 +1,8 @@
 // Tests of the one-parameter rotation families the witness search samples
 // (tools/cfgen/decide/rotation_family.cpp): the spins about an axis that keep a set's PCs
-// locally admissible (admissible_spins), and the residual that makes the PCs' planes meet
-// where their normals are dependent (translation_residual).
+// locally admissible (admissible_spins), the residual that makes the PCs' planes meet
+// where their normals are dependent (translation_residual), and the finitely many rotations
+// three perpendicularity conditions leave (perp_roots).
 
 #include "cfgen/decide/rotation_family.hpp"
 #include "analysed_pair.hpp"
@@ -12,8 +13,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
+#include <random>
 #include <vector>
 
 namespace {
@@ -107,7 +110,8 @@ TEST_CASE("admissible spins: the samples' centres where they are admissible, non
 
 TEST_CASE(
     "translation residual: two parallel edges on two parallel faces meet only where the edges' "
-    "height difference is the faces'; independent planes leave no residual",
+    "height difference is the faces', with or without a third PC; independent planes leave no "
+    "residual",
     "[rotation_family][cfgen]") {
   // A 40 x 10 x 10 box turned by theta about z: its edges along z at x = 0 and x = 40 rise
   // 40 sin(theta) apart. On the small L-block's floor top (y = 10) and wall top (y = 40), 30
@@ -141,6 +145,22 @@ TEST_CASE(
     CHECK(std::abs(std::abs(residual(theta)) - std::abs(40 * std::sin(theta) - 30) / std::sqrt(2)) <
           kRounding);
   CHECK((residual(root - 0.01) > 0) != (residual(root + 0.01) > 0));
+  // The two edges alone: their planes are parallel, and meet where the offsets agree; the
+  // residual is the offsets' difference itself.
+  cf::PcSet two;
+  two.insert(cf::Pc{cf::PcType::kEF, e_near, floor_top});
+  two.insert(cf::Pc{cf::PcType::kEF, e_far, wall_top});
+  for (double theta : {0.0, 0.3, root, 1.2}) {
+    const std::optional<double> r = cf::gen::internal::translation_residual(
+        A, B, two, cf::gen::axis_angle(Vec3::UnitZ(), theta));
+    REQUIRE(r.has_value());
+    CHECK(std::abs(std::abs(*r) - std::abs(40 * std::sin(theta) - 30)) < kRounding);
+  }
+  // An edge on the floor's top and a vertex on the wall's side: independent planes.
+  cf::PcSet across;
+  across.insert(cf::Pc{cf::PcType::kEF, e_near, floor_top});
+  across.insert(cf::Pc{cf::PcType::kVF, 3, wall});
+  CHECK(!cf::gen::internal::translation_residual(A, B, across, Mat3::Identity()).has_value());
 
   // Three faces of B at right angles: the planes always meet.
   const int bottom = cf::test::face_with_plane(B, -Vec3::UnitZ(), 0);
@@ -150,4 +170,79 @@ TEST_CASE(
   corner.insert(cf::Pc{cf::PcType::kFF, 5, wall});
   corner.insert(cf::Pc{cf::PcType::kFF, 0, bottom});
   CHECK(!cf::gen::internal::translation_residual(A, B, corner, Mat3::Identity()).has_value());
+}
+
+namespace {
+
+cf::Vec3 unit_in(std::mt19937_64& rng) {
+  std::normal_distribution<double> g;
+  return cf::Vec3(g(rng), g(rng), g(rng)).normalized();
+}
+
+// The largest residual of the three conditions at R.
+double worst(const cf::gen::RotConstraints& c, const Mat3& R) {
+  double r = 0;
+  for (const auto& [u, w] : c.perp) r = std::max(r, std::abs((R * u).dot(w)));
+  return r;
+}
+
+bool listed(const std::vector<Mat3>& roots, const Mat3& R) {
+  constexpr double kSame = 1e-6;  // Frobenius: one root, found two ways
+  return std::any_of(roots.begin(), roots.end(),
+                     [&](const Mat3& Q) { return (Q - R).norm() < kSame; });
+}
+
+}  // namespace
+
+TEST_CASE(
+    "perp roots: every rotation meeting three perpendicularity conditions, whatever rotation a "
+    "projection starts from",
+    "[rotation_family][cfgen]") {
+  std::mt19937_64 rng(11);
+  std::size_t total = 0, projected = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    // Conditions met by a known rotation: u_i random, w_i random across R* u_i.
+    const Mat3 R_star =
+        cf::gen::axis_angle(unit_in(rng), std::uniform_real_distribution<>(0, 3)(rng));
+    cf::gen::RotConstraints c;
+    for (int i = 0; i < 3; ++i) {
+      const Vec3 u = unit_in(rng);
+      c.perp.push_back({u, (R_star * u).cross(unit_in(rng)).normalized()});
+    }
+    const std::optional<std::vector<Mat3>> roots = cf::gen::internal::perp_roots(c);
+    REQUIRE(roots.has_value());
+    CHECK(roots->size() <= 8);      // a resultant of degree 8 in e^(i phi)
+    CHECK(roots->size() % 2 == 0);  // generic roots come in pairs (the torus' degree is even)
+    for (const Mat3& R : *roots) {
+      CHECK(worst(c, R) <= cf::gen::kRotAccepted);
+      CHECK((R.transpose() * R - Mat3::Identity()).norm() < 1e-12);
+      CHECK(R.determinant() > 0);
+    }
+    CHECK(listed(*roots, R_star));
+    total += roots->size();
+    // Every rotation Gauss-Newton reaches from 200 random starts is one of them.
+    for (int s = 0; s < 200; ++s) {
+      Mat3 R = cf::gen::axis_angle(unit_in(rng), std::uniform_real_distribution<>(0, M_PI)(rng));
+      if (!cf::gen::internal::project_perp(c, R)) continue;
+      ++projected;
+      CHECK(listed(*roots, R));
+    }
+  }
+  CHECK(projected > 4000);  // most starts converge
+  CHECK(total >= 80);       // at least the known root and its partner each time
+}
+
+TEST_CASE("perp roots: dependent or missing conditions leave no finite answer",
+          "[rotation_family][cfgen]") {
+  const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ();
+  cf::gen::RotConstraints c;
+  c.perp = {{x, z}, {x, z}, {y, x}};  // the first two the same: a curve of rotations
+  CHECK_FALSE(cf::gen::internal::perp_roots(c).has_value());
+  c.perp = {{x, z}, {y, x}};  // two conditions: a curve
+  CHECK_FALSE(cf::gen::internal::perp_roots(c).has_value());
+  // x, y and z all across z: impossible, a rotation keeps them spanning space.
+  c.perp = {{x, z}, {y, z}, {z, z}};
+  const std::optional<std::vector<Mat3>> none = cf::gen::internal::perp_roots(c);
+  REQUIRE(none.has_value());
+  CHECK(none->empty());
 }

@@ -8,6 +8,7 @@
 #include "analysed_pair.hpp"
 #include "cfgen/enumerate/enumerate.hpp"
 #include "cfgen/generate.hpp"
+#include "fixtures.hpp"
 #include "mesh/model_loader.hpp"
 #include "ngon_models.hpp"
 #include "scratch.hpp"
@@ -79,4 +80,49 @@ TEST_CASE(
   // was measured, so that only a real loss fails.
   CHECK(found * 100 >= tried * 65);
   CHECK(climbed * 100 >= tried * 5);
+}
+
+TEST_CASE(
+    "witness search: a cube wedged across a square hole by two opposite edges on the facing "
+    "walls, where A's width across the walls must be the hole's",
+    "[witness][cfgen]") {
+  // A cube of side 16.8 (a square prism along y) and a block 6.56 thick with a square hole
+  // of side 18.5, both as diamonds in xz. Two diagonally opposite side edges of the cube on two
+  // facing walls: the walls' planes are parallel, so a translation places both edges only
+  // where the cube's width across them is 18.5, a condition on the rotation that random
+  // rotations never meet (translation_residual with two PCs).
+  const double side = 16.8, hole = 18.5;
+  const double r = side / std::sqrt(2.0), r_in = hole / std::sqrt(2.0);
+  const std::string a =
+      cf::test::write_file("wedge_cube.off", cf::test::ngon_off(4, r, 0, 0, side));
+  const std::string b =
+      cf::test::write_file("wedge_hole.off", cf::test::ngon_off(4, 25, r_in, 0, 6.56));
+  cf::test::AnalysedPair p(cf::tools::load_model(a, {}), cf::tools::load_model(b, {}));
+  const cf::gen::SearchParams params = cf::tools::scaled_search(p.A, p.B, {});
+  const cf::gen::WitnessSearch search(p.ai, p.bi, params);
+  auto edge_at = [&](double x, double z) {
+    return cf::test::edge_between(p.A, cf::test::vertex_at(p.A, {x, 0, z}),
+                                  cf::test::vertex_at(p.A, {x, side, z}));
+  };
+  const int e0 = edge_at(r, 0), e2 = edge_at(-r, 0);
+  const cf::Vec3 n = cf::Vec3(1, 0, 1).normalized();
+  const int wall_out = cf::test::face_with_plane(p.B, -n, -r_in / std::sqrt(2.0));
+  const int wall_in = cf::test::face_with_plane(p.B, n, -r_in / std::sqrt(2.0));
+  REQUIRE(e0 >= 0);
+  REQUIRE(e2 >= 0);
+  REQUIRE(wall_out >= 0);
+  REQUIRE(wall_in >= 0);
+  cf::PcSet pcs;
+  pcs.insert(cf::Pc{cf::PcType::kEF, e0, wall_out});
+  pcs.insert(cf::Pc{cf::PcType::kEF, e2, wall_in});
+  const cf::gen::Witness w = search.find(pcs, {});
+  REQUIRE(w.found);
+  CHECK(search.verify(pcs, w.pose) >= params.min_clearance);
+  // The edges' separation across the walls is the hole's width: each edge lies on its wall to
+  // the touch tolerance, and parallel to it to the rotational conditions' 1e-8, which over
+  // the 17 mm edge is under 2e-7 mm.
+  constexpr double kWidthTol = 1e-6;  // mm
+  const cf::Vec3 d = w.pose.R_BA * (p.A.vertices()[p.A.edges()[e0].v0.index()].p -
+                                    p.A.vertices()[p.A.edges()[e2].v0.index()].p);
+  CHECK(std::abs(std::abs(d.dot(n)) - hole) < kWidthTol);
 }

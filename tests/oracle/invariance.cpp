@@ -124,19 +124,44 @@ int count_sound(const Graph& g, const std::vector<CfKey>& only, KeyOf key_of) {
       .sound;
 }
 
+// The inverse of a map from the moved graph's elements to the first's.
+ElementMap inverse(const ElementMap& m) {
+  ElementMap inv;
+  auto flip = [](const std::vector<int>& v) {
+    std::vector<int> w(v.size(), -1);
+    for (std::size_t i = 0; i < v.size(); ++i) w[static_cast<std::size_t>(v[i])] = int(i);
+    return w;
+  };
+  inv.vertex = flip(m.vertex);
+  inv.edge = flip(m.edge);
+  inv.face = flip(m.face);
+  return inv;
+}
+
 // One line per set only one graph holds: "first"/"moved", the set in the first graph's
-// numbering, and its witness in the first files' frames (R row by row, then t), so that a
-// missed CF can be examined against the run that missed it.
+// numbering, and its witness in the first files' frames (R row by row, then t); then after
+// "| moved:" the set in the moved graph's numbering and the witness in the moved files'
+// frames, so that a missed CF can be examined against the run that missed it.
 void write_differences(const std::string& path, const Graph& first, const Graph& moved,
                        const InvarianceResult& r, const ElementMap& ma, const ElementMap& mb,
                        const Pose& XA, const Pose& XB) {
   std::ofstream out(path);
   out.precision(17);
-  auto line = [&](const char* which, const CfKey& key, const Pose& X) {
-    out << which << " " << key_string(key) << " |";
+  const ElementMap ia = inverse(ma), ib = inverse(mb);
+  auto pose = [&](const Pose& X) {
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) out << " " << X.R(i, j);
     for (int i = 0; i < 3; ++i) out << " " << X.t(i);
+  };
+  auto line = [&](const char* which, const CfKey& key, const Pose& X) {
+    out << which << " " << key_string(key) << " |";
+    pose(X);
+    // In the moved frames: x'_B = XB(X(XA^-1(x'_A))).
+    Pose Y;
+    Y.R = XB.R * X.R * XA.R.transpose();
+    Y.t = XB.R * (X.t - X.R * XA.R.transpose() * XA.t) + XB.t;
+    out << " | moved: " << key_string(map_key(key, ia, ib)) << " |";
+    pose(Y);
     out << "\n";
   };
   const std::set<CfKey> only_first(r.only_first.begin(), r.only_first.end());

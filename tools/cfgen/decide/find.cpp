@@ -480,10 +480,10 @@ std::vector<Mat3> FindRun::family_ends() const {
 }
 
 // Where the PCs' planes are dependent at every rotation of the family (translation_residual:
-// two parallel edges of A on two parallel faces of B, and a third PC), the LP is infeasible
-// except on a curve of rotations where the planes meet, which samples never hit. Projects the
-// family's samples onto that curve, walks it from the first locally admissible ones, and
-// returns along each walk the locally admissible rotation that places the contacts deepest,
+// two parallel edges of A on two parallel faces of B, alone or with a third PC), the LP is
+// infeasible except on a curve of rotations where the planes meet, which samples never hit.
+// Projects the family's samples onto that curve, walks it from the first locally admissible ones,
+// and returns along each walk the locally admissible rotation that places the contacts deepest,
 // where that reaches min_margin.
 std::vector<Mat3> FindRun::consistent_rotations(const std::vector<Mat3>& rots) const {
   constexpr std::size_t kStarts = 4;  // projected rotations walked from

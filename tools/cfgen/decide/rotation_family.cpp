@@ -4,10 +4,13 @@
 
 #include <cf/geometry.hpp>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <complex>
 #include <limits>
 
 namespace cf::gen::internal {
@@ -139,6 +142,114 @@ bool project_perp(const RotConstraints& c, Mat3& R) {
   return satisfies(c, R);
 }
 
+namespace {
+
+// The rotations meeting c.perp[0], R = Rot(w1, phi) R0 Rot(u1, psi) with R0 u1 perpendicular
+// to w1 (every such rotation once), and on them the other two conditions, each
+// [1 cos psi sin psi] M [1 cos phi sin phi]^T.
+struct PerpTorus {
+  Vec3 u1, w1;
+  Mat3 R0;
+  Mat3 M[2];
+
+  Mat3 rotation(double phi, double psi) const {
+    return axis_angle(w1, phi) * R0 * axis_angle(u1, psi);
+  }
+  // (C, A, B) of condition k + 1 at phi: it reads A cos psi + B sin psi + C == 0.
+  Vec3 at(int k, double phi) const { return M[k] * Vec3(1, std::cos(phi), std::sin(phi)); }
+};
+
+PerpTorus perp_torus(const RotConstraints& c) {
+  PerpTorus t;
+  t.u1 = c.perp[0].first.normalized();
+  t.w1 = c.perp[0].second.normalized();
+  const Vec3 e = Vec3::Unit(t.w1.cwiseAbs().minCoeff() == std::abs(t.w1.x()) ? 0 : 1);
+  t.R0 = align(t.u1, t.w1.cross(e).normalized());
+  for (int k = 0; k < 2; ++k) {
+    const Vec3 u = c.perp[k + 1].first, w = c.perp[k + 1].second;
+    // Rot(u1, psi) u and Rot(w1, -phi) w, each split into its constant, cos and sin parts.
+    const Vec3 X[3] = {u.dot(t.u1) * t.u1, u - u.dot(t.u1) * t.u1, t.u1.cross(u)};
+    const Vec3 Y[3] = {w.dot(t.w1) * t.w1, w - w.dot(t.w1) * t.w1, -t.w1.cross(w)};
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) t.M[k](a, b) = (t.R0 * X[a]).dot(Y[b]);
+  }
+  return t;
+}
+
+// The two conditions at phi as a linear system in (cos psi, sin psi): its determinant and
+// Cramer's numerators. A common root psi exists where nx^2 + ny^2 == det^2.
+struct PerpCramer {
+  double det, nx, ny;
+};
+PerpCramer perp_cramer(const PerpTorus& t, double phi) {
+  const Vec3 g = t.at(0, phi), h = t.at(1, phi);  // (C, A, B) each
+  return {g[1] * h[2] - h[1] * g[2], h[0] * g[2] - g[0] * h[2], h[1] * g[0] - g[1] * h[0]};
+}
+
+// The real roots phi of a trigonometric polynomial of degree at most 4, given by its values
+// at 16 equally spaced angles: the unit-circle roots of z^4 F (a polynomial of degree 8 in
+// z = e^(i phi)), with a band around the circle so that a nearly double root is kept (the
+// caller polishes each). Nothing when F vanishes identically.
+std::optional<std::vector<double>> trig_roots(const std::array<double, 16>& F) {
+  using C = std::complex<double>;
+  std::array<C, 9> a{};  // a[m]: the coefficient of e^(i (m - 4) phi)
+  double scale = 0;
+  for (int m = 0; m < 9; ++m) {
+    for (int j = 0; j < 16; ++j) a[m] += F[j] * std::polar(1.0 / 16, -(m - 4) * 2 * M_PI * j / 16);
+    scale = std::max(scale, std::abs(a[m]));
+  }
+  if (scale < 1e-12) return std::nullopt;
+  int lo = 0, hi = 8;
+  while (std::abs(a[lo]) <= 1e-13 * scale) ++lo;
+  while (std::abs(a[hi]) <= 1e-13 * scale) --hi;
+  std::vector<double> phis;
+  const int d = hi - lo;
+  if (d == 0) return phis;
+  Eigen::MatrixXcd comp = Eigen::MatrixXcd::Zero(d, d);
+  for (int r = 1; r < d; ++r) comp(r, r - 1) = 1;
+  for (int r = 0; r < d; ++r) comp(r, d - 1) = -a[lo + r] / a[hi];
+  const Eigen::VectorXcd z = Eigen::ComplexEigenSolver<Eigen::MatrixXcd>(comp, false).eigenvalues();
+  for (int r = 0; r < d; ++r)
+    if (std::abs(std::log(std::abs(z[r]))) < 0.05) phis.push_back(std::arg(z[r]));
+  return phis;
+}
+
+}  // namespace
+
+std::optional<std::vector<Mat3>> perp_roots(const RotConstraints& c) {
+  if (!c.align.empty() || c.perp.size() != 3) return std::nullopt;
+  for (const auto& [u, w] : c.perp)
+    if (u.norm() < 1e-12 || w.norm() < 1e-12) return std::nullopt;
+  const PerpTorus t = perp_torus(c);
+  std::array<double, 16> F{};
+  for (int j = 0; j < 16; ++j) {
+    const PerpCramer p = perp_cramer(t, 2 * M_PI * j / 16);
+    F[j] = p.nx * p.nx + p.ny * p.ny - p.det * p.det;
+  }
+  const std::optional<std::vector<double>> phis = trig_roots(F);
+  if (!phis) return std::nullopt;
+  std::vector<Mat3> out;
+  for (double phi : *phis) {
+    std::vector<double> psis;
+    const PerpCramer p = perp_cramer(t, phi);
+    const Vec3 g = t.at(0, phi), h = t.at(1, phi);
+    if (std::abs(p.det) > 1e-6 * g.tail<2>().norm() * h.tail<2>().norm()) {
+      psis.push_back(std::atan2(p.ny / p.det, p.nx / p.det));
+    } else {
+      // The conditions are parallel in (cos psi, sin psi) here: each one's own roots.
+      bool all_g = false, all_h = false;
+      trig_solve(g[1], g[2], -g[0], psis, all_g);
+      trig_solve(h[1], h[2], -h[0], psis, all_h);
+      if (all_g && all_h) return std::nullopt;  // a circle of rotations at this phi
+    }
+    for (double psi : psis) {
+      Mat3 R = t.rotation(phi, psi);
+      if (project_perp(c, R)) add_unique(out, R);
+    }
+  }
+  return out;
+}
+
 // Walks a one-parameter family of rotations (one alignment with its spin free, or two
 // perpendicularity conditions) away from R by steps of about h rad, at most n steps along
 // each branch: the rotations along each branch, R excluded. Where the two conditions'
@@ -234,7 +345,7 @@ std::vector<double> admissible_spins(const ModelInfo& a, const ModelInfo& b, con
 std::optional<double> translation_residual(const Polyhedron& A, const Polyhedron& B,
                                            const PcSet& pcs, const Mat3& R) {
   constexpr double kDependent = 1e-9;  // |det| of unit normals: dependent up to rounding
-  if (pcs.size() != 3) return std::nullopt;
+  if (pcs.size() != 3 && pcs.size() != 2) return std::nullopt;
   Vec3 n[3];
   double h[3];
   int i = 0;
@@ -276,6 +387,10 @@ std::optional<double> translation_residual(const Polyhedron& A, const Polyhedron
       }
     }
     ++i;
+  }
+  if (pcs.size() == 2) {
+    if (n[0].cross(n[1]).norm() > kDependent) return std::nullopt;
+    return h[1] - (n[0].dot(n[1]) > 0 ? h[0] : -h[0]);
   }
   if (std::abs(n[0].cross(n[1]).dot(n[2])) > kDependent) return std::nullopt;
   // The plane of the normals, from the first pair not near parallel: the same pair all along

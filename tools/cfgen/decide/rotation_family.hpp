@@ -25,6 +25,13 @@ void add_unique(std::vector<Mat3>& out, const Mat3& R);
 std::vector<Mat3> align_family(const RotConstraints& c, const std::vector<Mat3>& seeds, int samples,
                                bool* finite_out = nullptr);
 
+/// Every rotation meeting three perpendicularity conditions (c.perp.size() == 3, no
+/// alignment), each to kRotAccepted: at most eight, found from the resultant of the second
+/// and third conditions over the family that meets the first, so that the answer depends on
+/// the conditions alone, not on a starting rotation. Nothing when the conditions leave a
+/// continuum (they are dependent) or are not three perpendicularities.
+std::optional<std::vector<Mat3>> perp_roots(const RotConstraints& c);
+
 /// Gauss-Newton projection of R onto { (R u_i) . w_i == 0 }; false when it does not converge.
 bool project_perp(const RotConstraints& c, Mat3& R);
 
@@ -46,8 +53,11 @@ std::vector<std::vector<Mat3>> walk_family(const RotConstraints& c, const Mat3& 
 /// parallel to both edges. Where three such normals lie in one plane at every rotation of a
 /// family (two PCs on the faces beside an edge of B and an e-e on that edge), the planes meet
 /// only where z . h = 0, z the left null vector of the rows oriented by n_1 x n_2: a condition
-/// on the rotation alone, met at isolated points of the family. Returns z . h (mm) at R, or
-/// nothing when the set has not three PCs or the normals are independent at R.
+/// on the rotation alone, met at isolated points of the family. Two PCs on parallel planes
+/// (two parallel edges of A on the facing walls of a slot) meet only where h_2 = s h_1, s the
+/// sign of n_1 . n_2: A's width across them must be the slot's. Returns z . h (mm) at R, or
+/// h_2 - s h_1 for two PCs; nothing when the set has not two or three PCs or the normals are
+/// independent at R.
 std::optional<double> translation_residual(const Polyhedron& A, const Polyhedron& B,
                                            const PcSet& pcs, const Mat3& R);
 

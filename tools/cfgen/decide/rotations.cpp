@@ -35,6 +35,9 @@ std::vector<Mat3> WitnessSearch::family_samples(const PcSet& pcs, const std::vec
   } else if (!c.perp.empty()) {
     for (Mat3 R : seeds)
       if (project_perp(c, R)) add_unique(rots, R);
+    // Three conditions leave finitely many rotations: all of them, whatever the seeds reach.
+    if (const auto roots = perp_roots(c))
+      for (const Mat3& R : *roots) add_unique(rots, R);
   } else {
     for (const Mat3& R : seeds) add_unique(rots, R);
   }

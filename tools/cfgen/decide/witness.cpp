@@ -197,27 +197,35 @@ std::vector<int> WitnessSearch::piece_slots(const PcSet& pcs) const {
   return slot_sizes;
 }
 
+std::optional<std::vector<Mat3>> WitnessSearch::finite_rotations(const PcSet& pcs) const {
+  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
+  if (c.align.empty()) return perp_roots(c);
+  bool finite = false;
+  std::vector<Mat3> rots = align_family(c, {}, 0, &finite);
+  if (!finite && !rots.empty()) return std::nullopt;
+  // No other condition fixed the spin: the family is continuous unless a condition failed,
+  // and align_family returns nothing either way. Tell them apart with one sample.
+  if (!finite && !align_family(c, {}, 1).empty()) return std::nullopt;
+  return rots;
+}
+
 RuleVerdict WitnessSearch::refuted_by(const PcSet& pcs) const {
   if (const RuleVerdict v = implausible_by(pcs); v.rule != Rule::kNone) return v;
   for (int i = 0; i < pcs.size(); ++i)
     for (int j = i + 1; j < pcs.size(); ++j)
       if (mirror_corners(*A_.model, *B_.model, pcs[i], pcs[j], verified_local_slack()))
         return {Rule::kMirrorCorners, i, j};
-  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
-  if (c.align.empty()) return {};  // a continuous family of rotations: not decided here
-  bool finite = false;
-  const std::vector<Mat3> rots = align_family(c, {}, 0, &finite);
-  if (!finite && !rots.empty()) return {};
-  if (!finite) {
-    // No other condition fixed the spin: the family is continuous unless a condition failed,
-    // and align_family returns nothing either way. Tell them apart with one sample.
-    if (!align_family(c, {}, 1).empty()) return {};
-  }
+  const std::optional<std::vector<Mat3>> finite = finite_rotations(pcs);
+  if (!finite) return {};  // a continuous family of rotations: not decided here
+  const std::vector<Mat3>& rots = *finite;
   std::size_t combos = 1;
   const std::vector<int> slot_sizes = piece_slots(pcs);
   for (int n : slot_sizes) combos *= static_cast<std::size_t>(n);
   if (combos > 4096) return {};
-  if (rots.empty()) return {Rule::kRotationalConditions};
+  // Without an f-f, the checker cannot recheck that no rotation exists (docs/certificates.md):
+  // the finite-rotations rule, with its cells, stands for that case too.
+  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
+  if (rots.empty()) return {c.align.empty() ? Rule::kFiniteRotations : Rule::kRotationalConditions};
   // Finitely many rotations: each must be locally penetrating or leave no room to place the
   // contacts inside their elements (the LP over every combination of convex pieces).
   for (const Mat3& R : rots) {

@@ -80,12 +80,17 @@ class WitnessSearch : public Verifier {
 
   /// For a set `find` found no witness for: true when it is proven invalid within the
   /// search's tolerances (a necessary condition fails, or its rotational conditions leave
-  /// finitely many rotations and at each the PCs are locally penetrating or cannot be placed
-  /// inside their elements with a THIN pose's margin, thin_params). False means undecided:
-  /// the search gave up without a proof.
+  /// finitely many rotations (finite_rotations) and at each the PCs are locally penetrating or
+  /// cannot be placed inside their elements with a THIN pose's margin, thin_params). False means
+  /// undecided: the search gave up without a proof.
   bool refuted(const PcSet& pcs) const { return refuted_by(pcs).rule != Rule::kNone; }
   /// The rule that proves `pcs` invalid, as refuted() decides it; kNone: undecided.
   RuleVerdict refuted_by(const PcSet& pcs) const;
+
+  /// The rotations that meet the set's rotational conditions when they are finitely many
+  /// (two alignments; an alignment and a condition that fixes its spin; three
+  /// perpendicularities), possibly none; nothing when they leave a continuum.
+  std::optional<std::vector<Mat3>> finite_rotations(const PcSet& pcs) const;
 
   /// Cheap necessary conditions on a candidate set (no geometry search).
   bool plausible(const PcSet& pcs) const { return implausible_by(pcs).rule == Rule::kNone; }
