@@ -133,7 +133,9 @@ bool project_perp(const RotConstraints& c, Mat3& R) {
       r[i] = Ru.dot(c.perp[i].second);
       J.row(i) = Ru.cross(c.perp[i].second).transpose();
     }
-    if (r.cwiseAbs().maxCoeff() < 1e-14) return true;
+    double worst = 0;  // a plain loop: GCC 12 misreads maxCoeff on a bounded vector here
+    for (int i = 0; i < k; ++i) worst = std::max(worst, std::abs(r[i]));
+    if (worst < 1e-14) return true;
     const Eigen::Vector3d d = -J.completeOrthogonalDecomposition().solve(r);
     if (!d.allFinite() || d.norm() < 1e-16) break;
     const double ang = std::min(d.norm(), 0.5);
