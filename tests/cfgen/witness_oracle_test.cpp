@@ -145,20 +145,25 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "find: two parallel edges on two parallel faces and a third PC, whose planes meet only on a "
-    "curve of rotations, are found from no seed, and the oracle reads the witness as that CF",
+    "find: two PCs on two parallel faces and a third PC, whose planes meet only on a curve of "
+    "rotations, are found from no seed, and the oracle reads the witness as that CF",
     "[witness][oracle]") {
   // An L-part across a U-channel: two of its parallel edges on two parallel faces of the
   // channel at different heights, and an edge crossing an edge of the channel (seed 7481) or a
   // face of the L on an edge (seed 7493). The three contact planes' normals lie in one plane
   // at every rotation, so the translation exists only where the residual of their offsets
-  // vanishes: the recall soak's only misses before the search walked that curve.
+  // vanishes: the recall soak's only misses before the search walked that curve. Seed 14: a
+  // triangular prism across a U-channel, an edge on one inner wall, a vertex on the facing
+  // wall and an edge crossing an edge of the channel; the rotations anchored at the two point
+  // contacts must be projected onto the e-f's condition, or the program places the contacts
+  // at rotations that are no pose of the set and the walk is never tried.
   struct Case {
     std::uint64_t seed;
     std::vector<const char*> pcs;
   };
   const std::vector<Case> cases{{7481, {"e-f:7:9", "e-f:12:6", "e-e:10:23"}},
-                                {7493, {"e-f:8:5", "e-f:14:6", "f-e:7:8"}}};
+                                {7493, {"e-f:8:5", "e-f:14:6", "f-e:7:8"}},
+                                {14, {"e-f:0:4", "v-f:5:8", "e-e:2:9"}}};
   for (const Case& c : cases)
     found_as_cf(c.seed, c.pcs,
                 [](const cf::test::OraclePair& p, const cf::PcSet& pcs, const cf::gen::Witness& w) {

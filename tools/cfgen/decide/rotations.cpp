@@ -297,11 +297,19 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs,
   std::vector<std::pair<double, std::size_t>> order;
   if (pts.size() < 2) return cands;
   const double min_local = std::sin(p_.angle_margin);
-  auto consider = [&](const Mat3& R, bool exact) {
-    const double m = local_margin(pcs, R);
-    if (m <= min_local) return;
-    order.push_back({exact ? -2.0 - m : -m, cands.size()});
-    cands.push_back(R);
+  // The anchors place the point contacts only; the set's other PCs (an e-f beside an e-e and
+  // a v-f) still ask their rotational conditions, so each rotation is projected onto them.
+  // Unprojected, a rotation whose contacts the program places would count as near a witness
+  // and keep the search from the stages meant for sets whose planes never meet.
+  const RotConstraints conditions = rotation_constraints(pcs, A, B);
+  const bool conditioned = !conditions.align.empty() || !conditions.perp.empty();
+  auto consider = [&](const Mat3& R0, bool exact) {
+    for (const Mat3& R : conditioned ? project_onto(conditions, R0) : std::vector<Mat3>{R0}) {
+      const double m = local_margin(pcs, R);
+      if (m <= min_local) continue;
+      order.push_back({exact ? -2.0 - m : -m, cands.size()});
+      cands.push_back(R);
+    }
   };
   // The anchored rotation with the largest local margin short of min_local: the contacts
   // placed, some PC locally penetrating by a little.
