@@ -165,8 +165,9 @@ PerpTorus perp_torus(const RotConstraints& c) {
   PerpTorus t;
   t.u1 = c.perp[0].first.normalized();
   t.w1 = c.perp[0].second.normalized();
-  const Vec3 e = Vec3::Unit(t.w1.cwiseAbs().minCoeff() == std::abs(t.w1.x()) ? 0 : 1);
-  t.R0 = align(t.u1, t.w1.cross(e).normalized());
+  Eigen::Index least = 0;  // the axis farthest from w1, for a well-conditioned perpendicular
+  t.w1.cwiseAbs().minCoeff(&least);
+  t.R0 = align(t.u1, t.w1.cross(Vec3::Unit(least)).normalized());
   for (int k = 0; k < 2; ++k) {
     const Vec3 u = c.perp[k + 1].first, w = c.perp[k + 1].second;
     // Rot(u1, psi) u and Rot(w1, -phi) w, each split into its constant, cos and sin parts.

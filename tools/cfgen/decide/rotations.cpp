@@ -303,13 +303,15 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs,
   // and keep the search from the stages meant for sets whose planes never meet.
   const RotConstraints conditions = rotation_constraints(pcs, A, B);
   const bool conditioned = !conditions.align.empty() || !conditions.perp.empty();
+  auto keep = [&](const Mat3& R, bool exact) {
+    const double m = local_margin(pcs, R);
+    if (m <= min_local) return;
+    order.push_back({exact ? -2.0 - m : -m, cands.size()});
+    cands.push_back(R);
+  };
   auto consider = [&](const Mat3& R0, bool exact) {
-    for (const Mat3& R : conditioned ? project_onto(conditions, R0) : std::vector<Mat3>{R0}) {
-      const double m = local_margin(pcs, R);
-      if (m <= min_local) continue;
-      order.push_back({exact ? -2.0 - m : -m, cands.size()});
-      cands.push_back(R);
-    }
+    if (!conditioned) return keep(R0, exact);
+    for (const Mat3& R : project_onto(conditions, R0)) keep(R, exact);
   };
   // The anchored rotation with the largest local margin short of min_local: the contacts
   // placed, some PC locally penetrating by a little.

@@ -223,9 +223,10 @@ RuleVerdict WitnessSearch::refuted_by(const PcSet& pcs) const {
   for (int n : slot_sizes) combos *= static_cast<std::size_t>(n);
   if (combos > 4096) return {};
   // Without an f-f, the checker cannot recheck that no rotation exists (docs/certificates.md):
-  // the finite-rotations rule, with its cells, stands for that case too.
-  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
-  if (rots.empty()) return {c.align.empty() ? Rule::kFiniteRotations : Rule::kRotationalConditions};
+  // the finite-rotations rule, evidence only, stands for that case too.
+  const bool ff =
+      std::any_of(pcs.begin(), pcs.end(), [](const Pc& pc) { return pc.type == PcType::kFF; });
+  if (rots.empty()) return {ff ? Rule::kRotationalConditions : Rule::kFiniteRotations};
   // Finitely many rotations: each must be locally penetrating or leave no room to place the
   // contacts inside their elements (the LP over every combination of convex pieces).
   for (const Mat3& R : rots) {
