@@ -246,3 +246,50 @@ TEST_CASE("perp roots: dependent or missing conditions leave no finite answer",
   REQUIRE(none.has_value());
   CHECK(none->empty());
 }
+
+TEST_CASE(
+    "align family: a condition that holds along the whole spin to its tolerance is a family, "
+    "not two roots",
+    "[rotation_family]") {
+  // One f-f (A's +z face against B's +z face: R z = -z) and an e-f whose edge of A runs
+  // 2e-7 rad off +z and whose face of B has a normal 1e-7 rad off perpendicular to B's: read
+  // from float32 files, a box's vertical edge against a wall at a right angle to the floor.
+  // Over the spin, (R u) . w runs between -3e-7 and 1e-7: exactly zero at two spins, within
+  // the models' precision at every one.
+  cf::gen::RotConstraints c;
+  c.align.push_back({Vec3(0, 0, 1), Vec3(0, 0, -1)});
+  c.perp.push_back({Vec3(2e-7, 0, 1).normalized(), Vec3(1, 0, 1e-7).normalized()});
+  constexpr int kSamples = 12;
+  bool finite = false;
+  // Exact models (kRotAccepted, 1e-8): the two roots.
+  CHECK(cf::gen::internal::align_family(c, {}, kSamples, &finite).size() == 2);
+  CHECK(finite);
+  // Tolerance 5e-7 (models known to their precision): every sampled spin, no finite claim.
+  c.align_tol = {5e-7};
+  c.perp_tol = {5e-7};
+  const std::vector<Mat3> rots = cf::gen::internal::align_family(c, {}, kSamples, &finite);
+  CHECK_FALSE(finite);
+  CHECK(rots.size() == kSamples);
+  for (const Mat3& R : rots) CHECK(cf::gen::satisfies(c, R));
+}
+
+TEST_CASE("project perp: two conditions equal to their tolerance are projected onto as one",
+          "[rotation_family]") {
+  // An e-f and an f-e whose conditions are the same to 1e-7: A's edge along +x on B's face of
+  // normal +y, and A's face of normal +x (1e-7 off the edge) against B's edge along +y (1e-7
+  // off the normal). Treated as two independent rows, Gauss-Newton steps along their
+  // difference, a direction they barely constrain.
+  cf::gen::RotConstraints c;
+  c.perp.push_back({Vec3(1, 0, 0), Vec3(0, 1, 0)});
+  c.perp.push_back({Vec3(1, 1e-7, 0).normalized(), Vec3(0, 1, 1e-7).normalized()});
+  c.perp_tol = {5e-7, 5e-7};
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> g;
+  int projected = 0;
+  for (int k = 0; k < 50; ++k) {
+    Mat3 R = cf::gen::axis_angle(Vec3(g(rng), g(rng), g(rng)).normalized(), 0.3);
+    if (cf::gen::internal::project_perp(c, R)) ++projected;
+    CHECK(cf::gen::satisfies(c, R));
+  }
+  CHECK(projected == 50);
+}

@@ -5,6 +5,7 @@
 
 #include "cfgen/verify/verifier.hpp"
 #include "analysed_pair.hpp"
+#include "cfgen/verify/rotation_conditions.hpp"
 #include "fixtures.hpp"
 
 #include <catch2/catch.hpp>
@@ -201,4 +202,39 @@ TEST_CASE(
     }
   CHECK(same_way > 0);
   CHECK(facing > 0);
+}
+
+TEST_CASE(
+    "models known to a precision: a face tilted within it still lies on the other face; beyond "
+    "it, not",
+    "[verify]") {
+  // The cube on the slab, tilted about x through the centre of its bottom face. Exact models
+  // hold the face-face condition to 1e-8; models read to 1e-5 mm (float32 of 100 mm
+  // coordinates) hold it to 4 (1e-5 / 10 + 1e-5 / 40) = 5e-6 rad (kRotPerPrecision over the
+  // two faces' widths), and the tilted face lies along B's to that tilt.
+  cf::test::AnalysedPair exact(cf::test::box(10, 10, 10, "A"), cf::test::box(40, 40, 10, "B"));
+  cf::test::AnalysedPair rounded(cf::test::box(10, 10, 10, "A"), cf::test::box(40, 40, 10, "B"));
+  rounded.ai = cf::gen::analyse_model(rounded.A, 1e-5);
+  rounded.bi = cf::gen::analyse_model(rounded.B, 1e-5);
+  const cf::gen::RotConstraints c = cf::gen::rotation_constraints(kOnTop, rounded.ai, rounded.bi);
+  REQUIRE(c.align_tol.size() == 1);
+  CHECK(c.align_tol[0] == Approx(5e-6).epsilon(1e-9));
+  auto tilted = [](double angle) {
+    Pose p;
+    p.R_BA = Eigen::AngleAxisd(angle, Vec3::UnitX()).toRotationMatrix();
+    p.t_BA = Vec3(15, 15, 10) - p.R_BA * Vec3(5, 5, 0);  // the bottom face's centre at (20, 20, 10)
+    return p;
+  };
+  std::string why;
+  const cf::gen::Verifier v_exact(exact.ai, exact.bi, kParams);
+  const cf::gen::Verifier v_rounded(rounded.ai, rounded.bi, kParams);
+  CHECK(v_exact.verify(kOnTop, tilted(2e-6), &why) < 0);
+  CHECK(why == "a line or plane PC is not parallel to its face");
+  CHECK(v_rounded.verify(kOnTop, tilted(2e-6), &why) == kParams.good_clearance);
+  CHECK(v_rounded.verify(kOnTop, tilted(2e-5), &why) < 0);
+  CHECK(why == "a line or plane PC is not parallel to its face");
+  // The tilt allowed to the face's vertices: (5e-6 - 1e-8) rad over its 14.1 mm diagonal.
+  CHECK(cf::gen::tilt_allowance(rounded.ai, rounded.bi, kOnTop[0]) ==
+        Approx((5e-6 - cf::gen::kRotAccepted) * std::sqrt(200.0)).epsilon(1e-9));
+  CHECK(cf::gen::tilt_allowance(exact.ai, exact.bi, kOnTop[0]) == 0);
 }

@@ -37,9 +37,9 @@ Mesh moved_renumbered(const Mesh& m, const Pose& X, std::mt19937_64& rng) {
   return out;
 }
 
-ElementMap map_elements(const Poly& moved, const Poly& first, const Pose& X) {
+ElementMap map_elements(const Poly& moved, const Poly& first, const Pose& X, double rel_tol) {
   ElementMap m;
-  const double tol = 1e-7 * first.diag;
+  const double tol = rel_tol * first.diag;
   for (std::size_t i = 0; i < moved.V.size(); ++i) {
     const Vec3 p = X.inv(moved.V[i].p);
     int best = -1;
@@ -193,15 +193,18 @@ InvarianceResult run_invariance(const ShapePair& pair, const InvarianceOptions& 
   const Pose XA = random_rigid(rng), XB = random_rigid(rng);
   write_off(pair.A, (dir / "A.off").string());
   write_off(pair.B, (dir / "B.off").string());
-  write_off(moved_renumbered(pair.A, XA, rng), (dir / "A_moved.off").string());
-  write_off(moved_renumbered(pair.B, XB, rng), (dir / "B_moved.off").string());
+  const std::string moved_ext = o.float32_stl ? ".stl" : ".off";
+  const auto write = o.float32_stl ? write_stl_float32 : write_off;
+  write(moved_renumbered(pair.A, XA, rng), (dir / ("A_moved" + moved_ext)).string());
+  write(moved_renumbered(pair.B, XB, rng), (dir / ("B_moved" + moved_ext)).string());
   try {
     auto generate = [&](const std::string& suffix, double& seconds) {
       const auto t0 = std::chrono::steady_clock::now();
       const std::string g = (dir / ("G" + suffix + ".json")).string();
+      const std::string ext = suffix.empty() ? ".off" : moved_ext;
       const int rc =
-          run(o, (dir / ("A" + suffix + ".off")).string(), (dir / ("B" + suffix + ".off")).string(),
-              g, (dir / ("cfgen" + suffix + ".log")).string());
+          run(o, (dir / ("A" + suffix + ext)).string(), (dir / ("B" + suffix + ext)).string(), g,
+              (dir / ("cfgen" + suffix + ".log")).string());
       seconds = seconds_since(t0);
       if (rc != 0)
         throw std::runtime_error("cfgen exited with status " + std::to_string(rc) + " (see " +
@@ -209,8 +212,11 @@ InvarianceResult run_invariance(const ShapePair& pair, const InvarianceOptions& 
       return read_graph(g);
     };
     const Graph first = generate("", r.first_s), moved = generate("_moved", r.moved_s);
-    const ElementMap ma = map_elements(moved.A, first.A, XA);
-    const ElementMap mb = map_elements(moved.B, first.B, XB);
+    // float32 holds a coordinate to 6e-8 of it; the models sit within a few diagonals of
+    // their origins.
+    const double map_tol = o.float32_stl ? 1e-5 : 1e-7;
+    const ElementMap ma = map_elements(moved.A, first.A, XA, map_tol);
+    const ElementMap mb = map_elements(moved.B, first.B, XB, map_tol);
     if (!ma.problem.empty() || !mb.problem.empty())
       throw std::runtime_error("the graphs' models differ: A: " + ma.problem +
                                "; B: " + mb.problem);

@@ -22,14 +22,15 @@ Mesh moved_renumbered(const Mesh& m, const Pose& X, std::mt19937_64& rng);
 
 /// The map from the elements of `moved` (a graph model built from the moved files) to those
 /// of `first`: vertex i of `moved` is vertex vertex[i] of `first`, and so on. Vertices match
-/// when X.inv of one is within 1e-7 of the diagonal of the other (the features of both are
-/// the same solid's, read from 17-digit files); edges by their two vertices, faces by their
-/// vertex sets. Empty `problem` when every element has its image; otherwise what is missing.
+/// when X.inv of one is within `tol` times the diagonal of the other (the features of both
+/// are the same solid's: 1e-7 for 17-digit files, more for float32 ones); edges by their two
+/// vertices, faces by their vertex sets. Empty `problem` when every element has its image;
+/// otherwise what is missing.
 struct ElementMap {
   std::vector<int> vertex, edge, face;
   std::string problem;
 };
-ElementMap map_elements(const Poly& moved, const Poly& first, const Pose& X);
+ElementMap map_elements(const Poly& moved, const Poly& first, const Pose& X, double tol = 1e-7);
 
 /// `key` (in the moved graph's numbering) in the first graph's numbering, sorted.
 CfKey map_key(const CfKey& key, const ElementMap& a, const ElementMap& b);
@@ -39,7 +40,10 @@ struct InvarianceOptions {
   int threads = 2;                      // cfgen -j
   std::vector<std::string> cfgen_args;  // more options for both runs
   std::uint64_t motion_seed = 1;        // the motions and the renumbering
-  std::string keep_dir;                 // "" = a temporary directory, removed if all worked
+  /// The moved copy written as binary STL with float32 coordinates (write_stl_float32), as CAD
+  /// and mesh tools write a part, instead of 17-digit OFF.
+  bool float32_stl = false;
+  std::string keep_dir;  // "" = a temporary directory, removed if all worked
 };
 
 struct InvarianceResult {

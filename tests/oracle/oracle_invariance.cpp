@@ -1,10 +1,11 @@
 // oracle_invariance: whether cfgen's graph of a model pair depends only on the solids.
 //
-//   oracle_invariance --seed N [--extra K] [--motion-seed M] [--cfgen PATH] [-j THREADS]
-//                     [--keep DIR] [--list K] [-- CFGEN_OPTIONS...]
+//   oracle_invariance --seed N [--extra K] [--motion-seed M] [--float32] [--cfgen PATH]
+//                     [-j THREADS] [--keep DIR] [--list K] [-- CFGEN_OPTIONS...]
 //
 // Writes the oracle's pair of seed N, and a copy with each model moved by its own random
-// rigid motion and renumbered (vertices, facets, each facet's first vertex), runs cfgen on
+// rigid motion and renumbered (vertices, facets, each facet's first vertex), with --float32
+// as binary STL with float32 coordinates (facets triangulated), runs cfgen on
 // both and compares the CF sets through the map between the graphs' elements. Prints one
 // line (seed, both counts, the sets only one graph holds, how many of those have a witness
 // the oracle finds sound, so that the other run missed a CF, cfgen's times, the pair), then
@@ -27,10 +28,12 @@ namespace {
 
 void usage() {
   std::puts(
-      "usage: oracle_invariance --seed N [--extra K] [--motion-seed M] [--cfgen PATH]\n"
-      "                         [-j THREADS] [--keep DIR] [--list K] [-- CFGEN_OPTIONS...]\n"
+      "usage: oracle_invariance --seed N [--extra K] [--motion-seed M] [--float32]\n"
+      "                         [--cfgen PATH] [-j THREADS] [--keep DIR] [--list K]\n"
+      "                         [-- CFGEN_OPTIONS...]\n"
       "Runs cfgen on the oracle's pair of seed N and on a copy with each model moved by a\n"
-      "random rigid motion and renumbered (from --motion-seed, default 1), and compares the\n"
+      "random rigid motion and renumbered (from --motion-seed, default 1), with --float32\n"
+      "written as binary STL with float32 coordinates (17-digit OFF otherwise), and compares the\n"
       "CF sets through the map between the two graphs' elements. --keep: keep the models,\n"
       "graphs and cfgen logs in DIR. --list: print up to K differing sets each way (default\n"
       "10). Options after -- go to both cfgen runs. Exit 0 when the CF sets are the same, 1\n"
@@ -64,6 +67,8 @@ int main(int argc, char** argv) {
       } else if (pair.take(a, val)) {  // --seed, --extra
       } else if (a == "--motion-seed") {
         o.motion_seed = std::stoull(val());
+      } else if (a == "--float32") {
+        o.float32_stl = true;
       } else if (a == "--cfgen") {
         o.cfgen = val();
       } else if (a == "-j" || a == "--threads") {

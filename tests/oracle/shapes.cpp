@@ -1,8 +1,11 @@
 #include "shapes.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -30,6 +33,46 @@ void write_off(const Mesh& m, const std::string& path) {
     o << f.size();
     for (int i : f) o << " " << i;
     o << "\n";
+  }
+  if (!o) throw std::runtime_error("error writing " + path);
+}
+
+void write_stl_float32(const Mesh& m, const std::string& path) {
+  std::vector<std::array<int, 3>> tris;
+  for (const auto& f : m.F) {
+    // The facet in its plane, in a frame (u, v) with u x v along its outward normal, so that
+    // its counter-clockwise loop stays counter-clockwise.
+    Vec3 n = Vec3::Zero();
+    for (std::size_t k = 0; k < f.size(); ++k) n += m.V[f[k]].cross(m.V[f[(k + 1) % f.size()]]);
+    n.normalize();
+    const Vec3 u = n.unitOrthogonal(), v = n.cross(u);
+    std::vector<Vec2> loop;
+    for (int i : f) loop.emplace_back(m.V[i].dot(u), m.V[i].dot(v));
+    for (const auto& t : triangulate(loop, {})) tris.push_back({f[t[0]], f[t[1]], f[t[2]]});
+  }
+  std::ofstream o(path, std::ios::binary);
+  if (!o) throw std::runtime_error("cannot write " + path);
+  char header[80] = {};
+  std::snprintf(header, sizeof header, "%s, float32, written by the test oracle", m.name.c_str());
+  o.write(header, sizeof header);
+  auto put_u32 = [&](std::uint32_t x) {
+    const unsigned char b[4] = {static_cast<unsigned char>(x), static_cast<unsigned char>(x >> 8),
+                                static_cast<unsigned char>(x >> 16),
+                                static_cast<unsigned char>(x >> 24)};
+    o.write(reinterpret_cast<const char*>(b), 4);
+  };
+  auto put_f32 = [&](double x) {
+    const float f = static_cast<float>(x);
+    std::uint32_t bits = 0;
+    std::memcpy(&bits, &f, 4);
+    put_u32(bits);
+  };
+  put_u32(static_cast<std::uint32_t>(tris.size()));
+  for (const auto& t : tris) {
+    for (int k = 0; k < 3; ++k) put_f32(0);
+    for (int i : t)
+      for (int k = 0; k < 3; ++k) put_f32(m.V[i][k]);
+    o.write("\0\0", 2);
   }
   if (!o) throw std::runtime_error("error writing " + path);
 }

@@ -21,6 +21,9 @@ struct Mesh {
 };
 
 void write_off(const Mesh& m, const std::string& path);
+/// Binary STL as CAD and mesh tools write it: each facet triangulated (ear clipping in its
+/// plane), every coordinate rounded to float32, the facet normals left zero.
+void write_stl_float32(const Mesh& m, const std::string& path);
 Mesh read_off(const std::string& path);  // throws std::runtime_error
 
 double mesh_volume(const Mesh& m);

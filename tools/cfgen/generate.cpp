@@ -302,8 +302,8 @@ int run_generate(const GenerateArgs& args) {
   const Polyhedron& B = mb.model;
   // The other ranks of an MPI run say nothing that rank 0 says.
   if (!args.share.load || args.shard.index == 0) warn_sizes(A, B);
-  const gen::ModelInfo ai = gen::analyse_model(A);
-  const gen::ModelInfo bi = gen::analyse_model(B);
+  const gen::ModelInfo ai = gen::analyse_model(A, ma.precision_mm);
+  const gen::ModelInfo bi = gen::analyse_model(B, mb.precision_mm);
 
   gen::EnumerateOptions opt;
   // Lengths scale with the smaller model (RelativeLengths).

@@ -130,6 +130,7 @@ CellSearchLimits decision_limits(const WitnessSearch& search, std::size_t max_ce
   limits.touch_tol = search.params().touch_tol;
   limits.margin = thin_params(search.params()).min_margin;
   limits.local_slack = search.verified_local_slack();
+  limits.rot_tol = max_condition_tol(search.a(), search.b());
   return limits;
 }
 
@@ -152,7 +153,7 @@ CellSearchResult search_cells(const ModelInfo& a, const ModelInfo& b, const PcSe
   const CellRelaxation relaxation(a, b, pcs, limits.touch_tol, limits.margin, limits.local_slack,
                                   limits.rot_tol);
   const DeepPoints deep(a, b);
-  const RotConstraints conditions = rotation_constraints(pcs, *a.model, *b.model);
+  const RotConstraints conditions = rotation_constraints(pcs, a, b);
   const double size = limits.scale > 0
                           ? limits.scale
                           : std::max((a.model->bbox_max() - a.model->bbox_min()).norm(),

@@ -465,7 +465,7 @@ std::vector<Mat3> FindRun::family_ends() const {
   constexpr double kWalkStep = 0.03;  // rad
   constexpr int kWalkSteps = 60;      // up to 1.8 rad each way
   constexpr int kInside = 4;          // rotations tried inside each end, kWalkStep apart
-  const RotConstraints c = rotation_constraints(pcs_, *s_.a().model, *s_.b().model);
+  const RotConstraints c = rotation_constraints(pcs_, s_.a(), s_.b());
   std::vector<Mat3> ends;
   for (const Mat3& R : near_)
     for (const std::vector<Mat3>& path : walk_family(c, R, kWalkStep, kWalkSteps)) {
@@ -492,7 +492,7 @@ std::vector<Mat3> FindRun::consistent_rotations(const std::vector<Mat3>& rots) c
   const Polyhedron& A = *s_.a().model;
   const Polyhedron& B = *s_.b().model;
   std::vector<Mat3> out;
-  const RotConstraints c = rotation_constraints(pcs_, A, B);
+  const RotConstraints c = rotation_constraints(pcs_, s_.a(), s_.b());
   // Whether the planes are dependent holds along the whole family: the rotations tried
   // already tell, before the samples are made again.
   if (!c.align.empty() || (!rots.empty() && !translation_residual(A, B, pcs_, rots.front())))

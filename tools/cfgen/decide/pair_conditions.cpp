@@ -294,11 +294,12 @@ bool PairConditions::forced_normal_fails(const Pc& x, const Pc& e) const {
   const Polyhedron& B = *B_.model;
   const Vec3& da = A.edges()[e.a].dir;
   const Vec3& db = B.edges()[e.b].dir;
-  // At a witness the rotational condition holds to kRotAccepted and the e-e's edges are at
+  // At a witness the rotational condition holds to its tolerance and the e-e's edges are at
   // least the slack (a sine) from parallel, so the contact plane's normal N is within
-  // 2 (kRotAccepted + 2 kParallel) / slack of the direction (its component in the plane
-  // of the two edges is at most their residuals over the sine between them).
-  const double off = 2 * (kRotAccepted + 2 * kParallel) / slack_;
+  // 2 (tolerance + 2 kParallel) / slack of the direction (its component in the plane of the
+  // two edges is at most their residuals over the sine between them).
+  const double rot_tol = condition_tol(A_, a_kind(x.type), x.a, B_, b_kind(x.type), x.b);
+  const double off = 2 * (rot_tol + 2 * kParallel) / slack_;
   const double need = slack_ - off;
   // verify's e-e terms with N = m (B's frame; B's edge's faces on the far side of it) and
   // with R^T N = u (A's frame; A's edge's faces on the near side).
@@ -315,10 +316,10 @@ bool PairConditions::forced_normal_fails(const Pc& x, const Pc& e) const {
       const Vec3& n = B.faces()[x.b].normal;
       if (A.edges()[x.a].dir.cross(da).norm() > kParallel || std::abs(db.dot(n)) > kParallel)
         return false;
-      // v = R^T n, perpendicular to the edges (to kRotAccepted): the e-f's own local margin
+      // v = R^T n, perpendicular to the edges (to rot_tol): the e-f's own local margin
       // (its wedge on n's side) and the e-e's terms of A with N = sg n.
       auto turn = [&](double sg) {
-        return turn_allows(da, A_.wedges[x.a], slack_ - kRotAccepted, wa, sg, need);
+        return turn_allows(da, A_.wedges[x.a], slack_ - rot_tol, wa, sg, need);
       };
       return !(b_side(n) && turn(1)) && !(b_side(-n) && turn(-1));
     }
@@ -329,7 +330,7 @@ bool PairConditions::forced_normal_fails(const Pc& x, const Pc& e) const {
       // u = R n, perpendicular to the edges: the f-e's local margin and the e-e's terms of B
       // with N = sg u (B's faces on the far side).
       auto turn = [&](double sg) {
-        return turn_allows(db, B_.wedges[x.b], slack_ - kRotAccepted, wb, -sg, need);
+        return turn_allows(db, B_.wedges[x.b], slack_ - rot_tol, wb, -sg, need);
       };
       return !(a_side(n) && turn(1)) && !(a_side(-n) && turn(-1));
     }
@@ -365,6 +366,11 @@ bool PairConditions::parallel_normals_fail(const Pc& x, const Pc& y) const {
   return lo > off && hi < M_PI - off;
 }
 
+double PairConditions::condition_turn(const Pc& x) const {
+  if (x.type != PcType::kFF && x.type != PcType::kEF && x.type != PcType::kFE) return 0;
+  return condition_tol(A_, a_kind(x.type), x.a, B_, b_kind(x.type), x.b);
+}
+
 bool PairConditions::compatible(const Pc& x, const Pc& y) const {
   const ElementKind kax = a_kind(x.type), kay = a_kind(y.type), kbx = b_kind(x.type),
                     kby = b_kind(y.type);
@@ -376,18 +382,23 @@ bool PairConditions::compatible(const Pc& x, const Pc& y) const {
   if (a.dist_lo > b.dist_hi + length_tol_ || b.dist_lo > a.dist_hi + length_tol_) return false;
   // Angle between the contact normals: R maps A's outward normal u at each contact onto
   // -m, m B's outward normal there, so the angle between u_x and u_y equals that between m_x
-  // and m_y.
-  if (a.angle_lo > b.angle_hi + 2 * angle_tol_ || b.angle_lo > a.angle_hi + 2 * angle_tol_)
-    return false;
+  // and m_y. A line or plane PC holds its rotational condition only to its tolerance
+  // (rotation_conditions.hpp), so its normal on one side is that far from the other side's
+  // cone, and the angles may differ by as much.
+  const double turn_x = condition_turn(x), turn_y = condition_turn(y);
+  const double angle_tol = 2 * angle_tol_ + turn_x + turn_y;
+  if (a.angle_lo > b.angle_hi + angle_tol || b.angle_lo > a.angle_hi + angle_tol) return false;
   // Height of one contact point over the other's contact plane: with q = R p + t on both
   // contacts, (q_y - q_x) . m_x = -(p_y - p_x) . u_x, so B's range must meet minus A's; and
-  // the same over y's plane.
-  auto heights_meet = [&](const Allowed& ha, const Allowed& hb) {
-    return !(hb.height_lo > -ha.height_lo + length_tol_ ||
-             -ha.height_hi > hb.height_hi + length_tol_);
+  // the same over y's plane. Over a line or plane PC's plane the two sides differ by its
+  // condition's tolerance times the distance between the points.
+  auto heights_meet = [&](const Allowed& ha, const Allowed& hb, double turn) {
+    const double tol = length_tol_ + turn * ha.dist_hi;
+    return !(hb.height_lo > -ha.height_lo + tol || -ha.height_hi > hb.height_hi + tol);
   };
   // Last, a normal the rotation cannot choose: a few products, where the above are look-ups.
-  return heights_meet(a, b) && heights_meet(a_.at(kay, y.a, kax, x.a), b_.at(kby, y.b, kbx, x.b)) &&
+  return heights_meet(a, b, turn_x) &&
+         heights_meet(a_.at(kay, y.a, kax, x.a), b_.at(kby, y.b, kbx, x.b), turn_y) &&
          !forced_normal_fails(x, y) && !forced_normal_fails(y, x) && !parallel_normals_fail(x, y);
 }
 

@@ -97,6 +97,8 @@ class PairConditions {
   };
   static Side build(const ModelInfo& m, double cone_margin, double angle_tol,
                     double contact_margin);
+  // rad: what x's rotational condition may leave (condition_tol), 0 for a point PC.
+  double condition_turn(const Pc& x) const;
 
   const ModelInfo& A_;
   const ModelInfo& B_;

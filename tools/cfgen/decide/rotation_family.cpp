@@ -16,16 +16,21 @@
 namespace cf::gen::internal {
 namespace {
 
-// Solutions theta of a cos(theta) + b sin(theta) == d; `all` when it holds for every theta.
-bool trig_solve(double a, double b, double d, std::vector<double>& out, bool& all) {
+// Solutions theta of a cos(theta) + b sin(theta) == d to within tol (rad); `all` when it
+// holds for every theta. Where |d| exceeds hypot(a, b) by at most tol, the closest theta.
+// A condition that varies along the circle by no more than its tolerance (tol above
+// rounding: the models' precision) holds on an arc or nowhere, not at isolated roots: `all`
+// when it holds somewhere, and the caller checks each rotation it takes.
+bool trig_solve(double a, double b, double d, std::vector<double>& out, bool& all,
+                double tol = kRotTol) {
   const double r = std::hypot(a, b);
   all = false;
-  if (r < 1e-12) {
-    all = std::abs(d) < kRotTol;
+  if (r < 1e-12 || (tol > kRotTol && r <= 2 * tol)) {
+    all = std::abs(d) < tol + r;
     return all;
   }
   double c = d / r;
-  if (std::abs(c) > 1 + 1e-9) return false;
+  if (std::abs(c) > 1 + std::max(1e-9, tol / r)) return false;
   c = std::clamp(c, -1.0, 1.0);
   const double phi = std::atan2(b, a);
   const double delta = std::acos(c);
@@ -33,6 +38,10 @@ bool trig_solve(double a, double b, double d, std::vector<double>& out, bool& al
   if (delta > 1e-9 && delta < M_PI - 1e-9) out.push_back(phi - delta);
   return true;
 }
+
+// The tolerance trig_solve takes for a condition of tolerance t: kRotTol on exact models,
+// whose conditions are met to rounding; t where the models' precision sets it.
+double solve_tol(double t) { return t > kRotAccepted ? t : kRotTol; }
 
 // theta maximising trace(S^T Rot(axis, theta) R0): the family member closest to S.
 double closest_theta(const Vec3& axis, const Mat3& R0, const Mat3& S) {
@@ -86,7 +95,7 @@ std::vector<Mat3> align_family(const RotConstraints& c, const std::vector<Mat3>&
   const Mat3 R0 = align(a1, axis);
   std::vector<double> thetas;
   bool finite = false;
-  auto consider = [&](const Vec3& u0, const Vec3& w, double target) {
+  auto consider = [&](const Vec3& u0, const Vec3& w, double target, double tol) {
     const Vec3 u = R0 * u0;
     const Vec3 u_par = u.dot(axis) * axis;
     const double A = (u - u_par).dot(w);
@@ -94,7 +103,7 @@ std::vector<Mat3> align_family(const RotConstraints& c, const std::vector<Mat3>&
     const double C = u_par.dot(w);
     std::vector<double> sol;
     bool all = false;
-    if (!trig_solve(A, B, target - C, sol, all)) return false;
+    if (!trig_solve(A, B, target - C, sol, all, solve_tol(tol))) return false;
     if (all) return true;
     if (!finite) {
       thetas = sol;
@@ -103,9 +112,9 @@ std::vector<Mat3> align_family(const RotConstraints& c, const std::vector<Mat3>&
     return true;
   };
   for (std::size_t i = 1; i < c.align.size(); ++i)
-    if (!consider(c.align[i].first, c.align[i].second, 1.0)) return {};
-  for (const auto& [u, w] : c.perp)
-    if (!consider(u, w, 0.0)) return {};
+    if (!consider(c.align[i].first, c.align[i].second, 1.0, c.align_tol_of(i))) return {};
+  for (std::size_t i = 0; i < c.perp.size(); ++i)
+    if (!consider(c.perp[i].first, c.perp[i].second, 0.0, c.perp_tol_of(i))) return {};
   if (finite_out) *finite_out = finite;
   if (!finite) {
     for (const Mat3& S : seeds) thetas.push_back(closest_theta(axis, R0, S));
@@ -122,6 +131,7 @@ std::vector<Mat3> align_family(const RotConstraints& c, const std::vector<Mat3>&
 // Gauss-Newton projection of R onto { (R u_i) . w_i == 0 }.
 bool project_perp(const RotConstraints& c, Mat3& R) {
   const int k = static_cast<int>(c.perp.size());
+  const double rank_tol = c.max_tol() > kRotAccepted ? c.max_tol() : 0;
   // At most three conditions: fixed-capacity matrices keep this hot loop off the heap.
   using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
   using Jac = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 3, 3>;
@@ -136,7 +146,13 @@ bool project_perp(const RotConstraints& c, Mat3& R) {
     double worst = 0;  // a plain loop: GCC 12 misreads maxCoeff on a bounded vector here
     for (int i = 0; i < k; ++i) worst = std::max(worst, std::abs(r[i]));
     if (worst < 1e-14) return true;
-    const Eigen::Vector3d d = -J.completeOrthogonalDecomposition().solve(r);
+    Eigen::CompleteOrthogonalDecomposition<Jac> cod;
+    // Conditions the same to within their tolerance (an edge along a face's normal against
+    // an edge along another face's, each to the models' precision) count as one: a
+    // rank-deficient step, not a huge one along their difference.
+    if (rank_tol > 0) cod.setThreshold(rank_tol);
+    cod.compute(J);
+    const Eigen::Vector3d d = -cod.solve(r);
     if (!d.allFinite() || d.norm() < 1e-16) break;
     const double ang = std::min(d.norm(), 0.5);
     R = axis_angle(d.normalized(), ang) * R;

@@ -28,7 +28,7 @@ using namespace internal;
 
 std::vector<Mat3> WitnessSearch::family_samples(const PcSet& pcs, const std::vector<Mat3>& seeds,
                                                 int samples) const {
-  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
+  const RotConstraints c = rotation_constraints(pcs, A_, B_);
   std::vector<Mat3> rots;
   if (!c.align.empty()) {
     rots = align_family(c, seeds, samples);
@@ -301,7 +301,7 @@ std::vector<Mat3> WitnessSearch::anchored_rotations(const PcSet& pcs,
   // a v-f) still ask their rotational conditions, so each rotation is projected onto them.
   // Unprojected, a rotation whose contacts the program places would count as near a witness
   // and keep the search from the stages meant for sets whose planes never meet.
-  const RotConstraints conditions = rotation_constraints(pcs, A, B);
+  const RotConstraints conditions = rotation_constraints(pcs, A_, B_);
   const bool conditioned = !conditions.align.empty() || !conditions.perp.empty();
   auto keep = [&](const Mat3& R, bool exact) {
     const double m = local_margin(pcs, R);
@@ -382,7 +382,7 @@ std::vector<Mat3> WitnessSearch::rotation_candidates(const PcSet& pcs,
 }
 
 std::vector<Mat3> WitnessSearch::rotation_steps(const PcSet& pcs, const Mat3& R, double h) const {
-  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
+  const RotConstraints c = rotation_constraints(pcs, A_, B_);
   std::vector<Mat3> out;
   if (c.align.size() >= 2) return out;  // the rotation is fixed
   if (c.align.size() == 1) {

@@ -385,7 +385,7 @@ bool WitnessSearch::obstacle_step(const PcSet& pcs, const Mat3& R, const std::ve
                                   const LpVector& x, const std::vector<LinearProgram::Row>& cuts,
                                   const std::vector<std::vector<Vec3>>& cut_points, double turn,
                                   Mat3& next) const {
-  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
+  const RotConstraints c = rotation_constraints(pcs, A_, B_);
   if (c.align.size() >= 2 || (c.align.size() == 1 && !c.perp.empty())) return false;  // fixed
   // The contact rows at R and at R turned by h about each axis: the rows keep their order and
   // their variables, so the difference of each coefficient and right side, over h, is its

@@ -86,13 +86,15 @@ RuleVerdict WitnessSearch::implausible_by(const PcSet& pcs) const {
   // (along B's normal), whatever the spin and the slide in the plane. So every other PC's
   // contact point, a common point of its two elements, needs the two elements' height
   // ranges over that plane to meet.
-  // A witness meets the f-f's alignment to kRotAccepted, which tilts heights by that much
+  // A witness meets the f-f's alignment to its tolerance, which tilts heights by that much
   // per mm of A; both contacts touch within touch_tol.
   const Polyhedron& mA = *A_.model;
-  const double tol = kRotAccepted * (mA.bbox_max() - mA.bbox_min()).norm() + 2 * p_.touch_tol;
   for (int f = 0; f < pcs.size(); ++f) {
     const Pc& ff = pcs[f];
     if (ff.type != PcType::kFF) continue;
+    const double tol = condition_tol(A_, ElementKind::kFace, ff.a, B_, ElementKind::kFace, ff.b) *
+                           (mA.bbox_max() - mA.bbox_min()).norm() +
+                       2 * p_.touch_tol;
     const Face& fa = A_.model->faces()[ff.a];
     const Face& fb = B_.model->faces()[ff.b];
     for (int k = 0; k < pcs.size(); ++k) {
@@ -164,7 +166,7 @@ Witness WitnessSearch::image_witness(const PcSet& pcs, const Pose& image) const 
   w.clearance = verify(pcs, image);
   w.found = w.clearance >= p_.min_clearance;
   if (w.found) return w;
-  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
+  const RotConstraints c = rotation_constraints(pcs, A_, B_);
   for (const Mat3& R : project_onto(c, image.R_BA)) {
     Pose q = image;
     q.R_BA = R;
@@ -198,7 +200,7 @@ std::vector<int> WitnessSearch::piece_slots(const PcSet& pcs) const {
 }
 
 std::optional<std::vector<Mat3>> WitnessSearch::finite_rotations(const PcSet& pcs) const {
-  const RotConstraints c = rotation_constraints(pcs, *A_.model, *B_.model);
+  const RotConstraints c = rotation_constraints(pcs, A_, B_);
   if (c.align.empty()) return perp_roots(c);
   bool finite = false;
   std::vector<Mat3> rots = align_family(c, {}, 0, &finite);

@@ -1,5 +1,7 @@
 #include "cfgen/verify/analysis.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -147,9 +149,31 @@ void BoxIndex::query(const Vec3& q_lo, const Vec3& q_hi, std::uint64_t* out) con
   }
 }
 
-ModelInfo analyse_model(const Polyhedron& m) {
+namespace {
+
+// A face's width: the extent of its outer loop across the direction of least spread (the
+// least eigenvector of the loop's 2D scatter), which for a rectangle is its shorter side.
+double face_width(const Face& f) {
+  const auto& loop = f.loops_2d.front();
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& p : loop) mean += p;
+  mean /= static_cast<double>(loop.size());
+  Eigen::Matrix2d S = Eigen::Matrix2d::Zero();
+  for (const auto& p : loop) S += (p - mean) * (p - mean).transpose();
+  const Eigen::Vector2d d = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(S).eigenvectors().col(0);
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const auto& p : loop) lo = std::min(lo, p.dot(d)), hi = std::max(hi, p.dot(d));
+  return hi - lo;
+}
+
+}  // namespace
+
+ModelInfo analyse_model(const Polyhedron& m, double precision_mm) {
   ModelInfo info;
   info.model = &m;
+  info.precision_mm = precision_mm;
+  for (const Edge& E : m.edges()) info.extent[1].push_back(E.length);
+  for (const Face& F : m.faces()) info.extent[2].push_back(face_width(F));
   const double tol = 1e-9 * m.size();
   info.cones.resize(m.num_vertices());
   for (std::size_t v = 0; v < m.num_vertices(); ++v) {

@@ -96,10 +96,18 @@ struct ModelInfo {
   BoxIndex boxes;
   int box_offset[3] = {0, 0, 0};
   std::pair<Vec3, double> bound{Vec3::Zero(), 0.0};  // bounding sphere of the whole model
+  /// mm: how closely the model holds the geometry its file gave (the larger of the loader's
+  /// precision_mm and deviation_mm, tools/mesh/model_loader.hpp); 0 for an exact model. An
+  /// edge's direction and a face's normal hold to about precision_mm over their extent.
+  double precision_mm = 0;
+  /// mm: each edge's length and each face's width (the least extent of its vertices across
+  /// one of its sides), indexed by kind then element; none for vertices.
+  std::vector<double> extent[3];
 };
 
+/// The facts above of `m`, which holds its file's geometry to `precision_mm` (mm; 0: exact).
 /// @throws cf::Error when the model has a face that cannot be partitioned.
-ModelInfo analyse_model(const Polyhedron& m);
+ModelInfo analyse_model(const Polyhedron& m, double precision_mm = 0);
 
 /// True when p lies strictly inside the solid (ray casting; directions that graze an edge or
 /// vertex are retried). Points within `boundary_tol` of the boundary count as outside.

@@ -65,6 +65,19 @@ SearchParams recorded_params(const CfGraph& g, SearchParams p) {
   return p;
 }
 
+double recorded_precision(const CfGraph& g, const char* model) {
+  const auto meta = nlohmann::json::parse(g.metadata_json());
+  const auto it = meta.find("parameters");
+  if (it == meta.end() || !it->is_object()) return 0;
+  const auto p = it->find("precision_mm");
+  if (p == it->end() || !p->is_object() || !p->contains(model)) return 0;
+  const auto& m = (*p)[model];
+  if (!m.is_number() || !(m.get<double>() >= 0) || !std::isfinite(m.get<double>()))
+    throw Error("reading the generator's parameters: /parameters/precision_mm/" +
+                std::string(model) + " = " + m.dump() + " is not a finite number >= 0");
+  return m.get<double>();
+}
+
 namespace {
 
 SearchParams check_params(const CfGraph& g, const SearchParams& defaults) {
@@ -78,8 +91,8 @@ SearchParams check_params(const CfGraph& g, const SearchParams& defaults) {
 }  // namespace
 
 RecordCheck::RecordCheck(const CfGraph& g, const SearchParams& defaults)
-    : a_(analyse_model(g.model_a())),
-      b_(analyse_model(g.model_b())),
+    : a_(analyse_model(g.model_a(), recorded_precision(g, "A"))),
+      b_(analyse_model(g.model_b(), recorded_precision(g, "B"))),
       verifier_(a_, b_, check_params(g, defaults)) {}
 
 std::string RecordCheck::check(const CfRecord& r) const { return check_record(verifier_, r); }

@@ -42,4 +42,9 @@ std::string check_record(const Verifier& v, const CfRecord& r);
 /// @throws cf::Error when a member present is not a positive finite number.
 SearchParams recorded_params(const CfGraph& g, SearchParams defaults);
 
+/// mm: the precision the generator measured of `model` ("A" or "B"), the member of
+/// /parameters/precision_mm (ModelInfo::precision_mm); 0 when the graph does not say.
+/// @throws cf::Error when the value is not a finite number >= 0.
+double recorded_precision(const CfGraph& g, const char* model);
+
 }  // namespace cf::gen

@@ -1,5 +1,7 @@
 #include "cfgen/verify/touch.hpp"
 
+#include "detect/polygon_clipping.hpp"  // libcf's private header: one polygon overlap
+
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/point_xy.hpp>
 #include <boost/geometry/geometries/polygon.hpp>
@@ -39,6 +41,38 @@ bool segment_in_open_face(const Polyhedron& m, FaceId f, const Vec3& p, const Ve
   return false;
 }
 
+// Loops as libcf's flat polygon (outer loop counter-clockwise, holes clockwise), for its
+// overlap(), which classifies boundary pieces within a tolerance: Boost.Geometry's
+// intersection returns nothing for a face inside another whose sides lie along the other's
+// to within float rounding (a cube in a corner read from float32 STL).
+struct FlatPolygon {
+  std::vector<internal::Vec2> pts;
+  std::vector<int> lb{0};
+  explicit FlatPolygon(const std::vector<std::vector<Eigen::Vector2d>>& loops) {
+    for (std::size_t l = 0; l < loops.size(); ++l) {
+      double area2 = 0;
+      const auto& loop = loops[l];
+      for (std::size_t k = 0; k < loop.size(); ++k)
+        area2 += internal::cross2(loop[k], loop[(k + 1) % loop.size()]);
+      if ((area2 > 0) == (l == 0))
+        pts.insert(pts.end(), loop.begin(), loop.end());
+      else
+        pts.insert(pts.end(), loop.rbegin(), loop.rend());
+      lb.push_back(static_cast<int>(pts.size()));
+    }
+  }
+  internal::Poly2 poly() const { return {pts.data(), lb.data(), static_cast<int>(lb.size()) - 1}; }
+};
+
+// The area and centroid of the overlap of two faces' loops in one plane, boundaries that
+// run along each other within tol counted once.
+internal::Overlap2 loops_overlap(const std::vector<std::vector<Eigen::Vector2d>>& a,
+                                 const std::vector<std::vector<Eigen::Vector2d>>& b, double tol) {
+  const FlatPolygon pa(a), pb(b);
+  std::vector<double> params(2 + 2 * std::max(pa.pts.size(), pb.pts.size()));
+  return internal::overlap(pa.poly(), pb.poly(), tol, params.data(), [](const internal::Vec2&) {});
+}
+
 Poly face_polygon(const std::vector<std::vector<Eigen::Vector2d>>& loops) {
   Poly poly;
   for (std::size_t l = 0; l < loops.size(); ++l) {
@@ -65,16 +99,25 @@ std::optional<Vec3> face_overlap_centroid(const Polyhedron& A, const Pose& pose,
   const Poly pa = face_polygon(loops_a), pb = face_polygon(fb.loops_2d);
   std::vector<Poly> inter;
   bg::intersection(pa, pb, inter);
-  double best = 0;
+  double best = 0, total = 0;
   std::optional<Vec3> out;
   for (const auto& p : inter) {
     const double area = std::abs(bg::area(p));
+    total += area;
     if (area <= best) continue;
     P2 c;
     bg::centroid(p, c);
     best = area;
     out = fb.offset * fb.normal + c.x() * fb.u + c.y() * fb.v;
   }
+  // Where Boost.Geometry misses area (sides along each other to rounding), the whole
+  // overlap's centroid, when it lies in both faces.
+  const double tol = 1e-9 * std::max(A.size(), B.size());
+  const internal::Overlap2 o = loops_overlap(loops_a, fb.loops_2d, tol);
+  if (o.area - total <= tol * std::max(A.size(), B.size())) return out;
+  const Vec3 c = fb.offset * fb.normal + o.centroid.x() * fb.u + o.centroid.y() * fb.v;
+  if (B.face_inset(FaceId(b), c) > 0 && A.face_inset(FaceId(a), pose.inverse_apply(c)) > 0)
+    return c;
   return out;
 }
 
@@ -146,12 +189,7 @@ bool open_touch(const Polyhedron& A, const Pose& pose, ElementKind ka, int a, co
     loops_a.emplace_back();
     for (VertexId v : loop) loops_a.back().push_back(B.face_coords(FaceId(b), vA(v.value())));
   }
-  const Poly pa = face_polygon(loops_a), pb = face_polygon(fb.loops_2d);
-  std::vector<Poly> inter;
-  bg::intersection(pa, pb, inter);
-  double area = 0;
-  for (const auto& p : inter) area += bg::area(p);
-  return area > tol * std::max(A.size(), B.size());
+  return loops_overlap(loops_a, fb.loops_2d, tol).area > tol * std::max(A.size(), B.size());
 }
 
 }  // namespace cf::gen

@@ -179,7 +179,13 @@ bool arc_bound_helps(const ModelInfo& A_, const ModelInfo& B_, const Pc& pc, con
 }  // namespace
 
 Verifier::Verifier(const ModelInfo& a, const ModelInfo& b, const SearchParams& p)
-    : A_(a), B_(b), p_(p), scale_(std::max(a.model->size(), b.model->size())) {}
+    : A_(a),
+      B_(b),
+      p_(p),
+      scale_(std::max(a.model->size(), b.model->size())),
+      // Exact models' directions hold to rounding; others' to what their rotational
+      // conditions leave (rotation_conditions.hpp), which tilts a face's sides as much.
+      direction_tol_(std::max(1e-9, max_condition_tol(a, b) - kRotAccepted)) {}
 
 double Verifier::verified_local_slack() const { return 0.5 * std::sin(p_.angle_margin); }
 
@@ -295,7 +301,7 @@ bool Verifier::cones_disjoint(const Pose& pose, ElementKind ka, int a, ElementKi
   using K = ElementKind;
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
-  const double tol = 1e-9;  // on unit directions
+  const double tol = direction_tol_;  // on unit directions
   const Mat3& R = pose.R_BA;
   // A point on the open touching set, and a short probe length that stays near it.
   const ClosestPoints cp = element_distance(A, pose, ka, a, B, kb, b);
@@ -343,7 +349,7 @@ bool Verifier::cones_disjoint(const Pose& pose, ElementKind ka, int a, ElementKi
     const Vec3 da = R * A.edges()[a].dir;
     const Vec3& db = B.edges()[b].dir;
     Vec3 N = da.cross(db);
-    if (N.norm() > 1e-9) {
+    if (N.norm() > tol) {  // edges parallel to the models' precision are collinear
       // Crossing edges: the only plane that can separate the wedges holds both edges.
       if (!A.edges()[a].convex || !B.edges()[b].convex) return false;
       N.normalize();
@@ -401,6 +407,55 @@ double Verifier::verify(const PcSet& pcs, const Pose& pose, std::string* why) co
   return verify(pcs, pose, why, nullptr);
 }
 
+namespace {
+
+// mm: tilt_allowance of each PC of a set.
+using PcTilts = std::array<double, PcSet::kMaxPcs>;
+PcTilts pc_tilts(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs) {
+  PcTilts t{};
+  for (int i = 0; i < pcs.size(); ++i) t[i] = tilt_allowance(a, b, pcs[i]);
+  return t;
+}
+
+// Whether the closures of elements x and y of m share a vertex.
+bool closures_meet(const Polyhedron& m, ElementKind kx, int x, ElementKind ky, int y) {
+  auto vertices = [&](ElementKind k, int i, VertexId(&two)[2]) -> std::pair<const VertexId*, int> {
+    if (k == ElementKind::kFace) {
+      const auto& v = m.faces()[i].vertices;
+      return {v.data(), static_cast<int>(v.size())};
+    }
+    if (k == ElementKind::kEdge) {
+      two[0] = m.edges()[i].v0, two[1] = m.edges()[i].v1;
+      return {two, 2};
+    }
+    two[0] = VertexId(i);
+    return {two, 1};
+  };
+  VertexId bx[2], by[2];
+  const auto [px, nx] = vertices(kx, x, bx);
+  const auto [py, ny] = vertices(ky, y, by);
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j)
+      if (px[i] == py[j]) return true;
+  return false;
+}
+
+// mm: how close elements a of A and b of B must be to touch: touch_tol, and where both meet
+// a line or plane PC's elements (share a vertex with them) that lie along each other only to
+// the PC's tilt (tilt_allowance), that tilt more: the faces beside a face-edge PC that meet
+// along its edge are that far apart, not touching.
+double touch_along(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs, const PcTilts& tilt,
+                   double touch_tol, ElementKind ka, int a, ElementKind kb, int b) {
+  double along = touch_tol;
+  for (int i = 0; i < pcs.size(); ++i)
+    if (tilt[i] > 0 && closures_meet(A, ka, a, a_kind(pcs[i].type), pcs[i].a) &&
+        closures_meet(B, kb, b, b_kind(pcs[i].type), pcs[i].b))
+      along = std::max(along, touch_tol + tilt[i]);
+  return along;
+}
+
+}  // namespace
+
 bool covered_by(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs, ElementKind ka, int a,
                 ElementKind kb, int b) {
   for (const Pc& pc : pcs)
@@ -425,13 +480,14 @@ bool Verifier::still_fails(const PcSet& pcs, const Pose& pose, const FailedPair&
   // verify's overlap test, for a pair that is a PC or covered by one (as recorded).
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
-  return overlap_at(pose, f.ka, f.a, f.kb, f.b,
-                    element_distance(A, pose, f.ka, f.a, B, f.kb, f.b).distance);
+  return overlap_at(
+      pose, f.ka, f.a, f.kb, f.b, element_distance(A, pose, f.ka, f.a, B, f.kb, f.b).distance,
+      touch_along(A, B, pcs, pc_tilts(A_, B_, pcs), p_.touch_tol, f.ka, f.a, f.kb, f.b));
 }
 
-bool Verifier::overlap_at(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b,
-                          double d) const {
-  return d <= p_.touch_tol && open_touch(*A_.model, pose, ka, a, *B_.model, kb, b, p_.touch_tol) &&
+bool Verifier::overlap_at(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b, double d,
+                          double tol) const {
+  return d <= tol && open_touch(*A_.model, pose, ka, a, *B_.model, kb, b, tol) &&
          !cones_disjoint(pose, ka, a, kb, b);
 }
 
@@ -453,7 +509,7 @@ double Verifier::verify(const PcSet& pcs, const Pose& pose, std::string* why,
   // Line and plane PCs need their rotational conditions (a rotation found by a motion may
   // only nearly satisfy them).
   {
-    const RotConstraints c = rotation_constraints(pcs, A, B);
+    const RotConstraints c = rotation_constraints(pcs, A_, B_);
     if (!satisfies(c, pose.R_BA)) return reject("a line or plane PC is not parallel to its face");
   }
   // Pairwise distinct contact planes.
@@ -471,6 +527,7 @@ double Verifier::verify(const PcSet& pcs, const Pose& pose, std::string* why,
   a_vertex_gap.assign(A.num_vertices(), clearance);
   b_vertex_gap.assign(B.num_vertices(), clearance);
   int touching_pcs = 0;
+  const PcTilts tilt = pc_tilts(A_, B_, pcs);
   // Pairs proven farther apart than good_clearance can neither touch nor lower the clearance
   // below what counts as good: not measured.
   NearPairs near(A_, B_, pose, p_.good_clearance);
@@ -491,14 +548,15 @@ double Verifier::verify(const PcSet& pcs, const Pose& pose, std::string* why,
     for (const Pc& pc : pcs)
       if (a_kind(pc.type) == ka && b_kind(pc.type) == kb && pc.a == a && pc.b == b) is_pc = true;
     const bool covered = covered_by(A, B, pcs, ka, a, kb, b);
+    const double along = touch_along(A, B, pcs, tilt, p_.touch_tol, ka, a, kb, b);
     if (is_pc) {
-      if (d > p_.touch_tol)
+      if (d > along)
         return reject_with([&] {
           return "PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " apart by " + std::to_string(d);
         });
       // The open elements must touch: a face meeting an edge only at its own boundary
       // realises an edge-edge PC, not face-edge.
-      if (!open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol))
+      if (!open_touch(A, pose, ka, a, B, kb, b, along))
         return reject_with([&] {
           return "PC " + to_string(pc_of(pcs, ka, a, kb, b)) + " touches only on its boundary";
         });
@@ -508,7 +566,7 @@ double Verifier::verify(const PcSet& pcs, const Pose& pose, std::string* why,
     // disjoint interiors; pairs that touch only through their boundaries are judged
     // as those boundary pairs. This catches a face of A running through a reflex edge
     // of B, which no pair reports as crossing.
-    if ((is_pc || covered) && overlap_at(pose, ka, a, kb, b, d)) {
+    if ((is_pc || covered) && overlap_at(pose, ka, a, kb, b, d, along)) {
       if (failed) *failed = FailedPair{FailedPair::Kind::kOverlap, ka, kb, a, b};
       return reject_with([&] {
         return "A and B overlap where " + kind_name(ka) + std::to_string(a) + " touches " +
@@ -518,7 +576,7 @@ double Verifier::verify(const PcSet& pcs, const Pose& pose, std::string* why,
     if (!is_pc && !covered) {
       // Closed elements that meet only on their boundaries do not touch: their boundary
       // elements do, and those pairs are judged on their own.
-      if (d <= p_.touch_tol && !open_touch(A, pose, ka, a, B, kb, b, p_.touch_tol)) continue;
+      if (d <= along && !open_touch(A, pose, ka, a, B, kb, b, along)) continue;
       if (d < p_.min_clearance) {
         if (failed) *failed = FailedPair{FailedPair::Kind::kObstacle, ka, kb, a, b};
         return reject_with([&] {

@@ -141,14 +141,16 @@ class Verifier {
   // vertex-vertex probe along each cone's inward axis).
   bool cones_disjoint(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b) const;
   // Whether A and B overlap where element a of A touches element b of B, d apart: they
-  // touch in open points and their tangent cones there are not disjoint (verify's test for a
-  // PC or a pair a PC covers).
-  bool overlap_at(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b, double d) const;
+  // touch in open points (within tol) and their tangent cones there are not disjoint
+  // (verify's test for a PC or a pair a PC covers).
+  bool overlap_at(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b, double d,
+                  double tol) const;
 
   const ModelInfo& A_;
   const ModelInfo& B_;
   SearchParams p_;
   double scale_;
+  double direction_tol_;  // on unit directions: rounding, or the models' precision over extent
 };
 
 /// "v", "e" or "f": the letter of an element's kind in messages.
