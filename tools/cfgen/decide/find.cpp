@@ -493,22 +493,24 @@ std::vector<Mat3> FindRun::consistent_rotations(const std::vector<Mat3>& rots) c
   const Polyhedron& B = *s_.b().model;
   std::vector<Mat3> out;
   const RotConstraints c = rotation_constraints(pcs_, s_.a(), s_.b());
+  const double dependent = direction_tol(s_.a(), s_.b());
   // Whether the planes are dependent holds along the whole family: the rotations tried
   // already tell, before the samples are made again.
-  if (!c.align.empty() || (!rots.empty() && !translation_residual(A, B, pcs_, rots.front())))
+  if (!c.align.empty() ||
+      (!rots.empty() && !translation_residual(A, B, pcs_, rots.front(), dependent)))
     return out;
   const std::vector<Mat3> samples =
       s_.family_samples(pcs_, s_.spread_rotations(pcs_, seeds_), p_.theta_samples);
-  if (samples.empty() || !translation_residual(A, B, pcs_, samples.front())) return out;
+  if (samples.empty() || !translation_residual(A, B, pcs_, samples.front(), dependent)) return out;
   std::vector<Mat3> starts;
   for (Mat3 R : samples)
-    if (starts.size() < kStarts && project_consistent(A, B, pcs_, c, R) &&
+    if (starts.size() < kStarts && project_consistent(A, B, pcs_, c, R, dependent) &&
         s_.local_margin(pcs_, R) > min_local_)
       add_unique(starts, R);
   const std::vector<int> first_pieces(slot_sizes_.size(), 0);
   for (const Mat3& R0 : starts)
     for (const std::vector<Mat3>& path :
-         walk_consistent(A, B, pcs_, c, R0, kWalkStep, kWalkSteps)) {
+         walk_consistent(A, B, pcs_, c, R0, kWalkStep, kWalkSteps, dependent)) {
       double best = p_.min_margin;
       std::optional<Mat3> best_R;
       for (const Mat3& R : path) {

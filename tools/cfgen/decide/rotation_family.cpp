@@ -362,8 +362,7 @@ std::vector<double> admissible_spins(const ModelInfo& a, const ModelInfo& b, con
 }
 
 std::optional<double> translation_residual(const Polyhedron& A, const Polyhedron& B,
-                                           const PcSet& pcs, const Mat3& R) {
-  constexpr double kDependent = 1e-9;  // |det| of unit normals: dependent up to rounding
+                                           const PcSet& pcs, const Mat3& R, double dependent) {
   if (pcs.size() != 3 && pcs.size() != 2) return std::nullopt;
   Vec3 n[3];
   double h[3];
@@ -408,10 +407,10 @@ std::optional<double> translation_residual(const Polyhedron& A, const Polyhedron
     ++i;
   }
   if (pcs.size() == 2) {
-    if (n[0].cross(n[1]).norm() > kDependent) return std::nullopt;
+    if (n[0].cross(n[1]).norm() > dependent) return std::nullopt;
     return h[1] - (n[0].dot(n[1]) > 0 ? h[0] : -h[0]);
   }
-  if (std::abs(n[0].cross(n[1]).dot(n[2])) > kDependent) return std::nullopt;
+  if (std::abs(n[0].cross(n[1]).dot(n[2])) > dependent) return std::nullopt;
   // The plane of the normals, from the first pair not near parallel: the same pair all along
   // a family, so that the residual's sign is continuous there.
   Vec3 m = n[0].cross(n[1]);
@@ -428,11 +427,11 @@ namespace {
 // The perpendicularity conditions' residuals and the planes' (scaled by 1 / size), and their
 // Jacobian in a turn of R (numerical).
 bool consistency_rows(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs,
-                      const RotConstraints& c, const Mat3& R, Eigen::VectorXd& r,
+                      const RotConstraints& c, const Mat3& R, double dependent, Eigen::VectorXd& r,
                       Eigen::MatrixXd* J) {
   const double size = std::max((A.bbox_max() - A.bbox_min()).norm(), 1e-9);
   auto rows = [&](const Mat3& Q, Eigen::VectorXd& out) {
-    const std::optional<double> t = translation_residual(A, B, pcs, Q);
+    const std::optional<double> t = translation_residual(A, B, pcs, Q, dependent);
     if (!t) return false;
     out.resize(static_cast<Eigen::Index>(c.perp.size()) + 1);
     for (std::size_t i = 0; i < c.perp.size(); ++i)
@@ -461,14 +460,21 @@ Vec3 consistent_tangent(const Eigen::MatrixXd& J) {
 }  // namespace
 
 bool project_consistent(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs,
-                        const RotConstraints& c, Mat3& R) {
+                        const RotConstraints& c, Mat3& R, double dependent) {
   if (!c.align.empty()) return false;
+  // As project_perp: conditions equal to within their tolerance count as one, and then hold
+  // to it rather than to rounding.
+  const double rank_tol = c.max_tol() > kRotAccepted ? c.max_tol() : 0;
   Eigen::VectorXd r;
   Eigen::MatrixXd J;
   for (int it = 0; it < 40; ++it) {
-    if (!consistency_rows(A, B, pcs, c, R, r, &J)) return false;
+    if (!consistency_rows(A, B, pcs, c, R, dependent, r, &J)) return false;
     if (r.cwiseAbs().maxCoeff() < 1e-13) return true;
-    const Eigen::Vector3d d = -J.completeOrthogonalDecomposition().solve(r);
+    if (rank_tol > 0 && std::abs(r[r.size() - 1]) < 1e-13 && satisfies(c, R)) return true;
+    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
+    if (rank_tol > 0) cod.setThreshold(rank_tol);
+    cod.compute(J);
+    const Eigen::Vector3d d = -cod.solve(r);
     if (!d.allFinite() || d.norm() < 1e-16) return false;
     R = axis_angle(d.normalized(), std::min(d.norm(), 0.3)) * R;
   }
@@ -477,11 +483,11 @@ bool project_consistent(const Polyhedron& A, const Polyhedron& B, const PcSet& p
 
 std::vector<std::vector<Mat3>> walk_consistent(const Polyhedron& A, const Polyhedron& B,
                                                const PcSet& pcs, const RotConstraints& c,
-                                               const Mat3& R, double h, int n) {
+                                               const Mat3& R, double h, int n, double dependent) {
   std::vector<std::vector<Mat3>> paths;
   Eigen::VectorXd r;
   Eigen::MatrixXd J;
-  if (!consistency_rows(A, B, pcs, c, R, r, &J)) return paths;
+  if (!consistency_rows(A, B, pcs, c, R, dependent, r, &J)) return paths;
   const Vec3 t0 = consistent_tangent(J);
   for (double sg : {1.0, -1.0}) {
     std::vector<Mat3> path;
@@ -489,7 +495,8 @@ std::vector<std::vector<Mat3>> walk_consistent(const Polyhedron& A, const Polyhe
     Vec3 dir = sg * t0;
     for (int k = 0; k < n; ++k) {
       Mat3 next = axis_angle(dir, h) * Q;
-      if (!project_consistent(A, B, pcs, c, next) || !consistency_rows(A, B, pcs, c, next, r, &J))
+      if (!project_consistent(A, B, pcs, c, next, dependent) ||
+          !consistency_rows(A, B, pcs, c, next, dependent, r, &J))
         break;
       Vec3 t = consistent_tangent(J);
       dir = t.dot(dir) < 0 ? Vec3(-t) : t;  // keep going the same way

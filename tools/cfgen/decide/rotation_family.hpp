@@ -57,19 +57,24 @@ std::vector<std::vector<Mat3>> walk_family(const RotConstraints& c, const Mat3& 
 /// (two parallel edges of A on the facing walls of a slot) meet only where h_2 = s h_1, s the
 /// sign of n_1 . n_2: A's width across them must be the slot's. Returns z . h (mm) at R, or
 /// h_2 - s h_1 for two PCs; nothing when the set has not two or three PCs or the normals are
-/// independent at R.
+/// independent at R: further than `dependent` (a sine, or the determinant of three unit
+/// normals) from dependent; direction_tol on models known to a precision, whose parallel
+/// faces are parallel only to it.
 std::optional<double> translation_residual(const Polyhedron& A, const Polyhedron& B,
-                                           const PcSet& pcs, const Mat3& R);
+                                           const PcSet& pcs, const Mat3& R,
+                                           double dependent = 1e-9);
 
 /// Rotations that meet the perpendicularity conditions of `c` (no alignment) and make the
 /// PCs' planes meet (translation_residual == 0), where the residual is defined: R projected
 /// onto them by Gauss-Newton (false when that fails), and the curve of such rotations walked
 /// from R by steps of h rad, at most n each way (both ways, R excluded).
+/// `dependent` as translation_residual's.
 bool project_consistent(const Polyhedron& A, const Polyhedron& B, const PcSet& pcs,
-                        const RotConstraints& c, Mat3& R);
+                        const RotConstraints& c, Mat3& R, double dependent = 1e-9);
 std::vector<std::vector<Mat3>> walk_consistent(const Polyhedron& A, const Polyhedron& B,
                                                const PcSet& pcs, const RotConstraints& c,
-                                               const Mat3& R, double h, int n);
+                                               const Mat3& R, double h, int n,
+                                               double dependent = 1e-9);
 
 /// Spins phi (rad) at which R0 Rot(axis, phi) (axis: unit, A's frame) holds every PC of `pcs`
 /// locally admissible, its local margin (Verifier::local_margin) above min_local: the centres

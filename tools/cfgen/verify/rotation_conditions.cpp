@@ -39,6 +39,10 @@ double max_condition_tol(const ModelInfo& a, const ModelInfo& b) {
   return std::max(kRotAccepted, kRotPerPrecision * (max_tilt(a) + max_tilt(b)));
 }
 
+double direction_tol(const ModelInfo& a, const ModelInfo& b) {
+  return std::max(1e-9, max_condition_tol(a, b) - kRotAccepted);
+}
+
 double tilt_allowance(const ModelInfo& a, const ModelInfo& b, const Pc& pc) {
   constexpr ElementKind kE = ElementKind::kEdge, kF = ElementKind::kFace;
   switch (pc.type) {

@@ -62,6 +62,12 @@ double condition_tol(const ModelInfo& a, ElementKind ka, int ia, const ModelInfo
 /// rad: the largest condition_tol of any pair of elements of `a` and `b`.
 double max_condition_tol(const ModelInfo& a, const ModelInfo& b);
 
+/// Sine to which two directions of the models count as parallel, or a direction as in a
+/// plane: 1e-9 (rounding) on exact models, what max_condition_tol leaves over kRotAccepted on
+/// models known to a precision (two faces at a right angle in the design are at one to
+/// 1e-7 rad in a float32 file).
+double direction_tol(const ModelInfo& a, const ModelInfo& b);
+
 /// mm: how far a line or plane PC's element of A may lie off the other element's line or
 /// plane, beyond touching, when its condition leaves what the models' precision allows over
 /// kRotAccepted: that excess times the element's extent (an f-f's face of A across, an e-f's

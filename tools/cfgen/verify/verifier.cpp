@@ -183,9 +183,7 @@ Verifier::Verifier(const ModelInfo& a, const ModelInfo& b, const SearchParams& p
       B_(b),
       p_(p),
       scale_(std::max(a.model->size(), b.model->size())),
-      // Exact models' directions hold to rounding; others' to what their rotational
-      // conditions leave (rotation_conditions.hpp), which tilts a face's sides as much.
-      direction_tol_(std::max(1e-9, max_condition_tol(a, b) - kRotAccepted)) {}
+      direction_tol_(direction_tol(a, b)) {}
 
 double Verifier::verified_local_slack() const { return 0.5 * std::sin(p_.angle_margin); }
 
@@ -350,15 +348,18 @@ bool Verifier::cones_disjoint(const Pose& pose, ElementKind ka, int a, ElementKi
     const Vec3& db = B.edges()[b].dir;
     Vec3 N = da.cross(db);
     if (N.norm() > tol) {  // edges parallel to the models' precision are collinear
-      // Crossing edges: the only plane that can separate the wedges holds both edges.
+      // Crossing edges: the only plane that can separate the wedges holds both edges. An
+      // edge tilted by tol (models known to a precision) turns that plane by tol over the
+      // sine between the edges.
       if (!A.edges()[a].convex || !B.edges()[b].convex) return false;
+      const double side_tol = tol > 1e-9 ? tol / N.norm() : tol;
       N.normalize();
       auto side = [&](const Vec3& n) {
         return std::min({B_.wedges[b].into_left.dot(n), B_.wedges[b].into_right.dot(n),
                          -(R * A_.wedges[a].into_left).dot(n),
                          -(R * A_.wedges[a].into_right).dot(n)});
       };
-      return std::max(side(N), side(-N)) >= -tol;
+      return std::max(side(N), side(-N)) >= -side_tol;
     }
     // Collinear edges: the two wedges' angular sectors about the common line must not overlap.
     const Vec3 u = B_.wedges[b].into_left, w = db.cross(u);
