@@ -293,3 +293,28 @@ TEST_CASE("project perp: two conditions equal to their tolerance are projected o
   }
   CHECK(projected == 50);
 }
+
+TEST_CASE(
+    "translation residual: planes parallel to within a given sine count as parallel, not as "
+    "meeting",
+    "[rotation_family][cfgen]") {
+  // An e-f on B's floor top (normal +y) and an f-v on A's bottom face (normal -y, turned with
+  // A): at a turn of 1e-7 rad about z the planes are 1e-7 from parallel, as two faces at a
+  // right angle in the design are in a float32 file. Exact models keep rounding's 1e-9 and see
+  // two planes meeting in a line; models known to their precision pass it (direction_tol).
+  const cf::Polyhedron A = cf::test::box(40, 10, 10, "A");
+  const cf::Polyhedron B = cf::test::small_l_block();
+  const int e_near = cf::test::edge_between(A, 0, 4);
+  const int bottom = face_with_normal(A, Vec3(0, -1, 0));
+  const int floor_top = cf::test::face_with_plane(B, Vec3::UnitY(), 10);
+  REQUIRE(e_near >= 0);
+  REQUIRE(bottom >= 0);
+  REQUIRE(floor_top >= 0);
+  cf::PcSet pcs;
+  pcs.insert(cf::Pc{cf::PcType::kEF, e_near, floor_top});
+  pcs.insert(cf::Pc{cf::PcType::kFV, bottom, 0});
+  const Mat3 R = cf::gen::axis_angle(Vec3::UnitZ(), 1e-7);
+  CHECK_FALSE(cf::gen::internal::translation_residual(A, B, pcs, R).has_value());
+  CHECK(cf::gen::internal::translation_residual(A, B, pcs, R, 1e-6).has_value());
+  CHECK_FALSE(cf::gen::internal::translation_residual(A, B, pcs, R, 1e-8).has_value());
+}
