@@ -166,14 +166,19 @@ double face_width(const Face& f) {
   return hi - lo;
 }
 
+// ModelInfo::extent: each edge's length and each face's width.
+void add_extents(const Polyhedron& m, ModelInfo& info) {
+  for (const Edge& E : m.edges()) info.extent[1].push_back(E.length);
+  for (const Face& F : m.faces()) info.extent[2].push_back(face_width(F));
+}
+
 }  // namespace
 
 ModelInfo analyse_model(const Polyhedron& m, double precision_mm) {
   ModelInfo info;
   info.model = &m;
   info.precision_mm = precision_mm;
-  for (const Edge& E : m.edges()) info.extent[1].push_back(E.length);
-  for (const Face& F : m.faces()) info.extent[2].push_back(face_width(F));
+  add_extents(m, info);
   const double tol = 1e-9 * m.size();
   info.cones.resize(m.num_vertices());
   for (std::size_t v = 0; v < m.num_vertices(); ++v) {
