@@ -1527,3 +1527,50 @@ TEST_CASE("cfgen: cube in a U-channel wider than the cube", "[cfgen][hand]") {
   CHECK(found == 48);
   check_witnesses(g, "cube vs U-channel");
 }
+
+TEST_CASE("cfgen: cube in a slot exactly its width, whose faces never touch one wall alone",
+          "[cfgen][hand]") {
+  // The U-channel's slot is 30 mm wide (walls x = 20, normal +x, and x = 50, normal -x; floor
+  // y = 20), the cube's width: whenever a cube face lies on one wall, the opposite face lies
+  // on the other. No single PC of a face on a wall is a CF, nor a face on the floor with a
+  // face on one wall; the CFs of faces on the walls are the cube held between both, lifted
+  // or on the floor. (A face on the floor alone is a CF: the cube turned about the vertical,
+  // over the slot's open end.) Levels that pair only valid sets never propose them: a set is
+  // a candidate when its subsets are valid or open (failed, no rule refutes them).
+  const Generated& g = generated(
+      "cube/exact_slot", [] { return load("cube.off"); },
+      [] { return cf::test::from_oracle(oracle::make_u_channel(30, 20, 20, 80, 80), "slot"); });
+  const Polyhedron& A = *g.A;
+  const Polyhedron& B = *g.B;
+  const int left = face_with(B, Vec3::UnitX(), 20), right = face_with(B, -Vec3::UnitX(), -50),
+            floor = face_with(B, Vec3::UnitY(), 20);
+  std::set<std::vector<Pc>> want2, want3, got2, got3;
+  for (const Vec3& a : axes()) {
+    const Pc l{PcType::kFF, cube_face(A, a), left}, r{PcType::kFF, cube_face(A, -a), right};
+    const PcSet walls({l, r});
+    want2.insert({walls.begin(), walls.end()});
+    for (const Vec3& b : axes()) {
+      if (std::abs(a.dot(b)) > 0.5) continue;
+      const PcSet seat({l, r, Pc{PcType::kFF, cube_face(A, b), floor}});
+      want3.insert({seat.begin(), seat.end()});
+    }
+  }
+  REQUIRE(want2.size() == 6);   // 3 axes across the slot, each either way
+  REQUIRE(want3.size() == 24);  // and 4 faces down for each
+  auto wall = [&](const Pc& pc) { return pc.b == left || pc.b == right; };
+  for (std::size_t i = 0; i < g.graph->num_cfs(); ++i) {
+    const PcSet& s = g.graph->cf(cf::CfId(static_cast<int>(i))).pcs;
+    int on_walls = 0;
+    bool ff_inside = true;
+    for (const Pc& pc : s) {
+      on_walls += pc.type == PcType::kFF && wall(pc);
+      ff_inside = ff_inside && pc.type == PcType::kFF && (wall(pc) || pc.b == floor);
+    }
+    INFO("CF {" << cf::to_string(s) << "}");
+    CHECK(on_walls != 1);  // a face on one wall has the opposite face on the other
+    if (on_walls == 2 && ff_inside) (s.size() == 2 ? got2 : got3).insert({s.begin(), s.end()});
+  }
+  CHECK(got2 == want2);
+  CHECK(got3 == want3);
+  check_witnesses(g, "cube in an exact slot");
+}

@@ -5,8 +5,13 @@
 #include "analysed_pair.hpp"
 #include "cfgen/decide/task.hpp"
 #include "fixtures.hpp"
+#include "oracle_pair.hpp"
+#include "shapes.hpp"
 
 #include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
 
 namespace {
 
@@ -78,4 +83,46 @@ TEST_CASE(
   const PcSet one_vertex({Pc{PcType::kVF, 0, kTop}, Pc{PcType::kVF, 0, 2}});
   CHECK_FALSE(search.plausible(one_vertex));
   CHECK(search.refuted(one_vertex));
+}
+
+TEST_CASE("decide: a face forced onto a second wall is read where the search was blocked",
+          "[decide]") {
+  // A 10 mm cube in a slot exactly 10 mm wide (walls x = 20, normal +x, and x = 30, normal -x):
+  // a face on one wall puts the opposite face on the other, so the single PC has no witness,
+  // and the failed search reports the pair of PCs it met wherever it placed the contact.
+  cf::test::AnalysedPair p(cf::test::box(10, 10, 10, "A"),
+                           cf::test::from_oracle(oracle::make_u_channel(10, 20, 20, 40, 40), "U"));
+  const cf::gen::WitnessSearch search(p.ai, p.bi, {});
+  auto face_with = [](const cf::Polyhedron& m, const cf::Vec3& n, double d) {
+    for (std::size_t f = 0; f < m.num_faces(); ++f)
+      if ((m.faces()[f].normal - n).norm() < 1e-9 && std::abs(m.faces()[f].offset - d) < 1e-9)
+        return static_cast<int>(f);
+    return -1;
+  };
+  const int left = face_with(p.B, cf::Vec3::UnitX(), 20);
+  const int right = face_with(p.B, -cf::Vec3::UnitX(), -30);
+  const int a_left = face_with(p.A, -cf::Vec3::UnitX(), 0);  // box spans [0, 10]^3
+  const int a_right = face_with(p.A, cf::Vec3::UnitX(), 10);
+  REQUIRE(left >= 0);
+  REQUIRE(right >= 0);
+  REQUIRE(a_left >= 0);
+  REQUIRE(a_right >= 0);
+  cf::gen::Task t;
+  t.pcs = PcSet({Pc{PcType::kFF, a_left, left}});
+  const cf::gen::TaskResult r = cf::gen::decide(search, t);
+  CHECK_FALSE(r.witness.found);
+  CHECK_FALSE(search.refuted(t.pcs));  // open: it holds, only never alone
+  const PcSet both({Pc{PcType::kFF, a_left, left}, Pc{PcType::kFF, a_right, right}});
+  REQUIRE_FALSE(r.met.empty());
+  for (const cf::gen::Discovery& d : r.met) {
+    INFO("met {" << cf::to_string(d.pcs) << "}");
+    CHECK(d.pcs.contains(t.pcs[0]));
+    CHECK(d.pcs.size() > 1);
+  }
+  const bool pair_met = std::any_of(r.met.begin(), r.met.end(),
+                                    [&](const cf::gen::Discovery& d) { return d.pcs == both; });
+  CHECK(pair_met);
+  // The pose it was met at is a witness of the pair, up to refining the translation.
+  for (const cf::gen::Discovery& d : r.met)
+    if (d.pcs == both) CHECK(search.refine(both, d.pose).found);
 }

@@ -28,6 +28,13 @@ class FindRun {
         seeds_only_(seeds_only),
         slot_sizes_(s.piece_slots(pcs)) {}
   Witness run();
+  /// The poses the last stage climbs from (Blocked) whose obstacle touches, in the order met.
+  std::vector<Pose> blocked_poses() const {
+    std::vector<Pose> out;
+    for (const Blocked& b : blocked_)
+      if (const Pose pose{b.R, b.t}; s_.obstacle_touches(pose, b.obstacle)) out.push_back(pose);
+    return out;
+  }
 
  private:
   using FailedPair = Verifier::FailedPair;
@@ -559,9 +566,12 @@ Witness FindRun::run() {
 
 namespace cf::gen {
 
-Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds,
-                            bool seeds_only) const {
-  return internal::FindRun(*this, pcs, seeds, seeds_only).run();
+Witness WitnessSearch::find(const PcSet& pcs, const std::vector<Mat3>& seeds, bool seeds_only,
+                            std::vector<Pose>* blocked) const {
+  internal::FindRun run(*this, pcs, seeds, seeds_only);
+  const Witness w = run.run();
+  if (blocked && !w.found) *blocked = run.blocked_poses();
+  return w;
 }
 
 }  // namespace cf::gen

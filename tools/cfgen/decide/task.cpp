@@ -1,13 +1,41 @@
 #include "cfgen/decide/task.hpp"
 
+#include <algorithm>
+
 namespace cf::gen {
+
+namespace {
+
+// The contact sets larger than `pcs` and holding all of it, read at the poses where a failed
+// search placed its contacts and met another pair of elements: contacts such a pose forces (a
+// part in a slot exactly its width touches both walls) make a set the levels may not propose
+// (docs/generator.md, "Enumeration, level by level").
+std::vector<Discovery> forced_supersets(const WitnessSearch& search, const PcSet& pcs,
+                                        const std::vector<Pose>& blocked) {
+  std::vector<Discovery> out;
+  for (const Pose& pose : blocked) {
+    PcSet t;
+    if (!search.contacts_at(pose, t) || t.size() <= pcs.size()) continue;
+    bool holds = true;
+    for (const Pc& pc : pcs) holds = holds && t.contains(pc);
+    const bool known =
+        std::any_of(out.begin(), out.end(), [&](const Discovery& d) { return d.pcs == t; });
+    if (holds && !known) out.push_back({t, pose});
+  }
+  return out;
+}
+
+}  // namespace
 
 TaskResult decide(const WitnessSearch& search, const Task& task) {
   TaskResult r;
   switch (task.kind) {
-    case Task::Kind::kFind:
-      r.witness = search.find(task.pcs, task.seeds);
+    case Task::Kind::kFind: {
+      std::vector<Pose> blocked;
+      r.witness = search.find(task.pcs, task.seeds, false, &blocked);
+      r.met = forced_supersets(search, task.pcs, blocked);
       break;
+    }
     case Task::Kind::kFindNear:
       r.witness = search.find(task.pcs, task.seeds, true);
       break;

@@ -29,9 +29,11 @@ struct Task {
 };
 
 struct TaskResult {
-  Witness witness;             // kFind, kFindOrRefine, kFindNear, kVerify (pose and clearance)
-  std::vector<Discovery> met;  // kExplore: the contact sets met, in a fixed order
-  std::vector<PcSet> sets;     // the enumeration's own items (Stage::compute), not a search's
+  Witness witness;  // kFind, kFindOrRefine, kFindNear, kVerify (pose and clearance)
+  // kExplore: the contact sets met, in a fixed order; kFind without a witness: the larger
+  // sets read where the contacts were placed and something else touched (forced contacts)
+  std::vector<Discovery> met;
+  std::vector<PcSet> sets;  // the enumeration's own items (Stage::compute), not a search's
 };
 
 /// Answers one task with `search`.

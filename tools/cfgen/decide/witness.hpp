@@ -64,7 +64,11 @@ class WitnessSearch : public Verifier {
   /// With `seeds_only`, a search near given rotations: tries only the seeds and rotations
   /// 0.01 and 0.025 rad about each axis from them (projected onto the PCs' rotational
   /// conditions), then climbs past the obstacles met there.
-  Witness find(const PcSet& pcs, const std::vector<Mat3>& seeds, bool seeds_only = false) const;
+  /// When no witness is found and `blocked` is given, it receives the poses where the
+  /// contacts were placed and the centred translation touched another pair of elements (up
+  /// to 4).
+  Witness find(const PcSet& pcs, const std::vector<Mat3>& seeds, bool seeds_only = false,
+               std::vector<Pose>* blocked = nullptr) const;
 
   /// A witness for `pcs` near `pose`, a pose where they hold (found by a motion): moved
   /// towards the centre of the translations that keep the contacts, or `pose` itself, when

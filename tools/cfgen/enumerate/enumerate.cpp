@@ -26,28 +26,29 @@ Enumerator::Enumerator(const WitnessSearch& search, const EnumerateOptions& opt,
   out_.symmetries_b = sym_.size_b();
 }
 
-// Levels and motion to a fixed point, then the neighbour rounds, to a fixed point of both: a
-// single PC or a pair that only motion found takes part in the levels above it like any
-// other (a CF's subsets need not be found first).
+// Levels and motion to a fixed point, then the open single PCs admitted to the pairs, then
+// the neighbour rounds, to a fixed point of all: a single PC or a pair that only motion found
+// takes part in the levels above it like any other (a CF's subsets need not be found first).
 Enumeration Enumerator::run() {
   singles_level();
   for (;;) {
     if (opt_.max_pcs >= 2) pairs_level();
     if (opt_.max_pcs >= 3) triples_level();
     motion_closure();
-    const bool grew = (opt_.max_pcs >= 2 && valid_[0].size() > singles_paired_) ||
+    const bool grew = (opt_.max_pcs >= 2 && valid_[0].size() > singles_valid_) ||
                       (opt_.max_pcs >= 3 && valid_[1].size() > pairs_tripled_);
-    if (!grew && neighbour_round() == 0) break;
+    if (!grew && !admit_open_singles() && neighbour_round() == 0) break;
   }
   release_neighbour_rounds();
   if (opt_.close_orbits) close_orbits();
   for (int l = 0; l < 3; ++l) out_.levels[l].valid = valid_[l].size();
   if (!opt_.records) return std::move(out_);
+  // What was searched is done with; the proofs take a large pair's failed sets in memory.
+  PcSetMap<std::uint8_t>().swap(seen_);
   find_undecided();
   build_records();
   // The search's own sets are done with: a large pair's candidates take hundreds of MB,
   // which the transitions and the file need more.
-  PcSetSet().swap(seen_);
   std::vector<PcSet>().swap(failed_);
   PcSetMap<Mat3>().swap(witness_rot_);
   for (auto& v : valid_) std::vector<std::pair<PcSet, Witness>>().swap(v);

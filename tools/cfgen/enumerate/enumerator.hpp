@@ -28,6 +28,8 @@ constexpr std::size_t kOrbitTries = 4;
 // witness reach the images of the same. On the hexagonal pair 4 find 13 orbits more than 1
 // at 17% more time, 16 one more than 4.
 constexpr std::size_t kWitnessesPerOrbit = 4;
+// seen_'s value for a set searched with every subset's witness, or met outside the levels.
+constexpr std::uint8_t kAllSeeds = 0xff;
 
 struct PcSetHash {
   std::size_t operator()(const PcSet& s) const { return s.hash(); }
@@ -79,6 +81,12 @@ class Enumerator {
   void singles_level();
   std::vector<PcSet> single_candidates() const;
   std::vector<Mat3> seeds_from_subsets(const PcSet& s) const;
+  int valid_subsets(const PcSet& s) const;
+  void update_open_singles();
+  bool admit_open_singles();
+  void retry_if_seeded(const PcSet& s, std::vector<PcSet>& cands);
+  void note_seeds(const std::vector<PcSet>& cands);
+  void mark_searched(const PcSet& s);
   std::vector<PcSet> build_pairs();
   void pairs_level();
   void triples_level();
@@ -89,7 +97,7 @@ class Enumerator {
   Sample sample_sets(int level, const std::vector<PcSet>& pool, const SeedsOf& seeds_of,
                      std::size_t count, std::size_t tries);
   std::vector<PcSet> grown_sets(int level, const std::vector<PcSet>& singles, double& mean_added);
-  std::vector<PcSet> with_valid_subsets(const std::vector<PcSet>& pool, double& fraction);
+  std::vector<PcSet> with_candidate_subsets(const std::vector<PcSet>& pool, double& fraction);
   double explore_seconds(std::size_t count, std::vector<Discovery>& singles);
   struct PairSample {
     std::size_t singles = 0;  // motion-only single PCs sampled
@@ -106,6 +114,7 @@ class Enumerator {
   void motion_closure();
   void more_witnesses(Clock::time_point t0);
   void explore_frontier(Clock::time_point t0);
+  std::size_t search_met(const std::vector<Discovery>& met, Clock::time_point t0);
   // neighbours.cpp
   void know_neighbours(const std::vector<Pc>& pcs);
   template <class R>
@@ -151,7 +160,8 @@ class Enumerator {
   // finish.cpp
   void close_orbits();
   void find_undecided();
-  void decide_over_cells(std::vector<char>& state, std::vector<Witness>& found,
+  void decide_over_cells(std::vector<char>& state,
+                         std::vector<std::pair<std::size_t, Witness>>& found,
                          std::vector<SetDecision>& decisions);
   std::vector<std::pair<PcSet, Witness>> find_thin(const std::vector<PcSet>& open);
   SetDecision certified(const PcSet& s, const RuleVerdict& rule, CellSearchLimits limits) const;
@@ -172,12 +182,33 @@ class Enumerator {
   Enumeration out_;
   std::vector<std::pair<PcSet, Witness>> valid_[3];
   std::vector<PcSet> failed_;  // candidates the search found no witness for
-  // Every set that reached the witness search or was found valid: nothing is searched twice.
-  PcSetSet seen_;
+  // Every set that reached the witness search or was found valid, with how many of its
+  // subsets one PC smaller were valid when it was searched (kAllSeeds: all of them, or a set
+  // met outside the levels): nothing is searched twice with the same seeds.
+  PcSetMap<std::uint8_t> seen_;
   PcSetMap<Mat3> witness_rot_;                    // seeds for the sets above them
   std::vector<std::pair<PcSet, Pose>> frontier_;  // valid sets not explored by motion yet
-  std::size_t singles_paired_ = 0;                // valid_[0][0, singles_paired_) have been paired
-  std::size_t pairs_tripled_ = 0;                 // valid pairs when the triples were last built
+  // Contact sets the levels' failed searches met where their contacts were placed (TaskResult::
+  // met of kFind), for motion_closure.
+  std::vector<Discovery> forced_;
+  // The single PCs pairs are built from, valid or open (update_open_singles), in the order met,
+  // with each one's index; singles_[0, singles_paired_) have been paired.
+  std::vector<Pc> singles_;
+  std::map<Pc, std::size_t> single_at_;
+  std::size_t singles_paired_ = 0;
+  // The rule (refuted_by) of each failed single PC, by index in failed_, worked out for
+  // failed_[0, failed_classified_).
+  std::unordered_map<std::size_t, RuleVerdict> failed_rule_;
+  std::size_t failed_classified_ = 0;
+  // The failed single PCs no rule refutes, and whether they are paired yet.
+  std::vector<Pc> open_singles_;
+  bool open_admitted_ = false;
+  // This level's candidates with fewer valid subsets one PC smaller than all, with how many;
+  // those it searches again (already in failed_).
+  PcSetMap<std::uint8_t> level_seeds_;
+  PcSetSet retrying_;
+  std::size_t singles_valid_ = 0;  // valid single PCs when the pairs were last built
+  std::size_t pairs_tripled_ = 0;  // valid pairs when the triples were last built
   int motion_rounds_ = 0;
   int neighbour_rounds_ = 0;
   // The neighbour rounds' memory: members searched so far, tries per orbit, PC neighbours.
@@ -200,8 +231,9 @@ class Enumerator {
   // The images' witnesses of the sets about to be accepted, by set, with the witness pose
   // they were computed from (prefetch_images); cleared after each batch.
   PcSetMap<std::pair<Pose, std::vector<Witness>>> prefetched_;
-  // The estimate's sets searched and not found (estimate.cpp).
-  PcSetSet known_invalid_;
+  // The estimate's sets searched and not found, each with whether it is an open single PC:
+  // no rule refutes it (estimate.cpp).
+  PcSetMap<bool> known_failed_;
   std::size_t samples_ = kEstimateSamples;  // estimate(): orbits searched per level
 };
 

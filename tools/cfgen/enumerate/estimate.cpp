@@ -234,12 +234,13 @@ std::vector<PcSet> Enumerator::grown_sets(int level, const std::vector<PcSet>& s
   return pool;
 }
 
-// Of `pool`, the sets whose subsets one PC smaller are all valid, as the run's candidates
-// are: their unknown subsets searched once each (a candidate is not worth a level's retries),
-// samples_ sets at a time, until samples_ such sets are found or kGrowRounds batches have
-// been tried. fraction: the share of the sets tried that have them all valid.
-std::vector<PcSet> Enumerator::with_valid_subsets(const std::vector<PcSet>& pool,
-                                                  double& fraction) {
+// Of `pool`, the sets whose subsets one PC smaller are all valid (a pair's single PCs valid or
+// open: failed, and no rule refutes them), as the run's candidates are: their unknown subsets
+// searched once each (a candidate is not worth a level's retries), samples_ sets at a time,
+// until samples_ such sets are found or kGrowRounds batches have been tried. fraction: the
+// share of the sets tried that are candidates.
+std::vector<PcSet> Enumerator::with_candidate_subsets(const std::vector<PcSet>& pool,
+                                                      double& fraction) {
   std::vector<PcSet> out;
   std::size_t tried = 0;
   auto subsets = [](const PcSet& s) {
@@ -253,19 +254,29 @@ std::vector<PcSet> Enumerator::with_valid_subsets(const std::vector<PcSet>& pool
     std::vector<PcSet> unknown;
     for (std::size_t i = b; i < e; ++i)
       for (const PcSet& sub : subsets(pool[i]))
-        if (!witness_rot_.count(sub) && !known_invalid_.count(sub)) unknown.push_back(sub);
+        if (!witness_rot_.count(sub) && !known_failed_.count(sub)) unknown.push_back(sub);
     std::sort(unknown.begin(), unknown.end(), pcset_less);
     unknown.erase(std::unique(unknown.begin(), unknown.end()), unknown.end());
     if (!unknown.empty())
       sample_sets(
           unknown[0].size() - 1, unknown, [this](const PcSet& x) { return seeds_from_subsets(x); },
           unknown.size(), 1);
-    for (const PcSet& sub : unknown)
-      if (!witness_rot_.count(sub)) known_invalid_.insert(sub);
+    std::vector<char> open(unknown.size(), 0);
+    runner_.for_each(unknown.size(), [&](std::size_t i) {
+      open[i] =
+          unknown[i].size() == 1 && !witness_rot_.count(unknown[i]) && !search_.refuted(unknown[i]);
+    });
+    for (std::size_t i = 0; i < unknown.size(); ++i)
+      if (!witness_rot_.count(unknown[i])) known_failed_.emplace(unknown[i], open[i] != 0);
+    auto candidate = [&](const PcSet& sub) {  // valid, or an open single PC
+      if (witness_rot_.count(sub)) return true;
+      const auto it = known_failed_.find(sub);
+      return it != known_failed_.end() && it->second;
+    };
     for (std::size_t i = b; i < e; ++i) {
       ++tried;
       bool all = true;
-      for (const PcSet& sub : subsets(pool[i])) all = all && witness_rot_.count(sub) > 0;
+      for (const PcSet& sub : subsets(pool[i])) all = all && candidate(sub);
       if (all) out.push_back(pool[i]);
     }
   }
@@ -457,7 +468,7 @@ RunEstimate Enumerator::estimate(int threads, std::size_t samples) {
     const LevelEstimate& below = e.levels[level - 1];
     if (valid_[level - 1].empty() || below.valid <= 0) break;
     double added = 0, fraction = 0;
-    const std::vector<PcSet> pool = with_valid_subsets(grown_sets(level, c1, added), fraction);
+    const std::vector<PcSet> pool = with_candidate_subsets(grown_sets(level, c1, added), fraction);
     LevelEstimate& l = e.levels[level];
     l.candidates = below.valid * added * fraction / (level + 1);  // each counted by its PCs
     const Sample sample = sample_sets(level, pool, subsets, samples_, kOrbitTries);

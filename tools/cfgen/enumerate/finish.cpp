@@ -117,19 +117,21 @@ void Enumerator::find_undecided() {
           state[i] = kKnown;
           return;
         }
-        const RuleVerdict rule = search_.refuted_by(s);
+        const auto ruled = failed_rule_.find(i);
+        const RuleVerdict rule =
+            ruled != failed_rule_.end() ? ruled->second : search_.refuted_by(s);
         if (keep) decisions[i] = certified(s, rule, limits);
         if (rule.rule == Rule::kNone) state[i] = kOpen;
       },
       &ev, t0);
-  std::vector<Witness> found(failed_.size());
+  std::vector<std::pair<std::size_t, Witness>> found;  // (set, witness) the cells found
   decide_over_cells(state, found, decisions);
   std::vector<PcSet> open;
   for (std::size_t i = 0; i < failed_.size(); ++i) {
     if (state[i] == kOpen) open.push_back(failed_[i]);
     if (state[i] == kOverCells || state[i] == kImage) ++out_.refuted_over_cells;
-    if (state[i] == kFound) add_with_images(failed_[i], found[i], known);
   }
+  for (const auto& [i, w] : found) add_with_images(failed_[i], w, known);
   std::sort(open.begin(), open.end(), pcset_less);
   finished(ev, t0, std::to_string(open.size()) + " without a proof");
   PcSetSet thin_sets;
@@ -141,8 +143,10 @@ void Enumerator::find_undecided() {
     thin_sets.insert(s);
     out_.thin.push_back({s, w});
   }
-  for (const PcSet& s : open)
-    if (!thin_sets.count(s) && !known.count(s)) out_.undecided.push_back(s);
+  open.erase(std::remove_if(open.begin(), open.end(),
+                            [&](const PcSet& s) { return thin_sets.count(s) || known.count(s); }),
+             open.end());
+  out_.undecided = std::move(open);  // sorted, as found
 
   if (!keep) return;
   // Sets the cells found witnesses for, or made CFs as their images, are in the graph.
@@ -166,13 +170,18 @@ void Enumerator::find_undecided() {
 // refute it), the others over cubes when opt_.cube_cells asks. The first set of each orbit
 // in failed_'s order is searched; the other open members of its orbit follow it: kImage
 // when it is refuted, CFs when it has a witness (add_with_images, later), else open.
-void Enumerator::decide_over_cells(std::vector<char>& state, std::vector<Witness>& found,
+void Enumerator::decide_over_cells(std::vector<char>& state,
+                                   std::vector<std::pair<std::size_t, Witness>>& found,
                                    std::vector<SetDecision>& decisions) {
   const CellSearchLimits arcs = decision_limits(search_, kArcCellsPerOrbit, opt_.resolution);
   const CellSearchLimits cubes = decision_limits(search_, opt_.cube_cells, opt_.resolution);
+  // Cubes only for sets whose subsets one PC smaller are CFs: those with an open subset are
+  // most of the failed triples, and a set's cubes cost up to opt_.cube_cells programs.
   auto takes_cells = [&](std::size_t i) {
     const PcSet& s = failed_[i];
-    return state[i] == kOpen && (has_ff(s) ? s.size() >= 2 : opt_.cube_cells > 0);
+    if (state[i] != kOpen) return false;
+    if (has_ff(s)) return s.size() >= 2;
+    return opt_.cube_cells > 0 && (s.size() == 1 || valid_subsets(s) == s.size());
   };
   // Each open set that takes cells, with the first member of its orbit; the first members.
   std::vector<std::pair<std::size_t, std::size_t>> member_of;  // (set, its orbit's first)
@@ -190,6 +199,7 @@ void Enumerator::decide_over_cells(std::vector<char>& state, std::vector<Witness
   }
   const auto t0 = Clock::now();
   ProgressEvent ev{"cells", "orbits of open sets", 0, searched.size(), 0, false, {}};
+  std::vector<Witness> witness(searched.size());
   runner_.for_each(
       searched.size(),
       [&](std::size_t j) {
@@ -211,10 +221,12 @@ void Enumerator::decide_over_cells(std::vector<char>& state, std::vector<Witness
         }
         if (r.outcome == CellSearchResult::Outcome::kWitness) {
           state[i] = kFound;
-          found[i] = r.witness;
+          witness[j] = r.witness;
         }
       },
       &ev, t0);
+  for (std::size_t j = 0; j < searched.size(); ++j)
+    if (state[searched[j]] == kFound) found.emplace_back(searched[j], witness[j]);
   std::size_t refuted = 0;
   for (std::size_t i : searched) refuted += state[i] == kOverCells;
   finished(ev, t0, std::to_string(refuted) + " refuted");
@@ -243,27 +255,38 @@ void Enumerator::decide_over_cells(std::vector<char>& state, std::vector<Witness
 std::vector<std::pair<PcSet, Witness>> Enumerator::find_thin(const std::vector<PcSet>& open) {
   const WitnessSearch thin(search_.a(), search_.b(), thin_params(search_.params()));
   std::vector<std::pair<PcSet, Witness>> out;
-  std::vector<PcSet> todo;  // one set per orbit, then the members no image reached
-  PcSetSet first_of_orbit;
-  const PcSetSet open_set(open.begin(), open.end());
-  for (const PcSet& s : open)
-    if (first_of_orbit.insert(sym_.canonical(s)).second) todo.push_back(s);
+  // `open` is sorted: a set's index by binary search, and flags by index instead of hash
+  // sets (a large pair has millions of open sets).
+  auto index_of = [&](const PcSet& t) {
+    const auto it = std::lower_bound(open.begin(), open.end(), t, pcset_less);
+    return it != open.end() && *it == t ? static_cast<std::size_t>(it - open.begin()) : open.size();
+  };
+  std::vector<PcSet> todo;                  // one set per orbit, then the members no image reached
+  std::vector<char> taken(open.size(), 0);  // in todo, or an image of a set in it
+  for (std::size_t i = 0; i < open.size(); ++i) {
+    if (taken[i]) continue;
+    todo.push_back(open[i]);
+    for (std::size_t k = 0; k < sym_.size(); ++k)
+      if (const std::size_t j = index_of(sym_.image(open[i], k)); j < open.size()) taken[j] = 1;
+  }
   const auto t0 = Clock::now();
   ProgressEvent ev{"thin sets", "open candidate sets", 0, todo.size(), 0, false, {}};
-  PcSetSet done;
+  std::vector<char> done(open.size(), 0);  // searched, or an image of a set found
   for (int pass = 0; pass < 2 && !todo.empty(); ++pass) {
     std::vector<Witness> w(todo.size());
     runner_.for_each(
         todo.size(), [&](std::size_t i) { w[i] = thin.find(todo[i], {}); },
         pass == 0 ? &ev : nullptr, t0);
-    for (std::size_t i = 0; i < todo.size(); ++i) done.insert(todo[i]);
+    for (const PcSet& t : todo) done[index_of(t)] = 1;
     std::vector<std::pair<PcSet, Witness>> images;
     for (std::size_t i = 0; i < todo.size(); ++i) {
       if (!w[i].found) continue;
       out.push_back({todo[i], w[i]});
       for (std::size_t k = 1; k < sym_.size() && pass == 0; ++k) {
         const PcSet t = sym_.image(todo[i], k);
-        if (!open_set.count(t) || !done.insert(t).second) continue;
+        const std::size_t j = index_of(t);
+        if (j == open.size() || done[j]) continue;
+        done[j] = 1;
         Witness v = w[i];
         v.pose = sym_.image(w[i].pose, k);
         images.push_back({t, v});

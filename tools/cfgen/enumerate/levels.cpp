@@ -1,6 +1,6 @@
-// The candidate levels: every single PC that local convexity allows, the pairs of valid
-// single PCs that the necessary conditions allow, and the triples whose three pairs are valid;
-// each level searched one orbit at a time.
+// The candidate levels: every single PC that local convexity allows, the pairs of single PCs
+// (valid, or open: failed, and no rule refutes them) that the necessary conditions allow, and
+// the triples whose three pairs are valid; each level searched one orbit at a time.
 
 #include "cfgen/enumerate/enumerator.hpp"
 
@@ -53,7 +53,7 @@ void Enumerator::accept(int level, const PcSet& s, const Witness& w) {
     if (!v.found) continue;
     valid_[level].push_back({t, v});
     witness_rot_.emplace(t, v.pose.R_BA);
-    seen_.insert(t);
+    mark_searched(t);
     ++out_.levels[level].by_symmetry;
   }
 }
@@ -142,6 +142,8 @@ std::size_t Enumerator::search_orbits(int level, const OrbitGroups& orbits, cons
     std::vector<std::size_t> open;
     for (std::size_t o = 0; o < orbits.size(); ++o) {
       if (done[o] || attempt >= orbits.count(o)) continue;
+      // One member of an orbit with an open subset: those sets are many, nearly all invalid.
+      if (attempt > 0 && level_seeds_.count(orbits.member(o, 0))) continue;
       if (witness_rot_.count(orbits.member(o, attempt))) {
         done[o] = 1;  // an image of a CF found meanwhile
         continue;
@@ -152,7 +154,7 @@ std::size_t Enumerator::search_orbits(int level, const OrbitGroups& orbits, cons
     // Taken once the stage has run, their images verified together (prefetch_images).
     std::vector<std::pair<std::size_t, Witness>> found;
     auto take = [&](std::size_t i, const Witness& w) {
-      seen_.insert(orbits.member(open[i], attempt));
+      mark_searched(orbits.member(open[i], attempt));
       if (w.found) found.emplace_back(i, w);
     };
     // Seeds come from the sets below this level, which the results of this stage do not
@@ -167,7 +169,10 @@ std::size_t Enumerator::search_orbits(int level, const OrbitGroups& orbits, cons
       t.seeds = seeds_of(t.pcs);
       return t;
     };
-    stage.take = [&](std::size_t i, TaskResult&& r) { take(i, r.witness); };
+    stage.take = [&](std::size_t i, TaskResult&& r) {
+      take(i, r.witness);
+      forced_.insert(forced_.end(), r.met.begin(), r.met.end());
+    };
     stage.progress = attempt == 0 ? &ev : nullptr;
     stage.started = t0;
     runner_.run(stage);
@@ -200,7 +205,8 @@ std::size_t Enumerator::search_rest(int level, const OrbitGroups& orbits, const 
   const std::vector<TaskResult> r = run_tasks(runner_, rest, nullptr, t0);
   prefetch_found(rest, r);
   for (std::size_t i = 0; i < rest.size(); ++i) {
-    seen_.insert(rest[i].pcs);
+    mark_searched(rest[i].pcs);
+    forced_.insert(forced_.end(), r[i].met.begin(), r[i].met.end());
     if (r[i].witness.found && !witness_rot_.count(rest[i].pcs))
       accept(level, rest[i].pcs, r[i].witness);
   }
@@ -222,8 +228,8 @@ void Enumerator::run_level(int level, std::vector<PcSet> all, const SeedsOf& see
   // The other members: valid as images above, or failed with their orbit.
   for (const PcSet& m : orbits.members) {
     if (witness_rot_.count(m)) continue;
-    seen_.insert(m);
-    failed_.push_back(m);
+    mark_searched(m);
+    if (!retrying_.count(m)) failed_.push_back(m);  // a retry is in failed_ already
   }
   LevelStats& st = out_.levels[level];
   st.candidates += searched;
@@ -266,12 +272,81 @@ std::vector<Mat3> Enumerator::seeds_from_subsets(const PcSet& s) const {
   return seeds;
 }
 
-// Level 2 over the valid single PCs not paired yet (with every valid single PC).
+// How many of s's subsets one PC smaller are valid: the witnesses that seed its search.
+int Enumerator::valid_subsets(const PcSet& s) const {
+  int n = 0;
+  for (int k = 0; k < s.size(); ++k) n += static_cast<int>(witness_rot_.count(without(s, k)));
+  return n;
+}
+
+// The failed single PCs that no rule refutes (WitnessSearch::refuted_by) are open: a pose may
+// realise them with the other contacts of a pair (a face against one wall of a slot exactly
+// the part's width touches the other too). Each one's rule is kept for find_undecided. The
+// valid single PCs found since join singles_, the single PCs pairs are built from, and so do
+// the open ones once admitted (admit_open_singles).
+void Enumerator::update_open_singles() {
+  std::vector<std::size_t> todo;
+  for (std::size_t i = failed_classified_; i < failed_.size(); ++i)
+    if (failed_[i].size() == 1) todo.push_back(i);
+  failed_classified_ = failed_.size();
+  std::vector<RuleVerdict> rule(todo.size());
+  runner_.for_each(todo.size(),
+                   [&](std::size_t k) { rule[k] = search_.refuted_by(failed_[todo[k]]); });
+  for (std::size_t k = 0; k < todo.size(); ++k) {
+    failed_rule_.emplace(todo[k], rule[k]);
+    if (rule[k].rule == Rule::kNone) open_singles_.push_back(failed_[todo[k]][0]);
+  }
+  for (const auto& [s, w] : valid_[0])
+    if (single_at_.emplace(s[0], singles_.size()).second) singles_.push_back(s[0]);
+  if (open_admitted_)
+    for (const Pc& pc : open_singles_)
+      if (single_at_.emplace(pc, singles_.size()).second) singles_.push_back(pc);
+}
+
+// Admits the open single PCs to the pairs, once the levels and motion have reached a fixed
+// point without them: pairs of open PCs are many and nearly all invalid, and searched before
+// that point they change the order in which the search meets the rest (on the hexagonal peg
+// and hole it then finds 432 CFs fewer). True when there are any to admit.
+bool Enumerator::admit_open_singles() {
+  if (open_admitted_) return false;
+  open_admitted_ = true;
+  return !open_singles_.empty();
+}
+
+// Adds s to `cands`, once, when it was searched while some of its subsets one PC smaller were
+// open and more of them are valid now: searched again, seeded with the new witnesses.
+void Enumerator::retry_if_seeded(const PcSet& s, std::vector<PcSet>& cands) {
+  const auto it = seen_.find(s);
+  if (it == seen_.end() || it->second >= s.size() || witness_rot_.count(s) ||
+      valid_subsets(s) <= it->second)
+    return;
+  if (retrying_.insert(s).second) cands.push_back(s);
+}
+
+// Notes how many of each candidate's subsets one PC smaller are valid, for those with fewer
+// than all (level_seeds_), for mark_searched.
+void Enumerator::note_seeds(const std::vector<PcSet>& cands) {
+  std::vector<std::uint8_t> n(cands.size());
+  runner_.for_each(cands.size(), [&](std::size_t i) {
+    n[i] = static_cast<std::uint8_t>(valid_subsets(cands[i]));
+  });
+  level_seeds_.clear();
+  for (std::size_t i = 0; i < cands.size(); ++i)
+    if (n[i] < cands[i].size()) level_seeds_.emplace(cands[i], n[i]);
+}
+
+// Marks s searched (seen_), with how many of its subsets seeded it (level_seeds_; kAllSeeds for
+// a set searched with all of them, or met outside the levels).
+void Enumerator::mark_searched(const PcSet& s) {
+  const auto it = level_seeds_.find(s);
+  seen_.insert_or_assign(s, it == level_seeds_.end() ? kAllSeeds : it->second);
+}
+
+// Level 2 over the single PCs (valid or open) not paired yet, each with every one before it.
 std::vector<PcSet> Enumerator::build_pairs() {
-  const std::size_t n = valid_[0].size();
+  const std::size_t n = singles_.size();
   if (n > std::numeric_limits<std::uint32_t>::max())
-    throw Error("level 2: " + std::to_string(n) +
-                " valid single PCs, more than the pairs' indices hold");
+    throw Error("level 2: " + std::to_string(n) + " single PCs, more than the pairs' indices hold");
   // Each new single PC against the ones before it, on all cores (the conditions cost
   // microseconds a pair, and big models have millions of pairs); joined in order. Each
   // partner is kept as its index (a tenth of a set's size) until the sets are built, so that
@@ -279,9 +354,9 @@ std::vector<PcSet> Enumerator::build_pairs() {
   std::vector<std::vector<std::uint32_t>> by_j(n - singles_paired_);
   runner_.for_each(by_j.size(), [&](std::size_t k) {
     const std::size_t j = singles_paired_ + k;
-    const Pc& y = valid_[0][j].first[0];
+    const Pc& y = singles_[j];
     for (std::size_t i = 0; i < j; ++i) {
-      const Pc& x = valid_[0][i].first[0];
+      const Pc& x = singles_[i];
       // The table lookups first: they reject most pairs, for less than the set and its hash.
       if (!pair_ok_.compatible(x, y)) continue;
       PcSet s({x, y});
@@ -294,8 +369,8 @@ std::vector<PcSet> Enumerator::build_pairs() {
   std::vector<PcSet> c2;
   c2.reserve(total);
   for (std::size_t k = 0; k < by_j.size(); ++k) {
-    const Pc& y = valid_[0][singles_paired_ + k].first[0];
-    for (std::uint32_t i : by_j[k]) c2.push_back(PcSet({valid_[0][i].first[0], y}));
+    const Pc& y = singles_[singles_paired_ + k];
+    for (std::uint32_t i : by_j[k]) c2.push_back(PcSet({singles_[i], y}));
     std::vector<std::uint32_t>().swap(by_j[k]);
   }
   singles_paired_ = n;
@@ -303,19 +378,29 @@ std::vector<PcSet> Enumerator::build_pairs() {
 }
 
 void Enumerator::pairs_level() {
-  run_level(1, build_pairs(), [this](const PcSet& s) { return seeds_from_subsets(s); });
+  update_open_singles();
+  std::vector<PcSet> c2 = build_pairs();
+  // The pairs of a single PC found valid since the last time, searched before without it.
+  for (std::size_t i = singles_valid_; i < valid_[0].size(); ++i)
+    for (const Pc& y : singles_) {
+      PcSet s = valid_[0][i].first;
+      if (s.insert(y)) retry_if_seeded(s, c2);
+    }
+  singles_valid_ = valid_[0].size();
+  note_seeds(c2);
+  run_level(1, std::move(c2), [this](const PcSet& s) { return seeds_from_subsets(s); });
+  retrying_.clear();
+  level_seeds_.clear();
 }
 
 // Level 3 over every set whose three pairs are valid and that was not searched yet.
 void Enumerator::triples_level() {
-  // The valid pairs as partners: for each single PC x, the valid single PCs z (by index in
-  // valid_[0]) with {x, z} valid. A pair's third PCs are the partners of both.
-  std::map<Pc, std::size_t> single_at;
-  for (std::size_t i = 0; i < valid_[0].size(); ++i) single_at.emplace(valid_[0][i].first[0], i);
+  // The valid pairs as partners: for each single PC x, the single PCs z (by index in singles_)
+  // with {x, z} valid. A pair's third PCs are the partners of both.
   std::map<Pc, std::vector<std::size_t>> partners;
   for (const auto& [s, w] : valid_[1])
     for (int k = 0; k < 2; ++k)
-      if (auto it = single_at.find(s[1 - k]); it != single_at.end())
+      if (auto it = single_at_.find(s[1 - k]); it != single_at_.end())
         partners[s[k]].push_back(it->second);
   for (auto& [pc, v] : partners) {
     std::sort(v.begin(), v.end());
@@ -329,8 +414,8 @@ void Enumerator::triples_level() {
     common.clear();
     std::set_intersection(x->second.begin(), x->second.end(), y->second.begin(), y->second.end(),
                           std::back_inserter(common));
-    for (std::size_t i : common) {  // in valid_[0]'s order
-      const Pc& z = valid_[0][i].first[0];
+    for (std::size_t i : common) {  // in singles_'s order
+      const Pc& z = singles_[i];
       if (!(s[1] < z)) continue;  // z beyond both, so each triple is built once
       PcSet t;
       t.insert(s[0]);

@@ -1,7 +1,8 @@
 // Closure by motion (explore.hpp): from every witness, translations and rotations that keep
 // some PCs and break the others, to the first contact. Sets met that are not in the graph yet
 // are searched (seeded with the rotation they were met at), and their own witnesses explored
-// in the next round, until a round adds nothing.
+// in the next round, until a round adds nothing. The contact sets the levels' failed searches
+// met where their contacts were placed (forced contacts) are searched the same way.
 
 #include "cfgen/enumerate/enumerator.hpp"
 
@@ -36,7 +37,7 @@ void Enumerator::more_witnesses(Clock::time_point t0) {
     if (witness_rot_.count(more[i].pcs)) {
       frontier_.push_back({more[i].pcs, r[i].witness.pose});
     } else {  // its image witness did not verify: a CF by its own witness
-      seen_.insert(more[i].pcs);
+      mark_searched(more[i].pcs);
       accept(more[i].pcs.size() - 1, more[i].pcs, r[i].witness);
     }
   }
@@ -60,16 +61,26 @@ void Enumerator::explore_frontier(Clock::time_point t0) {
     explore[i].pose = frontier_[i].second;
   }
   const std::vector<TaskResult> met = run_tasks(runner_, explore, &ev, t0);
-  // The first discovery of each new set, in frontier order: independent of thread count.
+  std::vector<Discovery> all;
+  for (const TaskResult& r : met) all.insert(all.end(), r.met.begin(), r.met.end());
+  frontier_.clear();
+  const std::size_t found = search_met(all, t0);
+  finished(ev, t0, std::to_string(found) + " new CFs");
+}
+
+// The sets of `met` not in the graph yet that the necessary conditions allow, the first
+// discovery of each in order (independent of thread count), one of each orbit: searched from
+// the pose met (kFindOrRefine), those found accepted and added to the frontier with the pose
+// met too. Returns how many were found.
+std::size_t Enumerator::search_met(const std::vector<Discovery>& met, Clock::time_point t0) {
   std::vector<Discovery> fresh;
   PcSetSet pending;
   PcSetSet pending_orbits;  // one search per orbit a round
-  for (const TaskResult& r : met)
-    for (const Discovery& d : r.met)
-      if (d.pcs.size() <= opt_.max_pcs && !witness_rot_.count(d.pcs) &&
-          pending.insert(d.pcs).second && conditions_hold(d.pcs) &&
-          pending_orbits.insert(sym_.canonical(d.pcs)).second)
-        fresh.push_back(d);
+  for (const Discovery& d : met)
+    if (d.pcs.size() <= opt_.max_pcs && !witness_rot_.count(d.pcs) &&
+        pending.insert(d.pcs).second && conditions_hold(d.pcs) &&
+        pending_orbits.insert(sym_.canonical(d.pcs)).second)
+      fresh.push_back(d);
   std::vector<Task> search_fresh(fresh.size());
   for (std::size_t i = 0; i < fresh.size(); ++i) {
     search_fresh[i].kind = Task::Kind::kFindOrRefine;
@@ -78,7 +89,6 @@ void Enumerator::explore_frontier(Clock::time_point t0) {
   }
   const std::vector<TaskResult> res = run_tasks(runner_, search_fresh, nullptr, t0);
   prefetch_found(search_fresh, res);
-  frontier_.clear();
   std::size_t found = 0;
   for (std::size_t i = 0; i < fresh.size(); ++i) {
     if (!res[i].witness.found) continue;
@@ -87,7 +97,7 @@ void Enumerator::explore_frontier(Clock::time_point t0) {
       continue;
     }
     const int level = fresh[i].pcs.size() - 1;
-    seen_.insert(fresh[i].pcs);
+    mark_searched(fresh[i].pcs);
     accept(level, fresh[i].pcs, res[i].witness);
     // Explore from where motion met the set too: another pose in its region, which reaches
     // what the witness's orientation does not.
@@ -96,10 +106,16 @@ void Enumerator::explore_frontier(Clock::time_point t0) {
     ++found;
   }
   prefetched_.clear();
-  finished(ev, t0, std::to_string(found) + " new CFs");
+  return found;
 }
 
 void Enumerator::motion_closure() {
+  // The contact sets the levels' failed searches were blocked by (forced contacts) first.
+  if (!forced_.empty()) {
+    std::vector<Discovery> forced;
+    forced.swap(forced_);
+    search_met(forced, Clock::now());
+  }
   while (!frontier_.empty()) {
     const auto t0 = Clock::now();
     if (sym_.size() > 1) more_witnesses(t0);

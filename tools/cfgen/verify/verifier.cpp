@@ -475,6 +475,14 @@ bool Verifier::still_blocked(const PcSet& pcs, const Pose& pose, const Obstacle&
   return d > p_.touch_tol || open_touch(A, pose, o.ka, o.a, B, o.kb, o.b, p_.touch_tol);
 }
 
+bool Verifier::obstacle_touches(const Pose& pose, const Obstacle& o) const {
+  if (!o.set) return false;
+  const Polyhedron& A = *A_.model;
+  const Polyhedron& B = *B_.model;
+  return element_distance(A, pose, o.ka, o.a, B, o.kb, o.b).distance <= p_.touch_tol &&
+         open_touch(A, pose, o.ka, o.a, B, o.kb, o.b, p_.touch_tol);
+}
+
 bool Verifier::still_fails(const PcSet& pcs, const Pose& pose, const FailedPair& f) const {
   if (f.kind == FailedPair::Kind::kObstacle) return still_blocked(pcs, pose, f.obstacle());
   if (f.kind != FailedPair::Kind::kOverlap) return false;

@@ -87,6 +87,9 @@ class Verifier {
   /// min_clearance at `pose` (and touching in open points if within touch_tol): then verify
   /// refuses `pose` too. False proves nothing.
   bool still_blocked(const PcSet& pcs, const Pose& pose, const Obstacle& o) const;
+  /// True when the obstacle's pair touches at `pose` in open points (within touch_tol): a
+  /// contact the pose makes besides the PCs it was verified for.
+  bool obstacle_touches(const Pose& pose, const Obstacle& o) const;
 
   /// The pair of elements a refused pose failed on: an obstacle (as Obstacle), or a PC or a
   /// pair a PC covers where A and B overlap (touching, tangent cones not disjoint).
