@@ -280,6 +280,51 @@ void report_written(const GenerateArgs& args, const gen::Enumeration& e, const P
               << " s -> " << args.out_path << '\n';
 }
 
+// The enumeration's options from the command line's; `writes`: this process writes the graph
+// (the other shards stop after the last stage), `certifies` its certificates too.
+gen::EnumerateOptions enumerate_options(const GenerateArgs& args, bool writes, bool certifies) {
+  gen::EnumerateOptions opt;
+  opt.max_pcs = args.max_pcs;
+  opt.use_symmetry = args.symmetry && !args.thorough;
+  opt.close_orbits = args.thorough;
+  opt.cube_cells = args.cube_cells;
+  opt.resolution = args.resolution;
+  opt.records = writes;
+  opt.certificates = certifies;
+  return opt;
+}
+
+// How the run's stages are executed: threads, shards, the checkpoint (none when
+// checkpoint_dir is empty), the stop request.
+gen::ExecuteOptions execute_options(const GenerateArgs& args, const std::string& checkpoint_dir,
+                                    const std::vector<std::string>& inputs) {
+  gen::ExecuteOptions exec;
+  exec.threads = args.threads;
+  exec.shard = args.shard;
+  exec.shard_patience = args.shard_patience;
+  // Another shard's chunk is a file to look for (a stat each), another rank's a message.
+  exec.shard_poll = args.share.load ? 0.005 : 0.05;  // s
+  if (!checkpoint_dir.empty())
+    exec.checkpoint = open_checkpoint(checkpoint_dir, run_fingerprint(args), inputs);
+  exec.checkpoint = gen::either(exec.checkpoint, args.share);
+  exec.stop = args.stop;
+  return exec;
+}
+
+// What an MPI rank or a shard took from the others and waited for them.
+void report_sharing(const GenerateArgs& args, const gen::Executor& executor, bool writes) {
+  if (args.share.load)
+    std::cerr << "cfgen: rank " << args.shard.index << " of " << args.shard.count << ": took "
+              << executor.shared_chunks() << " chunks from the other ranks, waited "
+              << executor.waited_seconds() << " s for them\n";
+  else if (args.shard.count > 0)
+    std::cerr << "cfgen: shard " << args.shard.index << "/" << args.shard.count << ": took "
+              << executor.shared_chunks() << " chunks from the other shards, waited "
+              << executor.waited_seconds() << " s for them, computed "
+              << executor.taken_over_chunks() << " of theirs that did not come"
+              << (writes ? "" : "; shard 0 writes the graph") << '\n';
+}
+
 }  // namespace
 
 int run_generate(const GenerateArgs& args) {
@@ -305,17 +350,10 @@ int run_generate(const GenerateArgs& args) {
   const gen::ModelInfo ai = gen::analyse_model(A, ma.precision_mm);
   const gen::ModelInfo bi = gen::analyse_model(B, mb.precision_mm);
 
-  gen::EnumerateOptions opt;
   // Lengths scale with the smaller model (RelativeLengths).
   const double diag = length_scale(A, B);
   const gen::SearchParams search = scaled_search(A, B, args.rel, args.search);
-  opt.max_pcs = args.max_pcs;
-  opt.use_symmetry = args.symmetry && !args.thorough;
-  opt.close_orbits = args.thorough;
-  opt.cube_cells = args.cube_cells;
-  opt.resolution = args.resolution;
-  opt.records = writes;  // the other shards stop after the last stage
-  opt.certificates = certifies;
+  const gen::EnumerateOptions opt = enumerate_options(args, writes, certifies);
   const gen::WitnessSearch ws(ai, bi, search);
   if (args.estimate) {
     try {
@@ -336,16 +374,7 @@ int run_generate(const GenerateArgs& args) {
   const std::string& checkpoint_dir = plan.checkpoint_dir;
   const bool default_checkpoint = plan.default_checkpoint;
   const double predicted = plan.predicted;
-  gen::ExecuteOptions exec;
-  exec.threads = args.threads;
-  exec.shard = args.shard;
-  exec.shard_patience = args.shard_patience;
-  // Another shard's chunk is a file to look for (a stat each), another rank's a message.
-  exec.shard_poll = args.share.load ? 0.005 : 0.05;  // s
-  if (!checkpoint_dir.empty())
-    exec.checkpoint = open_checkpoint(checkpoint_dir, run_fingerprint(args), inputs);
-  exec.checkpoint = gen::either(exec.checkpoint, args.share);
-  exec.stop = args.stop;
+  gen::ExecuteOptions exec = execute_options(args, checkpoint_dir, inputs);
   const bool terminal = isatty(STDERR_FILENO) != 0;
   gen::ProgressPrinter printer(std::cerr, terminal);
   if (!args.quiet)
@@ -373,16 +402,7 @@ int run_generate(const GenerateArgs& args) {
               << executor.resumed_chunks() << " finished chunks\n";
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (args.share.load && !args.quiet)
-    std::cerr << "cfgen: rank " << args.shard.index << " of " << args.shard.count << ": took "
-              << executor.shared_chunks() << " chunks from the other ranks, waited "
-              << executor.waited_seconds() << " s for them\n";
-  else if (args.shard.count > 0 && !args.quiet)
-    std::cerr << "cfgen: shard " << args.shard.index << "/" << args.shard.count << ": took "
-              << executor.shared_chunks() << " chunks from the other shards, waited "
-              << executor.waited_seconds() << " s for them, computed "
-              << executor.taken_over_chunks() << " of theirs that did not come"
-              << (writes ? "" : "; shard 0 writes the graph") << '\n';
+  if (!args.quiet) report_sharing(args, executor, writes);
   if (!writes) return 0;
 
   const nlohmann::json meta = graph_meta(e, args, search, opt, diag, A, B, ma, mb);

@@ -172,13 +172,8 @@ void add_extents(const Polyhedron& m, ModelInfo& info) {
   for (const Face& F : m.faces()) info.extent[2].push_back(face_width(F));
 }
 
-}  // namespace
-
-ModelInfo analyse_model(const Polyhedron& m, double precision_mm) {
-  ModelInfo info;
-  info.model = &m;
-  info.precision_mm = precision_mm;
-  add_extents(m, info);
+// Each vertex's tangent cone: its edges' rays, their centre, whether it is pointed.
+void add_cones(const Polyhedron& m, ModelInfo& info) {
   const double tol = 1e-9 * m.size();
   info.cones.resize(m.num_vertices());
   for (std::size_t v = 0; v < m.num_vertices(); ++v) {
@@ -215,6 +210,10 @@ ModelInfo analyse_model(const Polyhedron& m, double precision_mm) {
     }
     c.pointed = pointed;
   }
+}
+
+// Each edge's wedge: the directions into its two faces and their bisector.
+void add_wedges(const Polyhedron& m, ModelInfo& info) {
   info.wedges.resize(m.num_edges());
   for (std::size_t e = 0; e < m.num_edges(); ++e) {
     const Edge& E = m.edges()[e];
@@ -226,6 +225,10 @@ ModelInfo analyse_model(const Polyhedron& m, double precision_mm) {
     const Vec3 bis = nl + nr;
     w.bisector = bis.norm() > 1e-12 ? bis.normalized() : Vec3::Zero();
   }
+}
+
+// Each face's convex pieces, largest first.
+void add_pieces(const Polyhedron& m, ModelInfo& info) {
   info.pieces.resize(m.num_faces());
   for (std::size_t f = 0; f < m.num_faces(); ++f) {
     auto pieces = convex_partition(m.faces()[f].loops_2d);
@@ -237,6 +240,10 @@ ModelInfo analyse_model(const Polyhedron& m, double precision_mm) {
     });
     info.pieces[f] = std::move(pieces);
   }
+}
+
+// Bounding spheres and boxes of the elements (with their index) and the whole model's sphere.
+void add_bounds(const Polyhedron& m, ModelInfo& info) {
   for (const Vertex& V : m.vertices()) info.spheres[0].push_back({V.p, 0.0});
   for (std::size_t e = 0; e < m.num_edges(); ++e) {
     const Vec3 a = m.edge_point(EdgeId(static_cast<int>(e)), 0);
@@ -273,6 +280,10 @@ ModelInfo analyse_model(const Polyhedron& m, double precision_mm) {
     for (const Vertex& V : m.vertices())
       info.bound.second = std::max(info.bound.second, (V.p - info.bound.first).norm());
   }
+}
+
+// Each face's plane, shared by coplanar faces.
+void add_face_planes(const Polyhedron& m, ModelInfo& info) {
   info.face_plane.assign(m.num_faces(), -1);
   int next = 0;
   const double ptol = 1e-7 * m.size();
@@ -287,6 +298,20 @@ ModelInfo analyse_model(const Polyhedron& m, double precision_mm) {
     }
     ++next;
   }
+}
+
+}  // namespace
+
+ModelInfo analyse_model(const Polyhedron& m, double precision_mm) {
+  ModelInfo info;
+  info.model = &m;
+  info.precision_mm = precision_mm;
+  add_extents(m, info);
+  add_cones(m, info);
+  add_wedges(m, info);
+  add_pieces(m, info);
+  add_bounds(m, info);
+  add_face_planes(m, info);
   return info;
 }
 

@@ -420,25 +420,19 @@ PcTilts pc_tilts(const ModelInfo& a, const ModelInfo& b, const PcSet& pcs) {
 
 // Whether the closures of elements x and y of m share a vertex.
 bool closures_meet(const Polyhedron& m, ElementKind kx, int x, ElementKind ky, int y) {
-  auto vertices = [&](ElementKind k, int i, VertexId(&two)[2]) -> std::pair<const VertexId*, int> {
-    if (k == ElementKind::kFace) {
-      const auto& v = m.faces()[i].vertices;
-      return {v.data(), static_cast<int>(v.size())};
-    }
-    if (k == ElementKind::kEdge) {
-      two[0] = m.edges()[i].v0, two[1] = m.edges()[i].v1;
-      return {two, 2};
-    }
-    two[0] = VertexId(i);
-    return {two, 1};
-  };
-  VertexId bx[2], by[2];
-  const auto [px, nx] = vertices(kx, x, bx);
-  const auto [py, ny] = vertices(ky, y, by);
-  for (int i = 0; i < nx; ++i)
-    for (int j = 0; j < ny; ++j)
-      if (px[i] == py[j]) return true;
-  return false;
+  auto in_y = [&](VertexId v) { return in_closure(m, ElementKind::kVertex, v.value(), ky, y); };
+  if (kx == ElementKind::kFace) {
+    const auto& vs = m.faces()[x].vertices;
+    return std::any_of(vs.begin(), vs.end(), in_y);
+  }
+  if (kx == ElementKind::kEdge) return in_y(m.edges()[x].v0) || in_y(m.edges()[x].v1);
+  return in_y(VertexId(x));
+}
+
+// Whether elements a of A and b of B, d apart (mm), touch in open points within tol (mm).
+bool touching(const Polyhedron& A, const Pose& pose, ElementKind ka, int a, const Polyhedron& B,
+              ElementKind kb, int b, double d, double tol) {
+  return d <= tol && open_touch(A, pose, ka, a, B, kb, b, tol);
 }
 
 // mm: how close elements a of A and b of B must be to touch: touch_tol, and where both meet
@@ -472,15 +466,15 @@ bool Verifier::still_blocked(const PcSet& pcs, const Pose& pose, const Obstacle&
   if (covered_by(A, B, pcs, o.ka, o.a, o.kb, o.b)) return false;  // verify judges those otherwise
   const double d = element_distance(A, pose, o.ka, o.a, B, o.kb, o.b).distance;
   if (d >= p_.min_clearance) return false;
-  return d > p_.touch_tol || open_touch(A, pose, o.ka, o.a, B, o.kb, o.b, p_.touch_tol);
+  return d > p_.touch_tol || touching(A, pose, o.ka, o.a, B, o.kb, o.b, d, p_.touch_tol);
 }
 
 bool Verifier::obstacle_touches(const Pose& pose, const Obstacle& o) const {
   if (!o.set) return false;
   const Polyhedron& A = *A_.model;
   const Polyhedron& B = *B_.model;
-  return element_distance(A, pose, o.ka, o.a, B, o.kb, o.b).distance <= p_.touch_tol &&
-         open_touch(A, pose, o.ka, o.a, B, o.kb, o.b, p_.touch_tol);
+  return touching(A, pose, o.ka, o.a, B, o.kb, o.b,
+                  element_distance(A, pose, o.ka, o.a, B, o.kb, o.b).distance, p_.touch_tol);
 }
 
 bool Verifier::still_fails(const PcSet& pcs, const Pose& pose, const FailedPair& f) const {
@@ -496,7 +490,7 @@ bool Verifier::still_fails(const PcSet& pcs, const Pose& pose, const FailedPair&
 
 bool Verifier::overlap_at(const Pose& pose, ElementKind ka, int a, ElementKind kb, int b, double d,
                           double tol) const {
-  return d <= tol && open_touch(*A_.model, pose, ka, a, *B_.model, kb, b, tol) &&
+  return touching(*A_.model, pose, ka, a, *B_.model, kb, b, d, tol) &&
          !cones_disjoint(pose, ka, a, kb, b);
 }
 
