@@ -289,9 +289,16 @@ EFResult edge_face_test(const Poly& P, const Face& f, const Vec3& p, const Vec3&
   }
   if (ins.empty()) return r;
   std::vector<Interval> cuts{{-1.0, tol / L}, {1.0 - tol / L, 2.0}};
+  // Where the edge's foot on the plane is within tol of the face's boundary, the edge meets
+  // the boundary, not the open face: an edge nearly parallel to a boundary edge that it crosses
+  // (an e-e at a small angle) rises out of the plane within tol over a stretch as long as tol
+  // over the angle, always beside the boundary (within tol in the plane, so within sqrt(2) tol
+  // in space).
+  const Vec3 pf = f.to3(P2), qf = f.to3(Q2);
   for (int e : f.edges) {
     Interval iv;
-    if (capsule_interval(p, q, P.V[P.E[e].v0].p, P.V[P.E[e].v1].p, tol, &iv)) cuts.push_back(iv);
+    const Vec3 a = f.to3(f.to2(P.V[P.E[e].v0].p)), b = f.to3(f.to2(P.V[P.E[e].v1].p));
+    if (capsule_interval(pf, qf, a, b, tol, &iv)) cuts.push_back(iv);
   }
   std::vector<Interval> rem = subtract(ins, cuts);
   double best = -1;

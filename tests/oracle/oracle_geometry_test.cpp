@@ -311,6 +311,41 @@ TEST_CASE("contact normals point from B into A for every non-degenerate type") {
   CHECK((normal_into_a(table, flipped) - s).norm() < kSame);
 }
 
+TEST_CASE("an e-e at a small angle is not read as line contacts on the ridge's faces") {
+  // A: a box whose ridge x = y = 10 runs along z; its material lies towards -x, -y. B: a 60
+  // degree wedge whose apex edge is the z axis, its material towards +x, +y. A is placed with
+  // its ridge through the origin, turned by 1.7 degrees about the wedges' bisector (1, 1, 0), so
+  // the two ridges cross at that angle in the plane x + y = 0 that separates the solids, 42
+  // touch tolerances from A's corner at z = -20. Towards that corner B's edge rises out of A's
+  // face x = 10 at 0.021 rad and leaves the ridge's capsule (radius tol) 34 tolerances from the
+  // crossing, still within tol of the plane, and meets the capsule of the face's end edge
+  // z = -20 before it rises out of it: 7 tolerances within tol of the face's plane and, in
+  // space, more than tol from its boundary, but beside the ridge in the plane. That is the e-e
+  // seen at the tolerance, not an f-e.
+  Poly A = prism({{0, 0}, {10, 0}, {10, 10}, {0, 10}}, -20, 20, "box");
+  const double half = 30 * kPi / 180;
+  const Vec2 bis(std::sqrt(0.5), std::sqrt(0.5));
+  auto ray = [&](double turn) {  // a side of the wedge, 40 mm long
+    return Vec2(40 * (bis.x() * std::cos(turn) - bis.y() * std::sin(turn)),
+                40 * (bis.x() * std::sin(turn) + bis.y() * std::cos(turn)));
+  };
+  Poly B = prism({{0, 0}, ray(-half), ray(half)}, -20, 20, "wedge");
+  const double theta = 1.7 * kPi / 180;
+  const Vec3 axis = Vec3(1, 1, 0).normalized();
+  Pose X;
+  X.R = Eigen::AngleAxisd(theta, axis).toRotationMatrix();
+  const Classifier C(A, B, tol_for(A, B));
+  X.t = -X.R * Vec3(10, 10, -20 + 42 * C.tol().len);
+  const Verdict V = C.classify(X);
+  INFO(V.describe());
+  REQUIRE(V.valid_cf());
+  REQUIRE(V.pcs.size() == 1);
+  const Touch& t = V.touches[V.pcs[0]];
+  CHECK(t.type == PcType::EE);
+  CHECK(std::abs(t.sin_angle - std::sin(theta)) < 1e-9);
+  for (const Touch& u : V.touches) CHECK(u.type == PcType::EE);
+}
+
 TEST_CASE("the L-foot inside a wall is caught although elements only touch on boundaries") {
   // B: floor slab (top y = 0 for x > 0) and a wall x in [-10, 0] rising to y = 20; reflex edge
   // at x = 0, y = 0. A: an L-part whose bottom face (y = 0) runs through B's reflex edge and
