@@ -135,11 +135,12 @@ void Enumerator::find_undecided() {
   std::sort(open.begin(), open.end(), pcset_less);
   finished(ev, t0, std::to_string(open.size()) + " without a proof");
   PcSetSet thin_sets;
-  for (auto& [s, w] : find_thin(open)) {
-    if (w.clearance >= search_.params().min_clearance && w.margin >= search_.params().min_margin) {
-      add_with_images(s, w, known);  // as clear as a witness: valid after all
-      continue;
-    }
+  const auto thin = find_thin(open);
+  for (const auto& [s, w] : thin)  // as clear as a witness: valid after all, with its images
+    if (w.clearance >= search_.params().min_clearance && w.margin >= search_.params().min_margin)
+      add_with_images(s, w, known);
+  for (const auto& [s, w] : thin) {
+    if (known.count(s)) continue;  // a CF, or the image of one
     thin_sets.insert(s);
     out_.thin.push_back({s, w});
   }
@@ -304,6 +305,11 @@ std::vector<std::pair<PcSet, Witness>> Enumerator::find_thin(const std::vector<P
       else
         todo.push_back(t);
   }
+  // The searches report the margin their translation program reached, 0 where none ran: the
+  // set's margin is the verifier's own measure at the pose.
+  runner_.for_each(out.size(), [&](std::size_t i) {
+    out[i].second.margin = search_.contact_margin(out[i].first, out[i].second.pose);
+  });
   finished(ev, t0, std::to_string(out.size()) + " realised thin");
   std::sort(out.begin(), out.end(),
             [](const auto& x, const auto& y) { return pcset_less(x.first, y.first); });
