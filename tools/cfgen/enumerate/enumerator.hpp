@@ -145,6 +145,9 @@ class Enumerator {
   bool valid_change_among(const PcSet& s, const PcSetMap<std::vector<Pc>>& new_by_rest) const;
   void screen_failed(std::size_t i, const PcSetMap<std::vector<Pc>>& new_by_rest,
                      std::vector<Kept>& kept);
+  void index_cfs_by_pc();
+  using CoverFn = std::function<bool(const PcSet& t, const Mat3& R_witness)>;
+  bool any_covering_cf(const PcSet& s, const std::size_t (&since)[3], const CoverFn& fn) const;
   void screen_cf(int level, std::size_t i, const PcSetMap<std::vector<Pc>>& new_by_rest,
                  std::vector<Kept>& kept);
   // A neighbour round's tasks as its screening takes them (neighbours.cpp).
@@ -228,6 +231,11 @@ class Enumerator {
   std::size_t near_screened_cfs_[3] = {0, 0, 0};
   bool near_screened_none_ = true;  // this round's new_cfs_by_rest() holds every CF
   std::map<Pc, std::vector<Pc>> pc_neighbours_;
+  // The CFs by PC, each entry its level (top two bits) and index in valid_, extended at the
+  // start of each round; the CFs of each level that the round's screening counts as old.
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cfs_by_pc_;  // by pc_key
+  std::size_t by_pc_indexed_[3] = {0, 0, 0};
+  std::size_t near_since_[3] = {0, 0, 0};
   // The images' witnesses of the sets about to be accepted, by set, with the witness pose
   // they were computed from (prefetch_images); cleared after each batch.
   PcSetMap<std::pair<Pose, std::vector<Witness>>> prefetched_;

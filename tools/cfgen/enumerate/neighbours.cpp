@@ -1,11 +1,12 @@
 // Failed sets near their neighbours (after each fixed point): a CF valid only in a sliver of
 // orientations (a peg tilted across a hole's rim) is missed by the search's samples, but the
 // CFs one change away (one PC replaced by a neighbouring PC, cf::neighbouring_pcs) hold on
-// either side of it, at rotations a few hundredths of a radian from the one it needs. Each
-// failed set with such CFs is searched again near their witnesses (WitnessSearch::find,
-// seeds_only): one member of an orbit a round, up to kOrbitTries members over the rounds, as
-// the levels do, each member once. The rounds add CFs, never take one away, so a graph holds
-// every CF the fixed point before them found.
+// either side of it, at rotations a few hundredths of a radian from the one it needs, and so
+// do the CFs that cover it (a face on the wall where the set has a vertex). Each failed set
+// with such CFs is searched again near their witnesses (WitnessSearch::find, seeds_only): one
+// member of an orbit a round, up to kOrbitTries members over the rounds, as the levels do, each
+// member once. The rounds add CFs, never take one away, so a graph holds every CF the fixed point
+// before them found.
 
 #include "cfgen/enumerate/enumerator.hpp"
 
@@ -20,8 +21,49 @@ namespace {
 
 // Witnesses of neighbouring CFs a failed set is searched again from.
 constexpr std::size_t kNeighbourSeeds = 16;
+
 // Sets or CFs a chunk of a round's screening: a few milliseconds of work.
 constexpr std::size_t kScreenChunk = 4096;
+// since[] for every CF, old or new (any_covering_cf).
+constexpr std::size_t kAllCfs[3] = {0, 0, 0};
+
+// The elements of m that hold (kind, i) in their closures, itself first.
+std::vector<std::pair<ElementKind, int>> elements_over(const Polyhedron& m, ElementKind kind,
+                                                       int i) {
+  std::vector<std::pair<ElementKind, int>> out{{kind, i}};
+  if (kind == ElementKind::kVertex) {
+    for (EdgeId e : m.vertices()[i].edges) out.push_back({ElementKind::kEdge, e.value()});
+    for (FaceId f : m.vertices()[i].faces) out.push_back({ElementKind::kFace, f.value()});
+  } else if (kind == ElementKind::kEdge) {
+    out.push_back({ElementKind::kFace, m.edges()[i].left.value()});
+    out.push_back({ElementKind::kFace, m.edges()[i].right.value()});
+  }
+  return out;
+}
+
+// The PC type of an A element of kind ka against a B element of kind kb; none for the
+// degenerate pairs (v-v, v-e, e-v).
+std::optional<PcType> type_of(ElementKind ka, ElementKind kb) {
+  for (PcType t : {PcType::kFF, PcType::kEF, PcType::kFE, PcType::kVF, PcType::kFV, PcType::kEE})
+    if (a_kind(t) == ka && b_kind(t) == kb) return t;
+  return std::nullopt;
+}
+
+// A PC as one number: the key of cfs_by_pc_.
+std::uint64_t pc_key(const Pc& p) {
+  return static_cast<std::uint64_t>(p.type) << 56 | static_cast<std::uint64_t>(p.a) << 28 |
+         static_cast<std::uint64_t>(p.b);
+}
+
+// The PCs whose elements hold p's in their closures, p among them: a CF with such a PC holds
+// p's contact, and lifting the rest of that PC's elements off leaves p.
+std::vector<Pc> covering_pcs(const Pc& p, const Polyhedron& A, const Polyhedron& B) {
+  std::vector<Pc> out;
+  for (const auto& [ka, a] : elements_over(A, a_kind(p.type), p.a))
+    for (const auto& [kb, b] : elements_over(B, b_kind(p.type), p.b))
+      if (const auto t = type_of(ka, kb)) out.push_back({*t, a, b});
+  return out;
+}
 
 }  // namespace
 
@@ -118,9 +160,54 @@ bool Enumerator::valid_change_among(const PcSet& s,
   return false;
 }
 
-// Screens one failed set into `kept`; marks it dead when it can never be worth a search.
+// Extends cfs_by_pc_ with the CFs found since it was last extended.
+void Enumerator::index_cfs_by_pc() {
+  for (std::uint32_t l = 0; l < 3; ++l) {
+    for (std::size_t i = by_pc_indexed_[l]; i < valid_[l].size(); ++i)
+      for (const Pc& pc : valid_[l][i].first)
+        cfs_by_pc_[pc_key(pc)].push_back(l << 30 | static_cast<std::uint32_t>(i));
+    by_pc_indexed_[l] = valid_[l].size();
+  }
+}
+
+// Calls fn with each CF t other than s, found at or after since[level], that covers s (each PC
+// of s lies in the closures of a PC of t: t's witness realises s's contacts, and lifting the
+// rest of t's elements off can leave exactly s), until fn returns true; whether it did. The
+// CFs are looked up through the PC of s with the fewest covering PCs.
+bool Enumerator::any_covering_cf(const PcSet& s, const std::size_t (&since)[3],
+                                 const CoverFn& fn) const {
+  std::vector<Pc> through;
+  for (const Pc& p : s)
+    if (std::vector<Pc> c = covering_pcs(p, A_, B_); through.empty() || c.size() < through.size())
+      through = std::move(c);
+  for (const Pc& q : through) {
+    const auto it = cfs_by_pc_.find(pc_key(q));
+    if (it == cfs_by_pc_.end()) continue;
+    for (const std::uint32_t e : it->second) {
+      const std::uint32_t l = e >> 30, i = e & ((1u << 30) - 1);
+      if (i < since[l]) continue;
+      const auto& [t, w] = valid_[l][i];
+      if (t == s) continue;
+      const bool covers = std::all_of(s.begin(), s.end(), [&](const Pc& p) {
+        return covered_by(A_, B_, t, a_kind(p.type), p.a, b_kind(p.type), p.b);
+      });
+      if (covers && fn(t, w.pose.R_BA)) return true;
+    }
+  }
+  return false;
+}
+
+// Screens one failed set into `kept`; marks it dead when it can never be worth a search. A
+// CF that covers a failed single or pair counts as a set one change away: its witness is as
+// near. Failed triples are left out: the triples on a pair found so are candidates of the next
+// level, and screening the 12-gon peg and hole's 1.4 million failed triples took 25 s.
 void Enumerator::screen_failed(std::size_t i, const PcSetMap<std::vector<Pc>>& new_by_rest,
                                std::vector<Kept>& kept) {
+  NearState& st = failed_near_[i];
+  if (!st.valid_change && !failed_dead_[i] && failed_[i].size() <= 2 &&
+      any_covering_cf(failed_[i], st.checked ? near_since_ : kAllCfs,
+                      [](const PcSet&, const Mat3&) { return true; }))
+    st.valid_change = true;
   PcSet orbit;
   const Near r = near_candidate(failed_[i], failed_near_[i], new_by_rest, orbit);
   if (r == Near::kYes) kept.push_back({failed_[i], orbit});
@@ -185,7 +272,9 @@ std::vector<Task> Enumerator::neighbour_tasks() {
     for (const Pc& q : pc_neighbours_.at(next[i])) next.push_back(q);
   know_neighbours(next);
   const PcSetMap<std::vector<Pc>> new_by_rest = new_cfs_by_rest();
+  index_cfs_by_pc();
   near_screened_none_ = near_screened_cfs_[0] + near_screened_cfs_[1] + near_screened_cfs_[2] == 0;
+  std::copy(std::begin(near_screened_cfs_), std::end(near_screened_cfs_), near_since_);
   failed_dead_.resize(failed_.size(), 0);
   failed_near_.resize(failed_.size());
   for (int l = 0; l < 3; ++l) {
@@ -241,11 +330,20 @@ void Enumerator::take_near(const PcSet& s, const PcSet& orbit, RoundTake& round)
   Task t;
   t.kind = Task::Kind::kFindNear;
   t.pcs = s;
+  // The witnesses of the valid changes and of the CFs that cover s, taken in turn.
+  std::vector<Mat3> changed, covering;
   changes_of(s, [&](const PcSet& n, int, const Pc&) {
     if (auto it = witness_rot_.find(n);
-        it != witness_rot_.end() && t.seeds.size() < kNeighbourSeeds)
-      t.seeds.push_back(it->second);
+        it != witness_rot_.end() && changed.size() < kNeighbourSeeds)
+      changed.push_back(it->second);
   });
+  any_covering_cf(s, kAllCfs, [&](const PcSet&, const Mat3& R) {
+    covering.push_back(R);
+    return covering.size() >= kNeighbourSeeds;
+  });
+  for (std::size_t k = 0; t.seeds.size() < kNeighbourSeeds && k < kNeighbourSeeds; ++k)
+    for (const auto* from : {&changed, &covering})
+      if (k < from->size() && t.seeds.size() < kNeighbourSeeds) t.seeds.push_back((*from)[k]);
   round.tasks.push_back(std::move(t));
 }
 
@@ -261,6 +359,7 @@ void Enumerator::release_neighbour_rounds() {
     std::vector<std::vector<NearChange>>().swap(cf_near_[l]);
   }
   std::map<Pc, std::vector<Pc>>().swap(pc_neighbours_);
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>>().swap(cfs_by_pc_);
 }
 
 // One round; returns the number of CFs found.
